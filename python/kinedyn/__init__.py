@@ -1,0 +1,17 @@
+"""kinedyn: robot kinematics and dynamics, symbolic for people and numeric (Rust) for programs."""
+
+from .description import DHRow, Frame, Inertia, Joint, Link
+from .robot import Robot
+from . import robots
+
+__version__ = "0.1.0"
+
+
+def load(path, **kwargs) -> Robot:
+    """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension."""
+    from .description.files import load as _load
+
+    return _load(path, **kwargs)
+
+
+__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "__version__"]

@@ -1,0 +1,166 @@
+"""Small math helpers that work on plain numbers (NumPy) and on SymPy expressions alike.
+
+A robot description may hold SymPy symbols; these helpers return a ``sympy.Matrix`` when any
+input is symbolic and a float ``numpy.ndarray`` otherwise, so the description code is written once.
+Poses are 4x4 homogeneous transforms ``a_from_b`` (a point in b's coordinates -> a's coordinates).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+import numpy as np
+import sympy as sp
+
+__all__ = [
+    "is_symbolic",
+    "as_value",
+    "identity",
+    "rot_x",
+    "rot_y",
+    "rot_z",
+    "rot_axis",
+    "rpy_to_matrix",
+    "translation",
+    "homogeneous",
+    "pose_inverse",
+    "matmul",
+    "to_float_array",
+]
+
+
+def is_symbolic(*values: Any) -> bool:
+    """True if any value (scalar, sequence, array or matrix) contains a non-numeric SymPy expression."""
+    for v in values:
+        if isinstance(v, sp.MatrixBase):
+            if any(not e.is_number for e in v):
+                return True
+        elif isinstance(v, sp.Basic):
+            if not v.is_number:
+                return True
+        elif isinstance(v, np.ndarray):
+            if v.dtype == object and any(is_symbolic(e) for e in v.flat):
+                return True
+        elif isinstance(v, (list, tuple)):
+            if any(is_symbolic(e) for e in v):
+                return True
+    return False
+
+
+def as_value(x: Any) -> Any:
+    """A scalar as a float when it is a plain number, else as a SymPy expression."""
+    if isinstance(x, sp.Basic):
+        return float(x) if x.is_number and x.is_real is not False and not x.free_symbols else x
+    if isinstance(x, str):
+        return sp.sympify(x)
+    return float(x)
+
+
+def _module(*values: Any):
+    return sp if is_symbolic(*values) else np
+
+
+def identity():
+    return np.eye(4)
+
+
+def _hom(R, p, symbolic: bool):
+    if symbolic:
+        T = sp.eye(4)
+        T[:3, :3] = sp.Matrix(R)
+        T[:3, 3] = sp.Matrix(p)
+        return T
+    T = np.eye(4)
+    T[:3, :3] = np.asarray(R, dtype=float)
+    T[:3, 3] = np.asarray(p, dtype=float)
+    return T
+
+
+def rot_x(angle):
+    m = _module(angle)
+    c, s = m.cos(angle), m.sin(angle)
+    return _hom([[1, 0, 0], [0, c, -s], [0, s, c]], [0, 0, 0], m is sp)
+
+
+def rot_y(angle):
+    m = _module(angle)
+    c, s = m.cos(angle), m.sin(angle)
+    return _hom([[c, 0, s], [0, 1, 0], [-s, 0, c]], [0, 0, 0], m is sp)
+
+
+def rot_z(angle):
+    m = _module(angle)
+    c, s = m.cos(angle), m.sin(angle)
+    return _hom([[c, -s, 0], [s, c, 0], [0, 0, 1]], [0, 0, 0], m is sp)
+
+
+def rot_axis(axis: Iterable, angle):
+    """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues' formula), as a 4x4 pose."""
+    axis = list(axis)
+    m = _module(angle, axis)
+    x, y, z = axis
+    c, s = m.cos(angle), m.sin(angle)
+    v = 1 - c
+    R = [
+        [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
+        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
+        [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
+    ]
+    return _hom(R, [0, 0, 0], m is sp)
+
+
+def rpy_to_matrix(roll, pitch, yaw):
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll), as a 4x4 pose."""
+    return matmul(rot_z(yaw), rot_y(pitch), rot_x(roll))
+
+
+def translation(x, y, z):
+    symbolic = is_symbolic(x, y, z)
+    return _hom(np.eye(3) if not symbolic else sp.eye(3), [x, y, z], symbolic)
+
+
+def homogeneous(R, p):
+    return _hom(R, p, is_symbolic(R, p))
+
+
+def matmul(*poses):
+    """Product of 4x4 poses; symbolic if any factor is."""
+    if is_symbolic(*poses):
+        out = sp.eye(4)
+        for T in poses:
+            out = out * sp.Matrix(T)
+        return out
+    out = np.eye(4)
+    for T in poses:
+        out = out @ np.asarray(T, dtype=float)
+    return out
+
+
+def pose_inverse(T):
+    """Inverse of a 4x4 rigid transform: [R^T, -R^T p]."""
+    if is_symbolic(T):
+        T = sp.Matrix(T)
+        R = T[:3, :3]
+        return _hom(R.T, -R.T * T[:3, 3], True)
+    T = np.asarray(T, dtype=float)
+    R = T[:3, :3]
+    return _hom(R.T, -R.T @ T[:3, 3], False)
+
+
+def to_float_array(value, shape=None, what: str = "value") -> np.ndarray:
+    """Convert numbers / numeric SymPy matrices to a float array; explain when symbols remain."""
+    if is_symbolic(value):
+        free = set()
+        for e in (value if isinstance(value, sp.MatrixBase) else np.asarray(value, dtype=object).flat):
+            if isinstance(e, sp.Basic):
+                free |= e.free_symbols
+        raise ValueError(
+            f"{what} contains SymPy symbols {sorted(map(str, free))}; substitute numbers first "
+            f"(robot.subs({{...}})) before numeric computation"
+        )
+    if isinstance(value, sp.MatrixBase):
+        value = np.array(value.tolist(), dtype=float)
+    arr = np.asarray(value, dtype=float)
+    if shape is not None and arr.shape != tuple(shape):
+        raise ValueError(f"{what} must have shape {tuple(shape)}, got {arr.shape}")
+    return arr

@@ -1,0 +1,175 @@
+"""Links and frames of a robot description, and the kinematic tree compiled from them.
+
+Description (what a user writes; numbers or SymPy symbols)::
+
+    Link(name, parent, joint, placement, post, inertia)
+
+    parent link frame --placement--> joint frame --joint motion(q + offset)--> --post--> link frame
+
+``placement`` is the joint frame in the parent link's frame at q = 0 (URDF's ``<joint><origin>``),
+``post`` a fixed transform from the moved joint frame to the link frame (identity for URDF; the
+``Tx(a) Rx(alpha)`` part of a standard DH row), ``inertia`` is given in the link frame.
+
+Compiled tree (what the engines read): fixed joints are merged into the moving link that carries
+them, and every body's frame is its *joint* frame after motion ("body frame"), as in Featherstone's
+and Pinocchio's models. Every link (fixed ones included) and every extra frame becomes a named frame
+``(body index or -1 for the base, body_from_frame)``. Bodies are numbered depth-first in declaration
+order, so ``parent[i] < i``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+import sympy as sp
+
+from .._math import identity, is_symbolic, matmul
+from .inertia import Inertia
+from .joint import Joint
+
+__all__ = ["Link", "Frame", "Body", "NamedFrame", "KinematicTree", "build_tree"]
+
+
+def _pose(value, what: str):
+    if is_symbolic(value):
+        T = sp.Matrix(value)
+    else:
+        T = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value, dtype=float)
+    if tuple(T.shape) != (4, 4):
+        raise ValueError(f"{what} must be a 4x4 homogeneous transform, got shape {tuple(T.shape)}")
+    if not is_symbolic(T):
+        if not np.all(np.isfinite(T)):
+            raise ValueError(f"{what} contains non-finite values")
+        R = T[:3, :3]
+        if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0 or not np.allclose(T[3], [0, 0, 0, 1]):
+            raise ValueError(f"{what} is not a rigid transform (rotation part not orthonormal or last row not 0 0 0 1)")
+    return T
+
+
+@dataclass(frozen=True)
+class Link:
+    name: str
+    parent: Optional[str]
+    joint: Joint
+    placement: Any = field(default_factory=identity)
+    post: Any = field(default_factory=identity)
+    inertia: Inertia = field(default_factory=Inertia)
+
+    def __post_init__(self):
+        object.__setattr__(self, "placement", _pose(self.placement, f"placement of link '{self.name}'"))
+        object.__setattr__(self, "post", _pose(self.post, f"post transform of link '{self.name}'"))
+        if self.inertia is None:
+            object.__setattr__(self, "inertia", Inertia())
+        self.inertia.validate(f"link '{self.name}'")
+
+
+@dataclass(frozen=True)
+class Frame:
+    """An extra named frame fixed to a link (``link=None`` means the base), e.g. a tool frame."""
+
+    name: str
+    link: Optional[str]
+    placement: Any = field(default_factory=identity)
+
+    def __post_init__(self):
+        object.__setattr__(self, "placement", _pose(self.placement, f"placement of frame '{self.name}'"))
+
+
+@dataclass(frozen=True)
+class Body:
+    """A moving body of the compiled tree (one per joint coordinate)."""
+
+    name: str  # the moving link's name
+    joint: Joint
+    parent: int  # parent body index, -1 = base
+    placement: Any  # parent body frame -> joint frame at q = 0
+    inertia: Inertia  # in the body (joint) frame, fixed children merged
+
+
+@dataclass(frozen=True)
+class NamedFrame:
+    name: str
+    body: int  # -1 = base
+    placement: Any  # body frame -> this frame
+
+
+@dataclass(frozen=True)
+class KinematicTree:
+    bodies: tuple
+    frames: tuple
+    base: str
+
+    @property
+    def n(self) -> int:
+        return len(self.bodies)
+
+    @property
+    def parents(self) -> list:
+        return [b.parent for b in self.bodies]
+
+    def frame_index(self, name: str) -> int:
+        for i, f in enumerate(self.frames):
+            if f.name == name:
+                return i
+        raise KeyError(name)
+
+
+def build_tree(links, frames, base: str) -> KinematicTree:
+    """Compile links into bodies (fixed joints merged) and named frames; check the tree's shape."""
+    names = [base]
+    for link in links:
+        if link.name in names:
+            raise ValueError(f"link name '{link.name}' is used twice")
+        names.append(link.name)
+    children: dict = {base: []}
+    for link in links:
+        children.setdefault(link.name, [])
+    for link in links:
+        parent = base if link.parent is None else link.parent
+        if parent not in children:
+            raise ValueError(f"link '{link.name}': its parent link '{parent}' does not exist")
+        children[parent].append(link)
+
+    bodies: list = []
+    named: list = [NamedFrame(base, -1, identity())]
+    # each entry: (link, body index that carries it, body_from_linkframe)
+    carriers: dict = {base: (-1, identity())}
+    stack = list(reversed(children[base]))
+    seen = set()
+    while stack:
+        link = stack.pop()
+        seen.add(link.name)
+        parent_body, body_from_parent_frame = carriers[link.parent if link.parent is not None else base]
+        if link.joint.is_moving:
+            index = len(bodies)
+            placement = matmul(body_from_parent_frame, link.placement)
+            bodies.append(Body(link.name, link.joint, parent_body, placement, link.inertia.transformed(link.post)))
+            carriers[link.name] = (index, link.post)
+        else:
+            # a fixed joint: the link is rigidly part of its parent's body
+            body_from_link = matmul(body_from_parent_frame, link.placement, link.post)
+            carriers[link.name] = (parent_body, body_from_link)
+            if parent_body >= 0:
+                b = bodies[parent_body]
+                merged = b.inertia + link.inertia.transformed(body_from_link)
+                bodies[parent_body] = Body(b.name, b.joint, b.parent, b.placement, merged)
+        named.append(NamedFrame(link.name, *carriers[link.name]))
+        stack.extend(reversed(children[link.name]))
+    missing = [l.name for l in links if l.name not in seen]
+    if missing:
+        raise ValueError(
+            f"links {missing} are not connected to the base '{base}': their parents form a cycle "
+            "or the tree has a second root"
+        )
+    for frame in frames:
+        owner = base if frame.link is None else frame.link
+        if owner not in carriers:
+            raise ValueError(f"frame '{frame.name}' is attached to unknown link '{owner}'")
+        if frame.name in names:
+            raise ValueError(f"frame name '{frame.name}' is already the name of a link or frame")
+        names.append(frame.name)
+        body, body_from_link = carriers[owner]
+        named.append(NamedFrame(frame.name, body, matmul(body_from_link, frame.placement)))
+    return KinematicTree(tuple(bodies), tuple(named), base)

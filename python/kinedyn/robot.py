@@ -1,0 +1,412 @@
+"""``kinedyn.Robot``: one robot description read by both engines.
+
+The description (links, joints, frames, inertias, gravity) is frozen and may hold SymPy symbols.
+The numeric engine compiles it once into a native ``_core.Model`` (Rust, f64) on first use; every
+numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core once.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+from typing import Mapping, Optional, Sequence
+
+import numpy as np
+import sympy as sp
+
+from ._math import as_value, is_symbolic, matmul, to_float_array
+from .description.dh import DHRow, links_from_dh
+from .description.joint import Joint
+from .description.link import Frame, KinematicTree, Link, build_tree
+
+__all__ = ["Robot"]
+
+_REFERENCES = {"world": 0, "local": 1, "spatial": 2}
+
+
+class Robot:
+    """A kinematic tree of links connected by revolute, prismatic and fixed joints.
+
+    Build one with :meth:`from_dh`, :meth:`from_urdf`, :func:`kinedyn.load`, the built-in catalogue
+    ``kinedyn.robots``, or directly from :class:`Link` and :class:`Frame` objects.
+    """
+
+    def __init__(
+        self,
+        links: Sequence[Link],
+        frames: Sequence[Frame] = (),
+        *,
+        gravity=(0.0, 0.0, -9.81),
+        base: str = "base",
+        tool: Optional[str] = None,
+        name: str = "robot",
+        dh: Optional[Sequence[DHRow]] = None,
+        dh_convention: Optional[str] = None,
+        source: str = "",
+    ):
+        self.name = name
+        self.links = tuple(links)
+        self.frames = tuple(frames)
+        self.base = base
+        g = tuple(as_value(v) for v in gravity)
+        if len(g) != 3:
+            raise ValueError(f"gravity must have 3 components, got {len(g)}")
+        self.gravity = g
+        self.dh = tuple(dh) if dh is not None else None
+        self.dh_convention = dh_convention
+        self.source = source
+        self.tree: KinematicTree = build_tree(self.links, self.frames, base)
+        if self.tree.n == 0:
+            raise ValueError(f"robot '{name}' has no moving joint")
+        names = [f.name for f in self.tree.frames]
+        if tool is None:
+            tool = "tool" if "tool" in names else self.tree.bodies[-1].name
+        if tool not in names:
+            raise ValueError(f"tool frame '{tool}' is not a frame of robot '{name}' (frames: {names})")
+        self.tool = tool
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_dh(
+        cls,
+        rows,
+        convention: str = "standard",
+        *,
+        gravity=(0.0, 0.0, -9.81),
+        base_pose=None,
+        tool=None,
+        name: str = "dh_robot",
+        source: str = "",
+    ) -> "Robot":
+        """A serial arm from a DH table (see :mod:`kinedyn.description.dh` for the conventions).
+
+        ``rows``: DHRow objects, mappings with keys theta/d/a/alpha/kind/inertia/limits..., or tuples
+        ``(theta, d, a, alpha[, kind])``. ``base_pose``: the 4x4 pose of DH frame 0 in the world.
+        ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always
+        added; identity if not given).
+        """
+        links, dh_rows = links_from_dh(rows, convention)
+        if base_pose is not None:
+            first = links[0]
+            links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
+        frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
+        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source)
+
+    @classmethod
+    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None) -> "Robot":
+        """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`)."""
+        from .description.urdf import robot_from_urdf
+
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool)
+
+    def replace(self, **changes) -> "Robot":
+        """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
+        kwargs = dict(
+            links=self.links,
+            frames=self.frames,
+            gravity=self.gravity,
+            base=self.base,
+            tool=self.tool,
+            name=self.name,
+            dh=self.dh,
+            dh_convention=self.dh_convention,
+            source=self.source,
+        )
+        kwargs.update(changes)
+        return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
+
+    def lock_joints(self, values: Mapping[str, float]) -> "Robot":
+        """A new robot with the named joints fixed at the given values (e.g. a gripper's fingers)."""
+        from ._math import rot_axis, translation
+
+        names = {l.joint.name for l in self.links if l.joint.is_moving}
+        unknown = set(values) - names
+        if unknown:
+            raise ValueError(f"lock_joints: unknown joints {sorted(unknown)} (moving joints: {sorted(names)})")
+        links = []
+        for link in self.links:
+            j = link.joint
+            if j.name in values:
+                x = values[j.name] + j.offset
+                motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
+                fixed = Joint(j.name, "fixed", j.axis)
+                link = Link(link.name, link.parent, fixed, matmul(link.placement, motion), link.post, link.inertia)
+            links.append(link)
+        return self.replace(links=links, dh=None)
+
+    # ------------------------------------------------------------------ description queries
+    @property
+    def n(self) -> int:
+        """Number of joint coordinates."""
+        return self.tree.n
+
+    @property
+    def joints(self) -> tuple:
+        return tuple(b.joint for b in self.tree.bodies)
+
+    @property
+    def joint_names(self) -> list:
+        return [b.joint.name for b in self.tree.bodies]
+
+    @property
+    def body_names(self) -> list:
+        """Names of the moving links, in joint order."""
+        return [b.name for b in self.tree.bodies]
+
+    @property
+    def frame_names(self) -> list:
+        return [f.name for f in self.tree.frames]
+
+    @property
+    def parents(self) -> list:
+        return self.tree.parents
+
+    @property
+    def lower_limits(self) -> np.ndarray:
+        return np.array([j.lower for j in self.joints])
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        return np.array([j.upper for j in self.joints])
+
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        return np.array([j.velocity_limit for j in self.joints])
+
+    @property
+    def effort_limits(self) -> np.ndarray:
+        return np.array([j.effort_limit for j in self.joints])
+
+    @property
+    def is_symbolic(self) -> bool:
+        return bool(self.symbols)
+
+    @cached_property
+    def symbols(self) -> set:
+        """Free SymPy symbols in the description (empty for a numeric robot)."""
+        free: set = set()
+
+        def add(v):
+            if isinstance(v, sp.MatrixBase):
+                free.update(v.free_symbols)
+            elif isinstance(v, sp.Basic):
+                free.update(v.free_symbols)
+            elif isinstance(v, (tuple, list)):
+                for e in v:
+                    add(e)
+
+        add(self.gravity)
+        for link in self.links:
+            j = link.joint
+            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb])
+            add([link.inertia.mass, link.inertia.com, link.inertia.inertia])
+            if is_symbolic(link.placement):
+                add(link.placement)
+            if is_symbolic(link.post):
+                add(link.post)
+        for f in self.frames:
+            if is_symbolic(f.placement):
+                add(f.placement)
+        return free
+
+    def subs(self, mapping: Mapping) -> "Robot":
+        """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs)."""
+        mapping = {sp.Symbol(k) if isinstance(k, str) else k: v for k, v in mapping.items()}
+
+        def f(v):
+            if isinstance(v, (sp.Basic, sp.MatrixBase)):
+                out = v.subs(mapping)
+                if isinstance(out, sp.MatrixBase):
+                    return out if is_symbolic(out) else np.array(out.tolist(), dtype=float)
+                return as_value(out)
+            return v
+
+        links = []
+        for link in self.links:
+            j = link.joint
+            joint = Joint(
+                j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
+                j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb),
+            )
+            links.append(Link(link.name, link.parent, joint, f(link.placement), f(link.post), link.inertia.subs(mapping)))
+        frames = [Frame(fr.name, fr.link, f(fr.placement)) for fr in self.frames]
+        dh = None
+        if self.dh is not None:
+            dh = [
+                DHRow(f(r.theta), f(r.d), f(r.a), f(r.alpha), r.kind, r.name, r.inertia.subs(mapping), r.lower, r.upper,
+                      r.velocity_limit, r.effort_limit, f(r.gear_ratio), f(r.rotor_inertia), f(r.viscous), f(r.coulomb))
+                for r in self.dh
+            ]
+        return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
+
+    def save(self, path) -> None:
+        """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
+        from .description.files import save
+
+        save(self, path)
+
+    def inertial_parameters(self) -> np.ndarray:
+        """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
+        (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
+        return np.concatenate([to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies])
+
+    def frame_index(self, frame: str) -> int:
+        try:
+            return self.tree.frame_index(frame)
+        except KeyError:
+            raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
+
+    def __repr__(self) -> str:
+        return f"Robot(name={self.name!r}, n={self.n}, joints={self.joint_names}, tool={self.tool!r})"
+
+    # ------------------------------------------------------------------ numeric engine
+    @cached_property
+    def _model(self):
+        """The compiled native model (built once; numeric descriptions only)."""
+        from . import _core
+
+        if self.symbols:
+            raise ValueError(
+                f"robot '{self.name}' has symbolic parameters {sorted(map(str, self.symbols))}: "
+                "use robot.subs({...}) to give them values before numeric computation"
+            )
+        bodies = self.tree.bodies
+        n = len(bodies)
+        parent = np.array([b.parent for b in bodies], dtype=np.int64)
+        kind = np.array([0 if b.joint.kind == "revolute" else 1 for b in bodies], dtype=np.int64)
+        axis = np.array([to_float_array(b.joint.axis, (3,), f"axis of joint '{b.joint.name}'") for b in bodies])
+        offset = np.array([float(b.joint.offset) for b in bodies])
+        placement = np.array([to_float_array(b.placement, (4, 4), f"placement of '{b.name}'") for b in bodies])
+        inertia = self.inertial_parameters().reshape(n, 10)
+        armature = np.array([float(b.joint.armature) for b in bodies])
+        viscous = np.array([float(b.joint.viscous) for b in bodies])
+        coulomb = np.array([float(b.joint.coulomb) for b in bodies])
+        gravity = to_float_array(self.gravity, (3,), "gravity")
+        frames = self.tree.frames
+        frame_body = np.array([f.body for f in frames], dtype=np.int64)
+        frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
+        return _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement)
+
+    @cached_property
+    def _link_frame_ids(self) -> np.ndarray:
+        return np.array([self.frame_index(name) for name in self.body_names], dtype=np.int64)
+
+    @staticmethod
+    def _state(x) -> np.ndarray:
+        return np.ascontiguousarray(x, dtype=np.float64)
+
+    def _reference(self, reference: str) -> int:
+        try:
+            return _REFERENCES[reference]
+        except KeyError:
+            raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'") from None
+
+    def _point(self, point) -> Optional[np.ndarray]:
+        if point is None:
+            return None
+        p = np.ascontiguousarray(point, dtype=np.float64)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise ValueError(f"point must be 3 finite coordinates in the frame's axes, got {point!r}")
+        return p
+
+    # kinematics ---------------------------------------------------------------------------
+    def forward_kinematics(self, q) -> np.ndarray:
+        """Poses of the moving links' frames in the base: (n, 4, 4), or (N, n, 4, 4) for a batch."""
+        return self._model.frame_poses(self._state(q), self._link_frame_ids)
+
+    def frame_poses(self, q, frames: Optional[Sequence[str]] = None) -> np.ndarray:
+        """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
+        names = self.frame_names if frames is None else list(frames)
+        ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
+        return self._model.frame_poses(self._state(q), ids)
+
+    def pose(self, q, frame: Optional[str] = None) -> np.ndarray:
+        """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
+        ids = np.array([self.frame_index(frame or self.tool)], dtype=np.int64)
+        out = self._model.frame_poses(self._state(q), ids)
+        return out[..., 0, :, :]
+
+    def jacobian(self, q, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+        """Geometric Jacobian (6, n), rows [linear; angular] (see docs/conventions.md).
+
+        ``reference="world"``: velocity of the frame origin (or of ``point``, given in the frame's
+        axes) and angular velocity, in base axes; ``"local"``: both in the frame's axes;
+        ``"spatial"``: the spatial Jacobian (velocity of the body point at the base origin).
+        """
+        return self._model.jacobian(self._state(q), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+
+    def frame_velocity(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+        """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
+        return self._model.frame_velocity(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+
+    def jacobian_dot_qd(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+        """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
+        return self._model.jdot_qd(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+
+    # dynamics -----------------------------------------------------------------------------
+    def _f_ext(self, f_ext):
+        if f_ext is None:
+            return None
+        return np.ascontiguousarray(f_ext, dtype=np.float64)
+
+    def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
+        """tau = M qdd + C qd + g + friction - sum J_i^T f_ext_i (recursive Newton-Euler).
+
+        ``f_ext``: (n, 6) wrenches [force; moment] acting on each body, in base axes at the body
+        frame origin, or None."""
+        return self._model.inverse_dynamics(self._state(q), self._state(qd), self._state(qdd), self._f_ext(f_ext))
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """M(q) (composite-rigid-body algorithm), reflected rotor inertia included."""
+        return self._model.mass_matrix(self._state(q))
+
+    def mass_matrix_inverse(self, q) -> np.ndarray:
+        return self._model.mass_matrix_inverse(self._state(q))
+
+    def forward_dynamics(self, q, qd, tau, f_ext=None) -> np.ndarray:
+        """qdd solving M qdd = tau - C qd - g - friction + J^T f_ext (articulated-body algorithm)."""
+        return self._model.forward_dynamics(self._state(q), self._state(qd), self._state(tau), self._f_ext(f_ext))
+
+    def coriolis_matrix(self, q, qd) -> np.ndarray:
+        """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
+        return self._model.coriolis_matrix(self._state(q), self._state(qd))
+
+    def christoffel(self, q) -> np.ndarray:
+        """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58)."""
+        return self._model.christoffel(self._state(q))
+
+    def gravity_torque(self, q) -> np.ndarray:
+        """g(q) = dP/dq."""
+        return self._model.gravity_torque(self._state(q))
+
+    def bias_torque(self, q, qd) -> np.ndarray:
+        """C(q, qd) qd + g(q) (without friction)."""
+        return self._model.bias_torque(self._state(q), self._state(qd))
+
+    def kinetic_energy(self, q, qd):
+        return self._model.kinetic_energy(self._state(q), self._state(qd))
+
+    def potential_energy(self, q):
+        return self._model.potential_energy(self._state(q))
+
+    def regressor(self, q, qd, qdd) -> np.ndarray:
+        """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
+        return self._model.regressor(self._state(q), self._state(qd), self._state(qdd))
+
+    def neutral(self) -> np.ndarray:
+        """The zero configuration (n,)."""
+        return np.zeros(self.n)
+
+    def random_configuration(self, rng=None, size=None) -> np.ndarray:
+        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
+        rng = np.random.default_rng(rng)
+        lo = self.lower_limits.copy()
+        hi = self.upper_limits.copy()
+        for i, j in enumerate(self.joints):
+            span = math.pi if j.kind == "revolute" else 1.0
+            if not math.isfinite(lo[i]):
+                lo[i] = -span
+            if not math.isfinite(hi[i]):
+                hi[i] = span
+        shape = (self.n,) if size is None else (size, self.n)
+        return rng.uniform(lo, hi, size=shape)
