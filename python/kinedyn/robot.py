@@ -393,6 +393,13 @@ class Robot:
         """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         return self._model.regressor(self._state(q), self._state(qd), self._state(qdd))
 
+    # symbolic engine ----------------------------------------------------------------------
+    def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs):
+        """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
+        from .symbolic import equations_of_motion
+
+        return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
+
     def neutral(self) -> np.ndarray:
         """The zero configuration (n,)."""
         return np.zeros(self.n)
