@@ -1,0 +1,17 @@
+//! kinedyn-core: rigid-body kinematics and dynamics of robot manipulators, in pure Rust.
+//!
+//! A [`Model`] (immutable, built once) and a [`Data`] (scratch and outputs, one per thread) are
+//! passed to free functions in [`algorithms`], `algorithm(&model, &mut data, inputs)`, as in
+//! Featherstone's RBDA and Pinocchio. Spatial vectors are `[linear; angular]` (DESIGN.md).
+
+pub mod algorithms;
+pub mod data;
+pub mod error;
+pub mod joint;
+pub mod model;
+pub mod spatial;
+
+pub use data::Data;
+pub use error::{Error, Result};
+pub use joint::{Joint, JointKind};
+pub use model::{Frame, Model};

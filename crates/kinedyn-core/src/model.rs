@@ -1,0 +1,128 @@
+//! `Model`: the immutable, flat description the algorithms read (built once, f64 only).
+//!
+//! Bodies are numbered so that `parent[i] < i`. Body i's frame is its joint frame after the joint
+//! moved: `parent_from_body(q) = parent_from_joint[i] * jcalc(q_i + offset_i)`.
+
+use crate::error::{Error, Result};
+use crate::joint::Joint;
+use crate::spatial::{Inertia, Transform, Vec3};
+
+/// A named frame rigidly attached to a body (`None`: the base).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub body: Option<usize>,
+    pub body_from_frame: Transform,
+}
+
+/// The compiled robot: kinematic tree, inertias, drive and friction data, gravity and frames.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Number of bodies = number of joint coordinates.
+    pub n: usize,
+    /// Parent body of each body (`None` = base); `parent[i] < i`.
+    pub parent: Vec<Option<usize>>,
+    pub joints: Vec<Joint>,
+    /// Added to the joint coordinate before `jcalc` (DH theta / d offsets).
+    pub offset: Vec<f64>,
+    /// Fixed placement of each joint frame in its parent body's frame.
+    pub parent_from_joint: Vec<Transform>,
+    /// Rigid-body inertia of each body about its frame origin, body axes.
+    pub inertia: Vec<Inertia>,
+    /// Reflected rotor inertia `r^2 J_m` per joint (added to `M[i][i]`).
+    pub armature: Vec<f64>,
+    /// Viscous friction coefficient per joint: `tau_f = viscous qd + coulomb sign(qd)`.
+    pub viscous: Vec<f64>,
+    pub coulomb: Vec<f64>,
+    /// Gravity acceleration in base coordinates (e.g. `[0, 0, -9.81]`).
+    pub gravity: Vec3,
+    pub frames: Vec<Frame>,
+    /// `support[i]`: body i and its ancestors, ascending (the joints that move body i).
+    pub support: Vec<Vec<usize>>,
+}
+
+fn finite(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(Error::InvalidModel(format!("{what} has a non-finite value at index {k}"))),
+        None => Ok(()),
+    }
+}
+
+impl Model {
+    /// Build and validate a model. All per-body vectors must have length `parent.len()`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        parent: Vec<Option<usize>>,
+        joints: Vec<Joint>,
+        offset: Vec<f64>,
+        parent_from_joint: Vec<Transform>,
+        inertia: Vec<Inertia>,
+        armature: Vec<f64>,
+        viscous: Vec<f64>,
+        coulomb: Vec<f64>,
+        gravity: Vec3,
+        frames: Vec<Frame>,
+    ) -> Result<Self> {
+        let n = parent.len();
+        let lens = [
+            ("joints", joints.len()),
+            ("offset", offset.len()),
+            ("placement", parent_from_joint.len()),
+            ("inertia", inertia.len()),
+            ("armature", armature.len()),
+            ("viscous", viscous.len()),
+            ("coulomb", coulomb.len()),
+        ];
+        for (what, len) in lens {
+            if len != n {
+                return Err(Error::InvalidModel(format!("{what} has {len} entries for {n} bodies")));
+            }
+        }
+        for (i, p) in parent.iter().enumerate() {
+            if let Some(p) = p {
+                if *p >= i {
+                    return Err(Error::InvalidModel(format!(
+                        "body {i} has parent {p}: bodies must be numbered so that parent < child (a cycle or bad order)"
+                    )));
+                }
+            }
+        }
+        for (i, j) in joints.iter().enumerate() {
+            let norm = j.axis.norm();
+            if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
+                return Err(Error::InvalidModel(format!("joint {i}: axis {:?} is not a unit vector", j.axis.as_slice())));
+            }
+        }
+        finite("offset", &offset)?;
+        finite("armature", &armature)?;
+        finite("viscous", &viscous)?;
+        finite("coulomb", &coulomb)?;
+        finite("gravity", gravity.as_slice())?;
+        for (i, x) in parent_from_joint.iter().enumerate() {
+            finite(&format!("placement of body {i}"), &x.to_homogeneous())?;
+        }
+        for (i, inr) in inertia.iter().enumerate() {
+            finite(&format!("inertia of body {i}"), &inr.to_parameters())?;
+            if inr.mass < 0.0 {
+                return Err(Error::InvalidModel(format!("body {i} has negative mass {}", inr.mass)));
+            }
+        }
+        for (k, f) in frames.iter().enumerate() {
+            if let Some(b) = f.body {
+                if b >= n {
+                    return Err(Error::InvalidModel(format!("frame {k} is attached to body {b}, but there are {n} bodies")));
+                }
+            }
+            finite(&format!("placement of frame {k}"), &f.body_from_frame.to_homogeneous())?;
+        }
+        let mut support: Vec<Vec<usize>> = Vec::with_capacity(n);
+        for i in 0..n {
+            let mut s = match parent[i] {
+                Some(p) => support[p].clone(),
+                None => Vec::new(),
+            };
+            s.push(i);
+            support.push(s);
+        }
+        Ok(Self { n, parent, joints, offset, parent_from_joint, inertia, armature, viscous, coulomb, gravity, frames, support })
+    }
+}

@@ -1,0 +1,74 @@
+use super::{skew, Force, Mat3, Motion, Vec3};
+use std::ops::{Add, AddAssign};
+
+/// Rigid-body spatial inertia about a frame's origin (RBDA eq. 2.63), stored by its
+/// 10 parameters: mass `m`, first moment `h = m c` and the rotational inertia `i_o` about the
+/// origin (not about the centre of mass), all in the frame's axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Inertia {
+    pub mass: f64,
+    pub h: Vec3,
+    pub i_o: Mat3,
+}
+
+impl Inertia {
+    #[inline]
+    pub fn new(mass: f64, h: Vec3, i_o: Mat3) -> Self {
+        Self { mass, h, i_o }
+    }
+    #[inline]
+    pub fn zero() -> Self {
+        Self::default()
+    }
+    /// From `[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` about the origin (Pinocchio's order).
+    pub fn from_parameters(p: &[f64]) -> Self {
+        Self::new(
+            p[0],
+            Vec3::new(p[1], p[2], p[3]),
+            Mat3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]),
+        )
+    }
+    pub fn to_parameters(&self) -> [f64; 10] {
+        let i = &self.i_o;
+        [self.mass, self.h.x, self.h.y, self.h.z, i[(0, 0)], i[(0, 1)], i[(1, 1)], i[(0, 2)], i[(1, 2)], i[(2, 2)]]
+    }
+    /// Momentum `I v` of a body moving with twist `v`: `[m v_o - h x w; I_o w + h x v_o]`.
+    #[inline]
+    pub fn mul_motion(&self, v: &Motion) -> Force {
+        Force::new(self.mass * v.lin - self.h.cross(&v.ang), self.i_o * v.ang + self.h.cross(&v.lin))
+    }
+    /// Kinetic energy `1/2 v . I v`.
+    #[inline]
+    pub fn kinetic_energy(&self, v: &Motion) -> f64 {
+        0.5 * v.dot(&self.mul_motion(v))
+    }
+    /// Same body, axes rotated by `r` (origin unchanged): `h' = R h`, `I' = R I R^T`.
+    #[inline]
+    pub fn rotated(&self, r: &Mat3) -> Self {
+        Self::new(self.mass, r * self.h, r * self.i_o * r.transpose())
+    }
+    /// Same body, origin moved to `-t` (i.e. expressed in a frame whose origin is at `-t` from
+    /// this one, same axes): the parallel-axis theorem written on `h` so that `m = 0` is fine:
+    /// `h' = h + m t`, `I' = I - [t]x[h]x - [h]x[t]x - m [t]x[t]x` (derivation: docs/notation.md).
+    #[inline]
+    pub fn translated(&self, t: &Vec3) -> Self {
+        let (st, sh) = (skew(t), skew(&self.h));
+        Self::new(self.mass, self.h + self.mass * t, self.i_o - st * sh - sh * st - self.mass * st * st)
+    }
+}
+
+impl Add for Inertia {
+    type Output = Inertia;
+    #[inline]
+    fn add(self, o: Inertia) -> Inertia {
+        Inertia::new(self.mass + o.mass, self.h + o.h, self.i_o + o.i_o)
+    }
+}
+impl AddAssign for Inertia {
+    #[inline]
+    fn add_assign(&mut self, o: Inertia) {
+        self.mass += o.mass;
+        self.h += o.h;
+        self.i_o += o.i_o;
+    }
+}

@@ -1,0 +1,34 @@
+//! Spatial (6-D) vector algebra, ordered `[linear; angular]` as in DESIGN.md (Pinocchio's order).
+//!
+//! Featherstone, *Rigid Body Dynamics Algorithms* (RBDA), ch. 2, writes motion vectors `[w; v]`;
+//! here the same quantities are stored as named 3-vectors, so the ordering is only a convention of
+//! the public arrays. Types never mix: a `Motion` is not a `Force`, a `Transform` names its frames.
+//!
+//! | RBDA symbol | here                         | meaning                                   |
+//! |-------------|------------------------------|-------------------------------------------|
+//! | `v`, `a`    | `Motion { lin, ang }`        | twist / acceleration at the frame origin  |
+//! | `f`         | `Force { lin, ang }`         | wrench: force, moment about the origin    |
+//! | `^B X_A`    | `Transform` `a_from_b` (inverse) | rigid transform between frames        |
+//! | `I`         | `Inertia`                    | rigid-body inertia about the frame origin |
+//! | `v x`, `v x*` | `Motion::cross_motion`, `cross_force` | spatial cross products          |
+
+mod force;
+mod inertia;
+mod motion;
+mod transform;
+
+pub use force::Force;
+pub use inertia::Inertia;
+pub use motion::Motion;
+pub use transform::Transform;
+
+/// 3-vector of f64.
+pub type Vec3 = nalgebra::Vector3<f64>;
+/// 3x3 matrix of f64.
+pub type Mat3 = nalgebra::Matrix3<f64>;
+
+/// `[v]x`, the cross-product matrix: `skew(v) * w == v.cross(&w)`.
+#[inline]
+pub fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}

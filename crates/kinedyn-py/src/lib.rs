@@ -1,0 +1,313 @@
+//! `kinedyn._core`: PyO3 + rust-numpy glue around kinedyn-core, and nothing else.
+//!
+//! One place converts and checks shapes (`Batch::gather`), one place runs a per-state kernel over
+//! one state or a batch with the GIL released (`Batch::run`). Every kernel is a call into the core.
+
+use std::sync::Mutex;
+
+use kinedyn_core::algorithms::{self, Reference};
+use kinedyn_core::spatial::{Inertia, Transform, Vec3};
+use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
+use numpy::ndarray::ArrayViewD;
+use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+
+fn core_err(e: CoreError) -> PyErr {
+    match e {
+        CoreError::SingularMassMatrix(_) => PyRuntimeError::new_err(e.to_string()),
+        _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+/// A float64 array as a contiguous vector, copying only when the layout requires it.
+fn contiguous(a: &ArrayViewD<f64>) -> Vec<f64> {
+    a.iter().copied().collect()
+}
+
+fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
+    let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
+    PyValueError::new_err(format!(
+        "{name} must have shape ({exp}) or a batch (N, {exp}), got {got:?}"
+    ))
+}
+
+/// Inputs of one call, flattened: `values[k]` holds `batch` states of `width[k]` numbers each.
+struct Batch {
+    /// `None` for a single state (outputs lose the leading axis).
+    batch: Option<usize>,
+    values: Vec<Vec<f64>>,
+    width: Vec<usize>,
+}
+
+impl Batch {
+    /// Check each input against its per-state shape; all inputs share one batch size.
+    fn gather(inputs: &[(&str, &PyReadonlyArrayDyn<f64>, &[usize])]) -> PyResult<Self> {
+        let mut batch: Option<Option<usize>> = None;
+        let mut values = Vec::with_capacity(inputs.len());
+        let mut width = Vec::with_capacity(inputs.len());
+        for (name, array, shape) in inputs {
+            let got = array.shape();
+            let this = if got == *shape {
+                None
+            } else if got.len() == shape.len() + 1 && &got[1..] == *shape {
+                Some(got[0])
+            } else {
+                return Err(reshape_error(name, shape, got));
+            };
+            match batch {
+                None => batch = Some(this),
+                Some(b) if b != this => {
+                    return Err(PyValueError::new_err(format!(
+                        "{name} has batch shape {got:?}, which does not match the other arguments (batch {b:?})"
+                    )))
+                }
+                _ => {}
+            }
+            let view = array.as_array();
+            let data = match view.as_slice() {
+                Some(s) => s.to_vec(),
+                None => contiguous(&view),
+            };
+            let w: usize = shape.iter().product();
+            if let Some(k) = data.iter().position(|x| !x.is_finite()) {
+                let state = if w > 0 { k / w } else { 0 };
+                let at = if this.is_some() { format!(" in state {state}") } else { String::new() };
+                return Err(PyValueError::new_err(format!(
+                    "{name} contains a non-finite value (NaN or inf) at index {}{at}",
+                    k % w.max(1)
+                )));
+            }
+            values.push(data);
+            width.push(w);
+        }
+        Ok(Self { batch: batch.flatten(), values, width })
+    }
+
+    fn len(&self) -> usize {
+        self.batch.unwrap_or(1)
+    }
+
+    /// Run `kernel(model, data, inputs_of_state, out_of_state)` on every state, GIL released;
+    /// batches run in parallel chunks, each with its own `Data`.
+    fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    where
+        F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
+    {
+        let per_state: usize = out_shape.iter().product();
+        let count = self.len();
+        let mut out = vec![0.0; per_state * count];
+        let model = &m.model;
+        let state = |k: usize| -> Vec<&[f64]> {
+            self.values.iter().zip(&self.width).map(|(v, w)| &v[k * w..(k + 1) * w]).collect()
+        };
+        let result: Result<(), CoreError> = py.detach(|| {
+            if count <= 64 {
+                let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
+                for (k, o) in out.chunks_mut(per_state.max(1)).enumerate().take(count) {
+                    kernel(model, &mut guard, &state(k), o)?;
+                }
+                Ok(())
+            } else {
+                const CHUNK: usize = 64;
+                out.par_chunks_mut((per_state * CHUNK).max(1)).enumerate().try_for_each(|(c, block)| {
+                    let mut data = Data::new(model);
+                    for (i, o) in block.chunks_mut(per_state.max(1)).enumerate() {
+                        kernel(model, &mut data, &state(c * CHUNK + i), o)?;
+                    }
+                    Ok(())
+                })
+            }
+        });
+        result.map_err(core_err)?;
+        let mut shape: Vec<usize> = Vec::with_capacity(out_shape.len() + 1);
+        if let Some(b) = self.batch {
+            shape.push(b);
+        }
+        shape.extend_from_slice(out_shape);
+        let flat = numpy::PyArray1::from_vec(py, out);
+        Ok(flat.reshape(shape)?)
+    }
+}
+
+/// The compiled model plus one cached `Data` for single-state calls.
+#[pyclass(name = "Model", module = "kinedyn._core", frozen)]
+struct PyModel {
+    model: Model,
+    data: Mutex<Data>,
+}
+
+fn vec_of(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[usize]) -> PyResult<Vec<f64>> {
+    if a.shape() != shape {
+        return Err(reshape_error(name, shape, a.shape()));
+    }
+    Ok(contiguous(&a.as_array()))
+}
+
+fn reference(code: i64) -> PyResult<Reference> {
+    match code {
+        0 => Ok(Reference::World),
+        1 => Ok(Reference::Local),
+        2 => Ok(Reference::Spatial),
+        _ => Err(PyValueError::new_err(format!("reference code must be 0 (world), 1 (local) or 2 (spatial), got {code}"))),
+    }
+}
+
+impl PyModel {
+    fn n(&self) -> usize {
+        self.model.n
+    }
+
+    fn frame(&self, frame: i64) -> PyResult<usize> {
+        let nf = self.model.frames.len();
+        if frame < 0 || frame as usize >= nf {
+            return Err(PyValueError::new_err(format!("frame index {frame} out of range (the model has {nf} frames)")));
+        }
+        Ok(frame as usize)
+    }
+
+    fn point(point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Option<Vec3>> {
+        point
+            .map(|p| {
+                let v = vec_of("point", &p, &[3])?;
+                if v.iter().any(|x| !x.is_finite()) {
+                    return Err(PyValueError::new_err("point contains a non-finite value"));
+                }
+                Ok(Vec3::new(v[0], v[1], v[2]))
+            })
+            .transpose()
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        parent: Vec<i64>,
+        kind: Vec<i64>,
+        axis: PyReadonlyArrayDyn<f64>,
+        offset: Vec<f64>,
+        placement: PyReadonlyArrayDyn<f64>,
+        inertia: PyReadonlyArrayDyn<f64>,
+        armature: Vec<f64>,
+        viscous: Vec<f64>,
+        coulomb: Vec<f64>,
+        gravity: Vec<f64>,
+        frame_body: Vec<i64>,
+        frame_placement: PyReadonlyArrayDyn<f64>,
+    ) -> PyResult<Self> {
+        let n = parent.len();
+        let nf = frame_body.len();
+        let axis = vec_of("axis", &axis, &[n, 3])?;
+        let placement = vec_of("placement", &placement, &[n, 4, 4])?;
+        let inertia = vec_of("inertia", &inertia, &[n, 10])?;
+        let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
+        if kind.len() != n {
+            return Err(PyValueError::new_err(format!("kind has {} entries for {n} bodies", kind.len())));
+        }
+        if gravity.len() != 3 {
+            return Err(PyValueError::new_err(format!("gravity must have 3 components, got {}", gravity.len())));
+        }
+        let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
+            match p {
+                -1 => Ok(None),
+                p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
+                p => Err(PyValueError::new_err(format!("{what} {k}: body index {p} is out of range (-1..{n})"))),
+            }
+        };
+        let parent = parent.iter().enumerate().map(|(i, &p)| body_index("parent of body", i, p)).collect::<PyResult<Vec<_>>>()?;
+        let joints = kind
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| {
+                let kind = match k {
+                    0 => JointKind::Revolute,
+                    1 => JointKind::Prismatic,
+                    _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
+                };
+                Ok(Joint { kind, axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]) })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
+        let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
+        let frames = frame_body
+            .iter()
+            .enumerate()
+            .map(|(k, &b)| {
+                Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
+            .map_err(core_err)?;
+        let data = Mutex::new(Data::new(&model));
+        Ok(Self { model, data })
+    }
+
+    #[getter(n)]
+    fn get_n(&self) -> usize {
+        self.model.n
+    }
+
+    #[getter]
+    fn n_frames(&self) -> usize {
+        self.model.frames.len()
+    }
+
+    /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
+    fn frame_poses<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frames: Vec<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let ids = frames.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[ids.len(), 4, 4], |model, data, x, out| {
+            algorithms::forward_kinematics(model, data, x[0]);
+            for (k, &f) in ids.iter().enumerate() {
+                out[16 * k..16 * k + 16].copy_from_slice(&algorithms::frame_pose(model, data, f).to_homogeneous());
+            }
+            Ok(())
+        })
+    }
+
+    /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
+    #[pyo3(signature = (q, frame, reference, point=None))]
+    fn jacobian<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[6, n], |model, data, x, out| {
+            algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
+            Ok(())
+        })
+    }
+
+    /// Twist J qd (6,) or (N, 6).
+    #[pyo3(signature = (q, qd, frame, reference, point=None))]
+    fn frame_velocity<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[6], |model, data, x, out| {
+            out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+            Ok(())
+        })
+    }
+
+    /// Acceleration drift dJ/dt qd (6,) or (N, 6).
+    #[pyo3(signature = (q, qd, frame, reference, point=None))]
+    fn jdot_qd<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[6], |model, data, x, out| {
+            out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+            Ok(())
+        })
+    }
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyModel>()?;
+    Ok(())
+}
