@@ -1,0 +1,469 @@
+"""Robot files: ``load(path)`` by extension (URDF, YAML, TOML) and ``save(robot, path)`` (YAML, TOML).
+
+The YAML/TOML format (docs/model-files.md) has two flavours:
+
+- DH-based, with a ``joints:`` list of DH rows (``convention: standard|modified``);
+- tree-based, with a ``links:`` list of links, each with its joint and inertial data.
+
+Both share ``name``, ``gravity``, ``units: {angle: deg|rad}``, ``frames:`` and ``source``. A string
+that is not a number becomes a SymPy expression (``"l1"``, ``"m1*l1**2/12"``). ``save`` writes a
+robot with a DH table as DH and any other robot as a tree, always in radians, so that ``load``
+gives back the same kinematics, inertias and limits.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tomllib
+from typing import Any, Optional
+
+import numpy as np
+import sympy as sp
+import tomli_w
+import yaml
+
+from .._math import as_value, is_symbolic, matmul, pose_inverse, rpy_to_matrix, translation
+from .dh import DHRow, links_from_dh
+from .inertia import Inertia
+from .joint import Joint
+from .link import Frame, Link
+
+__all__ = ["load", "save", "robot_from_mapping", "robot_to_mapping"]
+
+_TOP_COMMON = {"name", "gravity", "units", "frames", "source"}
+_TOP_DH = _TOP_COMMON | {"convention", "base_pose", "tool", "tool_frame", "joints"}
+_TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
+_ROW_KEYS = {"theta", "d", "a", "alpha", "type", "name", "limits", "mass", "com", "inertia",
+             "gear_ratio", "rotor_inertia", "viscous", "coulomb"}
+_LINK_KEYS = {"name", "parent", "joint", "inertial", "post"}
+_JOINT_KEYS = {"name", "type", "axis", "origin", "offset", "limits", "gear_ratio", "rotor_inertia", "viscous", "coulomb"}
+_INERTIAL_KEYS = {"mass", "com", "inertia"}
+_LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
+_POSE_KEYS = {"xyz", "rpy"}
+_FRAME_KEYS = {"name", "link", "origin"}
+_TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+# names SymPy would otherwise read as constants or functions (I = sqrt(-1), E, S, N, O, Q, beta...)
+_LOCALS = {n: sp.Symbol(n) for n in ("I", "E", "S", "N", "O", "Q", "beta", "gamma", "zeta")}
+_EXPRESSION = re.compile(r"^[A-Za-z0-9_.+\-*/() ]+$")
+
+
+# ============================================================================ public functions
+def load(path, **kwargs):
+    """A robot from ``.urdf`` (``kwargs``: gravity, tool), ``.yaml``/``.yml`` or ``.toml`` (``kwargs``
+    replace constructor arguments, e.g. ``gravity=``)."""
+    path = os.fspath(path)
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".urdf":
+        from .urdf import robot_from_urdf
+
+        return robot_from_urdf(path, **kwargs)
+    if ext not in (".yaml", ".yml", ".toml"):
+        raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .yaml, .yml or .toml)")
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None
+    data = _parse_toml(text, path) if ext == ".toml" else _parse_yaml(text, path)
+    robot = robot_from_mapping(data, where=path)
+    return robot.replace(**kwargs) if kwargs else robot
+
+
+def save(robot, path) -> None:
+    """Write ``robot`` to a ``.yaml``/``.yml`` or ``.toml`` robot file (angles in radians)."""
+    path = os.fspath(path)
+    ext = os.path.splitext(path)[1].lower()
+    data = robot_to_mapping(robot)
+    if ext in (".yaml", ".yml"):
+        text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=120)
+    elif ext == ".toml":
+        text = tomli_w.dumps(data)
+    else:
+        raise ValueError(f"{path}: can only save robots as .yaml, .yml or .toml, not '{ext}'")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def _parse_yaml(text: str, where: str):
+    try:
+        return yaml.safe_load(text)
+    except yaml.MarkedYAMLError as e:
+        mark = e.problem_mark or e.context_mark
+        line = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
+        raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
+    except yaml.YAMLError as e:
+        raise ValueError(f"{where}: invalid YAML: {e}") from None
+
+
+def _parse_toml(text: str, where: str):
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:  # the message ends with "(at line L, column C)"
+        raise ValueError(f"{where}: invalid TOML: {e}") from None
+
+
+# ============================================================================ reading a mapping
+class _Reader:
+    """Converts values of one robot file, knowing where it is (for messages) and its angle unit."""
+
+    def __init__(self, where: str):
+        self.where = where
+        self.deg = False
+
+    def fail(self, ctx: str, message: str):
+        raise ValueError(f"{self.where}: {ctx}: {message}")
+
+    def check_keys(self, mapping, known: set, ctx: str) -> dict:
+        if not isinstance(mapping, dict):
+            self.fail(ctx, f"expected a mapping, got {type(mapping).__name__}")
+        for key in mapping:
+            if key not in known:
+                self.fail(ctx, f"unknown key '{key}' (known keys: {', '.join(sorted(known))})")
+        return mapping
+
+    def value(self, raw, ctx: str):
+        """A float, or a SymPy expression for a string that is not a number."""
+        if isinstance(raw, bool) or raw is None:
+            self.fail(ctx, f"expected a number or an expression, got {raw!r}")
+        if isinstance(raw, (int, float)):
+            return float(raw)
+        if isinstance(raw, str):
+            if not _EXPRESSION.match(raw) or "__" in raw:
+                self.fail(ctx, f"'{raw}' is not a number or an arithmetic expression of symbols")
+            try:
+                return as_value(sp.sympify(raw, locals=_LOCALS))
+            except (sp.SympifyError, SyntaxError, TypeError) as e:
+                self.fail(ctx, f"cannot read '{raw}' as a number or expression ({e})")
+        self.fail(ctx, f"expected a number or an expression, got {type(raw).__name__}")
+
+    def number(self, raw, ctx: str) -> float:
+        v = self.value(raw, ctx)
+        if isinstance(v, sp.Basic):
+            self.fail(ctx, f"must be a number, got the expression '{raw}'")
+        return v
+
+    def angle(self, raw, ctx: str):
+        v = self.value(raw, ctx)
+        if not self.deg:
+            return v
+        return v * sp.pi / 180 if isinstance(v, sp.Basic) else v * math.pi / 180
+
+    def vector(self, raw, ctx: str, n: int = 3, angles: bool = False) -> tuple:
+        if not isinstance(raw, (list, tuple)) or len(raw) != n:
+            self.fail(ctx, f"expected a list of {n} values, got {raw!r}")
+        f = self.angle if angles else self.value
+        return tuple(f(v, f"{ctx}[{i}]") for i, v in enumerate(raw))
+
+    def pose(self, raw, ctx: str):
+        """``{xyz: [x, y, z], rpy: [roll, pitch, yaw]}`` -> 4x4 (rpy as in URDF)."""
+        raw = self.check_keys(raw, _POSE_KEYS, ctx)
+        xyz = self.vector(raw.get("xyz", [0, 0, 0]), f"{ctx}.xyz")
+        rpy = self.vector(raw.get("rpy", [0, 0, 0]), f"{ctx}.rpy", angles=True)
+        return matmul(translation(*xyz), rpy_to_matrix(*rpy))
+
+    def limits(self, raw, revolute: bool, ctx: str) -> dict:
+        raw = self.check_keys(raw, _LIMIT_KEYS, ctx)
+        out = {}
+        for key, field in (("lower", "lower"), ("upper", "upper"), ("velocity", "velocity_limit")):
+            if key in raw:
+                v = self.number(raw[key], f"{ctx}.{key}")
+                out[field] = v * math.pi / 180 if (revolute and self.deg) else v
+        if "effort" in raw:
+            out["effort_limit"] = self.number(raw["effort"], f"{ctx}.effort")
+        return out
+
+    def inertia(self, raw: dict, ctx: str) -> Inertia:
+        """mass, com (link frame) and inertia about the COM (mapping ixx.. or 3x3 list)."""
+        mass = self.value(raw.get("mass", 0.0), f"{ctx}.mass")
+        com = self.vector(raw.get("com", [0, 0, 0]), f"{ctx}.com")
+        tensor = raw.get("inertia", {})
+        if isinstance(tensor, dict):
+            tensor = self.check_keys(tensor, set(_TENSOR_KEYS), f"{ctx}.inertia")
+            ixx, ixy, ixz, iyy, iyz, izz = (self.value(tensor.get(k, 0.0), f"{ctx}.inertia.{k}") for k in _TENSOR_KEYS)
+            tensor = ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))
+        elif isinstance(tensor, (list, tuple)) and len(tensor) == 3:
+            tensor = tuple(self.vector(r, f"{ctx}.inertia[{i}]") for i, r in enumerate(tensor))
+        else:
+            self.fail(f"{ctx}.inertia", "expected {ixx, ixy, ixz, iyy, iyz, izz} or a 3x3 list")
+        try:
+            return Inertia(mass, com, tensor)
+        except ValueError as e:
+            self.fail(ctx, str(e))
+
+    def drive(self, raw: dict, ctx: str) -> dict:
+        return {k: self.value(raw[k], f"{ctx}.{k}") for k in ("gear_ratio", "rotor_inertia", "viscous", "coulomb") if k in raw}
+
+
+def robot_from_mapping(data, where: str = "<robot mapping>"):
+    """A robot from the parsed contents of a YAML/TOML robot file (see docs/model-files.md)."""
+    r = _Reader(where)
+    if not isinstance(data, dict):
+        raise ValueError(f"{where}: a robot file must hold a mapping at the top level, got {type(data).__name__}")
+    if ("joints" in data) == ("links" in data):
+        raise ValueError(f"{where}: a robot file needs exactly one of 'joints' (DH table) or 'links' (tree)")
+    dh = "joints" in data
+    r.check_keys(data, _TOP_DH if dh else _TOP_TREE, "top level")
+    units = r.check_keys(data.get("units", {}), {"angle"}, "units")
+    if units.get("angle", "rad") not in ("deg", "rad"):
+        r.fail("units.angle", f"must be 'deg' or 'rad', got {units['angle']!r}")
+    r.deg = units.get("angle") == "deg"
+    common = {
+        "gravity": r.vector(data.get("gravity", [0, 0, -9.81]), "gravity"),
+        "name": str(data.get("name", "robot")),
+        "source": str(data.get("source", where)),
+    }
+    frames = _frames(r, data.get("frames", []))
+    try:
+        return _dh_robot(r, data, common, frames) if dh else _tree_robot(r, data, common, frames)
+    except ValueError as e:
+        if str(e).startswith(where):
+            raise
+        raise ValueError(f"{where}: {e}") from None
+
+
+def _frames(r: _Reader, raw) -> list:
+    if not isinstance(raw, list):
+        r.fail("frames", "expected a list of {name, link, origin}")
+    out = []
+    for i, f in enumerate(raw):
+        ctx = f"frames[{i}]"
+        f = r.check_keys(f, _FRAME_KEYS, ctx)
+        if "name" not in f:
+            r.fail(ctx, "a frame needs a 'name'")
+        origin = r.pose(f["origin"], f"{ctx}.origin") if "origin" in f else np.eye(4)
+        out.append(Frame(str(f["name"]), f.get("link"), origin))
+    return out
+
+
+def _dh_robot(r: _Reader, data: dict, common: dict, frames: list):
+    from ..robot import Robot
+
+    convention = data.get("convention", "standard")
+    if convention not in ("standard", "modified"):
+        r.fail("convention", f"must be 'standard' or 'modified', got {convention!r}")
+    if not isinstance(data["joints"], list) or not data["joints"]:
+        r.fail("joints", "expected a non-empty list of DH rows")
+    rows = [_dh_row(r, row, i) for i, row in enumerate(data["joints"])]
+    base_pose = r.pose(data["base_pose"], "base_pose") if "base_pose" in data else None
+    tool = r.pose(data["tool"], "tool") if "tool" in data else None
+    robot = Robot.from_dh(rows, convention, base_pose=base_pose, tool=tool, **common)
+    if frames or "tool_frame" in data:
+        robot = robot.replace(frames=robot.frames + tuple(frames), tool=data.get("tool_frame", "tool"))
+    return robot
+
+
+def _dh_row(r: _Reader, row, i: int) -> DHRow:
+    ctx = f"joints row {i + 1}"
+    row = r.check_keys(row, _ROW_KEYS, ctx)
+    kind = row.get("type", "revolute")
+    if kind not in ("revolute", "prismatic"):
+        r.fail(f"{ctx}.type", f"must be 'revolute' or 'prismatic', got {kind!r}")
+    limits = r.limits(row.get("limits", {}), kind == "revolute", f"{ctx}.limits")
+    return DHRow(
+        theta=r.angle(row.get("theta", 0.0), f"{ctx}.theta"),
+        d=r.value(row.get("d", 0.0), f"{ctx}.d"),
+        a=r.value(row.get("a", 0.0), f"{ctx}.a"),
+        alpha=r.angle(row.get("alpha", 0.0), f"{ctx}.alpha"),
+        kind=kind,
+        name=None if row.get("name") is None else str(row["name"]),
+        inertia=r.inertia(row, ctx),
+        **limits,
+        **r.drive(row, ctx),
+    )
+
+
+def _tree_robot(r: _Reader, data: dict, common: dict, frames: list):
+    from ..robot import Robot
+
+    if not isinstance(data["links"], list) or not data["links"]:
+        r.fail("links", "expected a non-empty list of links")
+    links = [_tree_link(r, link, i) for i, link in enumerate(data["links"])]
+    tool = data.get("tool")
+    if tool is not None and not isinstance(tool, str):
+        r.fail("tool", "in a tree-based file 'tool' names a frame or link")
+    return Robot(links, frames, base=str(data.get("base", "base")), tool=tool, **common)
+
+
+def _tree_link(r: _Reader, raw, i: int) -> Link:
+    ctx = f"links row {i + 1}"
+    raw = r.check_keys(raw, _LINK_KEYS, ctx)
+    if "name" not in raw:
+        r.fail(ctx, "a link needs a 'name'")
+    ctx = f"{ctx} ('{raw['name']}')"
+    j = r.check_keys(raw.get("joint", {"type": "fixed"}), _JOINT_KEYS, f"{ctx}.joint")
+    kind = j.get("type", "revolute")
+    if kind not in ("revolute", "continuous", "prismatic", "fixed"):
+        r.fail(f"{ctx}.joint.type", f"must be revolute, continuous, prismatic or fixed, got {kind!r}")
+    revolute = kind in ("revolute", "continuous")
+    offset_reader = r.angle if revolute else r.value
+    joint = Joint(
+        name=str(j.get("name", f"{raw['name']}_joint")),
+        kind=kind,
+        axis=r.vector(j.get("axis", [0, 0, 1]), f"{ctx}.joint.axis"),
+        offset=offset_reader(j.get("offset", 0.0), f"{ctx}.joint.offset"),
+        **r.limits(j.get("limits", {}), revolute, f"{ctx}.joint.limits"),
+        **r.drive(j, f"{ctx}.joint"),
+    )
+    placement = r.pose(j["origin"], f"{ctx}.joint.origin") if "origin" in j else np.eye(4)
+    post = r.pose(raw["post"], f"{ctx}.post") if "post" in raw else np.eye(4)
+    inertial = r.check_keys(raw.get("inertial", {}), _INERTIAL_KEYS, f"{ctx}.inertial")
+    return Link(str(raw["name"]), raw.get("parent"), joint, placement, post, r.inertia(inertial, f"{ctx}.inertial"))
+
+
+# ============================================================================ writing a mapping
+def robot_to_mapping(robot) -> dict:
+    """The YAML/TOML contents for ``robot``: DH flavour when it has a consistent DH table."""
+    data: dict = {"name": robot.name, "gravity": [_dump(g) for g in robot.gravity]}
+    if robot.source:
+        data["source"] = robot.source
+    base_pose = _dh_base_pose(robot)
+    if base_pose is not None:
+        data.update(_dh_mapping(robot, base_pose))
+    else:
+        data.update(_tree_mapping(robot))
+    return data
+
+
+def _dump(v):
+    if isinstance(v, sp.Basic):
+        return float(v) if not v.free_symbols else str(v)
+    return float(v)
+
+
+def _rpy(R) -> list:
+    """Inverse of rpy_to_matrix: R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    R = np.asarray(R, dtype=float)
+    pitch = math.atan2(-R[2, 0], math.hypot(R[0, 0], R[1, 0]))
+    if math.hypot(R[0, 0], R[1, 0]) < 1e-12:  # gimbal lock: put everything in yaw
+        angles = [0.0, pitch, math.atan2(-R[0, 1], R[1, 1])]
+    else:
+        angles = [math.atan2(R[2, 1], R[2, 2]), pitch, math.atan2(R[1, 0], R[0, 0])]
+    return [a + 0.0 for a in angles]  # no -0.0 in files
+
+
+def _is_identity(T) -> bool:
+    if is_symbolic(T):
+        return sp.Matrix(T) == sp.eye(4)
+    return np.allclose(np.asarray(T, dtype=float), np.eye(4), atol=1e-15)
+
+
+def _pose_mapping(T, what: str) -> dict:
+    T = sp.Matrix(T) if is_symbolic(T) else np.asarray(T, dtype=float)
+    if is_symbolic(T[:3, :3]):
+        raise ValueError(f"cannot save {what}: its rotation is symbolic (only translations may hold symbols)")
+    R = np.array(sp.Matrix(T[:3, :3]).tolist(), dtype=float) if isinstance(T, sp.MatrixBase) else T[:3, :3]
+    return {"xyz": [_dump(T[i, 3]) for i in range(3)], "rpy": _rpy(R)}
+
+
+def _same_pose(A, B) -> bool:
+    if is_symbolic(A) or is_symbolic(B):
+        return sp.simplify(sp.Matrix(A) - sp.Matrix(B)) == sp.zeros(4, 4)
+    return np.allclose(np.asarray(A, dtype=float), np.asarray(B, dtype=float), atol=1e-12)
+
+
+def _dh_base_pose(robot):
+    """The base pose of the DH table if ``robot.links`` are exactly what its DH table gives, else None."""
+    if robot.dh is None or robot.dh_convention is None:
+        return None
+    links, _ = links_from_dh(robot.dh, robot.dh_convention)
+    if len(links) != len(robot.links):
+        return None
+    base_pose = matmul(robot.links[0].placement, pose_inverse(links[0].placement))
+    for k, (mine, theirs) in enumerate(zip(robot.links, links)):
+        placement = matmul(base_pose, theirs.placement) if k == 0 else theirs.placement
+        same = (
+            (mine.name, mine.parent, mine.joint, mine.inertia) == (theirs.name, theirs.parent, theirs.joint, theirs.inertia)
+            and _same_pose(mine.placement, placement)
+            and _same_pose(mine.post, theirs.post)
+        )
+        if not same:
+            return None
+    return base_pose
+
+
+def _limits_mapping(joint) -> dict:
+    out = {}
+    for key, field in (("lower", "lower"), ("upper", "upper"), ("velocity", "velocity_limit"), ("effort", "effort_limit")):
+        v = getattr(joint, field)
+        if math.isfinite(v):
+            out[key] = float(v)
+    return out
+
+
+def _drive_mapping(obj) -> dict:
+    defaults = {"gear_ratio": 1.0, "rotor_inertia": 0.0, "viscous": 0.0, "coulomb": 0.0}
+    return {k: _dump(getattr(obj, k)) for k, d in defaults.items() if getattr(obj, k) != d}
+
+
+def _inertia_mapping(inertia: Inertia) -> dict:
+    I = inertia.inertia
+    tensor = {k: _dump(I[r][c]) for k, (r, c) in zip(_TENSOR_KEYS, ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)))}
+    return {"mass": _dump(inertia.mass), "com": [_dump(c) for c in inertia.com], "inertia": tensor}
+
+
+def _frames_mapping(frames) -> list:
+    out = []
+    for f in frames:
+        entry: dict = {"name": f.name}
+        if f.link is not None:
+            entry["link"] = f.link
+        entry["origin"] = _pose_mapping(f.placement, f"frame '{f.name}'")
+        out.append(entry)
+    return out
+
+
+def _dh_mapping(robot, base_pose) -> dict:
+    out: dict = {"convention": robot.dh_convention, "units": {"angle": "rad"}}
+    if not _is_identity(base_pose):
+        out["base_pose"] = _pose_mapping(base_pose, "the base pose")
+    last = robot.links[-1].name
+    tool = [f for f in robot.frames if f.name == "tool" and f.link == last]
+    if tool and not _is_identity(tool[0].placement):
+        out["tool"] = _pose_mapping(tool[0].placement, "the tool frame")
+    extra = [f for f in robot.frames if not (f.name == "tool" and f.link == last)]
+    if extra:
+        out["frames"] = _frames_mapping(extra)
+    if robot.tool != "tool":
+        out["tool_frame"] = robot.tool
+    rows = []
+    for k, (row, link) in enumerate(zip(robot.dh, robot.links)):
+        entry: dict = {"name": link.joint.name, "type": row.kind}
+        entry.update({key: _dump(getattr(row, key)) for key in ("theta", "d", "a", "alpha")})
+        limits = _limits_mapping(link.joint)
+        if limits:
+            entry["limits"] = limits
+        entry.update(_inertia_mapping(row.inertia))
+        entry.update(_drive_mapping(row))
+        rows.append(entry)
+    out["joints"] = rows
+    return out
+
+
+def _tree_mapping(robot) -> dict:
+    out: dict = {"base": robot.base, "tool": robot.tool, "units": {"angle": "rad"}}
+    links = []
+    for link in robot.links:
+        j = link.joint
+        joint: dict = {"name": j.name, "type": j.kind, "axis": [_dump(a) for a in j.axis]}
+        if not _is_identity(link.placement):
+            joint["origin"] = _pose_mapping(link.placement, f"the joint origin of link '{link.name}'")
+        if _dump(j.offset) != 0.0:
+            joint["offset"] = _dump(j.offset)
+        limits = _limits_mapping(j)
+        if limits:
+            joint["limits"] = limits
+        joint.update(_drive_mapping(j))
+        entry: dict = {"name": link.name}
+        if link.parent is not None:
+            entry["parent"] = link.parent
+        entry["joint"] = joint
+        if not _is_identity(link.post):
+            entry["post"] = _pose_mapping(link.post, f"the post transform of link '{link.name}'")
+        entry["inertial"] = _inertia_mapping(link.inertia)
+        links.append(entry)
+    out["links"] = links
+    if robot.frames:
+        out["frames"] = _frames_mapping(robot.frames)
+    return out
