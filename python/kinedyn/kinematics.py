@@ -1,0 +1,185 @@
+"""Velocity and force mapping through the Jacobian (Spong ch. 4; Yoshikawa 1985).
+
+All functions take the task rows to use: ``task="full"`` (6 rows [v; w]), ``"position"`` (the 3
+rows of the linear velocity), ``"orientation"``, ``"planar"`` (rows x, y: the tutorial's 2x2
+Jacobian of a planar arm) or an explicit list of row indices. Jacobians are the ``reference``
+Jacobians of :meth:`kinedyn.Robot.jacobian` (default "world": base axes, textbook J = [J_v; J_w]).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional, Sequence, Union
+
+import numpy as np
+
+__all__ = [
+    "task_rows",
+    "task_jacobian",
+    "tool_velocity",
+    "joint_torques",
+    "joint_velocities",
+    "manipulability",
+    "singular_values",
+    "SingularityReport",
+    "singularity_report",
+]
+
+_TASKS = {
+    "full": [0, 1, 2, 3, 4, 5],
+    "position": [0, 1, 2],
+    "orientation": [3, 4, 5],
+    "planar": [0, 1],
+    "planar_pose": [0, 1, 5],
+}
+_ROW_NAMES = ["vx", "vy", "vz", "wx", "wy", "wz"]
+
+Task = Union[str, Sequence[int]]
+
+
+def task_rows(task: Task) -> list:
+    """Row indices of the 6-row Jacobian for a task name or an explicit list."""
+    if isinstance(task, str):
+        try:
+            return list(_TASKS[task])
+        except KeyError:
+            raise ValueError(f"unknown task '{task}' (use one of {list(_TASKS)} or a list of row indices 0..5)") from None
+    rows = [int(r) for r in task]
+    if not rows or any(r < 0 or r > 5 for r in rows) or len(set(rows)) != len(rows):
+        raise ValueError(f"task rows must be distinct indices in 0..5, got {list(task)}")
+    return rows
+
+
+def task_jacobian(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+    """The selected rows of the frame Jacobian: (m, n), or (N, m, n) for a batch of q."""
+    return robot.jacobian(q, frame, reference)[..., task_rows(task), :]
+
+
+def _vector(x, size: int, what: str) -> np.ndarray:
+    v = np.asarray(x, dtype=float)
+    if v.shape != (size,):
+        raise ValueError(f"{what} must have {size} components for this task, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{what} contains NaN or inf")
+    return v
+
+
+def tool_velocity(robot, q, qd, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+    """Tool twist (selected rows) ``J(q) qd``."""
+    J = task_jacobian(robot, q, frame, task, reference)
+    return J @ _vector(qd, robot.n, "qd")
+
+
+def joint_torques(robot, q, wrench, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+    """Static joint torques balancing a tool wrench: ``tau = J^T F`` (Spong §4.10).
+
+    ``wrench`` has one entry per task row (e.g. (Fx, Fy) with ``task="planar"``; [force; moment]
+    with ``"full"``). These are the torques the joints must apply for the tool to exert F on the
+    environment (equivalently, the joint torques caused by F applied to the tool, with a sign flip).
+    """
+    J = task_jacobian(robot, q, frame, task, reference)
+    return J.T @ _vector(wrench, J.shape[0], "wrench")
+
+
+def joint_velocities(
+    robot,
+    q,
+    velocity,
+    frame: Optional[str] = None,
+    task: Task = "full",
+    method: str = "pinv",
+    damping: float = 1e-2,
+    reference: str = "world",
+) -> np.ndarray:
+    """Joint rates producing a tool velocity: ``qd = J^-1 v`` (``method="inverse"``, square and
+    non-singular J only), the Moore-Penrose pseudo-inverse (``"pinv"``: least-squares, minimum norm)
+    or damped least squares (``"dls"``: ``J^T (J J^T + lambda^2 I)^-1 v``, Nakamura & Hanafusa 1986;
+    Wampler 1986), which stays bounded near singularities."""
+    J = task_jacobian(robot, q, frame, task, reference)
+    v = _vector(velocity, J.shape[0], "velocity")
+    if method == "inverse":
+        if J.shape[0] != J.shape[1]:
+            raise ValueError(f"method='inverse' needs a square Jacobian; the task gives {J.shape[0]}x{J.shape[1]} (use 'pinv' or 'dls')")
+        report = singularity_report(robot, q, frame, task, reference)
+        if report.singular:
+            raise ValueError(f"the Jacobian is singular at this configuration: {report.summary()}")
+        return np.linalg.solve(J, v)
+    if method == "pinv":
+        return np.linalg.pinv(J) @ v
+    if method == "dls":
+        if damping < 0 or not np.isfinite(damping):
+            raise ValueError(f"damping must be a finite number >= 0, got {damping}")
+        m = J.shape[0]
+        return J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(m), v)
+    raise ValueError(f"method must be 'inverse', 'pinv' or 'dls', got '{method}'")
+
+
+def singular_values(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+    """Singular values of the task Jacobian, descending; (N, k) for a batch."""
+    return np.linalg.svd(task_jacobian(robot, q, frame, task, reference), compute_uv=False)
+
+
+def manipulability(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world"):
+    """Yoshikawa's measure ``w = sqrt(det(J J^T))`` = the product of the singular values."""
+    s = singular_values(robot, q, frame, task, reference)
+    m = len(task_rows(task))
+    if m > robot.n:  # J J^T is rank deficient by construction
+        return np.zeros(s.shape[:-1]) if s.ndim > 1 else 0.0
+    return np.prod(s, axis=-1)
+
+
+@dataclass
+class SingularityReport:
+    """Rank of the task Jacobian at q and what is lost when it drops."""
+
+    rank: int
+    rows: int
+    n_joints: int
+    singular_values: np.ndarray
+    #: task-space directions the tool cannot move in (unit vectors over the task rows)
+    lost_directions: list = field(default_factory=list)
+    #: joint-space directions that do not move the tool (null space of J)
+    null_motions: list = field(default_factory=list)
+    row_names: list = field(default_factory=list)
+    condition_number: float = float("inf")
+
+    @property
+    def singular(self) -> bool:
+        """True when the rank is below the largest possible, min(task rows, joints)."""
+        return self.rank < min(self.rows, self.n_joints)
+
+    def summary(self) -> str:
+        if not self.singular:
+            return f"full rank {self.rank} (condition number {self.condition_number:.3g})"
+        dirs = "; ".join(
+            "[" + ", ".join(f"{c:+.3f} {name}" for c, name in zip(d, self.row_names) if abs(c) > 1e-9) + "]"
+            for d in self.lost_directions
+        )
+        return f"rank {self.rank} < {min(self.rows, self.n_joints)}: the tool cannot move along {dirs}"
+
+
+def singularity_report(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> SingularityReport:
+    """Rank, singular values and the lost task directions of the Jacobian at one configuration.
+
+    A singular value below ``tol * max(1, sigma_max)`` counts as zero."""
+    rows = task_rows(task)
+    J = task_jacobian(robot, q, frame, rows, reference)
+    if J.ndim != 2:
+        raise ValueError("singularity_report takes one configuration q of shape (n,)")
+    U, s, Vt = np.linalg.svd(J)
+    threshold = tol * max(1.0, s[0] if s.size else 1.0)
+    rank = int(np.sum(s > threshold))
+    # left singular vectors beyond the rank span the directions the tool cannot move in
+    lost = [U[:, k] for k in range(rank, J.shape[0])]
+    null = [Vt[k] for k in range(rank, J.shape[1])]
+    cond = float(s[0] / s[-1]) if s.size and s[-1] > 0 else float("inf")
+    return SingularityReport(
+        rank=rank,
+        rows=len(rows),
+        n_joints=robot.n,
+        singular_values=s,
+        lost_directions=lost,
+        null_motions=null,
+        row_names=[_ROW_NAMES[r] for r in rows],
+        condition_number=cond,
+    )
