@@ -1,0 +1,194 @@
+"""The built-in catalogue: every robot builds, its DH tree matches a hand-written DH product,
+standard == modified DH of the same arm, the UR5 DH model equals example-robot-data's URDF after
+the documented base/tool offsets, overrides work."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import kinedyn as kd
+from kinedyn.robots import industrial
+from reference import UR5, all_frame_poses, erd, frame_pose, pose, random_q, rotation
+
+X, Y, Z = np.eye(3)
+
+
+def rot(axis, angle) -> np.ndarray:
+    return pose(rotation(axis, angle))
+
+
+def trans(x, y, z) -> np.ndarray:
+    return pose(None, [x, y, z])
+
+
+def standard_dh_tool(rows, q, kinds) -> np.ndarray:
+    """Product of Rz(theta) Tz(d) Tx(a) Rx(alpha), written out here (Spong eq. 3.10)."""
+    T = np.eye(4)
+    for (theta, d, a, alpha), qi, kind in zip(rows, q, kinds):
+        theta, d = (theta + qi, d) if kind == "revolute" else (theta, d + qi)
+        T = T @ rot(Z, theta) @ trans(0, 0, d) @ trans(a, 0, 0) @ rot(X, alpha)
+    return T
+
+
+def modified_dh_tool(rows, q, kinds) -> np.ndarray:
+    """Product of Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i) (Craig eq. 3.6)."""
+    T = np.eye(4)
+    for (alpha, a, theta, d), qi, kind in zip(rows, q, kinds):
+        theta, d = (theta + qi, d) if kind == "revolute" else (theta, d + qi)
+        T = T @ rot(X, alpha) @ trans(a, 0, 0) @ rot(Z, theta) @ trans(0, 0, d)
+    return T
+
+
+@pytest.mark.parametrize("name", kd.robots.names())
+def test_builtin_builds_with_a_cited_source(name):
+    robot = kd.robots.get(name)
+    factory = kd.robots.CATALOGUE[name]
+    assert robot.n >= 2 and robot.source
+    assert factory.__doc__
+
+
+@pytest.mark.parametrize("name", kd.robots.names())
+def test_builtin_tree_matches_its_dh_table(name):
+    robot = kd.robots.get(name)
+    rows = [(float(r.theta), float(r.d), float(r.a), float(r.alpha)) for r in robot.dh]
+    kinds = [r.kind for r in robot.dh]
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q = random_q(robot, rng)
+        np.testing.assert_allclose(frame_pose(robot, q), standard_dh_tool(rows, q, kinds), atol=1e-12)
+
+
+def test_unknown_builtin():
+    with pytest.raises(ValueError, match="unknown built-in robot 'nope'"):
+        kd.robots.get("nope")
+
+
+# ------------------------------------------------------------------------ standard vs modified
+def test_puma_standard_equals_modified_dh():
+    """PUMA 560 rewritten by hand in Craig's modified convention (alpha_{i-1}, a_{i-1}, theta_i, d_i)."""
+    std = kd.robots.puma560()
+    a2, a3, d3, d4 = 0.4318, 0.0203, 0.15005, 0.4318
+    h = math.pi / 2
+    modified = [(0, 0, 0, 0), (h, 0, 0, 0), (0, a2, 0, d3), (-h, a3, 0, d4), (h, 0, 0, 0), (-h, 0, 0, 0)]
+    rows = [dict(alpha=al, a=a, theta=th, d=d) for al, a, th, d in modified]
+    mod = kd.Robot.from_dh(rows, convention="modified")  # standard's last Tx(a6) Rx(alpha6) is identity
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        np.testing.assert_allclose(frame_pose(mod, q), frame_pose(std, q), atol=1e-12)
+        np.testing.assert_allclose(frame_pose(mod, q), modified_dh_tool(modified, q, ["revolute"] * 6), atol=1e-12)
+
+
+def test_three_link_standard_equals_modified_with_tool():
+    """Elbow 3R: the modified table plus a tool Tx(a3) Rx(alpha3) gives the standard tool pose."""
+    L1, L2, L3 = 0.7, 0.5, 0.3
+    std = kd.Robot.from_dh([(0, L1, 0, math.pi / 2), (0, 0, L2, 0), (0.2, 0, L3, 0.4)])
+    mod_rows = [(0, 0, 0, L1), (math.pi / 2, 0, 0, 0), (0, L2, 0.2, 0)]
+    mod = kd.Robot.from_dh(
+        [dict(alpha=al, a=a, theta=th, d=d) for al, a, th, d in mod_rows],
+        convention="modified",
+        tool=trans(L3, 0, 0) @ rot(X, 0.4),
+    )
+    for q in np.random.default_rng(2).uniform(-3, 3, (5, 3)):
+        np.testing.assert_allclose(frame_pose(mod, q), frame_pose(std, q), atol=1e-12)
+
+
+# ------------------------------------------------------------------------ UR5: URDF vs DH
+def test_ur5_urdf_and_dh_agree_after_documented_offsets():
+    urdf = kd.Robot.from_urdf(erd(*UR5))
+    dh = kd.robots.ur5()
+    assert urdf.joint_names == dh.joint_names
+    A, B = industrial.UR5_URDF_BASE_FROM_DH_BASE, industrial.UR5_DH_TOOL_FROM_URDF_TOOL0
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        q = random_q(dh, rng)
+        np.testing.assert_allclose(frame_pose(urdf, q, "tool0"), A @ frame_pose(dh, q) @ B, atol=1e-9)
+    # the URDF's "base" frame (ROS-Industrial's controller base) is the DH base
+    np.testing.assert_allclose(all_frame_poses(urdf, np.zeros(6))["base"], A, atol=1e-12)
+
+
+def test_ur5_inertial_data_matches_urdf_where_they_share_sources():
+    """Masses agree with ur_description except the forearm (UR: 2.33 kg, URDF: 2.275 kg); the
+    cylinder tensors of links 1-3 agree once both are expressed in world axes."""
+    urdf = kd.Robot.from_urdf(erd(*UR5))
+    dh = kd.robots.ur5()
+    A = industrial.UR5_URDF_BASE_FROM_DH_BASE
+    q = random_q(dh, np.random.default_rng(8))
+    fu, fd = all_frame_poses(urdf, q), all_frame_poses(dh, q)
+    for i, (lu, ld) in enumerate(zip(urdf.body_names, dh.body_names)):
+        iu = next(l for l in urdf.links if l.name == lu).inertia
+        idh = next(l for l in dh.links if l.name == ld).inertia
+        if i != 2:
+            assert idh.mass == pytest.approx(iu.mass)
+        if i < 3:
+            Ru, Rd = fu[lu][:3, :3], (A @ fd[ld])[:3, :3]
+            world_u = Ru @ np.array(iu.inertia) @ Ru.T * (idh.mass / iu.mass)
+            world_d = Rd @ np.array(idh.inertia) @ Rd.T
+            np.testing.assert_allclose(world_d, world_u, rtol=1e-6, atol=1e-12)  # URDF rounds to ~10 digits
+
+
+def test_ur5_published_values():
+    dh = kd.robots.ur5()
+    assert [float(r.d) for r in dh.dh] == [0.089159, 0, 0, 0.10915, 0.09465, 0.0823]
+    assert [float(r.a) for r in dh.dh] == [0, -0.425, -0.39225, 0, 0, 0]
+    assert [l.inertia.mass for l in dh.links] == [3.7, 8.393, 2.33, 1.219, 1.219, 0.1879]
+    np.testing.assert_allclose(dh.upper_limits, 2 * math.pi)
+
+
+# ------------------------------------------------------------------------ PUMA, Stanford
+def test_puma_published_inertia_of_link3_is_not_physical():
+    """Why puma560 raises link 3's Izz: the tabulated tensor fails the triangle inequality."""
+    with pytest.raises(ValueError, match="triangle inequality"):
+        kd.Inertia(4.8, (0, 0, 0), np.diag([0.066, 0.086, 0.0125]))
+    kd.Inertia(4.8, (0, 0, 0), np.diag(industrial.PUMA560_INERTIAS[2]))
+
+
+def test_puma_motor_and_friction_options():
+    plain = kd.robots.puma560(motors=False)
+    assert all(j.armature == 0 for j in plain.joints)
+    robot = kd.robots.puma560(friction=True)
+    jm, gear, b, (tp, tn) = industrial.PUMA560_MOTORS[0]
+    j1 = robot.joints[0]
+    assert j1.armature == pytest.approx(gear**2 * jm)
+    assert j1.viscous == pytest.approx(b * gear**2)
+    assert j1.coulomb == pytest.approx(abs(gear) * (tp - tn) / 2)
+    assert kd.robots.puma560().joints[0].viscous == 0.0
+
+
+def test_puma_limits_in_degrees():
+    robot = kd.robots.puma560()
+    np.testing.assert_allclose(np.degrees(robot.lower_limits), [-160, -45, -225, -110, -100, -266])
+    np.testing.assert_allclose(np.degrees(robot.upper_limits), [160, 225, 45, 170, 100, 266])
+
+
+def test_stanford_prismatic_boom():
+    robot = kd.robots.stanford()
+    assert [j.kind for j in robot.joints][2] == "prismatic"
+    assert robot.lower_limits[2] == pytest.approx(12 * 0.0254)
+    q = np.zeros(6)
+    q[2] = 0.5
+    lower = frame_pose(robot, q)
+    q[2] = 0.7
+    # sliding the boom 0.2 m moves the tool 0.2 m along z2
+    assert np.linalg.norm(frame_pose(robot, q)[:3, 3] - lower[:3, 3]) == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("factory", [kd.robots.puma560, kd.robots.stanford, kd.robots.ur5])
+def test_overrides(factory):
+    masses = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+    robot = factory(masses=masses, gravity=(0, 0, -1.62))
+    assert [l.inertia.mass for l in robot.links] == masses
+    assert robot.gravity == (0.0, 0.0, -1.62)
+    with pytest.raises(ValueError, match="masses needs 6 entries"):
+        factory(masses=[1.0])
+
+
+def test_length_overrides_change_kinematics():
+    base = frame_pose(kd.robots.puma560(), np.zeros(6))
+    longer = frame_pose(kd.robots.puma560(a2=0.5), np.zeros(6))
+    assert longer[0, 3] - base[0, 3] == pytest.approx(0.5 - 0.4318)
+    ur = frame_pose(kd.robots.ur5(d1=0.2), np.zeros(6))
+    assert ur[2, 3] - frame_pose(kd.robots.ur5(), np.zeros(6))[2, 3] == pytest.approx(0.2 - 0.089159)
