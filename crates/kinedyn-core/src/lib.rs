@@ -10,6 +10,7 @@ pub mod error;
 pub mod joint;
 pub mod model;
 pub mod spatial;
+pub mod testing;
 
 pub use data::Data;
 pub use error::{Error, Result};

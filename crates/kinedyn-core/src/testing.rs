@@ -1,0 +1,94 @@
+//! Seeded random models for identity tests and benchmarks (RigidBodyDynamics.jl's approach:
+//! algorithms checked against each other on random chains and trees).
+
+use crate::joint::{axis_angle, Joint, JointKind};
+use crate::model::{Frame, Model};
+use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+
+/// A small deterministic generator (SplitMix64), so tests need no external RNG crate.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+    pub fn vec3(&mut self, lo: f64, hi: f64) -> Vec3 {
+        Vec3::new(self.uniform(lo, hi), self.uniform(lo, hi), self.uniform(lo, hi))
+    }
+    pub fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = self.vec3(-1.0, 1.0);
+            let n = v.norm();
+            if n > 0.1 && n <= 1.0 {
+                return v / n;
+            }
+        }
+    }
+    pub fn rotation(&mut self) -> Mat3 {
+        let axis = self.unit();
+        axis_angle(&axis, self.uniform(-std::f64::consts::PI, std::f64::consts::PI))
+    }
+    pub fn vector(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| self.uniform(lo, hi)).collect()
+    }
+}
+
+/// A physically valid random inertia: positive mass, centre of mass and principal moments that
+/// satisfy the triangle inequality, in random axes.
+pub fn random_inertia(rng: &mut Rng) -> Inertia {
+    let mass = rng.uniform(0.5, 3.0);
+    let com = rng.vec3(-0.3, 0.3);
+    // principal moments from a random box: always a real body
+    let (a, b, c) = (rng.uniform(0.05, 0.5), rng.uniform(0.05, 0.5), rng.uniform(0.05, 0.5));
+    let k = mass / 12.0;
+    let principal = Mat3::from_diagonal(&Vec3::new(k * (b * b + c * c), k * (a * a + c * c), k * (a * a + b * b)));
+    let r = rng.rotation();
+    let i_c = r * principal * r.transpose();
+    // about the body origin: I_o = I_c - m [c]x [c]x
+    let sc = crate::spatial::skew(&com);
+    Inertia::new(mass, mass * com, i_c - mass * sc * sc)
+}
+
+/// A random model of `n` bodies: a serial chain (`branching = false`) or a tree where each body's
+/// parent is any earlier body. Random axes, placements, inertias, offsets, armature, friction;
+/// one extra frame per body at a random placement.
+pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
+    let mut rng = Rng::new(seed);
+    let mut parent = Vec::with_capacity(n);
+    let mut joints = Vec::with_capacity(n);
+    let mut placements = Vec::with_capacity(n);
+    let mut inertias = Vec::with_capacity(n);
+    for i in 0..n {
+        parent.push(match (i, branching) {
+            (0, _) => None,
+            (_, false) => Some(i - 1),
+            (_, true) => Some((rng.next_u64() % i as u64) as usize),
+        });
+        let kind = if rng.uniform(0.0, 1.0) < 0.25 { JointKind::Prismatic } else { JointKind::Revolute };
+        joints.push(Joint { kind, axis: rng.unit() });
+        placements.push(Transform::new(rng.rotation(), rng.vec3(-0.5, 0.5)));
+        inertias.push(random_inertia(&mut rng));
+    }
+    let offset = rng.vector(n, -0.5, 0.5);
+    let armature = rng.vector(n, 0.0, 0.2);
+    let viscous = rng.vector(n, 0.0, 0.5);
+    let coulomb = rng.vector(n, 0.0, 0.3);
+    let frames = (0..n)
+        .map(|b| Frame { body: Some(b), body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)) })
+        .chain(std::iter::once(Frame { body: None, body_from_frame: Transform::identity() }))
+        .collect();
+    Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(0.0, 0.0, -9.81), frames)
+        .expect("random models are valid by construction")
+}

@@ -1,0 +1,84 @@
+"""The command line: exit codes, --json documents equal to the library's numbers, bad input."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import kinedyn as kd
+from kinedyn.cli import main
+
+pytest.importorskip("kinedyn._core", reason="the native module is not built")
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def run_json(capsys, *argv):
+    code, out, err = run(capsys, *argv, "--json")
+    assert code == 0, err
+    return json.loads(out)
+
+
+def test_robots_lists_the_catalogue(capsys):
+    doc = run_json(capsys, "robots")
+    assert set(doc["robots"]) == set(kd.robots.names())
+    code, out, _ = run(capsys, "robots")
+    assert code == 0 and "planar_2r" in out
+
+
+def test_info_default_robot_is_the_tutorial_arm(capsys):
+    doc = run_json(capsys, "info")
+    robot = kd.robots.planar_2r()
+    assert doc["name"] == "planar_2r" and doc["n"] == 2
+    assert [r["a"] for r in doc["dh"]] == [2.0, 3.0]
+    assert doc["total_mass"] == pytest.approx(sum(float(b.inertia.mass) for b in robot.tree.bodies))
+    code, out, _ = run(capsys, "info", "puma560")
+    assert code == 0 and "DH table" in out and "mass properties" in out
+
+
+def test_fk_json_equals_library_pose(capsys):
+    doc = run_json(capsys, "fk", "elbow_3r", "--q", "10", "20", "-30", "--deg")
+    robot = kd.robots.elbow_3r()
+    expected = robot.pose(np.radians([10, 20, -30]))
+    np.testing.assert_allclose(doc["frames"]["tool"]["pose"], expected, atol=1e-12)
+    doc = run_json(capsys, "fk", "elbow_3r", "--all")
+    assert set(doc["frames"]) == set(robot.frame_names)
+
+
+def test_jacobian_json_reports_singularity(capsys):
+    doc = run_json(capsys, "jacobian", "--q", "0.5", "0", "--task", "planar")
+    robot = kd.robots.planar_2r()
+    np.testing.assert_allclose(doc["jacobian"], robot.jacobian([0.5, 0.0])[:2], atol=1e-12)
+    assert doc["singular"] is True and doc["rank"] == 1
+    doc = run_json(capsys, "jacobian", "--q", "0.5", "1.0", "--task", "planar")
+    assert doc["singular"] is False
+    assert doc["manipulability"] == pytest.approx(2 * 3 * math.sin(1.0))
+
+
+def test_robot_files_are_accepted(capsys, tmp_path):
+    path = tmp_path / "arm.yaml"
+    kd.robots.elbow_3r().save(path)
+    doc = run_json(capsys, "fk", str(path), "--q", "0.1", "0.2", "0.3")
+    np.testing.assert_allclose(doc["frames"]["tool"]["pose"], kd.robots.elbow_3r().pose([0.1, 0.2, 0.3]), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["fk", "no_such_robot"], "neither a built-in"),
+        (["fk", "planar_2r", "--q", "1", "2", "3"], "needs 2 values"),
+        (["jacobian", "planar_2r", "--frame", "hand"], "unknown frame"),
+        (["info", "missing.urdf"], "does not exist"),
+        (["jacobian", "planar_2r", "--task", "xy"], "unknown task"),
+    ],
+)
+def test_bad_input_exits_nonzero_with_a_message(capsys, argv, message):
+    code, _, err = run(capsys, *argv)
+    assert code == 1 and message in err and "Traceback" not in err
