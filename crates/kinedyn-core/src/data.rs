@@ -4,7 +4,7 @@
 //! (no dirty flags): an algorithm that needs forward kinematics runs it.
 
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Transform};
+use crate::spatial::{ArticulatedInertia, Force, Inertia, Motion, Transform, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Data {
@@ -26,6 +26,48 @@ pub struct Data {
     pub tau: Vec<f64>,
     /// Joint-space output matrix, row-major n x n (M, C, ...).
     pub m: Vec<f64>,
+
+    // ---- articulated-body algorithm (RBDA Table 7.1) ----
+    /// Articulated inertias `IA_i` (body coordinates).
+    pub ia: Vec<ArticulatedInertia>,
+    /// Articulated bias forces `pA_i` (body coordinates).
+    pub pa: Vec<Force>,
+    /// `U_i = IA_i s_i`.
+    pub u_f: Vec<Force>,
+    /// `1 / D_i`, `D_i = s_i^T U_i + armature_i`.
+    pub d_inv: Vec<f64>,
+    /// `u_i = tau_i - s_i^T pA_i`.
+    pub u: Vec<f64>,
+    /// Velocity-product accelerations `c_i = v_i x s_i qd_i`.
+    pub c: Vec<Motion>,
+    /// Joint accelerations (forward dynamics output), length n.
+    pub qdd: Vec<f64>,
+    /// Second joint-space matrix, row-major n x n (M^-1, factorisations).
+    pub m2: Vec<f64>,
+    /// Joint-space scratch vector, length n.
+    pub x: Vec<f64>,
+
+    // ---- Coriolis matrix, world coordinates (coriolis.rs) ----
+    /// `s_i` in world coordinates.
+    pub s_w: Vec<Motion>,
+    /// Body twists in world coordinates.
+    pub v_w: Vec<Motion>,
+    /// `ds_i/dt = v_i x s_i` in world coordinates.
+    pub sd_w: Vec<Motion>,
+    /// Body inertias in world coordinates.
+    pub i_w: Vec<Inertia>,
+    /// Composite inertias and their time derivatives (world coordinates).
+    pub ic_w: Vec<Inertia>,
+    pub icd_w: Vec<Inertia>,
+    /// Composite momenta `sum I_k v_k` over each subtree (world coordinates).
+    pub hc_w: Vec<Force>,
+
+    // ---- gravity (gravity.rs) ----
+    /// Composite mass and first moment of each subtree, body coordinates.
+    pub mc: Vec<f64>,
+    pub hc: Vec<Vec3>,
+    /// Gravity acceleration in body axes.
+    pub g_b: Vec<Vec3>,
 }
 
 impl Data {
@@ -41,6 +83,25 @@ impl Data {
             ic: vec![Inertia::zero(); n],
             tau: vec![0.0; n],
             m: vec![0.0; n * n],
+            ia: vec![ArticulatedInertia::default(); n],
+            pa: vec![Force::zero(); n],
+            u_f: vec![Force::zero(); n],
+            d_inv: vec![0.0; n],
+            u: vec![0.0; n],
+            c: vec![Motion::zero(); n],
+            qdd: vec![0.0; n],
+            m2: vec![0.0; n * n],
+            x: vec![0.0; n],
+            s_w: vec![Motion::zero(); n],
+            v_w: vec![Motion::zero(); n],
+            sd_w: vec![Motion::zero(); n],
+            i_w: vec![Inertia::zero(); n],
+            ic_w: vec![Inertia::zero(); n],
+            icd_w: vec![Inertia::zero(); n],
+            hc_w: vec![Force::zero(); n],
+            mc: vec![0.0; n],
+            hc: vec![Vec3::zeros(); n],
+            g_b: vec![Vec3::zeros(); n],
         }
     }
 }

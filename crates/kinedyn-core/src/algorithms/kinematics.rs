@@ -13,12 +13,18 @@ fn joint_coordinate(model: &Model, q: &[f64], i: usize) -> f64 {
     q[i] + model.offset[i]
 }
 
+/// `parent_from_body` of body i at q: `parent_from_joint[i] * joint_from_body(q_i + offset_i)`.
+#[inline]
+pub fn parent_from_body(model: &Model, q: &[f64], i: usize) -> Transform {
+    let (joint_from_body, _) = model.joints[i].jcalc(joint_coordinate(model, q, i));
+    model.parent_from_joint[i] * joint_from_body
+}
+
 /// Fills `data.parent_from_body` and `data.world_from_body` at `q`.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     for i in 0..model.n {
         // parent_from_body = parent_from_joint * joint_from_body(q_i)
-        let (joint_from_body, _) = model.joints[i].jcalc(joint_coordinate(model, q, i));
-        let parent_from_body = model.parent_from_joint[i] * joint_from_body;
+        let parent_from_body = parent_from_body(model, q, i);
         data.parent_from_body[i] = parent_from_body;
         data.world_from_body[i] = match model.parent[i] {
             Some(p) => data.world_from_body[p] * parent_from_body,

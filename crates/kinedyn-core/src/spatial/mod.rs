@@ -11,12 +11,15 @@
 //! | `^B X_A`    | `Transform` `a_from_b` (inverse) | rigid transform between frames        |
 //! | `I`         | `Inertia`                    | rigid-body inertia about the frame origin |
 //! | `v x`, `v x*` | `Motion::cross_motion`, `cross_force` | spatial cross products          |
+//! | `I^A`       | `ArticulatedInertia`         | articulated-body inertia (3x3 blocks)     |
 
+mod articulated;
 mod force;
 mod inertia;
 mod motion;
 mod transform;
 
+pub use articulated::ArticulatedInertia;
 pub use force::Force;
 pub use inertia::Inertia;
 pub use motion::Motion;

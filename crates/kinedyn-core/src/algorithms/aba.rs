@@ -1,0 +1,104 @@
+//! Forward dynamics by the articulated-body algorithm.
+//!
+//! Source: RBDA Table 7.1 (Featherstone 2008, §7.3), gravity as the base acceleration `a_0 = -g`.
+//! Drives as in DESIGN.md: the reflected rotor inertia adds to the joint's articulated inertia,
+//! `D_i = s_i^T IA_i s_i + armature_i`, and friction is moved to the input side,
+//! `tau_i - viscous_i qd_i - coulomb_i sign(qd_i)`. A joint whose `D_i` vanishes (a massless
+//! subtree, a point mass on the axis) makes `M` singular: reported as an error naming the joint.
+//!
+//! | symbol        | here                         | meaning                                       |
+//! |---------------|------------------------------|-----------------------------------------------|
+//! | `^iX_λ(i)`    | `x_up` (`parent_from_body`)  | parent -> body i transform (used inverted)     |
+//! | `v_i`, `c_i`  | `data.v[i]`, `data.c[i]`     | body twist, velocity-product acceleration      |
+//! | `I^A_i`       | `data.ia[i]`                 | articulated inertia (3x3 blocks)               |
+//! | `p^A_i`       | `data.pa[i]`                 | articulated bias force                         |
+//! | `U_i`, `D_i`, `u_i` | `data.u_f`, `1/data.d_inv`, `data.u` | RBDA's joint-space projections  |
+//! | `I^a`, `p^a`  | `ia`, `pa`                   | what body i passes to its parent               |
+//! | `a_i`         | `data.a[i]`                  | body acceleration (gravity included)           |
+
+use super::kinematics::{forward_kinematics, parent_from_body};
+use super::rnea::friction;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::spatial::{ArticulatedInertia, Force, Motion};
+
+/// Relative size under which `D_i` counts as zero (`D_i <= EPS_D * trace(IA_i)`).
+const EPS_D: f64 = 1e-13;
+
+/// `qdd = aba(q, qd, tau, f_ext)` written to `data.qdd`; `f_ext` as in [`super::rnea::rnea`].
+pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[f64], f_ext: Option<&[f64]>) -> Result<&'d [f64]> {
+    let n = model.n;
+    if f_ext.is_some() {
+        forward_kinematics(model, data, q);
+    }
+    // pass 1, root to leaves
+    for i in 0..n {
+        // X_J, s_i = jcalc(q_i);  ^iX_λ = X_J X_T
+        let x_up = parent_from_body(model, q, i);
+        data.parent_from_body[i] = x_up;
+        // v_i = ^iX_λ v_λ + s_i qd_i ;  c_i = v_i x s_i qd_i
+        let vj = data.s[i] * qd[i];
+        let v = match model.parent[i] {
+            Some(p) => x_up.inv_act_motion(&data.v[p]) + vj,
+            None => vj,
+        };
+        data.v[i] = v;
+        data.c[i] = v.cross_motion(&vj);
+        // I^A_i = I_i ;  p^A_i = v_i x* I_i v_i - ^iX_0^* f^x_i
+        let inertia = &model.inertia[i];
+        data.ia[i] = ArticulatedInertia::from(inertia);
+        let mut pa = v.cross_force(&inertia.mul_motion(&v));
+        if let Some(fx) = f_ext {
+            let r = &data.world_from_body[i].rot;
+            let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
+            pa -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
+        }
+        data.pa[i] = pa;
+    }
+    // pass 2, leaves to root
+    for i in (0..n).rev() {
+        let s = data.s[i];
+        let ia = data.ia[i];
+        // U_i = I^A_i s_i ;  D_i = s_i^T U_i + armature_i ;  u_i = tau_i - friction_i - s_i^T p^A_i
+        let u_f = ia.mul_motion(&s);
+        let d = s.dot(&u_f) + model.armature[i];
+        if !(d > EPS_D * (ia.trace() + model.armature[i])) || !d.is_finite() {
+            return Err(Error::SingularMassMatrix(format!(
+                "joint {i} has articulated inertia D = {d:e} about its axis (a massless or inertia-free subtree); forward dynamics is undefined"
+            )));
+        }
+        let d_inv = 1.0 / d;
+        let u = tau[i] - friction(model, i, qd[i]) - s.dot(&data.pa[i]);
+        data.u_f[i] = u_f;
+        data.d_inv[i] = d_inv;
+        data.u[i] = u;
+        if let Some(p) = model.parent[i] {
+            // I^a = I^A_i - U_i D_i^-1 U_i^T ;  p^a = p^A_i + I^a c_i + U_i D_i^-1 u_i
+            let ia_small = ia.sub_rank_one(&u_f, d_inv);
+            let pa = data.pa[i] + ia_small.mul_motion(&data.c[i]) + u_f * (d_inv * u);
+            // I^A_λ += ^λX_i^* I^a ^iX_λ ;  p^A_λ += ^λX_i^* p^a
+            let x_up = &data.parent_from_body[i];
+            let add = x_up.act_articulated(&ia_small);
+            let padd = x_up.act_force(&pa);
+            let parent = &mut data.ia[p];
+            parent.a += add.a;
+            parent.b += add.b;
+            parent.c += add.c;
+            data.pa[p] += padd;
+        }
+    }
+    // pass 3, root to leaves
+    let a0 = Motion::new(-model.gravity, Default::default());
+    for i in 0..n {
+        // a'_i = ^iX_λ a_λ + c_i ;  qdd_i = D_i^-1 (u_i - U_i^T a'_i) ;  a_i = a'_i + s_i qdd_i
+        let ap = match model.parent[i] {
+            Some(p) => data.parent_from_body[i].inv_act_motion(&data.a[p]),
+            None => data.parent_from_body[i].inv_act_motion(&a0),
+        } + data.c[i];
+        let qdd = data.d_inv[i] * (data.u[i] - ap.dot(&data.u_f[i]));
+        data.qdd[i] = qdd;
+        data.a[i] = ap + data.s[i] * qdd;
+    }
+    Ok(&data.qdd)
+}

@@ -1,0 +1,36 @@
+//! Kinetic and potential energy.
+//!
+//! Sources: RBDA eq. 2.71 (`T = 1/2 v . I v` per body) and Spong, Hutchinson & Vidyasagar,
+//! *Robot Modeling and Control* (2006) §7.1: `K = 1/2 qd^T M qd`, `P = -sum_i m_i g . c_i`.
+//! The reflected rotor inertia is part of `M` (DESIGN.md), so `K` counts `1/2 armature qd^2`.
+//!
+//! | symbol   | here                      | meaning                                        |
+//! |----------|---------------------------|------------------------------------------------|
+//! | `v_i`    | `data.v[i]`               | body twist, body coordinates                   |
+//! | `I_i`    | `model.inertia[i]`        | body inertia about its origin                  |
+//! | `m_i c_i`| `world_from_body . h_i`   | first moment in the base frame                 |
+//! | `g`      | `model.gravity`           | gravity acceleration, base coordinates         |
+
+use super::kinematics::{forward_kinematics, forward_velocity};
+use crate::data::Data;
+use crate::model::Model;
+
+/// `K(q, qd) = 1/2 sum_i v_i . I_i v_i + 1/2 sum_i armature_i qd_i^2 (= 1/2 qd^T M qd)`.
+pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
+    forward_velocity(model, data, q, qd);
+    // K = sum_i 1/2 v_i . I_i v_i + 1/2 J_m r^2 qd_i^2
+    (0..model.n).map(|i| model.inertia[i].kinetic_energy(&data.v[i]) + 0.5 * model.armature[i] * qd[i] * qd[i]).sum()
+}
+
+/// `P(q) = -sum_i m_i g . c_i` (zero at the base origin), so that `g(q) = dP/dq`.
+pub fn potential_energy(model: &Model, data: &mut Data, q: &[f64]) -> f64 {
+    forward_kinematics(model, data, q);
+    // P = -g . sum_i (R_i h_i + m_i p_i)
+    -(0..model.n)
+        .map(|i| {
+            let x = &data.world_from_body[i];
+            let inertia = &model.inertia[i];
+            model.gravity.dot(&(x.rot * inertia.h + inertia.mass * x.trans))
+        })
+        .sum::<f64>()
+}

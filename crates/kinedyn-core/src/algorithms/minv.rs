@@ -1,0 +1,91 @@
+//! The inverse mass matrix `M(q)^-1` by the sparse `L^T D L` factorisation of the CRBA's `M`.
+//!
+//! Source: RBDA §6.5, Table 6.3 (`L^T D L` factorisation exploiting branch-induced sparsity:
+//! `L[k][i] != 0` only when i supports k) and Table 6.4's back-substitutions. Column j of `M^-1`
+//! solves `L^T D L x = e_j`; the lower triangle is computed and mirrored (symmetric to the bit).
+//!
+//! | symbol      | here                 | meaning                                                |
+//! |-------------|----------------------|--------------------------------------------------------|
+//! | `H`         | `data.m`             | `M(q)` from [`super::crba::crba`] (armature included)   |
+//! | `L`, `D`    | `data.m2`            | unit lower `L` below the diagonal, `D` on the diagonal  |
+//! | `λ(i)`      | `model.parent[i]`    | parent of joint i                                      |
+//! | `x`         | `data.x`             | one column of `M^-1` being solved                       |
+
+use super::crba::crba;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// Relative size under which a pivot `D_k` counts as zero.
+const EPS_D: f64 = 1e-13;
+
+/// Factor `data.m` (= M) into `data.m2` as `L^T D L` (RBDA Table 6.3).
+pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
+    let n = model.n;
+    let h = &mut data.m2;
+    h.copy_from_slice(&data.m[..n * n]);
+    let scale: f64 = (0..n).map(|i| data.m[i * n + i]).fold(0.0, f64::max);
+    for k in (0..n).rev() {
+        let hkk = h[k * n + k];
+        if !(hkk > EPS_D * scale) || !hkk.is_finite() {
+            return Err(Error::SingularMassMatrix(format!(
+                "joint {k} has pivot D = {hkk:e} in the L^T D L factorisation of M (a massless or inertia-free subtree)"
+            )));
+        }
+        // for i = λ(k) up the tree: a = H_ki / H_kk ; H_ij -= a H_kj for j = i, λ(i), ... ; H_ki = a
+        let mut i = model.parent[k];
+        while let Some(ii) = i {
+            let a = h[k * n + ii] / hkk;
+            let mut j = Some(ii);
+            while let Some(jj) = j {
+                h[ii * n + jj] -= a * h[k * n + jj];
+                j = model.parent[jj];
+            }
+            h[k * n + ii] = a;
+            i = model.parent[ii];
+        }
+    }
+    Ok(())
+}
+
+/// `M(q)^-1` written row-major to `data.m` (n x n); `data.m2` holds the factors of `M`.
+pub fn mass_matrix_inverse<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d [f64]> {
+    let n = model.n;
+    crba(model, data, q);
+    ltdl(model, data)?;
+    let (l, x, out) = (&data.m2, &mut data.x, &mut data.m);
+    for col in 0..n {
+        // b = e_col
+        x[..n].fill(0.0);
+        x[col] = 1.0;
+        // L^T z = b: for i = n-1..0, z_i = b_i; b_j -= L_ij z_i for the ancestors j of i
+        for i in (0..n).rev() {
+            let zi = x[i];
+            let mut j = model.parent[i];
+            while let Some(jj) = j {
+                x[jj] -= l[i * n + jj] * zi;
+                j = model.parent[jj];
+            }
+        }
+        // w = D^-1 z
+        for i in 0..n {
+            x[i] /= l[i * n + i];
+        }
+        // L y = w: y_i = w_i - sum_{j ancestors of i} L_ij y_j
+        for i in 0..n {
+            let mut yi = x[i];
+            let mut j = model.parent[i];
+            while let Some(jj) = j {
+                yi -= l[i * n + jj] * x[jj];
+                j = model.parent[jj];
+            }
+            x[i] = yi;
+        }
+        // keep the lower triangle (rows >= col) of column col, mirrored into the upper one
+        for r in col..n {
+            out[r * n + col] = x[r];
+            out[col * n + r] = x[r];
+        }
+    }
+    Ok(&data.m)
+}

@@ -1,0 +1,119 @@
+//! Inverse dynamics by the recursive Newton-Euler algorithm.
+//!
+//! Source: R. Featherstone, *Rigid Body Dynamics Algorithms* (RBDA), Springer 2008, Table 5.1
+//! (gravity as a fictitious base acceleration `a_0 = -g`, §5.3), with external forces as in
+//! eq. 5.20 and the drive terms of DESIGN.md: `tau = M qdd + C qd + g + friction - J^T f_ext`.
+//!
+//! | symbol      | here                       | meaning                                            |
+//! |-------------|----------------------------|----------------------------------------------------|
+//! | `^iX_λ(i)`  | `x_up[i]` (`parent_from_body`, used inverted) | parent -> body i motion transform |
+//! | `s_i`       | `data.s[i]`                | joint motion subspace, body coordinates            |
+//! | `v_i, a_i`  | `data.v[i], data.a[i]`     | body twist / acceleration (gravity included)       |
+//! | `f_i`       | `data.f[i]`                | force transmitted by joint i onto body i           |
+//! | `I_i`       | `model.inertia[i]`         | body inertia about its origin                      |
+//! | `f^x_i`     | `f_ext` (base axes, body origin) | external wrench on body i                    |
+//! | `J_m r^2`   | `model.armature[i]`        | reflected rotor inertia, adds `armature qdd`       |
+
+use super::kinematics::{forward_kinematics, parent_from_body};
+use crate::data::Data;
+use crate::model::Model;
+use crate::spatial::{Force, Motion};
+
+/// `sign(x)` with `sign(0) = 0` (Coulomb friction is zero at rest).
+#[inline]
+pub(crate) fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Joint friction `viscous qd + coulomb sign(qd)` of joint i.
+#[inline]
+pub(crate) fn friction(model: &Model, i: usize, qd: f64) -> f64 {
+    model.viscous[i] * qd + model.coulomb[i] * sign(qd)
+}
+
+/// What `rnea_with` includes besides the rigid-body terms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RneaTerms {
+    /// Gravity as the base acceleration `-g`.
+    pub gravity: bool,
+    /// Joint friction and reflected rotor inertia (`armature qdd`).
+    pub drives: bool,
+}
+
+impl RneaTerms {
+    pub const ALL: Self = Self { gravity: true, drives: true };
+    pub const RIGID: Self = Self { gravity: true, drives: false };
+}
+
+/// `tau = rnea(q, qd, qdd, f_ext)` with gravity, friction and armature (written to `data.tau`).
+///
+/// `f_ext`: `n * 6` numbers, per body `[force; moment]` in base axes about the body-frame origin.
+pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>) -> &'d [f64] {
+    rnea_with(model, data, q, qd, qdd, f_ext, RneaTerms::ALL)
+}
+
+/// RNEA with a choice of terms (the bias `C qd + g` is `rnea_with(q, qd, 0, None, RIGID)`).
+pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, terms: RneaTerms) -> &'d [f64] {
+    let n = model.n;
+    if f_ext.is_some() {
+        // world_from_body rotations are needed to bring f_ext into body axes
+        forward_kinematics(model, data, q);
+    }
+    // a_0 = -g (a fictitious upward acceleration of the base replaces gravity)
+    let a0 = if terms.gravity { Motion::new(-model.gravity, Default::default()) } else { Motion::zero() };
+    for i in 0..n {
+        // X_J, s = jcalc(q_i);  ^iX_λ = X_J X_T (stored as its inverse, parent_from_body)
+        let x_up = parent_from_body(model, q, i);
+        data.parent_from_body[i] = x_up;
+        let s = data.s[i];
+        let vj = s * qd[i];
+        // v_i = ^iX_λ v_λ + s_i qd_i ;  a_i = ^iX_λ a_λ + s_i qdd_i + v_i x s_i qd_i
+        let (v, a) = match model.parent[i] {
+            Some(p) => (x_up.inv_act_motion(&data.v[p]) + vj, x_up.inv_act_motion(&data.a[p])),
+            None => (vj, x_up.inv_act_motion(&a0)),
+        };
+        let a = a + s * qdd[i] + v.cross_motion(&vj);
+        // f_i = I_i a_i + v_i x* I_i v_i - ^iX_0^* f^x_i
+        let inertia = &model.inertia[i];
+        let mut f = inertia.mul_motion(&a) + v.cross_force(&inertia.mul_motion(&v));
+        if let Some(fx) = f_ext {
+            let r = &data.world_from_body[i].rot;
+            let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
+            f -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
+        }
+        data.v[i] = v;
+        data.a[i] = a;
+        data.f[i] = f;
+    }
+    for i in (0..n).rev() {
+        // tau_i = s_i^T f_i (+ armature qdd_i + friction(qd_i))
+        let mut tau = data.s[i].dot(&data.f[i]);
+        if terms.drives {
+            tau += model.armature[i] * qdd[i] + friction(model, i, qd[i]);
+        }
+        data.tau[i] = tau;
+        // f_λ(i) += ^λX_i^* f_i
+        if let Some(p) = model.parent[i] {
+            let fp = data.parent_from_body[i].act_force(&data.f[i]);
+            data.f[p] += fp;
+        }
+    }
+    &data.tau
+}
+
+/// The bias torque `C(q, qd) qd + g(q)`: RNEA at `qdd = 0` without friction (written to `data.tau`).
+pub fn bias_torque<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64]) -> &'d [f64] {
+    let n = model.n;
+    // qdd = 0 is passed through data.x (no allocation)
+    let mut zero = std::mem::take(&mut data.x);
+    zero[..n].fill(0.0);
+    rnea_with(model, data, q, qd, &zero, None, RneaTerms::RIGID);
+    data.x = zero;
+    &data.tau
+}

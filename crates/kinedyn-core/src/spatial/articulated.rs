@@ -1,0 +1,69 @@
+use super::{Force, Inertia, Mat3, Motion, Transform, Vec3};
+
+/// A symmetric 6x6 articulated-body inertia (RBDA §7.2), kept as three 3x3 blocks in our
+/// `[linear; angular]` order: `f = IA m` is `f.lin = a m.lin + b m.ang`,
+/// `f.ang = b^T m.lin + c m.ang` (`a`, `c` symmetric). A rigid body is the special case
+/// `a = m 1`, `b = -[h]x`, `c = I_o`; an articulated inertia leaves that 10-parameter family once
+/// a joint's `U D^-1 U^T` is removed, so it needs its own type.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ArticulatedInertia {
+    pub a: Mat3,
+    pub b: Mat3,
+    pub c: Mat3,
+}
+
+impl From<&Inertia> for ArticulatedInertia {
+    #[inline]
+    fn from(i: &Inertia) -> Self {
+        let h = &i.h;
+        Self {
+            a: Mat3::from_diagonal_element(i.mass),
+            // b = -[h]x
+            b: Mat3::new(0.0, h.z, -h.y, -h.z, 0.0, h.x, h.y, -h.x, 0.0),
+            c: i.i_o,
+        }
+    }
+}
+
+impl ArticulatedInertia {
+    /// `IA m`.
+    #[inline]
+    pub fn mul_motion(&self, m: &Motion) -> Force {
+        Force::new(self.a * m.lin + self.b * m.ang, self.b.tr_mul(&m.lin) + self.c * m.ang)
+    }
+    /// `IA - u u^T / d` (RBDA Table 7.1's `I^a = I^A - U D^-1 U^T`), `u` the force `U = IA s`.
+    #[inline]
+    pub fn sub_rank_one(&self, u: &Force, d_inv: f64) -> Self {
+        let ul = u.lin * d_inv;
+        let ua = u.ang * d_inv;
+        Self { a: self.a - ul * u.lin.transpose(), b: self.b - ul * u.ang.transpose(), c: self.c - ua * u.ang.transpose() }
+    }
+    /// Trace of the 6x6 matrix (a scale for singularity tests; >= 0 for a positive semidefinite IA).
+    #[inline]
+    pub fn trace(&self) -> f64 {
+        self.a.trace() + self.c.trace()
+    }
+}
+
+/// `[t]x` for a translation.
+#[inline]
+fn skew(t: &Vec3) -> Mat3 {
+    super::skew(t)
+}
+
+impl Transform {
+    /// An articulated inertia given in b's frame, expressed in a's: `X^* IA X^-1` (RBDA eq. 2.66
+    /// for a general symmetric 6x6). With rotated blocks `A = R a R^T`, `B = R b R^T`,
+    /// `C = R c R^T` and `T = [t]x`: `a' = A`, `b' = B - A T`, `c' = C + T B - B^T T - T A T`.
+    #[inline]
+    pub fn act_articulated(&self, ia: &ArticulatedInertia) -> ArticulatedInertia {
+        let r = &self.rot;
+        let ra = r * ia.a * r.transpose();
+        let rb = r * ia.b * r.transpose();
+        let rc = r * ia.c * r.transpose();
+        let t = skew(&self.trans);
+        let at = ra * t;
+        let tb = t * rb;
+        ArticulatedInertia { a: ra, b: rb - at, c: rc + tb + tb.transpose() - t * at }
+    }
+}
