@@ -22,6 +22,7 @@ from .description.link import Frame, KinematicTree, Link, build_tree
 __all__ = ["Robot"]
 
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
+_F64 = np.dtype(np.float64)
 
 
 class Robot:
@@ -250,9 +251,13 @@ class Robot:
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
         return np.concatenate([to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies])
 
+    @cached_property
+    def _frame_ids(self) -> dict:
+        return {f.name: i for i, f in enumerate(self.tree.frames)}
+
     def frame_index(self, frame: str) -> int:
         try:
-            return self.tree.frame_index(frame)
+            return self._frame_ids[frame]
         except KeyError:
             raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
 
@@ -293,6 +298,9 @@ class Robot:
 
     @staticmethod
     def _state(x) -> np.ndarray:
+        # float64 arrays pass through (the core reads any layout); anything else is converted
+        if type(x) is np.ndarray and x.dtype is _F64:
+            return x
         return np.ascontiguousarray(x, dtype=np.float64)
 
     def _reference(self, reference: str) -> int:
