@@ -352,35 +352,64 @@ class Robot:
         return self._model.jdot_qd(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
     # dynamics -----------------------------------------------------------------------------
+    # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
+    # friction = viscous qd + coulomb sign(qd), M including the reflected rotor inertia r^2 J_m.
     def _f_ext(self, f_ext):
         if f_ext is None:
             return None
         return np.ascontiguousarray(f_ext, dtype=np.float64)
 
-    def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
-        """tau = M qdd + C qd + g + friction - sum J_i^T f_ext_i (recursive Newton-Euler).
+    def _singular(self, error: RuntimeError) -> RuntimeError:
+        """The core's singular-mass-matrix error with the joint's name added."""
+        import re
 
-        ``f_ext``: (n, 6) wrenches [force; moment] acting on each body, in base axes at the body
-        frame origin, or None."""
+        message = str(error)
+        match = re.search(r"joint (\d+)", message)
+        if match and int(match.group(1)) < self.n:
+            name = self.joint_names[int(match.group(1))]
+            message = message.replace(match.group(0), f"{match.group(0)} ('{name}')", 1)
+        return RuntimeError(f"robot '{self.name}': {message}")
+
+    @staticmethod
+    def _scalar(x):
+        return float(x) if np.ndim(x) == 0 else x
+
+    def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
+        """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
+
+        ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving body, acting on
+        the body, in base axes, the moment taken about the body-frame origin (the joint frame), so
+        that ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")`` maps it to torques;
+        or None."""
         return self._model.inverse_dynamics(self._state(q), self._state(qd), self._state(qdd), self._f_ext(f_ext))
 
     def mass_matrix(self, q) -> np.ndarray:
-        """M(q) (composite-rigid-body algorithm), reflected rotor inertia included."""
+        """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric."""
         return self._model.mass_matrix(self._state(q))
 
     def mass_matrix_inverse(self, q) -> np.ndarray:
-        return self._model.mass_matrix_inverse(self._state(q))
+        """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
+        try:
+            return self._model.mass_matrix_inverse(self._state(q))
+        except RuntimeError as e:
+            raise self._singular(e) from None
 
     def forward_dynamics(self, q, qd, tau, f_ext=None) -> np.ndarray:
-        """qdd solving M qdd = tau - C qd - g - friction + J^T f_ext (articulated-body algorithm)."""
-        return self._model.forward_dynamics(self._state(q), self._state(qd), self._state(tau), self._f_ext(f_ext))
+        """qdd solving M qdd = tau - C qd - g - friction + sum_i J_i^T f_ext_i (articulated-body
+        algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
+        mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
+        try:
+            return self._model.forward_dynamics(self._state(q), self._state(qd), self._state(tau), self._f_ext(f_ext))
+        except RuntimeError as e:
+            raise self._singular(e) from None
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         return self._model.coriolis_matrix(self._state(q), self._state(qd))
 
     def christoffel(self, q) -> np.ndarray:
-        """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58)."""
+        """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
+        ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
         return self._model.christoffel(self._state(q))
 
     def gravity_torque(self, q) -> np.ndarray:
@@ -392,14 +421,34 @@ class Robot:
         return self._model.bias_torque(self._state(q), self._state(qd))
 
     def kinetic_energy(self, q, qd):
-        return self._model.kinetic_energy(self._state(q), self._state(qd))
+        """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
+        return self._scalar(self._model.kinetic_energy(self._state(q), self._state(qd)))
 
     def potential_energy(self, q):
-        return self._model.potential_energy(self._state(q))
+        """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
+        return self._scalar(self._model.potential_energy(self._state(q)))
+
+    def center_of_mass(self, q) -> np.ndarray:
+        """Centre of mass of the moving links in base coordinates, (3,) or (N, 3)."""
+        return self._model.center_of_mass(self._state(q))
+
+    def momentum(self, q, qd) -> np.ndarray:
+        """Spatial momentum of the robot, (6,) or (N, 6): [linear momentum; angular momentum about
+        the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
+        return self._model.momentum(self._state(q), self._state(qd))
 
     def regressor(self, q, qd, qdd) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         return self._model.regressor(self._state(q), self._state(qd), self._state(qdd))
+
+    def base_parameters(self, samples: int = 200, rng=0, tol: float = 1e-9):
+        """A minimal identifiable parameter set (:class:`kinedyn.dynamics.BaseParameters`): column
+        indices of the regressor kept, the grouping matrix with ``pi_base = grouping @ pi``, and
+        ``pi_base`` of this robot, so that ``Y[:, indices] @ pi_base == Y @ pi``. Found by QR with
+        column pivoting on regressors stacked at ``samples`` random states."""
+        from .dynamics import base_parameters
+
+        return base_parameters(self, samples=samples, rng=rng, tol=tol)
 
     # symbolic engine ----------------------------------------------------------------------
     def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs):

@@ -26,6 +26,12 @@ fn contiguous(a: &ArrayViewD<f64>) -> Vec<f64> {
     a.iter().copied().collect()
 }
 
+/// Input `k` of a state if the call was given it (absent inputs are empty slices).
+#[inline]
+fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
+    x.get(k).copied().filter(|v| !v.is_empty())
+}
+
 fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
     let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
     PyValueError::new_err(format!(
@@ -301,6 +307,148 @@ impl PyModel {
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[6], |model, data, x, out| {
             out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+            Ok(())
+        })
+    }
+
+    // ---- dynamics (issue 3): each method takes one state or a batch, like the kinematics above ----
+
+    /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
+    #[pyo3(signature = (q, qd, qdd, f_ext=None))]
+    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, qdd: PyReadonlyArrayDyn<f64>, f_ext: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let (s1, s6) = ([n], [n, 6]);
+        let batch = match f_ext.as_ref() {
+            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+        };
+        batch.run(py, self, &[n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
+            Ok(())
+        })
+    }
+
+    /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[n, n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::crba(model, data, x[0]));
+            Ok(())
+        })
+    }
+
+    /// M^-1 (n, n) | (N, n, n).
+    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[n, n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
+            Ok(())
+        })
+    }
+
+    /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
+    #[pyo3(signature = (q, qd, tau, f_ext=None))]
+    fn forward_dynamics<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, tau: PyReadonlyArrayDyn<f64>, f_ext: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let (s1, s6) = ([n], [n, 6]);
+        let batch = match f_ext.as_ref() {
+            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+        };
+        batch.run(py, self, &[n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
+            Ok(())
+        })
+    }
+
+    /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
+    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[n, n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
+            Ok(())
+        })
+    }
+
+    /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
+    fn christoffel<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[n, n, n], |model, data, x, out| {
+            algorithms::christoffel(model, data, x[0], out);
+            Ok(())
+        })
+    }
+
+    /// g (n,) | (N, n).
+    fn gravity_torque<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
+            Ok(())
+        })
+    }
+
+    /// C qd + g (n,) | (N, n), without friction.
+    fn bias_torque<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[n], |model, data, x, out| {
+            out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
+            Ok(())
+        })
+    }
+
+    /// K () | (N,).
+    fn kinetic_energy<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[], |model, data, x, out| {
+            out[0] = algorithms::kinetic_energy(model, data, x[0], x[1]);
+            Ok(())
+        })
+    }
+
+    /// P () | (N,).
+    fn potential_energy<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[], |model, data, x, out| {
+            out[0] = algorithms::potential_energy(model, data, x[0]);
+            Ok(())
+        })
+    }
+
+    /// Y (n, 10 n) | (N, n, 10 n).
+    fn regressor<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, qdd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
+        batch.run(py, self, &[n, 10 * n], |model, data, x, out| {
+            algorithms::regressor(model, data, x[0], x[1], x[2], out);
+            Ok(())
+        })
+    }
+
+    /// Centre of mass (3,) | (N, 3) in base coordinates.
+    fn center_of_mass<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n])])?;
+        batch.run(py, self, &[3], |model, data, x, out| {
+            out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
+            Ok(())
+        })
+    }
+
+    /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
+    fn momentum<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+        batch.run(py, self, &[6], |model, data, x, out| {
+            out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
             Ok(())
         })
     }

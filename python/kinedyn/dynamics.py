@@ -1,0 +1,86 @@
+"""Numeric dynamics helpers that live above the native core: base (identifiable) parameters.
+
+The regressor ``Y(q, qd, qdd)`` (n, 10 n) of :meth:`kinedyn.Robot.regressor` is linear in the
+10 standard inertial parameters of every body (``robot.inertial_parameters()``, per body
+``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` about the body-frame origin). Some columns
+are zero (a parameter that never affects the torques) and some are linear combinations of others
+(parameters that only act in fixed groups), so ``pi`` is not identifiable from torques. The base
+parameters are a minimal set found numerically (Gautier, "Numerical calculation of the base
+inertial parameters of robots", J. Robotic Systems 8(4), 1991): stack ``Y`` at random states into
+``W``, take a QR decomposition with column pivoting ``W P = Q R``; the first ``b`` pivots (``b`` the
+numerical rank) are independent columns ``W_1``, the rest satisfy ``W_2 = W_1 beta`` with
+``beta = R_11^-1 R_12``. Then ``W pi = W_1 (pi_1 + beta pi_2)``: ``pi_base = grouping @ pi``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["BaseParameters", "base_parameters"]
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """A minimal identifiable parameter set.
+
+    ``indices`` (b,): the columns of the full regressor kept, ascending (``Y_base = Y[..., indices]``);
+    ``grouping`` (b, 10 n): ``pi_base = grouping @ pi`` for any parameter vector ``pi``;
+    ``values`` (b,): ``grouping @ robot.inertial_parameters()``;
+    ``names`` (b,): the kept standard parameters, e.g. ``"link2.m cx"``.
+    ``Y_base @ pi_base == Y @ pi == tau`` (rigid-body torque, without friction and rotor inertia).
+    """
+
+    indices: np.ndarray
+    grouping: np.ndarray
+    values: np.ndarray
+    names: tuple
+
+    @property
+    def count(self) -> int:
+        return len(self.indices)
+
+    def regressor(self, Y: np.ndarray) -> np.ndarray:
+        """The base regressor from a full one (n, 10 n) or a batch (N, n, 10 n)."""
+        return np.asarray(Y)[..., self.indices]
+
+
+PARAMETER_NAMES = ("m", "m cx", "m cy", "m cz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+
+
+def base_parameters(robot, samples: int = 200, rng=0, tol: float = 1e-9) -> BaseParameters:
+    """Base parameters of ``robot`` from ``samples`` random states (seeded by ``rng``).
+
+    ``tol``: a pivot ``|R_kk| <= tol |R_00|`` ends the independent set (numerical rank).
+    """
+    from scipy.linalg import qr, solve_triangular
+
+    n = robot.n
+    rng = np.random.default_rng(rng)
+    q = robot.random_configuration(rng, size=samples)
+    qd = rng.uniform(-2.0, 2.0, size=(samples, n))
+    qdd = rng.uniform(-4.0, 4.0, size=(samples, n))
+    W = robot.regressor(q, qd, qdd).reshape(samples * n, 10 * n)
+    # scale columns so that the rank test does not depend on the units of each parameter
+    scale = np.linalg.norm(W, axis=0)
+    nonzero = scale > 0
+    Ws = W[:, nonzero] / scale[nonzero]
+    cols = np.flatnonzero(nonzero)
+    _, R, piv = qr(Ws, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(R))
+    b = int(np.sum(diag > tol * diag[0])) if diag.size else 0
+    # W_2 = W_1 beta  (scaled columns: undo the scaling on both sides)
+    beta_s = solve_triangular(R[:b, :b], R[:b, b:]) if b < R.shape[1] else np.zeros((b, 0))
+    independent = cols[piv[:b]]
+    dependent = cols[piv[b:]]
+    beta = beta_s * scale[dependent][None, :] / scale[independent][:, None]
+    beta[np.abs(beta) < 1e-10 * max(1.0, np.abs(beta).max(initial=0.0))] = 0.0
+    order = np.argsort(independent)
+    grouping = np.zeros((b, 10 * n))
+    grouping[np.arange(b), independent] = 1.0
+    grouping[:, dependent] = beta
+    grouping = grouping[order]
+    indices = independent[order]
+    names = tuple(f"{robot.body_names[k // 10]}.{PARAMETER_NAMES[k % 10]}" for k in indices)
+    return BaseParameters(indices=indices, grouping=grouping, values=grouping @ robot.inertial_parameters(), names=names)
