@@ -354,10 +354,30 @@ class Robot:
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
     # friction = viscous qd + coulomb sign(qd), M including the reflected rotor inertia r^2 J_m.
-    def _f_ext(self, f_ext):
+    @cached_property
+    def _link_origin_in_body(self) -> Optional[np.ndarray]:
+        """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
+        frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
+        u = np.zeros((self.n, 3))
+        for i, name in enumerate(self.body_names):
+            T = to_float_array(self.tree.frames[self.frame_index(name)].placement, (4, 4), f"frame '{name}'")
+            u[i] = T[:3, :3].T @ T[:3, 3]
+        return u if np.any(u) else None
+
+    def _f_ext(self, q, f_ext):
+        """Wrenches about the link-frame origins -> about the body-frame origins the core uses:
+        ``n_body = n_link + (p_link - p_body) x f``, ``p_link - p_body = R_link R_bl^T t_bl``."""
         if f_ext is None:
             return None
-        return np.ascontiguousarray(f_ext, dtype=np.float64)
+        f = np.ascontiguousarray(f_ext, dtype=np.float64)
+        u = self._link_origin_in_body
+        if u is None or f.shape[-2:] != (self.n, 6):
+            return f  # (wrong shapes are reported by the core)
+        R = self.forward_kinematics(q)[..., :3, :3]
+        d = np.einsum("...ij,...j->...i", R, u)
+        f = f.copy()
+        f[..., 3:] += np.cross(d, f[..., :3])
+        return f
 
     def _singular(self, error: RuntimeError) -> RuntimeError:
         """The core's singular-mass-matrix error with the joint's name added."""
@@ -377,11 +397,12 @@ class Robot:
     def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
-        ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving body, acting on
-        the body, in base axes, the moment taken about the body-frame origin (the joint frame), so
-        that ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")`` maps it to torques;
-        or None."""
-        return self._model.inverse_dynamics(self._state(q), self._state(qd), self._state(qdd), self._f_ext(f_ext))
+        ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
+        (``robot.body_names``), acting on the link, in base axes, the moment taken about the origin of
+        the link's frame (``robot.forward_kinematics(q)[i]``), so that it maps to joint torques by
+        ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
+        q = self._state(q)
+        return self._model.inverse_dynamics(q, self._state(qd), self._state(qdd), self._f_ext(q, f_ext))
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric."""
@@ -399,7 +420,8 @@ class Robot:
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
         try:
-            return self._model.forward_dynamics(self._state(q), self._state(qd), self._state(tau), self._f_ext(f_ext))
+            q = self._state(q)
+            return self._model.forward_dynamics(q, self._state(qd), self._state(tau), self._f_ext(q, f_ext))
         except RuntimeError as e:
             raise self._singular(e) from None
 
