@@ -54,12 +54,70 @@ impl Joint {
         }
     }
 
+    /// `parent_from_joint * joint_from_body(x)` without forming the joint rotation when the axis
+    /// is a coordinate axis (DH joints and most URDF joints): rotating about e_k only mixes two
+    /// columns of the placement's rotation, `R Rz(x) = [c r0 + s r1, c r1 - s r0, r2]`.
+    #[inline]
+    pub fn compose(&self, parent_from_joint: &Transform, x: f64) -> Transform {
+        let r = &parent_from_joint.rot;
+        match self.kind {
+            JointKind::Prismatic => Transform::new(*r, parent_from_joint.trans + r * (self.axis * x)),
+            JointKind::Revolute => {
+                let a = &self.axis;
+                let (s, c) = x.sin_cos();
+                // index pair (i, j) rotated into each other, sign of the axis
+                let pair = if a.x == 0.0 && a.y == 0.0 {
+                    Some((0, 1, a.z))
+                } else if a.y == 0.0 && a.z == 0.0 {
+                    Some((1, 2, a.x))
+                } else if a.x == 0.0 && a.z == 0.0 {
+                    Some((2, 0, a.y))
+                } else {
+                    None
+                };
+                match pair {
+                    Some((i, j, sign)) => {
+                        let s = s * sign;
+                        let (ri, rj) = (r.column(i).into_owned(), r.column(j).into_owned());
+                        let mut rot = *r;
+                        rot.set_column(i, &(ri * c + rj * s));
+                        rot.set_column(j, &(rj * c - ri * s));
+                        Transform::new(rot, parent_from_joint.trans)
+                    }
+                    None => Transform::new(r * axis_angle(a, x), parent_from_joint.trans),
+                }
+            }
+        }
+    }
+
     /// The motion subspace `s` in the body frame (independent of q for these kinds).
     #[inline]
     pub fn subspace(&self) -> Motion {
         match self.kind {
             JointKind::Revolute => Motion::new(Vec3::zeros(), self.axis),
             JointKind::Prismatic => Motion::new(self.axis, Vec3::zeros()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The specialised composition equals the general `placement * jcalc(x)` for every axis case.
+    #[test]
+    fn compose_equals_placement_times_jcalc() {
+        let placement = Transform::new(axis_angle(&Vec3::new(0.3, -0.5, 0.8).normalize(), 0.9), Vec3::new(0.1, -0.2, 0.3));
+        let axes = [Vec3::x(), Vec3::y(), Vec3::z(), -Vec3::x(), -Vec3::y(), -Vec3::z(), Vec3::new(1.0, 2.0, -2.0) / 3.0];
+        for axis in axes {
+            for kind in [JointKind::Revolute, JointKind::Prismatic] {
+                let joint = Joint { kind, axis };
+                for x in [-2.5, 0.0, 0.7, 3.1] {
+                    let expected = placement * joint.jcalc(x).0;
+                    let got = joint.compose(&placement, x);
+                    assert!((got.rot - expected.rot).abs().max() < 1e-15 && (got.trans - expected.trans).abs().max() < 1e-15, "{kind:?} {axis:?} {x}");
+                }
+            }
         }
     }
 }

@@ -92,3 +92,34 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
     Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(0.0, 0.0, -9.81), frames)
         .expect("random models are valid by construction")
 }
+
+/// A serial revolute arm from standard DH rows `(d, a, alpha)` (Spong/Corke convention), with
+/// seeded random inertias: body i's frame is joint i's frame, `placement_i = Tx(a_{i-1})
+/// Rx(alpha_{i-1}) Tz(d_i)`; the last link's DH frame is frame 0 of the model (the tool).
+pub fn dh_model(rows: &[(f64, f64, f64)], seed: u64) -> Model {
+    let mut rng = Rng::new(seed);
+    let n = rows.len();
+    let tx_rx = |a: f64, alpha: f64| Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0));
+    let mut placements = Vec::with_capacity(n);
+    let mut previous = Transform::identity();
+    for &(d, a, alpha) in rows {
+        placements.push(previous * Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d)));
+        previous = tx_rx(a, alpha);
+    }
+    let joints = vec![Joint { kind: JointKind::Revolute, axis: Vec3::z() }; n];
+    let parent = (0..n).map(|i| i.checked_sub(1)).collect();
+    let inertias = (0..n).map(|_| random_inertia(&mut rng)).collect();
+    let tool = Frame { body: Some(n - 1), body_from_frame: previous };
+    Model::new(parent, joints, vec![0.0; n], placements, inertias, vec![0.0; n], vec![0.0; n], vec![0.0; n], Vec3::new(0.0, 0.0, -9.81), vec![tool])
+        .expect("a DH arm is a valid model")
+}
+
+/// Universal Robots' published UR5 DH rows `(d, a, alpha)`.
+pub const UR5_DH: [(f64, f64, f64); 6] = [
+    (0.089159, 0.0, std::f64::consts::FRAC_PI_2),
+    (0.0, -0.425, 0.0),
+    (0.0, -0.39225, 0.0),
+    (0.10915, 0.0, std::f64::consts::FRAC_PI_2),
+    (0.09465, 0.0, -std::f64::consts::FRAC_PI_2),
+    (0.0823, 0.0, 0.0),
+];

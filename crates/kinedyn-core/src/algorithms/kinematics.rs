@@ -16,8 +16,7 @@ fn joint_coordinate(model: &Model, q: &[f64], i: usize) -> f64 {
 /// `parent_from_body` of body i at q: `parent_from_joint[i] * joint_from_body(q_i + offset_i)`.
 #[inline]
 pub fn parent_from_body(model: &Model, q: &[f64], i: usize) -> Transform {
-    let (joint_from_body, _) = model.joints[i].jcalc(joint_coordinate(model, q, i));
-    model.parent_from_joint[i] * joint_from_body
+    model.joints[i].compose(&model.parent_from_joint[i], joint_coordinate(model, q, i))
 }
 
 /// Fills `data.parent_from_body` and `data.world_from_body` at `q`.
