@@ -1,0 +1,85 @@
+"""``kinedyn tutorial`` and ``kinedyn report`` (registered by kinedyn.cli through add_report_commands)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..cli import console, emit, load_robot, parse_q
+
+__all__ = ["add_report_commands"]
+
+
+def cmd_tutorial(args) -> int:
+    from . import tutorial
+
+    questions = [args.question] if args.question else None
+    answers = tutorial.work(questions)
+    payload = {"questions": tutorial.to_json(answers), "misprints": {a.key: [c.quantity for c in a.misprints] for a in answers}}
+
+    def render():
+        if args.format == "markdown":
+            print(tutorial.render_markdown(answers))
+        else:
+            tutorial.render_text(answers, console())
+
+    emit(args, payload, render)
+    return 0
+
+
+def cmd_report(args) -> int:
+    from .. import robots
+    from .html import collect, default_configuration, write_report
+
+    spec = args.robot or robots.DEFAULT
+    robot = load_robot(spec)
+    q = parse_q(args.q, robot, args.deg) if args.q is not None else default_configuration(robot)
+    qd = parse_q(args.qd, robot, args.deg) if args.qd is not None else None
+    if not (args.t > 0 and math.isfinite(args.t)):
+        raise ValueError(f"--t must be a positive number of seconds, got {args.t}")
+    out = Path(args.output)
+    if out.parent and not out.parent.exists():
+        raise ValueError(f"cannot write '{out}': the folder '{out.parent}' does not exist")
+    data = collect(robot, q, qd, name=spec, t_end=args.t, eom_joints=args.eom_joints)
+    public = {k: v for k, v in data.items() if not k.startswith("_")}
+    from .html import build_report
+
+    out.write_text(build_report(robot, q, qd, name=spec, data=data), encoding="utf-8")
+    payload = {"path": str(out.resolve()), **public}
+    payload.pop("simulation", None)
+    if "simulation" in data:
+        payload["simulation_energy_drift"] = data["simulation"]["energy_drift"]
+
+    def render():
+        c = console()
+        c.print(f"[bold]{robot.name}[/bold]: report written to [cyan]{out}[/cyan] ({out.stat().st_size / 1024:.0f} KiB, self-contained; open it in a browser)")
+        c.print(f"  q = {np.array2string(np.asarray(q), precision=4)}, Jacobian rank {data['rank']} ({data['singularity']})")
+        if data.get("properties"):
+            bad = [p["property"] for p in data["properties"] if not p["ok"]]
+            c.print("  properties: " + ("[green]all hold[/green]" if not bad else f"[bold red]failing: {', '.join(bad)}[/bold red]"))
+
+    emit(args, payload, render)
+    return 0
+
+
+def add_report_commands(subparsers) -> None:
+    from .tutorial import QUESTIONS
+
+    p = subparsers.add_parser("tutorial", help="work the seed tutorial (METR4202 Tutorial 4) with kinedyn, step by step, against its printed answers")
+    p.add_argument("--question", "-q", choices=QUESTIONS, help="one question (default: all)")
+    p.add_argument("--format", choices=["text", "markdown"], default="text", help="text (tables, colour on a terminal) or markdown with LaTeX")
+    p.add_argument("--json", action="store_true", help="print one JSON document instead")
+    p.set_defaults(func=cmd_tutorial)
+
+    p = subparsers.add_parser("report", help="one self-contained HTML report of a robot: 3-D view, Jacobian, equations of motion, properties, simulation")
+    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
+    p.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default: report.html)")
+    p.add_argument("--q", nargs="+", type=float, metavar="Q", help="joint values (default: a generic, non-singular configuration)")
+    p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="joint velocities at the start of the simulation (default zeros)")
+    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    p.add_argument("--t", type=float, default=3.0, help="simulated seconds of free motion (default 3)")
+    p.add_argument("--eom-joints", type=int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
+    p.add_argument("--json", action="store_true", help="print the report's numbers as one JSON document")
+    p.set_defaults(func=cmd_report)

@@ -1,0 +1,511 @@
+"""``kinedyn report``: one self-contained HTML file about a robot that opens offline.
+
+Sections: the joint and DH tables; an interactive 3-D view (inline canvas renderer, assets/viewer.js,
+running the same forward kinematics as kinedyn.Robot); the tool pose, Jacobian and singular values;
+the equations of motion typeset as MathML from the symbolic engine; the properties check (M symmetric
+positive definite, dM/dt - 2C skew and dM/dt = C + C^T by finite differences, the regressor reproduces
+tau, RNEA = M qdd + C qd + g); and plots (inline SVG) of a short free motion under gravity with its
+energy. Every script and style is inlined; nothing is fetched. All numbers shown are also in the JSON
+block ``#kinedyn-data`` (and ``kinedyn report --json``).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import re
+from importlib import resources
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence
+
+import numpy as np
+
+__all__ = ["default_configuration", "collect", "build_report", "write_report", "latex_to_mathml", "svg_plot"]
+
+
+# ------------------------------------------------------------------ data
+def default_configuration(robot) -> np.ndarray:
+    """A generic (non-singular) configuration: 0.5, -0.7, 0.5, -0.7, ... rad (m for prismatic joints,
+    x 0.2), clipped to the joint limits."""
+    q = np.array([(0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2) for i, j in enumerate(robot.joints)])
+    return np.clip(q, robot.lower_limits, robot.upper_limits)
+
+
+def _has_dynamics(robot) -> bool:
+    """Whether this build of kinedyn has the numeric dynamics (the native core's mass matrix)."""
+    try:
+        robot.mass_matrix(np.zeros(robot.n))
+        return True
+    except (AttributeError, NotImplementedError):
+        return False
+
+
+def _model_for_view(robot, q) -> dict:
+    """What the inline viewer needs to run the forward kinematics itself."""
+    tree = robot.tree
+    bodies = []
+    for b in tree.bodies:
+        bodies.append({
+            "parent": int(b.parent),
+            "kind": b.joint.kind,
+            "axis": [float(a) for a in b.joint.axis],
+            "offset": float(b.joint.offset),
+            "placement": np.asarray(b.placement, dtype=float).ravel().tolist(),
+        })
+    frames = [{"name": f.name, "body": int(f.body), "placement": np.asarray(f.placement, dtype=float).ravel().tolist()} for f in tree.frames]
+    # size of the scene: the farthest frame origin over q and a few random configurations
+    qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
+    reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 1e-3)
+    gravity = np.asarray(robot.gravity, dtype=float)
+    up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
+    axes = np.array([np.asarray(robot.pose(q, name)[:3, 2]) for name in robot.body_names])
+    planar = all(j.kind == "revolute" for j in robot.joints) and np.allclose(np.abs(axes @ axes[0]), 1.0, atol=1e-9) and abs(axes[0] @ up) < 1e-9
+    if planar:  # look along the common joint axis: the arm is drawn as in the textbook's figure
+        view_from = axes[0]
+    else:  # an isometric view from the front-right, above the base
+        side = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
+        side /= np.linalg.norm(side)
+        front = np.cross(side, up)
+        view_from = 0.8 * front - 0.6 * side + 0.45 * up
+    return {
+        "bodies": bodies,
+        "frames": frames,
+        "joint_names": robot.joint_names,
+        "lower": [float(x) if math.isfinite(x) else None for x in robot.lower_limits],
+        "upper": [float(x) if math.isfinite(x) else None for x in robot.upper_limits],
+        "q": [float(x) for x in q],
+        "tool": robot.tool,
+        "reach": reach,
+        "center": [0.0, 0.0, 0.0] if planar else (0.5 * reach * up).tolist(),
+        "up": up.tolist(),
+        "view_from": np.asarray(view_from, dtype=float).tolist(),
+    }
+
+
+def _simulate(robot, q0, qd0, t_end: float, samples: int = 241) -> Dict[str, np.ndarray]:
+    """Free motion (tau = 0) from (q0, qd0): kd.simulate where this kinedyn has it, else SciPy's solve_ivp
+    (DOP853, tight tolerances) on robot.forward_dynamics."""
+    import kinedyn as kd
+
+    t_eval = np.linspace(0.0, t_end, samples)
+    x0 = np.concatenate([q0, qd0])
+    if hasattr(kd, "simulate"):
+        traj = kd.simulate(robot, (0.0, t_end), x0, method="rk45")
+        t, q, qd = np.asarray(traj.t), np.asarray(traj.q), np.asarray(traj.qd)
+        how = "kd.simulate(robot, (0, T), x0, method='rk45')"
+    else:
+        from scipy.integrate import solve_ivp
+
+        n = robot.n
+        zero = np.zeros(n)
+        f = lambda _t, x: np.concatenate([x[n:], robot.forward_dynamics(x[:n], x[n:], zero)])
+        sol = solve_ivp(f, (0.0, t_end), x0, method="DOP853", t_eval=t_eval, rtol=1e-10, atol=1e-10)
+        if not sol.success:
+            raise RuntimeError(f"simulation failed: {sol.message}")
+        t, q, qd = sol.t, sol.y[:n].T, sol.y[n:].T
+        how = "scipy.integrate.solve_ivp (DOP853, rtol = atol = 1e-10) on robot.forward_dynamics"
+    K = np.asarray(robot.kinetic_energy(q, qd), dtype=float)
+    P = np.asarray(robot.potential_energy(q), dtype=float)
+    return {"t": t, "q": q, "qd": qd, "K": K, "P": P, "H": K + P, "method": how}
+
+
+def _properties(robot, q, qd, rng) -> List[dict]:
+    """The textbook's properties at (q, qd), each with its measured residual."""
+    out = []
+    n = robot.n
+    M = robot.mass_matrix(q)
+    eig = np.linalg.eigvalsh((M + M.T) / 2)
+    scale = max(1.0, float(np.max(np.abs(M))))
+    asym = float(np.max(np.abs(M - M.T)))
+    out.append({"property": "M(q) symmetric", "measure": "max |M - M^T|", "value": asym, "ok": asym <= 1e-12 * scale})
+    out.append({"property": "M(q) positive definite", "measure": "smallest eigenvalue of M", "value": float(eig[0]), "ok": bool(eig[0] > 0)})
+    h = 1e-6
+    Mdot = (robot.mass_matrix(q + h * qd) - robot.mass_matrix(q - h * qd)) / (2 * h)
+    C = robot.coriolis_matrix(q, qd)
+    N = Mdot - 2 * C
+    tol = 1e-6 * max(1.0, float(np.max(np.abs(Mdot))), float(np.max(np.abs(C))))
+    skew = float(np.max(np.abs(N + N.T)))
+    out.append({"property": "dM/dt - 2C skew-symmetric", "measure": "max |N + N^T|, dM/dt by central differences", "value": skew, "ok": skew <= tol})
+    cct = float(np.max(np.abs(Mdot - C - C.T)))
+    out.append({"property": "dM/dt = C + C^T", "measure": "max |dM/dt - C - C^T|", "value": cct, "ok": cct <= tol})
+    qdd = rng.uniform(-1, 1, n)
+    tau = robot.inverse_dynamics(q, qd, qdd)
+    lhs = M @ qdd + C @ qd + robot.gravity_torque(q)
+    friction = any(float(j.viscous) or float(j.coulomb) for j in robot.joints)
+    if not friction:
+        r = float(np.max(np.abs(tau - lhs)))
+        out.append({"property": "RNEA = M qdd + C qd + g", "measure": "max |tau_RNEA - (M qdd + C qd + g)| at a random qdd", "value": r, "ok": r <= 1e-9 * max(1.0, float(np.max(np.abs(tau))))})
+    rotor = any(float(j.rotor_inertia) for j in robot.joints)
+    if hasattr(robot, "regressor") and not friction and not rotor:
+        Y = robot.regressor(q, qd, qdd)
+        r = float(np.max(np.abs(Y @ robot.inertial_parameters() - tau)))
+        out.append({"property": "linear in the parameters", "measure": "max |Y(q, qd, qdd) pi - tau|", "value": r, "ok": r <= 1e-9 * max(1.0, float(np.max(np.abs(tau))))})
+    return out
+
+
+def _symbolic_eom(robot, name: Optional[str], max_joints: int):
+    """The equations of motion to typeset: of the built-in arm with its parameters as symbols where the
+    catalogue offers that, else of the robot as given. None (with the reason) for large arms."""
+    if robot.n > max_joints:
+        return None, f"The symbolic equations of motion are typeset for arms with up to {max_joints} joints (this one has {robot.n}); `kinedyn report --eom-joints {robot.n}` derives them anyway."
+    from .. import robots
+
+    subject = robot
+    if name in robots.CATALOGUE:
+        try:
+            subject = robots.get(name, symbolic=True)
+        except (TypeError, ValueError, AttributeError):
+            subject = robot
+    if not hasattr(subject, "equations_of_motion"):
+        return None, "This kinedyn has no symbolic engine."
+    try:
+        eom = subject.equations_of_motion()
+    except ImportError:
+        return None, "This kinedyn has no symbolic engine."
+    return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
+
+
+def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, seed: int = 0) -> dict:
+    """Every number of the report (JSON-friendly, plus the symbolic equations under "_eom")."""
+    from ..kinematics import singularity_report
+
+    q = default_configuration(robot) if q is None else np.asarray(q, dtype=float)
+    qd = np.zeros(robot.n) if qd is None else np.asarray(qd, dtype=float)
+    if q.shape != (robot.n,) or qd.shape != (robot.n,):
+        raise ValueError(f"q and qd need {robot.n} values for robot '{robot.name}'")
+    rng = np.random.default_rng(seed)
+    T = robot.pose(q)
+    J = robot.jacobian(q)
+    rep = singularity_report(robot, q)
+    data: dict = {
+        "robot": robot.name,
+        "source": robot.source,
+        "n": robot.n,
+        "joint_names": robot.joint_names,
+        "gravity": [float(x) for x in robot.gravity],
+        "q": q.tolist(),
+        "qd": qd.tolist(),
+        "tool": robot.tool,
+        "tool_pose": T.tolist(),
+        "jacobian": J.tolist(),
+        "singular_values": rep.singular_values.tolist(),
+        "rank": rep.rank,
+        "singular": rep.singular,
+        "condition_number": rep.condition_number,
+        "singularity": rep.summary(),
+        "joints": [{"name": j.name, "type": j.kind, "axis": [float(a) for a in j.axis], "offset": float(j.offset),
+                    "lower": float(j.lower), "upper": float(j.upper)} for j in robot.joints],
+        "dh_convention": robot.dh_convention,
+        "dh": None if robot.dh is None else [{"theta": float(r.theta), "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha), "type": r.kind} for r in robot.dh],
+        "bodies": [{"link": b.name, "mass": float(b.inertia.mass), "com": [float(c) for c in b.inertia.com]} for b in robot.tree.bodies],
+    }
+    data["dynamics"] = _has_dynamics(robot)
+    if data["dynamics"]:
+        qd_check = qd if np.any(qd) else rng.uniform(-1, 1, robot.n)
+        data["mass_matrix"] = robot.mass_matrix(q).tolist()
+        data["mass_matrix_eigenvalues"] = np.linalg.eigvalsh(robot.mass_matrix(q)).tolist()
+        data["gravity_torque"] = robot.gravity_torque(q).tolist()
+        data["properties_qd"] = qd_check.tolist()
+        data["properties"] = _properties(robot, q, qd_check, rng)
+        sim = _simulate(robot, q, qd, t_end)
+        data["simulation"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in sim.items()}
+        H = sim["H"]
+        data["simulation"]["energy_drift"] = float(np.max(np.abs(H - H[0])))
+        data["properties"].append({"property": "energy conserved (tau = 0, no friction)", "measure": f"max |H(t) - H(0)| over the {t_end:g} s simulation",
+                                   "value": data["simulation"]["energy_drift"], "ok": data["simulation"]["energy_drift"] <= 1e-6 * max(1.0, float(np.max(np.abs(H))))
+                                   or any(float(j.viscous) or float(j.coulomb) for j in robot.joints)})
+    eom, note = _symbolic_eom(robot, name, eom_joints)
+    data["_eom"] = eom
+    data["eom_note"] = note
+    return data
+
+
+# ------------------------------------------------------------------ MathML
+_GREEK = {"tau": "τ", "omega": "ω", "theta": "θ", "alpha": "α", "partial": "∂", "lambda": "λ", "pi": "π"}
+
+
+def latex_to_mathml(s: str) -> str:
+    """Presentation MathML for the small LaTeX of equation names (subscripts, \\frac, \\dot, \\ddot,
+    \\partial, \\mathcal, Greek letters) as written by the symbolic engine's steps."""
+    pos = 0
+
+    def group() -> str:
+        nonlocal pos
+        if pos < len(s) and s[pos] == "{":
+            pos += 1
+            out = seq("}")
+            pos += 1
+            return f"<mrow>{out}</mrow>"
+        return atom()
+
+    def atom() -> str:
+        nonlocal pos
+        c = s[pos]
+        if c == "\\":
+            m = re.match(r"\\([A-Za-z]+)", s[pos:])
+            if not m:
+                pos += 2
+                return f"<mo>{html.escape(s[pos - 1])}</mo>"
+            cmd = m.group(1)
+            pos += len(m.group(0))
+            if cmd == "frac":
+                a = group()
+                b = group()
+                return f"<mfrac>{a}{b}</mfrac>"
+            if cmd in ("dot", "ddot"):
+                return f"<mover accent=\"true\">{group()}<mo>{'˙' if cmd == 'dot' else '¨'}</mo></mover>"
+            if cmd == "mathcal":
+                inner = re.sub(r"<[^>]+>", "", group())
+                return f"<mi mathvariant=\"script\">{inner}</mi>"
+            if cmd in ("left", "right"):
+                return ""
+            if cmd == "partial":
+                return "<mo>∂</mo>"
+            if cmd in _GREEK:
+                return f"<mi>{_GREEK[cmd]}</mi>"
+            return f"<mi>{html.escape(cmd)}</mi>"
+        pos += 1
+        if c.isdigit():
+            return f"<mn>{c}</mn>"
+        if c.isalpha():
+            return f"<mi>{c}</mi>"
+        if c == " ":
+            return ""
+        return f"<mo>{html.escape(c)}</mo>"
+
+    def seq(stop: Optional[str]) -> str:
+        nonlocal pos
+        parts: List[str] = []
+        while pos < len(s) and (stop is None or s[pos] != stop):
+            if s[pos] in "_^" and parts:
+                op = s[pos]
+                pos += 1
+                sub = group()
+                base = parts.pop()
+                parts.append(f"<msub>{base}{sub}</msub>" if op == "_" else f"<msup>{base}{sub}</msup>")
+            else:
+                parts.append(group() if s[pos] == "{" else atom())
+        return "".join(parts)
+
+    return f"<mrow>{seq(None)}</mrow>"
+
+
+def _value_mathml(value) -> str:
+    import sympy as sp
+
+    m = sp.mathml(value, printer="presentation")
+    # matrices: brackets drawn by CSS (class bm), which needs no stretchy glyphs in the reader's fonts
+    m = re.sub(r"<mrow><mo>\[</mo><mtable>(.*?)</mtable><mo>\]</mo></mrow>", r'<mtable class="bm">\1</mtable>', m)
+    # kinedyn's state symbols qd_i, qdd_i are printed with dots, as in the textbooks
+    m = m.replace("<mi>qdd</mi>", '<mover accent="true"><mi>q</mi><mo>¨</mo></mover>')
+    m = m.replace("<mi>qd</mi>", '<mover accent="true"><mi>q</mi><mo>˙</mo></mover>')
+    return m
+
+
+def _equation(lhs: str, value) -> str:
+    return (f'<div class="eq"><math xmlns="http://www.w3.org/1998/Math/MathML" display="block">'
+            f"<mrow>{latex_to_mathml(lhs)}<mo>=</mo>{_value_mathml(value)}</mrow></math></div>")
+
+
+# ------------------------------------------------------------------ SVG plots
+_COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"]
+
+
+def _ticks(lo: float, hi: float, n: int = 5) -> List[float]:
+    if hi - lo <= 0:
+        return [lo]
+    raw = (hi - lo) / n
+    mag = 10 ** math.floor(math.log10(raw))
+    step = min((m * mag for m in (1, 2, 2.5, 5, 10) if m * mag >= raw), default=raw)
+    start = math.ceil(lo / step) * step
+    return [start + k * step for k in range(int((hi - start) / step + 1e-9) + 1)]
+
+
+def svg_plot(x, series: Sequence[tuple], title: str, xlabel: str, ylabel: str, width: int = 520, height: int = 270) -> str:
+    """A line plot as inline SVG: ``series`` = [(label, y), ...]."""
+    x = np.asarray(x, dtype=float)
+    ys = [np.asarray(y, dtype=float) for _, y in series]
+    ylo = min(float(np.min(y)) for y in ys)
+    yhi = max(float(np.max(y)) for y in ys)
+    if yhi - ylo < 1e-9 * max(1.0, abs(yhi)):
+        ylo, yhi = ylo - 1.0, yhi + 1.0
+    pad = 0.06 * (yhi - ylo)
+    ylo, yhi = ylo - pad, yhi + pad
+    L, R, Tp, B = 62, 14, 46, 44
+    W, H = width - L - R, height - Tp - B
+    px = lambda v: L + W * (v - x[0]) / (x[-1] - x[0] if x[-1] > x[0] else 1.0)
+    py = lambda v: Tp + H * (1 - (v - ylo) / (yhi - ylo))
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" role="img" aria-label="{html.escape(title)}">',
+           f'<text x="{width / 2}" y="18" text-anchor="middle" font-size="13" font-weight="600" fill="#243238">{html.escape(title)}</text>']
+    for v in _ticks(ylo, yhi):
+        out.append(f'<line x1="{L}" x2="{L + W}" y1="{py(v):.1f}" y2="{py(v):.1f}" stroke="#eceee9"/>')
+        out.append(f'<text x="{L - 6}" y="{py(v) + 4:.1f}" text-anchor="end" font-size="11" fill="#5f6b73">{v:.4g}</text>')
+    for v in _ticks(float(x[0]), float(x[-1])):
+        out.append(f'<line y1="{Tp}" y2="{Tp + H}" x1="{px(v):.1f}" x2="{px(v):.1f}" stroke="#f1f2ee"/>')
+        out.append(f'<text y="{Tp + H + 16}" x="{px(v):.1f}" text-anchor="middle" font-size="11" fill="#5f6b73">{v:.4g}</text>')
+    out.append(f'<rect x="{L}" y="{Tp}" width="{W}" height="{H}" fill="none" stroke="#9aa5aa"/>')
+    for k, ((label, _), y) in enumerate(zip(series, ys)):
+        pts = " ".join(f"{px(a):.1f},{py(b):.1f}" for a, b in zip(x, y))
+        c = _COLOURS[k % len(_COLOURS)]
+        out.append(f'<polyline points="{pts}" fill="none" stroke="{c}" stroke-width="1.8"/>')
+        out.append(f'<line x1="{L + 4 + 95 * k}" x2="{L + 22 + 95 * k}" y1="{Tp - 10}" y2="{Tp - 10}" stroke="{c}" stroke-width="2.5"/>'
+                   f'<text x="{L + 26 + 95 * k}" y="{Tp - 6}" font-size="11" fill="#243238">{html.escape(label)}</text>')
+    out.append(f'<text x="{L + W / 2}" y="{height - 8}" text-anchor="middle" font-size="12" fill="#36454c">{html.escape(xlabel)}</text>')
+    out.append(f'<text transform="translate(14 {Tp + H / 2}) rotate(-90)" text-anchor="middle" font-size="12" fill="#36454c">{html.escape(ylabel)}</text>')
+    out.append("</svg>")
+    return "".join(out)
+
+
+# ------------------------------------------------------------------ HTML
+def _f(v, digits: int = 6) -> str:
+    v = float(v)
+    if math.isinf(v):
+        return "∞" if v > 0 else "-∞"
+    if abs(v) < 1e-13:
+        v = 0.0
+    return f"{v:.{digits}g}"
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence], numeric_from: int = 1, cls: str = "") -> str:
+    h = "".join(f"<th>{html.escape(str(c))}</th>" for c in headers)
+    body = []
+    for r in rows:
+        cells = []
+        for k, c in enumerate(r):
+            css = ' class="num"' if k >= numeric_from else ""
+            cells.append(f"<td{css}>{c if isinstance(c, _Raw) else html.escape(str(c))}</td>")
+        body.append("<tr>" + "".join(cells) + "</tr>")
+    return f'<table class="{cls}"><thead><tr>{h}</tr></thead><tbody>{"".join(body)}</tbody></table>'
+
+
+class _Raw(str):
+    """Table cell HTML that is not escaped."""
+
+
+def _matrix_table(M, rows: Sequence[str], cols: Sequence[str], cls: str) -> str:
+    return _table(["", *cols], [[r, *(_f(v) for v in row)] for r, row in zip(rows, np.atleast_2d(M))], cls=cls)
+
+
+def _asset(name: str) -> str:
+    return resources.files("kinedyn.report").joinpath("assets", name).read_text(encoding="utf-8")
+
+
+def _json_script(obj, element_id: str) -> str:
+    text = json.dumps(obj, allow_nan=False).replace("</", "<\\/")
+    return f'<script type="application/json" id="{element_id}">{text}</script>'
+
+
+def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, data: Optional[dict] = None) -> str:
+    """The report as one HTML string (see the module docstring)."""
+    from ..cli import _jsonable
+
+    import kinedyn
+
+    d = data if data is not None else collect(robot, q, qd, name=name, t_end=t_end, eom_joints=eom_joints)
+    q = np.asarray(d["q"])
+    eom = d.pop("_eom", None)
+    parts: List[str] = []
+    revolute = [j["type"] == "revolute" for j in d["joints"]]
+    q_text = ", ".join(f"{_f(v)} rad ({_f(math.degrees(v), 5)}°)" if r else f"{_f(v)} m" for v, r in zip(q, revolute))
+
+    # --- description
+    rows = [[j["name"], j["type"], " ".join(_f(a) for a in j["axis"]), _f(j["offset"]), f"[{_f(j['lower'])}, {_f(j['upper'])}]"] for j in d["joints"]]
+    sec = ["<section id='description'><h2>Joints and links</h2>", _table(["joint", "type", "axis", "offset", "limits"], rows, numeric_from=2, cls="joints")]
+    if d["dh"] is not None:
+        dh_rows = []
+        for i, r in enumerate(d["dh"], 1):
+            rev = r["type"] == "revolute"
+            dh_rows.append([str(i), f"q{i}" + (f" + {_f(r['theta'])}" if r["theta"] else "") if rev else _f(r["theta"]),
+                            _f(r["d"]) if rev else f"q{i}" + (f" + {_f(r['d'])}" if r["d"] else ""), _f(r["a"]), f"{_f(math.degrees(r['alpha']))}°"])
+        sec.append(f"<h3>DH table ({html.escape(d['dh_convention'] or '')})</h3>")
+        sec.append(_table(["link", "θ", "d [m]", "a [m]", "α"], dh_rows, cls="dh"))
+    sec.append("<h3>Mass properties</h3>")
+    sec.append(_table(["link", "mass [kg]", "centre of mass in the link frame [m]"], [[b["link"], _f(b["mass"]), " ".join(_f(c) for c in b["com"])] for b in d["bodies"]], cls="bodies"))
+    sec.append(f"<p class='note'>gravity {html.escape(str([_f(g) for g in d['gravity']]))} m/s²</p></section>")
+    description = "".join(sec)
+
+    # --- 3-D view and kinematics
+    model = _model_for_view(robot, q)
+    view = ["<section id='view'><h2>The arm at q</h2><div class='grid'><div>",
+            '<canvas id="kinedyn-view" width="720" height="520" aria-label="3-D view of the arm"></canvas>',
+            "<p class='note'>Drag to rotate, scroll to zoom. Links grey, revolute joints orange, prismatic violet; base axes x red, y green, z blue; the small triad is the tool frame.</p>",
+            "</div><div><h3>Joints</h3><div id='kinedyn-sliders'></div><p><button id='kinedyn-reset' type='button'>reset</button> <span id='kinedyn-tool'></span></p>",
+            f"<p class='note'>q = ({html.escape(q_text)})</p>",
+            "<h3>Tool pose</h3>", _matrix_table(d["tool_pose"], ["", "", "", ""], ["", "", "", ""], "pose"),
+            "</div></div>"]
+    names = ["vx", "vy", "vz", "ωx", "ωy", "ωz"]
+    view.append(f"<h3>Jacobian of '{html.escape(d['tool'])}' (base axes, rows [v; ω])</h3>")
+    view.append(_matrix_table(d["jacobian"], names, d["joint_names"], "jacobian"))
+    view.append(_table(["", *[f"σ{k + 1}" for k in range(len(d["singular_values"]))]], [["singular values", *(_f(s) for s in d["singular_values"])]], cls="singular-values"))
+    cls = "bad" if d["singular"] else "ok"
+    view.append(f"<p>Rank {d['rank']}, condition number {_f(d['condition_number'], 4)}: <span class='{cls}'>{html.escape(d['singularity'])}</span></p></section>")
+    view_html = "".join(view)
+
+    # --- equations of motion
+    eq = ["<section id='equations'><h2>Equations of motion</h2>",
+          "<p>M(q) q̈ + C(q, q̇) q̇ + g(q) = τ, derived symbolically by Lagrange's method (robot.equations_of_motion()).</p>"]
+    if eom is not None:
+        eq.append(f"<p class='note'>{html.escape(d['eom_note'])}; C from Christoffel symbols (Spong eq. 9.62).</p>")
+        for lhs, value in [("D(q)", eom.M), (r"C(q, \dot{q})", eom.C), ("g(q)", eom.g)]:
+            eq.append(_equation(lhs, value))
+        for k in range(eom.n):  # one line per joint: the torques are long
+            eq.append(_equation(f"\\tau_{{{k + 1}}}", eom.tau[k]))
+        steps = getattr(eom, "steps", None) or []
+        if steps:
+            eq.append("<details><summary>every step of the derivation</summary>")
+            for k, step in enumerate(steps, 1):
+                eq.append(f"<h3>Step {k}: {html.escape(step.title)}</h3>")
+                if step.text:
+                    eq.append(f"<p class='note'>{html.escape(step.text)}</p>")
+                for lhs, value in step.equations:
+                    eq.append(_equation(lhs, value))
+            eq.append("</details>")
+    else:
+        eq.append(f"<p class='note'>{html.escape(d['eom_note'] or '')}</p>")
+    eq.append("</section>")
+    eq_html = "".join(eq)
+
+    # --- dynamics: numbers, properties, simulation
+    if d["dynamics"]:
+        dyn = ["<section id='dynamics'><h2>Dynamics at q</h2>",
+               "<h3>Mass matrix M(q)</h3>", _matrix_table(d["mass_matrix"], d["joint_names"], d["joint_names"], "mass-matrix"),
+               _table(["", *d["joint_names"]], [["eigenvalues of M", *(_f(v) for v in d["mass_matrix_eigenvalues"])], ["gravity torque g(q) [N m]", *(_f(v) for v in d["gravity_torque"])]], cls="gravity"),
+               "<h3>Properties check</h3>",
+               f"<p class='note'>at q above and q̇ = ({', '.join(_f(v, 4) for v in d['properties_qd'])}).</p>"]
+        prow = [[p["property"], p["measure"], _f(p["value"], 3), _Raw("<span class='ok'>holds</span>" if p["ok"] else "<span class='bad'>FAILS</span>")] for p in d["properties"]]
+        dyn.append(_table(["property", "measured", "value", ""], prow, numeric_from=2, cls="properties"))
+        s = d["simulation"]
+        t = np.asarray(s["t"])
+        qs = np.asarray(s["q"])
+        plots = [svg_plot(t, [(nm, qs[:, k]) for k, nm in enumerate(d["joint_names"])], "joint positions", "t [s]", "q [rad or m]"),
+                 svg_plot(t, [("kinetic K", s["K"]), ("potential P", s["P"]), ("total H", s["H"])], "energy", "t [s]", "energy [J]")]
+        dyn.append(f"<h3>Free motion under gravity (τ = 0) for {_f(t[-1], 3)} s from q, q̇ = 0</h3>")
+        dyn.append("<div class='plots'>" + "".join(plots) + "</div>")
+        dyn.append(f"<p class='note'>integrated with {html.escape(s['method'])}; the total energy changes by at most {_f(s['energy_drift'], 3)} J.</p></section>")
+        dyn_html = "".join(dyn)
+    else:
+        dyn_html = "<section id='dynamics'><h2>Dynamics</h2><p class='note'>This build of kinedyn has no numeric dynamics (robot.mass_matrix); the properties check and the simulation appear once it does.</p></section>"
+
+    public = _jsonable({k: v for k, v in d.items() if not k.startswith("_")})
+    title = f"kinedyn report: {d['robot']}"
+    page = f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{html.escape(title)}</title>
+<style>{_asset("report.css")}</style></head>
+<body><header><h1>{html.escape(d['robot'])}</h1><p>{d['n']} joints · {html.escape(d['source'] or 'robot file')} · kinedyn {html.escape(kinedyn.__version__)}</p></header>
+<main>{view_html}{description}{eq_html}{dyn_html}</main>
+<footer>Generated by <code>kinedyn report</code>. Self-contained: no network access, every script and style is in this file.</footer>
+{_json_script(model, "kinedyn-model")}
+{_json_script(public, "kinedyn-data")}
+<script>{_asset("viewer.js")}</script>
+</body></html>
+"""
+    return page
+
+
+def write_report(robot, path="report.html", q=None, qd=None, **kwargs) -> Path:
+    """Write the report to ``path``; returns the path."""
+    path = Path(path)
+    path.write_text(build_report(robot, q, qd, **kwargs), encoding="utf-8")
+    return path
