@@ -13,6 +13,7 @@ Values may be floats or SymPy expressions.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
@@ -21,7 +22,14 @@ import sympy as sp
 
 from .._math import as_value, is_symbolic
 
-__all__ = ["Inertia", "skew"]
+__all__ = ["Inertia", "PhysicalConsistencyWarning", "skew"]
+
+
+class PhysicalConsistencyWarning(UserWarning):
+    """Inertial data that no rigid body can have, kept as given (e.g. a published table)."""
+
+
+_WARNED: set = set()
 
 
 def skew(v):
@@ -60,7 +68,8 @@ class Inertia:
         return is_symbolic(self.mass, self.com, self.inertia)
 
     def validate(self, where: str = "") -> None:
-        """Physical consistency of numeric values: m >= 0, I symmetric, PSD, triangle inequality."""
+        """Physical consistency of numeric values: m >= 0, I symmetric and PSD (errors); the triangle
+        inequality of principal moments (a warning)."""
         where = f" of {where}" if where else ""
         if is_symbolic(self.mass, self.com, self.inertia):
             return
@@ -84,11 +93,16 @@ class Inertia:
                 f"inertia tensor{where} is not positive semi-definite (eigenvalues {eig}); "
                 "check the signs of the products of inertia (URDF uses +ixy for the tensor entry)"
             )
-        # principal moments must satisfy the triangle inequality for a real body
-        if eig[0] + eig[1] < eig[2] - max(tol, 1e-9 * eig[2]):
-            raise ValueError(
+        # a real body's principal moments satisfy the triangle inequality; published tables (the
+        # PUMA 560's) and CAD exports sometimes do not: warn, since M stays positive definite
+        key = tuple(np.round(eig, 12))
+        if eig[0] + eig[1] < eig[2] - max(tol, 1e-9 * eig[2]) and key not in _WARNED:
+            _WARNED.add(key)  # once per body: rotated copies made while compiling share eigenvalues
+            warnings.warn(
                 f"inertia tensor{where} violates the triangle inequality of principal moments "
-                f"({eig}): no rigid body has this inertia"
+                f"({eig}): no rigid body has this inertia (kept as given)",
+                PhysicalConsistencyWarning,
+                stacklevel=3,
             )
 
     # ---- named constructors -------------------------------------------------------------------

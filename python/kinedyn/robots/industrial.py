@@ -74,9 +74,9 @@ PUMA560_COMS = (
     (0.0, 0.0, 0.032),
 )
 PUMA560_INERTIAS = (
-    (0.175, 0.35, 0.175),  # published (0, 0.35, 0): see puma560's docstring
+    (0.0, 0.35, 0.0),  # not a rigid body's (triangle inequality): see puma560's docstring
     (0.13, 0.524, 0.539),
-    (0.066, 0.086, 0.020),  # published Izz = 0.0125: see puma560's docstring
+    (0.066, 0.086, 0.0125),  # not a rigid body's: see puma560's docstring
     (1.8e-3, 1.3e-3, 1.8e-3),
     (0.3e-3, 0.4e-3, 0.3e-3),
     (0.15e-3, 0.15e-3, 0.04e-3),
@@ -126,13 +126,11 @@ def puma560(
     joint limits from Wang & Chen (1991); all as tabulated in Corke's Robotics Toolbox
     ``mdl_puma560.m`` (module constants ``PUMA560_*`` hold them).
 
-    Two published inertias are not those of any rigid body and are adjusted (the only changes):
-
-    - link 1: ``I = (0, 0.35, 0)`` fails the triangle inequality Ixx + Izz >= Iyy. Link 1 only ever
-      rotates about y1 (= z0) and has zero mass, so Ixx and Izz never enter the dynamics; they are
-      set to 0.175, the smallest equal values that make the tensor physical.
-    - link 3: ``Izz = 0.0125`` fails Ixx + Izz >= Iyy (0.066 + 0.0125 < 0.086). Izz is raised to
-      0.020, the smallest value that satisfies it (Armstrong et al. note uncertainties of this size).
+    Two published inertias are not those of any rigid body (link 1's (0, 0.35, 0) and link 3's
+    Izz = 0.0125 < Iyy - Ixx fail the triangle inequality of principal moments); they are kept as
+    published, so kinedyn agrees with other tools using the same table (a
+    ``PhysicalConsistencyWarning`` says so once per process). Link 1 has zero mass and turns about y1 only,
+    so its Ixx and Izz never enter the dynamics.
 
     ``motors=True`` adds the reflected rotor inertia G^2 Jm to each joint (gear_ratio = G,
     rotor_inertia = Jm). ``friction=True`` adds the motor friction referred to the joint:
@@ -184,7 +182,7 @@ STANFORD_INERTIAS = (
     (0.108, 0.018, 0.100),
     (2.51, 2.51, 0.006),
     (0.002, 0.001, 0.001),
-    (0.003, 0.0004, 0.0026),  # published Izz = 0: see stanford's docstring
+    (0.003, 0.0004, 0.0),  # not a rigid body's: see stanford's docstring
     (0.013, 0.013, 0.0003),
 )
 STANFORD_ROTOR_INERTIAS = (0.953, 2.193, 0.782, 0.106, 0.097, 0.020)
@@ -226,8 +224,8 @@ def stanford(
     inertias and reflected armature inertias Jm from Paul (1981) Tables 6.5 and 6.6; all as
     tabulated in Corke's Robotics Toolbox ``mdl_stanford.m`` (module constants ``STANFORD_*``).
 
-    Changed from the published table: link 5's ``I = (0.003, 0.0004, 0)`` fails the triangle
-    inequality Iyy + Izz >= Ixx; Izz is set to 0.0026, the smallest value that makes it physical.
+    Link 5's published ``I = (0.003, 0.0004, 0)`` fails the triangle inequality Iyy + Izz >= Ixx;
+    it is kept as published.
     The published centres of mass of links 2, 3 and 6 (e.g. -6.447 m along z3) are kept as
     tabulated by Corke although they look like a unit slip; pass ``coms=`` to use others.
 
