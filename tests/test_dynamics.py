@@ -322,3 +322,13 @@ def test_massless_chain_is_a_clear_error_from_forward_dynamics():
     # rotor inertia alone makes the joints accelerate: qdd = tau / (r^2 J_m)
     geared = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, gear_ratio=10.0, rotor_inertia=1e-3)) for l in links]
     close(kd.Robot(geared).forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2)), [10.0, 10.0])
+
+
+def test_lists_and_integer_arrays_are_accepted():
+    robot = kd.robots.puma560()
+    q = [0, 1, 0, -1, 0, 2]
+    qf = np.array(q, float)
+    assert np.array_equal(robot.mass_matrix(q), robot.mass_matrix(qf))
+    assert np.array_equal(robot.inverse_dynamics(q, q, np.array(q)), robot.inverse_dynamics(qf, qf, qf))
+    assert np.array_equal(robot.gravity_torque(np.array(q, np.float32)), robot.gravity_torque(np.array(q, np.float32).astype(float)))
+    assert robot.potential_energy(q) == robot.potential_energy(qf)

@@ -1,4 +1,4 @@
-use super::{skew, Force, Mat3, Motion, Vec3};
+use super::{Force, Mat3, Motion, Vec3};
 use std::ops::{Add, AddAssign};
 
 /// Rigid-body spatial inertia about a frame's origin (RBDA eq. 2.63), stored by its
@@ -52,8 +52,22 @@ impl Inertia {
     /// `h' = h + m t`, `I' = I - [t]x[h]x - [h]x[t]x - m [t]x[t]x` (derivation: docs/notation.md).
     #[inline]
     pub fn translated(&self, t: &Vec3) -> Self {
-        let (st, sh) = (skew(t), skew(&self.h));
-        Self::new(self.mass, self.h + self.mass * t, self.i_o - st * sh - sh * st - self.mass * st * st)
+        // with [a]x[b]x = b a^T - (a . b) 1 the three products are outer products:
+        // I' = I - (h t^T + t h^T) - m t t^T + (2 t . h + m t . t) 1   (symmetric: 6 entries)
+        let (m, h) = (self.mass, &self.h);
+        let d = 2.0 * t.dot(h) + m * t.dot(t);
+        let mt = m * t;
+        let e = |r: usize, c: usize| -h[r] * t[c] - t[r] * h[c] - mt[r] * t[c];
+        let (xx, yy, zz) = (e(0, 0) + d, e(1, 1) + d, e(2, 2) + d);
+        let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
+        let i = &self.i_o;
+        #[rustfmt::skip]
+        let i_o = Mat3::new(
+            i[(0, 0)] + xx, i[(0, 1)] + xy, i[(0, 2)] + xz,
+            i[(1, 0)] + xy, i[(1, 1)] + yy, i[(1, 2)] + yz,
+            i[(2, 0)] + xz, i[(2, 1)] + yz, i[(2, 2)] + zz,
+        );
+        Self::new(m, h + mt, i_o)
     }
 }
 
