@@ -75,9 +75,12 @@ def bench(name: str) -> None:
         b = median_time(pin_loop, repeat=3, number=1) / BATCH
         print(f"{label + ', per state, 10k batch vs loop':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
     # Pinocchio's own batch: (nq, N) matrices; the transpose of a C-ordered (N, nq) array is free
-    out = np.zeros((n, BATCH))
+    pool = pin.ModelPool(model)
+    out = np.zeros((n, BATCH), order="F")
+    pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out)
+    assert np.allclose(out.T, robot.inverse_dynamics(Q, V, A), atol=1e-9)
     a = median_time(lambda: robot.inverse_dynamics(Q, V, A), repeat=5, number=3) / BATCH
-    b = median_time(lambda: pin.rneaInParallel(1, model, data, Q.T, V.T, A.T, out), repeat=5, number=3) / BATCH
+    b = median_time(lambda: pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out), repeat=5, number=3) / BATCH
     print(f"{'inverse_dynamics, per state vs rneaInParallel(1)':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
 
 
