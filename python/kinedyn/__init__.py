@@ -3,6 +3,7 @@
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .robot import Robot
 from . import robots
+from .symbolic import LagrangianSystem
 
 __version__ = "0.1.0"
 
@@ -14,4 +15,4 @@ def load(path, **kwargs) -> Robot:
     return _load(path, **kwargs)
 
 
-__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "__version__"]
+__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "__version__"]

@@ -1,0 +1,341 @@
+"""``EquationsOfMotion``: the symbolic equations of one robot or Lagrangian system, with the steps that
+led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and generated code.
+
+    M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau           (Spong eq. 9.61, DESIGN.md)
+
+``eom.christoffel[i][j][k]`` is c_ijk of Spong eq. 9.58 (0-based indices), ``C[k, j] = sum_i c_ijk qd_i``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence
+
+import sympy as sp
+
+__all__ = ["EquationsOfMotion", "Step", "equations_of_motion"]
+
+
+@dataclass
+class Step:
+    """One step of a derivation: a title, a sentence, and equations ``(lhs LaTeX, SymPy value)``."""
+
+    title: str
+    text: str = ""
+    equations: List[tuple] = field(default_factory=list)
+
+    def to_latex(self, names=None) -> str:
+        lines = [r"\text{" + self.title + "}"]
+        for lhs, value in self.equations:
+            lines.append(f"{lhs} = {sp.latex(value, symbol_names=names or {})}")
+        return " \\\\\n".join(lines)
+
+
+def _ops(exprs) -> Dict[str, int]:
+    """Counts of multiplications, additions (subtractions and negations included), divisions and
+    function calls (sin, cos, sign) in expressions, the way Khalil & Dombre count them (x**2 counts as
+    one product; sign changes are listed under "neg" and left out of the total)."""
+    counts = {"mul": 0, "add": 0, "div": 0, "fun": 0, "neg": 0}
+    for e in exprs:
+        v = sp.count_ops(e, visual=True)
+        if v == 0:
+            continue
+        for term in sp.Add.make_args(v):
+            coeff, sym = term.as_coeff_Mul()
+            name = str(sym)
+            if name in ("MUL", "POW"):
+                counts["mul"] += int(coeff)
+            elif name in ("ADD", "SUB"):
+                counts["add"] += int(coeff)
+            elif name == "NEG":  # a sign change, folded into the next addition by any compiler
+                counts["neg"] += int(coeff)
+            elif name == "DIV":
+                counts["div"] += int(coeff)
+            else:
+                counts["fun"] += int(coeff)
+    counts["total"] = counts["mul"] + counts["add"] + counts["div"] + counts["fun"]
+    return counts
+
+
+class EquationsOfMotion:
+    """Symbolic equations of motion (see the module docstring). Built by
+    :func:`equations_of_motion` (robots) or :meth:`kinedyn.LagrangianSystem.equations_of_motion`."""
+
+    def __init__(
+        self,
+        q,
+        qd,
+        qdd,
+        M,
+        C,
+        g,
+        *,
+        K=None,
+        P=None,
+        friction=None,
+        christoffel=None,
+        tau=None,
+        steps=None,
+        name: str = "",
+        method: str = "lagrange",
+        latex_names: Optional[dict] = None,
+        program=None,
+        model=None,
+        extra: Optional[dict] = None,
+    ):
+        self.q = sp.Matrix(q)
+        self.qd = sp.Matrix(qd)
+        self.qdd = sp.Matrix(qdd)
+        self.n = len(self.q)
+        self.name = name
+        self.method = method
+        self._M, self._C, self._g = M, C, g
+        self._K, self._P = K, P
+        self._friction = friction
+        self._christoffel = christoffel
+        self._tau = tau
+        self._steps = steps
+        self.latex_names = dict(latex_names or {})
+        self.program = program  # Newton-Euler customised model (kinedyn.symbolic.newton_euler.Program)
+        self.model = model  # (RingModel, derivation dict) for robots
+        self.extra = dict(extra or {})
+
+    # ------------------------------------------------------------------ lazily computed parts
+    @staticmethod
+    def _get(value):
+        return value() if callable(value) else value
+
+    @property
+    def M(self) -> sp.Matrix:
+        """The inertia matrix D(q) (Spong 9.47), reflected rotor inertia on the diagonal."""
+        self._M = self._get(self._M)
+        return self._M
+
+    D = M
+
+    @property
+    def C(self) -> sp.Matrix:
+        self._C = self._get(self._C)
+        return self._C
+
+    @property
+    def g(self) -> sp.Matrix:
+        self._g = self._get(self._g)
+        return self._g
+
+    @property
+    def K(self):
+        self._K = self._get(self._K)
+        if self._K is None:
+            self._K = sp.expand((self.qd.T * self.M * self.qd)[0, 0] / 2)
+        return self._K
+
+    @property
+    def P(self):
+        self._P = self._get(self._P)
+        return self._P
+
+    @property
+    def L(self):
+        """The Lagrangian L = K - P."""
+        return self.K - self.P
+
+    @property
+    def H(self):
+        """The Hamiltonian (total energy) H = K + P, as a function of q and qd (see :meth:`hamiltonian`)."""
+        return self.K + self.P
+
+    @property
+    def friction(self) -> sp.Matrix:
+        """Joint friction viscous * qd + coulomb * sign(qd) (zero when the description has none)."""
+        self._friction = self._get(self._friction)
+        if self._friction is None:
+            self._friction = sp.zeros(self.n, 1)
+        return self._friction
+
+    @property
+    def christoffel(self):
+        """c[i][j][k] (Spong eq. 9.58), nested lists of SymPy expressions."""
+        self._christoffel = self._get(self._christoffel)
+        return self._christoffel
+
+    @property
+    def tau(self) -> sp.Matrix:
+        """tau = M qdd + C qd + g + friction."""
+        self._tau = self._get(self._tau)
+        if self._tau is None:
+            self._tau = (self.M * self.qdd + self.C * self.qd + self.g).applyfunc(sp.expand) + self.friction
+        return self._tau
+
+    @property
+    def steps(self) -> List[Step]:
+        self._steps = self._get(self._steps)
+        return self._steps or []
+
+    # ------------------------------------------------------------------ derived forms
+    def hamiltonian(self):
+        """(p, H(q, p), qdot(q, p), pdot(q, p)): momenta p = M qd and Hamilton's equations
+        qdot = dH/dp, pdot = -dH/dq (+ generalised forces)."""
+        p = sp.Matrix(sp.symbols(f"p1:{self.n + 1}", real=True))
+        Minv = self.M.inv() if self.n <= 3 else self.M.inv(method="LU")
+        H = sp.expand((p.T * Minv * p)[0, 0] / 2) + self.P
+        qdot = sp.Matrix([sp.diff(H, pi) for pi in p])
+        pdot = sp.Matrix([-sp.diff(H, qi) for qi in self.q])
+        return p, H, qdot, pdot
+
+    def phase_space(self, u=None):
+        """(x, f, u): the state x = (q, qd) and x' = f(x, u) = (qd, M^-1 (u - C qd - g - friction))
+        (LaValle eq. 13.148). ``u`` defaults to symbols tau1..taun."""
+        if u is None:
+            u = sp.Matrix(sp.symbols(f"tau1:{self.n + 1}", real=True))
+        u = sp.Matrix(u)
+        rhs = u - self.C * self.qd - self.g - self.friction
+        qdd = self.M.LUsolve(rhs) if self.n > 2 else self.M.inv() * rhs
+        x = sp.Matrix.vstack(self.q, self.qd)
+        return x, sp.Matrix.vstack(self.qd, qdd), u
+
+    def regressor(self, known=None):
+        """(Y, Theta): tau (without friction) == Y(q, qd, qdd) Theta exactly, Theta a minimal vector of
+        grouped parameters (see :mod:`kinedyn.symbolic.regressor`)."""
+        from .regressor import regressor
+
+        return regressor(self, known=known)
+
+    def subs(self, mapping) -> "EquationsOfMotion":
+        """The same equations with parameters replaced (numbers or other expressions)."""
+        mapping = {sp.Symbol(k) if isinstance(k, str) else k: v for k, v in dict(mapping).items()}
+        f = lambda m: m.subs(mapping) if m is not None else None
+        return EquationsOfMotion(
+            self.q, self.qd, self.qdd, f(self.M), f(self.C), f(self.g), K=f(self.K), P=f(self.P), friction=f(self.friction),
+            christoffel=[[[c.subs(mapping) for c in row] for row in plane] for plane in self.christoffel] if self.christoffel else None,
+            name=self.name, method=self.method, latex_names=self.latex_names,
+        )
+
+    @property
+    def parameters(self) -> list:
+        """Free symbols of the equations other than the state, sorted by name."""
+        state = set(self.q) | set(self.qd) | set(self.qdd)
+        free = set()
+        for m in (self.M, self.C, self.g, self.friction):
+            free |= m.free_symbols
+        free |= sp.sympify(self.P).free_symbols if self.P is not None else set()
+        return sorted(free - state, key=str)
+
+    # ------------------------------------------------------------------ code
+    def to_code(self, language: str = "numpy", what: Sequence[str] = ("M", "C", "g", "tau"), name: Optional[str] = None) -> str:
+        """Source code (``"python"``, ``"numpy"`` or ``"c"``) computing the requested matrices, with
+        common subexpressions eliminated; see :mod:`kinedyn.symbolic.codegen`."""
+        from .codegen import generate
+
+        return generate(self, language, what, name=name)
+
+    def compile(self, what: Sequence[str] = ("M", "C", "g", "tau"), backend: str = "auto", params=None):
+        """Fast callables for the requested matrices: C compiled with the system compiler when
+        available (``backend="c"``), NumPy otherwise; each accepts one state or a batch (N, n)."""
+        from .codegen import compile_eom
+
+        return compile_eom(self, what, backend=backend, params=params)
+
+    def op_count(self, what: str = "tau", cse: bool = False) -> Dict[str, int]:
+        """Operation counts of ``tau`` (or ``M``, ``g``...) as formed; for the Newton-Euler method the
+        customised model with its intermediate variables; ``cse=True`` after common-subexpression
+        elimination."""
+        if what == "tau" and self.program is not None:
+            return self.program.op_count(cse=cse)
+        exprs = list(getattr(self, what))
+        if cse:
+            repl, red = sp.cse(exprs, order="none")
+            exprs = [e for _, e in repl] + list(red)
+        return _ops(exprs)
+
+    # ------------------------------------------------------------------ rendering
+    def _final_equations(self):
+        return [
+            ("D(q)", self.M),
+            (r"C(q, \dot{q})", self.C),
+            ("g(q)", self.g),
+            (r"\tau", self.tau),
+        ]
+
+    def to_latex(self, steps: bool = True) -> str:
+        """A LaTeX ``align*`` block: the steps of the derivation (if any) and the final matrices."""
+        names = self.latex_names
+        body = []
+        for step in self.steps if steps else []:
+            body.append(r"&\text{" + step.title + r"} \\")
+            for lhs, value in step.equations:
+                body.append(f"{lhs} &= {sp.latex(value, symbol_names=names)} \\\\")
+        body.append(r"&\text{Equations of motion: } D(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau \\")
+        for lhs, value in self._final_equations():
+            body.append(f"{lhs} &= {sp.latex(value, symbol_names=names)} \\\\")
+        return "\\begin{align*}\n" + "\n".join(body) + "\n\\end{align*}"
+
+    def to_markdown(self) -> str:
+        """Markdown with LaTeX math (``$$ ... $$``), one section per step."""
+        names = self.latex_names
+        out = [f"# Equations of motion{': ' + self.name if self.name else ''} ({self.method})", ""]
+        for k, step in enumerate(self.steps, start=1):
+            out += [f"## Step {k}: {step.title}", ""]
+            if step.text:
+                out += [step.text, ""]
+            for lhs, value in step.equations:
+                out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
+        out += ["## Result: $D(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
+        for lhs, value in self._final_equations():
+            out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
+        return "\n".join(out)
+
+    def to_mathml(self) -> str:
+        """Presentation MathML, one ``<math>`` element per equation."""
+        parts = []
+        for step in self.steps:
+            parts.append(f"<p>{step.title}</p>")
+            for lhs, value in step.equations:
+                parts.append(f'<math xmlns="http://www.w3.org/1998/Math/MathML" display="block"><mrow><mi>{_mathml_escape(lhs)}</mi><mo>=</mo>{sp.mathml(value, printer="presentation")}</mrow></math>')
+        for lhs, value in self._final_equations():
+            parts.append(f'<math xmlns="http://www.w3.org/1998/Math/MathML" display="block"><mrow><mi>{_mathml_escape(lhs)}</mi><mo>=</mo>{sp.mathml(value, printer="presentation")}</mrow></math>')
+        return "\n".join(parts)
+
+    def __str__(self) -> str:
+        out = [f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"]
+        for k, step in enumerate(self.steps, start=1):
+            out.append(f"\nStep {k}: {step.title}")
+            for lhs, value in step.equations:
+                out.append(f"  {_plain(lhs)} = {value}")
+        for lhs, value in self._final_equations():
+            out.append(f"{_plain(lhs)} = {value}")
+        return "\n".join(out)
+
+    def __repr__(self) -> str:
+        return f"EquationsOfMotion(name={self.name!r}, n={self.n}, method={self.method!r})"
+
+
+def _mathml_escape(s: str) -> str:
+    return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def _plain(lhs: str) -> str:
+    import re
+
+    s = lhs.replace(r"\dot{q}", "qd").replace(r"\ddot{q}", "qdd").replace(r"\tau", "tau")
+    s = re.sub(r"\\(frac|partial|mathcal|operatorname|left|right|text)", "", s)
+    return s.replace("{", "").replace("}", "").replace("\\", "")
+
+
+def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True) -> EquationsOfMotion:
+    """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
+
+    ``method="lagrange"``: Euler-Lagrange from K and P with every step kept (Spong §9.2-9.3).
+    ``method="newton_euler"``: the customised symbolic recursive Newton-Euler model with intermediate
+    variables (Khalil & Dombre); M, g and C are formed from it as well.
+    ``simplify=True`` gives the textbook (Fourier) form of every entry; ``False`` the product form.
+    """
+    if method == "lagrange":
+        from .robot_eom import lagrange_eom
+
+        return lagrange_eom(robot, simplify=simplify, with_steps=steps)
+    if method in ("newton_euler", "newton-euler", "rnea"):
+        from .robot_eom import newton_euler_eom
+
+        return newton_euler_eom(robot, simplify=simplify)
+    raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")

@@ -1,0 +1,317 @@
+"""Euler-Lagrange derivation of a robot's equations of motion, step by step (Spong §9.2-9.3).
+
+Symbols: q, qd, qdd (joint coordinates, velocities, accelerations); for body i with parent p:
+``E`` = parent_from_body rotation, ``r`` = body origin in parent axes, ``R``/``p`` = world_from_body
+rotation/origin, ``Jv``/``Jw`` = body-frame Jacobians of the body origin's linear velocity and of the
+angular velocity (3 x n), ``pi`` = [m, h = m c, I_o] the ten inertial parameters about the body origin.
+
+    Jw_i = E^T Jw_p + a_i e_i                (revolute)        omega_i = Jw_i qd
+    Jv_i = E^T (Jv_p - [r]x Jw_p) + a_i e_i  (prismatic)       v_i = Jv_i qd
+    D_i  = m Jv^T Jv - Jv^T [h]x Jw + Jw^T [h]x Jv + Jw^T I_o Jw
+         (= m Jvc^T Jvc + Jw^T R I_c R^T Jw of Spong eq. 9.46, written about the body origin so it is
+          linear in the parameters and needs no division by the mass)
+    D    = sum_i D_i + diag(r_i^2 J_m,i)          K = qd^T D qd / 2             (Spong 9.47)
+    P    = - sum_i g^T (m_i p_i + R_i h_i)                                        (Spong 9.48-9.49)
+    tau_k = d/dt dL/dqd_k - dL/dq_k,  L = K - P                                   (Spong 9.40)
+    c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2,  C_kj = sum_i c_ijk qd_i   (Spong 9.58, 9.62)
+
+All arithmetic is exact, in the normal form of :class:`kinedyn.symbolic.simplify.TrigRing`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import List
+
+import numpy as np
+import sympy as sp
+
+from .simplify import TrigRing
+
+__all__ = ["RingModel", "state_symbols", "derive_lagrange"]
+
+
+def _exact(value):
+    """A description value as SymPy, with integer-valued floats made exact (1.0 -> 1) so that a
+    symbolic robot stays exact; other floats are kept as given."""
+    if isinstance(value, (float, np.floating)):
+        f = float(value)
+        if abs(f) < 1e-13:
+            return sp.Integer(0)
+        return sp.Integer(int(f)) if f.is_integer() else sp.Float(f)
+    if isinstance(value, (int, np.integer)):
+        return sp.Integer(int(value))
+    e = sp.sympify(value)
+    floats = e.atoms(sp.Float)
+    if floats:
+        # inside a symbolic expression a float is round-off of exact arithmetic done in floats by
+        # the description (1.0/12 from a numpy rotation): recover the small rational it came from
+        e = e.xreplace({f: (_rational(float(f)) if e.free_symbols else _exact(float(f))) for f in floats})
+    return e
+
+
+def _rational(f: float):
+    from fractions import Fraction
+
+    fr = Fraction(f).limit_denominator(10000)
+    if abs(float(fr) - f) <= 1e-15 * max(1.0, abs(f)):
+        return sp.Rational(fr.numerator, fr.denominator)
+    return _exact(f)
+
+
+def _matrix(value) -> List[list]:
+    if isinstance(value, sp.MatrixBase):
+        return [[_exact(e) for e in row] for row in value.tolist()]
+    return [[_exact(e) for e in row] for row in np.asarray(value).tolist()]
+
+
+def state_symbols(robot):
+    """(q, qd, qdd) symbol lists named after the joints: q1 -> qd1, qdd1; shoulder -> shoulder_d, shoulder_dd."""
+    import re
+
+    q, qd, qdd = [], [], []
+    taken = {str(s) for s in robot.symbols}
+    for name in robot.joint_names:
+        m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
+        names = (name, f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (name, f"{name}_d", f"{name}_dd")
+        for n in names:
+            if n in taken:
+                raise ValueError(f"joint variable name '{n}' is also a parameter symbol of robot '{robot.name}': rename the joint or the symbol")
+        q.append(sp.Symbol(names[0], real=True))
+        qd.append(sp.Symbol(names[1], real=True))
+        qdd.append(sp.Symbol(names[2], real=True))
+    return q, qd, qdd
+
+
+def latex_names(q, qd, qdd) -> dict:
+    """LaTeX names for the velocity/acceleration symbols (\\dot q_1, \\ddot q_1)."""
+    out = {}
+    for a, b, c in zip(q, qd, qdd):
+        base = sp.latex(a)
+        out[b] = r"\dot{" + base + "}"
+        out[c] = r"\ddot{" + base + "}"
+    return out
+
+
+class RingModel:
+    """The robot's kinematics and energies in the exact trigonometric ring (see module docstring)."""
+
+    def __init__(self, robot, q, qd, qdd, inertias=None):
+        self.robot = robot
+        bodies = robot.tree.bodies
+        self.n = n = len(bodies)
+        # ---- the description as exact SymPy values
+        self.place_R, self.place_p, self.axis, self.offset, self.pi = [], [], [], [], []
+        self.com, self.armature, self.viscous, self.coulomb = [], [], [], []
+        leaves = []
+        for k, b in enumerate(bodies):
+            T = _matrix(b.placement)
+            self.place_R.append([row[:3] for row in T[:3]])
+            self.place_p.append([row[3] for row in T[:3]])
+            self.axis.append([_exact(a) for a in b.joint.axis])
+            off = _exact(b.joint.offset)
+            self.offset.append(off)
+            inertia = b.inertia if inertias is None else inertias[k]
+            pi = [sp.expand(sp.cancel(_exact(v))) if isinstance(v, sp.Basic) else _exact(v) for v in inertia.parameters()]
+            self.pi.append(pi)
+            self.com.append([_exact(c) for c in inertia.com])
+            self.armature.append(_exact(b.joint.armature))
+            self.viscous.append(_exact(b.joint.viscous))
+            self.coulomb.append(_exact(b.joint.coulomb))
+            leaves += sum(self.place_R[-1], []) + self.place_p[-1] + self.axis[-1] + pi + [self.armature[-1]]
+            if b.joint.kind == "revolute":
+                leaves += [sp.cos(off), sp.sin(off)] if not off.has(sp.Float) else []
+            else:
+                leaves.append(off)
+        self.gravity = [_exact(g) for g in robot.gravity]
+        leaves += self.gravity
+        self.leaves = leaves
+        kinds = [b.joint.kind for b in bodies]
+        self.ring = TrigRing(list(zip(q, kinds)), qd, qdd, leaves)
+        self.q, self.qd, self.qdd = q, qd, qdd
+        self._kinematics()
+
+    # ------------------------------------------------------------------ helpers
+    def _c(self, v):
+        return self.ring.const(v)
+
+    def _mat(self, A, B):
+        ring = self.ring
+        return [[ring.dot(A[i], [B[k][j] for k in range(len(B))]) for j in range(len(B[0]))] for i in range(len(A))]
+
+    def _matT(self, A, B):  # A^T B
+        ring = self.ring
+        return [[ring.dot([A[k][i] for k in range(len(A))], [B[k][j] for k in range(len(B))]) for j in range(len(B[0]))] for i in range(len(A[0]))]
+
+    def _vec(self, A, v):
+        return [self.ring.dot(row, v) for row in A]
+
+    @staticmethod
+    def _skew(v):
+        x, y, z = v
+        return [[0 * x, -z, y], [z, 0 * x, -x], [-y, x, 0 * x]]
+
+    def _joint_rotation(self, i):
+        """Rodrigues: R = C I + S [a]x + (1 - C) a a^T, with C, S the cosine/sine of q_i + offset."""
+        ring = self.ring
+        a = [self._c(x) for x in self.axis[i]]
+        C, S = ring.cos(i, self.offset[i]), ring.sin(i, self.offset[i])
+        one_c = ring.one - C
+        ax = self._skew(a)
+        return [[ring.reduce((C if r == k else ring.zero) + S * ax[r][k] + one_c * a[r] * a[k]) for k in range(3)] for r in range(3)]
+
+    # ------------------------------------------------------------------ kinematics
+    def _kinematics(self):
+        ring, n = self.ring, self.n
+        bodies = self.robot.tree.bodies
+        zero = ring.zero
+        self.E, self.r, self.R, self.p, self.Jv, self.Jw = [], [], [], [], [], []
+        for i, b in enumerate(bodies):
+            P_R = [[self._c(x) for x in row] for row in self.place_R[i]]
+            P_p = [self._c(x) for x in self.place_p[i]]
+            a = [self._c(x) for x in self.axis[i]]
+            if b.joint.kind == "revolute":
+                E = self._mat(P_R, self._joint_rotation(i))
+                r = P_p
+            else:
+                E = P_R
+                d = ring.coordinate(i) + self._c(self.offset[i])
+                r = [P_p[k] + ring.dot(P_R[k], [x * d for x in a]) for k in range(3)]
+            parent = b.parent
+            if parent < 0:
+                R, p = E, r
+                Jw = [[zero] * n for _ in range(3)]
+                Jv = [[zero] * n for _ in range(3)]
+            else:
+                Rp, pp = self.R[parent], self.p[parent]
+                R = self._mat(Rp, E)
+                p = [pp[k] + ring.dot(Rp[k], r) for k in range(3)]
+                # Jw_i = E^T Jw_p ; Jv_i = E^T (Jv_p - [r]x Jw_p)
+                Jw = self._matT(E, self.Jw[parent])
+                Sr = self._skew(r)
+                SJ = self._mat(Sr, self.Jw[parent])
+                Jv = self._matT(E, [[self.Jv[parent][k][j] - SJ[k][j] for j in range(n)] for k in range(3)])
+            if b.joint.kind == "revolute":
+                for k in range(3):
+                    Jw[k][i] = Jw[k][i] + a[k]
+            else:
+                for k in range(3):
+                    Jv[k][i] = Jv[k][i] + a[k]
+            self.E.append(E)
+            self.r.append(r)
+            self.R.append(R)
+            self.p.append(p)
+            self.Jw.append(Jw)
+            self.Jv.append(Jv)
+
+    def body_mass_matrix(self, i):
+        """D_i = m Jv^T Jv - Jv^T [h]x Jw + Jw^T [h]x Jv + Jw^T I_o Jw (body-origin form of Spong 9.46)."""
+        ring, n = self.ring, self.n
+        m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = [self._c(v) for v in self.pi[i]]
+        Jv, Jw = self.Jv[i], self.Jw[i]
+        Sh = self._skew([hx, hy, hz])
+        Io = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+        ShJw = self._mat(Sh, Jw)
+        ShJv = self._mat(Sh, Jv)
+        IJw = self._mat(Io, Jw)
+        B = [[ring.reduce(m * Jv[k][j] - ShJw[k][j]) for j in range(n)] for k in range(3)]  # m Jv - [h]x Jw
+        A = [[ring.reduce(IJw[k][j] + ShJv[k][j]) for j in range(n)] for k in range(3)]  # I_o Jw + [h]x Jv
+        D = [[None] * n for _ in range(n)]
+        for r in range(n):
+            for c in range(r, n):
+                v = ring.dot([Jv[k][r] for k in range(3)], [B[k][c] for k in range(3)])
+                v = ring.reduce(v + ring.dot([Jw[k][r] for k in range(3)], [A[k][c] for k in range(3)]))
+                D[r][c] = D[c][r] = v
+        return D
+
+    def mass_matrix(self):
+        ring, n = self.ring, self.n
+        D = [[ring.zero] * n for _ in range(n)]
+        for i in range(n):
+            Di = self.body_mass_matrix(i)
+            for r in range(n):
+                for c in range(n):
+                    D[r][c] = D[r][c] + Di[r][c]
+        for i in range(n):
+            D[i][i] = D[i][i] + self._c(self.armature[i])
+        return D
+
+    def potential_energy(self):
+        """P = - sum_i g^T (m_i p_i + R_i h_i)."""
+        ring = self.ring
+        g = [self._c(x) for x in self.gravity]
+        P = ring.zero
+        for i in range(self.n):
+            m = self._c(self.pi[i][0])
+            h = [self._c(x) for x in self.pi[i][1:4]]
+            Rh = self._vec(self.R[i], h)
+            P = P - ring.dot(g, [m * self.p[i][k] + Rh[k] for k in range(3)])
+        return ring.reduce(P)
+
+    def com_positions(self):
+        """World positions of the centres of mass, p_ci = p_i + R_i c_i (for the derivation's steps)."""
+        out = []
+        for i in range(self.n):
+            c = [self._c(x) for x in self.com[i]]
+            Rc = self._vec(self.R[i], c)
+            out.append([self.ring.reduce(self.p[i][k] + Rc[k]) for k in range(3)])
+        return out
+
+    def world_angular_jacobian(self, i):
+        return self._mat(self.R[i], self.Jw[i])
+
+
+def christoffel(ring: TrigRing, D):
+    """c[i][j][k] = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2 (Spong eq. 9.58), symmetric in i, j."""
+    n = len(D)
+    half = ring.const(sp.Rational(1, 2))
+    dD = [[[ring.diff_q(D[a][b], i) for i in range(n)] for b in range(n)] for a in range(n)]  # dD[a][b][i]
+    c = [[[None] * n for _ in range(n)] for _ in range(n)]
+    for i in range(n):
+        for j in range(i, n):
+            for k in range(n):
+                v = ring.reduce((dD[k][j][i] + dD[k][i][j] - dD[i][j][k]) * half)
+                c[i][j][k] = c[j][i][k] = v
+    return c
+
+
+def coriolis_matrix(ring: TrigRing, c):
+    """C[k][j] = sum_i c_ijk qd_i (Spong eq. 9.62)."""
+    n = len(c)
+    return [[ring.reduce(sum((c[i][j][k] * ring.velocity(i) for i in range(n)), ring.zero)) for j in range(n)] for k in range(n)]
+
+
+def derive_lagrange(model: RingModel):
+    """The Euler-Lagrange equations from K and P: returns a dict of ring elements (see module doc)."""
+    ring, n = model.ring, model.n
+    D = model.mass_matrix()
+    P = model.potential_energy()
+    # K = qd^T D qd / 2  (Spong 9.47)
+    half = ring.const(sp.Rational(1, 2))
+    K = ring.zero
+    for i in range(n):
+        K += D[i][i] * ring.velocity(i) ** 2 * half
+        for j in range(i + 1, n):
+            K += D[i][j] * ring.velocity(i) * ring.velocity(j)
+    K = ring.reduce(K)
+    L = K - P
+    dL_dqd = [ring.diff_qd(L, k) for k in range(n)]
+    ddt_dL_dqd = [ring.time_derivative(x) for x in dL_dqd]
+    dL_dq = [ring.diff_q(L, k) for k in range(n)]
+    tau = [ring.reduce(ddt_dL_dqd[k] - dL_dq[k]) for k in range(n)]
+    # M = d tau / d qdd ; g = tau(q, 0, 0) = dP/dq ; C from the Christoffel symbols of D
+    M = [[ring.diff_qdd(tau[k], j) for j in range(n)] for k in range(n)]
+    g = [ring.substitute_state(tau[k], qd_zero=True, qdd_zero=True) for k in range(n)]
+    c = christoffel(ring, D)
+    C = coriolis_matrix(ring, c)
+    # self-check (an identity, Spong 9.55-9.61): tau == M qdd + C qd + g, exactly
+    for k in range(n):
+        rhs = g[k]
+        for j in range(n):
+            rhs = rhs + M[k][j] * ring.acceleration(j) + C[k][j] * ring.velocity(j)
+        if not ring.is_zero(ring.reduce(rhs - tau[k]), tau[k]):
+            raise RuntimeError("internal error: Euler-Lagrange tau differs from M qdd + C qd + g")
+        for j in range(n):
+            if not ring.is_zero(M[k][j] - D[k][j], D[k][j]):
+                raise RuntimeError("internal error: d tau/d qdd differs from D(q)")
+    return dict(D=D, P=P, K=K, L=L, dL_dqd=dL_dqd, ddt_dL_dqd=ddt_dL_dqd, dL_dq=dL_dq, tau=tau, M=M, g=g, christoffel=c, C=C)

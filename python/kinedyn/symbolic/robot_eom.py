@@ -1,0 +1,210 @@
+"""Builds :class:`EquationsOfMotion` for a :class:`kinedyn.Robot` by either method."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .eom import EquationsOfMotion, Step
+from .lagrange import RingModel, _exact, christoffel, coriolis_matrix, derive_lagrange, latex_names, state_symbols
+from .newton_euler import newton_euler_program
+
+__all__ = ["lagrange_eom", "newton_euler_eom", "general_parameters"]
+
+
+def general_parameters(robot):
+    """Per-body symbols [M_j, MX_j, MY_j, MZ_j, XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j] (Khalil & Dombre's
+    names for the standard parameters about the body origin): a robot with general symbolic inertias."""
+    out = []
+    for j in range(1, robot.n + 1):
+        out.append(list(sp.symbols(f"M{j} MX{j} MY{j} MZ{j} XX{j} XY{j} YY{j} XZ{j} YZ{j} ZZ{j}", real=True)))
+    return out
+
+
+class _Inertias:
+    """Adapter: a 10-vector of parameters where RingModel expects an Inertia."""
+
+    def __init__(self, pi):
+        self._pi = list(pi)
+        m = pi[0]
+        self.com = tuple(sp.sympify(h) / m for h in pi[1:4]) if m != 0 else (0, 0, 0)
+
+    def parameters(self):
+        return self._pi
+
+
+def _friction(robot, qd):
+    return sp.Matrix([_exact(b.joint.viscous) * v + _exact(b.joint.coulomb) * sp.sign(v) for b, v in zip(robot.tree.bodies, qd)])
+
+
+def _outputs(model, d, simplify):
+    ring = model.ring
+    conv = (lambda p: ring.to_sympy(p)) if simplify else ring.to_product_form
+    mat = lambda rows: sp.Matrix([[conv(e) for e in row] for row in rows])
+    vec = lambda xs: sp.Matrix([conv(e) for e in xs])
+    return conv, mat, vec
+
+
+def _steps(robot, model, d, conv, mat, vec, q, qd):
+    """The derivation in the tutorial's order (Spong §9.2-9.3, eqs. 9.45-9.62)."""
+    ring, n = model.ring, model.n
+    steps = []
+    try:
+        pc = model.com_positions()
+        st = Step("Centre-of-mass positions r_ci(q) in the base frame", "Each link's centre of mass, from the forward kinematics.")
+        for i in range(n):
+            st.equations.append((f"r_{{c{i + 1}}}", vec(pc[i])))
+        steps.append(st)
+        st = Step("Velocity Jacobians", "v_ci = J_vci(q) qd and omega_i = J_wi(q) qd (Spong eq. 9.45); J_vci = d r_ci / dq.")
+        for i in range(n):
+            Jvc = [[ring.diff_q(pc[i][k], j) for j in range(n)] for k in range(3)]
+            st.equations.append((f"J_{{v_{{c{i + 1}}}}}", mat(Jvc)))
+            st.equations.append((f"J_{{\\omega_{{{i + 1}}}}}", mat(model.world_angular_jacobian(i))))
+        steps.append(st)
+    except Exception:  # centre of mass not polynomial (e.g. h/m with symbolic m): skip the display step
+        pass
+    qdv = sp.Matrix(qd)
+    steps.append(Step(
+        "Kinetic energy K = qd^T D(q) qd / 2",
+        "D(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
+        [("D(q)", mat(d["D"])), ("K", conv(d["K"]))],
+    ))
+    steps.append(Step("Potential energy P = sum_i m_i g^T r_ci", "(Spong eqs. 9.48-9.49; g points along gravity)", [("P", conv(d["P"]))]))
+    steps.append(Step("Lagrangian L = K - P", "", [(r"\mathcal{L}", conv(d["L"]))]))
+    st = Step("Derivatives of the Lagrangian", "For each coordinate: dL/dqd_k, its time derivative, and dL/dq_k (Spong eq. 9.40).")
+    names = [sp.latex(x) for x in q]
+    for k in range(n):
+        st.equations.append((f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial \\dot{{{names[k]}}}}}", conv(d["dL_dqd"][k])))
+        st.equations.append((f"\\frac{{d}}{{dt}}\\frac{{\\partial \\mathcal{{L}}}}{{\\partial \\dot{{{names[k]}}}}}", conv(d["ddt_dL_dqd"][k])))
+        st.equations.append((f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {names[k]}}}", conv(d["dL_dq"][k])))
+    steps.append(st)
+    st = Step("Joint torques tau_k = d/dt dL/dqd_k - dL/dq_k", "Friction, if any, is added separately: viscous qd + coulomb sign(qd).")
+    for k in range(n):
+        st.equations.append((f"\\tau_{{{k + 1}}}", conv(d["tau"][k])))
+    steps.append(st)
+    st = Step("Christoffel symbols c_ijk (non-zero ones)", "c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2 (Spong eq. 9.58), C_kj = sum_i c_ijk qd_i (eq. 9.62).")
+    c = d["christoffel"]
+    for k in range(n):
+        for i in range(n):
+            for j in range(i, n):
+                if c[i][j][k]:
+                    st.equations.append((f"c_{{{i + 1}{j + 1}{k + 1}}}", conv(c[i][j][k])))
+    steps.append(st)
+    return steps
+
+
+def _christoffel_sympy(c, conv):
+    n = len(c)
+    return [[[conv(c[i][j][k]) for k in range(n)] for j in range(n)] for i in range(n)]
+
+
+def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, parameters=None) -> EquationsOfMotion:
+    q, qd, qdd = state_symbols(robot)
+    inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
+    model = RingModel(robot, q, qd, qdd, inertias=inertias)
+    d = derive_lagrange(model)
+    conv, mat, vec = _outputs(model, d, simplify)
+    friction = _friction(robot, qd)
+    eom = EquationsOfMotion(
+        q, qd, qdd,
+        M=lambda: mat(d["M"]),
+        C=lambda: mat(d["C"]),
+        g=lambda: vec(d["g"]),
+        K=lambda: conv(d["K"]),
+        P=lambda: conv(d["P"]),
+        friction=friction,
+        christoffel=lambda: _christoffel_sympy(d["christoffel"], conv),
+        tau=lambda: vec(d["tau"]) + friction,
+        steps=(lambda: _steps(robot, model, d, conv, mat, vec, q, qd)) if with_steps else None,
+        name=robot.name,
+        method="lagrange",
+        latex_names=latex_names(q, qd, qdd),
+        model=(model, d),
+    )
+    return eom
+
+
+def _ring_converter(model):
+    """convert(expr, env) for Program.evaluate: SymPy expression -> exact ring element."""
+    ring = model.ring
+    qset = set(model.q)
+
+    def convert(e, env):
+        if e in env:
+            return env[e]
+        if e.is_Symbol:
+            if e in model.qd:
+                return ring.velocity(model.qd.index(e))
+            if e in model.qdd:
+                return ring.acceleration(model.qdd.index(e))
+            if e in qset:
+                return ring.coordinate(model.q.index(e))
+            return ring.const(e)
+        if isinstance(e, (sp.sin, sp.cos)):
+            arg = e.args[0]
+            i = next(k for k, x in enumerate(model.q) if arg.has(x))
+            off = sp.expand(arg - model.q[i])
+            return ring.cos(i, off) if isinstance(e, sp.cos) else ring.sin(i, off)
+        if not (e.free_symbols & (set(env) | qset | set(model.qd) | set(model.qdd))):
+            return ring.const(e)
+        if e.is_Add:
+            out = ring.zero
+            for a in e.args:
+                out += convert(a, env)
+            return out
+        if e.is_Mul:
+            out = ring.one
+            for a in e.args:
+                out = ring.reduce(out * convert(a, env))
+            return out
+        if e.is_Pow and e.exp.is_Integer and e.exp > 0:
+            base = convert(e.base, env)
+            out = ring.one
+            for _ in range(int(e.exp)):
+                out = ring.reduce(out * base)
+            return out
+        raise ValueError(f"cannot evaluate {e} exactly")
+
+    return convert
+
+
+def newton_euler_eom(robot, simplify: bool = True, parameters=None) -> EquationsOfMotion:
+    """Equations from the customised Newton-Euler model; tau, M, g, C come from the program alone
+    (M = d tau / d qdd and g = tau(q, 0, 0) of the exactly evaluated program, C from M's Christoffel
+    symbols), P and K from the kinematics."""
+    q, qd, qdd = state_symbols(robot)
+    prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
+    friction = _friction(robot, qd)
+    inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
+    cache = {}
+
+    def derived():
+        if not cache:
+            model = RingModel(robot, q, qd, qdd, inertias=inertias)
+            ring, n = model.ring, model.n
+            tau = [ring.reduce(t) for t in prog.evaluate(_ring_converter(model))]
+            M = [[ring.diff_qdd(tau[k], j) for j in range(n)] for k in range(n)]
+            g = [ring.substitute_state(t, qd_zero=True, qdd_zero=True) for t in tau]
+            c = christoffel(ring, M)
+            C = coriolis_matrix(ring, c)
+            P = model.potential_energy()
+            cache.update(model=model, tau=tau, M=M, g=g, christoffel=c, C=C, P=P)
+            conv, mat, vec = _outputs(model, None, simplify)
+            cache.update(conv=conv, mat=mat, vec=vec)
+        return cache
+
+    eom = EquationsOfMotion(
+        q, qd, qdd,
+        M=lambda: derived()["mat"](derived()["M"]),
+        C=lambda: derived()["mat"](derived()["C"]),
+        g=lambda: derived()["vec"](derived()["g"]),
+        P=lambda: derived()["conv"](derived()["P"]),
+        friction=friction,
+        christoffel=lambda: _christoffel_sympy(derived()["christoffel"], derived()["conv"]),
+        tau=lambda: derived()["vec"](derived()["tau"]) + friction,
+        name=robot.name,
+        method="newton_euler",
+        latex_names=latex_names(q, qd, qdd),
+        program=prog,
+    )
+    eom._derived = derived
+    return eom

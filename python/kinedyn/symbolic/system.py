@@ -1,0 +1,353 @@
+"""``LagrangianSystem``: equations of motion of any mechanism from its Lagrangian (LaValle §13.4,
+Spong §9.1-9.3), not only joint-coordinate robots.
+
+    L(q, qd, t) = K - P, or given directly
+    d/dt dL/dqd - dL/dq = u - B(q, qd) - A(q)^T lambda                  (LaValle 13.136, 13.181, 13.173)
+    natural systems (K = qd^T M(q) qd / 2, P = P(q)):
+        M(q) qdd + C(q, qd) qd + g(q) + B(q, qd) + A(q)^T lambda = u     (LaValle 13.183; C by Spong 9.58)
+    constraints: holonomic g_c(q) = 0 (A = d g_c / dq, LaValle 13.171) and Pfaffian A(q) qd = 0 (13.170).
+    Multipliers, from A qdd + (dA/dt) qd = 0:
+        lambda = (A M^-1 A^T)^-1 (A M^-1 (u - C qd - g - B) + (dA/dt) qd)
+    (LaValle's eqs. 13.180 / 13.184 leave out the (dA/dt) qd term, which is not zero when A depends
+    on q — for the particle on a sphere it is 2 |qd|^2 — and 13.180 also drops g; both kept here.)
+    Hamiltonian form: p = dL/dqd (= M qd), H = p.qd - L, qdot = dH/dp, pdot = -dH/dq + u - B.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Optional, Sequence
+
+import sympy as sp
+from sympy.core.function import AppliedUndef
+
+from .eom import EquationsOfMotion, Step
+from .simplify import simplify_trig
+
+__all__ = ["LagrangianSystem", "coordinates"]
+
+
+def _rate_names(name: str):
+    m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
+    return (f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (f"{name}_d", f"{name}_dd")
+
+
+def coordinates(names):
+    """(q, qd): real symbols for generalised coordinates and their velocities, e.g.
+    ``coordinates("p1 p2")`` -> ([p1, p2], [pd1, pd2]); ``coordinates("x")`` -> ([x], [x_d])."""
+    if isinstance(names, str):
+        names = names.replace(",", " ").split()
+    q = [sp.Symbol(n, real=True) for n in names]
+    qd = [sp.Symbol(_rate_names(n)[0], real=True) for n in names]
+    return q, qd
+
+
+def _as_list(value, what):
+    if value is None:
+        return []
+    if isinstance(value, sp.MatrixBase):
+        if value.shape[1] != 1 and value.shape[0] != 1:
+            raise ValueError(f"{what} must be a vector (a list or a column), got a {value.shape[0]}x{value.shape[1]} matrix")
+        return list(value)
+    if isinstance(value, sp.Basic):
+        return [value]
+    out = []
+    for v in value:
+        if isinstance(v, (list, tuple, sp.MatrixBase)):
+            raise ValueError(f"{what} must be a flat list of scalar expressions, got a nested entry {v!r}")
+        out.append(sp.sympify(v))
+    return out
+
+
+class LagrangianSystem:
+    """A mechanical system described by generalised coordinates and its Lagrangian.
+
+    ``LagrangianSystem(q, K=..., P=...)``, ``LagrangianSystem(q, L=...)``, or
+    :meth:`from_bodies`. ``q``: symbols (or names, or ``dynamicsymbols`` functions of time);
+    ``qd``: their velocity symbols (default from :func:`coordinates`' naming); ``forces``: generalised
+    forces u (default symbols u1..un); ``B``: non-conservative forces B(q, qd) (on the left side, as
+    friction); ``holonomic``: expressions g_c(q) = 0; ``pfaffian``: a k x n matrix A(q), A qd = 0.
+    """
+
+    def __init__(self, q, K=None, P=0, *, L=None, qd=None, t=None, forces=None, B=None, holonomic=None, pfaffian=None, name: str = ""):
+        q = list(q) if not isinstance(q, (str, sp.Basic)) else [q]
+        if not q:
+            raise ValueError("a Lagrangian system needs at least one generalised coordinate")
+        self.t = t if t is not None else sp.Symbol("t", real=True)
+        fun_rep = {}
+        coords = []
+        for c in q:
+            if isinstance(c, str):
+                if not re.fullmatch(r"[A-Za-z_]\w*", c):
+                    raise ValueError(f"coordinate name {c!r} is not a valid symbol name")
+                c = sp.Symbol(c, real=True)
+            if isinstance(c, AppliedUndef):  # q(t) from dynamicsymbols
+                self.t = c.args[0]
+                sym = sp.Symbol(c.func.__name__, real=True)
+                fun_rep[c] = sym
+                c = sym
+            if not isinstance(c, sp.Symbol):
+                raise ValueError(f"generalised coordinate {c!r} is not a symbol: give plain SymPy symbols (or names), e.g. sympy.symbols('q1 q2')")
+            coords.append(c)
+        if len(set(coords)) != len(coords):
+            raise ValueError(f"generalised coordinates repeat: {coords}")
+        self.q = coords
+        self.n = n = len(coords)
+        if qd is None:
+            qd = [sp.Symbol(_rate_names(c.name)[0], real=True) for c in coords]
+        qd = list(qd)
+        if len(qd) != n or not all(isinstance(v, sp.Symbol) for v in qd):
+            raise ValueError(f"qd must be {n} symbols, one velocity per coordinate, got {qd!r}")
+        self.qd = qd
+        self.qdd = [sp.Symbol(_rate_names(c.name)[1], real=True) for c in coords]
+        # replace q(t), q'(t), q''(t) by symbols
+        rep = {}
+        for f, sym in fun_rep.items():
+            i = coords.index(sym)
+            rep[sp.Derivative(f, self.t, 2)] = self.qdd[i]
+            rep[sp.Derivative(f, self.t)] = qd[i]
+        self._rep = (rep, fun_rep)
+        sub = self._sub
+        if L is None and K is None:
+            raise ValueError("give the kinetic energy K (and potential energy P) or the Lagrangian L")
+        if L is not None and K is not None:
+            raise ValueError("give either K and P or L, not both")
+        self.K = sub(K) if K is not None else None
+        self.P = sub(P) if K is not None else None
+        self.L = sub(L) if L is not None else self.K - self.P
+        for i, (c, v) in enumerate(zip(coords, qd)):
+            if not self.L.has(v):
+                src = "kinetic energy K" if K is not None else "Lagrangian L"
+                raise ValueError(
+                    f"coordinate {c}: its velocity {v} does not appear in the {src}, so the mass matrix is "
+                    f"singular (free symbols of {src}: {sorted(map(str, (self.K if K is not None else self.L).free_symbols))}); "
+                    "was the coordinate misspelt, or is the energy written with other velocity symbols?"
+                )
+        self.u = sp.Matrix(sp.symbols(f"u1:{n + 1}", real=True)) if forces is None else sp.Matrix(_as_list(sub(forces), "forces"))
+        if len(self.u) != n:
+            raise ValueError(f"forces must have {n} entries (one per coordinate), got {len(self.u)}")
+        self.B = sp.zeros(n, 1) if B is None else sp.Matrix(_as_list(sub(B), "B"))
+        if len(self.B) != n:
+            raise ValueError(f"non-conservative forces B must have {n} entries, got {len(self.B)}")
+        self.holonomic = [sub(e) for e in _as_list(holonomic, "holonomic constraints")]
+        state = set(qd) | set(self.qdd)
+        for e in self.holonomic:
+            if e.free_symbols & state:
+                raise ValueError(f"holonomic constraint {e} = 0 depends on velocities; write it as a Pfaffian constraint A(q) qd = 0")
+        rows = []
+        if self.holonomic:
+            rows.append(sp.Matrix([[sp.diff(e, c) for c in coords] for e in self.holonomic]))
+        if pfaffian is not None:
+            A = sp.Matrix(sub(sp.Matrix(pfaffian))) if not isinstance(pfaffian, sp.MatrixBase) else sub(pfaffian)
+            if A.shape[1] != n:
+                raise ValueError(f"Pfaffian constraint matrix A must have shape (k, {n}) for A(q) qd = 0, got {A.shape}")
+            if A.free_symbols & state:
+                raise ValueError("Pfaffian constraint matrix A(q) must not depend on velocities")
+            rows.append(A)
+        self.A = sp.Matrix.vstack(*rows) if rows else sp.zeros(0, n)
+        self.lam = sp.Matrix(sp.symbols(f"lambda1:{self.A.shape[0] + 1}", real=True)) if self.A.shape[0] else sp.zeros(0, 1)
+        self.name = name
+
+    def _sub(self, e):
+        if e is None:
+            return None
+        rep, fun_rep = self._rep
+        if isinstance(e, (list, tuple)):
+            return [self._sub(x) for x in e]
+        e = sp.sympify(e)
+        if rep:
+            e = e.xreplace(rep).xreplace(fun_rep) if not isinstance(e, sp.MatrixBase) else e.xreplace(rep).xreplace(fun_rep)
+        return e
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_bodies(cls, q, bodies: Sequence[dict], gravity=None, qd=None, **kwargs) -> "LagrangianSystem":
+        """Bodies given by expressions of the coordinates (Spong eqs. 9.41, 9.48):
+
+        each body is a dict with ``mass``, ``position`` (centre of mass, 2 or 3 coordinates),
+        optionally ``inertia`` (a scalar for planar motion or a 3x3 matrix, about the centre of mass
+        in the axes of ``angular_velocity``) and ``angular_velocity`` (a scalar or a 3-vector,
+        expressed in those axes, as an expression of qd). ``gravity``: the gravity vector (same
+        dimension as the positions), e.g. (0, -g). K = sum m |v_c|^2 / 2 + w^T I w / 2, P = -sum m gravity . r_c.
+        """
+        q_syms, qd_syms = (list(q), list(qd)) if qd is not None else (list(q), None)
+        qs = [sp.Symbol(c, real=True) if isinstance(c, str) else c for c in q_syms]
+        vs = qd_syms or [sp.Symbol(_rate_names(c.name)[0], real=True) for c in qs]
+        K = sp.Integer(0)
+        P = sp.Integer(0)
+        for k, body in enumerate(bodies):
+            unknown = set(body) - {"mass", "position", "inertia", "angular_velocity", "name"}
+            if unknown:
+                raise ValueError(f"body {k + 1}: unknown keys {sorted(unknown)}")
+            m = sp.sympify(body["mass"])
+            r = sp.Matrix(body["position"])
+            v = r.jacobian(qs) * sp.Matrix(vs)
+            K += m * (v.T * v)[0, 0] / 2
+            if gravity is not None:
+                gv = sp.Matrix(gravity)
+                if gv.shape != r.shape:
+                    raise ValueError(f"body {k + 1}: gravity has {len(gv)} components but the position has {len(r)}")
+                P -= m * (gv.T * r)[0, 0]
+            if "angular_velocity" in body:
+                w = body["angular_velocity"]
+                I = body.get("inertia", 0)
+                if isinstance(w, (list, tuple, sp.MatrixBase)):
+                    w = sp.Matrix(w)
+                    K += (w.T * sp.Matrix(I) * w)[0, 0] / 2
+                else:
+                    K += sp.sympify(I) * sp.sympify(w) ** 2 / 2
+        return cls(qs, K=sp.expand(K), P=sp.expand(P), qd=vs, **kwargs)
+
+    # ------------------------------------------------------------------ derivation
+    def _dt(self, e):
+        """Total time derivative: sum de/dq qd + de/dqd qdd + de/dt."""
+        out = sp.diff(e, self.t)
+        for c, v, a in zip(self.q, self.qd, self.qdd):
+            out += sp.diff(e, c) * v + sp.diff(e, v) * a
+        return out
+
+    def _simp(self, e):
+        return simplify_trig(sp.expand(e), self._trig_coords(), prismatic=self._poly_coords())
+
+    def _poly_coords(self):
+        """Coordinates that appear outside sin/cos somewhere (treated as polynomial variables)."""
+        out = []
+        exprs = [self.L] + list(self.B) + list(self.A) + self.holonomic
+        for c in self.q:
+            for e in exprs:
+                stripped = e.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1))
+                if stripped.has(c):
+                    out.append(c)
+                    break
+        return out
+
+    def _trig_coords(self):
+        return list(self.q)
+
+    def euler_lagrange(self):
+        """[d/dt dL/dqd_k - dL/dq_k for k] (LaValle eq. 13.118 / 13.124), unsimplified."""
+        return [self._dt(sp.diff(self.L, v)) - sp.diff(self.L, c) for c, v in zip(self.q, self.qd)]
+
+    def is_natural(self) -> bool:
+        """True when L = qd^T M(q) qd / 2 - P(q) (kinetic energy quadratic in qd, no time)."""
+        M = sp.hessian(self.L, self.qd)
+        if M.free_symbols & (set(self.qd) | {self.t}):
+            return False
+        zero = {v: 0 for v in self.qd}
+        rest = sp.expand(self.L - (sp.Matrix(self.qd).T * M * sp.Matrix(self.qd))[0, 0] / 2 - self.L.subs(zero))
+        return rest == 0 and not self.L.subs(zero).has(self.t)
+
+    def equations_of_motion(self, simplify: bool = True) -> EquationsOfMotion:
+        """M, C, g (natural systems; otherwise C = 0 and g holds the whole bias h(q, qd)), with the
+        steps of the derivation; ``extra`` holds the constraint Jacobian A, multipliers and forces."""
+        n = self.n
+        simp = self._simp if simplify else sp.expand
+        EL = self.euler_lagrange()
+        M = sp.hessian(self.L, self.qd).applyfunc(simp)
+        zero_acc = {a: 0 for a in self.qdd}
+        h = sp.Matrix([sp.expand(e.subs(zero_acc)) for e in EL])
+        natural = self.is_natural()
+        if natural:
+            P = -self.L.subs({v: 0 for v in self.qd})
+            g = sp.Matrix([simp(sp.diff(P, c)) for c in self.q])
+            dM = [[[sp.diff(M[a, b], c) for c in self.q] for b in range(n)] for a in range(n)]
+            chris = [[[simp((dM[k][j][i] + dM[k][i][j] - dM[i][j][k]) / 2) for k in range(n)] for j in range(n)] for i in range(n)]
+            C = sp.Matrix(n, n, lambda k, j: simp(sum(chris[i][j][k] * self.qd[i] for i in range(n))))
+            K = simp((sp.Matrix(self.qd).T * M * sp.Matrix(self.qd))[0, 0] / 2)
+            P = simp(P)
+        else:
+            g = h.applyfunc(simp)
+            C = sp.zeros(n, n)
+            chris = None
+            K, P = None, None
+        steps = [
+            Step("Lagrangian", "L = K - P" if self.K is not None else "given directly", [(r"\mathcal{L}", self.L)]),
+            Step("Euler-Lagrange equations d/dt dL/dqd_k - dL/dq_k = u_k - B_k - (A^T lambda)_k", "(LaValle eqs. 13.118, 13.181, 13.173)",
+                 [(f"E_{{{k + 1}}}", simp(e)) for k, e in enumerate(EL)]),
+        ]
+        if self.A.shape[0]:
+            steps.append(Step("Constraints A(q) qd = 0", "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows", [("A(q)", self.A)]))
+        from .lagrange import latex_names
+
+        eom = EquationsOfMotion(
+            self.q, self.qd, self.qdd, M, C, g,
+            K=K if natural else (lambda: None), P=P if natural else (lambda: None), friction=self.B,
+            christoffel=chris, steps=steps, name=self.name, method="lagrange",
+            latex_names=latex_names(self.q, self.qd, self.qdd),
+            extra=dict(A=self.A, multipliers=self.lam, forces=self.u, natural=natural, bias=h),
+        )
+        if not natural:
+            eom._K = None
+            eom._P = None
+        return eom
+
+    def multipliers(self, u=None, M=None, bias=None):
+        """lambda = (A M^-1 A^T)^-1 (A M^-1 (u - h - B) + (dA/dt) qd), h = C qd + g (see module doc)."""
+        if not self.A.shape[0]:
+            return sp.zeros(0, 1)
+        u = self.u if u is None else sp.Matrix(u)
+        if M is None:
+            M = sp.hessian(self.L, self.qd)
+        if bias is None:
+            bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
+        Ad = self.A.applyfunc(self._dt)
+        Minv = M.inv()
+        S = self.A * Minv * self.A.T
+        rhs = self.A * Minv * (u - bias - self.B) + Ad * sp.Matrix(self.qd)
+        return S.LUsolve(rhs)
+
+    def phase_space(self, u=None, simplify: bool = False):
+        """(x, f): x = (q, qd), x' = f(x) = (qd, M^-1 (u - h - B - A^T lambda)) with the multipliers
+        eliminated (LaValle 13.148 generalised)."""
+        u = self.u if u is None else sp.Matrix(u)
+        M = sp.hessian(self.L, self.qd)
+        bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
+        rhs = u - bias - self.B
+        if self.A.shape[0]:
+            rhs = rhs - self.A.T * self.multipliers(u, M, bias)
+        qdd = M.LUsolve(rhs)
+        if simplify:
+            qdd = qdd.applyfunc(sp.simplify)
+        return sp.Matrix.vstack(sp.Matrix(self.q), sp.Matrix(self.qd)), sp.Matrix.vstack(sp.Matrix(self.qd), qdd)
+
+    def energy(self):
+        """The energy function H = sum qd_k dL/dqd_k - L (= K + P for natural systems)."""
+        return sp.expand(sum(v * sp.diff(self.L, v) for v in self.qd) - self.L)
+
+    def hamiltonian(self):
+        """(p, H(q, p), qdot, pdot): p = dL/dqd, Hamilton's equations qdot = dH/dp, pdot = -dH/dq + u - B
+        (natural systems; p = M qd)."""
+        if not self.is_natural():
+            raise ValueError("hamiltonian(): the Legendre transform is formed here for natural systems (L = qd^T M qd / 2 - P)")
+        p = sp.Matrix(sp.symbols(f"p1:{self.n + 1}", real=True))
+        M = sp.hessian(self.L, self.qd)
+        qd_of_p = M.LUsolve(p)  # qd = M^-1 p
+        P = -self.L.subs({v: 0 for v in self.qd})
+        H = (p.T * qd_of_p)[0, 0] / 2 + P  # H = p^T M^-1 p / 2 + P
+        qdot = sp.Matrix([sp.diff(H, pi) for pi in p])
+        B = self.B.subs(dict(zip(self.qd, qd_of_p)))
+        pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B
+        return p, H, qdot, pdot
+
+    def numeric(self, params=None, u=None):
+        """A NumPy right-hand side f(t, x) for scipy.integrate.solve_ivp (x = (q, qd)), with the
+        parameters and forces substituted from ``params`` / ``u`` (default forces zero)."""
+        import numpy as np
+
+        params = {sp.Symbol(k, real=True) if isinstance(k, str) else k: v for k, v in dict(params or {}).items()}
+        # match parameter symbols by name (users may create them without assumptions)
+        free = {}
+        x, f = self.phase_space(u=sp.zeros(self.n, 1) if u is None else u)
+        names = {str(k): v for k, v in params.items()}
+        for s in f.free_symbols - set(self.q) - set(self.qd):
+            if str(s) in names:
+                free[s] = names[str(s)]
+        f = f.subs(free)
+        left = f.free_symbols - set(self.q) - set(self.qd) - {self.t}
+        if left:
+            raise ValueError(f"give values for the parameters {sorted(map(str, left))}")
+        fn = sp.lambdify([self.t, list(x)], list(f), "numpy")
+        return lambda t, y: np.array(fn(t, y), dtype=float)
+
+    def __repr__(self) -> str:
+        return f"LagrangianSystem(q={self.q}, constraints={self.A.shape[0]})"
