@@ -197,3 +197,22 @@ def test_length_overrides_change_kinematics():
     assert longer[0, 3] - base[0, 3] == pytest.approx(0.5 - 0.4318)
     ur = frame_pose(kd.robots.ur5(d1=0.2), np.zeros(6))
     assert ur[2, 3] - frame_pose(kd.robots.ur5(), np.zeros(6))[2, 3] == pytest.approx(0.2 - 0.089159)
+
+
+@pytest.mark.parametrize("name", ["planar_2r", "planar_3r", "elbow_3r", "cartesian_2p"])
+def test_symbolic_builtins_carry_symbols_and_agree_with_numbers(name):
+    """symbolic=True keeps exact angles (sympy.pi / 2) and substitutes back to the numeric robot."""
+    import inspect
+
+    factory = kd.robots.CATALOGUE[name]
+    symbolic = factory(symbolic=True)
+    assert symbolic.is_symbolic
+    numeric = factory()
+    values = {p.name: p.default for p in inspect.signature(factory).parameters.values() if isinstance(p.default, float)}
+    if name == "planar_2r":  # derived defaults: centre of mass at mid-length, I = m l^2 / 12
+        values.update(lc1=1.0, lc2=1.5, I1=4 / 12, I2=9 / 12)
+    substituted = symbolic.subs({s: values[s.name] for s in symbolic.symbols})
+    assert not substituted.is_symbolic
+    q = numeric.random_configuration(np.random.default_rng(1))
+    np.testing.assert_allclose(substituted.pose(q), numeric.pose(q), atol=1e-12)
+    np.testing.assert_allclose(substituted.inertial_parameters(), numeric.inertial_parameters(), atol=1e-12)

@@ -56,8 +56,17 @@ def as_value(x: Any) -> Any:
     return float(x)
 
 
+def _has_sympy(v: Any) -> bool:
+    if isinstance(v, (sp.Basic, sp.MatrixBase)):
+        return True
+    if isinstance(v, (list, tuple)):
+        return any(_has_sympy(e) for e in v)
+    return False
+
+
 def _module(*values: Any):
-    return sp if is_symbolic(*values) else np
+    """SymPy for symbols and for exact SymPy numbers (pi / 2 stays exact), NumPy otherwise."""
+    return sp if any(_has_sympy(v) for v in values) else np
 
 
 def identity():
