@@ -85,11 +85,15 @@ def state_symbols(robot):
 
 def latex_names(q, qd, qdd) -> dict:
     """LaTeX names for the velocity/acceleration symbols (\\dot q_1, \\ddot q_1)."""
+    import re
+
     out = {}
     for a, b, c in zip(q, qd, qdd):
         base = sp.latex(a)
-        out[b] = r"\dot{" + base + "}"
-        out[c] = r"\ddot{" + base + "}"
+        m = re.fullmatch(r"(.+?)_\{(.+)\}", base)
+        head, tail = (m.group(1), "_{" + m.group(2) + "}") if m else (base, "")
+        out[b] = r"\dot{" + head + "}" + tail
+        out[c] = r"\ddot{" + head + "}" + tail
     return out
 
 
