@@ -5,6 +5,8 @@
 
 use std::sync::Mutex;
 
+mod ik;
+
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
@@ -457,5 +459,6 @@ impl PyModel {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
+    ik::register(m)?;
     Ok(())
 }

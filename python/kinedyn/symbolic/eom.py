@@ -176,7 +176,7 @@ class EquationsOfMotion:
     def hamiltonian(self):
         """(p, H(q, p), qdot(q, p), pdot(q, p)): momenta p = M qd and Hamilton's equations
         qdot = dH/dp, pdot = -dH/dq (+ generalised forces)."""
-        p = sp.Matrix(sp.symbols(f"p1:{self.n + 1}", real=True))
+        p = sp.Matrix([sp.Symbol(f"p_{c.name}", real=True) for c in self.q])  # momentum conjugate to each q
         Minv = self.M.inv() if self.n <= 3 else self.M.inv(method="LU")
         H = sp.expand((p.T * Minv * p)[0, 0] / 2) + self.P
         qdot = sp.Matrix([sp.diff(H, pi) for pi in p])
@@ -229,12 +229,14 @@ class EquationsOfMotion:
 
         return generate(self, language, what, name=name)
 
-    def compile(self, what: Sequence[str] = ("M", "C", "g", "tau"), backend: str = "auto", params=None):
+    def compile(self, what: Sequence[str] = ("M", "C", "g", "tau"), backend: str = "auto", params=None, p=None):
         """Fast callables for the requested matrices: C compiled with the system compiler when
-        available (``backend="c"``), NumPy otherwise; each accepts one state or a batch (N, n)."""
+        available (``backend="c"``), NumPy otherwise; each accepts one state or a batch (N, n).
+        ``params``: {symbol or name: value} substituted before generation; ``p``: values of the
+        parameters left symbolic, in ``eom.parameters`` order, passed to every call."""
         from .codegen import compile_eom
 
-        return compile_eom(self, what, backend=backend, params=params)
+        return compile_eom(self, what, backend=backend, params=params, p=p)
 
     def op_count(self, what: str = "tau", cse: bool = False) -> Dict[str, int]:
         """Operation counts of ``tau`` (or ``M``, ``g``...) as formed; for the Newton-Euler method the

@@ -319,7 +319,7 @@ class LagrangianSystem:
         (natural systems; p = M qd)."""
         if not self.is_natural():
             raise ValueError("hamiltonian(): the Legendre transform is formed here for natural systems (L = qd^T M qd / 2 - P)")
-        p = sp.Matrix(sp.symbols(f"p1:{self.n + 1}", real=True))
+        p = sp.Matrix([sp.Symbol(f"p_{c.name}", real=True) for c in self.q])  # momentum conjugate to each q
         M = sp.hessian(self.L, self.qd)
         qd_of_p = M.LUsolve(p)  # qd = M^-1 p
         P = -self.L.subs({v: 0 for v in self.qd})

@@ -1,0 +1,495 @@
+//! Inverse kinematics: closed forms where the geometry has one, Levenberg-Marquardt everywhere.
+//!
+//! **Pose error** (base axes, `[linear; angular]` as everywhere in kinedyn):
+//!
+//! ```text
+//! e(q) = [ p_d - p(q) ;  log(R_d R(q)^T) ]          (6,)
+//! ```
+//!
+//! the log map of the pose error on R^3 x SO(3) expressed in base axes; to first order
+//! `de = J(q) dq` with `J` the world-aligned geometric Jacobian (`Reference::World`), which is why
+//! masks and weights act on base-axis components (x, y, z, rx, ry, rz).
+//!
+//! **Numeric solver** (`numeric_ik`): Levenberg-Marquardt with Sugihara's damping, "Solvability-
+//! unconcerned inverse kinematics by the Levenberg-Marquardt method", IEEE T-RO 27(5), 2011:
+//!
+//! ```text
+//! (J^T W J + lambda I) dq = J^T W e,     lambda = E + mu,     E = 1/2 e^T W e
+//! ```
+//!
+//! where Sugihara's constant bias `w_bar` (`lambda_min`) is made adaptive as in Marquardt's method:
+//! `mu` starts at `lambda_min`, shrinks tenfold after an accepted step (to 1e-14, so that the last
+//! steps are Gauss-Newton steps even near a singularity) and grows tenfold after a rejected one.
+//! The system is solved in task space, `dq = A^T (A A^T + lambda I)^-1 W^1/2 e` with `A = W^1/2 J` (a 6 x 6
+//! Cholesky solve whatever n is). A step is accepted only if it lowers E; joint limits are kept by
+//! projecting q on its box after each step, holding the joints that rest on a limit the step
+//! would cross (an active set); a run that stalls restarts from a random
+//! configuration inside the limits (seeded, so batches are reproducible).
+//!
+//! **Closed forms** (`analytic`, `subproblems`): candidates from the Paden-Kahan subproblems, mapped
+//! to q (`q = theta - offset`, revolute angles moved by 2 pi k into the limits, nearest the caller's
+//! reference), verified by forward kinematics and refined by a few Gauss-Newton steps
+//! (`analytic_solutions`).
+//!
+//! | symbol   | here          | meaning                                                  |
+//! |----------|---------------|----------------------------------------------------------|
+//! | `e`      | `e: [f64; 6]` | pose error `[p_d - p; log(R_d R^T)]`, base axes          |
+//! | `W`      | `weights`     | diagonal weights (mask) of the six error components      |
+//! | `J`      | `jac`         | world-aligned geometric Jacobian, 6 x n row-major         |
+//! | `lambda` | `lambda`      | damping                                                  |
+
+pub mod analytic;
+pub mod subproblems;
+
+pub use analytic::{AnalyticIk, Screw, Structure};
+
+use super::jacobian::{frame_jacobian, frame_pose_at, Reference};
+use crate::data::Data;
+use crate::model::Model;
+use crate::joint::JointKind;
+use crate::spatial::{Mat3, Transform, Vec3};
+use nalgebra::{Matrix6, Vector6};
+use std::f64::consts::PI;
+
+/// `log(R)` of a rotation matrix as a rotation vector (angle in [0, pi]), accurate near 0 and pi.
+pub fn log_so3(r: &Mat3) -> Vec3 {
+    // vee(R - R^T) = 2 sin(theta) w,  trace(R) = 1 + 2 cos(theta)
+    let v = Vec3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
+    let s = 0.5 * v.norm();
+    let c = 0.5 * (r.trace() - 1.0);
+    let theta = s.atan2(c);
+    if theta < 1e-6 {
+        // theta / (2 sin theta) = 1/2 + theta^2 / 12 + ...
+        return v * (0.5 + theta * theta / 12.0);
+    }
+    if theta < PI - 1e-4 {
+        return v * (theta / (2.0 * s));
+    }
+    // near pi: (R + R^T)/2 - cos(theta) I = (1 - cos(theta)) w w^T; w from its largest column, sign from v
+    let b = ((r + r.transpose()) * 0.5 - Mat3::identity() * c) / (1.0 - c);
+    let k = (0..3).max_by(|&i, &j| b[(i, i)].partial_cmp(&b[(j, j)]).unwrap()).unwrap();
+    let mut w = b.column(k).into_owned() / b[(k, k)].max(1e-300).sqrt();
+    w.normalize_mut();
+    if w.dot(&v) < 0.0 {
+        w = -w;
+    }
+    w * theta
+}
+
+/// Pose error `[p_d - p; log(R_d R^T)]` of `current` towards `target` (base axes).
+#[inline]
+pub fn pose_error(current: &Transform, target: &Transform) -> [f64; 6] {
+    let dp = target.trans - current.trans;
+    let dr = log_so3(&(target.rot * current.rot.transpose()));
+    [dp.x, dp.y, dp.z, dr.x, dr.y, dr.z]
+}
+
+/// Norms of the weighted position and orientation parts (components with weight 0 are ignored).
+#[inline]
+fn residuals(e: &[f64; 6], weights: &[f64; 6]) -> (f64, f64) {
+    let mut sq = [0.0; 2];
+    for k in 0..6 {
+        if weights[k] > 0.0 {
+            sq[k / 3] += e[k] * e[k];
+        }
+    }
+    (sq[0].sqrt(), sq[1].sqrt())
+}
+
+/// Settings of the numeric solver.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Weights of `[x, y, z, rx, ry, rz]`; a zero drops the component (position-only: `[1,1,1,0,0,0]`).
+    pub weights: [f64; 6],
+    /// Iterations per attempt.
+    pub max_iterations: usize,
+    /// Random restarts after the first attempt.
+    pub restarts: usize,
+    /// Success: position error (m) and orientation error (rad) below these.
+    pub position_tolerance: f64,
+    pub orientation_tolerance: f64,
+    /// Sugihara's bias damping `w_bar`.
+    pub lambda_min: f64,
+    /// Largest change of one joint in one step (rad or m).
+    pub max_step: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            weights: [1.0; 6],
+            max_iterations: 50,
+            restarts: 50,
+            position_tolerance: 1e-10,
+            orientation_tolerance: 1e-10,
+            lambda_min: 1e-6,
+            max_step: 0.5,
+        }
+    }
+}
+
+/// Result of one numeric solve.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub q: Vec<f64>,
+    pub success: bool,
+    pub position_error: f64,
+    pub orientation_error: f64,
+    /// Iterations over all attempts.
+    pub iterations: usize,
+    /// Attempts made (1 + restarts used).
+    pub attempts: usize,
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): a small seeded generator for restarts.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// A random configuration inside the limits (infinite limits: +-pi for revolute joints,
+/// +-1 m around `center` for prismatic ones).
+fn random_configuration(model: &Model, lower: &[f64], upper: &[f64], center: &[f64], rng: &mut Rng, out: &mut [f64]) {
+    for i in 0..model.n {
+        let span = if model.joints[i].kind == JointKind::Revolute { PI } else { 1.0 };
+        let lo = if lower[i].is_finite() { lower[i] } else if upper[i].is_finite() { upper[i] - 2.0 * span } else { center[i] - span };
+        let hi = if upper[i].is_finite() { upper[i] } else { lo + 2.0 * span };
+        out[i] = lo + (hi - lo) * rng.uniform();
+    }
+}
+
+#[inline]
+fn clamp_into(q: &mut [f64], lower: &[f64], upper: &[f64]) {
+    for i in 0..q.len() {
+        q[i] = q[i].clamp(lower[i], upper[i]);
+    }
+}
+
+/// Weighted cost `E = 1/2 e^T W e`.
+#[inline]
+fn cost(e: &[f64; 6], weights: &[f64; 6]) -> f64 {
+    0.5 * (0..6).map(|k| weights[k] * e[k] * e[k]).sum::<f64>()
+}
+
+/// Levenberg-Marquardt towards `target` for `frame`, from `q0`, within `[lower, upper]`.
+#[allow(clippy::too_many_arguments)]
+pub fn numeric_ik(
+    model: &Model,
+    data: &mut Data,
+    frame: usize,
+    target: &Transform,
+    q0: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    settings: &Settings,
+    seed: u64,
+) -> Outcome {
+    let n = model.n;
+    let w = &settings.weights;
+    let w_sqrt: [f64; 6] = std::array::from_fn(|k| w[k].max(0.0).sqrt());
+    let mut rng = Rng::new(seed);
+    let mut jac = vec![0.0; 6 * n];
+    let mut q = q0.to_vec();
+    let mut trial = vec![0.0; n];
+    let mut dq = vec![0.0; n];
+    let mut blocked = vec![false; n];
+    let mut best = Outcome { q: q.clone(), success: false, position_error: f64::INFINITY, orientation_error: f64::INFINITY, iterations: 0, attempts: 0 };
+    let mut best_cost = f64::INFINITY;
+    let converged = |e: &[f64; 6]| {
+        let (ep, er) = residuals(e, w);
+        ep <= settings.position_tolerance && er <= settings.orientation_tolerance
+    };
+    for attempt in 0..=settings.restarts {
+        if attempt > 0 {
+            random_configuration(model, lower, upper, q0, &mut rng, &mut q);
+        }
+        clamp_into(&mut q, lower, upper);
+        best.attempts = attempt + 1;
+        let mut e = pose_error(&frame_pose_at(model, data, &q, frame), target);
+        let mut big_e = cost(&e, w);
+        // adaptive part of the damping: shrinks after accepted steps (fast final convergence, also
+        // near singular configurations), grows after rejected ones
+        let mut mu = settings.lambda_min;
+        let mut done = false;
+        for _ in 0..settings.max_iterations {
+            if converged(&e) {
+                done = true;
+                break;
+            }
+            best.iterations += 1;
+            frame_jacobian(model, data, &q, frame, Reference::World, None, &mut jac);
+            // joints resting on a limit that the step would push further out are held (their
+            // columns dropped) and the step recomputed: a projected LM with an active set
+            let lambda = big_e + mu;
+            blocked.fill(false);
+            let mut solved = false;
+            for _ in 0..=n {
+                // S = A A^T + lambda I,  A = W^1/2 J (held columns zeroed)
+                let mut s = Matrix6::<f64>::identity() * lambda;
+                for a in 0..6 {
+                    for b in a..6 {
+                        let mut acc = 0.0;
+                        for j in 0..n {
+                            if !blocked[j] {
+                                acc += jac[a * n + j] * jac[b * n + j];
+                            }
+                        }
+                        let v = w_sqrt[a] * w_sqrt[b] * acc;
+                        s[(a, b)] += v;
+                        if a != b {
+                            s[(b, a)] += v;
+                        }
+                    }
+                }
+                let rhs = Vector6::from_fn(|k, _| w_sqrt[k] * e[k]);
+                let Some(chol) = s.cholesky() else { break };
+                let y = chol.solve(&rhs);
+                // dq = A^T y
+                let mut newly = false;
+                for j in 0..n {
+                    dq[j] = if blocked[j] { 0.0 } else { (0..6).map(|k| jac[k * n + j] * w_sqrt[k] * y[k]).sum() };
+                    let out_low = q[j] <= lower[j] + 1e-12 && dq[j] < 0.0;
+                    let out_high = q[j] >= upper[j] - 1e-12 && dq[j] > 0.0;
+                    if !blocked[j] && (out_low || out_high) {
+                        blocked[j] = true;
+                        newly = true;
+                    }
+                }
+                solved = true;
+                if !newly {
+                    break;
+                }
+                solved = false;
+            }
+            if !solved {
+                // every direction is blocked or the system is degenerate: take the last step projected
+                if dq.iter().all(|d| *d == 0.0) {
+                    break;
+                }
+            }
+            // no joint moves more than max_step
+            let largest = dq.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+            let scale = if largest > settings.max_step { settings.max_step / largest } else { 1.0 };
+            for j in 0..n {
+                trial[j] = q[j] + scale * dq[j];
+            }
+            clamp_into(&mut trial, lower, upper);
+            let e_new = pose_error(&frame_pose_at(model, data, &trial, frame), target);
+            let big_e_new = cost(&e_new, w);
+            if big_e_new < big_e {
+                let gain = big_e - big_e_new;
+                q.copy_from_slice(&trial);
+                e = e_new;
+                big_e = big_e_new;
+                mu = (mu * 0.1).max(1e-14);
+                // stalled far from the target (a local minimum or a limit): restart
+                if gain <= 1e-14 * big_e && !converged(&e) {
+                    break;
+                }
+            } else {
+                mu = (mu * 10.0).max(settings.lambda_min);
+                if mu > 1e8 {
+                    break;
+                }
+            }
+        }
+        if big_e < best_cost || done {
+            best_cost = big_e;
+            let (ep, er) = residuals(&e, w);
+            best.q.copy_from_slice(&q);
+            best.position_error = ep;
+            best.orientation_error = er;
+        }
+        if done {
+            best.success = true;
+            return best;
+        }
+    }
+    best
+}
+
+/// The chain's joints as screws at theta = 0 (q = -offset) and the home pose of `frame`, if
+/// `frame` is carried by the last body of a serial chain moved by every joint (`parent[i] = i - 1`).
+pub fn chain_screws(model: &Model, data: &mut Data, frame: usize) -> Option<(Vec<Screw>, Transform)> {
+    let n = model.n;
+    if model.frames[frame].body != Some(n.checked_sub(1)?) || (0..n).any(|i| model.parent[i] != i.checked_sub(1)) {
+        return None;
+    }
+    let zero: Vec<f64> = model.offset.iter().map(|o| -o).collect();
+    let home = frame_pose_at(model, data, &zero, frame);
+    let screws = (0..n)
+        .map(|i| {
+            // body frame = joint frame at theta = 0: the axis through its origin
+            let x = &data.world_from_body[i];
+            let w = x.rot * model.joints[i].axis;
+            match model.joints[i].kind {
+                JointKind::Revolute => Screw::Revolute(subproblems::Axis { w, r: x.trans }),
+                JointKind::Prismatic => Screw::Prismatic(w),
+            }
+        })
+        .collect();
+    Some((screws, home))
+}
+
+/// The closed-form solver of `frame`'s chain, if its geometry has one (see `analytic`).
+pub fn detect_analytic(model: &Model, data: &mut Data, frame: usize) -> Option<AnalyticIk> {
+    let (screws, home) = chain_screws(model, data, frame)?;
+    AnalyticIk::detect(screws, home)
+}
+
+/// Solutions of a closed-form solve after mapping, checking and limits.
+#[derive(Clone, Debug, Default)]
+pub struct AnalyticOutcome {
+    /// Joint vectors (q, offsets removed), nearest to the reference first.
+    pub solutions: Vec<Vec<f64>>,
+    pub position_error: Vec<f64>,
+    pub orientation_error: Vec<f64>,
+    /// Distinct verified solutions before the joint-limit filter.
+    pub found: usize,
+    /// A non-isolated solution set was met (a free joint was set from the reference).
+    pub singular: bool,
+}
+
+/// Move a revolute angle by 2 pi k: inside `[lo, hi]` nearest `reference` when possible, else
+/// nearest `reference`.
+#[inline]
+fn wrap_angle(x: f64, lo: f64, hi: f64, reference: f64) -> f64 {
+    let two_pi = 2.0 * PI;
+    let near = x + two_pi * ((reference - x) / two_pi).round();
+    if near >= lo && near <= hi {
+        return near;
+    }
+    // the representatives inside [lo, hi], if any: the one nearest reference
+    let mut best: Option<f64> = None;
+    if lo.is_finite() {
+        let first = x + two_pi * ((lo - x) / two_pi).ceil();
+        let mut v = first;
+        while v <= hi + 1e-12 && v <= first + 4.0 * two_pi {
+            if best.is_none_or(|b| (v - reference).abs() < (b - reference).abs()) {
+                best = Some(v);
+            }
+            v += two_pi;
+        }
+    } else if hi.is_finite() {
+        let v = x - two_pi * ((x - hi) / two_pi).ceil();
+        best = Some(v);
+    }
+    best.unwrap_or(near)
+}
+
+/// Closed-form solutions of `solver` for `frame` at `target`, as joint vectors.
+///
+/// `reference`: the caller's q0 (wrapping, ordering and free joints at singular targets);
+/// `respect_limits`: drop solutions outside `[lower, upper]` (revolute angles are first moved by
+/// 2 pi k into them); `tolerance`: largest accepted position (m) / orientation (rad) error after
+/// refinement.
+#[allow(clippy::too_many_arguments)]
+pub fn analytic_solutions(
+    model: &Model,
+    data: &mut Data,
+    solver: &AnalyticIk,
+    frame: usize,
+    target: &Transform,
+    position_only: bool,
+    reference: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    respect_limits: bool,
+    tolerance: f64,
+) -> AnalyticOutcome {
+    let n = model.n;
+    let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
+    let mut candidates = Vec::with_capacity(8);
+    let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
+    let weights = if position_only { [1.0, 1.0, 1.0, 0.0, 0.0, 0.0] } else { [1.0; 6] };
+    let refine = Settings { weights, max_iterations: 8, restarts: 0, position_tolerance: 1e-13, orientation_tolerance: 1e-13, lambda_min: 1e-12, max_step: 0.1 };
+    let free = vec![f64::INFINITY; n];
+    let neg_free = vec![f64::NEG_INFINITY; n];
+    let mut out = AnalyticOutcome { singular, ..Default::default() };
+    let mut kept: Vec<(Vec<f64>, f64, f64, bool)> = Vec::with_capacity(candidates.len());
+    for theta in &candidates {
+        let mut q: Vec<f64> = (0..n).map(|i| theta[i] - model.offset[i]).collect();
+        for i in 0..n {
+            if model.joints[i].kind == JointKind::Revolute {
+                q[i] = wrap_angle(q[i], lower[i], upper[i], reference[i]);
+            }
+        }
+        let e = pose_error(&frame_pose_at(model, data, &q, frame), target);
+        let (mut ep, mut er) = residuals(&e, &weights);
+        if ep > 1e-12 || er > 1e-12 {
+            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits)
+            if ep < 1e-4 && er < 1e-4 {
+                let r = numeric_ik(model, data, frame, target, &q, &neg_free, &free, &refine, 0);
+                if r.position_error <= ep && r.orientation_error <= er {
+                    q = r.q;
+                    ep = r.position_error;
+                    er = r.orientation_error;
+                }
+            }
+        }
+        if ep > tolerance || er > tolerance {
+            continue;
+        }
+        // distinct modulo 2 pi
+        let same = kept.iter().any(|(k, _, _, _)| {
+            (0..n).all(|i| {
+                let d = k[i] - q[i];
+                let d = if model.joints[i].kind == JointKind::Revolute { d - 2.0 * PI * (d / (2.0 * PI)).round() } else { d };
+                d.abs() < 1e-7
+            })
+        });
+        if same {
+            continue;
+        }
+        let inside = (0..n).all(|i| q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
+        kept.push((q, ep, er, inside));
+    }
+    out.found = kept.len();
+    let mut chosen: Vec<_> = kept.into_iter().filter(|k| k.3 || !respect_limits).collect();
+    let distance = |q: &Vec<f64>| (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
+    chosen.sort_by(|a, b| distance(&a.0).partial_cmp(&distance(&b.0)).unwrap_or(std::cmp::Ordering::Equal));
+    for (q, ep, er, _) in chosen {
+        out.solutions.push(q);
+        out.position_error.push(ep);
+        out.orientation_error.push(er);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::joint::axis_angle;
+
+    #[test]
+    fn log_is_the_inverse_of_exp() {
+        for &(x, y, z) in &[(0.3, -0.2, 0.5), (1e-8, 0.0, 2e-8), (0.0, 0.0, PI - 1e-9), (PI / 3f64.sqrt(), -PI / 3f64.sqrt(), PI / 3f64.sqrt() - 1e-7)] {
+            let v = Vec3::new(x, y, z);
+            let r = axis_angle(&v.normalize(), v.norm());
+            let back = log_so3(&r);
+            assert!((back - v).norm() < 1e-7, "{v:?} -> {back:?}");
+        }
+    }
+
+    #[test]
+    fn wrap_prefers_the_reference_inside_limits() {
+        assert!((wrap_angle(3.0 * PI / 2.0, -PI, PI, 0.0) + PI / 2.0).abs() < 1e-12);
+        assert!((wrap_angle(-PI / 2.0, -2.0 * PI, 2.0 * PI, 4.0) - 3.0 * PI / 2.0).abs() < 1e-12);
+        assert!((wrap_angle(3.0, -1.0, 1.0, 0.0) - 3.0).abs() < 1e-12 || wrap_angle(3.0, -1.0, 1.0, 0.0) < -1.0);
+    }
+}

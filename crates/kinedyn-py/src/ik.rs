@@ -1,0 +1,308 @@
+//! Inverse kinematics glue: `solve_ik` (batched Levenberg-Marquardt) and `AnalyticIk` (closed
+//! forms detected from a model's geometry). Shapes and targets are checked here; the work is in
+//! `kinedyn_core::algorithms::ik`, run with the GIL released.
+
+use std::sync::Mutex;
+
+use kinedyn_core::algorithms::ik::{self, AnalyticIk as CoreAnalytic, Settings};
+use kinedyn_core::spatial::{Mat3, Transform, Vec3};
+use kinedyn_core::{Data, Model};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rayon::prelude::*;
+
+use crate::PyModel;
+
+/// One target: a pose (4x4) or a position (3,), checked.
+fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResult<Transform> {
+    let at = index.map(|k| format!(" (target {k})")).unwrap_or_default();
+    if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!("target contains a non-finite value (NaN or inf) at flat index {k}{at}")));
+    }
+    if position {
+        return Ok(Transform::new(Mat3::identity(), Vec3::new(values[0], values[1], values[2])));
+    }
+    let t = Transform::from_homogeneous(values);
+    let bottom = &values[12..16];
+    if bottom[0].abs() > 1e-9 || bottom[1].abs() > 1e-9 || bottom[2].abs() > 1e-9 || (bottom[3] - 1.0).abs() > 1e-9 {
+        return Err(PyValueError::new_err(format!("target is not an SE(3) matrix: its last row is {bottom:?}, not [0, 0, 0, 1]{at}")));
+    }
+    let off = (t.rot.transpose() * t.rot - Mat3::identity()).abs().max();
+    if off > 1e-6 || t.rot.determinant() < 0.0 {
+        return Err(PyValueError::new_err(format!(
+            "target is not an SE(3) matrix: its rotation part is not orthonormal with det +1 (|R^T R - I| = {off:.2e}, det = {:.6}){at}",
+            t.rot.determinant()
+        )));
+    }
+    Ok(t)
+}
+
+/// Targets (4, 4) / (N, 4, 4) or positions (3,) / (N, 3): (transforms, batch size, position-only).
+fn gather_targets(targets: &PyReadonlyArrayDyn<f64>) -> PyResult<(Vec<Transform>, Option<usize>, bool)> {
+    let shape = targets.shape().to_vec();
+    let (batch, position) = match shape.as_slice() {
+        [4, 4] => (None, false),
+        [3] => (None, true),
+        [b, 4, 4] => (Some(*b), false),
+        [b, 3] => (Some(*b), true),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape:?}"
+            )))
+        }
+    };
+    let view = targets.as_array();
+    let flat: Vec<f64> = match view.as_slice() {
+        Some(s) => s.to_vec(),
+        None => view.iter().copied().collect(),
+    };
+    let width = if position { 3 } else { 16 };
+    let list = flat
+        .chunks(width)
+        .enumerate()
+        .map(|(k, c)| parse_target(c, position, batch.map(|_| k)))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok((list, batch, position))
+}
+
+fn vector(name: &str, a: &PyReadonlyArrayDyn<f64>, len: usize) -> PyResult<Vec<f64>> {
+    if a.shape() != [len] {
+        return Err(PyValueError::new_err(format!("{name} must have shape ({len},), got {:?}", a.shape())));
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
+
+fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
+    for i in 0..lower.len() {
+        if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
+            return Err(PyValueError::new_err(format!("joint {i}: limits [{}, {}] are not an interval", lower[i], upper[i])));
+        }
+    }
+    Ok(())
+}
+
+/// Levenberg-Marquardt inverse kinematics of `frame` for one target or a batch.
+///
+/// targets: (4, 4) | (3,) | (N, 4, 4) | (N, 3) (positions use weights on x, y, z only);
+/// q0: (n,) or (N, n); lower, upper: (n,); weights: (6,) for [x, y, z, rx, ry, rz].
+/// Returns (q, success, position_error, orientation_error, iterations) with a leading N for a batch.
+#[pyfunction]
+#[pyo3(signature = (model, frame, targets, q0, lower, upper, weights, max_iterations=50, restarts=50, position_tolerance=1e-10, orientation_tolerance=1e-10, lambda_min=1e-6, max_step=0.5, seed=0))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn solve_ik<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    frame: i64,
+    targets: PyReadonlyArrayDyn<f64>,
+    q0: PyReadonlyArrayDyn<f64>,
+    lower: PyReadonlyArrayDyn<f64>,
+    upper: PyReadonlyArrayDyn<f64>,
+    weights: PyReadonlyArrayDyn<f64>,
+    max_iterations: usize,
+    restarts: usize,
+    position_tolerance: f64,
+    orientation_tolerance: f64,
+    lambda_min: f64,
+    max_step: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m: &Model = &model.model;
+    let n = m.n;
+    let frame = model.frame(frame)?;
+    let (targets, batch, position) = gather_targets(&targets)?;
+    let count = targets.len();
+    let lower = vector("lower", &lower, n)?;
+    let upper = vector("upper", &upper, n)?;
+    check_limits(&lower, &upper)?;
+    let w = vector("weights", &weights, 6)?;
+    if w.iter().any(|x| !x.is_finite() || *x < 0.0) || w.iter().all(|x| *x == 0.0) {
+        return Err(PyValueError::new_err(format!("weights must be 6 finite values >= 0, not all zero; got {w:?}")));
+    }
+    let mut weights: [f64; 6] = [w[0], w[1], w[2], w[3], w[4], w[5]];
+    if position {
+        weights[3..].fill(0.0);
+    }
+    let q0_shape = q0.shape().to_vec();
+    let q0s: Vec<f64> = q0.as_array().iter().copied().collect();
+    let per_target = match (q0_shape.as_slice(), batch) {
+        ([k], _) if *k == n => false,
+        ([b, k], Some(nb)) if *k == n && *b == nb => true,
+        _ => return Err(PyValueError::new_err(format!("q0 must have shape ({n},) or ({count}, {n}), got {q0_shape:?}"))),
+    };
+    if q0s.iter().any(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err("q0 contains a non-finite value"));
+    }
+    let settings = Settings { weights, max_iterations, restarts, position_tolerance, orientation_tolerance, lambda_min, max_step };
+    let solve_one = |data: &mut Data, k: usize| {
+        let start = if per_target { &q0s[k * n..(k + 1) * n] } else { &q0s[..] };
+        // a seed per target: results do not depend on how the batch is split among threads
+        ik::numeric_ik(m, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(k as u64))
+    };
+    let outcomes: Vec<ik::Outcome> = py.detach(|| {
+        if count <= 4 {
+            let mut data = model.data.lock().unwrap_or_else(|e| e.into_inner());
+            (0..count).map(|k| solve_one(&mut data, k)).collect()
+        } else {
+            (0..count).into_par_iter().map_init(|| Data::new(m), |data, k| solve_one(data, k)).collect()
+        }
+    });
+    let mut q = Vec::with_capacity(count * n);
+    for o in &outcomes {
+        q.extend_from_slice(&o.q);
+    }
+    let success: Vec<bool> = outcomes.iter().map(|o| o.success).collect();
+    let pe: Vec<f64> = outcomes.iter().map(|o| o.position_error).collect();
+    let oe: Vec<f64> = outcomes.iter().map(|o| o.orientation_error).collect();
+    let it: Vec<i64> = outcomes.iter().map(|o| o.iterations as i64).collect();
+    let q = PyArray1::from_vec(py, q);
+    let result = match batch {
+        Some(b) => (
+            q.reshape([b, n])?.into_any(),
+            PyArray1::from_vec(py, success).into_any(),
+            PyArray1::from_vec(py, pe).into_any(),
+            PyArray1::from_vec(py, oe).into_any(),
+            PyArray1::from_vec(py, it).into_any(),
+        ),
+        None => (
+            q.into_any(),
+            success[0].into_pyobject(py)?.to_owned().into_any(),
+            pe[0].into_pyobject(py)?.into_any(),
+            oe[0].into_pyobject(py)?.into_any(),
+            it[0].into_pyobject(py)?.into_any(),
+        ),
+    };
+    Ok(result.into_pyobject(py)?.into_any())
+}
+
+/// A closed-form solver detected from a model's geometry (`None` from `detect` when there is none).
+#[pyclass(name = "AnalyticIk", module = "kinedyn._core", frozen)]
+pub struct PyAnalyticIk {
+    solver: CoreAnalytic,
+    model: Model,
+    data: Mutex<Data>,
+    frame: usize,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+}
+
+#[pymethods]
+impl PyAnalyticIk {
+    /// The solver of `frame`'s chain, or None if its geometry has no closed form here.
+    #[staticmethod]
+    fn detect(model: &PyModel, frame: i64, lower: PyReadonlyArrayDyn<f64>, upper: PyReadonlyArrayDyn<f64>) -> PyResult<Option<Self>> {
+        let frame = model.frame(frame)?;
+        let m = model.model.clone();
+        let lower = vector("lower", &lower, m.n)?;
+        let upper = vector("upper", &upper, m.n)?;
+        check_limits(&lower, &upper)?;
+        let mut data = Data::new(&m);
+        Ok(ik::detect_analytic(&m, &mut data, frame).map(|solver| Self { solver, model: m, data: Mutex::new(data), frame, lower, upper }))
+    }
+
+    /// Name of the detected structure (e.g. "spherical_wrist").
+    #[getter]
+    fn structure(&self) -> &'static str {
+        self.solver.structure.name()
+    }
+
+    /// Name of the arm of a spherical-wrist chain, else None.
+    #[getter]
+    fn arm(&self) -> Option<&'static str> {
+        self.solver.arm.map(|a| a.name())
+    }
+
+    /// Whether position-only targets (3,) have a closed form (else only full poses do).
+    #[getter]
+    fn solves_position(&self) -> bool {
+        self.solver.structure.solves_position()
+    }
+
+    /// All solutions for one target (4, 4) or position (3,):
+    /// (solutions (m, n) nearest `reference` first, position errors (m,), orientation errors (m,),
+    ///  distinct solutions found before the limit filter, singular flag).
+    #[pyo3(signature = (target, reference, respect_limits=true, tolerance=1e-9))]
+    #[allow(clippy::type_complexity)]
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        target: PyReadonlyArrayDyn<f64>,
+        reference: PyReadonlyArrayDyn<f64>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, usize, bool)> {
+        let n = self.model.n;
+        let (targets, batch, position) = gather_targets(&target)?;
+        if batch.is_some() {
+            return Err(PyValueError::new_err("AnalyticIk.solve takes one target; use solve_nearest for a batch"));
+        }
+        let reference = vector("reference", &reference, n)?;
+        let out = {
+            let mut data = self.data.lock().unwrap_or_else(|e| e.into_inner());
+            ik::analytic_solutions(&self.model, &mut data, &self.solver, self.frame, &targets[0], position, &reference, &self.lower, &self.upper, respect_limits, tolerance)
+        };
+        let m = out.solutions.len();
+        let flat: Vec<f64> = out.solutions.concat();
+        Ok((
+            PyArray1::from_vec(py, flat).reshape([m, n])?,
+            PyArray1::from_vec(py, out.position_error),
+            PyArray1::from_vec(py, out.orientation_error),
+            out.found,
+            out.singular,
+        ))
+    }
+
+    /// The solution nearest each reference for a batch of targets: (q (N, n), success (N,),
+    /// position errors (N,), orientation errors (N,)); q is NaN where no solution exists.
+    #[pyo3(signature = (targets, references, respect_limits=true, tolerance=1e-9))]
+    #[allow(clippy::type_complexity)]
+    fn solve_nearest<'py>(
+        &self,
+        py: Python<'py>,
+        targets: PyReadonlyArrayDyn<f64>,
+        references: PyReadonlyArrayDyn<f64>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let n = self.model.n;
+        let (targets, _, position) = gather_targets(&targets)?;
+        let count = targets.len();
+        let refs: Vec<f64> = references.as_array().iter().copied().collect();
+        if references.shape() != [count, n] {
+            return Err(PyValueError::new_err(format!("references must have shape ({count}, {n}), got {:?}", references.shape())));
+        }
+        let results: Vec<(Vec<f64>, bool, f64, f64)> = py.detach(|| {
+            (0..count)
+                .into_par_iter()
+                .map_init(
+                    || Data::new(&self.model),
+                    |data, k| {
+                        let r = &refs[k * n..(k + 1) * n];
+                        let out = ik::analytic_solutions(&self.model, data, &self.solver, self.frame, &targets[k], position, r, &self.lower, &self.upper, respect_limits, tolerance);
+                        match out.solutions.first() {
+                            Some(q) => (q.clone(), true, out.position_error[0], out.orientation_error[0]),
+                            None => (vec![f64::NAN; n], false, f64::NAN, f64::NAN),
+                        }
+                    },
+                )
+                .collect()
+        });
+        let mut q = Vec::with_capacity(count * n);
+        for r in &results {
+            q.extend_from_slice(&r.0);
+        }
+        Ok((
+            PyArray1::from_vec(py, q).reshape([count, n])?,
+            PyArray1::from_vec(py, results.iter().map(|r| r.1).collect()),
+            PyArray1::from_vec(py, results.iter().map(|r| r.2).collect()),
+            PyArray1::from_vec(py, results.iter().map(|r| r.3).collect()),
+        ))
+    }
+}
+
+/// Register the IK functions and classes in `kinedyn._core`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(solve_ik, m)?)?;
+    m.add_class::<PyAnalyticIk>()?;
+    Ok(())
+}
