@@ -1,0 +1,210 @@
+"""Symbolic derivation benchmark (issue 4; not a timed test).
+
+Time to derive and simplify the equations of motion of the planar 2R and 3R arms, the elbow arm and
+the PUMA 560 with kinedyn (Lagrange with steps, and the customised Newton-Euler model), beside
+sympy.physics.mechanics LagrangesMethod and KanesMethod on the same mechanisms built from the same
+description, in the same run; operation counts before and after common-subexpression elimination.
+
+    PYTHONPATH=python python benches/bench_symbolic.py [--puma-lagranges] [--repeat N]
+
+LagrangesMethod on the PUMA 560 takes minutes: it runs only with --puma-lagranges, once, in a
+subprocess capped at 400 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import subprocess
+import sys
+import time
+import warnings
+
+import numpy as np
+import sympy as sp
+
+import kinedyn as kd
+from kinedyn.description.dh import DHRow
+from kinedyn.description.inertia import Inertia
+from kinedyn.symbolic.eom import _ops
+from kinedyn.symbolic.lagrange import _exact, _matrix
+from kinedyn.symbolic.robot_eom import general_parameters, newton_euler_eom
+
+warnings.filterwarnings("ignore")
+
+
+def elbow_symbolic():
+    try:
+        return kd.robots.elbow_3r(symbolic=True)
+    except Exception:  # the description cannot yet build it with an exact pi/2 twist
+        L1, L2, L3, m1, m2, m3, g = sp.symbols("L1 L2 L3 m1 m2 m3 g", positive=True)
+        rod = lambda m, L: Inertia(m, (L / 2 - L, 0, 0), ((0, 0, 0), (0, m * L**2 / 12, 0), (0, 0, m * L**2 / 12)))
+        link1 = Inertia(m1, (0, -L1 / 2, 0), ((m1 * L1**2 / 12, 0, 0), (0, 0, 0), (0, 0, m1 * L1**2 / 12)))
+        rows = [DHRow(d=L1, alpha=math.pi / 2, inertia=link1), DHRow(a=L2, inertia=rod(m2, L2)), DHRow(a=L3, inertia=rod(m3, L3))]
+        return kd.Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_3r")
+
+
+def mechanics_model(robot):
+    """The robot as sympy.physics.mechanics bodies (same placements, axes, inertias, gravity)."""
+    from sympy.physics.mechanics import Point, ReferenceFrame, RigidBody, dynamicsymbols, inertia
+
+    n = robot.n
+    q = dynamicsymbols(f"q1:{n + 1}")
+    N = ReferenceFrame("N")
+    O = Point("O")
+    O.set_vel(N, 0)
+    frames, origins, bodies, loads = [], [], [], []
+    gN = _exact(robot.gravity[0]) * N.x + _exact(robot.gravity[1]) * N.y + _exact(robot.gravity[2]) * N.z
+    for i, b in enumerate(robot.tree.bodies):
+        pf, po = (N, O) if b.parent < 0 else (frames[b.parent], origins[b.parent])
+        T = _matrix(b.placement)
+        R = sp.Matrix([row[:3] for row in T[:3]])
+        p = [row[3] for row in T[:3]]
+        F = ReferenceFrame(f"P{i + 1}")
+        F.orient_explicit(pf, R)
+        a = [_exact(x) for x in b.joint.axis]
+        avec = a[0] * F.x + a[1] * F.y + a[2] * F.z
+        jo = po.locatenew(f"J{i + 1}", p[0] * pf.x + p[1] * pf.y + p[2] * pf.z)
+        off = _exact(b.joint.offset)
+        if b.joint.kind == "revolute":
+            B = ReferenceFrame(f"B{i + 1}")
+            B.orient_axis(F, avec, q[i] + off)
+            bo = jo
+        else:
+            B = F
+            bo = jo.locatenew(f"O{i + 1}", (q[i] + off) * avec)
+        inert = b.inertia
+        c = [_exact(x) for x in inert.com]
+        com = bo.locatenew(f"C{i + 1}", c[0] * B.x + c[1] * B.y + c[2] * B.z)
+        com.set_vel(N, com.pos_from(O).dt(N))
+        I = [[_exact(x) for x in row] for row in inert.inertia]
+        m = _exact(inert.mass)
+        body = RigidBody(f"b{i + 1}", com, B, m, (inertia(B, I[0][0], I[1][1], I[2][2], I[0][1], I[1][2], I[0][2]), com))
+        body.potential_energy = -m * gN.dot(com.pos_from(O))
+        frames.append(B)
+        origins.append(bo)
+        bodies.append(body)
+        loads.append((com, m * gN))
+    return N, q, bodies, loads
+
+
+def lagranges(robot):
+    from sympy.physics.mechanics import LagrangesMethod, Lagrangian
+
+    N, q, bodies, _ = mechanics_model(robot)
+    t = time.perf_counter()
+    LM = LagrangesMethod(Lagrangian(N, *bodies), q)
+    eqs = LM.form_lagranges_equations()
+    return time.perf_counter() - t, list(eqs)
+
+
+def kanes(robot):
+    from sympy.physics.mechanics import KanesMethod, dynamicsymbols
+
+    N, q, bodies, loads = mechanics_model(robot)
+    u = dynamicsymbols(f"u1:{robot.n + 1}")
+    t = time.perf_counter()
+    KM = KanesMethod(N, q_ind=q, u_ind=u, kd_eqs=[qi.diff() - ui for qi, ui in zip(q, u)])
+    fr, frstar = KM.kanes_equations(bodies, loads)
+    return time.perf_counter() - t, list(fr + frstar)
+
+
+def counts(exprs):
+    before = _ops(exprs)["total"]
+    repl, red = sp.cse(exprs, order="none")
+    after = _ops([e for _, e in repl] + list(red))["total"]
+    return before, after
+
+
+def ours(robot, method):
+    t = time.perf_counter()
+    eom = robot.equations_of_motion(method=method, steps=False)
+    if method == "lagrange":
+        exprs = list(eom.tau)  # forms and simplifies M, C, g and tau
+    else:
+        exprs = [e for _, e in eom.program.assignments] + list(eom.program.outputs["tau"])
+    return time.perf_counter() - t, exprs, eom
+
+
+def row(name, what, seconds, exprs):
+    b, a = counts(exprs)
+    print(f"{name:10s} {what:34s} {seconds:9.3f} s   ops {b:8d}   after cse {a:7d}", flush=True)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--puma-lagranges", action="store_true", help="also run LagrangesMethod on the PUMA 560 (minutes; once, capped)")
+    ap.add_argument("--child", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child == "puma-lagranges":
+        sec, eqs = lagranges(kd.robots.puma560())
+        print(f"{sec:.3f} {_ops(eqs)['total']}")
+        return
+    arms = [("planar_2r", kd.robots.planar_2r(symbolic=True)), ("planar_3r", kd.robots.planar_3r(symbolic=True)), ("elbow_3r", elbow_symbolic())]
+    print(f"{'robot':10s} {'method':34s} {'time':>11s}")
+    for name, robot in arms:
+        sec, exprs, _ = ours(robot, "lagrange")
+        row(name, "kinedyn lagrange (simplified tau)", sec, exprs)
+        sec, exprs, _ = ours(robot, "newton_euler")
+        row(name, "kinedyn newton_euler (program)", sec, exprs)
+        sec, eqs = lagranges(robot)
+        row(name, "sympy LagrangesMethod", sec, eqs)
+        sec, eqs = kanes(robot)
+        row(name, "sympy KanesMethod", sec, eqs)
+    puma = kd.robots.puma560()
+    sec, exprs, eom = ours(puma, "lagrange")
+    row("puma560", "kinedyn lagrange (simplified tau)", sec, exprs)
+    t = time.perf_counter()
+    M, g = eom.M, eom.g
+    print(f"{'puma560':10s} {'  of which M and g closed form':34s} (M, g ready {time.perf_counter() - t:.3f} s after tau)")
+    sec, exprs, ne = ours(puma, "newton_euler")
+    row("puma560", "kinedyn newton_euler (numbers)", sec, exprs)
+    print(f"{'':10s} {'  ops of the customised model':34s} {ne.op_count()}")
+    t = time.perf_counter()
+    neg = newton_euler_eom(puma, parameters=general_parameters(puma))
+    sec = time.perf_counter() - t
+    exprs = [e for _, e in neg.program.assignments] + list(neg.program.outputs["tau"])
+    row("puma560", "kinedyn newton_euler (general I)", sec, exprs)
+    print(f"{'':10s} {'  ops of the customised model':34s} {neg.op_count()}")
+    sec, eqs = kanes(puma)
+    row("puma560", "sympy KanesMethod", sec, eqs)
+    if args.puma_lagranges:
+        try:
+            out = subprocess.run([sys.executable, __file__, "--child", "puma-lagranges"], capture_output=True, text=True, timeout=400)
+            sec, ops = out.stdout.split()
+            print(f"{'puma560':10s} {'sympy LagrangesMethod':34s} {float(sec):9.3f} s   ops {int(ops):8d}")
+        except subprocess.TimeoutExpired:
+            print(f"{'puma560':10s} {'sympy LagrangesMethod':34s} > 400 s (stopped)")
+    else:
+        print(f"{'puma560':10s} {'sympy LagrangesMethod':34s} skipped (about 190 s here; --puma-lagranges)")
+    # generated C for the PUMA's inverse dynamics vs the numeric engine's Newton-Euler
+    f = ne.compile(what=("tau",), backend="c")
+    rng = np.random.default_rng(0)
+    q, qd, qdd = rng.normal(size=(3, 6))
+    reps = 20000
+    t = time.perf_counter()
+    for _ in range(reps):
+        f.tau(q, qd, qdd)
+    c_single = (time.perf_counter() - t) / reps * 1e6
+    Q, QD, QDD = rng.normal(size=(3, 10000, 6))
+    t = time.perf_counter()
+    f.tau(Q, QD, QDD)
+    c_batch = (time.perf_counter() - t) / 10000 * 1e6
+    print(f"generated C (PUMA tau): {c_single:.2f} us per call from Python, {c_batch:.3f} us per state in a batch of 10000 ({f.backend})")
+    try:
+        puma.inverse_dynamics(q, qd, qdd)
+        t = time.perf_counter()
+        for _ in range(reps):
+            puma.inverse_dynamics(q, qd, qdd)
+        n_single = (time.perf_counter() - t) / reps * 1e6
+        t = time.perf_counter()
+        puma.inverse_dynamics(Q, QD, QDD)
+        n_batch = (time.perf_counter() - t) / 10000 * 1e6
+        print(f"numeric engine RNEA  : {n_single:.2f} us per call from Python, {n_batch:.3f} us per state in a batch of 10000")
+        print(f"ratio numeric/generated: single {n_single / c_single:.2f}, batch {n_batch / c_batch:.2f}")
+    except Exception as exc:  # the native module may not be built
+        print(f"numeric engine unavailable: {exc}")
+
+
+if __name__ == "__main__":
+    main()
