@@ -351,6 +351,14 @@ class Robot:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
         return self._model.jdot_qd(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
+    def inverse_kinematics(self, target, q0=None, mask=None, method: str = "auto", respect_limits: bool = True, **kwargs):
+        """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
+        position, or a batch): closed form where the geometry has one, else numeric. Returns an
+        ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        from .ik import inverse_kinematics
+
+        return inverse_kinematics(self, target, q0=q0, mask=mask, method=method, respect_limits=respect_limits, **kwargs)
+
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
     # friction = viscous qd + coulomb sign(qd), M including the reflected rotor inertia r^2 J_m.

@@ -1,0 +1,125 @@
+"""``kinedyn ik ROBOT --xyz X Y Z [--rpy R P Y] [--all] [--json]``: inverse kinematics from the shell.
+
+Registered by ``kinedyn.cli`` through :func:`add_ik_command`. Exit status 0 when a solution was
+found, 2 when none exists (out of reach, or every solution outside the joint limits).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .solve import METHODS, inverse_kinematics
+
+__all__ = ["add_ik_command", "run_ik", "target_from_args"]
+
+
+def add_ik_command(subparsers):
+    """Register the ``ik`` subcommand on an argparse ``subparsers`` object; returns its parser."""
+    p = subparsers.add_parser(
+        "ik",
+        help="inverse kinematics: the joint values that put the tool at a target",
+        description=(
+            "Every joint vector that puts the tool (or --frame) at the target, nearest --q0 first: closed form when "
+            "the robot's geometry has one (planar 2R/3R, elbow arms, spherical wrists, UR-type arms), else "
+            "Levenberg-Marquardt. Without --rpy the target is the position only. Example (the tutorial's challenge): "
+            "kinedyn ik elbow_3r --xyz 1.0 0.2 0.5 --all"
+        ),
+    )
+    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
+    p.add_argument("--xyz", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"), help="target position of the frame origin (m)")
+    p.add_argument("--rpy", nargs=3, type=float, metavar=("ROLL", "PITCH", "YAW"),
+                   help="target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) (radians; degrees with --deg); omit for a position-only target")
+    p.add_argument("--all", action="store_true", help="print every solution (default: only the one nearest q0)")
+    p.add_argument("--q0", nargs="+", type=float, metavar="Q", help="reference / start joint values (default zeros)")
+    p.add_argument("--deg", action="store_true", help="--rpy and --q0 in degrees; angles printed in degrees")
+    p.add_argument("--frame", help="frame to place (default: the tool)")
+    p.add_argument("--method", default="auto", choices=METHODS, help="closed form, numeric, or auto (default)")
+    p.add_argument("--ignore-limits", action="store_true", help="keep solutions outside the joint limits")
+    p.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    p.set_defaults(func=run_ik)
+    return p
+
+
+def target_from_args(xyz, rpy=None, degrees: bool = False) -> np.ndarray:
+    """A 3-vector (no rpy) or a 4x4 pose from command-line values."""
+    p = np.array(xyz, dtype=float)
+    if rpy is None:
+        return p
+    from .._math import rpy_to_matrix
+
+    r, pi, y = (math.radians(v) if degrees else float(v) for v in rpy)
+    T = np.array(rpy_to_matrix(r, pi, y), dtype=float)
+    T[:3, 3] = p
+    return T
+
+
+def _load(spec):
+    from .. import robots
+
+    try:
+        from ..cli import load_robot
+    except ImportError:  # pragma: no cover - the CLI module is always there in a full install
+        return robots.get(spec or robots.DEFAULT)
+    return load_robot(spec or robots.DEFAULT)
+
+
+def run_ik(args) -> int:
+    robot = _load(args.robot)
+    target = target_from_args(args.xyz, args.rpy, args.deg)
+    q0 = None
+    if args.q0 is not None:
+        from ..cli import parse_q
+
+        q0 = parse_q(args.q0, robot, args.deg)
+    result = inverse_kinematics(robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame)
+    shown = result.solutions if args.all else result.solutions[:1]
+    revolute = np.array([j.kind == "revolute" for j in robot.joints])
+
+    def angles(q):
+        return np.where(revolute, np.degrees(q), q) if args.deg else q
+
+    payload = {
+        "robot": robot.name,
+        "frame": args.frame or robot.tool,
+        "target": target,
+        "units": "deg/m" if args.deg else "rad/m",
+        **result.to_dict(),
+        "solutions": [angles(q) for q in shown],
+        "position_error": result.position_error[: len(shown)],
+        "orientation_error": result.orientation_error[: len(shown)],
+        "count": len(result.solutions),
+    }
+    if payload["nearest_q"] is not None:
+        payload["nearest_q"] = angles(result.nearest_q)
+
+    def render():
+        from ..cli import console
+        from rich.table import Table
+
+        c = console()
+        what = f"position {np.array2string(target, precision=6)}" if target.shape == (3,) else \
+            f"pose at {np.array2string(target[:3, 3], precision=6)}, rpy {np.array2string(np.asarray(args.rpy), precision=6)}{' deg' if args.deg else ' rad'}"
+        c.print(f"[bold]{robot.name}[/bold]: '{payload['frame']}' to {what}; solver {result.solver}")
+        if len(shown):
+            unit = "deg" if args.deg else "rad"
+            c.width = max(c.width, 12 * (robot.n + 3))  # never truncate the numbers
+            table = Table(title=f"{len(result.solutions)} solution(s) ({unit}, m), nearest q0 first" + ("" if args.all else " (--all lists every one)"), title_justify="left")
+            table.add_column("#", justify="right")
+            for k, j in enumerate(robot.joints):
+                table.add_column(f"q{k + 1}", justify="right")
+            table.add_column("|dp| m", justify="right")
+            table.add_column("|dR| rad", justify="right")
+            for k, q in enumerate(shown):
+                table.add_row(str(k + 1), *(f"{v:.4f}" for v in angles(q)), f"{result.position_error[k]:.0e}", f"{result.orientation_error[k]:.0e}")
+            c.print(table)
+            if robot.joint_names != [f"q{k + 1}" for k in range(robot.n)]:
+                c.print("joints: " + ", ".join(f"q{k + 1} = {name}" for k, name in enumerate(robot.joint_names)))
+        style = "green" if result.success else "bold red"
+        c.print(f"[{style}]{result.message}[/{style}]")
+
+    from ..cli import emit
+
+    emit(args, payload, render)
+    return 0 if result.success else 2

@@ -1,0 +1,353 @@
+"""``inverse_kinematics``: closed forms where the chain's geometry has one, Levenberg-Marquardt else.
+
+Both solvers run in the native core (``crates/kinedyn-core/src/algorithms/ik.rs``); this module
+checks the inputs, picks the solver and packs the answer into an :class:`IKResult`.
+
+Target: a 4x4 pose of ``frame`` (default: the robot's tool) in the base, or a 3-vector position of
+its origin; a batch ``(N, 4, 4)`` / ``(N, 3)`` returns an :class:`IKBatchResult`.
+Residuals: position error ``|p_d - p(q)|`` (m) and orientation error ``|log(R_d R(q)^T)|`` (rad).
+Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes (0 drops one).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+__all__ = ["IKResult", "IKBatchResult", "inverse_kinematics", "analytic_structure", "METHODS"]
+
+METHODS = ("auto", "analytic", "numeric")
+_POSITION_MASK = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+_FULL_MASK = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
+
+
+@dataclass(slots=True)
+class IKResult:
+    """Joint vectors that put a frame at a target, and how well they do.
+
+    ``solutions``: (m, n), nearest to q0 first (m = 0 when none was found); ``position_error``,
+    ``orientation_error``: (m,) residual of each (orientation 0 for position targets);
+    ``success``: at least one solution within tolerance; ``solver``: ``"analytic:<structure>"`` or
+    ``"numeric:lm"``; ``iterations``: LM iterations (0 for closed forms); ``reachable``: False when
+    a closed form proved the target out of reach (None when unknown, e.g. the numeric solver failed);
+    ``singular``: the target lies on a singularity (a joint was free: it was set from q0);
+    ``found``: solutions before the joint-limit filter; ``nearest``: for an unreachable position
+    target, the nearest point the frame can reach (``nearest_q`` puts it there).
+    """
+
+    solutions: np.ndarray
+    success: bool
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    iterations: int
+    solver: str
+    reachable: Optional[bool] = True
+    singular: bool = False
+    found: int = 0
+    nearest: Optional[np.ndarray] = None
+    nearest_q: Optional[np.ndarray] = None
+    message: str = ""
+
+    @property
+    def q(self) -> Optional[np.ndarray]:
+        """The solution nearest q0, or None."""
+        return self.solutions[0] if len(self.solutions) else None
+
+    def __len__(self) -> int:
+        return len(self.solutions)
+
+    def __iter__(self):
+        return iter(self.solutions)
+
+    def to_dict(self) -> dict:
+        return {
+            "success": bool(self.success),
+            "solver": self.solver,
+            "solutions": self.solutions.tolist(),
+            "position_error": self.position_error.tolist(),
+            "orientation_error": self.orientation_error.tolist(),
+            "iterations": int(self.iterations),
+            "reachable": self.reachable,
+            "singular": bool(self.singular),
+            "found": int(self.found),
+            "nearest": None if self.nearest is None else self.nearest.tolist(),
+            "nearest_q": None if self.nearest_q is None else self.nearest_q.tolist(),
+            "message": self.message,
+        }
+
+    def __repr__(self) -> str:
+        return (
+            f"IKResult(success={self.success}, solver={self.solver!r}, solutions={len(self.solutions)}, "
+            f"max_position_error={_max(self.position_error):.3g}, max_orientation_error={_max(self.orientation_error):.3g}, "
+            f"message={self.message!r})"
+        )
+
+
+@dataclass(slots=True)
+class IKBatchResult:
+    """One answer per target of a batch: ``q`` (N, n) (the solution nearest each q0; NaN rows where a
+    closed form found none, the best iterate where the numeric solver failed), ``success`` (N,),
+    ``position_error``/``orientation_error`` (N,), ``iterations`` (N,), ``solver``."""
+
+    q: np.ndarray
+    success: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    iterations: np.ndarray
+    solver: str
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean(self.success)) if len(self.success) else 0.0
+
+    def __len__(self) -> int:
+        return len(self.q)
+
+
+def _max(a) -> float:
+    return float(np.max(a)) if len(a) else float("nan")
+
+
+# ------------------------------------------------------------------ per-robot cache
+class _Chain:
+    """What one (robot, frame) pair needs at every call, computed once."""
+
+    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute")
+
+    def __init__(self, robot, frame: str):
+        from .. import _core
+
+        self.frame = robot.frame_index(frame)
+        self.n = robot.n
+        self.model = robot._model
+        self.lower = np.ascontiguousarray(robot.lower_limits, dtype=float)
+        self.upper = np.ascontiguousarray(robot.upper_limits, dtype=float)
+        self.free_lower = np.full(self.n, -np.inf)
+        self.free_upper = np.full(self.n, np.inf)
+        # default start / reference: zeros, moved at least 10 % of the range away from finite limits
+        span = np.where(np.isfinite(self.upper - self.lower), self.upper - self.lower, 0.0)
+        self.start = np.clip(np.zeros(self.n), self.lower + 0.1 * span, self.upper - 0.1 * span)
+        self.revolute = np.array([j.kind == "revolute" for j in robot.joints])
+        self.solver = _core.AnalyticIk.detect(self.model, self.frame, self.lower, self.upper)
+
+
+def _chain(robot, frame: Optional[str]) -> _Chain:
+    cache = robot.__dict__.get("_ik_chains")
+    if cache is None:
+        cache = robot.__dict__["_ik_chains"] = {}
+    key = frame or robot.tool
+    chain = cache.get(key)
+    if chain is None:
+        chain = cache[key] = _Chain(robot, key)
+    return chain
+
+
+def analytic_structure(robot, frame: Optional[str] = None) -> Optional[str]:
+    """Name of the closed-form structure detected from the robot's geometry for ``frame``
+    (``"planar_2r"``, ``"planar_3r"``, ``"arm_intersecting_shoulder"``, ``"arm_parallel_elbow"``,
+    ``"spherical_wrist"``, ``"three_parallel"``), or None."""
+    solver = _chain(robot, frame).solver
+    return None if solver is None else solver.structure
+
+
+# ------------------------------------------------------------------ input checks
+def _target(target) -> tuple:
+    """(array, position_only, batch)."""
+    if isinstance(target, np.ndarray) and target.dtype == np.float64:
+        t = target
+    else:
+        try:
+            t = np.asarray(target, dtype=float)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"target must be numbers (a 4x4 pose or a 3-vector position), got {type(target).__name__}: {e}") from None
+    shape = t.shape
+    if shape == (4, 4):
+        return t, False, False
+    if shape == (3,):
+        return t, True, False
+    if len(shape) == 3 and shape[1:] == (4, 4):
+        return t, False, True
+    if len(shape) == 2 and shape[1] == 3:
+        return t, True, True
+    raise ValueError(f"target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape}")
+
+
+def _mask(mask) -> Optional[tuple]:
+    if mask is None:
+        return None
+    try:
+        m = np.asarray(mask, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"mask must be 6 weights for [x, y, z, rx, ry, rz], got {mask!r}") from None
+    if m.shape != (6,):
+        raise ValueError(f"mask must have 6 weights for [x, y, z, rx, ry, rz], got {m.size}: {mask!r}")
+    if not np.all(np.isfinite(m)) or np.any(m < 0) or not np.any(m > 0):
+        raise ValueError(f"mask weights must be finite, >= 0 and not all zero, got {m.tolist()}")
+    return tuple(float(v) for v in m)
+
+
+def _q0(q0, chain: _Chain, batch: Optional[int]) -> np.ndarray:
+    if q0 is None:
+        return chain.start
+    q = np.ascontiguousarray(q0, dtype=float)
+    n = chain.n
+    if q.shape != (n,) and not (batch is not None and q.shape == (batch, n)):
+        want = f"({n},)" + (f" or ({batch}, {n})" if batch is not None else "")
+        raise ValueError(f"q0 must have shape {want}, got {q.shape}")
+    if not np.all(np.isfinite(q)):
+        raise ValueError("q0 contains a non-finite value (NaN or inf)")
+    return q
+
+
+# ------------------------------------------------------------------ the solver
+def inverse_kinematics(
+    robot,
+    target,
+    q0=None,
+    mask=None,
+    method: str = "auto",
+    respect_limits: bool = True,
+    *,
+    frame: Optional[str] = None,
+    tolerance: float = 1e-9,
+    max_iterations: int = 50,
+    restarts: int = 50,
+    seed: int = 0,
+):
+    """Joint vectors that put ``frame`` (default: the tool) at ``target``.
+
+    ``target``: 4x4 pose or 3-vector position of the frame origin (or a batch of either).
+    ``q0``: start of the numeric solver and reference of the closed forms (solutions are ordered by
+    their distance to it, revolute angles are moved by 2 pi k next to it, free joints at
+    singularities take its value); default zeros, kept 10 % of the range inside finite limits. ``mask``: 6 weights of
+    ``[x, y, z, rx, ry, rz]`` (base axes); ``(1, 1, 1, 0, 0, 0)`` is a position target.
+    ``method``: ``"auto"`` (closed form when the geometry has one, else numeric), ``"analytic"``
+    or ``"numeric"``. ``respect_limits``: drop (closed form) or never leave (numeric) joint limits.
+    ``tolerance``: largest position (m) and orientation (rad) residual accepted.
+    ``max_iterations``/``restarts``/``seed``: numeric solver (iterations per attempt, random restarts).
+
+    Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    chain = _chain(robot, frame)
+    t, position, batch = _target(target)
+    weights = _mask(mask)
+    if weights is not None and not position:
+        if weights == _POSITION_MASK:
+            # a pose with a position mask is a position target
+            t = t[..., :3, 3]
+            position = True
+            weights = None
+        elif weights == _FULL_MASK:
+            weights = None
+    solver = chain.solver
+    analytic_ok = solver is not None and weights is None and (not position or solver.solves_position)
+    if method == "analytic" and not analytic_ok:
+        raise ValueError(_why_not_analytic(robot, chain, position, weights))
+    use_analytic = analytic_ok and method != "numeric"
+    nb = len(t) if batch else None
+    q_start = _q0(q0, chain, nb)
+    if batch:
+        return _batch(robot, chain, t, q_start, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed)
+    if use_analytic:
+        return _analytic(robot, chain, t, q_start, position, respect_limits, tolerance, seed)
+    return _numeric(robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed)
+
+
+def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:
+    if chain.solver is None:
+        return (
+            f"robot '{robot.name}' has no closed-form inverse kinematics here: its axes match none of the "
+            "structures kinedyn solves in closed form (planar 2R/3R, an RRR arm whose first two axes meet or whose "
+            "2nd and 3rd are parallel, 6R with a spherical wrist, 6R with three parallel axes); use method='numeric'"
+        )
+    if weights is not None:
+        return "a weighted mask has no closed form; use method='numeric' (or no mask / a position-only mask)"
+    return (
+        f"robot '{robot.name}' ({chain.solver.structure}, n={chain.n}) has no closed form for a position-only target "
+        "(the position leaves joints free); give a 4x4 pose or use method='numeric'"
+    )
+
+
+def _analytic(robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int) -> IKResult:
+    sols, pe, oe, found, singular = chain.solver.solve(t, q_ref, respect_limits, tolerance)
+    name = "analytic:" + chain.solver.structure
+    if len(sols):
+        return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else ""))
+    if found:
+        return IKResult(sols, False, pe, oe, 0, name, True, singular, found, message=f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)")
+    result = IKResult(sols, False, pe, oe, 0, name, False, singular, 0, message="target out of reach: no solution exists")
+    if position:
+        _nearest(robot, chain, t, q_ref, result, seed)
+    else:
+        result.message = "target out of reach: no joint vector gives this pose"
+    return result
+
+
+def _nearest(robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> None:
+    """The reachable point nearest an unreachable position (least squares by LM with restarts)."""
+    from .. import _core
+
+    q, _, _, _, _ = _core.solve_ik(chain.model, chain.frame, p, q_ref, chain.lower, chain.upper, np.ones(6), 200, 8, 1e-12, 1e-12, 1e-6, 0.5, seed)
+    result.nearest_q = q
+    result.nearest = robot.pose(q, robot.frame_names[chain.frame])[:3, 3]
+    d = float(np.linalg.norm(result.nearest - p))
+    result.message = f"target out of reach: no solution exists; the nearest reachable point is {np.array2string(result.nearest, precision=6)} ({d:.6g} m away)"
+
+
+def _numeric(robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
+    from .. import _core
+
+    w = np.asarray(weights if weights is not None else _FULL_MASK)
+    lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
+    tol = min(tolerance, 1e-10)
+    q, ok, pe, oe, it = _core.solve_ik(chain.model, chain.frame, t, q0, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed)
+    if not respect_limits:
+        q = _wrap(q, chain)
+    ok = bool(ok) and pe <= tolerance and oe <= tolerance
+    empty = np.zeros(0)
+    if ok:
+        singular = _is_singular(robot, chain, q, w if not position else np.asarray(_POSITION_MASK))
+        return IKResult(q[None, :], True, np.array([pe]), np.array([oe]), int(it), "numeric:lm", True, singular, 1, message="converged" + (" at a singular configuration" if singular else ""))
+    result = IKResult(np.zeros((0, chain.n)), False, empty, empty, int(it), "numeric:lm", None, False, 0, nearest_q=q,
+                      message=f"the numeric solver did not converge after {restarts} restarts (best residual {pe:.3g} m, {oe:.3g} rad); the target may be out of reach")
+    if position:
+        result.nearest = robot.pose(q, robot.frame_names[chain.frame])[:3, 3]
+        result.message += f"; nearest point reached {np.array2string(result.nearest, precision=6)}"
+    return result
+
+
+def _wrap(q: np.ndarray, chain: _Chain) -> np.ndarray:
+    """Revolute angles into (-pi, pi] (numeric runs without limits)."""
+    out = q.copy()
+    r = chain.revolute
+    out[..., r] = np.mod(out[..., r] + np.pi, 2 * np.pi) - np.pi
+    return out
+
+
+def _is_singular(robot, chain: _Chain, q, weights) -> bool:
+    J = robot.jacobian(q, robot.frame_names[chain.frame])[np.asarray(weights) > 0]
+    s = np.linalg.svd(J, compute_uv=False)
+    return bool(len(s) < J.shape[0] or s[-1] < 1e-6 * max(1.0, s[0]))
+
+
+def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed) -> IKBatchResult:
+    from .. import _core
+
+    N = len(t)
+    if use_analytic:
+        refs = np.ascontiguousarray(np.broadcast_to(q0, (N, chain.n)))
+        q, ok, pe, oe = chain.solver.solve_nearest(t, refs, respect_limits, tolerance)
+        return IKBatchResult(q, ok, pe, oe, np.zeros(N, dtype=np.int64), "analytic:" + chain.solver.structure)
+    w = np.asarray(weights if weights is not None else _FULL_MASK)
+    lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
+    tol = min(tolerance, 1e-10)
+    q, ok, pe, oe, it = _core.solve_ik(chain.model, chain.frame, t, q0, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed)
+    if not respect_limits:
+        q = _wrap(q, chain)
+    ok = ok & (pe <= tolerance) & (oe <= tolerance)
+    return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")
