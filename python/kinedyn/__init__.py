@@ -3,6 +3,8 @@
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .robot import Robot
 from . import robots
+from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
+from .simulate import Trajectory
 from .symbolic import LagrangianSystem
 
 __version__ = "0.1.0"
@@ -15,4 +17,4 @@ def load(path, **kwargs) -> Robot:
     return _load(path, **kwargs)
 
 
-__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "__version__"]
+__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate", "Trajectory", "__version__"]

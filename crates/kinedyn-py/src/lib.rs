@@ -6,6 +6,7 @@
 use std::sync::Mutex;
 
 mod ik;
+mod simulate;
 
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
@@ -460,5 +461,6 @@ impl PyModel {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     ik::register(m)?;
+    simulate::register(m)?;
     Ok(())
 }

@@ -5,6 +5,7 @@ pub mod coriolis;
 pub mod crba;
 pub mod energy;
 pub mod gravity;
+pub mod integrate;
 pub mod ik;
 pub mod jacobian;
 pub mod kinematics;

@@ -1,0 +1,273 @@
+//! Simulation glue: whole trajectories (one state or a batch) integrated by
+//! `kinedyn_core::algorithms::integrate`, with the torque as samples (no GIL, batches in parallel) or
+//! from a Python callable evaluated by the core's loop (GIL held while it runs).
+//!
+//! Both return `(q, qd, qdd, tau, steps, failures)`: arrays `(samples, n)` or `(N, samples, n)`,
+//! the number of steps completed per trajectory, and per trajectory `None` or a dict saying when and
+//! where it stopped (`step`, `t`, `joint`, `kind`, `value`, `message`).
+
+use std::cell::RefCell;
+
+use kinedyn_core::algorithms::integrate::{self, Failure, FailureKind, Method, Outcome, Record, Sampled, Settings};
+use kinedyn_core::Data;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+use rayon::prelude::*;
+
+use crate::{core_err, PyModel};
+
+fn method(name: &str) -> PyResult<Method> {
+    match name {
+        "rk4" => Ok(Method::Rk4),
+        "semi_implicit" | "semi_implicit_euler" | "symplectic_euler" => Ok(Method::SemiImplicitEuler),
+        "euler" => Ok(Method::Euler),
+        _ => Err(PyValueError::new_err(format!("unknown fixed-step method '{name}' (rk4, semi_implicit, euler)"))),
+    }
+}
+
+fn flat(name: &str, a: &PyReadonlyArrayDyn<f64>) -> PyResult<Vec<f64>> {
+    let v: Vec<f64> = a.as_array().iter().copied().collect();
+    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!("{name} contains a non-finite value (NaN or inf) at flat index {k}")));
+    }
+    Ok(v)
+}
+
+fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("step", f.step)?;
+    d.set_item("t", f.t)?;
+    d.set_item("joint", f.joint)?;
+    let (kind, value, message) = match &f.kind {
+        FailureKind::NonFinite => ("non_finite", None, String::new()),
+        FailureKind::Diverged(v) => ("diverged", Some(*v), String::new()),
+        FailureKind::Torque(v) => ("torque", Some(*v), String::new()),
+        FailureKind::Source(m) => ("source", None, m.clone()),
+        FailureKind::Singular(m) => ("singular", None, m.clone()),
+    };
+    d.set_item("kind", kind)?;
+    d.set_item("value", value)?;
+    d.set_item("message", message)?;
+    Ok(d)
+}
+
+/// Fresh output arrays `(batch?, samples, n)` x 4.
+fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize) -> [Bound<'py, PyArrayDyn<f64>>; 4] {
+    let shape: Vec<usize> = match batch {
+        Some(b) => vec![b, samples, n],
+        None => vec![samples, n],
+    };
+    std::array::from_fn(|_| PyArrayDyn::<f64>::zeros(py, shape.clone(), false))
+}
+
+fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcomes: &[Outcome]) -> PyResult<Bound<'py, PyTuple>> {
+    let steps = PyArray1::from_iter(py, outcomes.iter().map(|o| o.steps as i64));
+    let failures = PyList::empty(py);
+    for o in outcomes {
+        match &o.failure {
+            Some(f) => failures.append(failure_dict(py, f)?)?,
+            None => failures.append(py.None())?,
+        }
+    }
+    let [q, qd, qdd, tau] = arrays;
+    PyTuple::new(py, [q.into_any(), qd.into_any(), qdd.into_any(), tau.into_any(), steps.into_any(), failures.into_any()])
+}
+
+/// Check `q0`, `qd0` ((n,) or (N, n), same shape): (batch, q0, qd0 flattened).
+fn initial_states(n: usize, q0: &PyReadonlyArrayDyn<f64>, qd0: &PyReadonlyArrayDyn<f64>) -> PyResult<(Option<usize>, Vec<f64>, Vec<f64>)> {
+    let batch = match q0.shape() {
+        [m] if *m == n => None,
+        [b, m] if *m == n => Some(*b),
+        s => return Err(PyValueError::new_err(format!("q0 must have shape ({n},) or a batch (N, {n}), got {s:?}"))),
+    };
+    if qd0.shape() != q0.shape() {
+        return Err(PyValueError::new_err(format!("qd0 has shape {:?}, q0 has shape {:?}: they must match", qd0.shape(), q0.shape())));
+    }
+    Ok((batch, flat("q0", q0)?, flat("qd0", qd0)?))
+}
+
+/// Integrate from `q0, qd0` ((n,) or a batch (N, n)) over `steps` steps of `dt`, the torque given by
+/// samples `tau`: None (zero), `(S, n)` shared by every trajectory or `(N, S, n)` one per trajectory;
+/// S = 1 is a constant, else samples at `t0 + k dt` held over each step (`linear=False`, S >= steps)
+/// or interpolated (`linear=True`, S >= steps + 1). A batch runs in parallel without the GIL.
+#[pyfunction]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6))]
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_fixed<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyModel>,
+    method_name: &str,
+    q0: PyReadonlyArrayDyn<'py, f64>,
+    qd0: PyReadonlyArrayDyn<'py, f64>,
+    t0: f64,
+    dt: f64,
+    steps: usize,
+    tau: Option<PyReadonlyArrayDyn<'py, f64>>,
+    linear: bool,
+    record_every: usize,
+    max_speed: f64,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let m = model.get();
+    let n = m.model.n;
+    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed };
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
+    }
+    if record_every == 0 {
+        return Err(PyValueError::new_err("record_every must be at least 1"));
+    }
+    let (batch, q0, qd0) = initial_states(n, &q0, &qd0)?;
+    let count = batch.unwrap_or(1);
+    // torque samples: (rows per trajectory, shared?)
+    let (tau, rows, shared) = match tau.as_ref() {
+        None => (Vec::new(), 0, true),
+        Some(a) => {
+            let (rows, shared) = match a.shape() {
+                [s, w] if *w == n => (*s, true),
+                [b, s, w] if *w == n && Some(*b) == batch => (*s, false),
+                s => {
+                    return Err(PyValueError::new_err(format!(
+                        "tau must have shape (S, {n}) or, for a batch of {count}, ({count}, S, {n}); got {s:?}"
+                    )))
+                }
+            };
+            let need = if linear { steps + 1 } else { steps };
+            if rows != 1 && rows < need {
+                return Err(PyValueError::new_err(format!(
+                    "tau has {rows} samples; {steps} steps need {need} ({}), or 1 for a constant",
+                    if linear { "one per sample time, interpolated" } else { "one per step, held" }
+                )));
+            }
+            (flat("tau", a)?, rows, shared)
+        }
+    };
+    let samples = settings.samples();
+    let arrays = outputs(py, batch, samples, n);
+    // SAFETY: the arrays were created above; nothing else refers to them yet.
+    let mut views = Vec::with_capacity(4);
+    for a in arrays.iter() {
+        views.push(unsafe { a.as_slice_mut()? });
+    }
+    let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
+    let per = samples * n;
+    let model_ref = &m.model;
+    let run_one = |i: usize, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], t: &mut [f64]| -> Result<Outcome, kinedyn_core::Error> {
+        let values = if rows == 0 {
+            &tau[..0]
+        } else if shared {
+            &tau[..]
+        } else {
+            &tau[i * rows * n..(i + 1) * rows * n]
+        };
+        let mut source = Sampled { values, n, t0, dt, linear };
+        let mut data = Data::new(model_ref);
+        integrate::integrate(model_ref, &mut data, &settings, &q0[i * n..(i + 1) * n], &qd0[i * n..(i + 1) * n], &mut source, Record { q, qd, qdd, tau: t })
+    };
+    let outcomes: Vec<Outcome> = py
+        .detach(|| {
+            if count == 1 {
+                return Ok(vec![run_one(0, oq, oqd, oqdd, otau)?]);
+            }
+            oq.par_chunks_mut(per)
+                .zip(oqd.par_chunks_mut(per))
+                .zip(oqdd.par_chunks_mut(per))
+                .zip(otau.par_chunks_mut(per))
+                .enumerate()
+                .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(core_err)?;
+    result(py, arrays, &outcomes)
+}
+
+/// Integrate with the torque from `callback(step, t, q, qd) -> tau` (a Python callable returning n
+/// numbers; `step` is the index k of the step [t_k, t_k + dt] being taken), called by the core's loop at every stage (`hold=False`) or once per step, held
+/// (`hold=True`). A batch (N, n) runs its trajectories one after the other. An exception raised by
+/// the callback propagates unchanged.
+#[pyfunction]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6))]
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_callback<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyModel>,
+    method_name: &str,
+    q0: PyReadonlyArrayDyn<'py, f64>,
+    qd0: PyReadonlyArrayDyn<'py, f64>,
+    t0: f64,
+    dt: f64,
+    steps: usize,
+    callback: Bound<'py, PyAny>,
+    hold: bool,
+    record_every: usize,
+    max_speed: f64,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let m = model.get();
+    let n = m.model.n;
+    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed };
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
+    }
+    if record_every == 0 {
+        return Err(PyValueError::new_err("record_every must be at least 1"));
+    }
+    let (batch, q0, qd0) = initial_states(n, &q0, &qd0)?;
+    let count = batch.unwrap_or(1);
+    let samples = settings.samples();
+    let arrays = outputs(py, batch, samples, n);
+    let mut views = Vec::with_capacity(4);
+    for a in arrays.iter() {
+        views.push(unsafe { a.as_slice_mut()? });
+    }
+    let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
+    let per = samples * n;
+    let error: RefCell<Option<PyErr>> = RefCell::new(None);
+    let mut source = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
+        let mut call = || -> PyResult<()> {
+            let qa = PyArray1::from_slice(py, q);
+            let qda = PyArray1::from_slice(py, qd);
+            let value = callback.call1((k, t, qa, qda))?;
+            let got = match value.extract::<PyReadonlyArrayDyn<f64>>() {
+                Ok(a) if a.ndim() == 1 && a.len() == n => {
+                    out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
+                    return Ok(());
+                }
+                Ok(a) => a.shape().to_vec(),
+                Err(_) => {
+                    let v: Vec<f64> = value.extract()?;
+                    if v.len() == n {
+                        out.copy_from_slice(&v);
+                        return Ok(());
+                    }
+                    vec![v.len()]
+                }
+            };
+            Err(PyValueError::new_err(format!("the controller returned torques of shape {got:?} at t = {t}; the robot has {n} joints")))
+        };
+        call().map_err(|e| {
+            let message = e.to_string();
+            *error.borrow_mut() = Some(e);
+            message
+        })
+    };
+    let mut outcomes = Vec::with_capacity(count);
+    let mut data = Data::new(&m.model);
+    for i in 0..count {
+        let r = i * per..(i + 1) * per;
+        let out = Record { q: &mut oq[r.clone()], qd: &mut oqd[r.clone()], qdd: &mut oqdd[r.clone()], tau: &mut otau[r] };
+        let outcome = integrate::integrate(&m.model, &mut data, &settings, &q0[i * n..(i + 1) * n], &qd0[i * n..(i + 1) * n], &mut source, out)
+            .map_err(core_err)?;
+        if let Some(e) = error.borrow_mut().take() {
+            return Err(e);
+        }
+        outcomes.push(outcome);
+    }
+    result(py, arrays, &outcomes)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(integrate_fixed, m)?)?;
+    m.add_function(wrap_pyfunction!(integrate_callback, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,547 @@
+"""``kinedyn.simulate``: integrate the equations of motion of a robot or a Lagrangian system.
+
+Where the work happens (DESIGN.md: Rust does every hot loop):
+
+- A robot, a fixed-step method (``rk4``, ``semi_implicit``, ``euler``) and torques given as data (none,
+  a constant, or samples per step): the whole trajectory, or a batch of initial states (in
+  parallel), is one native call (``kinedyn._core.integrate_fixed``; the scheme is in
+  ``crates/kinedyn-core/src/algorithms/integrate.rs``).
+- A robot with a Python controller or a torque function ``u(t, q, qd)``: the core's integration loop
+  calls the Python function through a callback, at every Runge-Kutta stage (a continuous-time control
+  law, exact to the integrator's order) or, with ``hold=True``, once per step (a digital controller
+  at the integration rate, torque held: 4x fewer Python calls with RK4, an O(dt) torque error).
+  Trade-off: each call costs a few microseconds of Python against ~1-3 us for the articulated-body
+  algorithm, so a Python controller sets the speed (~20-40 us per RK4 step instead of ~5-10 us);
+  precompute open-loop torques as arrays where possible. A batch with a controller runs its states
+  one after the other.
+- External wrenches ``f_ext`` (they are given about the link frames, which move with q) and every
+  :class:`~kinedyn.simulate.systems.MechanicalSystem` / ``LagrangianSystem`` integrate in Python
+  with the same schemes, calling the compiled dynamics once per stage.
+- Adaptive methods (``rk45``, ``rk23``, ``dop853``, ``radau``, ``bdf``, ``lsoda``) use
+  ``scipy.integrate.solve_ivp`` with ``rtol``/``atol``; the samples are at multiples of ``dt``.
+
+Blow-ups stop the run with :class:`SimulationError` (when, where, which joint; the samples before
+it are in ``error.trajectory``) instead of returning NaN arrays.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from typing import Callable, Optional
+
+import numpy as np
+
+from .systems import MechanicalSystem
+from .trajectory import Trajectory
+
+__all__ = ["simulate", "SimulationError", "NonFiniteTorqueError", "FIXED_METHODS", "ADAPTIVE_METHODS"]
+
+FIXED_METHODS = ("rk4", "semi_implicit", "euler")
+ADAPTIVE_METHODS = {"rk45": "RK45", "rk23": "RK23", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF", "lsoda": "LSODA"}
+_ALIASES = {"semi_implicit_euler": "semi_implicit", "symplectic_euler": "semi_implicit", "symplectic": "semi_implicit"}
+
+
+class SimulationError(RuntimeError):
+    """A simulation stopped early. ``t``, ``step``, ``joint`` (index or None), ``index`` (the
+    trajectory of a batch), ``kind`` and ``trajectory`` (the samples before the failure)."""
+
+    def __init__(self, message, *, t=None, step=None, joint=None, index=None, kind=None, trajectory=None):
+        super().__init__(message)
+        self.t, self.step, self.joint, self.index, self.kind, self.trajectory = t, step, joint, index, kind, trajectory
+
+
+class NonFiniteTorqueError(SimulationError, ValueError):
+    """The controller or torque input produced NaN or infinity."""
+
+
+# ------------------------------------------------------------------ helpers
+class _Progress:
+    """A rich progress bar over simulated time, on stderr when it is a terminal."""
+
+    def __init__(self, enabled: bool, t0: float, t1: float, label: str):
+        self.bar = None
+        self.t0, self.t1 = t0, t1
+        self.last = 0.0
+        if enabled:
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+            from rich.console import Console
+
+            self.bar = Progress(TextColumn(label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
+                                console=Console(file=sys.stderr), transient=True)
+            self.task = self.bar.add_task(label, total=t1 - t0)
+            self.bar.start()
+
+    def update(self, t: float) -> None:
+        if self.bar is not None:
+            now = time.perf_counter()
+            if now - self.last > 0.05 or t >= self.t1:
+                self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
+                self.last = now
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _is_robot(system) -> bool:
+    return hasattr(system, "_model") and hasattr(system, "forward_dynamics")
+
+
+def _as_mechanical(system, params, baumgarte, points) -> MechanicalSystem:
+    if isinstance(system, MechanicalSystem):
+        if baumgarte is not None:
+            system.baumgarte = tuple(baumgarte)
+        return system
+    if hasattr(system, "euler_lagrange") and hasattr(system, "holonomic"):
+        return MechanicalSystem.from_lagrangian(system, params=params, points=points, baumgarte=tuple(baumgarte) if baumgarte is not None else (10.0, 10.0))
+    raise TypeError(
+        f"simulate needs a kinedyn.Robot, a kinedyn.symbolic.LagrangianSystem or a kinedyn.simulate.MechanicalSystem, got {type(system).__name__}"
+    )
+
+
+def _names(system) -> list:
+    return list(system.joint_names) if hasattr(system, "joint_names") else list(system.names)
+
+
+def _split_state(x0, n: int, name: str):
+    x = np.asarray(x0, dtype=float)
+    if x.ndim not in (1, 2) or x.shape[-1] != 2 * n:
+        raise ValueError(
+            f"x0 must be concatenate([q0, qd0]) with 2 n = {2 * n} entries for '{name}' ({n} coordinates), "
+            f"or a batch (N, {2 * n}); got shape {x.shape}"
+        )
+    if not np.all(np.isfinite(x)):
+        raise ValueError("x0 contains a non-finite value (NaN or inf)")
+    return np.ascontiguousarray(x[..., :n]), np.ascontiguousarray(x[..., n:])
+
+
+def _time_grid(t_span, dt, method):
+    if np.ndim(t_span) == 0:
+        t0, t1 = 0.0, float(t_span)
+    else:
+        if len(t_span) != 2:
+            raise ValueError(f"t_span must be a duration T or a pair (t0, t1), got {t_span!r}")
+        t0, t1 = float(t_span[0]), float(t_span[1])
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
+        raise ValueError(f"t_span must end after it starts (t1 > t0), got ({t0}, {t1})")
+    if dt is None:
+        dt = 1e-3
+    dt = float(dt)
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ValueError(f"dt must be a positive step in seconds, got {dt}")
+    steps = max(1, int(math.ceil((t1 - t0) / dt - 1e-9)))
+    return t0, t1, dt, steps
+
+
+def _sampled_u(u, n: int, steps: int, batch: Optional[int]):
+    """u as data: None -> None; (n,) constant -> (1, n); (steps, n) held; (steps + 1, n) linear;
+    (N, S, n) per trajectory. Returns (array or None, linear)."""
+    if u is None:
+        return None, False
+    a = np.asarray(u, dtype=float)
+    if a.ndim == 1:
+        a = a[None, :]
+    if a.shape[-1] != n:
+        raise ValueError(f"u must give {n} generalised forces per sample, got shape {np.shape(u)}")
+    if a.ndim == 3 and (batch is None or a.shape[0] != batch):
+        raise ValueError(f"u of shape {a.shape} is per trajectory but the batch has {batch} initial states")
+    rows = a.shape[-2]
+    if rows not in (1, steps, steps + 1):
+        raise ValueError(
+            f"u has {rows} samples: give 1 (a constant), {steps} (one per step, held over it) or "
+            f"{steps + 1} (one per sample time t0 + k dt, interpolated linearly)"
+        )
+    if not np.all(np.isfinite(a)):
+        k = np.argwhere(~np.isfinite(a))[0]
+        raise NonFiniteTorqueError(f"u contains a non-finite value at index {tuple(int(i) for i in k)}")
+    return np.ascontiguousarray(a), rows == steps + 1 and rows > 1
+
+
+def _u_at(a: np.ndarray, linear: bool, t0: float, dt: float, k: int, t: float):
+    """Sample of data-u for step k at time t (a: (S, n))."""
+    rows = a.shape[0]
+    if rows == 1:
+        return a[0]
+    k = min(k, rows - 1)
+    if linear and k + 1 < rows:
+        s = min(max((t - (t0 + k * dt)) / dt, 0.0), 1.0)
+        return (1 - s) * a[k] + s * a[k + 1]
+    return a[k]
+
+
+def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/s or m/s") -> tuple:
+    j = f.get("joint")
+    where = f" at joint {j} ('{names[j]}')" if j is not None and j < len(names) else ""
+    at = f"t = {f['t']:.6g} s (step {f['step']} of {steps})"
+    which = f" (trajectory {index} of the batch)" if index is not None else ""
+    kind = f["kind"]
+    if kind == "torque":
+        return NonFiniteTorqueError, f"the controller / input returned a non-finite torque ({f['value']}){where} at {at}{which}"
+    if kind == "diverged":
+        return SimulationError, (
+            f"simulation of '{system_name}' blew up at {at}{which}: speed {f['value']:.3g} {unit_speed}{where} exceeds "
+            f"max_speed; the samples before it are in error.trajectory (reduce dt, check the gains / inputs)"
+        )
+    if kind == "non_finite":
+        return SimulationError, f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory"
+    if kind == "singular":
+        return SimulationError, f"simulation of '{system_name}' stopped at {at}{which}: {f['message']}"
+    return SimulationError, f"simulation of '{system_name}' stopped at {at}{which}: {f.get('message', '')}"
+
+
+def _raise_failure(system, names, failures, steps_done, traj_factory, steps):
+    for index, f in enumerate(failures):
+        if f is not None:
+            cls, message = _failure_message(getattr(system, "name", "system"), names, f, index if len(failures) > 1 else None, steps)
+            partial = traj_factory(index, int(steps_done[index]))
+            raise cls(message, t=f["t"], step=f["step"], joint=f.get("joint"), index=index if len(failures) > 1 else None, kind=f["kind"], trajectory=partial)
+
+
+# ------------------------------------------------------------------ the Python fixed-step loop
+def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, max_speed, hold, progress):
+    """One trajectory with the schemes of integrate.rs, the dynamics called from Python."""
+    n = q0.size
+    samples = -(-steps // record_every) + 1
+    Q, QD, QDD, TAU = (np.zeros((samples, n)) for _ in range(4))
+    q, qd = q0.copy(), qd0.copy()
+    s = 0
+    failure = None
+
+    def evaluate(k, t, q, qd):
+        tau = np.asarray(torque(k, t, q, qd), dtype=float).reshape(n)
+        bad = np.flatnonzero(~np.isfinite(tau))
+        if bad.size:
+            raise _Stop(dict(step=k, t=t, joint=int(bad[0]), kind="torque", value=float(tau[bad[0]]), message=""))
+        return tau, accel(t, q, qd, tau)
+
+    k = 0
+    try:
+        for k in range(steps + 1):
+            t = t0 + k * dt
+            tau, a1 = evaluate(k, t, q, qd)
+            if k % record_every == 0 or k == steps:
+                Q[s], QD[s], QDD[s], TAU[s] = q, qd, a1, tau
+                s += 1
+                if progress is not None and s % 50 == 0:
+                    progress.update(t)
+            if k == steps:
+                break
+            if method == "euler":
+                q, qd = q + dt * qd, qd + dt * a1
+            elif method == "semi_implicit":
+                qd = qd + dt * a1
+                q = q + dt * qd
+            else:
+                f = (lambda tt, x, v: (tau, accel(tt, x, v, tau))[1]) if hold else (lambda tt, x, v: evaluate(k, tt, x, v)[1])
+                q2, v2 = q + 0.5 * dt * qd, qd + 0.5 * dt * a1
+                a2 = f(t + 0.5 * dt, q2, v2)
+                q3, v3 = q + 0.5 * dt * v2, qd + 0.5 * dt * a2
+                a3 = f(t + 0.5 * dt, q3, v3)
+                q4, v4 = q + dt * v3, qd + dt * a3
+                a4 = f(t + dt, q4, v4)
+                q = q + dt / 6 * (qd + 2 * v2 + 2 * v3 + v4)
+                qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            bad = np.flatnonzero(~(np.isfinite(q) & np.isfinite(qd)))
+            if bad.size:
+                raise _Stop(dict(step=k, t=t, joint=int(bad[0]), kind="non_finite", value=None, message=""))
+            fast = np.flatnonzero(np.abs(qd) > max_speed)
+            if fast.size:
+                raise _Stop(dict(step=k, t=t, joint=int(fast[0]), kind="diverged", value=float(qd[fast[0]]), message=""))
+    except _Stop as stop:
+        failure = stop.failure
+    except np.linalg.LinAlgError as e:
+        failure = dict(step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=f"singular system matrix ({e})")
+    except RuntimeError as e:
+        if "singular" not in str(e):
+            raise
+        failure = dict(step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=str(e))
+    return Q, QD, QDD, TAU, (k if failure else steps), s, failure
+
+
+class _Stop(Exception):
+    def __init__(self, failure):
+        super().__init__(failure["kind"])
+        self.failure = failure
+
+
+# ------------------------------------------------------------------ simulate
+def simulate(
+    system,
+    t_span,
+    x0,
+    u=None,
+    controller: Optional[Callable] = None,
+    method: str = "rk4",
+    dt: Optional[float] = None,
+    f_ext=None,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    progress: Optional[bool] = None,
+    *,
+    params: Optional[dict] = None,
+    hold: bool = False,
+    record_every: int = 1,
+    max_speed: float = 1e6,
+    baumgarte=None,
+    points=None,
+) -> Trajectory:
+    """Simulate ``system`` from ``x0 = concatenate([q0, qd0])`` over ``t_span`` (T or (t0, t1)).
+
+    ``system``: a :class:`kinedyn.Robot` (friction, rotor inertia and gravity of the robot included),
+    a :class:`kinedyn.symbolic.LagrangianSystem` (parameter values in ``params``; constraints
+    stabilised with Baumgarte's method, ``baumgarte=(alpha, beta)``, default (10, 10)), or a
+    :class:`~kinedyn.simulate.MechanicalSystem`. ``x0`` may be a batch (N, 2n).
+
+    Generalised force = ``u`` + ``controller(t, q, qd)``: ``u`` is None, a constant (n,), samples
+    (steps, n) held over each step or (steps + 1, n) at the sample times interpolated linearly (or
+    (N, S, n) per trajectory), or a function ``u(t, q, qd)``; ``controller`` any callable
+    ``(t, q, qd) -> tau`` (see :mod:`kinedyn.simulate.control`). Python callables are evaluated at
+    every integrator stage, or once per step with ``hold=True``.
+
+    ``method``: ``rk4`` (default), ``semi_implicit`` (symplectic Euler), ``euler`` (fixed step
+    ``dt``, default 1 ms) or ``rk45``, ``rk23``, ``dop853``, ``radau``, ``bdf``, ``lsoda`` (SciPy,
+    adaptive, ``rtol``/``atol``; samples every ``dt``). ``f_ext``: external wrenches on a robot's links,
+    (n, 6) constant or a function ``f(t, q, qd) -> (n, 6)`` (see :meth:`Robot.forward_dynamics`).
+    ``record_every``: keep every k-th step (fixed-step methods). ``progress``: a progress bar on
+    stderr (None: only on a terminal and for long runs). ``max_speed``: a joint speed above this is a
+    blow-up (:class:`SimulationError`).
+    """
+    method = _ALIASES.get(str(method).lower(), str(method).lower())
+    if method not in FIXED_METHODS and method not in ADAPTIVE_METHODS:
+        raise ValueError(f"unknown method '{method}': fixed-step {', '.join(FIXED_METHODS)}; adaptive {', '.join(ADAPTIVE_METHODS)}")
+    if int(record_every) < 1:
+        raise ValueError(f"record_every must be >= 1, got {record_every}")
+    record_every = int(record_every)
+    if controller is not None and not callable(controller):
+        raise TypeError(f"controller must be callable as controller(t, q, qd) -> tau, got {type(controller).__name__}")
+    robot = _is_robot(system)
+    mech = None if robot else _as_mechanical(system, params, baumgarte, points)
+    target = system if robot else mech
+    n = system.n if robot else mech.n
+    name = getattr(system, "name", "system")
+    names = _names(target)
+    q0, qd0 = _split_state(x0, n, name)
+    batch = q0.shape[0] if q0.ndim == 2 else None
+    t0, t1, dt, steps = _time_grid(t_span, dt, method)
+    if method in ADAPTIVE_METHODS:
+        record_every = 1
+    if callable(u):
+        u_fn, u_data, linear = u, None, False
+    else:
+        u_fn = None
+        u_data, linear = _sampled_u(u, n, steps, batch)
+    if callable(f_ext):
+        fext_fn = f_ext
+    elif f_ext is not None:
+        if not robot:
+            raise ValueError("f_ext applies to robots (wrenches on links); for a Lagrangian system put the generalised force in u")
+        fe = np.asarray(f_ext, dtype=float)
+        if fe.shape != (n, 6) or not np.all(np.isfinite(fe)):
+            raise ValueError(f"f_ext must be a finite (n, 6) = ({n}, 6) array of link wrenches, or a function of (t, q, qd)")
+        fext_fn = lambda t, q, qd: fe  # noqa: E731
+    else:
+        fext_fn = None
+    count = batch or 1
+    work = steps * count * (4 if method == "rk4" else 1)
+    native = robot and method in FIXED_METHODS and fext_fn is None
+    pure_native = native and u_fn is None and controller is None
+    if progress is None:
+        long = work > (2_000_000 if pure_native else 20_000)
+        progress = bool(long and sys.stderr.isatty())
+    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}")
+    if hasattr(controller, "reset"):
+        controller.reset()
+
+    def u_data_for(index):
+        if u_data is None:
+            return None
+        return u_data[index] if u_data.ndim == 3 else u_data
+
+    def torque_for(index):
+        """torque(k, t, q, qd) for trajectory `index` (None if no Python part)."""
+        data = u_data_for(index)
+
+        def torque(k, t, q, qd):
+            tau = np.zeros(n)
+            if data is not None:
+                tau = tau + _u_at(data, linear, t0, dt, k, t)
+            if u_fn is not None:
+                tau = tau + _checked(u_fn(t, q, qd), "u", t)
+            if controller is not None:
+                tau = tau + _checked(controller(t, q, qd), "the controller", t)
+            return np.ascontiguousarray(tau, dtype=float)
+
+        def _checked(value, what, t):
+            v = np.asarray(value, dtype=float)
+            if v.shape != (n,):
+                raise ValueError(f"{what} returned torques of shape {v.shape} at t = {t:g} s; {name} has {n} joints (shape ({n},))")
+            return v
+
+        return torque
+
+    info = dict(method=method, steps=steps, batch=batch, native=native)
+    start = time.perf_counter()
+    try:
+        if native:
+            out = _run_native(system, method, q0, qd0, t0, dt, steps, u_data, linear, None if pure_native else torque_for, hold, record_every, max_speed, bar, batch)
+            t = _sample_times(t0, dt, steps, record_every)
+        elif method in FIXED_METHODS:
+            out = _run_python(system if robot else mech, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, record_every, max_speed, bar, batch)
+            t = _sample_times(t0, dt, steps, record_every)
+        else:
+            out, t, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol, max_speed, bar, batch)
+            info["nfev"] = nfev
+    finally:
+        bar.close()
+    info["wall_time"] = time.perf_counter() - start
+    Q, QD, QDD, TAU, steps_done, failures = out
+
+    def partial(index, done):
+        k = done // record_every + 1 if method in FIXED_METHODS else done + 1
+        k = max(1, min(k, len(t)))
+        sl = (index, slice(0, k)) if batch is not None else (slice(0, k),)
+        return Trajectory(target, t[:k], Q[sl], QD[sl], QDD[sl], TAU[sl], method=method, dt=dt, info=info)
+
+    _raise_failure(target, names, failures, steps_done, partial, steps)
+    traj = Trajectory(target, t, Q, QD, QDD, TAU, method=method, dt=dt, info=info)
+    return traj
+
+
+def _sample_times(t0, dt, steps, every):
+    ks = np.arange(0, steps + 1, every)
+    if ks[-1] != steps:
+        ks = np.append(ks, steps)
+    return t0 + ks * dt
+
+
+def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_for, hold, every, max_speed, bar, batch):
+    """The core's integrator, in chunks when a progress bar is shown (chunk boundaries on recorded
+    steps, so the samples are the same as in one call)."""
+    from .. import _core
+
+    model = robot._model
+    chunks = 1 if bar.bar is None else min(50, max(1, steps // every))
+    per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
+    parts = []
+    k0, q, qd = 0, q0, qd0
+    while True:
+        m = min(per, steps - k0)
+        if torque_for is None:
+            tau = None
+            if u_data is not None:
+                rows = u_data.shape[-2]
+                if rows == 1:
+                    tau = u_data
+                else:
+                    tau = np.ascontiguousarray(u_data[..., k0 : k0 + m + (1 if linear else 0), :])
+            res = _core.integrate_fixed(model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed)
+        else:
+            if batch is None:
+                cb = _offset(torque_for(0), k0)
+                res = _core.integrate_callback(model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed)
+            else:
+                results = [
+                    _core.integrate_callback(model, method, q[i], qd[i], t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every, max_speed)
+                    for i in range(batch)
+                ]
+                res = tuple(np.stack([r[j] for r in results]) for j in range(4)) + (
+                    np.concatenate([r[4] for r in results]), [r[5][0] for r in results])
+        Qc, QDc, QDDc, TAUc, done, failures = res
+        done = np.asarray(done) + k0
+        failures = [None if f is None else {**f, "step": f["step"] + k0} for f in failures]
+        parts.append((Qc, QDc, QDDc, TAUc) if not parts else tuple(a[..., 1:, :] for a in (Qc, QDc, QDDc, TAUc)))
+        k0 += m
+        bar.update(t0 + k0 * dt)
+        if any(f is not None for f in failures) or k0 >= steps:
+            break
+        q = np.ascontiguousarray(Qc[..., -1, :])
+        qd = np.ascontiguousarray(QDc[..., -1, :])
+    arrays = tuple(np.concatenate([p[j] for p in parts], axis=-2) if len(parts) > 1 else parts[0][j] for j in range(4))
+    return arrays + (done, failures)
+
+
+def _offset(torque, k0):
+    return lambda k, t, q, qd: torque(k + k0, t, q, qd)
+
+
+def _accel_fn(target, robot, fext_fn):
+    if robot:
+        if fext_fn is None:
+            return lambda t, q, qd, tau: target.forward_dynamics(q, qd, tau)
+        return lambda t, q, qd, tau: target.forward_dynamics(q, qd, tau, fext_fn(t, q, qd))
+    return lambda t, q, qd, tau: target.accelerations(q, qd, tau)[0]
+
+
+def _run_python(target, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, every, max_speed, bar, batch):
+    accel = _accel_fn(target, robot, fext_fn)
+    results = []
+    for i in range(batch or 1):
+        qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
+        results.append(_fixed_python(accel, torque_for(i), method, t0, dt, steps, qi, qdi, every, max_speed, hold, bar))
+    return _stack(results, batch)
+
+
+def _stack(results, batch):
+    def pick(j):
+        return np.stack([r[j] for r in results]) if batch is not None else results[0][j]
+
+    return (pick(0), pick(1), pick(2), pick(3), np.array([r[4] for r in results]), [r[6] for r in results])
+
+
+def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch):
+    from scipy.integrate import solve_ivp
+
+    accel = _accel_fn(target, robot, fext_fn)
+    t_eval = t0 + np.arange(steps + 1) * dt
+    t_eval[-1] = min(t_eval[-1], t1)
+    n = q0.shape[-1]
+    results = []
+    nfev = 0
+    for i in range(batch or 1):
+        torque = torque_for(i)
+        qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
+
+        def step_of(t):
+            return int(min(max(math.floor((t - t0) / dt + 1e-9), 0), steps))
+
+        def rhs(t, x):
+            q, qd = x[:n], x[n:]
+            tau = torque(step_of(t), t, q, qd)
+            bad = np.flatnonzero(~np.isfinite(tau))
+            if bad.size:
+                raise _Stop(dict(step=step_of(t), t=t, joint=int(bad[0]), kind="torque", value=float(tau[bad[0]]), message=""))
+            bar.update(t)
+            return np.concatenate([qd, accel(t, q, qd, tau)])
+
+        def too_fast(t, x):
+            return max_speed - np.abs(x[n:]).max()
+
+        too_fast.terminal = True
+        failure = None
+        try:
+            sol = solve_ivp(rhs, (t0, t1), np.concatenate([qi, qdi]), method=scipy_method, t_eval=t_eval, rtol=rtol, atol=atol, events=too_fast)
+            nfev += sol.nfev
+            X = sol.y.T
+            if sol.status == 1:  # the speed event
+                te = float(sol.t_events[0][0])
+                xe = sol.y_events[0][0]
+                j = int(np.argmax(np.abs(xe[n:])))
+                failure = dict(step=step_of(te), t=te, joint=j, kind="diverged", value=float(xe[n + j]), message="")
+            elif sol.status < 0 or not np.all(np.isfinite(X)):
+                failure = dict(step=step_of(sol.t[-1] if sol.t.size else t0), t=float(sol.t[-1]) if sol.t.size else t0, joint=None, kind="non_finite", value=None,
+                               message=f"the adaptive solver failed: {sol.message}")
+        except _Stop as stop:
+            failure = stop.failure
+            X = np.zeros((0, 2 * n))
+        S = X.shape[0]
+        Q, QD = X[:, :n].copy(), X[:, n:].copy()
+        QDD, TAU = np.zeros((steps + 1, n)), np.zeros((steps + 1, n))
+        for k in range(S):
+            TAU[k] = torque(k, t_eval[k], Q[k], QD[k])
+            QDD[k] = accel(t_eval[k], Q[k], QD[k], TAU[k])
+        full = [np.zeros((steps + 1, n)) for _ in range(2)]
+        full[0][:S], full[1][:S] = Q, QD
+        results.append((full[0], full[1], QDD, TAU, max(S - 1, 0), S, failure))
+    return _stack(results, batch), t_eval, nfev

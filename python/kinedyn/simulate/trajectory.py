@@ -1,0 +1,321 @@
+"""``Trajectory``: the result of :func:`kinedyn.simulate`.
+
+Arrays, each with the samples on the first axis (a batch of N initial states adds a leading axis):
+``t`` (S,) [s]; ``q``, ``qd``, ``qdd``, ``tau`` (S, n) or (N, S, n); energies ``K``, ``P``, ``H = K + P``
+(S,) or (N, S) computed on first use. ``tau`` is the generalised force applied at each sample time and
+``qdd`` the acceleration there. For constrained systems ``constraint_error`` holds, per sample, the
+largest holonomic residual |phi(q)| and velocity residual |A(q) qd|.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+__all__ = ["Trajectory"]
+
+
+def _simpson_cumulative(y: np.ndarray, dx: float) -> np.ndarray:
+    """Cumulative integral of samples y (S, ...) spaced dx: trapezoid rule, with a Simpson correction
+    at even indices (so the value at the last sample is Simpson's when S is odd)."""
+    out = np.zeros_like(y)
+    out[1:] = np.cumsum(0.5 * dx * (y[1:] + y[:-1]), axis=0)
+    if y.shape[0] >= 3:
+        # Simpson on pairs of intervals: I_{2k} = sum dx/3 (y0 + 4 y1 + y2)
+        pairs = dx / 3.0 * (y[0:-2:2] + 4 * y[1:-1:2] + y[2::2])
+        out[2::2] = np.cumsum(pairs, axis=0)
+    return out
+
+
+class Trajectory:
+    """Samples of a simulated motion (see the module docstring)."""
+
+    def __init__(self, system, t, q, qd, qdd, tau, *, method: str = "", dt: Optional[float] = None, info: Optional[dict] = None, failure=None):
+        self.system = system
+        self.t = np.asarray(t, dtype=float)
+        self.q = np.asarray(q, dtype=float)
+        self.qd = np.asarray(qd, dtype=float)
+        self.qdd = np.asarray(qdd, dtype=float)
+        self.tau = np.asarray(tau, dtype=float)
+        self.method = method
+        self.dt = dt
+        self.info = dict(info or {})
+        self.failure = failure
+
+    # ------------------------------------------------------------------ shape
+    @property
+    def n(self) -> int:
+        return self.q.shape[-1]
+
+    @property
+    def batch(self) -> Optional[int]:
+        """N for a batch of trajectories, else None."""
+        return self.q.shape[0] if self.q.ndim == 3 else None
+
+    def __len__(self) -> int:
+        return self.t.size
+
+    def __getitem__(self, i) -> "Trajectory":
+        """Trajectory ``i`` of a batch."""
+        if self.batch is None:
+            raise TypeError("this is a single trajectory; index its arrays (.q[k]) instead")
+        return Trajectory(self.system, self.t, self.q[i], self.qd[i], self.qdd[i], self.tau[i], method=self.method, dt=self.dt, info=self.info)
+
+    @property
+    def x(self) -> np.ndarray:
+        """States concatenate([q, qd]) per sample."""
+        return np.concatenate([self.q, self.qd], axis=-1)
+
+    @property
+    def names(self) -> list:
+        s = self.system
+        if hasattr(s, "joint_names"):
+            return list(s.joint_names)
+        return list(getattr(s, "names", [f"q{i + 1}" for i in range(self.n)]))
+
+    def __repr__(self) -> str:
+        b = f", batch={self.batch}" if self.batch is not None else ""
+        return f"Trajectory(system={getattr(self.system, 'name', '?')!r}, samples={len(self)}, t=[{self.t[0]:g}, {self.t[-1]:g}] s, method={self.method!r}{b})"
+
+    # ------------------------------------------------------------------ energies
+    def _flat(self, a):
+        return a.reshape(-1, a.shape[-1])
+
+    def _per_sample(self, fn_batch, fn_single, *arrays):
+        shape = arrays[0].shape[:-1]
+        if fn_batch is not None:
+            out = np.asarray(fn_batch(*(np.ascontiguousarray(self._flat(a)) for a in arrays)), dtype=float)
+        else:
+            out = np.array([fn_single(*args) for args in zip(*(self._flat(a) for a in arrays))], dtype=float)
+        return out.reshape(shape)
+
+    @cached_property
+    def K(self) -> np.ndarray:
+        """Kinetic energy per sample [J]."""
+        s = self.system
+        if hasattr(s, "_model"):
+            return self._per_sample(s.kinetic_energy, None, self.q, self.qd)
+        if getattr(s, "kinetic_energy", None) is not None:
+            return self._per_sample(None, s.kinetic_energy, self.q, self.qd)
+        raise AttributeError("this system gives no kinetic energy (use .H)")
+
+    @cached_property
+    def P(self) -> np.ndarray:
+        """Potential energy per sample [J]."""
+        s = self.system
+        if hasattr(s, "_model"):
+            return self._per_sample(s.potential_energy, None, self.q)
+        if getattr(s, "potential_energy", None) is not None:
+            return self._per_sample(None, s.potential_energy, self.q)
+        raise AttributeError("this system gives no potential energy (use .H)")
+
+    @cached_property
+    def H(self) -> np.ndarray:
+        """Total energy K + P (the energy function qd . dL/dqd - L of a Lagrangian system) [J]."""
+        s = self.system
+        if not hasattr(s, "_model") and getattr(s, "energy", None) is not None:
+            return self._per_sample(None, s.energy, self.q, self.qd)
+        return self.K + self.P
+
+    @cached_property
+    def constraint_error(self) -> np.ndarray:
+        """(S, 2) or (N, S, 2): per sample [max |phi(q)|, max |A(q) qd|] (zeros if unconstrained)."""
+        s = self.system
+        if not getattr(s, "constrained", False):
+            return np.zeros(self.q.shape[:-1] + (2,))
+        out = np.array([s.constraint_residuals(a, b) for a, b in zip(self._flat(self.q), self._flat(self.qd))])
+        return out.reshape(self.q.shape[:-1] + (2,))
+
+    def friction_torque(self) -> np.ndarray:
+        """Joint friction viscous qd + coulomb sign(qd) of a robot per sample (zeros otherwise)."""
+        s = self.system
+        if not hasattr(s, "joints"):
+            return np.zeros_like(self.qd)
+        viscous = np.array([float(j.viscous) for j in s.joints])
+        coulomb = np.array([float(j.coulomb) for j in s.joints])
+        return viscous * self.qd + coulomb * np.sign(self.qd)
+
+    def energy_balance(self) -> dict:
+        """Passivity along the trajectory (Spong eq. 9.117, dH/dt = qd . tau): the work of the input
+        W(t) = int qd . tau dt, the energy dissipated by friction D(t) = int qd . friction dt, and
+        the residual H(t) - H(0) - (W - D), each (S,) (Simpson's rule on the samples; uniform
+        spacing required). ``relative``: max |residual| / max(1, max |W|, max |H - H(0)|)."""
+        if self.batch is not None:
+            raise TypeError("energy_balance() is per trajectory: use traj[i].energy_balance()")
+        dt = np.diff(self.t)
+        if dt.size and not np.allclose(dt, dt[0], rtol=1e-9, atol=0):
+            raise ValueError("energy_balance needs uniformly spaced samples")
+        h = float(dt[0]) if dt.size else 0.0
+        power = np.einsum("...i,...i->...", self.qd, self.tau)
+        loss = np.einsum("...i,...i->...", self.qd, self.friction_torque())
+        W = _simpson_cumulative(power, h)
+        D = _simpson_cumulative(loss, h)
+        dH = self.H - self.H[0]
+        residual = dH - (W - D)
+        # only the even samples carry Simpson's value; report the residual there
+        at = np.arange(0, len(self), 2) if len(self) >= 3 else np.arange(len(self))
+        scale = max(1.0, float(np.abs(W).max(initial=0)), float(np.abs(dH).max(initial=0)))
+        return {"t": self.t, "work": W, "dissipated": D, "dH": dH, "residual": residual, "relative": float(np.abs(residual[at]).max(initial=0)) / scale}
+
+    # ------------------------------------------------------------------ export
+    def _columns(self) -> tuple:
+        names = self.names
+        cols = {"t": self.t}
+        for key, arr in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd), ("tau", self.tau)):
+            for i, nm in enumerate(names):
+                cols[f"{key}[{nm}]"] = arr[:, i]
+        try:
+            cols["K"], cols["P"] = self.K, self.P
+        except AttributeError:
+            pass
+        try:
+            cols["H"] = self.H
+        except AttributeError:
+            pass
+        return list(cols), np.column_stack(list(cols.values()))
+
+    def to_csv(self, path) -> Path:
+        """One row per sample: t, q, qd, qdd, tau per joint, K, P, H (a header names the columns)."""
+        if self.batch is not None:
+            raise TypeError("to_csv writes one trajectory: use traj[i].to_csv(...) or to_npz for a batch")
+        header, data = self._columns()
+        path = Path(path)
+        np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+        return path
+
+    def to_npz(self, path) -> Path:
+        """Arrays t, q, qd, qdd, tau, K, P, H and joint names in one compressed NumPy file."""
+        path = Path(path)
+        arrays = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, names=np.array(self.names))
+        for key in ("K", "P", "H"):
+            try:
+                arrays[key] = getattr(self, key)
+            except AttributeError:
+                pass
+        np.savez_compressed(path, **arrays)
+        return path
+
+    # ------------------------------------------------------------------ plots
+    def plot(self, path=None, show: bool = False):
+        """Joint positions, velocities, torques and energies against time (matplotlib); saved to
+        ``path`` if given. Returns the Figure. Works with any backend (Agg included)."""
+        import matplotlib.pyplot as plt
+
+        if self.batch is not None:
+            raise TypeError("plot() draws one trajectory: use traj[i].plot()")
+        fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+        names = self.names
+        for ax, arr, label in zip(axes[:3], (self.q, self.qd, self.tau), ("q [rad | m]", "qd [rad/s | m/s]", "tau [N m | N]")):
+            for i in range(self.n):
+                ax.plot(self.t, arr[:, i], label=names[i])
+            ax.set_ylabel(label)
+            ax.grid(True, alpha=0.3)
+        axes[0].legend(loc="upper right", fontsize="small", ncol=min(self.n, 6))
+        ax = axes[3]
+        for key in ("K", "P", "H"):
+            try:
+                ax.plot(self.t, getattr(self, key), label=key)
+            except AttributeError:
+                pass
+        ax.set_ylabel("energy [J]")
+        ax.set_xlabel("t [s]")
+        ax.legend(loc="upper right", fontsize="small")
+        ax.grid(True, alpha=0.3)
+        fig.suptitle(f"{getattr(self.system, 'name', '')} ({self.method})")
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(path, dpi=100)
+        if show:
+            plt.show()
+        else:
+            plt.close(fig)
+        return fig
+
+    def _points(self) -> np.ndarray:
+        """(S, m, 3) positions to draw: base origin and every link frame origin of a robot, or the
+        system's ``points(q)``."""
+        s = self.system
+        if hasattr(s, "_model"):
+            T = s.forward_kinematics(np.ascontiguousarray(self.q))  # (S, n, 4, 4)
+            tool = s.pose(np.ascontiguousarray(self.q))[:, None, :3, 3]
+            base = np.zeros((len(self), 1, 3))
+            return np.concatenate([base, T[:, :, :3, 3], tool], axis=1)
+        if getattr(s, "points", None) is None:
+            raise ValueError("animate() needs positions: build the MechanicalSystem with points=...")
+        P = np.array([np.atleast_2d(s.points(qk)) for qk in self.q], dtype=float)
+        if P.shape[-1] == 2:
+            P = np.concatenate([P, np.zeros(P.shape[:-1] + (1,))], axis=-1)
+        return P
+
+    def animate(self, path, fps: int = 25, duration: Optional[float] = None, trail: bool = True):
+        """A stick figure of the motion: GIF (``.gif``, Pillow), HTML (``.html``, self-contained
+        JavaScript player) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
+        z = const (planar arms), else 3-D. Frames are taken every 1/fps seconds of simulated time.
+        Returns the path."""
+        import matplotlib.pyplot as plt
+        from matplotlib import animation
+
+        if self.batch is not None:
+            raise TypeError("animate() draws one trajectory: use traj[i].animate(...)")
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".gif", ".html", ".mp4"):
+            raise ValueError(f"animate writes .gif, .html or .mp4 files, got '{path.name}'")
+        P = self._points()
+        span = self.t[-1] - self.t[0]
+        frames = max(2, int(math.ceil((duration or span) * fps)) + 1)
+        idx = np.unique(np.round(np.linspace(0, len(self) - 1, frames)).astype(int))
+        planar = np.ptp(P[..., 2]) < 1e-9
+        lo, hi = P.reshape(-1, 3).min(axis=0), P.reshape(-1, 3).max(axis=0)
+        centre, radius = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3) * 1.1
+        fig = plt.figure(figsize=(5, 5))
+        if planar:
+            ax = fig.add_subplot(111)
+            ax.set_aspect("equal")
+            ax.set_xlim(centre[0] - radius, centre[0] + radius)
+            ax.set_ylim(centre[1] - radius, centre[1] + radius)
+            (line,) = ax.plot([], [], "o-", lw=3, color="tab:blue")
+            (path_line,) = ax.plot([], [], "-", lw=1, color="tab:orange", alpha=0.6)
+        else:
+            ax = fig.add_subplot(111, projection="3d")
+            for setl, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+                setl(c - radius, c + radius)
+            (line,) = ax.plot([], [], [], "o-", lw=3, color="tab:blue")
+            (path_line,) = ax.plot([], [], [], "-", lw=1, color="tab:orange", alpha=0.6)
+        ax.set_title(getattr(self.system, "name", ""))
+        label = ax.text2D(0.02, 0.95, "", transform=ax.transAxes) if not planar else ax.text(0.02, 0.95, "", transform=ax.transAxes)
+
+        def draw(k):
+            i = idx[k]
+            p = P[i]
+            tip = P[idx[: k + 1], -1]
+            if planar:
+                line.set_data(p[:, 0], p[:, 1])
+                if trail:
+                    path_line.set_data(tip[:, 0], tip[:, 1])
+            else:
+                line.set_data(p[:, 0], p[:, 1])
+                line.set_3d_properties(p[:, 2])
+                if trail:
+                    path_line.set_data(tip[:, 0], tip[:, 1])
+                    path_line.set_3d_properties(tip[:, 2])
+            label.set_text(f"t = {self.t[i]:.2f} s")
+            return line, path_line, label
+
+        anim = animation.FuncAnimation(fig, draw, frames=len(idx), interval=1000 / fps, blit=False)
+        try:
+            if suffix == ".gif":
+                anim.save(path, writer=animation.PillowWriter(fps=fps))
+            elif suffix == ".html":
+                path.write_text(anim.to_jshtml(fps=fps))
+            else:
+                if not animation.FFMpegWriter.isAvailable():
+                    raise RuntimeError("writing .mp4 needs ffmpeg on the PATH; write a .gif or .html instead")
+                anim.save(path, writer=animation.FFMpegWriter(fps=fps))
+        finally:
+            plt.close(fig)
+        return path
