@@ -115,7 +115,7 @@ def _max(a) -> float:
 class _Chain:
     """What one (robot, frame) pair needs at every call, computed once."""
 
-    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute")
+    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute", "position_ok")
 
     def __init__(self, robot, frame: str):
         from .. import _core
@@ -132,6 +132,7 @@ class _Chain:
         self.start = np.clip(np.zeros(self.n), self.lower + 0.1 * span, self.upper - 0.1 * span)
         self.revolute = np.array([j.kind == "revolute" for j in robot.joints])
         self.solver = _core.AnalyticIk.detect(self.model, self.frame, self.lower, self.upper)
+        self.position_ok = self.solver is not None and self.solver.solves_position
 
 
 def _chain(robot, frame: Optional[str]) -> _Chain:
@@ -231,9 +232,15 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
+    chain = _chain(robot, frame)
+    # fast path: one float64 target, closed form, no mask (checks of the target happen natively)
+    if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype == np.float64 and chain.solver is not None:
+        shape = target.shape
+        if shape == (4, 4) or (shape == (3,) and chain.position_ok):
+            q_ref = chain.start if q0 is None else _q0(q0, chain, None)
+            return _analytic(robot, chain, target, q_ref, shape == (3,), respect_limits, tolerance, seed)
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    chain = _chain(robot, frame)
     t, position, batch = _target(target)
     weights = _mask(mask)
     if weights is not None and not position:
@@ -245,7 +252,7 @@ def inverse_kinematics(
         elif weights == _FULL_MASK:
             weights = None
     solver = chain.solver
-    analytic_ok = solver is not None and weights is None and (not position or solver.solves_position)
+    analytic_ok = solver is not None and weights is None and (not position or chain.position_ok)
     if method == "analytic" and not analytic_ok:
         raise ValueError(_why_not_analytic(robot, chain, position, weights))
     use_analytic = analytic_ok and method != "numeric"
