@@ -1,6 +1,6 @@
 //! Joint kinds and the one function that decodes them, `jcalc` (RBDA §4.4, Table 4.1).
 
-use crate::spatial::{Mat3, Motion, Transform, Vec3};
+use crate::spatial::{Force, Inertia, Mat3, Motion, Transform, Vec3};
 
 /// The closed set of joint kinds of the compiled model (fixed joints are merged at build time).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,6 +87,45 @@ impl Joint {
                     None => Transform::new(r * axis_angle(a, x), parent_from_joint.trans),
                 }
             }
+        }
+    }
+
+    /// `s x`: the joint's twist at rate `x` (`[0; a x]` revolute, `[a x; 0]` prismatic).
+    #[inline]
+    pub fn motion(&self, x: f64) -> Motion {
+        match self.kind {
+            JointKind::Revolute => Motion::new(Vec3::zeros(), self.axis * x),
+            JointKind::Prismatic => Motion::new(self.axis * x, Vec3::zeros()),
+        }
+    }
+
+    /// `s^T f`: the component of a force along the joint (3 products instead of 6).
+    #[inline]
+    pub fn project(&self, f: &Force) -> f64 {
+        match self.kind {
+            JointKind::Revolute => self.axis.dot(&f.ang),
+            JointKind::Prismatic => self.axis.dot(&f.lin),
+        }
+    }
+
+    /// `v x (s x)` (RBDA's velocity-product term), using the zero half of `s`:
+    /// revolute `[v_lin x w; v_ang x w]` with `w = a x`, prismatic `[v_ang x l; 0]` with `l = a x`.
+    #[inline]
+    pub fn cross(&self, v: &Motion, x: f64) -> Motion {
+        let ax = self.axis * x;
+        match self.kind {
+            JointKind::Revolute => Motion::new(v.lin.cross(&ax), v.ang.cross(&ax)),
+            JointKind::Prismatic => Motion::new(v.ang.cross(&ax), Vec3::zeros()),
+        }
+    }
+
+    /// `I s` for a rigid-body inertia: revolute `[a x h; I_o a]`, prismatic `[m a; h x a]`.
+    #[inline]
+    pub fn inertia_times_s(&self, i: &Inertia) -> Force {
+        let a = &self.axis;
+        match self.kind {
+            JointKind::Revolute => Force::new(a.cross(&i.h), i.i_o * a),
+            JointKind::Prismatic => Force::new(a * i.mass, i.h.cross(a)),
         }
     }
 

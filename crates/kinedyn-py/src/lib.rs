@@ -3,16 +3,15 @@
 //! One place converts and checks shapes (`Batch::gather`), one place runs a per-state kernel over
 //! one state or a batch with the GIL released (`Batch::run`). Every kernel is a call into the core.
 
-use std::sync::Mutex;
+use std::borrow::Cow;
 
 mod ik;
-mod simulate;
+use std::sync::Mutex;
 
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
-use numpy::ndarray::ArrayViewD;
-use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -24,11 +23,6 @@ fn core_err(e: CoreError) -> PyErr {
     }
 }
 
-/// A float64 array as a contiguous vector, copying only when the layout requires it.
-fn contiguous(a: &ArrayViewD<f64>) -> Vec<f64> {
-    a.iter().copied().collect()
-}
-
 /// Input `k` of a state if the call was given it (absent inputs are empty slices).
 #[inline]
 fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
@@ -37,27 +31,65 @@ fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
 
 fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
     let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
-    PyValueError::new_err(format!(
-        "{name} must have shape ({exp}) or a batch (N, {exp}), got {got:?}"
-    ))
+    PyValueError::new_err(format!("{name} must have shape ({exp}) or a batch (N, {exp}), got {got:?}"))
 }
 
-/// Inputs of one call, flattened: `values[k]` holds `batch` states of `width[k]` numbers each.
-struct Batch {
+/// A NumPy float64 array as the inputs of one call. Two kinds: `PyReadonlyArrayDyn` (rust-numpy's
+/// borrow tracking, about 0.4 us per array) and a plain `Bound<PyArrayDyn<f64>>` (a type check
+/// only), which the hot dynamics methods take.
+trait StateArray<'a> {
+    fn dims(&self) -> &[usize];
+    /// The numbers in C order; `batch`: the call will release the GIL.
+    fn numbers(&'a self, batch: bool) -> Cow<'a, [f64]>;
+}
+
+impl<'a> StateArray<'a> for PyReadonlyArrayDyn<'_, f64> {
+    fn dims(&self) -> &[usize] {
+        self.shape()
+    }
+    fn numbers(&'a self, _batch: bool) -> Cow<'a, [f64]> {
+        // as_slice() also accepts Fortran order (memory order != logical order): C order only
+        match self.as_slice() {
+            Ok(s) if self.is_c_contiguous() => Cow::Borrowed(s),
+            _ => Cow::Owned(self.as_array().iter().copied().collect()),
+        }
+    }
+}
+
+impl<'a> StateArray<'a> for Bound<'_, PyArrayDyn<f64>> {
+    fn dims(&self) -> &[usize] {
+        self.shape()
+    }
+    fn numbers(&'a self, batch: bool) -> Cow<'a, [f64]> {
+        // SAFETY: a single state is read while this thread holds the GIL and runs no Python code,
+        // so nothing writes to the array meanwhile; a batch (run with the GIL released) is copied
+        // here, under the GIL, first.
+        if !batch && self.is_c_contiguous() {
+            if let Ok(s) = unsafe { self.as_slice() } {
+                return Cow::Borrowed(s);
+            }
+        }
+        Cow::Owned(unsafe { self.as_array() }.iter().copied().collect())
+    }
+}
+
+/// Inputs of one call: `values[k]` holds `batch` states of `width[k]` numbers each, borrowed from
+/// the NumPy array when it is C-contiguous (copied otherwise).
+struct Batch<'a> {
     /// `None` for a single state (outputs lose the leading axis).
     batch: Option<usize>,
-    values: Vec<Vec<f64>>,
+    values: Vec<Cow<'a, [f64]>>,
     width: Vec<usize>,
 }
 
-impl Batch {
+impl<'a> Batch<'a> {
     /// Check each input against its per-state shape; all inputs share one batch size.
-    fn gather(inputs: &[(&str, &PyReadonlyArrayDyn<f64>, &[usize])]) -> PyResult<Self> {
+    fn gather<A: StateArray<'a> + ?Sized>(inputs: &[(&str, &'a A, &[usize])]) -> PyResult<Self> {
         let mut batch: Option<Option<usize>> = None;
         let mut values = Vec::with_capacity(inputs.len());
         let mut width = Vec::with_capacity(inputs.len());
         for (name, array, shape) in inputs {
-            let got = array.shape();
+            let got = array.dims();
             let this = if got == *shape {
                 None
             } else if got.len() == shape.len() + 1 && &got[1..] == *shape {
@@ -74,11 +106,7 @@ impl Batch {
                 }
                 _ => {}
             }
-            let view = array.as_array();
-            let data = match view.as_slice() {
-                Some(s) => s.to_vec(),
-                None => contiguous(&view),
-            };
+            let data = array.numbers(this.is_some());
             let w: usize = shape.iter().product();
             if let Some(k) = data.iter().position(|x| !x.is_finite()) {
                 let state = if w > 0 { k / w } else { 0 };
@@ -94,49 +122,50 @@ impl Batch {
         Ok(Self { batch: batch.flatten(), values, width })
     }
 
-    fn len(&self) -> usize {
-        self.batch.unwrap_or(1)
+    /// The inputs of state `k` (at most 4 arguments per call).
+    fn state(&self, k: usize) -> [&[f64]; 4] {
+        let mut out: [&[f64]; 4] = [&[]; 4];
+        for (slot, (v, w)) in out.iter_mut().zip(self.values.iter().zip(&self.width)) {
+            *slot = &v[k * w..(k + 1) * w];
+        }
+        out
     }
 
-    /// Run `kernel(model, data, inputs_of_state, out_of_state)` on every state, GIL released;
-    /// batches run in parallel chunks, each with its own `Data`.
+    /// Run `kernel(model, data, inputs_of_state, out_of_state)` on every state, writing straight
+    /// into a fresh NumPy array. A single state runs with the cached `Data`, keeping the GIL (the
+    /// call is shorter than releasing it); a batch runs with the GIL released, in parallel
+    /// chunks that each own a `Data`.
     fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
-        let per_state: usize = out_shape.iter().product();
-        let count = self.len();
-        let mut out = vec![0.0; per_state * count];
-        let model = &m.model;
-        let state = |k: usize| -> Vec<&[f64]> {
-            self.values.iter().zip(&self.width).map(|(v, w)| &v[k * w..(k + 1) * w]).collect()
-        };
-        let result: Result<(), CoreError> = py.detach(|| {
-            if count <= 64 {
-                let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-                for (k, o) in out.chunks_mut(per_state.max(1)).enumerate().take(count) {
-                    kernel(model, &mut guard, &state(k), o)?;
-                }
-                Ok(())
-            } else {
-                const CHUNK: usize = 64;
-                out.par_chunks_mut((per_state * CHUNK).max(1)).enumerate().try_for_each(|(c, block)| {
-                    let mut data = Data::new(model);
-                    for (i, o) in block.chunks_mut(per_state.max(1)).enumerate() {
-                        kernel(model, &mut data, &state(c * CHUNK + i), o)?;
-                    }
-                    Ok(())
-                })
-            }
-        });
-        result.map_err(core_err)?;
+        let per_state: usize = out_shape.iter().product::<usize>().max(1);
         let mut shape: Vec<usize> = Vec::with_capacity(out_shape.len() + 1);
         if let Some(b) = self.batch {
             shape.push(b);
         }
         shape.extend_from_slice(out_shape);
-        let flat = numpy::PyArray1::from_vec(py, out);
-        Ok(flat.reshape(shape)?)
+        let array = PyArrayDyn::<f64>::zeros(py, shape, false);
+        // SAFETY: the array was created just above; no other reference to it exists yet.
+        let out = unsafe { array.as_slice_mut()? };
+        let model = &m.model;
+        let result: Result<(), CoreError> = if self.batch.is_none() {
+            let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
+            kernel(model, &mut guard, &self.state(0), out)
+        } else {
+            py.detach(|| {
+                const CHUNK: usize = 64;
+                out.par_chunks_mut(per_state * CHUNK).enumerate().try_for_each(|(c, block)| {
+                    let mut data = Data::new(model);
+                    for (i, o) in block.chunks_mut(per_state).enumerate() {
+                        kernel(model, &mut data, &self.state(c * CHUNK + i), o)?;
+                    }
+                    Ok(())
+                })
+            })
+        };
+        result.map_err(core_err)?;
+        Ok(array)
     }
 }
 
@@ -151,7 +180,7 @@ fn vec_of(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[usize]) -> PyResult<
     if a.shape() != shape {
         return Err(reshape_error(name, shape, a.shape()));
     }
-    Ok(contiguous(&a.as_array()))
+    Ok(a.as_array().iter().copied().collect())
 }
 
 fn reference(code: i64) -> PyResult<Reference> {
@@ -265,8 +294,8 @@ impl PyModel {
     }
 
     /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
-    fn frame_poses<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frames: Vec<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let ids = frames.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
+    fn frame_poses<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frames: PyReadonlyArray1<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let ids = frames.as_array().iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[ids.len(), 4, 4], |model, data, x, out| {
@@ -318,7 +347,7 @@ impl PyModel {
 
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, qdd: PyReadonlyArrayDyn<f64>, f_ext: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -332,7 +361,7 @@ impl PyModel {
     }
 
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -342,7 +371,7 @@ impl PyModel {
     }
 
     /// M^-1 (n, n) | (N, n, n).
-    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -353,7 +382,7 @@ impl PyModel {
 
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, tau: PyReadonlyArrayDyn<f64>, f_ext: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, tau: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -367,7 +396,7 @@ impl PyModel {
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
-    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -377,7 +406,7 @@ impl PyModel {
     }
 
     /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
-    fn christoffel<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn christoffel<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n, n], |model, data, x, out| {
@@ -387,7 +416,7 @@ impl PyModel {
     }
 
     /// g (n,) | (N, n).
-    fn gravity_torque<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n], |model, data, x, out| {
@@ -397,7 +426,7 @@ impl PyModel {
     }
 
     /// C qd + g (n,) | (N, n), without friction.
-    fn bias_torque<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[n], |model, data, x, out| {
@@ -407,7 +436,7 @@ impl PyModel {
     }
 
     /// K () | (N,).
-    fn kinetic_energy<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn kinetic_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[], |model, data, x, out| {
@@ -417,7 +446,7 @@ impl PyModel {
     }
 
     /// P () | (N,).
-    fn potential_energy<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn potential_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[], |model, data, x, out| {
@@ -427,7 +456,7 @@ impl PyModel {
     }
 
     /// Y (n, 10 n) | (N, n, 10 n).
-    fn regressor<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, qdd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn regressor<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
         batch.run(py, self, &[n, 10 * n], |model, data, x, out| {
@@ -437,7 +466,7 @@ impl PyModel {
     }
 
     /// Centre of mass (3,) | (N, 3) in base coordinates.
-    fn center_of_mass<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[3], |model, data, x, out| {
@@ -447,7 +476,7 @@ impl PyModel {
     }
 
     /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
-    fn momentum<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[6], |model, data, x, out| {
@@ -461,6 +490,5 @@ impl PyModel {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     ik::register(m)?;
-    simulate::register(m)?;
     Ok(())
 }

@@ -38,13 +38,14 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         let x_up = parent_from_body(model, q, i);
         data.parent_from_body[i] = x_up;
         // v_i = ^iX_λ v_λ + s_i qd_i ;  c_i = v_i x s_i qd_i
-        let vj = data.s[i] * qd[i];
+        let joint = &model.joints[i];
+        let vj = joint.motion(qd[i]);
         let v = match model.parent[i] {
             Some(p) => x_up.inv_act_motion(&data.v[p]) + vj,
             None => vj,
         };
         data.v[i] = v;
-        data.c[i] = v.cross_motion(&vj);
+        data.c[i] = joint.cross(&v, qd[i]);
         // I^A_i = I_i ;  p^A_i = v_i x* I_i v_i - ^iX_0^* f^x_i
         let inertia = &model.inertia[i];
         data.ia[i] = ArticulatedInertia::from(inertia);
@@ -58,18 +59,18 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
     }
     // pass 2, leaves to root
     for i in (0..n).rev() {
-        let s = data.s[i];
+        let joint = &model.joints[i];
         let ia = data.ia[i];
         // U_i = I^A_i s_i ;  D_i = s_i^T U_i + armature_i ;  u_i = tau_i - friction_i - s_i^T p^A_i
-        let u_f = ia.mul_motion(&s);
-        let d = s.dot(&u_f) + model.armature[i];
+        let u_f = ia.times_s(joint);
+        let d = joint.project(&u_f) + model.armature[i];
         if !(d > EPS_D * (ia.trace() + model.armature[i])) || !d.is_finite() {
             return Err(Error::SingularMassMatrix(format!(
                 "joint {i} has articulated inertia D = {d:e} about its axis (a massless or inertia-free subtree); forward dynamics is undefined"
             )));
         }
         let d_inv = 1.0 / d;
-        let u = tau[i] - friction(model, i, qd[i]) - s.dot(&data.pa[i]);
+        let u = tau[i] - friction(model, i, qd[i]) - joint.project(&data.pa[i]);
         data.u_f[i] = u_f;
         data.d_inv[i] = d_inv;
         data.u[i] = u;
@@ -98,7 +99,7 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         } + data.c[i];
         let qdd = data.d_inv[i] * (data.u[i] - ap.dot(&data.u_f[i]));
         data.qdd[i] = qdd;
-        data.a[i] = ap + data.s[i] * qdd;
+        data.a[i] = ap + model.joints[i].motion(qdd);
     }
     Ok(&data.qdd)
 }

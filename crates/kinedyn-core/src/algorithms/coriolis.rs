@@ -28,7 +28,7 @@
 use super::kinematics::{forward_kinematics, forward_velocity};
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{skew, Inertia, Mat3, Motion};
+use crate::spatial::{Inertia, Mat3, Motion};
 
 /// `dI/dt` of a rigid body with inertia `i` (about the world origin) moving with twist `v`
 /// (world coordinates): `(v x*) I - I (v x)` in parameters: mass rate 0,
@@ -36,9 +36,11 @@ use crate::spatial::{skew, Inertia, Mat3, Motion};
 #[inline]
 fn inertia_rate(i: &Inertia, v: &Motion) -> Inertia {
     let (vo, w, h) = (&v.lin, &v.ang, &i.h);
-    let wx = skew(w);
+    // [w]x I_o - I_o [w]x = A + A^T with A = [w]x I_o (I_o symmetric): columns w x (I_o e_k)
+    let a = Mat3::from_columns(&[w.cross(&i.i_o.column(0).into_owned()), w.cross(&i.i_o.column(1).into_owned()), w.cross(&i.i_o.column(2).into_owned())]);
     let vh = vo * h.transpose();
-    let io_dot = Mat3::from_diagonal_element(2.0 * h.dot(vo)) - vh - vh.transpose() + wx * i.i_o - i.i_o * wx;
+    let sym = a - vh;
+    let io_dot = Mat3::from_diagonal_element(2.0 * h.dot(vo)) + sym + sym.transpose();
     Inertia::new(0.0, i.mass * vo + w.cross(h), io_dot)
 }
 

@@ -31,14 +31,15 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
             data.ic[p] += ic;
         }
         // F = I^c_i s_i ;  H_ii = s_i^T F (+ armature_i)
-        let mut f = data.ic[i].mul_motion(&data.s[i]);
-        data.m[i * n + i] = data.s[i].dot(&f) + model.armature[i];
+        let joints = &model.joints[..n];
+        let mut f = joints[i].inertia_times_s(&data.ic[i]);
+        data.m[i * n + i] = joints[i].project(&f) + model.armature[i];
         // j = i; while λ(j) != 0: F = ^λX_j^* F; j = λ(j); H_ij = H_ji = F^T s_j
         let mut j = i;
         while let Some(p) = model.parent[j] {
             f = data.parent_from_body[j].act_force(&f);
             j = p;
-            let h = data.s[j].dot(&f);
+            let h = joints[j].project(&f);
             data.m[i * n + j] = h;
             data.m[j * n + i] = h;
         }

@@ -65,43 +65,48 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
         // world_from_body rotations are needed to bring f_ext into body axes
         forward_kinematics(model, data, q);
     }
+    // every per-body array sliced to n once: the loops below index them without bounds checks
+    let (parent, joints, inertia) = (&model.parent[..n], &model.joints[..n], &model.inertia[..n]);
+    let (q, qd, qdd) = (&q[..n], &qd[..n], &qdd[..n]);
+    let (x_up, v, a, f) = (&mut data.parent_from_body[..n], &mut data.v[..n], &mut data.a[..n], &mut data.f[..n]);
     // a_0 = -g (a fictitious upward acceleration of the base replaces gravity)
     let a0 = if terms.gravity { Motion::new(-model.gravity, Default::default()) } else { Motion::zero() };
     for i in 0..n {
         // X_J, s = jcalc(q_i);  ^iX_λ = X_J X_T (stored as its inverse, parent_from_body)
-        let x_up = parent_from_body(model, q, i);
-        data.parent_from_body[i] = x_up;
-        let s = data.s[i];
-        let vj = s * qd[i];
+        let x = parent_from_body(model, q, i);
+        let joint = &joints[i];
         // v_i = ^iX_λ v_λ + s_i qd_i ;  a_i = ^iX_λ a_λ + s_i qdd_i + v_i x s_i qd_i
-        let (v, a) = match model.parent[i] {
-            Some(p) => (x_up.inv_act_motion(&data.v[p]) + vj, x_up.inv_act_motion(&data.a[p])),
-            None => (vj, x_up.inv_act_motion(&a0)),
+        let (vp, ap) = match parent[i] {
+            Some(p) => (x.inv_act_motion(&v[p]), x.inv_act_motion(&a[p])),
+            None => (Motion::zero(), x.inv_act_motion(&a0)),
         };
-        let a = a + s * qdd[i] + v.cross_motion(&vj);
+        let vi = vp + joint.motion(qd[i]);
+        let ai = ap + joint.motion(qdd[i]) + joint.cross(&vi, qd[i]);
         // f_i = I_i a_i + v_i x* I_i v_i - ^iX_0^* f^x_i
-        let inertia = &model.inertia[i];
-        let mut f = inertia.mul_motion(&a) + v.cross_force(&inertia.mul_motion(&v));
+        let body = &inertia[i];
+        let mut fi = body.mul_motion(&ai) + vi.cross_force(&body.mul_motion(&vi));
         if let Some(fx) = f_ext {
             let r = &data.world_from_body[i].rot;
             let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
-            f -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
+            fi -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
         }
-        data.v[i] = v;
-        data.a[i] = a;
-        data.f[i] = f;
+        x_up[i] = x;
+        v[i] = vi;
+        a[i] = ai;
+        f[i] = fi;
     }
+    let tau = &mut data.tau[..n];
     for i in (0..n).rev() {
         // tau_i = s_i^T f_i (+ armature qdd_i + friction(qd_i))
-        let mut tau = data.s[i].dot(&data.f[i]);
+        let mut t = joints[i].project(&f[i]);
         if terms.drives {
-            tau += model.armature[i] * qdd[i] + friction(model, i, qd[i]);
+            t += model.armature[i] * qdd[i] + friction(model, i, qd[i]);
         }
-        data.tau[i] = tau;
+        tau[i] = t;
         // f_λ(i) += ^λX_i^* f_i
-        if let Some(p) = model.parent[i] {
-            let fp = data.parent_from_body[i].act_force(&data.f[i]);
-            data.f[p] += fp;
+        if let Some(p) = parent[i] {
+            let fp = x_up[i].act_force(&f[i]);
+            f[p] += fp;
         }
     }
     &data.tau

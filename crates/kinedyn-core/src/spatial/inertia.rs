@@ -45,7 +45,11 @@ impl Inertia {
     /// Same body, axes rotated by `r` (origin unchanged): `h' = R h`, `I' = R I R^T`.
     #[inline]
     pub fn rotated(&self, r: &Mat3) -> Self {
-        Self::new(self.mass, r * self.h, r * self.i_o * r.transpose())
+        // R I R^T is symmetric: A = R I, then the 6 distinct entries A_i . R_j
+        let a = r * self.i_o;
+        let e = |i: usize, j: usize| a[(i, 0)] * r[(j, 0)] + a[(i, 1)] * r[(j, 1)] + a[(i, 2)] * r[(j, 2)];
+        let (xx, xy, xz, yy, yz, zz) = (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2));
+        Self::new(self.mass, r * self.h, Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz))
     }
     /// Same body, origin moved to `-t` (i.e. expressed in a frame whose origin is at `-t` from
     /// this one, same axes): the parallel-axis theorem written on `h` so that `m = 0` is fine:
