@@ -384,3 +384,20 @@ def test_kd_simulate_is_the_function_and_the_package():
     assert kd.simulate is pkg and callable(kd.simulate)
     assert kd.Trajectory is Trajectory and kd.simulate.PD is PD
     assert math.isclose(kd.simulate(kd.robots.planar_2r(), 0.01, np.zeros(4)).t[-1], 0.01)
+
+
+def test_cli_simulate_json_and_files(tmp_path, capsys):
+    import json
+
+    from kinedyn.cli import main
+
+    png = tmp_path / "out.png"
+    code = main(["simulate", "planar_2r", "--t", "1", "--controller", "pdg", "--goal", "0.5", "-0.3", "--plot", str(png), "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and png.stat().st_size > 1000
+    assert doc["controller"] == "PD + gravity compensation" and doc["samples"] == 1001
+    robot = kd.robots.planar_2r()
+    ref = kd.simulate(robot, 1.0, np.zeros(4), controller=PDGravity(robot, 100.0, 20.0, [0.5, -0.3]))
+    np.testing.assert_allclose(doc["q_final"], ref.q[-1], rtol=0, atol=1e-14)
+    code = main(["simulate", "planar_2r", "--dt", "0"])
+    assert code == 1 and "dt must be a positive" in capsys.readouterr().err
