@@ -18,7 +18,7 @@ import sympy as sp
 import kinedyn as kd
 from kinedyn.description.dh import DHRow
 from kinedyn.description.inertia import Inertia
-from kinedyn.symbolic import EquationsOfMotion, equations_of_motion
+from kinedyn.symbolic import EquationsOfMotion
 
 warnings.filterwarnings("ignore", message=".*triangle inequality.*")
 

@@ -7,7 +7,6 @@ import warnings
 
 import numpy as np
 import pytest
-import sympy as sp
 
 import kinedyn as kd
 

@@ -76,10 +76,6 @@ class _C(C99CodePrinter):
         return f"(double)(({x} > 0) - ({x} < 0))"
 
 
-def _arr(name: str) -> str:
-    return name
-
-
 def generate(eom, language: str = "numpy", what: Sequence[str] = ("M", "C", "g", "tau"), name=None, params=None) -> str:
     blocks, pars = _blocks(eom, what, params)
     prefix = name or "eom"
@@ -119,7 +115,7 @@ def generate(eom, language: str = "numpy", what: Sequence[str] = ("M", "C", "g",
             for k, e in enumerate(exprs):
                 idx = (k // shape[1], k % shape[1]) if len(shape) == 2 else (k,)
                 lines.append(f"    out[{', '.join(map(str, idx))}] = {pr.doprint(e)}")
-            lines.append(f"    return numpy.moveaxis(out, list(range({len(shape)})), list(range(-{len(shape)}, 0)))" if True else "")
+            lines.append(f"    return numpy.moveaxis(out, list(range({len(shape)})), list(range(-{len(shape)}, 0)))")
             lines.append("")
         return "\n".join(lines)
     if language == "c":

@@ -9,7 +9,7 @@ led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and gene
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence
 
 import sympy as sp
 

@@ -91,8 +91,6 @@ def geared_link_robot(J_l=None, J_m=None, M=None, g=None, ell=None, r=None, B_m=
     """The same single link as a :class:`kinedyn.Robot` (a revolute joint about z with gear_ratio r,
     rotor_inertia J_m, viscous friction r^2 B_m at the joint); symbols by default. The link's frame
     has x along the link; gravity -g along y, so theta = 0 points along +x (P = M g ell sin theta)."""
-    import math
-
     from ..description.inertia import Inertia
     from ..description.joint import Joint
     from ..description.link import Link

@@ -20,7 +20,6 @@ All arithmetic is exact, in the normal form of :class:`kinedyn.symbolic.simplify
 
 from __future__ import annotations
 
-import math
 from typing import List
 
 import numpy as np

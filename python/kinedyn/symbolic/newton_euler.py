@@ -24,7 +24,7 @@ variables are removed at the end (the customised model keeps only what tau needs
 
 from __future__ import annotations
 
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List
 
 import sympy as sp
 

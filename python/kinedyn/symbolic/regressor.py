@@ -15,7 +15,6 @@ printed Theta3 and Theta5 differ).
 
 from __future__ import annotations
 
-from fractions import Fraction
 from typing import Dict, List
 
 import sympy as sp

@@ -16,7 +16,7 @@ Spong §9.1-9.3), not only joint-coordinate robots.
 from __future__ import annotations
 
 import re
-from typing import Optional, Sequence
+from typing import Sequence
 
 import sympy as sp
 from sympy.core.function import AppliedUndef
