@@ -324,20 +324,31 @@ def _plain(lhs: str) -> str:
     return s.replace("{", "").replace("}", "").replace("\\", "")
 
 
-def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True) -> EquationsOfMotion:
+def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None) -> EquationsOfMotion:
     """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
 
     ``method="lagrange"``: Euler-Lagrange from K and P with every step kept (Spong §9.2-9.3).
     ``method="newton_euler"``: the customised symbolic recursive Newton-Euler model with intermediate
     variables (Khalil & Dombre); M, g and C are formed from it as well.
     ``simplify=True`` gives the textbook (Fourier) form of every entry; ``False`` the product form.
+    ``parameters="general"`` replaces every body's inertia by the ten symbols M_j, MX_j, MY_j, MZ_j,
+    XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j (about the body origin, Khalil & Dombre's names), so that
+    ``eom.regressor()`` groups them into base parameters; a list of per-body 10-vectors is used as given.
     """
+    if isinstance(parameters, str):
+        if parameters != "general":
+            raise ValueError(f"parameters must be 'general' or a list of per-body 10-vectors, got {parameters!r}")
+        from .robot_eom import general_parameters
+
+        parameters = general_parameters(robot)
+    if parameters is not None and (len(parameters) != robot.n or any(len(p) != 10 for p in parameters)):
+        raise ValueError(f"parameters must hold {robot.n} vectors of 10 inertial parameters")
     if method == "lagrange":
         from .robot_eom import lagrange_eom
 
-        return lagrange_eom(robot, simplify=simplify, with_steps=steps)
+        return lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters)
     if method in ("newton_euler", "newton-euler", "rnea"):
         from .robot_eom import newton_euler_eom
 
-        return newton_euler_eom(robot, simplify=simplify)
+        return newton_euler_eom(robot, simplify=simplify, parameters=parameters)
     raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")

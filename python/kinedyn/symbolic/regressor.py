@@ -91,7 +91,8 @@ def regressor(eom, known=None):
             comb = [sp.Integer(0)] * idx + [scale]
         combos[key] = comb
     p = len(basis)
-    Theta = sp.Matrix([sp.Add(*[v * _mono(pgens, k) for k, v in b.items()]) for b in basis])
+    tidy = lambda v: sp.Integer(int(v)) if isinstance(v, sp.Float) and float(v).is_integer() else v
+    Theta = sp.Matrix([sp.Add(*[tidy(v) * _mono(pgens, k) for k, v in b.items()]) for b in basis])
     Yr = [[ring.zero] * p for _ in tau]
     for key, comb in combos.items():
         row, sm, km = key
