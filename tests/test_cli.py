@@ -82,3 +82,29 @@ def test_robot_files_are_accepted(capsys, tmp_path):
 def test_bad_input_exits_nonzero_with_a_message(capsys, argv, message):
     code, _, err = run(capsys, *argv)
     assert code == 1 and message in err and "Traceback" not in err
+
+
+def test_derive_symbolic_json_equals_the_library(capsys):
+    import sympy as sp
+
+    doc = run_json(capsys, "derive", "--symbolic")
+    eom = kd.robots.planar_2r(symbolic=True).equations_of_motion()
+    names = {str(s): s for s in eom.M.free_symbols | eom.g.free_symbols | set(eom.q) | set(eom.qd)}
+    M = sp.Matrix(doc["M"]).subs({sp.Symbol(k): v for k, v in names.items()})
+    assert sp.simplify(M - eom.M) == sp.zeros(2, 2)
+    assert doc["op_count"] and doc["q"] == ["q1", "q2"]
+
+
+@pytest.mark.parametrize("fmt, marker", [("latex", "\\"), ("c", "void"), ("python", "def "), ("markdown", "$")])
+def test_derive_formats_write_files(capsys, tmp_path, fmt, marker):
+    out = tmp_path / f"eom.{fmt}"
+    code, text, err = run(capsys, "derive", "elbow_3r", "--format", fmt, "-o", str(out))
+    assert code == 0, err
+    assert marker in out.read_text() and str(out) in text
+    if fmt == "python":
+        compile(out.read_text(), str(out), "exec")
+
+
+def test_derive_rejects_symbolic_for_a_robot_without_symbols(capsys):
+    code, _, err = run(capsys, "derive", "puma560", "--symbolic")
+    assert code == 1 and "--symbolic needs a built-in" in err

@@ -345,6 +345,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 0
     try:
         return int(args.func(args) or 0)
+    except BrokenPipeError:  # e.g. `kinedyn derive | head`: the reader left, nothing to report
+        sys.stderr.close()
+        return 0
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as e:
         message = e.args[0] if isinstance(e, KeyError) and e.args else e
         print(f"kinedyn {args.command}: error: {message}", file=sys.stderr)

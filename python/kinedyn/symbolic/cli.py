@@ -1,0 +1,79 @@
+"""``kinedyn derive ROBOT``: the symbolic equations of motion, as LaTeX, Markdown, MathML, text or code."""
+
+from __future__ import annotations
+
+import inspect
+from pathlib import Path
+
+FORMATS = ("text", "latex", "markdown", "mathml", "python", "numpy", "c")
+
+
+def _robot(args):
+    from .. import robots
+    from ..cli import load_robot
+
+    name = args.robot or robots.DEFAULT
+    if args.symbolic:
+        factory = robots.CATALOGUE.get(name)
+        if factory is None or "symbolic" not in inspect.signature(factory).parameters:
+            symbolic = [n for n, f in robots.CATALOGUE.items() if "symbolic" in inspect.signature(f).parameters]
+            raise ValueError(f"--symbolic needs a built-in with symbolic parameters ({', '.join(symbolic)}); got '{name}'")
+        return factory(symbolic=True)
+    return load_robot(name)
+
+
+def cmd_derive(args) -> int:
+    from ..cli import console, emit
+
+    robot = _robot(args)
+    eom = robot.equations_of_motion(
+        method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None
+    )
+    fmt = args.format
+    if fmt == "latex":
+        text = eom.to_latex()
+    elif fmt == "markdown":
+        text = eom.to_markdown()
+    elif fmt == "mathml":
+        text = eom.to_mathml()
+    elif fmt == "text":
+        text = str(eom)
+    else:
+        text = eom.to_code(fmt)
+    if args.output:
+        Path(args.output).write_text(text)
+    payload = {
+        "robot": robot.name,
+        "method": args.method,
+        "format": fmt,
+        "q": [str(s) for s in eom.q],
+        "M": [[str(e) for e in row] for row in eom.M.tolist()],
+        "C": [[str(e) for e in row] for row in eom.C.tolist()],
+        "g": [str(e) for e in eom.g],
+        "tau": [str(e) for e in eom.tau],
+        "op_count": eom.op_count(),
+        "output": args.output,
+        "text": None if args.output else text,
+    }
+
+    def render():
+        if args.output:
+            console().print(f"wrote the {fmt} equations of motion of '{robot.name}' to {args.output}")
+        else:
+            print(text)
+
+    emit(args, payload, render)
+    return 0
+
+
+def add_derive_command(subparsers) -> None:
+    p = subparsers.add_parser("derive", help="symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)")
+    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
+    p.add_argument("--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)")
+    p.add_argument("--general", action="store_true", help="replace every inertia by ten symbols (M1, MX1, ..., ZZ1)")
+    p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
+    p.add_argument("--format", default="text", choices=FORMATS)
+    p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
+    p.add_argument("-o", "--output", help="write to this file instead of the terminal")
+    p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
+    p.set_defaults(func=cmd_derive)
