@@ -55,3 +55,20 @@ def test_checker_catches_a_wrong_gravity(monkeypatch):
     monkeypatch.setattr(robot, "gravity_torque", lambda q: 1.01 * right(q))
     residuals = check_identities(robot, states=2)
     assert residuals["g == dP/dq (finite differences)"] > 1e-4
+
+
+def test_base_parameters_ignore_columns_that_are_rounding_noise():
+    """PUMA 560 link 2's m cz column is ~1e-15 (its axis geometry makes it vanish): no base
+    parameter may be such a column, and the base regressor is well conditioned and exact."""
+    robot = kd.robots.puma560()
+    base = robot.base_parameters()
+    rng = np.random.default_rng(3)
+    q, qd, qdd = robot.random_configuration(rng, size=50), rng.normal(size=(50, 6)), rng.normal(size=(50, 6))
+    W = robot.regressor(q, qd, qdd).reshape(-1, 60)
+    norms = np.linalg.norm(W[:, base.indices], axis=0)
+    assert norms.min() > 1e-8 * norms.max()
+    W_base = W[:, base.indices]  # Y_base: the independent columns
+    assert np.linalg.matrix_rank(W_base) == len(base.indices)
+    armature = np.array([float(j.armature) for j in robot.joints])
+    tau = robot.inverse_dynamics(q, qd, qdd) - armature * qdd  # the regressor excludes rotor inertia
+    np.testing.assert_allclose(W_base @ base.values, tau.ravel(), atol=1e-9)
