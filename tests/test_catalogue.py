@@ -5,6 +5,7 @@ the documented base/tool offsets, overrides work."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -147,8 +148,12 @@ def test_puma_published_inertias_are_kept_with_a_warning():
 
     assert industrial.PUMA560_INERTIAS[2] == (0.066, 0.086, 0.0125)
     inertia._WARNED.clear()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        kd.robots.puma560()  # documented in its docstring: no warning for the catalogue robot
+    inertia._WARNED.clear()
     with pytest.warns(PhysicalConsistencyWarning, match="triangle inequality"):
-        kd.robots.puma560()
+        kd.Inertia(4.8, (0, 0, 0), np.diag(industrial.PUMA560_INERTIAS[2]))  # a user's copy warns
 
 
 def test_puma_motor_and_friction_options():

@@ -9,6 +9,17 @@ from .symbolic import LagrangianSystem
 
 __version__ = "0.1.0"
 
+_SUBMODULES = ("analysis", "dynamics", "ik", "kinematics", "symbolic", "testing")
+
+
+def __getattr__(name):
+    """Submodules load on first use (kd.ik, kd.kinematics, kd.analysis, ...), keeping import fast."""
+    if name in _SUBMODULES:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module 'kinedyn' has no attribute '{name}'")
+
 
 def load(path, **kwargs) -> Robot:
     """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension."""
@@ -17,4 +28,7 @@ def load(path, **kwargs) -> Robot:
     return _load(path, **kwargs)
 
 
-__all__ = ["Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate", "Trajectory", "__version__"]
+__all__ = [
+    "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
+    "Trajectory", "__version__", *_SUBMODULES,
+]

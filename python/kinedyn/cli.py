@@ -2,7 +2,7 @@
 
 ROBOT is a built-in name (``kinedyn robots`` lists them) or a robot file (.urdf, .yaml, .toml).
 Every command prints readable tables (colour on a terminal) or, with ``--json``, one JSON document.
-Each command module registers itself with ``add_<name>_command(subparsers)``.
+Each capability module registers its commands with ``add_<name>_command(s)(subparsers)``.
 """
 
 from __future__ import annotations
@@ -285,8 +285,8 @@ def cmd_jacobian(args) -> int:
     return 0
 
 
-def _optional_commands() -> list:
-    """Commands contributed by other modules: (module, function) registered when importable."""
+def _command_modules() -> list:
+    """Commands contributed by the capability modules: (module, registration function)."""
     return [
         ("kinedyn.ik.cli", "add_ik_command"),
         ("kinedyn.symbolic.cli", "add_derive_command"),
@@ -326,14 +326,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--task", default="full", help="rows: full, position, orientation, planar, planar_pose (default full)")
     p.set_defaults(func=cmd_jacobian)
 
-    for module, function in _optional_commands():
-        try:
-            mod = importlib.import_module(module)
-        except ModuleNotFoundError as e:
-            if e.name and module.startswith(e.name):
-                continue
-            raise
-        getattr(mod, function)(sub)
+    for module, function in _command_modules():
+        getattr(importlib.import_module(module), function)(sub)
     return parser
 
 

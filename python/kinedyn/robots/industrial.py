@@ -12,20 +12,35 @@ frame i (metres); RTB's ``I = [Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` lists have all pr
 
 from __future__ import annotations
 
+import functools
 import math
+import warnings
 from typing import Optional, Sequence
 
 import numpy as np
 
 from .._math import rot_z
 from ..description.dh import DHRow
-from ..description.inertia import Inertia
+from ..description.inertia import Inertia, PhysicalConsistencyWarning
 from ..robot import Robot
 
 __all__ = ["puma560", "stanford", "ur5", "UR5_URDF_BASE_FROM_DH_BASE", "UR5_DH_TOOL_FROM_URDF_TOOL0"]
 
 _DEG = math.pi / 180
 _INCH = 0.0254
+
+
+def _published(factory):
+    """Published tables are kept as published and their docstrings name the entries no rigid body
+    can have, so building a catalogue robot does not repeat the PhysicalConsistencyWarning."""
+
+    @functools.wraps(factory)
+    def build(*args, **kwargs):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PhysicalConsistencyWarning)
+            return factory(*args, **kwargs)
+
+    return build
 
 
 def _inertia(mass, com, tensor) -> Inertia:
@@ -95,6 +110,7 @@ PUMA560_MOTORS = (
 PUMA560_LIMITS_DEG = ((-160, 160), (-45, 225), (-225, 45), (-110, 170), (-100, 100), (-266, 266))
 
 
+@_published
 def puma560(
     a2: float = 0.4318,
     a3: float = 0.0203,
@@ -128,8 +144,7 @@ def puma560(
 
     Two published inertias are not those of any rigid body (link 1's (0, 0.35, 0) and link 3's
     Izz = 0.0125 < Iyy - Ixx fail the triangle inequality of principal moments); they are kept as
-    published, so kinedyn agrees with other tools using the same table (a
-    ``PhysicalConsistencyWarning`` says so once per process). Link 1 has zero mass and turns about y1 only,
+    published, so kinedyn agrees with other tools using the same table. Link 1 has zero mass and turns about y1 only,
     so its Ixx and Izz never enter the dynamics.
 
     ``motors=True`` adds the reflected rotor inertia G^2 Jm to each joint (gear_ratio = G,
@@ -196,6 +211,7 @@ STANFORD_LIMITS = (
 )
 
 
+@_published
 def stanford(
     d1: float = 0.412,
     d2: float = 0.154,
