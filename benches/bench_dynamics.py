@@ -5,7 +5,9 @@
 Per call from Python (one state), and per state in a 10,000-state batch: one kinedyn call (rayon,
 ``--threads`` workers, default 1 for a like-for-like comparison) vs Pinocchio's Python loop, and for
 inverse dynamics vs Pinocchio's own batch ``rneaInParallel`` on one thread. Prints medians and the
-ratios measured in this run (speed-up = Pinocchio time / kinedyn time). Never run in CI.
+ratios measured in this run (speed-up = Pinocchio time / kinedyn time). The two sides of each
+ratio are timed alternately, many times, and the fastest run of each is kept: on a shared machine
+the minimum is the least disturbed estimate. Never run in CI.
 """
 
 from __future__ import annotations
@@ -24,9 +26,24 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import fmt_us, load_pair, median_time  # noqa: E402
+from common import fmt_us, load_pair  # noqa: E402
 
 BATCH = 10_000
+
+
+def paired(a, b, rounds: int = 15, number: int = 300):
+    """Seconds per call of ``a`` and ``b``, timed alternately; the fastest of ``rounds`` runs each."""
+    import time
+
+    a(), b()
+    best = [float("inf"), float("inf")]
+    for _ in range(rounds):
+        for k, fn in enumerate((a, b)):
+            t0 = time.perf_counter()
+            for _ in range(number):
+                fn()
+            best[k] = min(best[k], (time.perf_counter() - t0) / number)
+    return best
 
 
 def sym(M):
@@ -69,18 +86,18 @@ def bench(name: str) -> None:
     print(f"\n{name} ({n} joints)")
     print(f"{'':46s} {'kinedyn':>12s} {'pinocchio':>12s}   speed-up")
     for label, kd_one, pin_one, kd_batch, pin_loop in cases:
-        a, b = median_time(kd_one, repeat=7, number=2000), median_time(pin_one, repeat=7, number=2000)
+        a, b = paired(kd_one, pin_one)
         print(f"{label + ', per call':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
-        a = median_time(kd_batch, repeat=5, number=3) / BATCH
-        b = median_time(pin_loop, repeat=3, number=1) / BATCH
+        a, b = paired(kd_batch, pin_loop, rounds=5, number=1)
+        a, b = a / BATCH, b / BATCH
         print(f"{label + ', per state, 10k batch vs loop':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
     # Pinocchio's own batch: (nq, N) matrices; the transpose of a C-ordered (N, nq) array is free
     pool = pin.ModelPool(model)
     out = np.zeros((n, BATCH), order="F")
     pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out)
     assert np.allclose(out.T, robot.inverse_dynamics(Q, V, A), atol=1e-9)
-    a = median_time(lambda: robot.inverse_dynamics(Q, V, A), repeat=5, number=3) / BATCH
-    b = median_time(lambda: pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out), repeat=5, number=3) / BATCH
+    a, b = paired(lambda: robot.inverse_dynamics(Q, V, A), lambda: pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out), rounds=9, number=1)
+    a, b = a / BATCH, b / BATCH
     print(f"{'inverse_dynamics, per state vs rneaInParallel(1)':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
 
 
