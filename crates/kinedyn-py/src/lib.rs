@@ -6,6 +6,7 @@
 use std::borrow::Cow;
 
 mod ik;
+mod simulate;
 use std::sync::Mutex;
 
 use kinedyn_core::algorithms::{self, Reference};
@@ -490,5 +491,6 @@ impl PyModel {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     ik::register(m)?;
+    simulate::register(m)?;
     Ok(())
 }
