@@ -21,7 +21,7 @@ pub struct Joint {
 /// Rotation matrix about the unit vector `a` by `angle` (Rodrigues' formula).
 #[inline]
 pub fn axis_angle(a: &Vec3, angle: f64) -> Mat3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = crate::trig::sin_cos(angle);
     let v = 1.0 - c;
     Mat3::new(
         c + a.x * a.x * v,
@@ -34,6 +34,19 @@ pub fn axis_angle(a: &Vec3, angle: f64) -> Mat3 {
         a.z * a.y * v + a.x * s,
         c + a.z * a.z * v,
     )
+}
+
+/// `R` with columns i and j replaced by `c r_i + s r_j` and `c r_j - s r_i` (`R Rz(x)` for
+/// `(i, j) = (0, 1)`, `R Rx(x)` for `(1, 2)`, `R Ry(x)` for `(2, 0)`).
+#[inline(always)]
+fn rotate_columns<const I: usize, const J: usize>(r: &Mat3, c: f64, s: f64) -> Mat3 {
+    let mut rot = *r;
+    for k in 0..3 {
+        let (ri, rj) = (r[(k, I)], r[(k, J)]);
+        rot[(k, I)] = c * ri + s * rj;
+        rot[(k, J)] = c * rj - s * ri;
+    }
+    rot
 }
 
 impl Joint {
@@ -64,26 +77,20 @@ impl Joint {
             JointKind::Prismatic => Transform::new(*r, parent_from_joint.trans + r * (self.axis * x)),
             JointKind::Revolute => {
                 let a = &self.axis;
-                let (s, c) = x.sin_cos();
-                // index pair (i, j) rotated into each other, sign of the axis
-                let pair = if a.x == 0.0 && a.y == 0.0 {
-                    Some((0, 1, a.z))
+                let (s, c) = crate::trig::sin_cos(x);
+                // columns (i, j) rotated into each other; constant indices let the compiler
+                // emit 12 multiplications and no index arithmetic
+                let rot = if a.x == 0.0 && a.y == 0.0 {
+                    Some(rotate_columns::<0, 1>(r, c, s * a.z))
                 } else if a.y == 0.0 && a.z == 0.0 {
-                    Some((1, 2, a.x))
+                    Some(rotate_columns::<1, 2>(r, c, s * a.x))
                 } else if a.x == 0.0 && a.z == 0.0 {
-                    Some((2, 0, a.y))
+                    Some(rotate_columns::<2, 0>(r, c, s * a.y))
                 } else {
                     None
                 };
-                match pair {
-                    Some((i, j, sign)) => {
-                        let s = s * sign;
-                        let (ri, rj) = (r.column(i).into_owned(), r.column(j).into_owned());
-                        let mut rot = *r;
-                        rot.set_column(i, &(ri * c + rj * s));
-                        rot.set_column(j, &(rj * c - ri * s));
-                        Transform::new(rot, parent_from_joint.trans)
-                    }
+                match rot {
+                    Some(rot) => Transform::new(rot, parent_from_joint.trans),
                     None => Transform::new(r * axis_angle(a, x), parent_from_joint.trans),
                 }
             }

@@ -11,6 +11,7 @@ pub mod joint;
 pub mod model;
 pub mod spatial;
 pub mod testing;
+pub mod trig;
 
 pub use data::Data;
 pub use error::{Error, Result};
