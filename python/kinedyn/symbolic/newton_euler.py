@@ -1,25 +1,46 @@
 """Customised symbolic recursive Newton-Euler model (Khalil & Dombre, *Modeling, Identification and
-Control of Robots*, §9.4-9.5 "customized symbolic model"; Khalil & Kleinfinger 1987).
+Control of Robots*, §9.4-9.5 "customized symbolic model", §14.5 grouped (base) parameters; Khalil &
+Kleinfinger 1987).
 
-The recursion is the textbook one (Spong §9.6, Craig eqs. 6.45-6.53) written in body frames, with the
-10 standard inertial parameters about each body origin (first moments h = m c, inertia I_o), so no
-centre-of-mass position is ever formed. Symbols: ``E`` = parent_from_body rotation, ``ET`` its
-transpose, ``r`` = body origin in parent axes, ``a`` = joint axis in body axes::
+The recursion is the textbook one (Spong §9.6, Craig eqs. 6.45-6.53; K&D eqs. 9.88-9.92) written in
+body frames, with the 10 standard inertial parameters about each body origin (first moments h = m c,
+inertia I_o), so no centre-of-mass position is ever formed. Symbols: ``E`` = parent_from_body
+rotation, ``ET`` its transpose, ``r`` = body origin in parent axes, ``a`` = joint axis in body axes::
 
     w_j   = ET w_i + qd_j a                                   (angular velocity; revolute)
     wd_j  = ET wd_i + qdd_j a + (ET w_i) x (qd_j a)           (angular acceleration; revolute)
-    U_i   = [wd_i]x + [w_i]x [w_i]x                           (Khalil's U matrix)
+    U_i   = [wd_i]x + [w_i]x [w_i]x                           (Khalil's U matrix, K&D eq. 9.90)
     vd_j  = ET (vd_i + U_i r_j)  [+ 2 w_j x (qd_j a) + qdd_j a, prismatic];  vd_0 = -gravity
-    F_j   = m_j vd_j + U_j h_j                                 (force at the body origin)
-    N_j   = I_o wd_j + w_j x (I_o w_j) + h_j x vd_j            (moment about the body origin)
+    F_j   = m_j vd_j + U_j h_j                                 (force at the body origin, K&D 9.91)
+    N_j   = I_o wd_j + w_j x (I_o w_j) + h_j x vd_j            (moment about the body origin, K&D 9.92)
     f_j   = F_j + sum_children E_c f_c
     n_j   = N_j + sum_children (E_c n_c + r_c x (E_c f_c))
     tau_j = a . n_j (revolute) or a . f_j (prismatic) + r^2 J_m qdd_j + viscous qd_j + coulomb sign(qd_j)
 
+Two reductions of the customised model (``group=True``), neither of which changes tau:
+
+* **Grouped parameters** (K&D §14.5.2, rules for revolute and prismatic joints; Gautier & Khalil 1990):
+  a body rotationally symmetric about a revolute joint's axis, with no moment of inertia about it --
+  parameters (M_j, MZ_j a, YY_j (1 - a a^T)) for a joint about z -- has the same kinetic and potential
+  energy whether it moves with link j or with its parent, so those three parameters move to the
+  parent, transformed by the parallel-axis rule (m' = m, h' = E h + m r,
+  I' = E I E^T - m [r]x[r]x - [r]x[Eh]x - [Eh]x[r]x): link j keeps XXR_j = XX_j - YY_j and M_j = MZ_j =
+  YY_j = 0. Across a prismatic joint the rotational inertia moves to the parent whole. Transfers run
+  from the tips to the base; what reaches the fixed base has no effect. Grouped parameters that are
+  not plain symbols are named ``XXR3``, ``ZZR2``, ``MXR2``, ... (parameter-only operations, counted).
+* **The moment through U** (linearity in the inertia entries): I wd + w x (I w) written per parameter
+  reuses the entries of U and the products w_a w_b that F already needs::
+
+      N_x = XX wd_x + (ZZ - YY) w_y w_z + XY (-U_zx) + XZ U_yx + YZ (w_y^2 - w_z^2) + (h x vd)_x
+      N_y = YY wd_y + (XX - ZZ) w_x w_z + XY U_zy + XZ (w_z^2 - w_x^2) + YZ (-U_xy) + (h x vd)_y
+      N_z = ZZ wd_z + (YY - XX) w_x w_y + XY (w_x^2 - w_y^2) + XZ (-U_yz) + YZ U_xz + (h x vd)_z
+
 Every vector component that is not a plain symbol or number is stored as a named intermediate variable
 (``W2z``, ``WP3x``, ``VP3y``, ``U2xy``, ``F4x``, ``N4z``, ``f4x``, ``n4z``, ...); SymPy drops products with
 0 and 1 as they are formed, so structural zeros of the axes and rotation matrices cost nothing. Unused
-variables are removed at the end (the customised model keeps only what tau needs).
+variables are removed at the end (the customised model keeps only what tau needs). Each variable
+carries a tag (stage, link) and the per-link vectors are kept in ``Program.vectors``, so the
+derivation can be shown step by step (:func:`newton_euler_steps`).
 """
 
 from __future__ import annotations
@@ -30,7 +51,7 @@ import sympy as sp
 
 from .eom import _ops
 
-__all__ = ["Program", "newton_euler_program"]
+__all__ = ["Program", "newton_euler_program", "newton_euler_steps"]
 
 _XYZ = "xyz"
 
@@ -41,6 +62,9 @@ class Program:
     def __init__(self, reserved=()):
         self.assignments: List[tuple] = []
         self.outputs: Dict[str, list] = {}
+        self.tags: Dict[sp.Symbol, tuple] = {}  # variable -> (stage, link) for the step-by-step display
+        self.vectors: Dict[tuple, list] = {}  # (quantity, link) -> 3 expressions (w, wd, vd, F, N, f, n, ...)
+        self.tag = ("", 0)  # the tag given to variables made now
         self._names = {str(s) for s in reserved}
 
     def let(self, name: str, expr):
@@ -53,6 +77,7 @@ class Program:
         self._names.add(name)
         sym = sp.Symbol(name, real=True)
         self.assignments.append((sym, expr))
+        self.tags[sym] = self.tag
         return sym
 
     def prune(self) -> "Program":
@@ -110,11 +135,92 @@ def _matTvec(A, v):
     return [sum((A[k][r] * v[k] for k in range(3)), sp.Integer(0)) for r in range(3)]
 
 
-def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = True, friction: bool = True, exact=None) -> Program:
+_PNAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
+
+
+def _skew(v):
+    return [[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]
+
+
+def _matmul(A, B):
+    return [[sum((A[r][k] * B[k][c] for k in range(3)), sp.Integer(0)) for c in range(3)] for r in range(3)]
+
+
+def _to_parent(m, h, I, E, r):
+    """Parameters (m, h, I about the origin) of a body, re-expressed about the parent origin in parent
+    axes: m' = m, h' = E h + m r, I' = E I E^T - m [r]x[r]x - [r]x[Eh]x - [Eh]x[r]x (parallel axes)."""
+    Eh = _matvec(E, h)
+    ET = [[E[c][r_] for c in range(3)] for r_ in range(3)]
+    EIE = _matmul(_matmul(E, I), ET)
+    Sr, SEh = _skew(r), _skew(Eh)
+    SrSr, SrSEh, SEhSr = _matmul(Sr, Sr), _matmul(Sr, SEh), _matmul(SEh, Sr)
+    I2 = [[sp.expand(EIE[a][b] - m * SrSr[a][b] - SrSEh[a][b] - SEhSr[a][b]) for b in range(3)] for a in range(3)]
+    return m, [sp.expand(Eh[k] + m * r[k]) for k in range(3)], I2
+
+
+def _unpack(pi):
+    m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = pi
+    return m, [hx, hy, hz], [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+
+
+def _pack(m, h, I):
+    return [m, h[0], h[1], h[2], I[0][0], I[0][1], I[1][1], I[0][2], I[1][2], I[2][2]]
+
+
+def group_parameters(bodies, pi, placements, exact=None, let=None):
+    """Grouped parameters (K&D §14.5.2; see the module docstring): per-body 10-vectors, tips to base.
+
+    ``pi``: per-body exact parameter lists about the body origin; ``placements``: per-body
+    (E, r) = parent_from_joint-frame rotation and origin. ``let(name, expr)``: names the transferred
+    totals (MR4 = M4 + MR5, ...) so that the parents' groupings share them. Returns new lists."""
+    from .lagrange import _exact
+
+    exact = exact or _exact
+    let = let or (lambda name, e: e)
+    zero = sp.Integer(0)
+    pi = [list(p) for p in pi]
+    for j in reversed(range(len(bodies))):
+        b = bodies[j]
+        J = j + 1
+        m, h, I = _unpack(pi[j])
+        a = [exact(x) for x in b.joint.axis]
+        E, r = placements[j]
+        if b.joint.kind == "revolute":
+            k = next((k for k in range(3) if abs(a[k]) == 1 and all(a[i] == 0 for i in range(3) if i != k)), None)
+            if k is None:  # an oblique axis: left ungrouped (correct, only less reduced)
+                continue
+            z = (k + 2) % 3  # the perpendicular diagonal entry made zero (YY for an axis along z)
+            # what stays: XXR = XX - YY (axis z), formed from the expressions so that common terms cancel
+            rest_I = [[sp.expand(I[i][c] - (I[z][z] if (i == c and i != k) else zero)) for c in range(3)] for i in range(3)]
+            rest = (zero, [zero if i == k else h[i] for i in range(3)], rest_I)
+            m = let(f"MR{J}", m)
+            hk = let(f"{_PNAMES[1 + k]}R{J}", h[k])
+            lam = let(f"{_PNAMES[(4, 6, 9)[z]]}R{J}", I[z][z])
+            sym_h = [hk if i == k else zero for i in range(3)]
+            sym_I = [[(lam if (i == c and i != k) else zero) for c in range(3)] for i in range(3)]
+            sym = (m, sym_h, sym_I)
+            shift = r
+        else:  # prismatic: the rotational inertia moves with the parent's rotation
+            names = [["XX", "XY", "XZ"], ["XY", "YY", "YZ"], ["XZ", "YZ", "ZZ"]]
+            Iv = {}
+            for i in range(3):
+                for c in range(i, 3):
+                    Iv[i, c] = Iv[c, i] = let(f"{names[i][c]}R{J}", I[i][c])
+            sym = (zero, [zero] * 3, [[Iv[i, c] for c in range(3)] for i in range(3)])
+            rest = (m, h, [[zero] * 3 for _ in range(3)])
+            shift = [zero] * 3
+        pi[j] = _pack(*rest)
+        if b.parent >= 0:  # what reaches the fixed base has no effect
+            pi[b.parent] = [sp.expand(x + y) for x, y in zip(pi[b.parent], _pack(*_to_parent(*sym, E, shift)))]
+    return pi
+
+
+def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = True, friction: bool = True, exact=None, group: bool = True) -> Program:
     """The customised Newton-Euler model of ``robot`` (see the module docstring).
 
     ``parameters``: optional list of per-body 10-vectors [m, mx, my, mz, XX, XY, YY, XZ, YZ, ZZ]
     (about the body origin, body axes) replacing the description's inertias (e.g. general symbols).
+    ``group``: use grouped parameters and the U-form of the moment (same tau, fewer operations).
     ``exact``: the value converter (kinedyn.symbolic.lagrange._exact)."""
     from .lagrange import _exact, _matrix
 
@@ -127,7 +233,24 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
     children: Dict[int, list] = {i: [] for i in range(-1, n)}
     for j, b in enumerate(bodies):
         children[b.parent].append(j)
-    E, r, axis, w, wd, vd, U, pi = {}, {}, {}, {}, {}, {}, {}, {}
+    # ---- inertial parameters (about each body origin), grouped when asked
+    pi, placements = {}, []
+    for j, b in enumerate(bodies):
+        params = parameters[j] if parameters is not None else b.inertia.parameters()
+        pi[j] = [exact(sp.expand(sp.cancel(x)) if isinstance(x, sp.Basic) else x) for x in params]
+        T = _matrix(b.placement)
+        placements.append(([row[:3] for row in T[:3]], [row[3] for row in T[:3]]))
+    base = [pi[j] for j in range(n)]
+    if group:
+        grouped = group_parameters(bodies, base, placements, exact, let=lambda name, e: _let_tagged(prog, name, e))
+        for j in range(n):
+            prog.tag = ("parameters", j + 1)
+            pi[j] = [
+                let(f"{name}{'R' if sp.expand(new - old) != 0 else ''}{j + 1}", new)
+                for name, new, old in zip(_PNAMES, grouped[j], base[j])
+            ]
+            prog.vectors[("pi", j)] = pi[j]
+    E, r, axis, w, wd, vd, U, WW = {}, {}, {}, {}, {}, {}, {}, {}
     g = [exact(x) for x in robot.gravity]
     w[-1] = [zero] * 3
     wd[-1] = [zero] * 3
@@ -136,10 +259,9 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
     # ---- forward recursion: velocities and accelerations, base to tip
     for j, b in enumerate(bodies):
         J = j + 1
+        prog.tag = ("forward", J)
         i = b.parent
-        T = _matrix(b.placement)
-        PR = [row[:3] for row in T[:3]]
-        Pp = [row[3] for row in T[:3]]
+        PR, Pp = placements[j]
         a = [exact(x) for x in b.joint.axis]
         axis[j] = a
         off = exact(b.joint.offset)
@@ -157,7 +279,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             d = q[j] + off
             rj = [let(f"P{J}{_XYZ[k]}", Pp[k] + sum((PR[k][m] * a[m] for m in range(3)), zero) * d) for k in range(3)]
         E[j], r[j] = Ej, rj
-        # w_j = ET w_i + qd a ; wd_j = ET wd_i + qdd a + (ET w_i) x (qd a)
+        # w_j = ET w_i + qd a ; wd_j = ET wd_i + qdd a + (ET w_i) x (qd a)          (K&D eqs. 9.88-9.89)
         wi = [let(f"WI{J}{_XYZ[k]}", x) for k, x in enumerate(_matTvec(Ej, w[i]))]
         wdi = _matTvec(Ej, wd[i])
         if b.joint.kind == "revolute":
@@ -168,7 +290,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         else:
             w[j] = wi
             wd[j] = [let(f"WP{J}{_XYZ[k]}", x) for k, x in enumerate(wdi)]
-        # vd_j = ET (vd_i + U_i r_j) [+ 2 w_j x (qd a) + qdd a]
+        # vd_j = ET (vd_i + U_i r_j) [+ 2 w_j x (qd a) + qdd a]                        (K&D eq. 9.90)
         Ur = _matvec(U[i], rj)
         vin = [let(f"VI{J}{_XYZ[k]}", vd[i][k] + Ur[k]) for k in range(3)]
         v = _matTvec(Ej, vin)
@@ -182,28 +304,33 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         for a1 in range(3):
             for a2 in range(a1, 3):
                 ww[a1, a2] = ww[a2, a1] = let(f"WW{J}{_XYZ[a1]}{_XYZ[a2]}", w[j][a1] * w[j][a2])
+        WW[j] = ww
         Sw = [[0, -wd[j][2], wd[j][1]], [wd[j][2], 0, -wd[j][0]], [-wd[j][1], wd[j][0], 0]]
         U[j] = [[let(f"U{J}{_XYZ[a1]}{_XYZ[a2]}", Sw[a1][a2] + ww[a1, a2] - (ww[0, 0] + ww[1, 1] + ww[2, 2] if a1 == a2 else 0)) for a2 in range(3)] for a1 in range(3)]
-        params = parameters[j] if parameters is not None else b.inertia.parameters()
-        pi[j] = [exact(sp.expand(sp.cancel(x)) if isinstance(x, sp.Basic) else x) for x in params]
-    # ---- per-body force and moment at the body origin
+        prog.vectors[("w", j)], prog.vectors[("wd", j)], prog.vectors[("vd", j)] = w[j], wd[j], vd[j]
+        prog.vectors[("U", j)] = U[j]
+    # ---- per-body force and moment at the body origin                               (K&D eqs. 9.91-9.92)
     F, N = {}, {}
     for j in range(n):
         J = j + 1
-        m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = pi[j]
-        h = [hx, hy, hz]
-        Io = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+        prog.tag = ("forces", J)
+        m, h, Io = _unpack(pi[j])
         Uh = _matvec(U[j], h)
         F[j] = [let(f"F{J}{_XYZ[k]}", m * vd[j][k] + Uh[k]) for k in range(3)]
-        Jw = [let(f"JW{J}{_XYZ[k]}", x) for k, x in enumerate(_matvec(Io, w[j]))]
-        Jwd = _matvec(Io, wd[j])
-        c1 = _cross(w[j], Jw)
         c2 = _cross(h, vd[j])
-        N[j] = [let(f"N{J}{_XYZ[k]}", Jwd[k] + c1[k] + c2[k]) for k in range(3)]
+        if group:
+            N[j] = [let(f"N{J}{_XYZ[k]}", x + c2[k]) for k, x in enumerate(_moment_u_form(prog, J, Io, wd[j], WW[j], U[j]))]
+        else:
+            Jw = [let(f"JW{J}{_XYZ[k]}", x) for k, x in enumerate(_matvec(Io, w[j]))]
+            Jwd = _matvec(Io, wd[j])
+            c1 = _cross(w[j], Jw)
+            N[j] = [let(f"N{J}{_XYZ[k]}", Jwd[k] + c1[k] + c2[k]) for k in range(3)]
+        prog.vectors[("F", j)], prog.vectors[("N", j)] = F[j], N[j]
     # ---- backward recursion: f_j = F_j + sum E_c f_c ; n_j = N_j + sum (E_c n_c + r_c x E_c f_c)
     f, nn, tau = {}, {}, [None] * n
     for j in reversed(range(n)):
         J = j + 1
+        prog.tag = ("backward", J)
         fj, nj = list(F[j]), list(N[j])
         for c in children[j]:
             Ef = [let(f"FE{c + 1}{_XYZ[k]}", x) for k, x in enumerate(_matvec(E[c], f[c]))]
@@ -213,6 +340,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             nj = [nj[k] + En[k] + rf[k] for k in range(3)]
         f[j] = [let(f"f{J}{_XYZ[k]}", x) for k, x in enumerate(fj)]
         nn[j] = [let(f"n{J}{_XYZ[k]}", x) for k, x in enumerate(nj)]
+        prog.vectors[("f", j)], prog.vectors[("n", j)] = f[j], nn[j]
         b = bodies[j]
         gen = nn[j] if b.joint.kind == "revolute" else f[j]
         t = sum((axis[j][k] * gen[k] for k in range(3)), zero)
@@ -222,3 +350,30 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         tau[j] = t
     prog.outputs["tau"] = tau
     return prog.prune()
+
+
+def _let_tagged(prog, name, expr):
+    """A grouped-parameter variable, tagged with its link (the digits of its name)."""
+    import re
+
+    prog.tag = ("parameters", int(re.search(r"(\d+)$", name).group(1)))
+    return prog.let(name, expr)
+
+
+def _moment_u_form(prog, J, Io, wd, ww, U):
+    """I wd + w x (I w) per inertia entry, reusing U and w_a w_b (module docstring; the entries of
+    U are U_ab = [wd]x_ab + w_a w_b - |w|^2 delta_ab)."""
+    (XX, XY, XZ), (_, YY, YZ), (_, _, ZZ) = Io
+    let = prog.let
+    tag, prog.tag = prog.tag, ("parameters", J)  # differences of parameters: parameter-only work
+    d_zy = let(f"ZY{J}", ZZ - YY)
+    d_xz = let(f"XZD{J}", XX - ZZ)
+    d_yx = let(f"YX{J}", YY - XX)
+    prog.tag = tag
+    x, y, z = 0, 1, 2
+    # differences of squares, formed only when a product of inertia needs them
+    sq = lambda a, b, name: let(f"WD{J}{name}", ww[a, a] - ww[b, b])
+    Nx = XX * wd[x] + d_zy * ww[y, z] - XY * U[z][x] + XZ * U[y][x] + (YZ * sq(y, z, "yz") if YZ != 0 else 0)
+    Ny = YY * wd[y] + d_xz * ww[x, z] + XY * U[z][y] + (XZ * sq(z, x, "zx") if XZ != 0 else 0) - YZ * U[x][y]
+    Nz = ZZ * wd[z] + d_yx * ww[x, y] + (XY * sq(x, y, "xy") if XY != 0 else 0) - XZ * U[y][z] + YZ * U[x][z]
+    return [Nx, Ny, Nz]
