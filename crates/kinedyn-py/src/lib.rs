@@ -295,7 +295,7 @@ impl PyModel {
     }
 
     /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
-    fn frame_poses<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frames: PyReadonlyArray1<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn frame_poses<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frames: PyReadonlyArray1<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let ids = frames.as_array().iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
@@ -310,7 +310,7 @@ impl PyModel {
 
     /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
     #[pyo3(signature = (q, frame, reference, point=None))]
-    fn jacobian<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn jacobian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
@@ -322,7 +322,7 @@ impl PyModel {
 
     /// Twist J qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
-    fn frame_velocity<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn frame_velocity<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
@@ -334,7 +334,7 @@ impl PyModel {
 
     /// Acceleration drift dJ/dt qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
-    fn jdot_qd<'py>(&self, py: Python<'py>, q: PyReadonlyArrayDyn<f64>, qd: PyReadonlyArrayDyn<f64>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn jdot_qd<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;

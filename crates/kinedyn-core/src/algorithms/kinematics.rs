@@ -67,6 +67,8 @@ pub fn forward_acceleration(model: &Model, data: &mut Data, q: &[f64], qd: &[f64
 pub fn frame_pose(model: &Model, data: &Data, frame: usize) -> Transform {
     let f = &model.frames[frame];
     match f.body {
+        // a link frame of a URDF robot is its body frame: skip the product with the identity
+        Some(b) if f.body_from_frame == Transform::identity() => data.world_from_body[b],
         Some(b) => data.world_from_body[b] * f.body_from_frame,
         None => f.body_from_frame,
     }
