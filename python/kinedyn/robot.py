@@ -330,9 +330,16 @@ class Robot:
 
     def pose(self, q, frame: Optional[str] = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
-        ids = np.array([self.frame_index(frame or self.tool)], dtype=np.int64)
-        out = self._model.frame_poses(self._state(q), ids)
-        return out[..., 0, :, :]
+        out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
+        return out[0] if out.ndim == 3 else out[:, 0]
+
+    def _frame_id_array(self, frame: str) -> np.ndarray:
+        """A one-element id array per frame name, made once."""
+        cache = self.__dict__.setdefault("_frame_id_arrays", {})
+        ids = cache.get(frame)
+        if ids is None:
+            ids = cache[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
+        return ids
 
     def jacobian(self, q, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
         """Geometric Jacobian (6, n), rows [linear; angular] (see docs/conventions.md).
@@ -341,7 +348,11 @@ class Robot:
         axes) and angular velocity, in base axes; ``"local"``: both in the frame's axes;
         ``"spatial"``: the spatial Jacobian (velocity of the body point at the base origin).
         """
-        return self._model.jacobian(self._state(q), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+        fid = self._frame_ids.get(frame or self.tool)
+        ref = _REFERENCES.get(reference)
+        if fid is None or ref is None or point is not None:  # the checked path, with its error messages
+            fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
+        return self._model.jacobian(self._state(q), fid, ref, point)
 
     def frame_velocity(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
