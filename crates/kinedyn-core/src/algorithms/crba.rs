@@ -19,29 +19,31 @@ use crate::model::Model;
 /// `M(q)` written row-major to `data.m` (n x n), armature included.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
     let n = model.n;
+    // per-body arrays sliced to n once (no bounds checks in the loops below)
+    let (parent, joints, armature) = (&model.parent[..n], &model.joints[..n], &model.armature[..n]);
+    let (x_up, ic, m) = (&mut data.parent_from_body[..n], &mut data.ic[..n], &mut data.m[..n * n]);
     for i in 0..n {
         // X_J = jcalc(q_i);  ^iX_λ(i) = X_J X_T(i);  I^c_i = I_i
-        data.parent_from_body[i] = parent_from_body(model, q, i);
-        data.ic[i] = model.inertia[i];
+        x_up[i] = parent_from_body(model, q, i);
+        ic[i] = model.inertia[i];
     }
     for i in (0..n).rev() {
         // I^c_λ(i) += ^λX_i^* I^c_i ^iX_λ
-        if let Some(p) = model.parent[i] {
-            let ic = data.parent_from_body[i].act_inertia(&data.ic[i]);
-            data.ic[p] += ic;
+        if let Some(p) = parent[i] {
+            let add = x_up[i].act_inertia(&ic[i]);
+            ic[p] += add;
         }
         // F = I^c_i s_i ;  H_ii = s_i^T F (+ armature_i)
-        let joints = &model.joints[..n];
-        let mut f = joints[i].inertia_times_s(&data.ic[i]);
-        data.m[i * n + i] = joints[i].project(&f) + model.armature[i];
+        let mut f = joints[i].inertia_times_s(&ic[i]);
+        m[i * n + i] = joints[i].project(&f) + armature[i];
         // j = i; while λ(j) != 0: F = ^λX_j^* F; j = λ(j); H_ij = H_ji = F^T s_j
         let mut j = i;
-        while let Some(p) = model.parent[j] {
-            f = data.parent_from_body[j].act_force(&f);
+        while let Some(p) = parent[j] {
+            f = x_up[j].act_force(&f);
             j = p;
             let h = joints[j].project(&f);
-            data.m[i * n + j] = h;
-            data.m[j * n + i] = h;
+            m[i * n + j] = h;
+            m[j * n + i] = h;
         }
     }
     // zero the entries of joints on different branches (no common subtree)
