@@ -179,6 +179,26 @@ class Robot:
         return np.array([j.effort_limit for j in self.joints])
 
     @property
+    def armature(self) -> np.ndarray:
+        """Reflected rotor inertia r^2 J_m per joint (added to the diagonal of M)."""
+        return np.array([float(j.armature) for j in self.joints])
+
+    @property
+    def viscous(self) -> np.ndarray:
+        """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)."""
+        return np.array([float(j.viscous) for j in self.joints])
+
+    @property
+    def coulomb(self) -> np.ndarray:
+        """Coulomb friction level per joint."""
+        return np.array([float(j.coulomb) for j in self.joints])
+
+    def friction_torque(self, qd) -> np.ndarray:
+        """viscous * qd + coulomb * sign(qd), (n,) or (N, n)."""
+        qd = np.asarray(qd, dtype=float)
+        return self.viscous * qd + self.coulomb * np.sign(qd)
+
+    @property
     def is_symbolic(self) -> bool:
         return bool(self.symbols)
 

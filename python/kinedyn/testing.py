@@ -89,10 +89,8 @@ def check_identities(robot: Robot, states: int = 5, seed: Optional[int] = 0, h: 
         scale = max(1.0, float(np.abs(b).max(initial=0.0)))
         worst[name] = max(worst.get(name, 0.0), float(np.abs(a - b).max(initial=0.0)) / scale)
 
-    viscous = np.array([float(j.viscous) for j in robot.joints])
-    coulomb = np.array([float(j.coulomb) for j in robot.joints])
     pi = robot.inertial_parameters()
-    armature = np.array([float(j.armature) for j in robot.joints])
+    armature = robot.armature
     for _ in range(states):
         q = robot.random_configuration(rng)
         qd = rng.normal(size=n)
@@ -100,7 +98,7 @@ def check_identities(robot: Robot, states: int = 5, seed: Optional[int] = 0, h: 
         M = robot.mass_matrix(q)
         g = robot.gravity_torque(q)
         C = robot.coriolis_matrix(q, qd)
-        friction = viscous * qd + coulomb * np.sign(qd)
+        friction = robot.friction_torque(qd)
         tau = robot.inverse_dynamics(q, qd, qdd)
         bias = robot.bias_torque(q, qd)
         record("rnea == M qdd + C qd + g + friction", tau, M @ qdd + C @ qd + g + friction)

@@ -113,10 +113,7 @@ class Identification:
 
 
 def _drives(robot):
-    arm = np.array([float(j.armature) for j in robot.joints])
-    visc = np.array([float(j.viscous) for j in robot.joints])
-    coul = np.array([float(j.coulomb) for j in robot.joints])
-    return arm, visc, coul
+    return robot.armature, robot.viscous, robot.coulomb
 
 
 def excitation(robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0=None, seed: int = 0) -> Fourier:

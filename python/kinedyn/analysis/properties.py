@@ -68,10 +68,7 @@ class PropertiesReport:
 
 
 def _drives(robot):
-    arm = np.array([float(j.armature) for j in robot.joints])
-    visc = np.array([float(j.viscous) for j in robot.joints])
-    coul = np.array([float(j.coulomb) for j in robot.joints])
-    return arm, visc, coul
+    return robot.armature, robot.viscous, robot.coulomb
 
 
 def check_properties(robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:

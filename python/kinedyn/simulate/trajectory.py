@@ -133,11 +133,9 @@ class Trajectory:
     def friction_torque(self) -> np.ndarray:
         """Joint friction viscous qd + coulomb sign(qd) of a robot per sample (zeros otherwise)."""
         s = self.system
-        if not hasattr(s, "joints"):
+        if not hasattr(s, "friction_torque"):
             return np.zeros_like(self.qd)
-        viscous = np.array([float(j.viscous) for j in s.joints])
-        coulomb = np.array([float(j.coulomb) for j in s.joints])
-        return viscous * self.qd + coulomb * np.sign(self.qd)
+        return s.friction_torque(self.qd)
 
     def energy_balance(self) -> dict:
         """Passivity along the trajectory (Spong eq. 9.117, dH/dt = qd . tau): the work of the input
