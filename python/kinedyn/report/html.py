@@ -222,90 +222,16 @@ def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float 
 
 
 # ------------------------------------------------------------------ MathML
-_GREEK = {"tau": "τ", "omega": "ω", "theta": "θ", "alpha": "α", "partial": "∂", "lambda": "λ", "pi": "π"}
+# equations come from the symbolic engine's own MathML (EquationsOfMotion.equation_mathml: SymPy's
+# presentation printer, names built as MathML); latex_to_mathml stays importable from here
+from ..symbolic.render import latex_to_mathml  # noqa: E402
 
 
-def latex_to_mathml(s: str) -> str:
-    """Presentation MathML for the small LaTeX of equation names (subscripts, \\frac, \\dot, \\ddot,
-    \\partial, \\mathcal, Greek letters) as written by the symbolic engine's steps."""
-    pos = 0
-
-    def group() -> str:
-        nonlocal pos
-        if pos < len(s) and s[pos] == "{":
-            pos += 1
-            out = seq("}")
-            pos += 1
-            return f"<mrow>{out}</mrow>"
-        return atom()
-
-    def atom() -> str:
-        nonlocal pos
-        c = s[pos]
-        if c == "\\":
-            m = re.match(r"\\([A-Za-z]+)", s[pos:])
-            if not m:
-                pos += 2
-                return f"<mo>{html.escape(s[pos - 1])}</mo>"
-            cmd = m.group(1)
-            pos += len(m.group(0))
-            if cmd == "frac":
-                a = group()
-                b = group()
-                return f"<mfrac>{a}{b}</mfrac>"
-            if cmd in ("dot", "ddot"):
-                return f"<mover accent=\"true\">{group()}<mo>{'˙' if cmd == 'dot' else '¨'}</mo></mover>"
-            if cmd == "mathcal":
-                inner = re.sub(r"<[^>]+>", "", group())
-                return f"<mi mathvariant=\"script\">{inner}</mi>"
-            if cmd in ("left", "right"):
-                return ""
-            if cmd == "partial":
-                return "<mo>∂</mo>"
-            if cmd in _GREEK:
-                return f"<mi>{_GREEK[cmd]}</mi>"
-            return f"<mi>{html.escape(cmd)}</mi>"
-        pos += 1
-        if c.isdigit():
-            return f"<mn>{c}</mn>"
-        if c.isalpha():
-            return f"<mi>{c}</mi>"
-        if c == " ":
-            return ""
-        return f"<mo>{html.escape(c)}</mo>"
-
-    def seq(stop: Optional[str]) -> str:
-        nonlocal pos
-        parts: List[str] = []
-        while pos < len(s) and (stop is None or s[pos] != stop):
-            if s[pos] in "_^" and parts:
-                op = s[pos]
-                pos += 1
-                sub = group()
-                base = parts.pop()
-                parts.append(f"<msub>{base}{sub}</msub>" if op == "_" else f"<msup>{base}{sub}</msup>")
-            else:
-                parts.append(group() if s[pos] == "{" else atom())
-        return "".join(parts)
-
-    return f"<mrow>{seq(None)}</mrow>"
-
-
-def _value_mathml(value) -> str:
-    import sympy as sp
-
-    m = sp.mathml(value, printer="presentation")
+def _equation(eom, lhs, value) -> str:
+    m = eom.equation_mathml(lhs, value)
     # matrices: brackets drawn by CSS (class bm), which needs no stretchy glyphs in the reader's fonts
     m = re.sub(r"<mrow><mo>\[</mo><mtable>(.*?)</mtable><mo>\]</mo></mrow>", r'<mtable class="bm">\1</mtable>', m)
-    # kinedyn's state symbols qd_i, qdd_i are printed with dots, as in the textbooks
-    m = m.replace("<mi>qdd</mi>", '<mover accent="true"><mi>q</mi><mo>¨</mo></mover>')
-    m = m.replace("<mi>qd</mi>", '<mover accent="true"><mi>q</mi><mo>˙</mo></mover>')
-    return m
-
-
-def _equation(lhs: str, value) -> str:
-    return (f'<div class="eq"><math xmlns="http://www.w3.org/1998/Math/MathML" display="block">'
-            f"<mrow>{latex_to_mathml(lhs)}<mo>=</mo>{_value_mathml(value)}</mrow></math></div>")
+    return f'<div class="eq">{m}</div>'
 
 
 # ------------------------------------------------------------------ SVG plots
@@ -447,10 +373,12 @@ def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: f
           "<p>M(q) q̈ + C(q, q̇) q̇ + g(q) = τ, derived symbolically by Lagrange's method (robot.equations_of_motion()).</p>"]
     if eom is not None:
         eq.append(f"<p class='note'>{html.escape(d['eom_note'])}; C from Christoffel symbols (Spong eq. 9.62).</p>")
-        for lhs, value in [("D(q)", eom.M), (r"C(q, \dot{q})", eom.C), ("g(q)", eom.g)]:
-            eq.append(_equation(lhs, value))
+        from ..symbolic.render import name, of_q
+
+        for lhs, value in [(of_q("D"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]:
+            eq.append(_equation(eom, lhs, value))
         for k in range(eom.n):  # one line per joint: the torques are long
-            eq.append(_equation(f"\\tau_{{{k + 1}}}", eom.tau[k]))
+            eq.append(_equation(eom, name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), eom.tau[k]))
         steps = getattr(eom, "steps", None) or []
         if steps:
             eq.append("<details><summary>every step of the derivation</summary>")
@@ -459,7 +387,7 @@ def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: f
                 if step.text:
                     eq.append(f"<p class='note'>{html.escape(step.text)}</p>")
                 for lhs, value in step.equations:
-                    eq.append(_equation(lhs, value))
+                    eq.append(_equation(eom, lhs, value))
             eq.append("</details>")
     else:
         eq.append(f"<p class='note'>{html.escape(d['eom_note'] or '')}</p>")

@@ -261,12 +261,9 @@ class EquationsOfMotion:
 
     # ------------------------------------------------------------------ rendering
     def _final_equations(self):
-        return [
-            ("D(q)", self.M),
-            (r"C(q, \dot{q})", self.C),
-            ("g(q)", self.g),
-            (r"\tau", self.tau),
-        ]
+        from .render import name, of_q
+
+        return [(of_q("D"), self.M), (of_q("C", rates=True), self.C), (of_q("g"), self.g), (name(r"\tau", "tau", "tau"), self.tau)]
 
     def to_latex(self, steps: bool = True) -> str:
         """A LaTeX ``align*`` block: the steps of the derivation (if any) and the final matrices."""
@@ -296,41 +293,44 @@ class EquationsOfMotion:
             out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
         return "\n".join(out)
 
-    def to_mathml(self) -> str:
-        """Presentation MathML, one ``<math>`` element per equation."""
-        parts = []
-        for step in self.steps:
-            parts.append(f"<p>{step.title}</p>")
-            for lhs, value in step.equations:
-                parts.append(f'<math xmlns="http://www.w3.org/1998/Math/MathML" display="block"><mrow><mi>{_mathml_escape(lhs)}</mi><mo>=</mo>{sp.mathml(value, printer="presentation")}</mrow></math>')
-        for lhs, value in self._final_equations():
-            parts.append(f'<math xmlns="http://www.w3.org/1998/Math/MathML" display="block"><mrow><mi>{_mathml_escape(lhs)}</mi><mo>=</mo>{sp.mathml(value, printer="presentation")}</mrow></math>')
+    def equation_mathml(self, lhs, value, display: str = "block") -> str:
+        """One ``<math>`` element ``lhs = value`` in presentation MathML (SymPy's printer; q̇, q̈ with
+        dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
+        from .render import equation_mathml, rate_symbols
+
+        return equation_mathml(lhs, value, rate_symbols(self.q, self.qd, self.qdd), display=display)
+
+    def to_mathml(self, steps: bool = True) -> str:
+        """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per
+        equation) and the result, inside one ``<div>`` (well-formed XML, embeddable in HTML)."""
+        from html import escape
+
+        parts = ['<div class="kinedyn-eom">']
+        for k, step in enumerate(self.steps if steps else [], start=1):
+            parts.append(f"<section><h3>Step {k}: {escape(step.title)}</h3>")
+            if step.text:
+                parts.append(f"<p>{escape(step.text)}</p>")
+            parts += [self.equation_mathml(lhs, value) for lhs, value in step.equations]
+            parts.append("</section>")
+        parts.append("<section><h3>Result: M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</h3>")
+        parts += [self.equation_mathml(lhs, value) for lhs, value in self._final_equations()]
+        parts.append("</section></div>")
         return "\n".join(parts)
 
     def __str__(self) -> str:
+        from .render import text_of
+
         out = [f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"]
         for k, step in enumerate(self.steps, start=1):
             out.append(f"\nStep {k}: {step.title}")
             for lhs, value in step.equations:
-                out.append(f"  {_plain(lhs)} = {value}")
+                out.append(f"  {text_of(lhs)} = {value}")
         for lhs, value in self._final_equations():
-            out.append(f"{_plain(lhs)} = {value}")
+            out.append(f"{text_of(lhs)} = {value}")
         return "\n".join(out)
 
     def __repr__(self) -> str:
         return f"EquationsOfMotion(name={self.name!r}, n={self.n}, method={self.method!r})"
-
-
-def _mathml_escape(s: str) -> str:
-    return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
-
-
-def _plain(lhs: str) -> str:
-    import re
-
-    s = lhs.replace(r"\dot{q}", "qd").replace(r"\ddot{q}", "qdd").replace(r"\tau", "tau")
-    s = re.sub(r"\\(frac|partial|mathcal|operatorname|left|right|text)", "", s)
-    return s.replace("{", "").replace("}", "").replace("\\", "")
 
 
 def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None) -> EquationsOfMotion:
@@ -359,5 +359,5 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
     if method in ("newton_euler", "newton-euler", "rnea"):
         from .robot_eom import newton_euler_eom
 
-        return newton_euler_eom(robot, simplify=simplify, parameters=parameters)
+        return newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps)
     raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")

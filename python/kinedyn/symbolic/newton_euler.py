@@ -2,24 +2,25 @@
 Control of Robots*, §9.4-9.5 "customized symbolic model", §14.5 grouped (base) parameters; Khalil &
 Kleinfinger 1987).
 
-The recursion is the textbook one (Spong §9.6, Craig eqs. 6.45-6.53; K&D eqs. 9.88-9.92) written in
+The recursion is the textbook one (Spong §9.6, Craig eqs. 6.45-6.53; K&D ch. 9, Newton-Euler formulation) written in
 body frames, with the 10 standard inertial parameters about each body origin (first moments h = m c,
 inertia I_o), so no centre-of-mass position is ever formed. Symbols: ``E`` = parent_from_body
 rotation, ``ET`` its transpose, ``r`` = body origin in parent axes, ``a`` = joint axis in body axes::
 
     w_j   = ET w_i + qd_j a                                   (angular velocity; revolute)
     wd_j  = ET wd_i + qdd_j a + (ET w_i) x (qd_j a)           (angular acceleration; revolute)
-    U_i   = [wd_i]x + [w_i]x [w_i]x                           (Khalil's U matrix, K&D eq. 9.90)
+    U_i   = [wd_i]x + [w_i]x [w_i]x                           (Khalil's U matrix)
     vd_j  = ET (vd_i + U_i r_j)  [+ 2 w_j x (qd_j a) + qdd_j a, prismatic];  vd_0 = -gravity
-    F_j   = m_j vd_j + U_j h_j                                 (force at the body origin, K&D 9.91)
-    N_j   = I_o wd_j + w_j x (I_o w_j) + h_j x vd_j            (moment about the body origin, K&D 9.92)
+    F_j   = m_j vd_j + U_j h_j                                 (force at the body origin)
+    N_j   = I_o wd_j + w_j x (I_o w_j) + h_j x vd_j            (moment about the body origin)
     f_j   = F_j + sum_children E_c f_c
     n_j   = N_j + sum_children (E_c n_c + r_c x (E_c f_c))
     tau_j = a . n_j (revolute) or a . f_j (prismatic) + r^2 J_m qdd_j + viscous qd_j + coulomb sign(qd_j)
 
 Two reductions of the customised model (``group=True``), neither of which changes tau:
 
-* **Grouped parameters** (K&D §14.5.2, rules for revolute and prismatic joints; Gautier & Khalil 1990):
+* **Grouped parameters** (K&D ch. 9, the grouping rules of the base inertial parameters; Gautier & Khalil 1990,
+  Khalil & Kleinfinger 1987):
   a body rotationally symmetric about a revolute joint's axis, with no moment of inertia about it --
   parameters (M_j, MZ_j a, YY_j (1 - a a^T)) for a joint about z -- has the same kinetic and potential
   energy whether it moves with link j or with its parent, so those three parameters move to the
@@ -65,6 +66,7 @@ class Program:
         self.tags: Dict[sp.Symbol, tuple] = {}  # variable -> (stage, link) for the step-by-step display
         self.vectors: Dict[tuple, list] = {}  # (quantity, link) -> 3 expressions (w, wd, vd, F, N, f, n, ...)
         self.tag = ("", 0)  # the tag given to variables made now
+        self.all_assignments: List[tuple] = []
         self._names = {str(s) for s in reserved}
 
     def let(self, name: str, expr):
@@ -81,7 +83,9 @@ class Program:
         return sym
 
     def prune(self) -> "Program":
-        """Remove assignments the outputs do not use (dead-code elimination)."""
+        """Remove assignments the outputs do not use (dead-code elimination); ``all_assignments`` keeps
+        the whole recursion for the step-by-step display."""
+        self.all_assignments = list(self.assignments)
         needed = set()
         for exprs in self.outputs.values():
             for e in exprs:
@@ -168,7 +172,7 @@ def _pack(m, h, I):
 
 
 def group_parameters(bodies, pi, placements, exact=None, let=None):
-    """Grouped parameters (K&D §14.5.2; see the module docstring): per-body 10-vectors, tips to base.
+    """Grouped parameters (K&D's grouping rules; see the module docstring): per-body 10-vectors, tips to base.
 
     ``pi``: per-body exact parameter lists about the body origin; ``placements``: per-body
     (E, r) = parent_from_joint-frame rotation and origin. ``let(name, expr)``: names the transferred
@@ -279,7 +283,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             d = q[j] + off
             rj = [let(f"P{J}{_XYZ[k]}", Pp[k] + sum((PR[k][m] * a[m] for m in range(3)), zero) * d) for k in range(3)]
         E[j], r[j] = Ej, rj
-        # w_j = ET w_i + qd a ; wd_j = ET wd_i + qdd a + (ET w_i) x (qd a)          (K&D eqs. 9.88-9.89)
+        # w_j = ET w_i + qd a ; wd_j = ET wd_i + qdd a + (ET w_i) x (qd a)
         wi = [let(f"WI{J}{_XYZ[k]}", x) for k, x in enumerate(_matTvec(Ej, w[i]))]
         wdi = _matTvec(Ej, wd[i])
         if b.joint.kind == "revolute":
@@ -290,7 +294,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         else:
             w[j] = wi
             wd[j] = [let(f"WP{J}{_XYZ[k]}", x) for k, x in enumerate(wdi)]
-        # vd_j = ET (vd_i + U_i r_j) [+ 2 w_j x (qd a) + qdd a]                        (K&D eq. 9.90)
+        # vd_j = ET (vd_i + U_i r_j) [+ 2 w_j x (qd a) + qdd a]
         Ur = _matvec(U[i], rj)
         vin = [let(f"VI{J}{_XYZ[k]}", vd[i][k] + Ur[k]) for k in range(3)]
         v = _matTvec(Ej, vin)
@@ -309,7 +313,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         U[j] = [[let(f"U{J}{_XYZ[a1]}{_XYZ[a2]}", Sw[a1][a2] + ww[a1, a2] - (ww[0, 0] + ww[1, 1] + ww[2, 2] if a1 == a2 else 0)) for a2 in range(3)] for a1 in range(3)]
         prog.vectors[("w", j)], prog.vectors[("wd", j)], prog.vectors[("vd", j)] = w[j], wd[j], vd[j]
         prog.vectors[("U", j)] = U[j]
-    # ---- per-body force and moment at the body origin                               (K&D eqs. 9.91-9.92)
+    # ---- per-body force and moment at the body origin
     F, N = {}, {}
     for j in range(n):
         J = j + 1
@@ -377,3 +381,76 @@ def _moment_u_form(prog, J, Io, wd, ww, U):
     Ny = YY * wd[y] + d_xz * ww[x, z] + XY * U[z][y] + (XZ * sq(z, x, "zx") if XZ != 0 else 0) - YZ * U[x][y]
     Nz = ZZ * wd[z] + d_yx * ww[x, y] + (XY * sq(x, y, "xy") if XY != 0 else 0) - XZ * U[y][z] + YZ * U[x][z]
     return [Nx, Ny, Nz]
+
+
+def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
+    """The derivation of the customised model, step by step (for ``eom.steps``): the grouped parameters,
+    then per link the forward recursion (w, wd, vd and the centre-of-mass acceleration vdc), the force
+    and moment of each link, and the backward recursion (f, n, tau) from the tip to the base. Every
+    equation is an intermediate variable with its expression, as formed (K&D ch. 9; Spong §9.6 and Craig
+    eqs. 6.45-6.53 for the textbook form); the variables tau does not need are shown too."""
+    from .eom import Step
+    from .lagrange import _exact
+    from .render import name, symbol_name, vector_name
+
+    n = len(robot.tree.bodies)
+    assignments = prog.all_assignments or prog.assignments
+    by_tag: Dict[tuple, list] = {}
+    for sym, expr in assignments:
+        by_tag.setdefault(prog.tags.get(sym, ("", 0)), []).append((symbol_name(sym), expr))
+    V = lambda key, j: sp.Matrix(prog.vectors[(key, j)]) if (key, j) in prog.vectors else None
+    steps = []
+    # in program order (tips to base), and only those tau uses: the rest reached the fixed base
+    grouped = [(symbol_name(sym), expr) for sym, expr in prog.assignments if prog.tags.get(sym, ("",))[0] == "parameters"]
+    if grouped:
+        steps.append(Step(
+            "Grouped inertial parameters",
+            "Across a revolute joint about z, M_j, MZ_j and YY_j move to the parent (parallel-axis rule), leaving XXR_j = XX_j - YY_j; "
+            "across a prismatic joint the rotational inertia moves (Khalil & Dombre ch. 9; Gautier & Khalil 1990). Differences such as ZZ - YY are formed once.",
+            grouped,
+        ))
+    for j in range(n):
+        J = j + 1
+        st = Step(
+            f"Forward recursion, link {J}: w, wd, vd, vdc",
+            "w_j = E^T w_i + qd_j a_j, wd_j = E^T wd_i + qdd_j a_j + (E^T w_i) x qd_j a_j, U_j = [wd_j]x + [w_j]x[w_j]x, "
+            "vd_j = E^T (vd_i + U_i r_j), vd_cj = vd_j + U_j c_j (Craig eqs. 6.45-6.48 in body frames; K&D ch. 9); vd_0 = -gravity.",
+            list(by_tag.get(("forward", J), [])),
+        )
+        for key, lhs in (("w", vector_name(r"\omega", "w", "ω", J)), ("wd", vector_name(r"\omega", "wd", "ω", J, accent=1)), ("vd", vector_name("v", "vd", "v", J, accent=1))):
+            if V(key, j) is not None:
+                st.equations.append((lhs, V(key, j)))
+        inertia = robot.tree.bodies[j].inertia
+        if V("vd", j) is not None and V("U", j) is not None and _exact(inertia.mass) != 0:
+            c = sp.Matrix([_exact(x) for x in inertia.com])
+            U = sp.Matrix(prog.vectors[("U", j)])
+            st.equations.append((vector_name("v", "vd", "v", f"c{J}", accent=1), V("vd", j) + U * c))
+        steps.append(st)
+    for j in range(n):
+        J = j + 1
+        st = Step(
+            f"Force and moment of link {J} at its origin",
+            "F_j = m_j vd_cj = M_j vd_j + U_j MS_j, N_j = I_j wd_j + w_j x (I_j w_j) + MS_j x vd_j (Craig eqs. 6.49-6.50 about the origin; K&D ch. 9), "
+            "the moment written per inertia entry through U.",
+            list(by_tag.get(("forces", J), [])),
+        )
+        for key, latex, text in (("F", "F", "F"), ("N", "N", "N")):
+            if V(key, j) is not None:
+                st.equations.append((name(f"{latex}_{{{J}}}", f"{text}{J}", latex, str(J)), V(key, j)))
+        steps.append(st)
+    tau = prog.outputs.get("tau", [])
+    for j in reversed(range(n)):
+        J = j + 1
+        st = Step(
+            f"Backward recursion, link {J}: f, n, tau",
+            "f_j = F_j + sum_children E_c f_c, n_j = N_j + sum_children (E_c n_c + r_c x E_c f_c), "
+            "tau_j = a_j . n_j (revolute) or a_j . f_j (prismatic), plus r^2 J_m qdd_j (Craig eqs. 6.51-6.53).",
+            list(by_tag.get(("backward", J), [])),
+        )
+        for key in ("f", "n"):
+            if V(key, j) is not None:
+                st.equations.append((name(f"{key}_{{{J}}}", f"{key}{J}", key, str(J)), V(key, j)))
+        if j < len(tau):
+            st.equations.append((name(f"\\tau_{{{J}}}", f"tau_{J}", "tau", str(J)), tau[j]))
+        steps.append(st)
+    return steps

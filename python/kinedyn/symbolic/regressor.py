@@ -1,4 +1,4 @@
-"""Linearity in the parameters (Spong §9.5.3, eq. 9.121; Khalil & Dombre §9.6 and §12.5, base
+"""Linearity in the parameters (Spong §9.5.3, eq. 9.121; Khalil & Dombre ch. 9, base
 parameters): tau = Y(q, qd, qdd) Theta + tau_known, exactly.
 
 tau is expanded (in the exact trigonometric ring) into terms  (state monomial) x (known monomial) x

@@ -6,7 +6,8 @@ import sympy as sp
 
 from .eom import EquationsOfMotion, Step
 from .lagrange import RingModel, _exact, christoffel, coriolis_matrix, derive_lagrange, latex_names, state_symbols
-from .newton_euler import newton_euler_program
+from .newton_euler import newton_euler_program, newton_euler_steps
+from .render import dL_dq, dL_dqd, ddt_dL_dqd, lagrangian, name, of_q
 
 __all__ = ["lagrange_eom", "newton_euler_eom", "general_parameters"]
 
@@ -52,13 +53,13 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
         pc = model.com_positions()
         st = Step("Centre-of-mass positions r_ci(q) in the base frame", "Each link's centre of mass, from the forward kinematics.")
         for i in range(n):
-            st.equations.append((f"r_{{c{i + 1}}}", vec(pc[i])))
+            st.equations.append((name(f"r_{{c{i + 1}}}", f"r_c{i + 1}", "r", f"c{i + 1}"), vec(pc[i])))
         steps.append(st)
         st = Step("Velocity Jacobians", "v_ci = J_vci(q) qd and omega_i = J_wi(q) qd (Spong eq. 9.45); J_vci = d r_ci / dq.")
         for i in range(n):
             Jvc = [[ring.diff_q(pc[i][k], j) for j in range(n)] for k in range(3)]
-            st.equations.append((f"J_{{v_{{c{i + 1}}}}}", mat(Jvc)))
-            st.equations.append((f"J_{{\\omega_{{{i + 1}}}}}", mat(model.world_angular_jacobian(i))))
+            st.equations.append((_jac_name("v", f"c{i + 1}"), mat(Jvc)))
+            st.equations.append((_jac_name("omega", f"{i + 1}"), mat(model.world_angular_jacobian(i))))
         steps.append(st)
     except Exception:  # centre of mass not polynomial (e.g. h/m with symbolic m): skip the display step
         pass
@@ -66,20 +67,19 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
     steps.append(Step(
         "Kinetic energy K = qd^T D(q) qd / 2",
         "D(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
-        [("D(q)", mat(d["D"])), ("K", conv(d["K"]))],
+        [(of_q("D"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
     ))
-    steps.append(Step("Potential energy P = sum_i m_i g^T r_ci", "(Spong eqs. 9.48-9.49; g points along gravity)", [("P", conv(d["P"]))]))
-    steps.append(Step("Lagrangian L = K - P", "", [(r"\mathcal{L}", conv(d["L"]))]))
+    steps.append(Step("Potential energy P = sum_i m_i g^T r_ci", "(Spong eqs. 9.48-9.49; g points along gravity)", [(name("P", "P", "P"), conv(d["P"]))]))
+    steps.append(Step("Lagrangian L = K - P", "", [(lagrangian(), conv(d["L"]))]))
     st = Step("Derivatives of the Lagrangian", "For each coordinate: dL/dqd_k, its time derivative, and dL/dq_k (Spong eq. 9.40).")
-    names = [sp.latex(x) for x in q]
     for k in range(n):
-        st.equations.append((f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial \\dot{{{names[k]}}}}}", conv(d["dL_dqd"][k])))
-        st.equations.append((f"\\frac{{d}}{{dt}}\\frac{{\\partial \\mathcal{{L}}}}{{\\partial \\dot{{{names[k]}}}}}", conv(d["ddt_dL_dqd"][k])))
-        st.equations.append((f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {names[k]}}}", conv(d["dL_dq"][k])))
+        st.equations.append((dL_dqd(q[k], qd[k]), conv(d["dL_dqd"][k])))
+        st.equations.append((ddt_dL_dqd(q[k], qd[k]), conv(d["ddt_dL_dqd"][k])))
+        st.equations.append((dL_dq(q[k]), conv(d["dL_dq"][k])))
     steps.append(st)
     st = Step("Joint torques tau_k = d/dt dL/dqd_k - dL/dq_k", "Friction, if any, is added separately: viscous qd + coulomb sign(qd).")
     for k in range(n):
-        st.equations.append((f"\\tau_{{{k + 1}}}", conv(d["tau"][k])))
+        st.equations.append((name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", f"{k + 1}"), conv(d["tau"][k])))
     steps.append(st)
     st = Step("Christoffel symbols c_ijk (non-zero ones)", "c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2 (Spong eq. 9.58), C_kj = sum_i c_ijk qd_i (eq. 9.62).")
     c = d["christoffel"]
@@ -87,9 +87,18 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
         for i in range(n):
             for j in range(i, n):
                 if c[i][j][k]:
-                    st.equations.append((f"c_{{{i + 1}{j + 1}{k + 1}}}", conv(c[i][j][k])))
+                    st.equations.append((name(f"c_{{{i + 1}{j + 1}{k + 1}}}", f"c_{i + 1}{j + 1}{k + 1}", "c", f"{i + 1}{j + 1}{k + 1}"), conv(c[i][j][k])))
     steps.append(st)
     return steps
+
+
+def _jac_name(kind, index):
+    """J_{v_{c1}} (text J_vc1) or J_{omega_1} (text J_w1), with MathML subscripts of subscripts."""
+    from .render import Name, _mi, _tokens
+
+    if kind == "v":
+        return Name(f"J_{{v_{{{index}}}}}", f"J_v{index}", f"<msub><mi>J</mi><msub><mi>v</mi>{_tokens(index)}</msub></msub>")
+    return Name(f"J_{{\\omega_{{{index}}}}}", f"J_w{index}", f"<msub><mi>J</mi><msub>{_mi('ω')}{_tokens(index)}</msub></msub>")
 
 
 def _christoffel_sympy(c, conv):
@@ -167,7 +176,7 @@ def _ring_converter(model):
     return convert
 
 
-def newton_euler_eom(robot, simplify: bool = True, parameters=None) -> EquationsOfMotion:
+def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: bool = True) -> EquationsOfMotion:
     """Equations from the customised Newton-Euler model; tau, M, g, C come from the program alone
     (M = d tau / d qdd and g = tau(q, 0, 0) of the exactly evaluated program, C from M's Christoffel
     symbols), P and K from the kinematics."""
@@ -201,6 +210,7 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None) -> Equations
         friction=friction,
         christoffel=lambda: _christoffel_sympy(derived()["christoffel"], derived()["conv"]),
         tau=lambda: derived()["vec"](derived()["tau"]) + friction,
+        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd)) if with_steps else None,
         name=robot.name,
         method="newton_euler",
         latex_names=latex_names(q, qd, qdd),

@@ -22,6 +22,7 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from .eom import EquationsOfMotion, Step
+from .render import lagrangian, name, of_q
 from .simplify import simplify_trig
 
 __all__ = ["LagrangianSystem", "coordinates"]
@@ -261,12 +262,12 @@ class LagrangianSystem:
             chris = None
             K, P = None, None
         steps = [
-            Step("Lagrangian", "L = K - P" if self.K is not None else "given directly", [(r"\mathcal{L}", self.L)]),
+            Step("Lagrangian", "L = K - P" if self.K is not None else "given directly", [(lagrangian(), self.L)]),
             Step("Euler-Lagrange equations d/dt dL/dqd_k - dL/dq_k = u_k - B_k - (A^T lambda)_k", "(LaValle eqs. 13.118, 13.181, 13.173)",
-                 [(f"E_{{{k + 1}}}", simp(e)) for k, e in enumerate(EL)]),
+                 [(name(f"E_{{{k + 1}}}", f"E_{k + 1}", "E", f"{k + 1}"), simp(e)) for k, e in enumerate(EL)]),
         ]
         if self.A.shape[0]:
-            steps.append(Step("Constraints A(q) qd = 0", "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows", [("A(q)", self.A)]))
+            steps.append(Step("Constraints A(q) qd = 0", "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows", [(of_q("A"), self.A)]))
         from .lagrange import latex_names
 
         eom = EquationsOfMotion(
