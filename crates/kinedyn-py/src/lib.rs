@@ -12,7 +12,7 @@ use std::sync::Mutex;
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
-use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -295,8 +295,9 @@ impl PyModel {
     }
 
     /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
-    fn frame_poses<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frames: PyReadonlyArray1<i64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let ids = frames.as_array().iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
+    fn frame_poses<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frames: Bound<'py, PyArray1<i64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
+        let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[ids.len(), 4, 4], |model, data, x, out| {
