@@ -108,3 +108,18 @@ def test_derive_formats_write_files(capsys, tmp_path, fmt, marker):
 def test_derive_rejects_symbolic_for_a_robot_without_symbols(capsys):
     code, _, err = run(capsys, "derive", "puma560", "--symbolic")
     assert code == 1 and "--symbolic needs a built-in" in err
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["check", "no_such_robot"], "neither a built-in"),
+        (["identify", "planar_2r", "--noise", "-1"], "noise standard deviations must be >= 0"),
+        (["simulate", "planar_2r", "--t", "1", "--dt", "0"], "dt must be a positive"),
+        (["ik", "elbow_3r", "--xyz", "1", "0.2", "nan"], "NaN"),
+        (["derive", "no_such_robot"], "neither a built-in"),
+    ],
+)
+def test_capability_commands_reject_bad_input(capsys, argv, message):
+    code, _, err = run(capsys, *argv)
+    assert code == 1 and message in err and "Traceback" not in err

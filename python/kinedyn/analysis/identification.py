@@ -122,7 +122,9 @@ def excitation(robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q
     middle of finite joint limits, else 0)."""
     if q0 is None:
         lo, hi = robot.lower_limits, robot.upper_limits
-        q0 = np.where(np.isfinite(lo) & np.isfinite(hi), (lo + hi) / 2, 0.0)
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        q0 = np.zeros(robot.n)
+        q0[finite] = (lo[finite] + hi[finite]) / 2  # (-inf + inf) would be NaN
     return Fourier.random(robot.n, harmonics=harmonics, wf=2 * np.pi / period, amplitude=amplitude, q0=q0, seed=seed)
 
 
