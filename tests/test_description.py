@@ -217,3 +217,23 @@ def test_symbolic_robot_subs():
     assert not numeric.is_symbolic
     np.testing.assert_allclose(all_frame_poses(numeric, [0.0, 0.0])["tool"][:3, 3], [2.0, 0, 0], atol=1e-12)
     assert math.isclose(float(numeric.tree.bodies[0].inertia.mass), 1.0)
+
+
+def test_subs_by_name_finds_symbols_with_assumptions():
+    """The built-ins' symbols are positive; a name must still find them (Symbol("m1") alone would not)."""
+    robot = kd.robots.planar_2r(symbolic=True)
+    assert all(s.is_positive for s in robot.symbols)
+    values = {s.name: 1.0 for s in robot.symbols}
+    numeric = robot.subs(values)
+    assert not numeric.is_symbolic
+    assert robot.subs({"m1": 2.0}).symbols == robot.symbols - {s for s in robot.symbols if s.name == "m1"}
+    eom = robot.equations_of_motion()
+    assert "m1" not in {str(s) for s in eom.subs({"m1": 2.0}).parameters}
+    np.testing.assert_allclose(np.array(eom.subs(values).M.subs({eom.q[1]: 0.3}), dtype=float), numeric.mass_matrix([0.0, 0.3]))
+
+
+def test_subs_names_the_link_of_a_bad_value():
+    robot = kd.robots.planar_2r(symbolic=True)
+    values = {s.name: 1.0 for s in robot.symbols}
+    with pytest.raises(ValueError, match="link 'link1'.*mass is not finite"):
+        robot.subs({**values, "m1": float("nan")})

@@ -26,6 +26,7 @@ __all__ = [
     "pose_inverse",
     "matmul",
     "to_float_array",
+    "by_name",
 ]
 
 
@@ -173,3 +174,12 @@ def to_float_array(value, shape=None, what: str = "value") -> np.ndarray:
     if shape is not None and arr.shape != tuple(shape):
         raise ValueError(f"{what} must have shape {tuple(shape)}, got {arr.shape}")
     return arr
+
+
+def by_name(mapping, symbols) -> dict:
+    """``{symbol: value}`` from a mapping keyed by SymPy symbols or by names. A name is matched to the
+    symbol of that name among ``symbols`` whatever its assumptions (``"m1"`` finds
+    ``Symbol("m1", positive=True)``, which ``Symbol("m1")`` would not equal); other names become plain
+    symbols."""
+    named = {s.name: s for s in symbols if isinstance(s, sp.Symbol)}
+    return {(named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): v for k, v in dict(mapping).items()}

@@ -14,7 +14,7 @@ from typing import Mapping, Optional, Sequence
 import numpy as np
 import sympy as sp
 
-from ._math import as_value, is_symbolic, matmul, to_float_array
+from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.joint import Joint
 from .description.link import Frame, KinematicTree, Link, build_tree
@@ -231,8 +231,9 @@ class Robot:
         return free
 
     def subs(self, mapping: Mapping) -> "Robot":
-        """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs)."""
-        mapping = {sp.Symbol(k) if isinstance(k, str) else k: v for k, v in mapping.items()}
+        """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);
+        keys are symbols or their names."""
+        mapping = by_name(mapping, self.symbols)
 
         def f(v):
             if isinstance(v, (sp.Basic, sp.MatrixBase)):
@@ -249,7 +250,11 @@ class Robot:
                 j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
                 j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb),
             )
-            links.append(Link(link.name, link.parent, joint, f(link.placement), f(link.post), link.inertia.subs(mapping)))
+            try:
+                inertia = link.inertia.subs(mapping)
+            except ValueError as e:
+                raise ValueError(f"robot '{self.name}', link '{link.name}': {e}") from None
+            links.append(Link(link.name, link.parent, joint, f(link.placement), f(link.post), inertia))
         frames = [Frame(fr.name, fr.link, f(fr.placement)) for fr in self.frames]
         dh = None
         if self.dh is not None:

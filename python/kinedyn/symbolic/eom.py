@@ -211,8 +211,11 @@ class EquationsOfMotion:
         return base_parameters(self, known=known)
 
     def subs(self, mapping) -> "EquationsOfMotion":
-        """The same equations with parameters replaced (numbers or other expressions)."""
-        mapping = {sp.Symbol(k) if isinstance(k, str) else k: v for k, v in dict(mapping).items()}
+        """The same equations with parameters replaced (numbers or other expressions); keys are
+        symbols or their names."""
+        from .._math import by_name
+
+        mapping = by_name(mapping, self.parameters)
         f = lambda m: m.subs(mapping) if m is not None else None
         return EquationsOfMotion(
             self.q, self.qd, self.qdd, f(self.M), f(self.C), f(self.g), K=f(self.K), P=f(self.P), friction=f(self.friction),
