@@ -173,6 +173,30 @@ def test_singularity_report_names_the_lost_direction():
     assert not kin.singularity_report(robot, [q1, 1.0], task="planar").singular
 
 
+@pytest.mark.parametrize("method", ["inverse", "pinv", "dls"])
+def test_velocity_and_force_maps_take_batches(method):
+    """tool_velocity / joint_torques / joint_velocities on (N, n) configurations (and (N, m) vectors)
+    equal the loop over single ones (a batch used to be refused with a wrong component count)."""
+    robot = ROBOTS["puma560"]
+    Q = robot.random_configuration(np.random.default_rng(3), size=5)
+    V = np.random.default_rng(4).normal(size=(5, 6))
+    np.testing.assert_allclose(kin.tool_velocity(robot, Q, V), [kin.tool_velocity(robot, q, v) for q, v in zip(Q, V)], atol=1e-12)
+    np.testing.assert_allclose(kin.tool_velocity(robot, Q, V[0]), [kin.tool_velocity(robot, q, V[0]) for q in Q], atol=1e-12)
+    np.testing.assert_allclose(kin.joint_torques(robot, Q, V[0]), [kin.joint_torques(robot, q, V[0]) for q in Q], atol=1e-12)
+    qd = kin.joint_velocities(robot, Q, V, method=method)
+    assert qd.shape == (5, 6)
+    np.testing.assert_allclose(qd, [kin.joint_velocities(robot, q, v, method=method) for q, v in zip(Q, V)], rtol=1e-9, atol=1e-9)
+    with pytest.raises(ValueError, match=r"wrench must have 6 components for this task, shape \(6,\) or \(5, 6\); got shape \(4, 6\)"):
+        kin.joint_torques(robot, Q, V[:4])
+
+
+def test_inverse_rates_name_the_singular_configuration_of_a_batch():
+    robot = kd.robots.planar_2r()
+    Q = np.array([[0.4, 1.0], [0.7, 0.0]])
+    with pytest.raises(ValueError, match=r"singular at q = \[0.7 0. \] \(configuration 1 of the batch\)"):
+        kin.joint_velocities(robot, Q, [0.1, 0.1], task="planar", method="inverse")
+
+
 @pytest.mark.parametrize("name", ["planar_2r", "elbow_3r", "puma560"])
 def test_batch_equals_loop(name):
     robot = ROBOTS[name]

@@ -55,30 +55,38 @@ def task_jacobian(robot, q, frame: Optional[str] = None, task: Task = "full", re
     return robot.jacobian(q, frame, reference)[..., task_rows(task), :]
 
 
-def _vector(x, size: int, what: str) -> np.ndarray:
+def _vector(x, size: int, what: str, J: np.ndarray) -> np.ndarray:
+    """``x`` as (size,) or, next to a batch of Jacobians (N, m, n) or alone, as a batch (N, size)."""
     v = np.asarray(x, dtype=float)
-    if v.shape != (size,):
-        raise ValueError(f"{what} must have {size} components for this task, got shape {v.shape}")
+    batch = J.shape[0] if J.ndim == 3 else None
+    if v.shape != (size,) and not (v.ndim == 2 and v.shape[1] == size and (batch is None or v.shape[0] == batch)):
+        want = f"({size},)" + (f" or ({batch}, {size})" if batch is not None else f" or (N, {size})")
+        raise ValueError(f"{what} must have {size} components for this task, shape {want}; got shape {v.shape}")
     if not np.all(np.isfinite(v)):
         raise ValueError(f"{what} contains NaN or inf")
     return v
 
 
+def _mul(A: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A @ v for stacks of matrices (..., m, k) and of vectors (..., k)."""
+    return (A @ v[..., None])[..., 0]
+
+
 def tool_velocity(robot, q, qd, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
-    """Tool twist (selected rows) ``J(q) qd``."""
+    """Tool twist (selected rows) ``J(q) qd``; (N, m) for a batch of q and/or qd."""
     J = task_jacobian(robot, q, frame, task, reference)
-    return J @ _vector(qd, robot.n, "qd")
+    return _mul(J, _vector(qd, robot.n, "qd", J))
 
 
 def joint_torques(robot, q, wrench, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
-    """Static joint torques balancing a tool wrench: ``tau = J^T F`` (Spong §4.10).
+    """Static joint torques balancing a tool wrench: ``tau = J^T F`` (Spong §4.10); (N, n) for a batch.
 
     ``wrench`` has one entry per task row (e.g. (Fx, Fy) with ``task="planar"``; [force; moment]
     with ``"full"``). These are the torques the joints must apply for the tool to exert F on the
     environment (equivalently, the joint torques caused by F applied to the tool, with a sign flip).
     """
     J = task_jacobian(robot, q, frame, task, reference)
-    return J.T @ _vector(wrench, J.shape[0], "wrench")
+    return _mul(np.swapaxes(J, -1, -2), _vector(wrench, J.shape[-2], "wrench", J))
 
 
 def joint_velocities(
@@ -94,24 +102,28 @@ def joint_velocities(
     """Joint rates producing a tool velocity: ``qd = J^-1 v`` (``method="inverse"``, square and
     non-singular J only), the Moore-Penrose pseudo-inverse (``"pinv"``: least-squares, minimum norm)
     or damped least squares (``"dls"``: ``J^T (J J^T + lambda^2 I)^-1 v``, Nakamura & Hanafusa 1986;
-    Wampler 1986), which stays bounded near singularities."""
+    Wampler 1986), which stays bounded near singularities. (N, n) for a batch of q and/or v."""
+    if method not in ("inverse", "pinv", "dls"):
+        raise ValueError(f"method must be 'inverse', 'pinv' or 'dls', got '{method}'")
     J = task_jacobian(robot, q, frame, task, reference)
-    v = _vector(velocity, J.shape[0], "velocity")
+    v = _vector(velocity, J.shape[-2], "velocity", J)
     if method == "inverse":
-        if J.shape[0] != J.shape[1]:
-            raise ValueError(f"method='inverse' needs a square Jacobian; the task gives {J.shape[0]}x{J.shape[1]} (use 'pinv' or 'dls')")
-        report = singularity_report(robot, q, frame, task, reference)
-        if report.singular:
-            raise ValueError(f"the Jacobian is singular at this configuration: {report.summary()}")
-        return np.linalg.solve(J, v)
+        if J.shape[-2] != J.shape[-1]:
+            raise ValueError(f"method='inverse' needs a square Jacobian; the task gives {J.shape[-2]}x{J.shape[-1]} (use 'pinv' or 'dls')")
+        qs = np.asarray(q, dtype=float).reshape(-1, robot.n)
+        for k, Jk in enumerate(J.reshape(-1, *J.shape[-2:])):
+            report = _report(Jk, task_rows(task), robot.n, 1e-9)
+            if report.singular:
+                where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
+                raise ValueError(f"the Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}: {report.summary()}")
+        return np.linalg.solve(J, v[..., None])[..., 0]
     if method == "pinv":
-        return np.linalg.pinv(J) @ v
-    if method == "dls":
-        if damping < 0 or not np.isfinite(damping):
-            raise ValueError(f"damping must be a finite number >= 0, got {damping}")
-        m = J.shape[0]
-        return J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(m), v)
-    raise ValueError(f"method must be 'inverse', 'pinv' or 'dls', got '{method}'")
+        return _mul(np.linalg.pinv(J), v)
+    if not (damping >= 0 and np.isfinite(damping)):
+        raise ValueError(f"damping must be a finite number >= 0, got {damping}")
+    JT = np.swapaxes(J, -1, -2)
+    m = J.shape[-2]
+    return _mul(JT, np.linalg.solve(J @ JT + damping**2 * np.eye(m), v[..., None])[..., 0])
 
 
 def singular_values(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
@@ -165,7 +177,11 @@ def singularity_report(robot, q, frame: Optional[str] = None, task: Task = "full
     rows = task_rows(task)
     J = task_jacobian(robot, q, frame, rows, reference)
     if J.ndim != 2:
-        raise ValueError("singularity_report takes one configuration q of shape (n,)")
+        raise ValueError(f"singularity_report takes one configuration q of shape ({robot.n},), got shape {np.shape(q)}")
+    return _report(J, rows, robot.n, tol)
+
+
+def _report(J: np.ndarray, rows: list, n: int, tol: float) -> SingularityReport:
     U, s, Vt = np.linalg.svd(J)
     threshold = tol * max(1.0, s[0] if s.size else 1.0)
     rank = int(np.sum(s > threshold))
@@ -176,7 +192,7 @@ def singularity_report(robot, q, frame: Optional[str] = None, task: Task = "full
     return SingularityReport(
         rank=rank,
         rows=len(rows),
-        n_joints=robot.n,
+        n_joints=n,
         singular_values=s,
         lost_directions=lost,
         null_motions=null,
