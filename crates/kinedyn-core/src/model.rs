@@ -38,6 +38,11 @@ pub struct Model {
     pub frames: Vec<Frame>,
     /// `support[i]`: body i and its ancestors, ascending (the joints that move body i).
     pub support: Vec<Vec<usize>>,
+    /// `subtree_end[i]`: one past the largest index in body i's subtree (i and its descendants).
+    pub subtree_end: Vec<usize>,
+    /// Whether every subtree is the contiguous range `i..subtree_end[i]` (depth-first numbering:
+    /// always true for a serial chain), which lets the CRBA treat a subtree's columns as a block.
+    pub subtrees_contiguous: bool,
 }
 
 fn finite(what: &str, values: &[f64]) -> Result<()> {
@@ -123,6 +128,30 @@ impl Model {
             s.push(i);
             support.push(s);
         }
-        Ok(Self { n, parent, joints, offset, parent_from_joint, inertia, armature, viscous, coulomb, gravity, frames, support })
+        let mut subtree_end: Vec<usize> = (1..=n).collect();
+        let mut subtree_size = vec![1usize; n];
+        for i in (0..n).rev() {
+            if let Some(p) = parent[i] {
+                subtree_end[p] = subtree_end[p].max(subtree_end[i]);
+                subtree_size[p] += subtree_size[i];
+            }
+        }
+        let subtrees_contiguous = (0..n).all(|i| subtree_end[i] - i == subtree_size[i]);
+        Ok(Self {
+            n,
+            parent,
+            joints,
+            offset,
+            parent_from_joint,
+            inertia,
+            armature,
+            viscous,
+            coulomb,
+            gravity,
+            frames,
+            support,
+            subtree_end,
+            subtrees_contiguous,
+        })
     }
 }

@@ -14,10 +14,88 @@
 
 use super::kinematics::parent_from_body;
 use crate::data::Data;
+use crate::joint::JointKind;
 use crate::model::Model;
 
 /// `M(q)` written row-major to `data.m` (n x n), armature included.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
+    if model.subtrees_contiguous {
+        crba_blocks(model, data, q);
+    } else {
+        crba_chains(model, data, q);
+    }
+    &data.m
+}
+
+/// RBDA Table 6.2 with the force columns of a whole subtree carried together (Pinocchio's and
+/// RBDA §6.2's "F" as a 6 x n block): when subtree i is the index range `i..end_i`, the columns
+/// `F_k` (k in the subtree) are all in body i's frame after i's step, so row i of `M` is
+/// `s_i^T F_k` over the range, and one transform `^λX_i^*` moves the block to the parent. The
+/// transforms are computed in the same backward pass (no separate forward pass, nothing stored),
+/// and the column loops have independent iterations (no chain of dependent transforms per entry).
+fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
+    let n = model.n;
+    let (parent, joints, armature, end) = (&model.parent[..n], &model.joints[..n], &model.armature[..n], &model.subtree_end[..n]);
+    let (ic, m, f) = (&mut data.ic[..n], &mut data.m[..n * n], &mut data.f[..n]);
+    // I^c_i = I_i ;  H_rr = 0 for the roots r (their children add to it, see below)
+    ic.copy_from_slice(&model.inertia[..n]);
+    for (r, p) in parent.iter().enumerate() {
+        if p.is_none() {
+            m[r * n + r] = 0.0;
+        }
+    }
+    for i in (0..n).rev() {
+        let (joint, e) = (&joints[i], end[i]);
+        // bodies after the subtree are on other branches: H_ik = H_ki = 0
+        for k in e..n {
+            m[i * n + k] = 0.0;
+            m[k * n + i] = 0.0;
+        }
+        let p = match parent[i] {
+            None => {
+                // a root: its row beyond the diagonal came from its children;
+                // H_ii += s_i^T I_i s_i (+ armature_i)
+                m[i * n + i] += joint.project(&joint.inertia_times_s(&ic[i])) + armature[i];
+                continue;
+            }
+            Some(p) => p,
+        };
+        // F_i = I^c_i s_i  (column i, body i's frame)
+        f[i] = joint.inertia_times_s(&ic[i]);
+        // H_ik = H_ki = s_i^T F_k for k in subtree(i) (+ armature_i on the diagonal)
+        for k in i..e {
+            let h = joint.project(&f[k]);
+            m[i * n + k] = h;
+            m[k * n + i] = h;
+        }
+        m[i * n + i] += armature[i];
+        // ^λX_i = X_T(i) X_J(q_i), used on forces (its dual inverse)
+        let x = parent_from_body(model, q, i);
+        if parent[p].is_none() {
+            // the parent is a root: only its row is left to compute, and s_λ^T ^λX_i^* F_k is
+            // w^T F_k with w = ^iX_λ s_λ (s_λ in body i's frame); its composite inertia enters
+            // only H_λλ = s_λ^T I_λ s_λ + sum over children of w^T I^c_i w
+            let w = x.inv_act_motion(&joints[p].subspace());
+            for k in i..e {
+                let h = w.dot(&f[k]);
+                m[p * n + k] = h;
+                m[k * n + p] = h;
+            }
+            m[p * n + p] += w.dot(&ic[i].mul_motion(&w));
+            continue;
+        }
+        // I^c_λ(i) += ^λX_i^* I^c_i ^iX_λ(i)
+        let add = x.act_inertia(&ic[i]);
+        ic[p] += add;
+        // F_k = ^λX_i^* F_k for k in subtree(i)
+        for fk in &mut f[i..e] {
+            *fk = x.act_force(fk);
+        }
+    }
+}
+
+/// RBDA Table 6.2 entry by entry, `F` carried up the support of each body (any numbering).
+fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
     let n = model.n;
     // per-body arrays sliced to n once (no bounds checks in the loops below)
     let (parent, joints, armature) = (&model.parent[..n], &model.joints[..n], &model.armature[..n]);
@@ -47,10 +125,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
         }
     }
     // zero the entries of joints on different branches (no common subtree)
-    if model.support.iter().any(|s| s.len() != s.last().map_or(0, |&l| l + 1)) {
-        zero_unrelated(model, &mut data.m);
-    }
-    &data.m
+    zero_unrelated(model, &mut data.m);
 }
 
 /// Zero `M[i][j]` for joints i, j where neither supports the other (branching trees only).
@@ -70,4 +145,44 @@ fn zero_unrelated(model: &Model, m: &mut [f64]) {
 #[inline]
 pub(crate) fn is_ancestor(model: &Model, a: usize, b: usize) -> bool {
     model.support[b].binary_search(&a).is_ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{random_model, Rng};
+
+    /// The block form (contiguous subtrees) equals the entry-by-entry form, on chains and on a
+    /// depth-first-numbered tree.
+    #[test]
+    fn blocks_equal_chains() {
+        let tree = random_model(7, 9, false);
+        let parent = vec![None, Some(0), Some(1), Some(1), Some(3), Some(0), Some(5), Some(5), Some(0)];
+        let tree = Model::new(
+            parent,
+            tree.joints.clone(),
+            tree.offset.clone(),
+            tree.parent_from_joint.clone(),
+            tree.inertia.clone(),
+            tree.armature.clone(),
+            tree.viscous.clone(),
+            tree.coulomb.clone(),
+            tree.gravity,
+            vec![],
+        )
+        .unwrap();
+        assert!(tree.subtrees_contiguous);
+        for model in [random_model(3, 7, false), random_model(4, 1, false), tree] {
+            let mut data = Data::new(&model);
+            let q = Rng::new(5).vector(model.n, -3.0, 3.0);
+            crba_blocks(&model, &mut data, &q);
+            let blocks = data.m.clone();
+            data.m.fill(f64::NAN);
+            crba_chains(&model, &mut data, &q);
+            let scale = blocks.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            for (a, b) in blocks.iter().zip(&data.m) {
+                assert!((a - b).abs() <= 1e-14 * scale, "{a} {b}");
+            }
+        }
+    }
 }

@@ -57,11 +57,13 @@ impl Inertia {
     #[inline]
     pub fn translated(&self, t: &Vec3) -> Self {
         // with [a]x[b]x = b a^T - (a . b) 1 the three products are outer products:
-        // I' = I - (h t^T + t h^T) - m t t^T + (2 t . h + m t . t) 1   (symmetric: 6 entries)
+        // I' = I - (h t^T + t h^T) - m t t^T + (2 t . h + m t . t) 1, and with u = h + m t / 2
+        // I' = I - (u t^T + t u^T) + 2 (t . u) 1   (symmetric: 6 entries, 2 products each)
         let (m, h) = (self.mass, &self.h);
-        let d = 2.0 * t.dot(h) + m * t.dot(t);
         let mt = m * t;
-        let e = |r: usize, c: usize| -h[r] * t[c] - t[r] * h[c] - mt[r] * t[c];
+        let u = h + 0.5 * mt;
+        let d = 2.0 * t.dot(&u);
+        let e = |r: usize, c: usize| -(u[r] * t[c] + t[r] * u[c]);
         let (xx, yy, zz) = (e(0, 0) + d, e(1, 1) + d, e(2, 2) + d);
         let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
         let i = &self.i_o;
