@@ -449,6 +449,17 @@ def test_bad_input_gives_clear_errors():
         robot.inverse_kinematics(T, mask=[1, 1, 1, 1, 1, 0.5], method="analytic")
 
 
+@pytest.mark.parametrize("setting", [dict(tolerance=-1e-9), dict(tolerance=float("nan")), dict(max_iterations=-1), dict(restarts=-1), dict(seed=-1)])
+def test_bad_solver_settings_give_clear_errors(setting):
+    """A NaN tolerance used to report success; negative counts an OverflowError from the binding."""
+    robot = kd.robots.ur5()
+    T = robot.pose(np.zeros(6))
+    name = next(iter(setting))
+    for method in ("auto", "numeric"):
+        with pytest.raises(ValueError, match=f"{name} must be"):
+            robot.inverse_kinematics(T, method=method, **setting)
+
+
 # ------------------------------------------------------------------ command line
 def run_cli(argv, capsys):
     from kinedyn.cli import main

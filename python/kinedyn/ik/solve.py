@@ -232,6 +232,8 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
+    if not 0.0 < tolerance < np.inf or max_iterations < 0 or restarts < 0 or seed < 0:
+        _check_settings(tolerance, max_iterations, restarts, seed)
     chain = _chain(robot, frame)
     # fast path: one float64 target, closed form, no mask (checks of the target happen natively)
     if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype == np.float64 and chain.solver is not None:
@@ -263,6 +265,14 @@ def inverse_kinematics(
     if use_analytic:
         return _analytic(robot, chain, t, q_start, position, respect_limits, tolerance, seed)
     return _numeric(robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed)
+
+
+def _check_settings(tolerance, max_iterations, restarts, seed) -> None:
+    if not 0.0 < tolerance < np.inf:
+        raise ValueError(f"tolerance must be a positive number (m and rad), got {tolerance!r}")
+    for what, value in (("max_iterations", max_iterations), ("restarts", restarts), ("seed", seed)):
+        if value < 0:
+            raise ValueError(f"{what} must be a whole number >= 0, got {value!r}")
 
 
 def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:
