@@ -316,15 +316,22 @@ def _nearest(robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> Non
     result.message = f"target out of reach: no solution exists; the nearest reachable point is {np.array2string(result.nearest, precision=6)} ({d:.6g} m away)"
 
 
-def _numeric(robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
+def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> tuple:
+    """The core's LM solver for one target or a batch: (q, converged, position error, orientation
+    error, iterations), revolute angles wrapped when the limits are not kept."""
     from .. import _core
 
-    w = np.asarray(weights if weights is not None else _FULL_MASK)
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
     tol = min(tolerance, 1e-10)
     q, ok, pe, oe, it = _core.solve_ik(chain.model, chain.frame, t, q0, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed)
     if not respect_limits:
         q = _wrap(q, chain)
+    return q, ok, pe, oe, it
+
+
+def _numeric(robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
+    w = np.asarray(weights if weights is not None else _FULL_MASK)
+    q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed)
     ok = bool(ok) and pe <= tolerance and oe <= tolerance
     empty = np.zeros(0)
     if ok:
@@ -353,18 +360,12 @@ def _is_singular(robot, chain: _Chain, q, weights) -> bool:
 
 
 def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed) -> IKBatchResult:
-    from .. import _core
-
     N = len(t)
     if use_analytic:
         refs = np.ascontiguousarray(np.broadcast_to(q0, (N, chain.n)))
         q, ok, pe, oe = chain.solver.solve_nearest(t, refs, respect_limits, tolerance)
         return IKBatchResult(q, ok, pe, oe, np.zeros(N, dtype=np.int64), "analytic:" + chain.solver.structure)
     w = np.asarray(weights if weights is not None else _FULL_MASK)
-    lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
-    tol = min(tolerance, 1e-10)
-    q, ok, pe, oe, it = _core.solve_ik(chain.model, chain.frame, t, q0, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed)
-    if not respect_limits:
-        q = _wrap(q, chain)
+    q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed)
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")
