@@ -319,6 +319,24 @@ def test_bad_input_gives_clear_errors(puma):
         kd.simulate(puma, 0.01, np.r_[np.nan, np.zeros(11)])
     with pytest.raises(TypeError, match="LagrangianSystem"):
         kd.simulate("puma", 0.01, np.zeros(12))
+    with pytest.raises(ValueError, match="t_span must be a duration T or a pair"):
+        kd.simulate(puma, "1 s", np.zeros(12))
+    with pytest.raises(ValueError, match="dt must be a positive step in seconds, got 'fast'"):
+        kd.simulate(puma, 1.0, np.zeros(12), dt="fast")
+    for bad in (-1.0, float("nan")):  # a negative one stopped at step 0 as a "blow-up"; NaN never stopped
+        with pytest.raises(ValueError, match="max_speed must be a positive speed"):
+            kd.simulate(puma, 0.01, np.zeros(12), max_speed=bad)
+    with pytest.raises(ValueError, match="rtol and atol must be positive"):  # SciPy only warned
+        kd.simulate(puma, 0.01, np.zeros(12), method="rk45", rtol=-1.0)
+
+
+def test_controller_errors_name_the_problem(puma):
+    with pytest.raises(ValueError, match="made for 3 joints but 'puma560' has 6"):  # was a NumPy broadcast error
+        kd.simulate(puma, 0.01, np.zeros(12), controller=kd.simulate.PD(1.0, 1.0, np.zeros(3)))
+    with pytest.raises(ValueError, match="Kd contains a non-finite gain"):
+        kd.simulate.PD(1.0, [1.0, np.nan], np.zeros(2))
+    with pytest.raises(ValueError, match="set point contains NaN"):
+        kd.simulate.PDGravity(puma, 1.0, 1.0, np.full(6, np.nan))
 
 
 def test_non_finite_controller_torque_is_reported(puma):

@@ -172,6 +172,8 @@ def as_reference(ref, n: int) -> Reference:
     q = np.asarray(ref, dtype=float)
     if q.shape != (n,):
         raise ValueError(f"a set point needs {n} values, got shape {q.shape}")
+    if not np.all(np.isfinite(q)):
+        raise ValueError("the set point contains NaN or inf")
     return Constant(q)
 
 
@@ -186,6 +188,8 @@ def _gain(K, n: int, what: str) -> np.ndarray:
         K = np.diag(K)
     if K.shape != (n, n):
         raise ValueError(f"{what} must be a scalar, {n} diagonal gains or an {n}x{n} matrix, got shape {K.shape}")
+    if not np.all(np.isfinite(K)):
+        raise ValueError(f"{what} contains a non-finite gain (NaN or inf)")
     return K
 
 

@@ -118,17 +118,23 @@ def _split_state(x0, n: int, name: str):
 
 
 def _time_grid(t_span, dt, method):
-    if np.ndim(t_span) == 0:
-        t0, t1 = 0.0, float(t_span)
-    else:
-        if len(t_span) != 2:
-            raise ValueError(f"t_span must be a duration T or a pair (t0, t1), got {t_span!r}")
-        t0, t1 = float(t_span[0]), float(t_span[1])
+    try:
+        if np.ndim(t_span) == 0:
+            t0, t1 = 0.0, float(t_span)
+        else:
+            if len(t_span) != 2:
+                raise ValueError
+            t0, t1 = float(t_span[0]), float(t_span[1])
+    except (TypeError, ValueError):
+        raise ValueError(f"t_span must be a duration T or a pair (t0, t1) in seconds, got {t_span!r}") from None
     if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
         raise ValueError(f"t_span must end after it starts (t1 > t0), got ({t0}, {t1})")
     if dt is None:
         dt = 1e-3
-    dt = float(dt)
+    try:
+        dt = float(dt)
+    except (TypeError, ValueError):
+        raise ValueError(f"dt must be a positive step in seconds, got {dt!r}") from None
     if not (dt > 0 and math.isfinite(dt)):
         raise ValueError(f"dt must be a positive step in seconds, got {dt}")
     steps = max(1, int(math.ceil((t1 - t0) / dt - 1e-9)))
@@ -316,12 +322,19 @@ def simulate(
     record_every = int(record_every)
     if controller is not None and not callable(controller):
         raise TypeError(f"controller must be callable as controller(t, q, qd) -> tau, got {type(controller).__name__}")
+    if not max_speed > 0:
+        raise ValueError(f"max_speed must be a positive speed (rad/s or m/s), got {max_speed!r}")
+    if method in ADAPTIVE_METHODS and not (rtol > 0 and atol > 0 and math.isfinite(rtol) and math.isfinite(atol)):
+        raise ValueError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
     robot = _is_robot(system)
     mech = None if robot else _as_mechanical(system, params, baumgarte, points)
     target = system if robot else mech
     n = system.n if robot else mech.n
     name = getattr(system, "name", "system")
     names = _names(target)
+    controller_n = getattr(controller, "n", None)
+    if isinstance(controller_n, (int, np.integer)) and controller_n != n:
+        raise ValueError(f"the controller is made for {controller_n} joints but '{name}' has {n}")
     q0, qd0 = _split_state(x0, n, name)
     batch = q0.shape[0] if q0.ndim == 2 else None
     t0, t1, dt, steps = _time_grid(t_span, dt, method)
