@@ -46,13 +46,14 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let hz = 0.5 * z;
     let w = 1.0 - hz;
     let cos_r = w + (((1.0 - w) - hz) + poly_c);
-    // quadrant k mod 4
-    match (k as i64) & 3 {
-        0 => (sin_r, cos_r),
-        1 => (cos_r, -sin_r),
-        2 => (-sin_r, -cos_r),
-        _ => (-cos_r, sin_r),
-    }
+    // quadrant k mod 4: (sin, cos) of x is (s, c), (c, -s), (-s, -c), (-c, s) for k = 0..3,
+    // chosen with bit masks (joint angles of a batch make the quadrant unpredictable to a branch)
+    let k = k as i64;
+    let swap = ((k & 1) as u64).wrapping_neg();
+    let (sb, cb) = (sin_r.to_bits(), cos_r.to_bits());
+    let sin_bits = ((cb & swap) | (sb & !swap)) ^ (((k & 2) as u64) << 62);
+    let cos_bits = ((sb & swap) | (cb & !swap)) ^ ((((k + 1) & 2) as u64) << 62);
+    (f64::from_bits(sin_bits), f64::from_bits(cos_bits))
 }
 
 #[cfg(test)]
