@@ -312,6 +312,21 @@ def test_bad_shapes_and_non_finite_values():
         robot.forward_dynamics(q, q, np.full(6, np.inf))
 
 
+def test_python_side_helpers_check_their_inputs_too():
+    """friction_torque, random_configuration and base_parameters run in Python: they used to
+    broadcast a wrong shape, warn on inf, or return an empty parameter set."""
+    robot = kd.robots.ur5()
+    with pytest.raises(ValueError, match=r"qd must have shape \(6,\) or a batch \(N, 6\), got \(5,\)"):
+        robot.friction_torque(np.zeros(5))
+    with pytest.raises(ValueError, match="non-finite"):
+        robot.friction_torque(np.full(6, np.inf))
+    assert robot.friction_torque(np.zeros((3, 6))).shape == (3, 6)
+    with pytest.raises(ValueError, match="size must be a whole number"):
+        robot.random_configuration(size=-1)
+    with pytest.raises(ValueError, match="samples must be a whole number"):
+        robot.base_parameters(samples=0)
+
+
 def test_massless_chain_is_a_clear_error_from_forward_dynamics():
     links = [Link("a", None, Joint("shoulder")), Link("b", "a", Joint("elbow", axis=(0, 1, 0)), np.eye(4))]
     robot = kd.Robot(links, name="massless")

@@ -56,6 +56,8 @@ def base_parameters(robot, samples: int = 200, rng=0, tol: float = 1e-9) -> Base
     """
     from scipy.linalg import qr, solve_triangular
 
+    if not (isinstance(samples, (int, np.integer)) and samples >= 1):
+        raise ValueError(f"samples must be a whole number of random states >= 1, got {samples!r}")
     n = robot.n
     rng = np.random.default_rng(rng)
     q = robot.random_configuration(rng, size=samples)

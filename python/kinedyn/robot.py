@@ -196,6 +196,10 @@ class Robot:
     def friction_torque(self, qd) -> np.ndarray:
         """viscous * qd + coulomb * sign(qd), (n,) or (N, n)."""
         qd = np.asarray(qd, dtype=float)
+        if qd.shape[-1:] != (self.n,) or qd.ndim > 2:
+            raise ValueError(f"qd must have shape ({self.n},) or a batch (N, {self.n}), got {qd.shape}")
+        if not np.all(np.isfinite(qd)):
+            raise ValueError("qd contains a non-finite value (NaN or inf)")
         return self.viscous * qd + self.coulomb * np.sign(qd)
 
     @property
@@ -578,6 +582,8 @@ class Robot:
 
     def random_configuration(self, rng=None, size=None) -> np.ndarray:
         """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
+        if size is not None and not (isinstance(size, (int, np.integer)) and size >= 0):
+            raise ValueError(f"size must be a whole number of configurations >= 0 (or None for one), got {size!r}")
         rng = np.random.default_rng(rng)
         lo = self.lower_limits.copy()
         hi = self.upper_limits.copy()
