@@ -80,9 +80,7 @@ class Identification:
     def predict(self, q, qd, qdd) -> np.ndarray:
         """Torques of the identified model (base regressor times estimates plus the known drives)."""
         Y = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self.used]]
-        arm, visc, coul = _drives(self.nominal)
-        qd, qdd = np.asarray(qd), np.asarray(qdd)
-        return Y @ self.estimates + arm * qdd + visc * qd + coul * np.sign(qd)
+        return Y @ self.estimates + self.nominal.armature * np.asarray(qdd) + self.nominal.friction_torque(qd)
 
     def robot(self):
         """A :class:`kinedyn.Robot` with these base parameters (see the module docstring). Raises
@@ -110,10 +108,6 @@ class Identification:
                 s += f"   true {self.true_values[k]: .8g}   error {self.errors[k]: .2g}"
             lines.append(s)
         return "\n".join(lines)
-
-
-def _drives(robot):
-    return robot.armature, robot.viscous, robot.coulomb
 
 
 def excitation(robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0=None, seed: int = 0) -> Fourier:
@@ -154,8 +148,7 @@ def identify(robot, data: Measurements, weighted: bool = False, base=None) -> Id
     n = robot.n
     S = data.q.shape[0]
     Y = robot.regressor(data.q, data.qd, data.qdd)[..., base.indices]  # (S, n, b)
-    arm, visc, coul = _drives(robot)
-    y = data.tau - arm * data.qdd - visc * data.qd - coul * np.sign(data.qd)  # (S, n)
+    y = data.tau - robot.armature * data.qdd - robot.friction_torque(data.qd)  # (S, n)
     b = base.count
     if S * n <= b:
         raise ValueError(f"{S} samples x {n} joints = {S * n} equations cannot determine {b} base parameters")

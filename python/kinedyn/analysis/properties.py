@@ -67,10 +67,6 @@ class PropertiesReport:
         return "\n".join(lines)
 
 
-def _drives(robot):
-    return robot.armature, robot.viscous, robot.coulomb
-
-
 def check_properties(robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
     """Measure every property on ``samples`` random states (seeded) and one simulated trajectory of
     ``T`` seconds (RK4, step ``dt``, PD + gravity compensation towards a random set point, gains
@@ -130,11 +126,10 @@ def check_properties(robot, samples: int = 200, seed: int = 0, T: float = 2.0, d
     ))
 
     # linearity in the parameters
-    arm, visc, coul = _drives(robot)
     tau = robot.inverse_dynamics(Q, QD, QDD)
     Y = robot.regressor(Q, QD, QDD)
     pi = robot.inertial_parameters()
-    rigid = tau - arm * QDD - visc * QD - coul * np.sign(QD)
+    rigid = tau - robot.armature * QDD - robot.friction_torque(QD)
     lin = float(np.abs(np.einsum("skp,p->sk", Y, pi) - rigid).max() / max(1.0, float(np.abs(rigid).max())))
     checks.append(Check(
         "linearity in the parameters Y pi == tau", bool(lin <= 1e-10), lin, 1e-10,
@@ -154,7 +149,7 @@ def check_properties(robot, samples: int = 200, seed: int = 0, T: float = 2.0, d
         checks.append(Check(name, False, float("inf"), 0.0, f"the simulation failed: {e}", "Spong eqs. 9.113-9.117"))
         return PropertiesReport(robot.name, samples, checks)
     bal = traj.energy_balance()
-    coulomb = bool(np.any(coul > 0))
+    coulomb = bool(np.any(robot.coulomb > 0))
     tol_p = 1e-3 if coulomb else 1e-6
     checks.append(Check(
         name, bool(bal["relative"] <= tol_p), bal["relative"], tol_p,
