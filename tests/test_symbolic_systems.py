@@ -212,6 +212,28 @@ def test_constraint_with_wrong_shape():
         LagrangianSystem([x, y], K=(xd**2 + yd**2) / 2, qd=[xd, yd], holonomic=[x * xd])
 
 
+def test_energies_as_strings_use_the_systems_own_symbols():
+    """Names in a string are the coordinates' real symbols: "x_d" in K used to be another, plain
+    symbol, and the check then said x_d does not appear in K while listing it."""
+    (x,), (xd,) = coordinates("x")
+    written = LagrangianSystem([x], K="m*x_d**2/2", P="k*x**2/2", B=["c*x_d"])
+    made = LagrangianSystem([x], K=sp.Symbol("m") * xd**2 / 2, P=sp.Symbol("k") * x**2 / 2, B=[sp.Symbol("c") * xd])
+    assert written.equations_of_motion().tau == made.equations_of_motion().tau
+    (p, r), _ = coordinates("p r")
+    sphere = LagrangianSystem(["p", "r"], L="(p_d**2 + r_d**2)/2", holonomic=["p**2 + r**2 - 1"])
+    assert sphere.holonomic == [p**2 + r**2 - 1]
+
+
+def test_energies_that_are_not_one_expression_are_named():
+    (x,), (xd,) = coordinates("x")
+    with pytest.raises(ValueError, match="kinetic energy K could not be read as an expression"):
+        LagrangianSystem([x], K="m*x_d**2*(", P=0)
+    with pytest.raises(ValueError, match="kinetic energy K must be one scalar expression"):
+        LagrangianSystem([x], K=[xd**2, xd], P=0)
+    with pytest.raises(ValueError, match="potential energy P contains NaN"):
+        LagrangianSystem([x], K=xd**2 / 2, P=float("nan"))
+
+
 def test_non_symbol_coordinate():
     x, y = sp.symbols("x y")
     with pytest.raises(ValueError, match="is not a symbol"):

@@ -60,6 +60,22 @@ def _as_list(value, what):
     return out
 
 
+def _scalar(value, what: str, names: dict) -> sp.Expr:
+    """One scalar SymPy expression from an expression, a number or a string, or a ValueError naming
+    ``what``; in a string the coordinate and velocity names are the system's own symbols (``names``)."""
+    try:
+        e = sp.sympify(value, locals=names) if isinstance(value, str) else sp.sympify(value)
+    except (sp.SympifyError, TypeError) as err:
+        raise ValueError(f"{what} could not be read as an expression: {value!r} ({err.__class__.__name__})") from None
+    if isinstance(e, sp.MatrixBase) and e.shape == (1, 1):
+        e = e[0, 0]
+    if not isinstance(e, sp.Expr):
+        raise ValueError(f"{what} must be one scalar expression, got {type(e).__name__} {value!r}")
+    if e.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+        raise ValueError(f"{what} contains NaN or infinity: {e}")
+    return e
+
+
 class LagrangianSystem:
     """A mechanical system described by generalised coordinates and its Lagrangian.
 
@@ -113,9 +129,11 @@ class LagrangianSystem:
             raise ValueError("give the kinetic energy K (and potential energy P) or the Lagrangian L")
         if L is not None and K is not None:
             raise ValueError("give either K and P or L, not both")
-        self.K = sub(K) if K is not None else None
-        self.P = sub(P) if K is not None else None
-        self.L = sub(L) if L is not None else self.K - self.P
+        # in expressions given as strings, coordinate and velocity names are these symbols
+        self._names = names = {v.name: v for v in [*coords, *qd, *self.qdd, self.t] if isinstance(v, sp.Symbol)}
+        self.K = sub(_scalar(K, "the kinetic energy K", names)) if K is not None else None
+        self.P = sub(_scalar(P, "the potential energy P", names)) if K is not None else None
+        self.L = sub(_scalar(L, "the Lagrangian L", names)) if L is not None else self.K - self.P
         for i, (c, v) in enumerate(zip(coords, qd)):
             if not self.L.has(v):
                 src = "kinetic energy K" if K is not None else "Lagrangian L"
@@ -130,7 +148,7 @@ class LagrangianSystem:
         self.B = sp.zeros(n, 1) if B is None else sp.Matrix(_as_list(sub(B), "B"))
         if len(self.B) != n:
             raise ValueError(f"non-conservative forces B must have {n} entries, got {len(self.B)}")
-        self.holonomic = [sub(e) for e in _as_list(holonomic, "holonomic constraints")]
+        self.holonomic = _as_list(sub(holonomic), "holonomic constraints")
         state = set(qd) | set(self.qdd)
         for e in self.holonomic:
             if e.free_symbols & state:
@@ -155,7 +173,7 @@ class LagrangianSystem:
         rep, fun_rep = self._rep
         if isinstance(e, (list, tuple)):
             return [self._sub(x) for x in e]
-        e = sp.sympify(e)
+        e = sp.sympify(e, locals=self._names) if isinstance(e, str) else sp.sympify(e)
         if rep:
             e = e.xreplace(rep).xreplace(fun_rep) if not isinstance(e, sp.MatrixBase) else e.xreplace(rep).xreplace(fun_rep)
         return e
