@@ -105,7 +105,7 @@ def test_identification_from_a_different_prior_still_gives_the_true_base_paramet
     q, qd, qdd = puma.random_configuration(rng, size=10), rng.normal(size=(10, 6)), rng.normal(size=(10, 6))
     np.testing.assert_allclose(result.predict(q, qd, qdd), puma.inverse_dynamics(q, qd, qdd), atol=1e-8)
     assert np.abs(prior.inverse_dynamics(q, qd, qdd) - puma.inverse_dynamics(q, qd, qdd)).max() > 1e-2
-    with pytest.raises(ValueError, match="positive semi-definite|negative"):
+    with pytest.raises(ValueError, match=r"body 'link\d': .*(positive semi-definite|negative)"):
         result.robot()
 
 

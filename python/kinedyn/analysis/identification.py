@@ -221,7 +221,10 @@ def with_inertial_parameters(robot, pi):
                 Ic = Io + m * S @ S  # I_c = I_o + m [c]x [c]x
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    body_inertia = Inertia(m, tuple(c), 0.5 * (Ic + Ic.T))
+                    try:
+                        body_inertia = Inertia(m, tuple(c), 0.5 * (Ic + Ic.T))
+                    except ValueError as e:
+                        raise ValueError(f"body '{link.name}': {e}") from None
             post = np.asarray(link.post, dtype=float)
             inv = np.eye(4)
             inv[:3, :3] = post[:3, :3].T
