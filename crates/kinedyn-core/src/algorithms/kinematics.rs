@@ -14,7 +14,7 @@ fn joint_coordinate(model: &Model, q: &[f64], i: usize) -> f64 {
 }
 
 /// `parent_from_body` of body i at q: `parent_from_joint[i] * joint_from_body(q_i + offset_i)`.
-#[inline]
+#[inline(always)]
 pub fn parent_from_body(model: &Model, q: &[f64], i: usize) -> Transform {
     model.joints[i].compose(&model.parent_from_joint[i], joint_coordinate(model, q, i))
 }
