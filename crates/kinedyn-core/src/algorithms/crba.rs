@@ -14,7 +14,6 @@
 
 use super::kinematics::parent_from_body;
 use crate::data::Data;
-use crate::joint::JointKind;
 use crate::model::Model;
 
 /// `M(q)` written row-major to `data.m` (n x n), armature included.

@@ -44,6 +44,7 @@ pub mod subproblems;
 pub use analytic::{AnalyticIk, Screw, Structure};
 
 use super::jacobian::{frame_jacobian, frame_pose_at, Reference};
+use super::kinematics::parent_from_body;
 use crate::data::Data;
 use crate::model::Model;
 use crate::joint::JointKind;
@@ -365,12 +366,42 @@ pub struct AnalyticOutcome {
     pub singular: bool,
 }
 
+/// The integer nearest `x` (ties to even): adding and removing 1.5 2^52 rounds without a call to
+/// `round`, which baseline x86-64 lacks as an instruction; `|x| >= 2^51` is already an integer.
+#[inline]
+fn round(x: f64) -> f64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    if x.abs() < 2_251_799_813_685_248.0 {
+        (x + ROUND) - ROUND
+    } else {
+        x
+    }
+}
+
+/// Pose of `frame` at `q`: the products of `world_from_body` along the frame body's support, in
+/// the order `forward_kinematics` takes them (the same numbers), without filling `Data`.
+fn frame_pose_lean(model: &Model, q: &[f64], frame: usize) -> Transform {
+    let f = &model.frames[frame];
+    let Some(body) = f.body else { return f.body_from_frame };
+    let mut support = model.support[body].iter();
+    let first = support.next().copied().unwrap_or(body);
+    let mut world_from_body = parent_from_body(model, q, first);
+    for &i in support {
+        world_from_body = &world_from_body * &parent_from_body(model, q, i);
+    }
+    if f.body_from_frame == Transform::identity() {
+        world_from_body
+    } else {
+        world_from_body * f.body_from_frame
+    }
+}
+
 /// Move a revolute angle by 2 pi k: inside `[lo, hi]` nearest `reference` when possible, else
 /// nearest `reference`.
 #[inline]
 fn wrap_angle(x: f64, lo: f64, hi: f64, reference: f64) -> f64 {
     let two_pi = 2.0 * PI;
-    let near = x + two_pi * ((reference - x) / two_pi).round();
+    let near = x + two_pi * round((reference - x) / two_pi);
     if near >= lo && near <= hi {
         return near;
     }
@@ -418,10 +449,9 @@ pub fn analytic_solutions(
     let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
     let weights = if position_only { [1.0, 1.0, 1.0, 0.0, 0.0, 0.0] } else { [1.0; 6] };
     let refine = Settings { weights, max_iterations: 8, restarts: 0, position_tolerance: 1e-13, orientation_tolerance: 1e-13, lambda_min: 1e-12, max_step: 0.1 };
-    let free = vec![f64::INFINITY; n];
-    let neg_free = vec![f64::NEG_INFINITY; n];
     let mut out = AnalyticOutcome { singular, ..Default::default() };
-    let mut kept: Vec<(Vec<f64>, f64, f64, bool)> = Vec::with_capacity(candidates.len());
+    // (q, position error, orientation error, inside the limits, squared distance to the reference)
+    let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len());
     for theta in &candidates {
         let mut q: Vec<f64> = (0..n).map(|i| theta[i] - model.offset[i]).collect();
         for i in 0..n {
@@ -429,11 +459,12 @@ pub fn analytic_solutions(
                 q[i] = wrap_angle(q[i], lower[i], upper[i], reference[i]);
             }
         }
-        let e = pose_error(&frame_pose_at(model, data, &q, frame), target);
+        let e = pose_error(&frame_pose_lean(model, &q, frame), target);
         let (mut ep, mut er) = residuals(&e, &weights);
         if ep > 1e-12 || er > 1e-12 {
             // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits)
             if ep < 1e-4 && er < 1e-4 {
+                let (free, neg_free) = (vec![f64::INFINITY; n], vec![f64::NEG_INFINITY; n]);
                 let r = numeric_ik(model, data, frame, target, &q, &neg_free, &free, &refine, 0);
                 if r.position_error <= ep && r.orientation_error <= er {
                     q = r.q;
@@ -446,10 +477,10 @@ pub fn analytic_solutions(
             continue;
         }
         // distinct modulo 2 pi
-        let same = kept.iter().any(|(k, _, _, _)| {
+        let same = kept.iter().any(|(k, ..)| {
             (0..n).all(|i| {
                 let d = k[i] - q[i];
-                let d = if model.joints[i].kind == JointKind::Revolute { d - 2.0 * PI * (d / (2.0 * PI)).round() } else { d };
+                let d = if model.joints[i].kind == JointKind::Revolute { d - 2.0 * PI * round(d / (2.0 * PI)) } else { d };
                 d.abs() < 1e-7
             })
         });
@@ -457,13 +488,18 @@ pub fn analytic_solutions(
             continue;
         }
         let inside = (0..n).all(|i| q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
-        kept.push((q, ep, er, inside));
+        let distance = (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
+        kept.push((q, ep, er, inside, distance));
     }
     out.found = kept.len();
-    let mut chosen: Vec<_> = kept.into_iter().filter(|k| k.3 || !respect_limits).collect();
-    let distance = |q: &Vec<f64>| (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
-    chosen.sort_by(|a, b| distance(&a.0).partial_cmp(&distance(&b.0)).unwrap_or(std::cmp::Ordering::Equal));
-    for (q, ep, er, _) in chosen {
+    if respect_limits {
+        kept.retain(|k| k.3);
+    }
+    kept.sort_by(|a, b| a.4.partial_cmp(&b.4).unwrap_or(std::cmp::Ordering::Equal));
+    out.solutions.reserve_exact(kept.len());
+    out.position_error.reserve_exact(kept.len());
+    out.orientation_error.reserve_exact(kept.len());
+    for (q, ep, er, ..) in kept {
         out.solutions.push(q);
         out.position_error.push(ep);
         out.orientation_error.push(er);
