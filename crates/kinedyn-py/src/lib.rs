@@ -135,7 +135,7 @@ impl<'a> Batch<'a> {
     /// Run `kernel(model, data, inputs_of_state, out_of_state)` on every state, writing straight
     /// into a fresh NumPy array. A single state runs with the cached `Data`, keeping the GIL (the
     /// call is shorter than releasing it); a batch runs with the GIL released, in parallel
-    /// chunks that each own a `Data`.
+    /// chunks of 64 states, each rayon job reusing one `Data` over its chunks.
     fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
@@ -156,13 +156,16 @@ impl<'a> Batch<'a> {
         } else {
             py.detach(|| {
                 const CHUNK: usize = 64;
-                out.par_chunks_mut(per_state * CHUNK).enumerate().try_for_each(|(c, block)| {
-                    let mut data = Data::new(model);
-                    for (i, o) in block.chunks_mut(per_state).enumerate() {
-                        kernel(model, &mut data, &self.state(c * CHUNK + i), o)?;
-                    }
-                    Ok(())
-                })
+                // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
+                out.par_chunks_mut(per_state * CHUNK).enumerate().try_for_each_init(
+                    || Data::new(model),
+                    |data, (c, block)| {
+                        for (i, o) in block.chunks_mut(per_state).enumerate() {
+                            kernel(model, data, &self.state(c * CHUNK + i), o)?;
+                        }
+                        Ok(())
+                    },
+                )
             })
         };
         result.map_err(core_err)?;
