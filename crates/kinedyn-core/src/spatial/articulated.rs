@@ -56,12 +56,6 @@ impl ArticulatedInertia {
     }
 }
 
-/// `[t]x` for a translation.
-#[inline]
-fn skew(t: &Vec3) -> Mat3 {
-    super::skew(t)
-}
-
 impl Transform {
     /// An articulated inertia given in b's frame, expressed in a's: `X^* IA X^-1` (RBDA eq. 2.66
     /// for a general symmetric 6x6). With rotated blocks `A = R a R^T`, `B = R b R^T`,
@@ -69,12 +63,31 @@ impl Transform {
     #[inline]
     pub fn act_articulated(&self, ia: &ArticulatedInertia) -> ArticulatedInertia {
         let r = &self.rot;
-        let ra = r * ia.a * r.transpose();
+        let t = &self.trans;
+        // A = R a R^T and C = R c R^T are symmetric (6 entries each); B = R b R^T is not
+        let ra = rotate_symmetric(r, &ia.a);
         let rb = r * ia.b * r.transpose();
-        let rc = r * ia.c * r.transpose();
-        let t = skew(&self.trans);
-        let at = ra * t;
-        let tb = t * rb;
-        ArticulatedInertia { a: ra, b: rb - at, c: rc + tb + tb.transpose() - t * at }
+        let rc = rotate_symmetric(r, &ia.c);
+        // products with T = [t]x as column-wise cross products (T M = [t x m_0, t x m_1, t x m_2]);
+        // A T = -(T A)^T for a symmetric A
+        let at = -cross_columns(t, &ra).transpose();
+        let tb = cross_columns(t, &rb);
+        let tat = cross_columns(t, &at);
+        ArticulatedInertia { a: ra, b: rb - at, c: rc + tb + tb.transpose() - tat }
     }
+}
+
+/// `[t]x m` column by column.
+#[inline]
+fn cross_columns(t: &Vec3, m: &Mat3) -> Mat3 {
+    Mat3::from_columns(&[t.cross(&m.column(0).into_owned()), t.cross(&m.column(1).into_owned()), t.cross(&m.column(2).into_owned())])
+}
+
+/// `R S R^T` for a symmetric `S`: `A = R S`, then the 6 distinct entries `A_i . R_j`.
+#[inline]
+fn rotate_symmetric(r: &Mat3, s: &Mat3) -> Mat3 {
+    let a = r * s;
+    let e = |i: usize, j: usize| a[(i, 0)] * r[(j, 0)] + a[(i, 1)] * r[(j, 1)] + a[(i, 2)] * r[(j, 2)];
+    let (xx, xy, xz, yy, yz, zz) = (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2));
+    Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
 }
