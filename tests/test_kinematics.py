@@ -224,7 +224,7 @@ def test_any_layout_and_lists_are_accepted():
 
 def test_bad_inputs_give_clear_errors():
     robot = ROBOTS["elbow_3r"]
-    with pytest.raises(ValueError, match=r"q must have shape \(3\)"):
+    with pytest.raises(ValueError, match=r"q must have shape \(3,\) or a batch \(N, 3\), got \(2,\)$"):
         robot.pose([0.0, 0.0])
     with pytest.raises(ValueError, match=r"q must have shape"):
         robot.jacobian(np.zeros((2, 2, 3)))
@@ -232,7 +232,7 @@ def test_bad_inputs_give_clear_errors():
         robot.pose([0.0, float("nan"), 0.0])
     with pytest.raises(ValueError, match="non-finite.*state 1"):
         robot.jacobian([[0.0, 0, 0], [0.0, float("inf"), 0]])
-    with pytest.raises(ValueError, match="does not match"):
+    with pytest.raises(ValueError, match=r"qd has shape \(3, 3\), which does not match the other arguments \(a batch of 2 states\)"):
         robot.frame_velocity(np.zeros((2, 3)), np.zeros((3, 3)))
     with pytest.raises(ValueError, match="unknown frame 'hand'"):
         robot.pose([0, 0, 0], "hand")

@@ -30,9 +30,18 @@ fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
     x.get(k).copied().filter(|v| !v.is_empty())
 }
 
+/// A shape as Python prints it: `(5,)`, `(2, 3)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => format!("({})", shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
+    }
+}
+
 fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
     let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
-    PyValueError::new_err(format!("{name} must have shape ({exp}) or a batch (N, {exp}), got {got:?}"))
+    let one = if expected.len() == 1 { "," } else { "" };
+    PyValueError::new_err(format!("{name} must have shape ({exp}{one}) or a batch (N, {exp}), got {}", shape_text(got)))
 }
 
 /// A NumPy float64 array as the inputs of one call. Two kinds: `PyReadonlyArrayDyn` (rust-numpy's
@@ -102,7 +111,12 @@ impl<'a> Batch<'a> {
                 None => batch = Some(this),
                 Some(b) if b != this => {
                     return Err(PyValueError::new_err(format!(
-                        "{name} has batch shape {got:?}, which does not match the other arguments (batch {b:?})"
+                        "{name} has shape {}, which does not match the other arguments ({})",
+                        shape_text(got),
+                        match b {
+                            Some(b) => format!("a batch of {b} states"),
+                            None => "a single state".to_string(),
+                        }
                     )))
                 }
                 _ => {}
