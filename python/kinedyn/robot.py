@@ -21,6 +21,16 @@ from .description.link import Frame, KinematicTree, Link, build_tree
 
 __all__ = ["Robot"]
 
+_IK_SOLVE = None  # kinedyn.ik.inverse_kinematics, imported on first use (it loads the IK bindings)
+
+
+def _load_ik():
+    global _IK_SOLVE
+    from .ik import inverse_kinematics
+
+    _IK_SOLVE = inverse_kinematics
+    return _IK_SOLVE
+
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
 _F64 = np.dtype(np.float64)
 
@@ -395,9 +405,8 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
-        from .ik import inverse_kinematics
-
-        return inverse_kinematics(self, target, q0=q0, mask=mask, method=method, respect_limits=respect_limits, **kwargs)
+        solve = _IK_SOLVE or _load_ik()
+        return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,

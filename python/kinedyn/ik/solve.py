@@ -23,6 +23,8 @@ _POSITION_MASK = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
 _FULL_MASK = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 
 
+_F64 = np.dtype(np.float64)
+
 @dataclass(slots=True)
 class IKResult:
     """Joint vectors that put a frame at a target, and how well they do.
@@ -236,7 +238,7 @@ def inverse_kinematics(
         _check_settings(tolerance, max_iterations, restarts, seed)
     chain = _chain(robot, frame)
     # fast path: one float64 target, closed form, no mask (checks of the target happen natively)
-    if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype == np.float64 and chain.solver is not None:
+    if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype is _F64 and chain.solver is not None:
         shape = target.shape
         if shape == (4, 4) or (shape == (3,) and chain.position_ok):
             q_ref = chain.start if q0 is None else _q0(q0, chain, None)
