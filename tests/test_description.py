@@ -237,3 +237,12 @@ def test_subs_names_the_link_of_a_bad_value():
     values = {s.name: 1.0 for s in robot.symbols}
     with pytest.raises(ValueError, match="link 'link1'.*mass is not finite"):
         robot.subs({**values, "m1": float("nan")})
+
+
+def test_planar_idealisation_does_not_warn():
+    """Only Izz given (the planar textbook arm): one nonzero principal moment is accepted quietly."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Inertia(1.0, (0.5, 0, 0), np.diag([0.0, 0.0, 0.2]))

@@ -96,7 +96,9 @@ class Inertia:
         # a real body's principal moments satisfy the triangle inequality; published tables (the
         # PUMA 560's) and CAD exports sometimes do not: warn, since M stays positive definite
         key = tuple(np.round(eig, 12))
-        if eig[0] + eig[1] < eig[2] - max(tol, 1e-9 * eig[2]) and key not in _WARNED:
+        # one nonzero principal moment is the planar textbook idealisation (only Izz given): no warning
+        planar = eig[1] <= tol
+        if eig[0] + eig[1] < eig[2] - max(tol, 1e-9 * eig[2]) and not planar and key not in _WARNED:
             _WARNED.add(key)  # once per body: rotated copies made while compiling share eigenvalues
             warnings.warn(
                 f"inertia tensor{where} violates the triangle inequality of principal moments "
