@@ -9,6 +9,7 @@ pub mod data;
 pub mod error;
 pub mod joint;
 pub mod model;
+pub mod rng;
 pub mod spatial;
 pub mod testing;
 pub mod trig;

@@ -48,6 +48,7 @@ use super::kinematics::parent_from_body;
 use crate::data::Data;
 use crate::model::Model;
 use crate::joint::JointKind;
+use crate::rng::Rng;
 use crate::spatial::{Mat3, Transform, Vec3};
 use nalgebra::{Matrix6, Vector6};
 use std::f64::consts::PI;
@@ -142,27 +143,6 @@ pub struct Outcome {
     pub attempts: usize,
 }
 
-/// SplitMix64 (Steele, Lea & Flood 2014): a small seeded generator for restarts.
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
 /// A random configuration inside the limits (infinite limits: +-pi for revolute joints,
 /// +-1 m around `center` for prismatic ones).
 fn random_configuration(model: &Model, lower: &[f64], upper: &[f64], center: &[f64], rng: &mut Rng, out: &mut [f64]) {
@@ -170,7 +150,7 @@ fn random_configuration(model: &Model, lower: &[f64], upper: &[f64], center: &[f
         let span = if model.joints[i].kind == JointKind::Revolute { PI } else { 1.0 };
         let lo = if lower[i].is_finite() { lower[i] } else if upper[i].is_finite() { upper[i] - 2.0 * span } else { center[i] - span };
         let hi = if upper[i].is_finite() { upper[i] } else { lo + 2.0 * span };
-        out[i] = lo + (hi - lo) * rng.uniform();
+        out[i] = lo + (hi - lo) * rng.uniform(0.0, 1.0);
     }
 }
 
