@@ -322,9 +322,7 @@ class Robot:
         offset = np.array([float(b.joint.offset) for b in bodies])
         placement = np.array([to_float_array(b.placement, (4, 4), f"placement of '{b.name}'") for b in bodies])
         inertia = self.inertial_parameters().reshape(n, 10)
-        armature = np.array([float(b.joint.armature) for b in bodies])
-        viscous = np.array([float(b.joint.viscous) for b in bodies])
-        coulomb = np.array([float(b.joint.coulomb) for b in bodies])
+        armature, viscous, coulomb = self.armature, self.viscous, self.coulomb
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
         frame_body = np.array([f.body for f in frames], dtype=np.int64)
@@ -372,12 +370,15 @@ class Robot:
         out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
         return out[0] if out.ndim == 3 else out[:, 0]
 
+    @cached_property
+    def _frame_id_arrays(self) -> dict:
+        return {}
+
     def _frame_id_array(self, frame: str) -> np.ndarray:
         """A one-element id array per frame name, made once."""
-        cache = self.__dict__.setdefault("_frame_id_arrays", {})
-        ids = cache.get(frame)
+        ids = self._frame_id_arrays.get(frame)
         if ids is None:
-            ids = cache[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
+            ids = self._frame_id_arrays[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
         return ids
 
     def jacobian(self, q, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
