@@ -123,3 +123,15 @@ def test_derive_rejects_symbolic_for_a_robot_without_symbols(capsys):
 def test_capability_commands_reject_bad_input(capsys, argv, message):
     code, _, err = run(capsys, *argv)
     assert code == 1 and message in err and "Traceback" not in err
+
+
+def test_python_dash_m_kinedyn_is_the_command():
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run([sys.executable, "-m", "kinedyn", "fk", "planar_2r", "--q", "0", "0", "--json"], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["frames"]["tool"]["position"] == [5.0, 0.0, 0.0]
