@@ -12,6 +12,9 @@ pub struct Data {
     pub parent_from_body: Vec<Transform>,
     /// `world_from_body[i]` at the last q.
     pub world_from_body: Vec<Transform>,
+    /// `sin` and `cos` of each joint coordinate `q_i + offset_i` (`kinematics::joint_trig`).
+    pub sin: Vec<f64>,
+    pub cos: Vec<f64>,
     /// Motion subspace `s_i` of each joint in its body frame.
     pub s: Vec<Motion>,
     /// Body twists `v_i` in body coordinates.
@@ -76,6 +79,8 @@ impl Data {
         Self {
             parent_from_body: vec![Transform::identity(); n],
             world_from_body: vec![Transform::identity(); n],
+            sin: vec![0.0; n],
+            cos: vec![1.0; n],
             s: model.joints.iter().map(|j| j.subspace()).collect(),
             v: vec![Motion::zero(); n],
             a: vec![Motion::zero(); n],

@@ -22,6 +22,12 @@ pub struct Joint {
 #[inline]
 pub fn axis_angle(a: &Vec3, angle: f64) -> Mat3 {
     let (s, c) = crate::trig::sin_cos(angle);
+    axis_angle_trig(a, s, c)
+}
+
+/// `axis_angle` from the sine and cosine of the angle.
+#[inline]
+fn axis_angle_trig(a: &Vec3, s: f64, c: f64) -> Mat3 {
     let v = 1.0 - c;
     Mat3::new(
         c + a.x * a.x * v,
@@ -72,12 +78,19 @@ impl Joint {
     /// columns of the placement's rotation, `R Rz(x) = [c r0 + s r1, c r1 - s r0, r2]`.
     #[inline]
     pub fn compose(&self, parent_from_joint: &Transform, x: f64) -> Transform {
+        let (s, c) = crate::trig::sin_cos(x);
+        self.compose_trig(parent_from_joint, x, s, c)
+    }
+
+    /// `compose` with `(s, c) = (sin x, cos x)` given (computed for all joints at once by
+    /// `kinematics::joint_trig`, so that their polynomial evaluations overlap).
+    #[inline(always)]
+    pub fn compose_trig(&self, parent_from_joint: &Transform, x: f64, s: f64, c: f64) -> Transform {
         let r = &parent_from_joint.rot;
         match self.kind {
             JointKind::Prismatic => Transform::new(*r, parent_from_joint.trans + r * (self.axis * x)),
             JointKind::Revolute => {
                 let a = &self.axis;
-                let (s, c) = crate::trig::sin_cos(x);
                 // columns (i, j) rotated into each other; constant indices let the compiler
                 // emit 12 multiplications and no index arithmetic
                 let rot = if a.x == 0.0 && a.y == 0.0 {
@@ -91,7 +104,7 @@ impl Joint {
                 };
                 match rot {
                     Some(rot) => Transform::new(rot, parent_from_joint.trans),
-                    None => Transform::new(r * axis_angle(a, x), parent_from_joint.trans),
+                    None => Transform::new(r * axis_angle_trig(a, s, c), parent_from_joint.trans),
                 }
             }
         }

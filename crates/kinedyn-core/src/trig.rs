@@ -29,7 +29,7 @@ const C5: f64 = 2.087_572_321_298_174_827_90e-09;
 const C6: f64 = -1.135_964_755_778_819_482_65e-11;
 
 /// `(sin x, cos x)`.
-#[inline]
+#[inline(always)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() < 1e5) {
         return x.sin_cos();

@@ -16,7 +16,7 @@
 //! | `I^a`, `p^a`  | `ia`, `pa`                   | what body i passes to its parent               |
 //! | `a_i`         | `data.a[i]`                  | body acceleration (gravity included)           |
 
-use super::kinematics::{forward_kinematics, parent_from_body};
+use super::kinematics::{forward_kinematics, joint_transforms};
 use super::rnea::friction;
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -31,12 +31,13 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
     let n = model.n;
     if f_ext.is_some() {
         forward_kinematics(model, data, q);
+    } else {
+        joint_transforms(model, data, q);
     }
     // pass 1, root to leaves
     for i in 0..n {
         // X_J, s_i = jcalc(q_i);  ^iX_λ = X_J X_T
-        let x_up = parent_from_body(model, q, i);
-        data.parent_from_body[i] = x_up;
+        let x_up = data.parent_from_body[i];
         // v_i = ^iX_λ v_λ + s_i qd_i ;  c_i = v_i x s_i qd_i
         let joint = &model.joints[i];
         let vj = joint.motion(qd[i]);

@@ -12,7 +12,7 @@
 //! | `F`         | `f`                        | `I^c_i s_i`, carried up to the ancestors of i    |
 //! | `H`         | `data.m` (row-major n x n) | mass matrix `M(q)`                               |
 
-use super::kinematics::parent_from_body;
+use super::kinematics::{joint_trig, parent_from_body_trig};
 use crate::data::Data;
 use crate::model::Model;
 
@@ -34,8 +34,10 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
 /// and the column loops have independent iterations (no chain of dependent transforms per entry).
 fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
     let n = model.n;
+    joint_trig(model, data, q);
     let (parent, joints, armature, end) = (&model.parent[..n], &model.joints[..n], &model.armature[..n], &model.subtree_end[..n]);
     let (ic, m, f) = (&mut data.ic[..n], &mut data.m[..n * n], &mut data.f[..n]);
+    let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
     // I^c_i = I_i ;  H_rr = 0 for the roots r (their children add to it, see below)
     ic.copy_from_slice(&model.inertia[..n]);
     for (r, p) in parent.iter().enumerate() {
@@ -69,7 +71,7 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
         }
         m[i * n + i] += armature[i];
         // ^λX_i = X_T(i) X_J(q_i), used on forces (its dual inverse)
-        let x = parent_from_body(model, q, i);
+        let x = parent_from_body_trig(model, q, sin, cos, i);
         if parent[p].is_none() {
             // the parent is a root: only its row is left to compute, and s_λ^T ^λX_i^* F_k is
             // w^T F_k with w = ^iX_λ s_λ (s_λ in body i's frame); its composite inertia enters
@@ -96,12 +98,14 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
 /// RBDA Table 6.2 entry by entry, `F` carried up the support of each body (any numbering).
 fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
     let n = model.n;
+    joint_trig(model, data, q);
     // per-body arrays sliced to n once (no bounds checks in the loops below)
     let (parent, joints, armature) = (&model.parent[..n], &model.joints[..n], &model.armature[..n]);
     let (x_up, ic, m) = (&mut data.parent_from_body[..n], &mut data.ic[..n], &mut data.m[..n * n]);
+    let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
     for i in 0..n {
         // X_J = jcalc(q_i);  ^iX_λ(i) = X_J X_T(i);  I^c_i = I_i
-        x_up[i] = parent_from_body(model, q, i);
+        x_up[i] = parent_from_body_trig(model, q, sin, cos, i);
         ic[i] = model.inertia[i];
     }
     for i in (0..n).rev() {

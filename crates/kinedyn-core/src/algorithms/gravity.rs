@@ -12,7 +12,7 @@
 //! | `g_i`         | `data.g_b[i]`           | gravity acceleration in body i's axes          |
 //! | `m^c_i`, `h^c_i` | `data.mc[i]`, `data.hc[i]` | subtree mass and first moment (body i frame) |
 
-use super::kinematics::parent_from_body;
+use super::kinematics::joint_transforms;
 use crate::data::Data;
 use crate::joint::JointKind;
 use crate::model::Model;
@@ -20,15 +20,15 @@ use crate::model::Model;
 /// `g(q)` written to `data.tau`.
 pub fn gravity_torque<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
     let n = model.n;
+    joint_transforms(model, data, q);
     for i in 0..n {
         // g_i = R_λ,i^T g_λ  (g_0 = model.gravity) ;  m^c_i = m_i ;  h^c_i = h_i
-        let x_up = parent_from_body(model, q, i);
+        let x_up = data.parent_from_body[i];
         let g_parent = match model.parent[i] {
             Some(p) => data.g_b[p],
             None => model.gravity,
         };
         data.g_b[i] = x_up.rot.tr_mul(&g_parent);
-        data.parent_from_body[i] = x_up;
         data.mc[i] = model.inertia[i].mass;
         data.hc[i] = model.inertia[i].h;
     }

@@ -14,7 +14,7 @@
 //! | `A_i`       | `cols` (10 forces)     | `d f_i / d pi_i`, body coordinates               |
 //! | `Y`         | `out` (row-major n x 10n) | regressor                                    |
 
-use super::kinematics::parent_from_body;
+use super::kinematics::joint_transforms;
 use crate::data::Data;
 use crate::model::Model;
 use crate::spatial::{Force, Mat3, Motion, Vec3};
@@ -49,10 +49,10 @@ pub fn regressor(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f
     let w = 10 * n;
     out[..n * w].fill(0.0);
     let a0 = Motion::new(-model.gravity, Vec3::zeros());
+    joint_transforms(model, data, q);
     for i in 0..n {
         // v_i = ^iX_λ v_λ + s_i qd_i ;  a_i = ^iX_λ a_λ + s_i qdd_i + v_i x s_i qd_i  (a_0 = -g)
-        let x_up = parent_from_body(model, q, i);
-        data.parent_from_body[i] = x_up;
+        let x_up = data.parent_from_body[i];
         let vj = data.s[i] * qd[i];
         let (v, a) = match model.parent[i] {
             Some(p) => (x_up.inv_act_motion(&data.v[p]) + vj, x_up.inv_act_motion(&data.a[p])),

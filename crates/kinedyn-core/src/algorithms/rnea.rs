@@ -14,7 +14,7 @@
 //! | `f^x_i`     | `f_ext` (base axes, body origin) | external wrench on body i                    |
 //! | `J_m r^2`   | `model.armature[i]`        | reflected rotor inertia, adds `armature qdd`       |
 
-use super::kinematics::{forward_kinematics, parent_from_body};
+use super::kinematics::{forward_kinematics, joint_transforms};
 use crate::data::Data;
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
@@ -64,16 +64,18 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
     if f_ext.is_some() {
         // world_from_body rotations are needed to bring f_ext into body axes
         forward_kinematics(model, data, q);
+    } else {
+        joint_transforms(model, data, q);
     }
     // every per-body array sliced to n once: the loops below index them without bounds checks
     let (parent, joints, inertia) = (&model.parent[..n], &model.joints[..n], &model.inertia[..n]);
-    let (q, qd, qdd) = (&q[..n], &qd[..n], &qdd[..n]);
+    let (qd, qdd) = (&qd[..n], &qdd[..n]);
     let (x_up, v, a, f) = (&mut data.parent_from_body[..n], &mut data.v[..n], &mut data.a[..n], &mut data.f[..n]);
     // a_0 = -g (a fictitious upward acceleration of the base replaces gravity)
     let a0 = if terms.gravity { Motion::new(-model.gravity, Default::default()) } else { Motion::zero() };
     for i in 0..n {
         // X_J, s = jcalc(q_i);  ^iX_λ = X_J X_T (stored as its inverse, parent_from_body)
-        let x = parent_from_body(model, q, i);
+        let x = x_up[i];
         let joint = &joints[i];
         // v_i = ^iX_λ v_λ + s_i qd_i ;  a_i = ^iX_λ a_λ + s_i qdd_i + v_i x s_i qd_i
         let (vp, ap) = match parent[i] {
@@ -90,7 +92,6 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
             let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
             fi -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
         }
-        x_up[i] = x;
         v[i] = vi;
         a[i] = ai;
         f[i] = fi;

@@ -1,0 +1,77 @@
+//! A noise-robust A/B timer for optimising the core (never a CI gate): the minimum over rounds of
+//! the mean time per call, which a busy shared machine disturbs far less than criterion's median.
+//!   cargo bench -p kinedyn-core --bench quick [-- FILTER]
+//! Prints `model/algorithm  ns`, one line each. Copy the binary from `target/release/deps` to
+//! compare two builds back to back.
+
+mod models;
+
+use kinedyn_core::algorithms as alg;
+use kinedyn_core::Data;
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Calls of `f` that take about 1 ms.
+fn calls_per_ms(f: &mut dyn FnMut()) -> u64 {
+    let start = Instant::now();
+    let mut calls = 0u64;
+    while start.elapsed().as_micros() < 300 {
+        f();
+        calls += 1;
+    }
+    calls
+}
+
+/// Mean ns per call of `f` over `calls` calls.
+fn mean_ns(f: &mut dyn FnMut(), calls: u64) -> f64 {
+    let t = Instant::now();
+    for _ in 0..calls {
+        f();
+    }
+    t.elapsed().as_nanos() as f64 / calls as f64
+}
+
+/// Minimum over 100 rounds of the mean ns per call of `f` over ~1 ms batches.
+fn min_ns(mut f: impl FnMut()) -> f64 {
+    let calls = calls_per_ms(&mut f);
+    (0..100).map(|_| mean_ns(&mut f, calls)).fold(f64::INFINITY, f64::min)
+}
+
+/// A/B: the minimum ns per call of `a` and of `b`, their ~1 ms rounds interleaved so that both
+/// see the same machine (whose speed drifts by tens of percent here between runs).
+#[allow(dead_code)]
+fn min_ns_ab(mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64) {
+    let calls = calls_per_ms(&mut a);
+    let (mut ta, mut tb) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..400 {
+        ta = ta.min(mean_ns(&mut a, calls));
+        tb = tb.min(mean_ns(&mut b, calls));
+    }
+    (ta, tb)
+}
+
+fn main() {
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with("--")).unwrap_or_default();
+    for (name, model) in models::all() {
+        let n = model.n;
+        let mut data = Data::new(&model);
+        let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.7 * i as f64).collect();
+        let qd: Vec<f64> = (0..n).map(|i| 1.1 - 0.4 * i as f64).collect();
+        let qdd: Vec<f64> = (0..n).map(|i| -0.5 + 0.3 * i as f64).collect();
+        let tau = alg::rnea(&model, &mut data, &q, &qd, &qdd, None).to_vec();
+        let d = &mut data;
+        let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {
+            let key = format!("{name}/{alg}");
+            if key.contains(&filter) {
+                println!("{key:28} {:8.1}", min_ns(|| f(&mut *d)));
+            }
+        };
+        run("rnea", &mut |d| _ = black_box(alg::rnea(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None)[0]));
+        run("crba", &mut |d| _ = black_box(alg::crba(&model, d, black_box(&q))[0]));
+        run("aba", &mut |d| _ = black_box(alg::aba(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None).unwrap()[0]));
+        run("coriolis_matrix", &mut |d| _ = black_box(alg::coriolis_matrix(&model, d, black_box(&q), black_box(&qd))[0]));
+        run("gravity_torque", &mut |d| _ = black_box(alg::gravity_torque(&model, d, black_box(&q))[0]));
+        run("mass_matrix_inverse", &mut |d| _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0]));
+        run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
+    }
+}
