@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::joint::Joint;
-use crate::spatial::{Inertia, Transform, Vec3};
+use crate::spatial::{AxisRotation, Inertia, Transform, Vec3};
 
 /// A named frame rigidly attached to a body (`None`: the base).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +26,8 @@ pub struct Model {
     pub offset: Vec<f64>,
     /// Fixed placement of each joint frame in its parent body's frame.
     pub parent_from_joint: Vec<Transform>,
+    /// The class of each placement's rotation (identity, about a coordinate axis, general).
+    pub placement_rotation: Vec<AxisRotation>,
     /// Rigid-body inertia of each body about its frame origin, body axes.
     pub inertia: Vec<Inertia>,
     /// Reflected rotor inertia `r^2 J_m` per joint (added to `M[i][i]`).
@@ -137,12 +139,14 @@ impl Model {
             }
         }
         let subtrees_contiguous = (0..n).all(|i| subtree_end[i] - i == subtree_size[i]);
+        let placement_rotation = parent_from_joint.iter().map(|x| AxisRotation::classify(&x.rot)).collect();
         Ok(Self {
             n,
             parent,
             joints,
             offset,
             parent_from_joint,
+            placement_rotation,
             inertia,
             armature,
             viscous,

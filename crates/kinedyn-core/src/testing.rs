@@ -24,7 +24,9 @@ pub fn random_inertia(rng: &mut Rng) -> Inertia {
 
 /// A random model of `n` bodies: a serial chain (`branching = false`) or a tree where each body's
 /// parent is any earlier body. Random axes, placements, inertias, offsets, armature, friction;
-/// one extra frame per body at a random placement.
+/// one extra frame per body at a random placement. Half the joint axes are signed coordinate axes
+/// and half the placement rotations the identity or about a coordinate axis, so that the
+/// algorithms' fast paths for those (`Joint::compose`, `inertia_to_parent`) are exercised too.
 pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
     let mut rng = Rng::new(seed);
     let mut parent = Vec::with_capacity(n);
@@ -38,8 +40,13 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
             (_, true) => Some((rng.next_u64() % i as u64) as usize),
         });
         let kind = if rng.uniform(0.0, 1.0) < 0.25 { JointKind::Prismatic } else { JointKind::Revolute };
-        joints.push(Joint { kind, axis: rng.unit() });
-        placements.push(Transform::new(rng.rotation(), rng.vec3(-0.5, 0.5)));
+        joints.push(Joint { kind, axis: random_axis(&mut rng) });
+        let rotation = match rng.next_u64() % 4 {
+            0 => Mat3::identity(),
+            1 => axis_angle(&random_axis(&mut rng), rng.uniform(-3.0, 3.0)),
+            _ => rng.rotation(),
+        };
+        placements.push(Transform::new(rotation, rng.vec3(-0.5, 0.5)));
         inertias.push(random_inertia(&mut rng));
     }
     let offset = rng.vector(n, -0.5, 0.5);
@@ -52,6 +59,18 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
         .collect();
     Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(0.0, 0.0, -9.81), frames)
         .expect("random models are valid by construction")
+}
+
+/// A random unit vector, or (half of the time) a signed coordinate axis.
+fn random_axis(rng: &mut Rng) -> Vec3 {
+    let k = rng.next_u64() % 12;
+    if k >= 6 {
+        return rng.unit();
+    }
+    let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+    let mut axis = Vec3::zeros();
+    axis[(k / 2) as usize] = sign;
+    axis
 }
 
 /// A serial revolute arm from standard DH rows `(d, a, alpha)` (Spong/Corke convention), with

@@ -12,7 +12,7 @@
 //! | `F`         | `f`                        | `I^c_i s_i`, carried up to the ancestors of i    |
 //! | `H`         | `data.m` (row-major n x n) | mass matrix `M(q)`                               |
 
-use super::kinematics::{joint_trig, parent_from_body_trig};
+use super::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
 use crate::data::Data;
 use crate::model::Model;
 
@@ -86,7 +86,7 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
             continue;
         }
         // I^c_λ(i) += ^λX_i^* I^c_i ^iX_λ(i)
-        let add = x.act_inertia(&ic[i]);
+        let add = inertia_to_parent(model, i, &x, sin[i], cos[i], &ic[i]);
         ic[p] += add;
         // F_k = ^λX_i^* F_k for k in subtree(i)
         for fk in &mut f[i..e] {
@@ -111,7 +111,7 @@ fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
     for i in (0..n).rev() {
         // I^c_λ(i) += ^λX_i^* I^c_i ^iX_λ
         if let Some(p) = parent[i] {
-            let add = x_up[i].act_inertia(&ic[i]);
+            let add = inertia_to_parent(model, i, &x_up[i], sin[i], cos[i], &ic[i]);
             ic[p] += add;
         }
         // F = I^c_i s_i ;  H_ii = s_i^T F (+ armature_i)
@@ -153,7 +153,28 @@ pub(crate) fn is_ancestor(model: &Model, a: usize, b: usize) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{random_model, Rng};
+    use crate::spatial::AxisRotation;
+    use crate::testing::{dh_model, random_model, Rng, UR5_DH};
+
+    /// The two-factor inertia transform (coordinate-axis joints and placements) gives the same M
+    /// as the general one, on random models (half their axes and placements qualify) and a DH arm.
+    #[test]
+    fn coordinate_axis_fast_path_equals_general_transform() {
+        let models = [random_model(11, 8, false), random_model(12, 9, true), dh_model(&UR5_DH, 3)];
+        let fast_paths: usize = models.iter().map(|m| m.placement_rotation.iter().filter(|r| !matches!(r, AxisRotation::General)).count()).sum();
+        assert!(fast_paths >= 8, "the models exercise the fast path ({fast_paths} placements)");
+        for model in models {
+            let mut general = model.clone();
+            general.placement_rotation.fill(AxisRotation::General);
+            let q = Rng::new(2).vector(model.n, -3.0, 3.0);
+            let m_fast = crba(&model, &mut Data::new(&model), &q).to_vec();
+            let m_general = crba(&general, &mut Data::new(&general), &q).to_vec();
+            let scale = m_general.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            for (a, b) in m_fast.iter().zip(&m_general) {
+                assert!((a - b).abs() <= 1e-13 * scale, "{a} {b}");
+            }
+        }
+    }
 
     /// The block form (contiguous subtrees) equals the entry-by-entry form, on chains and on a
     /// depth-first-numbered tree.

@@ -5,7 +5,8 @@
 
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::Transform;
+use crate::joint::JointKind;
+use crate::spatial::{AxisRotation, Inertia, Transform};
 
 /// Joint coordinate seen by `jcalc`: q plus the model's offset.
 #[inline]
@@ -37,6 +38,29 @@ pub fn joint_trig(model: &Model, data: &mut Data, q: &[f64]) {
 #[inline(always)]
 pub fn parent_from_body_trig(model: &Model, q: &[f64], sin: &[f64], cos: &[f64], i: usize) -> Transform {
     model.joints[i].compose_trig(&model.parent_from_joint[i], joint_coordinate(model, q, i), sin[i], cos[i])
+}
+
+/// `^λX_i^* I ^iX_λ`: an inertia given in body i's frame, expressed in its parent's, where
+/// `x = parent_from_body` of body i and `(s, c)` the sine and cosine of its joint coordinate.
+///
+/// `x.rot = R_T R_J(q)`. When the joint turns about a coordinate axis and the placement rotation
+/// `R_T` is the identity or about a coordinate axis (DH tables, most URDFs), the two factors are
+/// applied one after the other, 17 products each (`Inertia::rotated_about`) instead of 54.
+#[inline(always)]
+pub fn inertia_to_parent(model: &Model, i: usize, x: &Transform, s: f64, c: f64, inertia: &Inertia) -> Inertia {
+    let (joint, placement) = (&model.joints[i], &model.placement_rotation[i]);
+    if matches!(placement, AxisRotation::General) {
+        return x.act_inertia(inertia);
+    }
+    let a = &joint.axis;
+    let in_joint_frame = match joint.kind {
+        JointKind::Prismatic => *inertia,
+        JointKind::Revolute if a.x == 0.0 && a.y == 0.0 => inertia.rotated_about::<0, 1>(c, s * a.z),
+        JointKind::Revolute if a.y == 0.0 && a.z == 0.0 => inertia.rotated_about::<1, 2>(c, s * a.x),
+        JointKind::Revolute if a.x == 0.0 && a.z == 0.0 => inertia.rotated_about::<2, 0>(c, s * a.y),
+        JointKind::Revolute => return x.act_inertia(inertia),
+    };
+    placement.rotate_inertia(&model.parent_from_joint[i].rot, &in_joint_frame).translated(&x.trans)
 }
 
 /// Fills `data.parent_from_body` at `q` (RBDA's `X_J X_T`, inverted), every joint's trigonometry first.

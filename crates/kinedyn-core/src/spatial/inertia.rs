@@ -51,6 +51,34 @@ impl Inertia {
         let (xx, xy, xz, yy, yz, zz) = (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2));
         Self::new(self.mass, r * self.h, Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz))
     }
+    /// Same body, axes rotated about the coordinate axis k by the angle with cosine `c` and sine
+    /// `s`, where `(I, J)` is `(0, 1)` for k = z, `(1, 2)` for x and `(2, 0)` for y (so that
+    /// `R e_I = c e_I + s e_J`): `rotated` with 17 products instead of 54, the I-J block by the
+    /// double angle: `I'_II = a + b C - I_IJ S`, `I'_JJ = a - b C + I_IJ S`, `I'_IJ = b S + I_IJ C`
+    /// with `a, b = (I_II +- I_JJ) / 2`, `C = c^2 - s^2`, `S = 2 c s`.
+    #[inline(always)]
+    pub fn rotated_about<const I: usize, const J: usize>(&self, c: f64, s: f64) -> Self {
+        const { assert!(I < 3 && J < 3 && I != J) };
+        let k = 3 - I - J;
+        let i = &self.i_o;
+        let (double_c, double_s) = (c * c - s * s, 2.0 * c * s);
+        let (a, b) = (0.5 * (i[(I, I)] + i[(J, J)]), 0.5 * (i[(I, I)] - i[(J, J)]));
+        let (bc, bs, xc, xs) = (b * double_c, b * double_s, i[(I, J)] * double_c, i[(I, J)] * double_s);
+        let mut i_o = *i;
+        i_o[(I, I)] = a + bc - xs;
+        i_o[(J, J)] = a - bc + xs;
+        let ij = bs + xc;
+        (i_o[(I, J)], i_o[(J, I)]) = (ij, ij);
+        let (ik, jk) = (c * i[(I, k)] - s * i[(J, k)], s * i[(I, k)] + c * i[(J, k)]);
+        (i_o[(I, k)], i_o[(k, I)]) = (ik, ik);
+        (i_o[(J, k)], i_o[(k, J)]) = (jk, jk);
+        let h = &self.h;
+        let mut h_r = *h;
+        h_r[I] = c * h[I] - s * h[J];
+        h_r[J] = s * h[I] + c * h[J];
+        Self::new(self.mass, h_r, i_o)
+    }
+
     /// Same body, origin moved to `-t` (i.e. expressed in a frame whose origin is at `-t` from
     /// this one, same axes): the parallel-axis theorem written on `h` so that `m = 0` is fine:
     /// `h' = h + m t`, `I' = I - [t]x[h]x - [h]x[t]x - m [t]x[t]x` (derivation: docs/notation.md).

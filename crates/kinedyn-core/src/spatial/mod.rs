@@ -14,12 +14,14 @@
 //! | `I^A`       | `ArticulatedInertia`         | articulated-body inertia (3x3 blocks)     |
 
 mod articulated;
+mod axis_rotation;
 mod force;
 mod inertia;
 mod motion;
 mod transform;
 
 pub use articulated::ArticulatedInertia;
+pub use axis_rotation::AxisRotation;
 pub use force::Force;
 pub use inertia::Inertia;
 pub use motion::Motion;
