@@ -30,8 +30,9 @@ pub fn joint_trig(model: &Model, data: &mut Data, q: &[f64]) {
     let n = model.n;
     let (q, offset, sin, cos) = (&q[..n], &model.offset[..n], &mut data.sin[..n], &mut data.cos[..n]);
     for i in 0..n {
-        (sin[i], cos[i]) = crate::trig::sin_cos(q[i] + offset[i]);
+        sin[i] = q[i] + offset[i];
     }
+    crate::trig::sin_cos_in_place(sin, cos);
 }
 
 /// `parent_from_body` of body i with the joint's sine and cosine from `joint_trig`.
