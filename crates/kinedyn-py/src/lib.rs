@@ -147,7 +147,8 @@ impl<'a> Batch<'a> {
     }
 
     /// Run `kernel(model, data, inputs_of_state, out_of_state)` on every state, writing straight
-    /// into a fresh NumPy array. A single state runs with the cached `Data`, keeping the GIL (the
+    /// into a fresh NumPy array; `kernel` must write every element of `out_of_state` (it is not
+    /// zeroed first). A single state runs with the cached `Data`, keeping the GIL (the
     /// call is shorter than releasing it); a batch runs with the GIL released, in parallel
     /// chunks of 64 states, each rayon job reusing one `Data` over its chunks.
     fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
@@ -160,8 +161,10 @@ impl<'a> Batch<'a> {
             shape.push(b);
         }
         shape.extend_from_slice(out_shape);
-        let array = PyArrayDyn::<f64>::zeros(py, shape, false);
-        // SAFETY: the array was created just above; no other reference to it exists yet.
+        // SAFETY: uninitialised memory, not zeros (a 10k-state M batch spent 10 % of its time in the
+        // memset): every kernel writes its whole output slice (its contract, see `kernel` above),
+        // and on an error the array is dropped unread. Created just above, nothing else refers to it.
+        let array = unsafe { PyArrayDyn::<f64>::new(py, shape, false) };
         let out = unsafe { array.as_slice_mut()? };
         let model = &m.model;
         let result: Result<(), CoreError> = if self.batch.is_none() {
