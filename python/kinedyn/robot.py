@@ -505,6 +505,48 @@ class Robot:
         except RuntimeError as e:
             raise self._singular(e) from None
 
+    def inverse_dynamics_derivatives(self, q, qd, qdd, f_ext=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(dtau/dq, dtau/dqd, dtau/dqdd = M)`` of :meth:`inverse_dynamics`, each (n, n) (or
+        (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical, by differentiating the recursive
+        Newton-Euler algorithm along each coordinate (exact, O(n^2); Pinocchio's
+        ``computeRNEADerivatives``). ``f_ext`` is held fixed in base axes and applied at the link-frame
+        origins, which move with q. Coulomb friction contributes its derivative zero (qd != 0)."""
+        q, qd, qdd = self._state(q), self._state(qd), self._state(qdd)
+        out = self._model.inverse_dynamics_derivatives(q, qd, qdd, self._f_ext(q, f_ext))
+        dq, dqd, M = out[..., 0, :, :], out[..., 1, :, :], out[..., 2, :, :]
+        shift = self._moment_shift_derivative(q, f_ext)
+        return (dq if shift is None else dq + shift), dqd, M
+
+    def forward_dynamics_derivatives(self, q, qd, tau, f_ext=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
+        (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
+        (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
+        q, qd, tau = self._state(q), self._state(qd), self._state(tau)
+        try:
+            out = self._model.forward_dynamics_derivatives(q, qd, tau, self._f_ext(q, f_ext))
+        except RuntimeError as e:
+            raise self._singular(e) from None
+        dq, dqd, Minv = out[..., 0, :, :], out[..., 1, :, :], out[..., 2, :, :]
+        shift = self._moment_shift_derivative(q, f_ext)
+        return (dq if shift is None else dq - Minv @ shift), dqd, Minv
+
+    def _moment_shift_derivative(self, q, f_ext) -> Optional[np.ndarray]:
+        """The part of dtau/dq the core does not see: :meth:`_f_ext` moves each moment to the body
+        origin with ``d_i(q) x f_i``, and ``d_i = R_i u_i`` turns with the joints supporting body i,
+        ``dd_i/dq_j = w_j x d_i`` (``w_j``: joint j's world axis, column j of body i's angular
+        Jacobian ``Jw_i``); tau has ``-Jw_i^T n_i``, so this adds ``-sum_i Jw_i^T ((w_j x d_i) x f_i)``
+        to column j. None when every link frame sits at its body origin (URDF) or without f_ext."""
+        u = self._link_origin_in_body
+        if f_ext is None or u is None:
+            return None
+        f = np.asarray(f_ext, dtype=np.float64)
+        R = self.forward_kinematics(q)[..., :3, :3]
+        d = np.einsum("...bij,bj->...bi", R, u)
+        Jw = np.stack([self.jacobian(q, frame=name)[..., 3:, :] for name in self.body_names], axis=-3)  # (..., b, 3, n)
+        dd = np.cross(np.swapaxes(Jw, -1, -2), d[..., :, None, :])  # (..., b, j, 3): w_j x d_b
+        dm = np.cross(dd, f[..., :, None, :3])  # (w_j x d_b) x f_b
+        return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
+
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         try:

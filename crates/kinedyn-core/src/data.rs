@@ -65,6 +65,19 @@ pub struct Data {
     /// Composite momenta `sum I_k v_k` over each subtree (world coordinates).
     pub hc_w: Vec<Force>,
 
+    // ---- derivatives (derivatives.rs): tangents of one sweep, body coordinates ----
+    /// `dv_i`, `da_i`: derivatives of twist and acceleration along one coordinate.
+    pub dv: Vec<Motion>,
+    pub da: Vec<Motion>,
+    /// `psi_i`: the moved coordinate's joint axis in body i's coordinates.
+    pub dpsi: Vec<Motion>,
+    /// `df^c_i`: derivative of the composite force.
+    pub dfc: Vec<Force>,
+    /// Whether body i moves with the coordinate of the sweep.
+    pub moved: Vec<bool>,
+    /// Forward dynamics' qdd while its derivatives are taken.
+    pub qdd_fd: Vec<f64>,
+
     // ---- gravity (gravity.rs) ----
     /// Composite mass and first moment of each subtree, body coordinates.
     pub mc: Vec<f64>,
@@ -104,6 +117,12 @@ impl Data {
             ic_w: vec![Inertia::zero(); n],
             icd_w: vec![Inertia::zero(); n],
             hc_w: vec![Force::zero(); n],
+            dv: vec![Motion::zero(); n],
+            da: vec![Motion::zero(); n],
+            dpsi: vec![Motion::zero(); n],
+            dfc: vec![Force::zero(); n],
+            moved: vec![false; n],
+            qdd_fd: vec![0.0; n],
             mc: vec![0.0; n],
             hc: vec![Vec3::zeros(); n],
             g_b: vec![Vec3::zeros(); n],

@@ -417,6 +417,40 @@ impl PyModel {
         })
     }
 
+    /// [dtau/dq, dtau/dqd, M] (3, n, n) | (N, 3, n, n): analytical derivatives of the RNEA.
+    #[pyo3(signature = (q, qd, qdd, f_ext=None))]
+    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let (s1, s6) = ([n], [n, 6]);
+        let batch = match f_ext.as_ref() {
+            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+        };
+        batch.run(py, self, &[3, n, n], |model, data, x, out| {
+            let (dq, rest) = out.split_at_mut(n * n);
+            let (dqd, m) = rest.split_at_mut(n * n);
+            algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd);
+            m.copy_from_slice(algorithms::crba(model, data, x[0]));
+            Ok(())
+        })
+    }
+
+    /// [dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1] (3, n, n) | (N, 3, n, n): derivatives of the ABA.
+    #[pyo3(signature = (q, qd, tau, f_ext=None))]
+    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, tau: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.n();
+        let (s1, s6) = ([n], [n, 6]);
+        let batch = match f_ext.as_ref() {
+            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+        };
+        batch.run(py, self, &[3, n, n], |model, data, x, out| {
+            let (dq, rest) = out.split_at_mut(n * n);
+            let (dqd, dtau) = rest.split_at_mut(n * n);
+            algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
+        })
+    }
+
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
     fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.n();

@@ -3,6 +3,7 @@
 pub mod aba;
 pub mod coriolis;
 pub mod crba;
+pub mod derivatives;
 pub mod energy;
 pub mod gravity;
 pub mod integrate;
@@ -17,6 +18,7 @@ pub mod rnea;
 pub use aba::aba;
 pub use coriolis::{christoffel, coriolis_matrix};
 pub use crba::crba;
+pub use derivatives::{aba_derivatives, rnea_derivatives};
 pub use energy::{kinetic_energy, potential_energy};
 pub use gravity::gravity_torque;
 pub use jacobian::{frame_jacobian, frame_pose_at, frame_velocity, jacobian_dot_qd, Reference};
