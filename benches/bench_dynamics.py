@@ -70,6 +70,8 @@ def bench(name: str) -> None:
     assert np.allclose(robot.forward_dynamics(q, qd, tau), pin.aba(model, data, q, qd, tau), atol=1e-9)
     assert np.allclose(robot.coriolis_matrix(q, qd), pin.computeCoriolisMatrix(model, data, q, qd), atol=1e-9)
     assert np.allclose(robot.gravity_torque(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
+    assert np.allclose(robot.inverse_dynamics_derivatives(q, qd, qdd)[0], pin.computeRNEADerivatives(model, data, q, qd, qdd)[0], atol=1e-8)
+    assert np.allclose(robot.forward_dynamics_derivatives(q, qd, tau)[0], pin.computeABADerivatives(model, data, q, qd, tau)[0], atol=1e-8)
 
     cases = [
         ("inverse_dynamics", lambda: robot.inverse_dynamics(q, qd, qdd), lambda: pin.rnea(model, data, q, qd, qdd),
@@ -82,6 +84,10 @@ def bench(name: str) -> None:
          lambda: robot.coriolis_matrix(Q, V), lambda: [pin.computeCoriolisMatrix(model, data, Q[k], V[k]) for k in range(BATCH)]),
         ("gravity_torque", lambda: robot.gravity_torque(q), lambda: pin.computeGeneralizedGravity(model, data, q),
          lambda: robot.gravity_torque(Q), lambda: [pin.computeGeneralizedGravity(model, data, Q[k]) for k in range(BATCH)]),
+        ("inverse_dynamics_derivatives", lambda: robot.inverse_dynamics_derivatives(q, qd, qdd), lambda: pin.computeRNEADerivatives(model, data, q, qd, qdd),
+         lambda: robot.inverse_dynamics_derivatives(Q, V, A), lambda: [pin.computeRNEADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
+        ("forward_dynamics_derivatives", lambda: robot.forward_dynamics_derivatives(q, qd, tau), lambda: pin.computeABADerivatives(model, data, q, qd, tau),
+         lambda: robot.forward_dynamics_derivatives(Q, V, A), lambda: [pin.computeABADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
     ]
     print(f"\n{name} ({n} joints)")
     print(f"{'':46s} {'kinedyn':>12s} {'pinocchio':>12s}   speed-up")

@@ -5,6 +5,8 @@
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -85,6 +87,10 @@ int main() {
     std::printf("%s/coriolis_matrix %.1f\n", name.c_str(), min_ns([&] { computeCoriolisMatrix(model, data, q, v); }));
     std::printf("%s/gravity_torque %.1f\n", name.c_str(), min_ns([&] { computeGeneralizedGravity(model, data, q); }));
     std::printf("%s/mass_matrix_inverse %.1f\n", name.c_str(), min_ns([&] { computeMinverse(model, data, q); }));
+    // the derivatives into preallocated matrices, as a controller would call them
+    Eigen::MatrixXd d1 = Eigen::MatrixXd::Zero(n, n), d2 = d1, d3 = d1;
+    std::printf("%s/rnea_derivatives %.1f\n", name.c_str(), min_ns([&] { computeRNEADerivatives(model, data, q, v, a, d1, d2, d3); }));
+    std::printf("%s/aba_derivatives %.1f\n", name.c_str(), min_ns([&] { computeABADerivatives(model, data, q, v, tau, d1, d2, d3); }));
   }
   return 0;
 }

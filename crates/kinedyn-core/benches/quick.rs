@@ -72,6 +72,9 @@ fn main() {
         run("coriolis_matrix", &mut |d| _ = black_box(alg::coriolis_matrix(&model, d, black_box(&q), black_box(&qd))[0]));
         run("gravity_torque", &mut |d| _ = black_box(alg::gravity_torque(&model, d, black_box(&q))[0]));
         run("mass_matrix_inverse", &mut |d| _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0]));
+        let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+        run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2));
+        run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
     }
 }
