@@ -3,6 +3,7 @@
 //! Algorithms overwrite what they use; nothing here is a precondition of another algorithm
 //! (no dirty flags): an algorithm that needs forward kinematics runs it.
 
+use crate::algorithms::derivatives::Tangent;
 use crate::model::Model;
 use crate::spatial::{ArticulatedInertia, Force, Inertia, Motion, Transform, Vec3};
 
@@ -66,15 +67,15 @@ pub struct Data {
     pub hc_w: Vec<Force>,
 
     // ---- derivatives (derivatives.rs): tangents of one sweep, body coordinates ----
-    /// `dv_i`, `da_i`: derivatives of twist and acceleration along one coordinate.
-    pub dv: Vec<Motion>,
-    pub da: Vec<Motion>,
+    /// Derivatives of twist, acceleration and composite force along q_j and along qd_j.
+    pub tangent_q: Vec<Tangent>,
+    pub tangent_qd: Vec<Tangent>,
     /// `psi_i`: the moved coordinate's joint axis in body i's coordinates.
     pub dpsi: Vec<Motion>,
-    /// `df^c_i`: derivative of the composite force.
-    pub dfc: Vec<Force>,
     /// Whether body i moves with the coordinate of the sweep.
     pub moved: Vec<bool>,
+    /// Body momenta `I_i v_i` (body coordinates).
+    pub iv: Vec<Force>,
     /// Forward dynamics' qdd while its derivatives are taken.
     pub qdd_fd: Vec<f64>,
 
@@ -117,11 +118,11 @@ impl Data {
             ic_w: vec![Inertia::zero(); n],
             icd_w: vec![Inertia::zero(); n],
             hc_w: vec![Force::zero(); n],
-            dv: vec![Motion::zero(); n],
-            da: vec![Motion::zero(); n],
+            tangent_q: vec![Tangent::default(); n],
+            tangent_qd: vec![Tangent::default(); n],
             dpsi: vec![Motion::zero(); n],
-            dfc: vec![Force::zero(); n],
             moved: vec![false; n],
+            iv: vec![Force::zero(); n],
             qdd_fd: vec![0.0; n],
             mc: vec![0.0; n],
             hc: vec![Vec3::zeros(); n],

@@ -43,11 +43,12 @@ use crate::error::Result;
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
 
-/// Which coordinate a tangent sweep differentiates along.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Direction {
-    Position,
-    Velocity,
+/// The derivatives of one body's twist, acceleration and composite force along one coordinate.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tangent {
+    pub dv: Motion,
+    pub da: Motion,
+    pub dfc: Force,
 }
 
 /// `dtau/dq` and `dtau/dqd` (row-major n x n: `[i * n + j] = dtau_i / dx_j`) at `(q, qd, qdd)`,
@@ -58,20 +59,25 @@ pub fn rnea_derivatives(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], q
     // the RNEA's own pass: parent_from_body, v_i, a_i and the composite forces f^c_i in data.f
     // (and world_from_body when f_ext is given)
     rnea(model, data, q, qd, qdd, f_ext);
+    // the body momenta I_i v_i, which every sweep uses
+    for i in 0..model.n {
+        data.iv[i] = model.inertia[i].mul_motion(&data.v[i]);
+    }
     for j in 0..model.n {
-        tangent_sweep(model, data, qd, f_ext, j, Direction::Position, dtau_dq);
-        tangent_sweep(model, data, qd, f_ext, j, Direction::Velocity, dtau_dqd);
+        tangent_sweeps(model, data, qd, f_ext, j, dtau_dq, dtau_dqd);
     }
 }
 
-/// Column j of `dtau/dq` or `dtau/dqd` (see the module documentation for each line).
-fn tangent_sweep(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f64]>, j: usize, direction: Direction, out: &mut [f64]) {
+/// Columns j of `dtau/dq` and `dtau/dqd`: the two tangent sweeps along q_j and qd_j, side by side
+/// (see the module documentation for each line).
+fn tangent_sweeps(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f64]>, j: usize, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
     let n = model.n;
     let a0 = Motion::new(-model.gravity, Default::default());
-    let (x_up, s, v, a, fc) = (&data.parent_from_body[..n], &data.s[..n], &data.v[..n], &data.a[..n], &data.f[..n]);
-    let (dv, da, psi, dfc, moved) = (&mut data.dv[..n], &mut data.da[..n], &mut data.dpsi[..n], &mut data.dfc[..n], &mut data.moved[..n]);
+    let (x_up, s, v, a, fc, iv) = (&data.parent_from_body[..n], &data.s[..n], &data.v[..n], &data.a[..n], &data.f[..n], &data.iv[..n]);
+    let (tq, tqd, psi, moved) = (&mut data.tangent_q[..n], &mut data.tangent_qd[..n], &mut data.dpsi[..n], &mut data.moved[..n]);
     // forward: only the subtree of j moves with coordinate j (every other tangent is zero)
-    dfc.fill(Force::zero());
+    tq.fill(Tangent::default());
+    tqd.fill(Tangent::default());
     moved.fill(false);
     for i in j..n {
         let p = model.parent[i];
@@ -80,51 +86,53 @@ fn tangent_sweep(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f64
         }
         moved[i] = true;
         let (x, joint, inertia) = (&x_up[i], &model.joints[i], &model.inertia[i]);
-        let (dvi, mut dai, psi_i) = if i == j {
+        let (mut q_i, mut qd_i, psi_i);
+        if i == j {
+            // along q_j: (^iX_λ v_λ) x s_i, (^iX_λ a_λ) x s_i ;  along qd_j: s_i, v_i x s_i
             let vp = p.map_or(Motion::zero(), |p| x.inv_act_motion(&v[p]));
-            match direction {
-                // (^iX_λ v_λ) x s_i ;  (^iX_λ a_λ) x s_i
-                Direction::Position => {
-                    let ap = x.inv_act_motion(&p.map_or(a0, |p| a[p]));
-                    (vp.cross_motion(&s[i]), ap.cross_motion(&s[i]), s[i])
-                }
-                // s_i ;  v_i x s_i
-                Direction::Velocity => (s[i], v[i].cross_motion(&s[i]), s[i]),
-            }
+            let ap = x.inv_act_motion(&p.map_or(a0, |p| a[p]));
+            q_i = Tangent { dv: vp.cross_motion(&s[i]), da: ap.cross_motion(&s[i]), dfc: Force::zero() };
+            qd_i = Tangent { dv: s[i], da: v[i].cross_motion(&s[i]), dfc: Force::zero() };
+            psi_i = s[i];
         } else {
             let p = p.expect("a moved body below j has a parent");
-            (x.inv_act_motion(&dv[p]), x.inv_act_motion(&da[p]), x.inv_act_motion(&psi[p]))
-        };
-        // + dv_i x s_i qd_i
-        dai += joint.cross(&dvi, qd[i]);
-        // df_i = I da + dv x* I v + v x* I dv (- d(R^T f^x) along q)
-        let mut dfi = inertia.mul_motion(&dai) + dvi.cross_force(&inertia.mul_motion(&v[i])) + v[i].cross_force(&inertia.mul_motion(&dvi));
-        if let (Some(fx), Direction::Position) = (f_ext, direction) {
+            let (tp, tdp) = (&tq[p], &tqd[p]);
+            q_i = Tangent { dv: x.inv_act_motion(&tp.dv), da: x.inv_act_motion(&tp.da), dfc: Force::zero() };
+            qd_i = Tangent { dv: x.inv_act_motion(&tdp.dv), da: x.inv_act_motion(&tdp.da), dfc: Force::zero() };
+            // psi (the moved axis in body axes) is needed only for the external wrenches
+            psi_i = if f_ext.is_some() { x.inv_act_motion(&psi[p]) } else { Motion::zero() };
+        }
+        for t in [&mut q_i, &mut qd_i] {
+            // da += dv_i x s_i qd_i ;  df_i = I da + dv x* I v + v x* I dv
+            t.da += joint.cross(&t.dv, qd[i]);
+            t.dfc = inertia.mul_motion(&t.da) + t.dv.cross_force(&iv[i]) + v[i].cross_force(&inertia.mul_motion(&t.dv));
+        }
+        if let Some(fx) = f_ext {
+            // - d(R_i^T f^x_i)/dq_j = -(R^T f^x) x w, w = psi_i's angular part
             let r = &data.world_from_body[i].rot;
             let w = &psi_i.ang;
             let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
             let (lin, ang) = (r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
-            dfi -= Force::new(lin.cross(w), ang.cross(w));
+            q_i.dfc -= Force::new(lin.cross(w), ang.cross(w));
         }
-        (dv[i], da[i], psi[i], dfc[i]) = (dvi, dai, psi_i, dfi);
+        (tq[i], tqd[i], psi[i]) = (q_i, qd_i, psi_i);
     }
     // backward: df^c_λ += ^λX_i^* (df^c_i + [i=j, along q] s_i x* f^c_i) ;  dtau_i = s_i^T df^c_i
     for i in (0..n).rev() {
-        let mut dti = model.joints[i].project(&dfc[i]);
-        if i == j && direction == Direction::Velocity {
-            dti += model.viscous[i];
+        let joint = &model.joints[i];
+        dtau_dq[i * n + j] = joint.project(&tq[i].dfc);
+        dtau_dqd[i * n + j] = joint.project(&tqd[i].dfc) + if i == j { model.viscous[i] } else { 0.0 };
+        let Some(p) = model.parent[i] else { continue };
+        if i > j && !moved[i] {
+            continue; // a branch that coordinate j does not move: nothing to carry up
         }
-        out[i * n + j] = dti;
-        if let Some(p) = model.parent[i] {
-            let mut g = dfc[i];
-            if i == j && direction == Direction::Position {
-                g += s[i].cross_force(&fc[i]);
-            } else if !moved[i] && i > j {
-                continue; // a branch that coordinate j does not move: nothing to carry up
-            }
-            let up = x_up[i].act_force(&g);
-            dfc[p] += up;
+        let mut g = tq[i].dfc;
+        if i == j {
+            g += s[i].cross_force(&fc[i]);
         }
+        let (up_q, up_qd) = (x_up[i].act_force(&g), x_up[i].act_force(&tqd[i].dfc));
+        tq[p].dfc += up_q;
+        tqd[p].dfc += up_qd;
     }
 }
 
@@ -151,18 +159,22 @@ pub fn aba_derivatives(
     rnea_derivatives(model, data, q, qd, &qdd_fd[..n], f_ext, dqdd_dq, dqdd_dqd);
     data.qdd_fd = qdd_fd;
     dqdd_dtau[..n * n].copy_from_slice(mass_matrix_inverse(model, data, q)?);
-    // dqdd/dx = -M^-1 dtau/dx, column by column through a scratch column
+    // dqdd/dx = -M^-1 dtau/dx: row r of the product is -sum_k minv[r][k] row k of dtau/dx,
+    // accumulated in a scratch matrix (data.m, free after the inverse) and copied back
     let minv = &dqdd_dtau[..n * n];
-    let column = &mut data.x[..n];
+    let scratch = &mut data.m[..n * n];
     for out in [dqdd_dq, dqdd_dqd] {
-        for c in 0..n {
-            for (r, value) in column.iter_mut().enumerate() {
-                *value = -(0..n).map(|k| minv[r * n + k] * out[k * n + c]).sum::<f64>();
-            }
-            for (r, value) in column.iter().enumerate() {
-                out[r * n + c] = *value;
+        scratch.fill(0.0);
+        for r in 0..n {
+            let row = &mut scratch[r * n..(r + 1) * n];
+            for k in 0..n {
+                let c = -minv[r * n + k];
+                for (value, d) in row.iter_mut().zip(&out[k * n..(k + 1) * n]) {
+                    *value += c * d;
+                }
             }
         }
+        out[..n * n].copy_from_slice(scratch);
     }
     Ok(())
 }
