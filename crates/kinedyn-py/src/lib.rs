@@ -162,15 +162,16 @@ impl<'a> Batch<'a> {
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
         let per_state: usize = out_shape.iter().product::<usize>().max(1);
-        let mut shape: Vec<usize> = Vec::with_capacity(out_shape.len() + 1);
-        if let Some(b) = self.batch {
-            shape.push(b);
+        // the output's shape, [N,] + out_shape, in a fixed array (ndarray keeps up to 4 dims inline)
+        let (mut dims, mut rank) = ([0usize; 5], 0);
+        for d in self.batch.iter().chain(out_shape) {
+            dims[rank] = *d;
+            rank += 1;
         }
-        shape.extend_from_slice(out_shape);
         // SAFETY: uninitialised memory, not zeros (a 10k-state M batch spent 10 % of its time in the
         // memset): every kernel writes its whole output slice (its contract, see `kernel` above),
         // and on an error the array is dropped unread. Created just above, nothing else refers to it.
-        let array = unsafe { PyArrayDyn::<f64>::new(py, shape, false) };
+        let array = unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) };
         let out = unsafe { array.as_slice_mut()? };
         let model = &m.model;
         let result: Result<(), CoreError> = if self.batch.is_none() {
