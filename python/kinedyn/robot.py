@@ -452,12 +452,6 @@ class Robot:
     def _scalar(x):
         return float(x) if np.ndim(x) == 0 else x
 
-    def _convert(self, method, *states):
-        """Second try of ``method`` after the core rejected an input with TypeError (a list, an
-        integer or float32 array): convert to float64 arrays once. Each method first passes its
-        arguments straight to the core (float64 arrays, the common case: no Python-side copy)."""
-        return method(*(self._state(x) for x in states))
-
     def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
@@ -466,27 +460,18 @@ class Robot:
         the link's frame (``robot.forward_kinematics(q)[i]``), so that it maps to joint torques by
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
         if f_ext is None:
-            try:
-                return self._model.inverse_dynamics(q, qd, qdd)
-            except TypeError:
-                return self._convert(self._model.inverse_dynamics, q, qd, qdd)
+            return self._model.inverse_dynamics(q, qd, qdd)
         q = self._state(q)
-        return self._model.inverse_dynamics(q, self._state(qd), self._state(qdd), self._f_ext(q, f_ext))
+        return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext))
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric."""
-        try:
-            return self._model.mass_matrix(q)
-        except TypeError:
-            return self._convert(self._model.mass_matrix, q)
+        return self._model.mass_matrix(q)
 
     def mass_matrix_inverse(self, q) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
-            try:
-                return self._model.mass_matrix_inverse(q)
-            except TypeError:
-                return self._convert(self._model.mass_matrix_inverse, q)
+            return self._model.mass_matrix_inverse(q)
         except RuntimeError as e:
             raise self._singular(e) from None
 
@@ -496,12 +481,9 @@ class Robot:
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
         try:
             if f_ext is None:
-                try:
-                    return self._model.forward_dynamics(q, qd, tau)
-                except TypeError:
-                    return self._convert(self._model.forward_dynamics, q, qd, tau)
+                return self._model.forward_dynamics(q, qd, tau)
             q = self._state(q)
-            return self._model.forward_dynamics(q, self._state(qd), self._state(tau), self._f_ext(q, f_ext))
+            return self._model.forward_dynamics(q, qd, tau, self._f_ext(q, f_ext))
         except RuntimeError as e:
             raise self._singular(e) from None
 
@@ -549,68 +531,41 @@ class Robot:
 
     def coriolis_matrix(self, q, qd) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
-        try:
-            return self._model.coriolis_matrix(q, qd)
-        except TypeError:
-            return self._convert(self._model.coriolis_matrix, q, qd)
+        return self._model.coriolis_matrix(q, qd)
 
     def christoffel(self, q) -> np.ndarray:
         """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
         ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
-        try:
-            return self._model.christoffel(q)
-        except TypeError:
-            return self._convert(self._model.christoffel, q)
+        return self._model.christoffel(q)
 
     def gravity_torque(self, q) -> np.ndarray:
         """g(q) = dP/dq."""
-        try:
-            return self._model.gravity_torque(q)
-        except TypeError:
-            return self._convert(self._model.gravity_torque, q)
+        return self._model.gravity_torque(q)
 
     def bias_torque(self, q, qd) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
-        try:
-            return self._model.bias_torque(q, qd)
-        except TypeError:
-            return self._convert(self._model.bias_torque, q, qd)
+        return self._model.bias_torque(q, qd)
 
     def kinetic_energy(self, q, qd):
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
-        try:
-            return self._scalar(self._model.kinetic_energy(q, qd))
-        except TypeError:
-            return self._scalar(self._convert(self._model.kinetic_energy, q, qd))
+        return self._scalar(self._model.kinetic_energy(q, qd))
 
     def potential_energy(self, q):
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
-        try:
-            return self._scalar(self._model.potential_energy(q))
-        except TypeError:
-            return self._scalar(self._convert(self._model.potential_energy, q))
+        return self._scalar(self._model.potential_energy(q))
 
     def center_of_mass(self, q) -> np.ndarray:
         """Centre of mass of the moving links in base coordinates, (3,) or (N, 3)."""
-        try:
-            return self._model.center_of_mass(q)
-        except TypeError:
-            return self._convert(self._model.center_of_mass, q)
+        return self._model.center_of_mass(q)
 
     def momentum(self, q, qd) -> np.ndarray:
         """Spatial momentum of the robot, (6,) or (N, 6): [linear momentum; angular momentum about
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
-        try:
-            return self._model.momentum(q, qd)
-        except TypeError:
-            return self._convert(self._model.momentum, q, qd)
+        return self._model.momentum(q, qd)
 
     def regressor(self, q, qd, qdd) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
-        try:
-            return self._model.regressor(q, qd, qdd)
-        except TypeError:
-            return self._convert(self._model.regressor, q, qd, qdd)
+        return self._model.regressor(q, qd, qdd)
 
     def base_parameters(self, samples: int = 200, rng=0, tol: float = 1e-9):
         """A minimal identifiable parameter set (:class:`kinedyn.dynamics.BaseParameters`): column

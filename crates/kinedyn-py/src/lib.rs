@@ -15,6 +15,7 @@ use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::IntoPyDict;
 use rayon::prelude::*;
 
 fn core_err(e: CoreError) -> PyErr {
@@ -82,6 +83,20 @@ impl<'a> StateArray<'a> for Bound<'_, PyArrayDyn<f64>> {
         }
         Cow::Owned(unsafe { self.as_array() }.iter().copied().collect())
     }
+}
+
+/// `x` as a float64 NumPy array: itself when it is one (a type check), else
+/// `numpy.asarray(x, dtype=float64)` (lists, integer or float32 arrays), so that every method takes
+/// what NumPy would.
+fn f64_array<'py>(x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    if let Ok(array) = x.cast::<PyArrayDyn<f64>>() {
+        return Ok(array.clone());
+    }
+    static ASARRAY: pyo3::sync::PyOnceLock<Py<PyAny>> = pyo3::sync::PyOnceLock::new();
+    let py = x.py();
+    let asarray = ASARRAY.get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?;
+    let kwargs = [("dtype", "float64")].into_py_dict(py)?;
+    Ok(asarray.bind(py).call((x,), Some(&kwargs))?.cast_into::<PyArrayDyn<f64>>()?)
 }
 
 /// The most arrays a method takes per state (q, qd, qdd, f_ext).
@@ -376,7 +391,11 @@ impl PyModel {
 
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
+        let qdd = f64_array(&qdd)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -390,7 +409,8 @@ impl PyModel {
     }
 
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -400,7 +420,8 @@ impl PyModel {
     }
 
     /// M^-1 (n, n) | (N, n, n).
-    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -411,7 +432,11 @@ impl PyModel {
 
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, tau: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
+        let tau = f64_array(&tau)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -426,7 +451,11 @@ impl PyModel {
 
     /// [dtau/dq, dtau/dqd, M] (3, n, n) | (N, 3, n, n): analytical derivatives of the RNEA.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
+        let qdd = f64_array(&qdd)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -444,7 +473,11 @@ impl PyModel {
 
     /// [dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1] (3, n, n) | (N, 3, n, n): derivatives of the ABA.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, tau: Bound<'py, PyArrayDyn<f64>>, f_ext: Option<Bound<'py, PyArrayDyn<f64>>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
+        let tau = f64_array(&tau)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
@@ -459,7 +492,9 @@ impl PyModel {
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
-    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[n, n], |model, data, x, out| {
@@ -469,7 +504,8 @@ impl PyModel {
     }
 
     /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
-    fn christoffel<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn christoffel<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n, n, n], |model, data, x, out| {
@@ -479,7 +515,8 @@ impl PyModel {
     }
 
     /// g (n,) | (N, n).
-    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[n], |model, data, x, out| {
@@ -489,7 +526,9 @@ impl PyModel {
     }
 
     /// C qd + g (n,) | (N, n), without friction.
-    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[n], |model, data, x, out| {
@@ -499,7 +538,9 @@ impl PyModel {
     }
 
     /// K () | (N,).
-    fn kinetic_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn kinetic_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[], |model, data, x, out| {
@@ -509,7 +550,8 @@ impl PyModel {
     }
 
     /// P () | (N,).
-    fn potential_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn potential_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[], |model, data, x, out| {
@@ -519,7 +561,10 @@ impl PyModel {
     }
 
     /// Y (n, 10 n) | (N, n, 10 n).
-    fn regressor<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, qdd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn regressor<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
+        let qdd = f64_array(&qdd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
         batch.run(py, self, &[n, 10 * n], |model, data, x, out| {
@@ -529,7 +574,8 @@ impl PyModel {
     }
 
     /// Centre of mass (3,) | (N, 3) in base coordinates.
-    fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
         batch.run(py, self, &[3], |model, data, x, out| {
@@ -539,7 +585,9 @@ impl PyModel {
     }
 
     /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
-    fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array(&q)?;
+        let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
         batch.run(py, self, &[6], |model, data, x, out| {
