@@ -65,6 +65,13 @@ pub struct Data {
     pub icd_w: Vec<Inertia>,
     /// Composite momenta `sum I_k v_k` over each subtree (world coordinates).
     pub hc_w: Vec<Force>,
+    /// Body accelerations (gravity included) and composite forces, world coordinates (derivatives.rs).
+    pub a_w: Vec<Motion>,
+    pub fc_w: Vec<Force>,
+    /// Per body `I^c s`, `dI^c/dt s`, `s x* h^c` (world coordinates, derivatives.rs).
+    pub alpha: Vec<Force>,
+    pub beta: Vec<Force>,
+    pub sigma: Vec<Force>,
 
     // ---- derivatives (derivatives.rs): tangents of one sweep, body coordinates ----
     /// Derivatives of twist, acceleration and composite force along q_j and along qd_j.
@@ -118,6 +125,11 @@ impl Data {
             ic_w: vec![Inertia::zero(); n],
             icd_w: vec![Inertia::zero(); n],
             hc_w: vec![Force::zero(); n],
+            a_w: vec![Motion::zero(); n],
+            fc_w: vec![Force::zero(); n],
+            alpha: vec![Force::zero(); n],
+            beta: vec![Force::zero(); n],
+            sigma: vec![Force::zero(); n],
             tangent_q: vec![Tangent::default(); n],
             tangent_qd: vec![Tangent::default(); n],
             dpsi: vec![Motion::zero(); n],

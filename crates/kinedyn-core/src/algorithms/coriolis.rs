@@ -34,7 +34,7 @@ use crate::spatial::{Inertia, Mat3, Motion};
 /// (world coordinates): `(v x*) I - I (v x)` in parameters: mass rate 0,
 /// `dh/dt = m v_o + w x h`, `dI_o/dt = 2 (h . v_o) 1 - v_o h^T - h v_o^T + [w]x I_o - I_o [w]x`.
 #[inline]
-fn inertia_rate(i: &Inertia, v: &Motion) -> Inertia {
+pub(crate) fn inertia_rate(i: &Inertia, v: &Motion) -> Inertia {
     let (vo, w, h) = (&v.lin, &v.ang, &i.h);
     // [w]x I_o - I_o [w]x = A + A^T with A = [w]x I_o (I_o symmetric): columns w x (I_o e_k)
     let a = Mat3::from_columns(&[w.cross(&i.i_o.column(0).into_owned()), w.cross(&i.i_o.column(1).into_owned()), w.cross(&i.i_o.column(2).into_owned())]);

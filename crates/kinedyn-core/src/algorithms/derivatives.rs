@@ -32,10 +32,12 @@
 //!
 //! Coulomb friction `coulomb sign(qd)` has derivative zero wherever it has one (qd != 0).
 //!
-//! Forward dynamics: `qdd = M^-1 (tau - b(q, qd))`, so with `qdd` from the ABA,
+//! Forward dynamics: `qdd = M^-1 (tau - b(q, qd))`, so with that `qdd`,
 //! `dqdd/dq = -M^-1 dtau/dq`, `dqdd/dqd = -M^-1 dtau/dqd` (both at that `qdd`) and
 //! `dqdd/dtau = M^-1` (Carpentier & Mansard 2018, §IV-B).
 
+use super::coriolis::inertia_rate;
+use super::kinematics::forward_kinematics;
 use super::minv::mass_matrix_inverse;
 use super::rnea::rnea;
 use crate::data::Data;
@@ -56,6 +58,17 @@ pub struct Tangent {
 /// results in `data` (`data.tau` is tau).
 #[allow(clippy::too_many_arguments)]
 pub fn rnea_derivatives(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+    match f_ext {
+        None => rnea_derivatives_world(model, data, q, qd, qdd, dtau_dq, dtau_dqd),
+        Some(_) => rnea_derivatives_tangent(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd),
+    }
+}
+
+/// [`rnea_derivatives`] by tangent sweeps in body coordinates (any `f_ext`; the reference the
+/// world-coordinate form is tested against).
+#[doc(hidden)]
+#[allow(clippy::too_many_arguments)]
+pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
     // the RNEA's own pass: parent_from_body, v_i, a_i and the composite forces f^c_i in data.f
     // (and world_from_body when f_ext is given)
     rnea(model, data, q, qd, qdd, f_ext);
@@ -65,6 +78,91 @@ pub fn rnea_derivatives(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], q
     }
     for j in 0..model.n {
         tangent_sweeps(model, data, qd, f_ext, j, dtau_dq, dtau_dqd);
+    }
+}
+
+/// [`rnea_derivatives`] without external wrenches, in world coordinates, where a coordinate's
+/// effect on its subtree is a rotation about its axis and needs no transform down the tree
+/// (the observation behind Carpentier & Mansard 2018). With `S_j` the joint axis, `p = λ(j)`,
+/// `v`, `a` twists and accelerations (`a_0 = -g`), `I^c_k`, `dI^c_k/dt`, `h^c_k = sum I_i v_i`,
+/// `F_k` the composite inertia, its rate, momentum and force of subtree k (as in `coriolis.rs`):
+/// moving q_j turns the subtree rigidly except that `v_p`, `a_p` stay put, so
+/// `dv_i/dq_j = S_j x (v_i - v_p)`, `da_i/dq_j = S_j x (a_i - a_p) - u x (v_i - v_p)` with
+/// `u = S_j x v_p`, and summing `df_i` over subtree k (using `I (u x v) + v x* I u = dI/dt u`)
+///
+/// ```text
+/// dF_k/dq_j  = S_j x* F_k + I^c_k w - u x* h^c_k - dI^c_k/dt u,       w = u x v_p - S_j x a_p
+/// dF_k/dqd_j = 2 I^c_k dS_j/dt + dI^c_k/dt S_j + S_j x* h^c_k,        dS_j/dt = v_p x S_j
+/// ```
+///
+/// for k in the subtree of j; an ancestor k of j sees `dF_j`. Then `dtau_k = S_k . dF_k`, plus
+/// `(S_j x S_k) . F_k` along q_j for k below j, which cancels the first term of `dF_k/dq_j`. With
+/// `alpha_k = I^c_k S_k`, `beta_k = dI^c_k/dt S_k` (both operators symmetric) and
+/// `sigma_k = S_k x* h^c_k`, each entry below j is three dot products:
+/// `dtau_k/dq_j = alpha_k . w + u . (sigma_k - beta_k)`, `dtau_k/dqd_j = 2 alpha_k . dS_j/dt + S_j . (beta_k - sigma_k)`.
+fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+    let n = model.n;
+    forward_kinematics(model, data, q);
+    let a0 = Motion::new(-model.gravity, Default::default());
+    let parent = &model.parent[..n];
+    let (s_w, v_w, a_w) = (&mut data.s_w[..n], &mut data.v_w[..n], &mut data.a_w[..n]);
+    let (ic, icd, hc, fc) = (&mut data.ic_w[..n], &mut data.icd_w[..n], &mut data.hc_w[..n], &mut data.fc_w[..n]);
+    // forward, world coordinates: S_i, v_i = v_p + S_i qd_i, a_i = a_p + S_i qdd_i + (v_p x S_i) qd_i,
+    // I_i, dI_i/dt, h_i = I_i v_i, f_i = I_i a_i + v_i x* h_i
+    for i in 0..n {
+        let x = &data.world_from_body[i];
+        let s = x.act_motion(&data.s[i]);
+        let (vp, ap) = parent[i].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
+        let v = vp + s * qd[i];
+        let a = ap + s * qdd[i] + vp.cross_motion(&s) * qd[i];
+        let inertia = x.act_inertia(&model.inertia[i]);
+        let h = inertia.mul_motion(&v);
+        (s_w[i], v_w[i], a_w[i]) = (s, v, a);
+        (ic[i], icd[i], hc[i], fc[i]) = (inertia, inertia_rate(&inertia, &v), h, inertia.mul_motion(&a) + v.cross_force(&h));
+    }
+    // backward: composite sums over each subtree
+    for i in (0..n).rev() {
+        if let Some(p) = parent[i] {
+            let (c, cd, h, f) = (ic[i], icd[i], hc[i], fc[i]);
+            ic[p] += c;
+            icd[p] += cd;
+            hc[p] += h;
+            fc[p] += f;
+        }
+    }
+    let (alpha, beta, sigma) = (&mut data.alpha[..n], &mut data.beta[..n], &mut data.sigma[..n]);
+    for k in 0..n {
+        (alpha[k], beta[k], sigma[k]) = (ic[k].mul_motion(&s_w[k]), icd[k].mul_motion(&s_w[k]), s_w[k].cross_force(&hc[k]));
+    }
+    dtau_dq[..n * n].fill(0.0);
+    dtau_dqd[..n * n].fill(0.0);
+    for j in 0..n {
+        let s = s_w[j];
+        let (vp, ap) = parent[j].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
+        let u = s.cross_motion(&vp);
+        let w = u.cross_motion(&vp) - s.cross_motion(&ap);
+        let sdot = vp.cross_motion(&s);
+        // the subtree of j: three dot products per entry
+        for k in j..n {
+            if k != j && model.support[k].binary_search(&j).is_err() {
+                continue;
+            }
+            dtau_dq[k * n + j] = w.dot(&alpha[k]) + u.dot(&(sigma[k] - beta[k]));
+            dtau_dqd[k * n + j] = 2.0 * sdot.dot(&alpha[k]) + s.dot(&(beta[k] - sigma[k]));
+        }
+        dtau_dqd[j * n + j] += model.viscous[j];
+        // the ancestors of j: dtau_k = S_k . dF_j
+        if parent[j].is_none() {
+            continue;
+        }
+        let df_q = s.cross_force(&fc[j]) + ic[j].mul_motion(&w) - u.cross_force(&hc[j]) - icd[j].mul_motion(&u);
+        let df_qd = ic[j].mul_motion(&sdot) * 2.0 + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
+        let mut k = parent[j];
+        while let Some(kk) = k {
+            dtau_dq[kk * n + j] = s_w[kk].dot(&df_q);
+            dtau_dqd[kk * n + j] = s_w[kk].dot(&df_qd);
+            k = parent[kk];
+        }
     }
 }
 
@@ -151,17 +249,22 @@ pub fn aba_derivatives(
     dqdd_dtau: &mut [f64],
 ) -> Result<()> {
     let n = model.n;
-    // qdd from the ABA, kept in data.qdd_fd while the derivatives of tau are taken there
-    super::aba::aba(model, data, q, qd, tau, f_ext)?;
-    let mut qdd_fd = std::mem::take(&mut data.qdd_fd);
-    qdd_fd[..n].copy_from_slice(&data.qdd[..n]);
-    // dtau/dq and dtau/dqd at (q, qd, qdd), into the outputs first
-    rnea_derivatives(model, data, q, qd, &qdd_fd[..n], f_ext, dqdd_dq, dqdd_dqd);
-    data.qdd_fd = qdd_fd;
+    // M^-1 first (an error for a singular M), then qdd = M^-1 (tau - rnea(q, qd, 0, f_ext)): the
+    // ABA's qdd to rounding, at half its cost now that M^-1 is needed anyway
     dqdd_dtau[..n * n].copy_from_slice(mass_matrix_inverse(model, data, q)?);
+    let mut qdd = std::mem::take(&mut data.qdd_fd);
+    qdd[..n].fill(0.0);
+    let bias = super::rnea::rnea(model, data, q, qd, &qdd[..n], f_ext);
+    let minv = &dqdd_dtau[..n * n];
+    for r in 0..n {
+        qdd[r] = (0..n).map(|k| minv[r * n + k] * (tau[k] - bias[k])).sum();
+    }
+    // dtau/dq and dtau/dqd at (q, qd, qdd), into the outputs first
+    rnea_derivatives(model, data, q, qd, &qdd[..n], f_ext, dqdd_dq, dqdd_dqd);
+    data.qdd_fd = qdd;
     // dqdd/dx = -M^-1 dtau/dx: row r of the product is -sum_k minv[r][k] row k of dtau/dx,
     // accumulated in a scratch matrix (data.m, free after the inverse) and copied back
-    let minv = &dqdd_dtau[..n * n];
+
     let scratch = &mut data.m[..n * n];
     for out in [dqdd_dq, dqdd_dqd] {
         scratch.fill(0.0);
@@ -222,6 +325,15 @@ mod tests {
                 let mut data = Data::new(&model);
                 let (mut dq, mut dqd) = (vec![0.0; n * n], vec![0.0; n * n]);
                 rnea_derivatives(&model, &mut data, &q, &qd, &qdd, f_ext, &mut dq, &mut dqd);
+                if f_ext.is_none() {
+                    // the world-coordinate form against the tangent sweeps: two derivations, one answer
+                    let (mut tq, mut tqd) = (vec![0.0; n * n], vec![0.0; n * n]);
+                    rnea_derivatives_tangent(&model, &mut data, &q, &qd, &qdd, None, &mut tq, &mut tqd);
+                    let scale = tq.iter().chain(&tqd).fold(1.0f64, |s, x| s.max(x.abs()));
+                    for (a, b) in dq.iter().chain(&dqd).zip(tq.iter().chain(&tqd)) {
+                        assert!((a - b).abs() <= 1e-12 * scale, "world {a} vs tangent {b}");
+                    }
+                }
                 let mut d = Data::new(&model);
                 let fd_q = central_difference(n, &q, |x| rnea(&model, &mut d, x, &qd, &qdd, f_ext).to_vec());
                 let fd_qd = central_difference(n, &qd, |x| rnea(&model, &mut d, &q, x, &qdd, f_ext).to_vec());
