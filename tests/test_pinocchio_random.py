@@ -99,6 +99,16 @@ def test_random_urdf_trees_agree_with_pinocchio(seed):
         np.testing.assert_allclose(robot.gravity_torque(q)[perm], pin.computeGeneralizedGravity(model, data, qp), atol=1e-9)
         taus = rng.normal(size=robot.n)
         np.testing.assert_allclose(robot.forward_dynamics(q, qd, taus)[perm], pin.aba(model, data, qp, qdp, taus[perm]), atol=1e-9)
+        # analytical derivatives (Pinocchio differentiates in its tangent space: d/dq for 1-dof joints)
+        block = np.ix_(perm, perm)
+        dq, dqd, _ = robot.inverse_dynamics_derivatives(q, qd, qdd)
+        pq, pqd, _ = pin.computeRNEADerivatives(model, data, qp, qdp, qddp)
+        np.testing.assert_allclose(dq[block], pq, atol=1e-8)
+        np.testing.assert_allclose(dqd[block], pqd, atol=1e-8)
+        aq, aqd, _ = robot.forward_dynamics_derivatives(q, qd, taus)
+        bq, bqd, _ = pin.computeABADerivatives(model, data, qp, qdp, taus[perm])
+        np.testing.assert_allclose(aq[block], bq, atol=1e-8 * max(1.0, np.abs(bq).max()))
+        np.testing.assert_allclose(aqd[block], bqd, atol=1e-8 * max(1.0, np.abs(bqd).max()))
 
 
 def test_the_generator_makes_trees_with_every_joint_kind():
