@@ -493,9 +493,9 @@ class Robot:
         Newton-Euler algorithm along each coordinate (exact, O(n^2); Pinocchio's
         ``computeRNEADerivatives``). ``f_ext`` is held fixed in base axes and applied at the link-frame
         origins, which move with q. Coulomb friction contributes its derivative zero (qd != 0)."""
-        q, qd, qdd = self._state(q), self._state(qd), self._state(qdd)
+        q = self._state(q)
         out = self._model.inverse_dynamics_derivatives(q, qd, qdd, self._f_ext(q, f_ext))
-        dq, dqd, M = out[..., 0, :, :], out[..., 1, :, :], out[..., 2, :, :]
+        dq, dqd, M = out if out.ndim == 3 else out.swapaxes(0, 1)  # (3, n, n) or (N, 3, n, n)
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq + shift), dqd, M
 
@@ -503,12 +503,12 @@ class Robot:
         """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
         (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
-        q, qd, tau = self._state(q), self._state(qd), self._state(tau)
+        q = self._state(q)
         try:
             out = self._model.forward_dynamics_derivatives(q, qd, tau, self._f_ext(q, f_ext))
         except RuntimeError as e:
             raise self._singular(e) from None
-        dq, dqd, Minv = out[..., 0, :, :], out[..., 1, :, :], out[..., 2, :, :]
+        dq, dqd, Minv = out if out.ndim == 3 else out.swapaxes(0, 1)
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq - Minv @ shift), dqd, Minv
 
@@ -518,9 +518,9 @@ class Robot:
         ``dd_i/dq_j = w_j x d_i`` (``w_j``: joint j's world axis, column j of body i's angular
         Jacobian ``Jw_i``); tau has ``-Jw_i^T n_i``, so this adds ``-sum_i Jw_i^T ((w_j x d_i) x f_i)``
         to column j. None when every link frame sits at its body origin (URDF) or without f_ext."""
-        u = self._link_origin_in_body
-        if f_ext is None or u is None:
+        if f_ext is None or self._link_origin_in_body is None:
             return None
+        u = self._link_origin_in_body
         f = np.asarray(f_ext, dtype=np.float64)
         R = self.forward_kinematics(q)[..., :3, :3]
         d = np.einsum("...bij,bj->...bi", R, u)
