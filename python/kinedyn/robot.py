@@ -493,9 +493,10 @@ class Robot:
         Newton-Euler algorithm along each coordinate (exact, O(n^2); Pinocchio's
         ``computeRNEADerivatives``). ``f_ext`` is held fixed in base axes and applied at the link-frame
         origins, which move with q. Coulomb friction contributes its derivative zero (qd != 0)."""
+        if f_ext is None:
+            return self._model.inverse_dynamics_derivatives(q, qd, qdd)
         q = self._state(q)
-        out = self._model.inverse_dynamics_derivatives(q, qd, qdd, self._f_ext(q, f_ext))
-        dq, dqd, M = out if out.ndim == 3 else out.swapaxes(0, 1)  # (3, n, n) or (N, 3, n, n)
+        dq, dqd, M = self._model.inverse_dynamics_derivatives(q, qd, qdd, self._f_ext(q, f_ext))
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq + shift), dqd, M
 
@@ -503,12 +504,13 @@ class Robot:
         """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
         (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
-        q = self._state(q)
         try:
-            out = self._model.forward_dynamics_derivatives(q, qd, tau, self._f_ext(q, f_ext))
+            if f_ext is None:
+                return self._model.forward_dynamics_derivatives(q, qd, tau)
+            q = self._state(q)
+            dq, dqd, Minv = self._model.forward_dynamics_derivatives(q, qd, tau, self._f_ext(q, f_ext))
         except RuntimeError as e:
             raise self._singular(e) from None
-        dq, dqd, Minv = out if out.ndim == 3 else out.swapaxes(0, 1)
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq - Minv @ shift), dqd, Minv
 

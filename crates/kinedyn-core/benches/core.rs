@@ -28,7 +28,7 @@ fn bench(c: &mut Criterion) {
         g.bench_function("christoffel", |b| b.iter(|| alg::christoffel(&model, &mut data, black_box(&q), &mut out[..n * n * n])));
         g.bench_function("regressor", |b| b.iter(|| alg::regressor(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), &mut out)));
         let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-        g.bench_function("rnea_derivatives", |b| b.iter(|| alg::rnea_derivatives(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2)));
+        g.bench_function("rnea_derivatives", |b| b.iter(|| alg::rnea_derivatives(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2, None)));
         g.bench_function("aba_derivatives", |b| b.iter(|| alg::aba_derivatives(&model, &mut data, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap()));
         g.bench_function("kinetic_energy", |b| b.iter(|| alg::kinetic_energy(&model, &mut data, black_box(&q), black_box(&qd))));
         g.finish();

@@ -73,7 +73,7 @@ fn main() {
         run("gravity_torque", &mut |d| _ = black_box(alg::gravity_torque(&model, d, black_box(&q))[0]));
         run("mass_matrix_inverse", &mut |d| _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0]));
         let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-        run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2));
+        run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2, None));
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         // a 10,000-state sweep (random states, one Data), per state: what a batch costs without the glue
         let states: Vec<Vec<f64>> = {

@@ -176,41 +176,71 @@ impl<'a> Batch<'a> {
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
+        let [array] = self.run_many::<1, _>(py, m, out_shape, |model, data, x, [out]| kernel(model, data, x, out))?;
+        Ok(array)
+    }
+
+    /// `run` for kernels with K outputs of the same per-state shape, returned as K arrays.
+    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
+    where
+        F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
+    {
         let per_state: usize = out_shape.iter().product::<usize>().max(1);
-        // the output's shape, [N,] + out_shape, in a fixed array (ndarray keeps up to 4 dims inline)
+        // the outputs' shape, [N,] + out_shape, in a fixed array (ndarray keeps up to 4 dims inline)
         let (mut dims, mut rank) = ([0usize; 5], 0);
         for d in self.batch.iter().chain(out_shape) {
             dims[rank] = *d;
             rank += 1;
         }
         // SAFETY: uninitialised memory, not zeros (a 10k-state M batch spent 10 % of its time in the
-        // memset): every kernel writes its whole output slice (its contract, see `kernel` above),
-        // and on an error the array is dropped unread. Created just above, nothing else refers to it.
-        let array = unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) };
-        let out = unsafe { array.as_slice_mut()? };
+        // memset): every kernel writes its whole output slices (its contract, see `kernel` above),
+        // and on an error the arrays are dropped unread. Created here, nothing else refers to them.
+        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = std::array::from_fn(|_| unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) });
+        let total = self.batch.unwrap_or(1) * per_state;
+        let mut bases = [OutputBase(std::ptr::null_mut()); K];
+        for (base, array) in bases.iter_mut().zip(&arrays) {
+            let slice = unsafe { array.as_slice_mut()? };
+            assert_eq!(slice.len(), total, "a fresh array has the requested size");
+            base.0 = slice.as_mut_ptr();
+        }
+        // SAFETY (both paths): state k's outputs are the disjoint ranges [k per_state, (k + 1)
+        // per_state) of the arrays, each written by exactly one kernel call.
+        let outputs = |k: usize| bases.map(|b| unsafe { std::slice::from_raw_parts_mut(b.0.add(k * per_state), per_state) });
         let model = &m.model;
-        let result: Result<(), CoreError> = if self.batch.is_none() {
-            let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-            kernel(model, &mut guard, &self.state(0), out)
-        } else {
-            py.detach(|| {
+        let result: Result<(), CoreError> = match self.batch {
+            None => {
+                let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
+                kernel(model, &mut guard, &self.state(0), outputs(0))
+            }
+            Some(states) => py.detach(|| {
                 const CHUNK: usize = 64;
                 // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
-                out.par_chunks_mut(per_state * CHUNK).enumerate().try_for_each_init(
+                (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
                     || Data::new(model),
-                    |data, (c, block)| {
-                        for (i, o) in block.chunks_mut(per_state).enumerate() {
-                            kernel(model, data, &self.state(c * CHUNK + i), o)?;
+                    |data, c| {
+                        for k in c * CHUNK..((c + 1) * CHUNK).min(states) {
+                            kernel(model, data, &self.state(k), outputs(k))?;
                         }
                         Ok(())
                     },
                 )
-            })
+            }),
         };
         result.map_err(core_err)?;
-        Ok(array)
+        Ok(arrays)
     }
 }
+
+/// Three arrays returned as a Python tuple.
+type Arrays3<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+
+/// Where an output array's numbers start, shared by the threads of a batch, each writing its own
+/// states' ranges (see `Batch::run_many`).
+#[derive(Clone, Copy)]
+struct OutputBase(*mut f64);
+// SAFETY: only ever used to write disjoint ranges, one state per kernel call.
+unsafe impl Send for OutputBase {}
+unsafe impl Sync for OutputBase {}
 
 /// The compiled model plus one cached `Data` for single-state calls.
 #[pyclass(name = "Model", module = "kinedyn._core", frozen)]
@@ -449,46 +479,39 @@ impl PyModel {
         })
     }
 
-    /// [dtau/dq, dtau/dqd, M] (3, n, n) | (N, 3, n, n): analytical derivatives of the RNEA.
+    /// (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
+        let (q, qd, qdd) = (f64_array(&q)?, f64_array(&qd)?, f64_array(&qdd)?);
         let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let qdd = f64_array(&qdd)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
         };
-        batch.run(py, self, &[3, n, n], |model, data, x, out| {
-            let (dq, rest) = out.split_at_mut(n * n);
-            let (dqd, m) = rest.split_at_mut(n * n);
-            algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd);
-            m.copy_from_slice(algorithms::crba(model, data, x[0]));
+        let [dq, dqd, m] = batch.run_many::<3, _>(py, self, &[n, n], |model, data, x, [dq, dqd, m]| {
+            algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
             Ok(())
-        })
+        })?;
+        Ok((dq, dqd, m))
     }
 
-    /// [dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1] (3, n, n) | (N, 3, n, n): derivatives of the ABA.
+    /// (dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1), each (n, n) | (N, n, n): derivatives of the ABA.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
+        let (q, qd, tau) = (f64_array(&q)?, f64_array(&qd)?, f64_array(&tau)?);
         let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let tau = f64_array(&tau)?;
         let n = self.n();
         let (s1, s6) = ([n], [n, 6]);
         let batch = match f_ext.as_ref() {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
         };
-        batch.run(py, self, &[3, n, n], |model, data, x, out| {
-            let (dq, rest) = out.split_at_mut(n * n);
-            let (dqd, dtau) = rest.split_at_mut(n * n);
+        let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, &[n, n], |model, data, x, [dq, dqd, dtau]| {
             algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
-        })
+        })?;
+        Ok((dq, dqd, dtau))
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.

@@ -54,13 +54,48 @@ pub struct Tangent {
 }
 
 /// `dtau/dq` and `dtau/dqd` (row-major n x n: `[i * n + j] = dtau_i / dx_j`) at `(q, qd, qdd)`,
-/// for the same `tau` as [`rnea`] (gravity, friction, armature, `f_ext`). Leaves `rnea`'s
-/// results in `data` (`data.tau` is tau).
+/// for the same `tau` as [`rnea`] (gravity, friction, armature, `f_ext`), and when asked for,
+/// `dtau/dqdd = M` (a by-product of the world-coordinate pass, else the CRBA).
 #[allow(clippy::too_many_arguments)]
-pub fn rnea_derivatives(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+pub fn rnea_derivatives(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    f_ext: Option<&[f64]>,
+    dtau_dq: &mut [f64],
+    dtau_dqd: &mut [f64],
+    mass_matrix: Option<&mut [f64]>,
+) {
     match f_ext {
-        None => rnea_derivatives_world(model, data, q, qd, qdd, dtau_dq, dtau_dqd),
-        Some(_) => rnea_derivatives_tangent(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd),
+        None => {
+            rnea_derivatives_world(model, data, q, qd, qdd, dtau_dq, dtau_dqd);
+            if let Some(m) = mass_matrix {
+                mass_matrix_from_world(model, data, m);
+            }
+        }
+        Some(_) => {
+            rnea_derivatives_tangent(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd);
+            if let Some(m) = mass_matrix {
+                m[..model.n * model.n].copy_from_slice(super::crba::crba(model, data, q));
+            }
+        }
+    }
+}
+
+/// `M` from the world-coordinate pass: `H_jk = S_j . (I^c_k S_k) = S_j . alpha_k` for j supporting
+/// k (the CRBA in world coordinates, RBDA §6.2), plus the armature on the diagonal.
+fn mass_matrix_from_world(model: &Model, data: &Data, m: &mut [f64]) {
+    let n = model.n;
+    m[..n * n].fill(0.0);
+    for k in 0..n {
+        for &j in &model.support[k] {
+            let h = data.s_w[j].dot(&data.alpha[k]);
+            m[j * n + k] = h;
+            m[k * n + j] = h;
+        }
+        m[k * n + k] += model.armature[k];
     }
 }
 
@@ -260,7 +295,7 @@ pub fn aba_derivatives(
         qdd[r] = (0..n).map(|k| minv[r * n + k] * (tau[k] - bias[k])).sum();
     }
     // dtau/dq and dtau/dqd at (q, qd, qdd), into the outputs first
-    rnea_derivatives(model, data, q, qd, &qdd[..n], f_ext, dqdd_dq, dqdd_dqd);
+    rnea_derivatives(model, data, q, qd, &qdd[..n], f_ext, dqdd_dq, dqdd_dqd, None);
     data.qdd_fd = qdd;
     // dqdd/dx = -M^-1 dtau/dx: row r of the product is -sum_k minv[r][k] row k of dtau/dx,
     // accumulated in a scratch matrix (data.m, free after the inverse) and copied back
@@ -324,7 +359,11 @@ mod tests {
             for f_ext in [None, Some(&fx[..])] {
                 let mut data = Data::new(&model);
                 let (mut dq, mut dqd) = (vec![0.0; n * n], vec![0.0; n * n]);
-                rnea_derivatives(&model, &mut data, &q, &qd, &qdd, f_ext, &mut dq, &mut dqd);
+                let mut m = vec![0.0; n * n];
+                rnea_derivatives(&model, &mut data, &q, &qd, &qdd, f_ext, &mut dq, &mut dqd, Some(&mut m));
+                // dtau/dqdd = M, from the world pass or the CRBA: against the CRBA on fresh Data
+                let m_crba = crate::algorithms::crba(&model, &mut Data::new(&model), &q).to_vec();
+                assert_close("M", &m, &m_crba);
                 if f_ext.is_none() {
                     // the world-coordinate form against the tangent sweeps: two derivations, one answer
                     let (mut tq, mut tqd) = (vec![0.0; n * n], vec![0.0; n * n]);
