@@ -394,3 +394,25 @@ def test_rotor_inertia_and_friction_enter_as_documented():
 def test_bad_method_is_refused():
     with pytest.raises(ValueError, match="method"):
         kd.robots.planar_2r().equations_of_motion(method="hamilton")
+
+
+def test_hamiltons_equations_reproduce_the_lagrangian_equations():
+    """With p = M qd, Hamilton's qdot is qd and pdot is d(M qd)/dt = dM/dt qd + M qdd along the
+    Lagrangian equations of motion (qdd from phase_space), friction and applied torques included."""
+    import dataclasses
+
+    robot = kd.robots.planar_2r()
+    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, viscous=0.3, coulomb=0.2)) if l.joint.is_moving else l for l in robot.links]
+    eom = robot.replace(links=links, dh=None).equations_of_motion()
+    p, H, qdot, pdot = eom.hamiltonian()
+    x, f, u = eom.phase_space()
+    rng = np.random.default_rng(4)
+    values = dict(zip(list(eom.q) + list(eom.qd) + list(u), rng.uniform(-1.5, 1.5, 3 * eom.n)))
+    M = eom.M.subs(values)
+    at_p = {**values, **dict(zip(p, M * sp.Matrix(eom.qd).subs(values)))}
+    qd = np.array(sp.Matrix(eom.qd).subs(values), dtype=float).ravel()
+    np.testing.assert_allclose(np.array(qdot.subs(at_p), dtype=float).ravel(), qd, atol=1e-12)
+    qdd = np.array(f[eom.n:, :].subs(values), dtype=float).ravel()
+    Mdot = sum((sp.diff(eom.M, qi) * vi for qi, vi in zip(eom.q, qd)), sp.zeros(eom.n, eom.n)).subs(values)
+    expected = np.array(Mdot, dtype=float) @ qd + np.array(M, dtype=float) @ qdd
+    np.testing.assert_allclose(np.array(pdot.subs(at_p), dtype=float).ravel(), expected, atol=1e-10)

@@ -173,14 +173,19 @@ class EquationsOfMotion:
         return self._steps or []
 
     # ------------------------------------------------------------------ derived forms
-    def hamiltonian(self):
-        """(p, H(q, p), qdot(q, p), pdot(q, p)): momenta p = M qd and Hamilton's equations
-        qdot = dH/dp, pdot = -dH/dq (+ generalised forces)."""
+    def hamiltonian(self, u=None):
+        """(p, H(q, p), qdot(q, p), pdot(q, p)): the momenta p = M qd, H = p^T M^-1 p / 2 + P and
+        Hamilton's equations with the generalised forces, qdot = dH/dp and
+        pdot = -dH/dq + u - friction(qdot). ``u`` defaults to symbols tau1..taun (as in
+        :meth:`phase_space`)."""
+        if u is None:
+            u = sp.Matrix(sp.symbols(f"tau1:{self.n + 1}", real=True))
         p = sp.Matrix([sp.Symbol(f"p_{c.name}", real=True) for c in self.q])  # momentum conjugate to each q
         Minv = self.M.inv() if self.n <= 3 else self.M.inv(method="LU")
         H = sp.expand((p.T * Minv * p)[0, 0] / 2) + self.P
         qdot = sp.Matrix([sp.diff(H, pi) for pi in p])
-        pdot = sp.Matrix([-sp.diff(H, qi) for qi in self.q])
+        friction = self.friction.subs(dict(zip(self.qd, qdot)), simultaneous=True)
+        pdot = sp.Matrix([-sp.diff(H, qi) for qi in self.q]) + sp.Matrix(u) - friction
         return p, H, qdot, pdot
 
     def phase_space(self, u=None):
