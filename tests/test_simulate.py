@@ -258,10 +258,11 @@ def test_baumgarte_pulls_a_perturbed_start_back_to_the_constraint():
     assert traj.constraint_error[-1, 0] < 1e-6
 
 
-def closed_five_bar():
+def closed_five_bar(g: float = 0.0):
     """Spong §9.4's parallelogram five-bar with four link angles a1..a4 and the loop closure as two
-    holonomic constraints (a horizontal linkage: no gravity, so the links never fold through the
-    parallelogram's singular flat configuration)."""
+    holonomic constraints, in a horizontal plane (g = 0) or a vertical one (gravity -g along y; from
+    the start state below it swings without passing the parallelogram's flat singular configuration,
+    min |a1 - a2| = 1.7 rad)."""
     from kinedyn.symbolic import LagrangianSystem, coordinates
 
     l1, l2, lc1, lc2, lc3, lc4 = 1.0, 0.7, 0.5, 0.35, 0.5, 0.2
@@ -275,15 +276,16 @@ def closed_five_bar():
         dict(mass=m[3], position=l1 * u(a1) - lc4 * u(a4), inertia=I[3], angular_velocity=d4),
     ]
     closure = list(l2 * u(a2) + l1 * u(a3) - (l1 * u(a1) + l2 * u(a4)))
-    system = LagrangianSystem.from_bodies([a1, a2, a3, a4], bodies, qd=[d1, d2, d3, d4], holonomic=closure, forces=[0] * 4, name="five-bar (closed)")
-    params = dict(l1=l1, l2=l2, lc1=lc1, lc2=lc2, lc3=lc3, lc4=lc4, g=0.0, m1=m[0], m2=m[1], m3=m[2], m4=m[3], I1=I[0], I2=I[1], I3=I[2], I4=I[3])
+    system = LagrangianSystem.from_bodies([a1, a2, a3, a4], bodies, qd=[d1, d2, d3, d4], gravity=(0, -g), holonomic=closure, forces=[0] * 4, name="five-bar (closed)")
+    params = dict(l1=l1, l2=l2, lc1=lc1, lc2=lc2, lc3=lc3, lc4=lc4, g=g, m1=m[0], m2=m[1], m3=m[2], m4=m[3], I1=I[0], I2=I[1], I3=I[2], I4=I[3])
     return system, params
 
 
-def test_five_bar_stays_closed_and_matches_the_reduced_model():
+@pytest.mark.parametrize("g", [0.0, 9.81])
+def test_five_bar_stays_closed_and_matches_the_reduced_model(g):
     from kinedyn.symbolic import examples
 
-    system, params = closed_five_bar()
+    system, params = closed_five_bar(g)
     x0 = np.r_[0.3, 2.0, 0.3, 2.0, 0.2, 0.1, 0.2, 0.1]
     traj = kd.simulate(system, 1.0, x0, dt=1e-3)
     pos, vel = traj.constraint_error.max(axis=0)
@@ -292,6 +294,7 @@ def test_five_bar_stays_closed_and_matches_the_reduced_model():
     # the two-coordinate model of examples.five_bar() (links 3, 4 follow 1, 2) gives the same motion
     reduced = kd.simulate(examples.five_bar(), 1.0, np.r_[0.3, 2.0, 0.2, 0.1], dt=1e-3, params=params)
     assert np.abs(reduced.q - traj.q[:, :2]).max() < 1e-9
+    assert np.abs(traj.q[:, 0] - traj.q[:, 1]).min() > 0.5  # away from the flat configuration
 
 
 def test_lagrangian_system_needs_its_parameters():
