@@ -4,6 +4,7 @@ console error, draws the 3-D view and typesets the equations."""
 
 from __future__ import annotations
 
+import html
 import io
 import json
 import math
@@ -57,6 +58,24 @@ def test_default_report_is_the_tutorial_arm(default_report):
     assert "<math" in page and "kinedyn-view" in page
 
 
+def test_default_report_works_the_tutorial(default_report):
+    """The default robot is the tutorial's arm, so its report carries the tutorial worked step by step:
+    every question, and a misprint verdict for exactly the printed answers the tutorial module finds wrong."""
+    from kinedyn.report import tutorial
+
+    page = default_report.read_text()
+    section = page[page.index("<section id='tutorial'>"):]
+    section = section[: section.index("</section>")]
+    answers = tutorial.work()
+    for a in answers:
+        assert html.escape(a.title) in section, a.title
+    misprints = [c.quantity for a in answers for c in a.misprints]
+    assert misprints, "the seed tutorial has misprints"
+    assert section.count("differs: misprint") == len(misprints)
+    assert section.count("the printed value is wrong") == len(misprints)
+    assert section.count("<math") >= 10
+
+
 def test_report_needs_no_network(default_report):
     page = default_report.read_text()
     assert not re.search(r"<(script|img|iframe|link|source)[^>]+(src|href)=", page, re.I)
@@ -79,6 +98,9 @@ def test_report_json_and_options(capsys, tmp_path):
     assert out.exists() and d["path"] == str(out.resolve())
     page_data = data_block(out.read_text())
     assert page_data["simulation"]["t"][-1] == pytest.approx(0.5)
+    assert "id='tutorial'" not in out.read_text()  # only the tutorial's arm gets the worked tutorial
+    code, _, _ = run(capsys, "report", "-o", str(tmp_path / "plain.html"), "--no-tutorial", "--t", "0.2")
+    assert code == 0 and "id='tutorial'" not in (tmp_path / "plain.html").read_text()
     # a 6-joint arm: no symbolic equations by default, and the report says why
     code, text, err = run(capsys, "report", "puma560", "-o", str(tmp_path / "p.html"), "--t", "0.2")
     assert code == 0, err

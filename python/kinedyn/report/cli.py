@@ -46,7 +46,9 @@ def cmd_report(args) -> int:
     public = {k: v for k, v in data.items() if not k.startswith("_")}
     from .html import build_report
 
-    out.write_text(build_report(robot, q, qd, name=spec, data=data), encoding="utf-8")
+    # the tutorial's arm (the default robot) gets the tutorial worked step by step
+    tutorial = spec == robots.DEFAULT and not args.no_tutorial
+    out.write_text(build_report(robot, q, qd, name=spec, data=data, tutorial=tutorial), encoding="utf-8")
     payload = {"path": str(out.resolve()), **public}
     payload.pop("simulation", None)
     if "simulation" in data:
@@ -81,5 +83,6 @@ def add_report_commands(subparsers) -> None:
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--t", type=float, default=3.0, help="simulated seconds of free motion (default 3)")
     p.add_argument("--eom-joints", type=int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
+    p.add_argument("--no-tutorial", action="store_true", help="leave out the worked tutorial (included for the default robot, the tutorial's arm)")
     p.add_argument("--json", action="store_true", help="print the report's numbers as one JSON document")
     p.set_defaults(func=cmd_report)

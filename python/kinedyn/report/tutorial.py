@@ -823,6 +823,59 @@ def render_markdown(answers: Sequence[Answer]) -> str:
     return "\n".join(out)
 
 
+def render_html(answers: Sequence[Answer]) -> str:
+    """The worked answers as one HTML ``<section>`` for the report: each question's steps, its
+    equations in presentation MathML (the tutorial's notation), its tables, and the verdict on each
+    printed answer with the deciding check and, for a misprint, the correct value."""
+    from html import escape
+
+    from ..symbolic.render import MATHML_NS, value_mathml
+
+    def equation(name: str, value) -> str:
+        if isinstance(value, str):
+            return f"<p><b>{escape(name)}</b> = {escape(value)}</p>"
+        lhs = f"<mtext>{escape(name)}</mtext>"
+        return f'<div class="eq"><math xmlns="{MATHML_NS}" display="block"><mrow>{lhs}<mo>=</mo>{value_mathml(_display(value))}</mrow></math></div>'
+
+    def table(headers, rows) -> str:
+        head = "".join(f"<th>{escape(str(h))}</th>" for h in headers)
+        body = "".join("<tr>" + "".join(f"<td>{escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
+        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+    def value(text: str, expr) -> str:
+        if expr is not None:
+            return f'<math xmlns="{MATHML_NS}">{value_mathml(_display(expr))}</math>'
+        return f"<code>{escape(text)}</code>"
+
+    out = ["<section id='tutorial'><h2>The tutorial, worked</h2>",
+           "<p class='note'>The seed tutorial's questions on this arm, worked by kinedyn step by step (<code>kinedyn tutorial</code> "
+           "prints the same in a terminal). Every printed answer is compared with kinedyn's and decided by an independent check.</p>"]
+    for a in answers:
+        title = f"Q{a.key}: {a.title}" if a.key != "challenge" else f"Challenge: {a.title}"
+        out += [f"<h3>{escape(title)}</h3>", f"<p><i>{escape(a.question)}</i></p>"]
+        for item in a.items:
+            if item[0] == "text":
+                out.append(f"<p>{escape(item[1])}</p>")
+            elif item[0] == "eq":
+                out.append(equation(item[1], item[2]))
+            else:
+                _, caption, headers, rows = item
+                out += [f"<p><b>{escape(caption)}</b></p>", table(headers, rows)]
+        if a.comparisons:
+            rows = []
+            for c in a.comparisons:
+                printed, mine = c.exprs[:2] if c.exprs else (None, None)
+                verdict = "<span class='ok'>agrees</span>" if c.agrees else "<span class='bad'>differs: misprint</span>"
+                rows.append(f"<tr><td>{escape(c.quantity)}</td><td>{value(c.printed, printed)}</td><td>{value(c.kinedyn, mine)}</td><td>{verdict}</td></tr>")
+            out.append("<table class='comparisons'><thead><tr><th>quantity</th><th>printed</th><th>kinedyn</th><th>verdict</th></tr></thead>"
+                       f"<tbody>{''.join(rows)}</tbody></table>")
+            for c in a.misprints:
+                out.append(f"<p><b class='bad'>{escape(c.quantity)}: the printed value is wrong.</b> Correct: "
+                           f"{value(c.correction or c.kinedyn, c.exprs[1] if c.exprs else None)}. Deciding check: {escape(c.check)}.</p>")
+    out.append("</section>")
+    return "\n".join(out)
+
+
 def _md_name(name: str) -> str:
     return r"\text{" + name.replace("_", r"\_").replace("^", r"\^{}") + "}"
 
