@@ -118,6 +118,8 @@ def test_derive_rejects_symbolic_for_a_robot_without_symbols(capsys):
         (["simulate", "planar_2r", "--t", "1", "--dt", "0"], "dt must be a positive"),
         (["ik", "elbow_3r", "--xyz", "1", "0.2", "nan"], "NaN"),
         (["derive", "no_such_robot"], "neither a built-in"),
+        (["dynamics", "planar_2r", "--q", "0", "0", "--qd", "1"], "--qd needs 2 values"),
+        (["dynamics", "planar_2r", "--tau", "1", "2", "3"], "--tau needs 2 values"),
     ],
 )
 def test_capability_commands_reject_bad_input(capsys, argv, message):
@@ -135,3 +137,19 @@ def test_python_dash_m_kinedyn_is_the_command():
     done = subprocess.run([sys.executable, "-m", "kinedyn", "fk", "planar_2r", "--q", "0", "0", "--json"], capture_output=True, text=True, env=env, timeout=120)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["frames"]["tool"]["position"] == [5.0, 0.0, 0.0]
+
+
+def test_dynamics_json_equals_the_library(capsys):
+    q, qd, qdd, tau = [0.1, -0.4, 0.7, 0.2, -1.0, 0.5], [0.3, 0.2, -0.1, 0.4, 0.0, 1.0], [1.0, -2.0, 0.5, 0.0, 0.3, -0.2], [5.0, 40.0, 10.0, 1.0, 0.5, 0.1]
+    args = ["dynamics", "ur5", "--q", *map(str, q), "--qd", *map(str, qd), "--qdd", *map(str, qdd), "--tau", *map(str, tau), "--derivatives"]
+    doc = run_json(capsys, *args)
+    robot = kd.robots.ur5()
+    np.testing.assert_allclose(doc["mass_matrix"], robot.mass_matrix(q), rtol=1e-13)
+    np.testing.assert_allclose(doc["coriolis_matrix"], robot.coriolis_matrix(q, qd), rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(doc["gravity_torque"], robot.gravity_torque(q), rtol=1e-13)
+    np.testing.assert_allclose(doc["tau"], robot.inverse_dynamics(q, qd, qdd), rtol=1e-13)
+    np.testing.assert_allclose(doc["forward_dynamics_qdd"], robot.forward_dynamics(q, qd, tau), rtol=1e-12)
+    np.testing.assert_allclose(doc["dtau_dq"], robot.inverse_dynamics_derivatives(q, qd, qdd)[0], rtol=1e-13, atol=1e-13)
+    assert doc["kinetic_energy"] == pytest.approx(robot.kinetic_energy(q, qd))
+    code, text, _ = run(capsys, *args)
+    assert code == 0 and "mass matrix" in text and "dtau/dq" in text

@@ -35,13 +35,14 @@ def load_robot(spec: str):
     raise ValueError(f"'{spec}' is neither a built-in robot ({', '.join(robots.names())}) nor a robot file (.urdf, .yaml, .toml)")
 
 
-def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False) -> np.ndarray:
-    """Joint values from the command line (zeros when omitted); degrees convert revolute joints only."""
+def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, flag: str = "--q") -> np.ndarray:
+    """Joint values (or rates) from the command line (zeros when omitted); degrees convert revolute
+    joints only. ``flag`` names the option in the error message."""
     if values is None:
         return np.zeros(robot.n)
     q = np.array(values, dtype=float)
     if q.shape != (robot.n,):
-        raise ValueError(f"--q needs {robot.n} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}), got {q.size}")
+        raise ValueError(f"{flag} needs {robot.n} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}), got {q.size}")
     if degrees:
         q = np.array([math.radians(v) if j.kind == "revolute" else v for v, j in zip(q, robot.joints)])
     return q
@@ -285,6 +286,49 @@ def cmd_jacobian(args) -> int:
     return 0
 
 
+def cmd_dynamics(args) -> int:
+    robot = _robot(args)
+    q = parse_q(args.q, robot, args.deg)
+    qd = parse_q(args.qd, robot, args.deg, "--qd")
+    qdd = parse_q(args.qdd, robot, args.deg, "--qdd")
+    M, C, g = robot.mass_matrix(q), robot.coriolis_matrix(q, qd), robot.gravity_torque(q)
+    payload = {
+        "robot": robot.name,
+        "q": q,
+        "qd": qd,
+        "qdd": qdd,
+        "mass_matrix": M,
+        "coriolis_matrix": C,
+        "gravity_torque": g,
+        "tau": robot.inverse_dynamics(q, qd, qdd),
+        "kinetic_energy": robot.kinetic_energy(q, qd),
+        "potential_energy": robot.potential_energy(q),
+    }
+    if args.tau is not None:
+        tau = parse_q(args.tau, robot, False, "--tau")
+        payload["applied_tau"] = tau
+        payload["forward_dynamics_qdd"] = robot.forward_dynamics(q, qd, tau)
+    if args.derivatives:
+        payload["dtau_dq"], payload["dtau_dqd"], _ = robot.inverse_dynamics_derivatives(q, qd, qdd)
+
+    def render():
+        c = console()
+        names = robot.joint_names
+        c.print(f"[bold]{robot.name}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}")
+        c.print(matrix_table("M(q), mass matrix", M, names, names))
+        c.print(matrix_table("C(q, qd), Coriolis matrix (Christoffel symbols)", C, names, names))
+        c.print(matrix_table("g(q), gravity torque and tau = M qdd + C qd + g + friction", np.column_stack([g, payload["tau"]]), names, ["g", "tau"]))
+        c.print(f"kinetic energy {payload['kinetic_energy']:.6g} J, potential energy {payload['potential_energy']:.6g} J")
+        if args.tau is not None:
+            c.print(f"forward dynamics: tau = {np.array2string(payload['applied_tau'], precision=6)} gives qdd = {np.array2string(payload['forward_dynamics_qdd'], precision=6)}")
+        if args.derivatives:
+            c.print(matrix_table("dtau/dq", payload["dtau_dq"], names, names))
+            c.print(matrix_table("dtau/dqd", payload["dtau_dqd"], names, names))
+
+    emit(args, payload, render)
+    return 0
+
+
 def _command_modules() -> list:
     """Commands contributed by the capability modules: (module, registration function)."""
     return [
@@ -325,6 +369,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reference", default="world", choices=["world", "local", "spatial"])
     p.add_argument("--task", default="full", help="rows: full, position, orientation, planar, planar_pose (default full)")
     p.set_defaults(func=cmd_jacobian)
+
+    p = sub.add_parser("dynamics", help="M, C, g and tau at a state (Rust core); forward dynamics with --tau; derivatives")
+    _robot_arg(p)
+    _state_args(p, with_qd=True)
+    p.add_argument("--qdd", nargs="+", type=float, metavar="QDD", help="joint accelerations for tau (default zeros)")
+    p.add_argument("--tau", nargs="+", type=float, metavar="TAU", help="joint torques/forces: also print the forward dynamics qdd")
+    p.add_argument("--derivatives", action="store_true", help="also print dtau/dq and dtau/dqd (analytical)")
+    p.set_defaults(func=cmd_dynamics)
 
     for module, function in _command_modules():
         getattr(importlib.import_module(module), function)(sub)
