@@ -94,7 +94,7 @@ def bench(name: str) -> None:
     for label, kd_one, pin_one, kd_batch, pin_loop in cases:
         a, b = paired(kd_one, pin_one)
         print(f"{label + ', per call':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
-        a, b = paired(kd_batch, pin_loop, rounds=5, number=1)
+        a, b = paired(kd_batch, pin_loop, rounds=15, number=1)
         a, b = a / BATCH, b / BATCH
         print(f"{label + ', per state, 10k batch vs loop':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
     # Pinocchio's own batch: (nq, N) matrices; the transpose of a C-ordered (N, nq) array is free
