@@ -347,3 +347,55 @@ def test_lists_and_integer_arrays_are_accepted():
     assert np.array_equal(robot.inverse_dynamics(q, q, np.array(q)), robot.inverse_dynamics(qf, qf, qf))
     assert np.array_equal(robot.gravity_torque(np.array(q, np.float32)), robot.gravity_torque(np.array(q, np.float32).astype(float)))
     assert robot.potential_energy(q) == robot.potential_energy(qf)
+
+
+def test_out_parameter_writes_in_place():
+    """NumPy's out=: the per-step methods write into the caller's array (no allocation per call),
+    return it, give the same numbers, for one state and a batch; a wrong out is a clear error."""
+    robot = with_drives(kd.robots.puma560())
+    n = robot.n
+    rng = np.random.default_rng(9)
+    for N in (None, 4):
+        shape = (n,) if N is None else (N, n)
+        q, qd, qdd = (rng.uniform(-1.5, 1.5, shape) for _ in range(3))
+        f = rng.uniform(-2, 2, shape[:-1] + (n, 6))
+        calls = [
+            ("inverse_dynamics", (q, qd, qdd), {}),
+            ("inverse_dynamics", (q, qd, qdd), {"f_ext": f}),
+            ("mass_matrix", (q,), {}),
+            ("mass_matrix_inverse", (q,), {}),
+            ("forward_dynamics", (q, qd, qdd), {}),
+            ("forward_dynamics", (q, qd, qdd), {"f_ext": f}),
+            ("coriolis_matrix", (q, qd), {}),
+            ("gravity_torque", (q,), {}),
+            ("bias_torque", (q, qd), {}),
+        ]
+        for name, args, kwargs in calls:
+            method = getattr(robot, name)
+            expected = method(*args, **kwargs)
+            out = np.full(expected.shape, np.nan)
+            got = method(*args, **kwargs, out=out)
+            assert got is out, name
+            np.testing.assert_array_equal(out, expected, err_msg=name)
+    q = np.zeros(n)
+    with pytest.raises(ValueError, match=r"out must have shape \(6, 6\), got \(6, 5\)"):
+        robot.mass_matrix(q, out=np.empty((6, 5)))
+    with pytest.raises(ValueError, match=r"out must have shape \(3, 6\)"):
+        robot.gravity_torque(np.zeros((3, 6)), out=np.empty(6))
+    with pytest.raises(TypeError, match="float64 NumPy array, got an array of dtype float32"):
+        robot.mass_matrix(q, out=np.empty((6, 6), dtype=np.float32))
+    with pytest.raises(TypeError, match="float64 NumPy array, got <class 'list'>"):
+        robot.gravity_torque(q, out=[0.0] * 6)
+    with pytest.raises(ValueError, match="writeable, C-contiguous"):
+        robot.mass_matrix(q, out=np.empty((6, 6), order="F"))
+    frozen = np.empty((6, 6))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable, C-contiguous"):
+        robot.mass_matrix(q, out=frozen)
+    with pytest.raises(ValueError, match="share memory with the inputs"):
+        robot.gravity_torque(q, out=q)
+    # a batch's inputs are copied before the GIL is released: an aliased out is fine there
+    Q = rng.uniform(-1, 1, (3, n))
+    expected = robot.gravity_torque(Q)
+    assert robot.gravity_torque(Q, out=Q) is Q
+    np.testing.assert_array_equal(Q, expected)

@@ -452,7 +452,7 @@ class Robot:
     def _scalar(x):
         return float(x) if np.ndim(x) == 0 else x
 
-    def inverse_dynamics(self, q, qd, qdd, f_ext=None) -> np.ndarray:
+    def inverse_dynamics(self, q, qd, qdd, f_ext=None, out=None) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
         ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
@@ -460,30 +460,32 @@ class Robot:
         the link's frame (``robot.forward_kinematics(q)[i]``), so that it maps to joint torques by
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
         if f_ext is None:
-            return self._model.inverse_dynamics(q, qd, qdd)
+            return self._model.inverse_dynamics(q, qd, qdd, None, out)
         q = self._state(q)
-        return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext))
+        return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext), out)
 
-    def mass_matrix(self, q) -> np.ndarray:
-        """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric."""
-        return self._model.mass_matrix(q)
+    def mass_matrix(self, q, out=None) -> np.ndarray:
+        """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric.
+        ``out``: a float64 array of the result's shape to write into instead of allocating one (as
+        NumPy's ``out=``; also on the other per-step methods, for control loops)."""
+        return self._model.mass_matrix(q, out)
 
-    def mass_matrix_inverse(self, q) -> np.ndarray:
+    def mass_matrix_inverse(self, q, out=None) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
-            return self._model.mass_matrix_inverse(q)
+            return self._model.mass_matrix_inverse(q, out)
         except RuntimeError as e:
             raise self._singular(e) from None
 
-    def forward_dynamics(self, q, qd, tau, f_ext=None) -> np.ndarray:
+    def forward_dynamics(self, q, qd, tau, f_ext=None, out=None) -> np.ndarray:
         """qdd solving M qdd = tau - C qd - g - friction + sum_i J_i^T f_ext_i (articulated-body
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
         try:
             if f_ext is None:
-                return self._model.forward_dynamics(q, qd, tau)
+                return self._model.forward_dynamics(q, qd, tau, None, out)
             q = self._state(q)
-            return self._model.forward_dynamics(q, qd, tau, self._f_ext(q, f_ext))
+            return self._model.forward_dynamics(q, qd, tau, self._f_ext(q, f_ext), out)
         except RuntimeError as e:
             raise self._singular(e) from None
 
@@ -531,22 +533,22 @@ class Robot:
         dm = np.cross(dd, f[..., :, None, :3])  # (w_j x d_b) x f_b
         return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
 
-    def coriolis_matrix(self, q, qd) -> np.ndarray:
+    def coriolis_matrix(self, q, qd, out=None) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
-        return self._model.coriolis_matrix(q, qd)
+        return self._model.coriolis_matrix(q, qd, out)
 
     def christoffel(self, q) -> np.ndarray:
         """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
         ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
         return self._model.christoffel(q)
 
-    def gravity_torque(self, q) -> np.ndarray:
+    def gravity_torque(self, q, out=None) -> np.ndarray:
         """g(q) = dP/dq."""
-        return self._model.gravity_torque(q)
+        return self._model.gravity_torque(q, out)
 
-    def bias_torque(self, q, qd) -> np.ndarray:
+    def bias_torque(self, q, qd, out=None) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
-        return self._model.bias_torque(q, qd)
+        return self._model.bias_torque(q, qd, out)
 
     def kinetic_energy(self, q, qd):
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""

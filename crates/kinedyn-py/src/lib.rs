@@ -13,7 +13,7 @@ use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 use rayon::prelude::*;
@@ -176,12 +176,53 @@ impl<'a> Batch<'a> {
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
-        let [array] = self.run_many::<1, _>(py, m, out_shape, |model, data, x, [out]| kernel(model, data, x, out))?;
+        self.run_out(py, m, out_shape, None, kernel)
+    }
+
+    /// `run` writing into the caller's array `out` when given (NumPy's `out=`: no allocation per
+    /// call), after checking that it is a writeable, C-contiguous float64 array of the result's
+    /// shape that shares no memory with the inputs.
+    fn run_out<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    where
+        F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
+    {
+        let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
+        let [array] = self.run_many::<1, _>(py, m, out_shape, [given], |model, data, x, [out]| kernel(model, data, x, out))?;
+        Ok(array)
+    }
+
+    /// `out` as the destination of this call's result (see `run_out`), or a clear error.
+    fn checked_out<'py>(&self, out: Bound<'py, PyAny>, out_shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let array = out.cast_into::<PyArrayDyn<f64>>().map_err(|e| {
+            let given = e.into_inner();
+            let what = match given.getattr("dtype") {
+                Ok(dtype) => format!("an array of dtype {dtype}"),
+                Err(_) => format!("{}", given.get_type()),
+            };
+            PyTypeError::new_err(format!("out must be a float64 NumPy array, got {what}"))
+        })?;
+        let expected: Vec<usize> = self.batch.iter().chain(out_shape).copied().collect();
+        if array.shape() != expected.as_slice() {
+            return Err(PyValueError::new_err(format!("out must have shape {}, got {}", shape_text(&expected), shape_text(array.shape()))));
+        }
+        // SAFETY: reading the flags of a live array object
+        let writeable = unsafe { (*array.as_array_ptr()).flags } & numpy::npyffi::flags::NPY_ARRAY_WRITEABLE != 0;
+        if !array.is_c_contiguous() || !writeable {
+            return Err(PyValueError::new_err("out must be a writeable, C-contiguous array"));
+        }
+        // SAFETY: only the address range is read, to compare it with the inputs'
+        let range = unsafe { array.as_slice() }?.as_ptr_range();
+        for values in &self.values {
+            let input = values.as_ptr_range();
+            if matches!(values, Cow::Borrowed(_)) && input.start < range.end && range.start < input.end {
+                return Err(PyValueError::new_err("out must not share memory with the inputs"));
+            }
+        }
         Ok(array)
     }
 
     /// `run` for kernels with K outputs of the same per-state shape, returned as K arrays.
-    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
+    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
@@ -195,7 +236,8 @@ impl<'a> Batch<'a> {
         // SAFETY: uninitialised memory, not zeros (a 10k-state M batch spent 10 % of its time in the
         // memset): every kernel writes its whole output slices (its contract, see `kernel` above),
         // and on an error the arrays are dropped unread. Created here, nothing else refers to them.
-        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = std::array::from_fn(|_| unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) });
+        // (or the caller's checked `out` arrays)
+        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = given.map(|g| g.unwrap_or_else(|| unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) }));
         let total = self.batch.unwrap_or(1) * per_state;
         let mut bases = [OutputBase(std::ptr::null_mut()); K];
         for (base, array) in bases.iter_mut().zip(&arrays) {
@@ -420,8 +462,8 @@ impl PyModel {
     // ---- dynamics (issue 3): each method takes one state or a batch, like the kinematics above ----
 
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
-    #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, qd, qdd, f_ext=None, out=None))]
+    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
         let q = f64_array(&q)?;
         let qd = f64_array(&qd)?;
@@ -432,37 +474,39 @@ impl PyModel {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
         };
-        batch.run(py, self, &[n], |model, data, x, out| {
+        batch.run_out(py, self, &[n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
             Ok(())
         })
     }
 
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, out=None))]
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[n, n], |model, data, x, out| {
+        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::crba(model, data, x[0]));
             Ok(())
         })
     }
 
     /// M^-1 (n, n) | (N, n, n).
-    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, out=None))]
+    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[n, n], |model, data, x, out| {
+        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
             Ok(())
         })
     }
 
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
-    #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, qd, tau, f_ext=None, out=None))]
+    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
         let q = f64_array(&q)?;
         let qd = f64_array(&qd)?;
@@ -473,7 +517,7 @@ impl PyModel {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
         };
-        batch.run(py, self, &[n], |model, data, x, out| {
+        batch.run_out(py, self, &[n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
             Ok(())
         })
@@ -490,7 +534,7 @@ impl PyModel {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
         };
-        let [dq, dqd, m] = batch.run_many::<3, _>(py, self, &[n, n], |model, data, x, [dq, dqd, m]| {
+        let [dq, dqd, m] = batch.run_many::<3, _>(py, self, &[n, n], [None, None, None], |model, data, x, [dq, dqd, m]| {
             algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
             Ok(())
         })?;
@@ -508,19 +552,20 @@ impl PyModel {
             Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
             None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
         };
-        let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, &[n, n], |model, data, x, [dq, dqd, dtau]| {
+        let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, &[n, n], [None, None, None], |model, data, x, [dq, dqd, dtau]| {
             algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
         })?;
         Ok((dq, dqd, dtau))
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
-    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, qd, out=None))]
+    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let q = f64_array(&q)?;
         let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[n, n], |model, data, x, out| {
+        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
             Ok(())
         })
@@ -538,23 +583,25 @@ impl PyModel {
     }
 
     /// g (n,) | (N, n).
-    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, out=None))]
+    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let q = f64_array(&q)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[n], |model, data, x, out| {
+        batch.run_out(py, self, &[n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
             Ok(())
         })
     }
 
     /// C qd + g (n,) | (N, n), without friction.
-    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    #[pyo3(signature = (q, qd, out=None))]
+    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let q = f64_array(&q)?;
         let qd = f64_array(&qd)?;
         let n = self.n();
         let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[n], |model, data, x, out| {
+        batch.run_out(py, self, &[n], out, |model, data, x, out| {
             out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
             Ok(())
         })
