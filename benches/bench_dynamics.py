@@ -97,6 +97,14 @@ def bench(name: str) -> None:
         a, b = paired(kd_batch, pin_loop, rounds=15, number=1)
         a, b = a / BATCH, b / BATCH
         print(f"{label + ', per state, 10k batch vs loop':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
+    # control-loop use: kinedyn writing into a preallocated array (out=), Pinocchio as above
+    M_out, tau_out = np.empty((n, n)), np.empty(n)
+    for label, kd_one, pin_one in [
+        ("inverse_dynamics, per call with out=", lambda: robot.inverse_dynamics(q, qd, qdd, out=tau_out), lambda: pin.rnea(model, data, q, qd, qdd)),
+        ("mass_matrix, per call with out=", lambda: robot.mass_matrix(q, out=M_out), lambda: pin.crba(model, data, q)),
+    ]:
+        a, b = paired(kd_one, pin_one)
+        print(f"{label:46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
     # Pinocchio's own batch: (nq, N) matrices; the transpose of a C-ordered (N, nq) array is free
     pool = pin.ModelPool(model)
     out = np.zeros((n, BATCH), order="F")
