@@ -75,16 +75,6 @@ fn main() {
         let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
         run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2, None));
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
-        // a 10,000-state sweep (random states, one Data), per state: what a batch costs without the glue
-        let states: Vec<Vec<f64>> = {
-            let mut rng = kinedyn_core::testing::Rng::new(7);
-            (0..10_000).map(|_| rng.vector(3 * n, -1.0, 1.0)).collect()
-        };
-        run("aba_sweep_per_state", &mut |d| {
-            for x in &states {
-                black_box(alg::aba(&model, d, &x[..n], &x[n..2 * n], &x[2 * n..], None).unwrap()[0]);
-            }
-        });
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
     }
 }
