@@ -1,12 +1,16 @@
 //! Analytical partial derivatives of inverse and forward dynamics.
 //!
-//! Inverse dynamics: `dtau/dq` and `dtau/dqd` by differentiating the recursive Newton-Euler
-//! algorithm (RBDA Table 5.1, as in `rnea.rs`) along each coordinate direction: one tangent
-//! ("forward-mode") sweep per direction, over the subtree the coordinate moves and back to the
-//! root, O(n^2) in all and exact (no finite differences). `dtau/dqdd = M`. This is the
-//! differentiation of RNEA that Carpentier & Mansard ("Analytical Derivatives of Rigid Body
-//! Dynamics Algorithms", RSS 2018) organise into one pass; here it is kept one direction at a
-//! time, which reads line by line against the RNEA.
+//! Inverse dynamics: `dtau/dq` and `dtau/dqd`, exact and O(n^2), by two derivations that the
+//! tests hold against each other (and against finite differences and Pinocchio):
+//! - in world coordinates ([`rnea_derivatives`] without external wrenches; the derivation is at
+//!   `rnea_derivatives_world`), where each entry is three dot products of subtree-composite
+//!   quantities: the organisation of Carpentier & Mansard, "Analytical Derivatives of Rigid Body
+//!   Dynamics Algorithms", RSS 2018;
+//! - by differentiating the recursive Newton-Euler algorithm (RBDA Table 5.1, as in `rnea.rs`)
+//!   line by line along each coordinate in body coordinates: one tangent ("forward-mode") sweep per
+//!   coordinate over the subtree it moves and back to the root (with external wrenches; below).
+//!
+//! `dtau/dqdd = M`.
 //!
 //! Derivation (body coordinates; body i's frame moves with q_i, `s_i` is constant in it). For a
 //! motion `m` given in the parent, `d(^iX_λ m)/dq_i = -s_i x ^iX_λ m = (^iX_λ m) x s_i`; for a
