@@ -21,7 +21,7 @@
 //!
 //! | symbol      | here                  | meaning                                          |
 //! |-------------|-----------------------|--------------------------------------------------|
-//! | `h`         | `settings.dt`         | step [s]                                         |
+//! | `h`         | `settings.dt`         | step (s)                                         |
 //! | `x_k`       | `q`, `qd`             | state at `t_k`, each length `n`                  |
 //! | `k1..k4`    | `kq[s]`, `kv[s]`      | stage derivatives of `q` and `qd`                |
 //! | `tau`       | `tau`                 | joint torque at a stage, length `n`              |
@@ -53,12 +53,12 @@ impl Method {
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
     pub method: Method,
-    /// Step `h` [s], > 0.
+    /// Step `h` (s), > 0.
     pub dt: f64,
     /// Number of steps; the trajectory has `steps / record_every + 1` samples (the last step is
     /// always recorded).
     pub steps: usize,
-    /// Start time [s].
+    /// Start time (s).
     pub t0: f64,
     /// Record every `record_every`-th step (>= 1).
     pub record_every: usize,
