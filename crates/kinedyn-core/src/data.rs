@@ -5,7 +5,7 @@
 
 use crate::algorithms::derivatives::Tangent;
 use crate::model::Model;
-use crate::spatial::{ArticulatedInertia, Force, Inertia, Motion, Transform, Vec3};
+use crate::spatial::{ArticulatedInertia, Force, Inertia, Mat3, Motion, Transform, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Data {
@@ -72,6 +72,10 @@ pub struct Data {
     pub alpha: Vec<Force>,
     pub beta: Vec<Force>,
     pub sigma: Vec<Force>,
+    /// Sums over each subtree of the external forces, their moments and `f p^T` (derivatives.rs).
+    pub ext_f: Vec<Vec3>,
+    pub ext_n: Vec<Vec3>,
+    pub ext_p: Vec<Mat3>,
 
     // ---- derivatives (derivatives.rs): tangents of one sweep, body coordinates ----
     /// Derivatives of twist, acceleration and composite force along q_j and along qd_j.
@@ -130,6 +134,9 @@ impl Data {
             alpha: vec![Force::zero(); n],
             beta: vec![Force::zero(); n],
             sigma: vec![Force::zero(); n],
+            ext_f: vec![Vec3::zeros(); n],
+            ext_n: vec![Vec3::zeros(); n],
+            ext_p: vec![Mat3::zeros(); n],
             tangent_q: vec![Tangent::default(); n],
             tangent_qd: vec![Tangent::default(); n],
             dpsi: vec![Motion::zero(); n],

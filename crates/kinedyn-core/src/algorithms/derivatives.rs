@@ -2,13 +2,13 @@
 //!
 //! Inverse dynamics: `dtau/dq` and `dtau/dqd`, exact and O(n^2), by two derivations that the
 //! tests hold against each other (and against finite differences and Pinocchio):
-//! - in world coordinates ([`rnea_derivatives`] without external wrenches; the derivation is at
-//!   `rnea_derivatives_world`), where each entry is three dot products of subtree-composite
+//! - in world coordinates ([`rnea_derivatives`]; the derivation is at `rnea_derivatives_world`),
+//!   where each entry is three dot products of subtree-composite
 //!   quantities: the organisation of Carpentier & Mansard, "Analytical Derivatives of Rigid Body
 //!   Dynamics Algorithms", RSS 2018;
 //! - by differentiating the recursive Newton-Euler algorithm (RBDA Table 5.1, as in `rnea.rs`)
 //!   line by line along each coordinate in body coordinates: one tangent ("forward-mode") sweep per
-//!   coordinate over the subtree it moves and back to the root (with external wrenches; below).
+//!   coordinate over the subtree it moves and back to the root ([`rnea_derivatives_tangent`]; below).
 //!
 //! `dtau/dqdd = M`.
 //!
@@ -47,7 +47,7 @@ use super::rnea::rnea;
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::{Force, Motion};
+use crate::spatial::{Force, Motion, Vec3};
 
 /// The derivatives of one body's twist, acceleration and composite force along one coordinate.
 #[derive(Clone, Copy, Debug, Default)]
@@ -59,7 +59,7 @@ pub struct Tangent {
 
 /// `dtau/dq` and `dtau/dqd` (row-major n x n: `[i * n + j] = dtau_i / dx_j`) at `(q, qd, qdd)`,
 /// for the same `tau` as [`rnea`] (gravity, friction, armature, `f_ext`), and when asked for,
-/// `dtau/dqdd = M` (a by-product of the world-coordinate pass, else the CRBA).
+/// `dtau/dqdd = M` (a by-product of the pass: the CRBA in world coordinates).
 #[allow(clippy::too_many_arguments)]
 pub fn rnea_derivatives(
     model: &Model,
@@ -72,19 +72,9 @@ pub fn rnea_derivatives(
     dtau_dqd: &mut [f64],
     mass_matrix: Option<&mut [f64]>,
 ) {
-    match f_ext {
-        None => {
-            rnea_derivatives_world(model, data, q, qd, qdd, dtau_dq, dtau_dqd);
-            if let Some(m) = mass_matrix {
-                mass_matrix_from_world(model, data, m);
-            }
-        }
-        Some(_) => {
-            rnea_derivatives_tangent(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd);
-            if let Some(m) = mass_matrix {
-                m[..model.n * model.n].copy_from_slice(super::crba::crba(model, data, q));
-            }
-        }
+    rnea_derivatives_world(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd);
+    if let Some(m) = mass_matrix {
+        mass_matrix_from_world(model, data, m);
     }
 }
 
@@ -103,8 +93,8 @@ fn mass_matrix_from_world(model: &Model, data: &Data, m: &mut [f64]) {
     }
 }
 
-/// [`rnea_derivatives`] by tangent sweeps in body coordinates (any `f_ext`; the reference the
-/// world-coordinate form is tested against).
+/// [`rnea_derivatives`] by tangent sweeps in body coordinates: the second derivation, which the
+/// world-coordinate form is tested against.
 #[doc(hidden)]
 #[allow(clippy::too_many_arguments)]
 pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
@@ -139,7 +129,15 @@ pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &
 /// `alpha_k = I^c_k S_k`, `beta_k = dI^c_k/dt S_k` (both operators symmetric) and
 /// `sigma_k = S_k x* h^c_k`, each entry below j is three dot products:
 /// `dtau_k/dq_j = alpha_k . w + u . (sigma_k - beta_k)`, `dtau_k/dqd_j = 2 alpha_k . dS_j/dt + S_j . (beta_k - sigma_k)`.
-fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+///
+/// External wrenches `(f_i, n_i)` (base axes, moment about body i's origin `p_i`) are the world
+/// force `(f_i, n_i + p_i x f_i)`, subtracted from `f_i`. They do not turn with the subtree; only
+/// their point moves, `dp_i/dq_j = S_j,lin + w_j x p_i`. Removing the rigid turn `S_j x* F^x` that
+/// the formula above applies to them, and adding the true change `(0, dp_i x f_i)`, adds
+/// `E_k(w_j) = (w_j x sum f_i, w_j x sum n_i + w_j tr(P_k) - P_k w_j)`, `P_k = sum f_i p_i^T` over
+/// subtree k, to `dF_k/dq_j` (Jacobi: `w x (p x f) - (w x p) x f = p x (w x f)`).
+#[allow(clippy::too_many_arguments)]
+fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
     let n = model.n;
     forward_kinematics(model, data, q);
     let a0 = Motion::new(-model.gravity, Default::default());
@@ -158,6 +156,13 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
         let h = inertia.mul_motion(&v);
         (s_w[i], v_w[i], a_w[i]) = (s, v, a);
         (ic[i], icd[i], hc[i], fc[i]) = (inertia, inertia_rate(&inertia, &v), h, inertia.mul_motion(&a) + v.cross_force(&h));
+        if let Some(fx) = f_ext {
+            // the wrench about the world origin, and its parts for the composite sums E_k
+            let (f, m) = (Vec3::from_column_slice(&fx[6 * i..6 * i + 3]), Vec3::from_column_slice(&fx[6 * i + 3..6 * i + 6]));
+            let p = x.trans;
+            fc[i] -= Force::new(f, m + p.cross(&f));
+            (data.ext_f[i], data.ext_n[i], data.ext_p[i]) = (f, m, f * p.transpose());
+        }
     }
     // backward: composite sums over each subtree
     for i in (0..n).rev() {
@@ -167,8 +172,17 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
             icd[p] += cd;
             hc[p] += h;
             fc[p] += f;
+            if f_ext.is_some() {
+                let (ef, en, ep) = (data.ext_f[i], data.ext_n[i], data.ext_p[i]);
+                data.ext_f[p] += ef;
+                data.ext_n[p] += en;
+                data.ext_p[p] += ep;
+            }
         }
     }
+    // E_k(w): how the subtree's wrenches change as coordinate j (axis w) turns it (see above)
+    let (ext_f, ext_n, ext_p) = (&data.ext_f[..n], &data.ext_n[..n], &data.ext_p[..n]);
+    let wrench_term = |k: usize, w: &Vec3| Force::new(w.cross(&ext_f[k]), w.cross(&ext_n[k]) + w * ext_p[k].trace() - ext_p[k] * w);
     let (alpha, beta, sigma) = (&mut data.alpha[..n], &mut data.beta[..n], &mut data.sigma[..n]);
     for k in 0..n {
         (alpha[k], beta[k], sigma[k]) = (ic[k].mul_motion(&s_w[k]), icd[k].mul_motion(&s_w[k]), s_w[k].cross_force(&hc[k]));
@@ -187,6 +201,9 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
                 continue;
             }
             dtau_dq[k * n + j] = w.dot(&alpha[k]) + u.dot(&(sigma[k] - beta[k]));
+            if f_ext.is_some() {
+                dtau_dq[k * n + j] += s_w[k].dot(&wrench_term(k, &s.ang));
+            }
             dtau_dqd[k * n + j] = 2.0 * sdot.dot(&alpha[k]) + s.dot(&(beta[k] - sigma[k]));
         }
         dtau_dqd[j * n + j] += model.viscous[j];
@@ -194,7 +211,10 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
         if parent[j].is_none() {
             continue;
         }
-        let df_q = s.cross_force(&fc[j]) + ic[j].mul_motion(&w) - u.cross_force(&hc[j]) - icd[j].mul_motion(&u);
+        let mut df_q = s.cross_force(&fc[j]) + ic[j].mul_motion(&w) - u.cross_force(&hc[j]) - icd[j].mul_motion(&u);
+        if f_ext.is_some() {
+            df_q += wrench_term(j, &s.ang);
+        }
         let df_qd = ic[j].mul_motion(&sdot) * 2.0 + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
         let mut k = parent[j];
         while let Some(kk) = k {
@@ -368,10 +388,10 @@ mod tests {
                 // dtau/dqdd = M, from the world pass or the CRBA: against the CRBA on fresh Data
                 let m_crba = crate::algorithms::crba(&model, &mut Data::new(&model), &q).to_vec();
                 assert_close("M", &m, &m_crba);
-                if f_ext.is_none() {
+                {
                     // the world-coordinate form against the tangent sweeps: two derivations, one answer
                     let (mut tq, mut tqd) = (vec![0.0; n * n], vec![0.0; n * n]);
-                    rnea_derivatives_tangent(&model, &mut data, &q, &qd, &qdd, None, &mut tq, &mut tqd);
+                    rnea_derivatives_tangent(&model, &mut data, &q, &qd, &qdd, f_ext, &mut tq, &mut tqd);
                     let scale = tq.iter().chain(&tqd).fold(1.0f64, |s, x| s.max(x.abs()));
                     for (a, b) in dq.iter().chain(&dqd).zip(tq.iter().chain(&tqd)) {
                         assert!((a - b).abs() <= 1e-12 * scale, "world {a} vs tangent {b}");
