@@ -74,6 +74,8 @@ fn main() {
         run("mass_matrix_inverse", &mut |d| _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0]));
         let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
         run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2, None));
+        let fx: Vec<f64> = (0..6 * n).map(|k| 0.1 * k as f64 - 1.0).collect();
+        run("rnea_derivatives_f_ext", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), Some(&fx), &mut d1, &mut d2, None));
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
     }
