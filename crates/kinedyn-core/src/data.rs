@@ -68,6 +68,8 @@ pub struct Data {
     /// Body accelerations (gravity included) and composite forces, world coordinates (derivatives.rs).
     pub a_w: Vec<Motion>,
     pub fc_w: Vec<Force>,
+    /// Scratch composite force changes, world coordinates (derivatives.rs).
+    pub dfc_w: Vec<Force>,
     /// Per body `I^c s`, `dI^c/dt s`, `s x* h^c` (world coordinates, derivatives.rs).
     pub alpha: Vec<Force>,
     pub beta: Vec<Force>,
@@ -131,6 +133,7 @@ impl Data {
             hc_w: vec![Force::zero(); n],
             a_w: vec![Motion::zero(); n],
             fc_w: vec![Force::zero(); n],
+            dfc_w: vec![Force::zero(); n],
             alpha: vec![Force::zero(); n],
             beta: vec![Force::zero(); n],
             sigma: vec![Force::zero(); n],

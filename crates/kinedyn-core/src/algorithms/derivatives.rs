@@ -42,7 +42,7 @@
 
 use super::coriolis::inertia_rate;
 use super::kinematics::forward_kinematics;
-use super::minv::mass_matrix_inverse;
+use super::minv::inverse_of_mass_matrix;
 use super::rnea::rnea;
 use crate::data::Data;
 use crate::error::Result;
@@ -138,11 +138,18 @@ pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &
 /// subtree k, to `dF_k/dq_j` (Jacobi: `w x (p x f) - (w x p) x f = p x (w x f)`).
 #[allow(clippy::too_many_arguments)]
 fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+    world_pass(model, data, q, qd, Some(qdd), f_ext);
+    world_derivatives(model, data, f_ext.is_some(), dtau_dq, dtau_dqd);
+}
+
+/// The world-coordinate quantities of [`rnea_derivatives_world`] at `(q, qd, qdd)` (`qdd = None`:
+/// zero), composite over each subtree, and `alpha`, `beta`, `sigma`; body inertias kept in `i_w`.
+fn world_pass(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: Option<&[f64]>, f_ext: Option<&[f64]>) {
     let n = model.n;
     forward_kinematics(model, data, q);
     let a0 = Motion::new(-model.gravity, Default::default());
     let parent = &model.parent[..n];
-    let (s_w, v_w, a_w) = (&mut data.s_w[..n], &mut data.v_w[..n], &mut data.a_w[..n]);
+    let (s_w, v_w, a_w, i_w) = (&mut data.s_w[..n], &mut data.v_w[..n], &mut data.a_w[..n], &mut data.i_w[..n]);
     let (ic, icd, hc, fc) = (&mut data.ic_w[..n], &mut data.icd_w[..n], &mut data.hc_w[..n], &mut data.fc_w[..n]);
     // forward, world coordinates: S_i, v_i = v_p + S_i qd_i, a_i = a_p + S_i qdd_i + (v_p x S_i) qd_i,
     // I_i, dI_i/dt, h_i = I_i v_i, f_i = I_i a_i + v_i x* h_i
@@ -151,10 +158,13 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
         let s = x.act_motion(&data.s[i]);
         let (vp, ap) = parent[i].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
         let v = vp + s * qd[i];
-        let a = ap + s * qdd[i] + vp.cross_motion(&s) * qd[i];
+        let mut a = ap + vp.cross_motion(&s) * qd[i];
+        if let Some(qdd) = qdd {
+            a += s * qdd[i];
+        }
         let inertia = x.act_inertia(&model.inertia[i]);
         let h = inertia.mul_motion(&v);
-        (s_w[i], v_w[i], a_w[i]) = (s, v, a);
+        (s_w[i], v_w[i], a_w[i], i_w[i]) = (s, v, a, inertia);
         (ic[i], icd[i], hc[i], fc[i]) = (inertia, inertia_rate(&inertia, &v), h, inertia.mul_motion(&a) + v.cross_force(&h));
         if let Some(fx) = f_ext {
             // the wrench about the world origin, and its parts for the composite sums E_k
@@ -180,13 +190,45 @@ fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64],
             }
         }
     }
-    // E_k(w): how the subtree's wrenches change as coordinate j (axis w) turns it (see above)
-    let (ext_f, ext_n, ext_p) = (&data.ext_f[..n], &data.ext_n[..n], &data.ext_p[..n]);
-    let wrench_term = |k: usize, w: &Vec3| Force::new(w.cross(&ext_f[k]), w.cross(&ext_n[k]) + w * ext_p[k].trace() - ext_p[k] * w);
     let (alpha, beta, sigma) = (&mut data.alpha[..n], &mut data.beta[..n], &mut data.sigma[..n]);
     for k in 0..n {
         (alpha[k], beta[k], sigma[k]) = (ic[k].mul_motion(&s_w[k]), icd[k].mul_motion(&s_w[k]), s_w[k].cross_force(&hc[k]));
     }
+}
+
+/// After `world_pass` at `qdd = 0`: the accelerations and composite forces at `qdd` (the
+/// accelerations are linear in qdd: `a_i += sum over the joints k supporting i of S_k qdd_k`).
+fn add_joint_accelerations(model: &Model, data: &mut Data, qdd: &[f64]) {
+    let n = model.n;
+    let (s_w, a_w, i_w, fc) = (&data.s_w[..n], &mut data.a_w[..n], &data.i_w[..n], &mut data.fc_w[..n]);
+    let (da, df) = (&mut data.dpsi[..n], &mut data.dfc_w[..n]);
+    for i in 0..n {
+        // da_i = da_p + S_i qdd_i ;  df_i = I_i da_i
+        da[i] = model.parent[i].map_or(Motion::zero(), |p| da[p]) + s_w[i] * qdd[i];
+        a_w[i] += da[i];
+        df[i] = i_w[i].mul_motion(&da[i]);
+    }
+    for i in (0..n).rev() {
+        if let Some(p) = model.parent[i] {
+            let d = df[i];
+            df[p] += d;
+        }
+        fc[i] += df[i];
+    }
+}
+
+/// The derivative loops of [`rnea_derivatives_world`], from the quantities `world_pass` left in `data`.
+fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+    let n = model.n;
+    let a0 = Motion::new(-model.gravity, Default::default());
+    let parent = &model.parent[..n];
+    let (s_w, v_w, a_w) = (&data.s_w[..n], &data.v_w[..n], &data.a_w[..n]);
+    let (ic, icd, hc, fc) = (&data.ic_w[..n], &data.icd_w[..n], &data.hc_w[..n], &data.fc_w[..n]);
+    let (alpha, beta, sigma) = (&data.alpha[..n], &data.beta[..n], &data.sigma[..n]);
+    // E_k(w): how the subtree's wrenches change as coordinate j (axis w) turns it (see above)
+    let (ext_f, ext_n, ext_p) = (&data.ext_f[..n], &data.ext_n[..n], &data.ext_p[..n]);
+    let wrench_term = |k: usize, w: &Vec3| Force::new(w.cross(&ext_f[k]), w.cross(&ext_n[k]) + w * ext_p[k].trace() - ext_p[k] * w);
+    let f_ext = wrenches.then_some(());
     dtau_dq[..n * n].fill(0.0);
     dtau_dqd[..n * n].fill(0.0);
     for j in 0..n {
@@ -308,19 +350,29 @@ pub fn aba_derivatives(
     dqdd_dtau: &mut [f64],
 ) -> Result<()> {
     let n = model.n;
-    // M^-1 first (an error for a singular M), then qdd = M^-1 (tau - rnea(q, qd, 0, f_ext)): the
-    // ABA's qdd to rounding, at half its cost now that M^-1 is needed anyway
-    dqdd_dtau[..n * n].copy_from_slice(mass_matrix_inverse(model, data, q)?);
-    let mut qdd = std::mem::take(&mut data.qdd_fd);
-    qdd[..n].fill(0.0);
-    let bias = super::rnea::rnea(model, data, q, qd, &qdd[..n], f_ext);
+    // one world pass at qdd = 0 gives M (composite inertias) and the bias b = tau(q, qd, 0)
+    // (composite forces, friction added); M^-1 by the sparse L^T D L factors (an error for a
+    // singular M); qdd = M^-1 (tau - b); then the accelerations and forces at that qdd
+    world_pass(model, data, q, qd, None, f_ext);
+    let mut m = std::mem::take(&mut data.m);
+    mass_matrix_from_world(model, data, &mut m);
+    data.m = m;
+    dqdd_dtau[..n * n].copy_from_slice(inverse_of_mass_matrix(model, data)?);
     let minv = &dqdd_dtau[..n * n];
-    for r in 0..n {
-        qdd[r] = (0..n).map(|k| minv[r * n + k] * (tau[k] - bias[k])).sum();
+    let qdd = &mut data.qdd_fd[..n];
+    for (r, value) in qdd.iter_mut().enumerate() {
+        *value = (0..n)
+            .map(|k| {
+                let bias = data.s_w[k].dot(&data.fc_w[k]) + super::rnea::friction(model, k, qd[k]);
+                minv[r * n + k] * (tau[k] - bias)
+            })
+            .sum();
     }
-    // dtau/dq and dtau/dqd at (q, qd, qdd), into the outputs first
-    rnea_derivatives(model, data, q, qd, &qdd[..n], f_ext, dqdd_dq, dqdd_dqd, None);
+    let qdd = std::mem::take(&mut data.qdd_fd);
+    add_joint_accelerations(model, data, &qdd[..n]);
     data.qdd_fd = qdd;
+    // dtau/dq and dtau/dqd at (q, qd, qdd), into the outputs first
+    world_derivatives(model, data, f_ext.is_some(), dqdd_dq, dqdd_dqd);
     // dqdd/dx = -M^-1 dtau/dx: row r of the product is -sum_k minv[r][k] row k of dtau/dx,
     // accumulated in a scratch matrix (data.m, free after the inverse) and copied back
 

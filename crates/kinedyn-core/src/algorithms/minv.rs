@@ -50,8 +50,13 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
 
 /// `M(q)^-1` written row-major to `data.m` (n x n); `data.m2` holds the factors of `M`.
 pub fn mass_matrix_inverse<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d [f64]> {
-    let n = model.n;
     crba(model, data, q);
+    inverse_of_mass_matrix(model, data)
+}
+
+/// The inverse of the mass matrix in `data.m`, written over it (`data.m2`: its factors).
+pub fn inverse_of_mass_matrix<'d>(model: &Model, data: &'d mut Data) -> Result<&'d [f64]> {
+    let n = model.n;
     ltdl(model, data)?;
     let (l, x, out) = (&data.m2, &mut data.x, &mut data.m);
     for col in 0..n {
