@@ -228,7 +228,6 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
     // E_k(w): how the subtree's wrenches change as coordinate j (axis w) turns it (see above)
     let (ext_f, ext_n, ext_p) = (&data.ext_f[..n], &data.ext_n[..n], &data.ext_p[..n]);
     let wrench_term = |k: usize, w: &Vec3| Force::new(w.cross(&ext_f[k]), w.cross(&ext_n[k]) + w * ext_p[k].trace() - ext_p[k] * w);
-    let f_ext = wrenches.then_some(());
     dtau_dq[..n * n].fill(0.0);
     dtau_dqd[..n * n].fill(0.0);
     for j in 0..n {
@@ -243,7 +242,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
                 continue;
             }
             dtau_dq[k * n + j] = w.dot(&alpha[k]) + u.dot(&(sigma[k] - beta[k]));
-            if f_ext.is_some() {
+            if wrenches {
                 dtau_dq[k * n + j] += s_w[k].dot(&wrench_term(k, &s.ang));
             }
             dtau_dqd[k * n + j] = 2.0 * sdot.dot(&alpha[k]) + s.dot(&(beta[k] - sigma[k]));
@@ -254,7 +253,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
             continue;
         }
         let mut df_q = s.cross_force(&fc[j]) + ic[j].mul_motion(&w) - u.cross_force(&hc[j]) - icd[j].mul_motion(&u);
-        if f_ext.is_some() {
+        if wrenches {
             df_q += wrench_term(j, &s.ang);
         }
         let df_qd = ic[j].mul_motion(&sdot) * 2.0 + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
