@@ -1,4 +1,5 @@
-"""Numeric dynamics helpers that live above the native core: base (identifiable) parameters.
+"""Numeric dynamics helpers that live above the native core: base (identifiable) parameters, and
+the linearisation of the equations of motion about a state (for LQR and other linear design).
 
 The regressor ``Y(q, qd, qdd)`` (n, 10 n) of :meth:`kinedyn.Robot.regressor` is linear in the
 10 standard inertial parameters of every body (``robot.inertial_parameters()``, per body
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BaseParameters", "base_parameters"]
+__all__ = ["BaseParameters", "base_parameters", "linearize"]
 
 
 @dataclass(frozen=True)
@@ -88,3 +89,28 @@ def base_parameters(robot, samples: int = 200, rng=0, tol: float = 1e-9) -> Base
     indices = independent[order]
     names = tuple(f"{robot.body_names[k // 10]}.{PARAMETER_NAMES[k % 10]}" for k in indices)
     return BaseParameters(indices=indices, grouping=grouping, values=grouping @ robot.inertial_parameters(), names=names)
+
+
+def linearize(robot, q, qd=None, tau=None):
+    """``(A, B)`` of ``d/dt [dq; dqd] = A [dq; dqd] + B dtau``: the equations of motion
+    ``qdd = FD(q, qd, tau)`` linearised about ``(q, qd, tau)`` with the analytical derivatives
+    (:meth:`kinedyn.Robot.forward_dynamics_derivatives`)::
+
+        A = [[0, I], [dqdd/dq, dqdd/dqd]],    B = [[0], [M^-1]]
+
+    ``qd`` defaults to zero and ``tau`` to the torque that holds the state without acceleration,
+    ``inverse_dynamics(q, qd, 0)`` (gravity and friction): an equilibrium when ``qd = 0``.
+    A batch of states gives ``(N, 2n, 2n)`` and ``(N, 2n, n)``."""
+    q = np.asarray(q, dtype=np.float64)
+    qd = np.zeros_like(q) if qd is None else np.asarray(qd, dtype=np.float64)
+    if tau is None:
+        tau = robot.inverse_dynamics(q, qd, np.zeros_like(q))
+    dq, dqd, minv = robot.forward_dynamics_derivatives(q, qd, tau)
+    n = robot.n
+    batch = q.shape[:-1]
+    A = np.zeros(batch + (2 * n, 2 * n))
+    A[..., :n, n:] = np.eye(n)
+    A[..., n:, :n], A[..., n:, n:] = dq, dqd
+    B = np.zeros(batch + (2 * n, n))
+    B[..., n:, :] = minv
+    return A, B
