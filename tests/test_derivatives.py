@@ -4,7 +4,6 @@ tree (with drives and external wrenches), batches, and Pinocchio's derivatives a
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -102,11 +101,11 @@ def test_bad_input_is_a_clear_error():
 
 def test_same_derivatives_as_pinocchio():
     pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) is an optional test oracle")
-    from test_pinocchio import CASES, robots_dir  # the same URDFs as the other oracle tests
+    from test_pinocchio import CASES  # the same URDFs as the other oracle tests
 
-    for name in ("ur5", "panda"):
-        rel, locked = CASES[name]
-        path = os.path.join(robots_dir(), rel)
+    for name in ("ur5", "panda", "iiwa"):
+        where, locked = CASES[name]
+        path = where()
         robot = kd.Robot.from_urdf(path)
         model = pin.buildModelFromUrdf(path)
         if locked:

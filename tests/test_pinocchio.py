@@ -1,5 +1,6 @@
-"""Pinocchio as an oracle (an optional test extra): the UR5, Panda and KUKA iiwa URDFs of the
-``example-robot-data`` package give the same tau, M, C, g, qdd, centre of mass and momentum.
+"""Pinocchio as an oracle (an optional test extra): the UR5 and Panda URDFs of the
+``example-robot-data`` package and the KUKA iiwa URDF (example-robot-data has none; pybullet's
+``pybullet_data`` does) give the same tau, M, C, g, qdd, centre of mass and momentum.
 
 URDF ``<dynamics damping friction>`` become kinedyn's joint friction, which Pinocchio's algorithms
 leave out; it is removed from kinedyn's results before comparing.
@@ -29,20 +30,31 @@ def robots_dir() -> str:
     pytest.skip("example-robot-data (pip install example-robot-data) is not installed")
 
 
+def iiwa_urdf() -> str:
+    """The KUKA LBR iiwa 14 URDF: example-robot-data's if a version ships it, else pybullet_data's."""
+    path = os.path.join(robots_dir(), "iiwa_description/urdf/iiwa.urdf")
+    if os.path.exists(path):
+        return path
+    try:
+        import pybullet_data
+    except ImportError:
+        pytest.skip("no KUKA iiwa URDF: example-robot-data has none and pybullet (pybullet_data) is not installed")
+    return os.path.join(pybullet_data.getDataPath(), "kuka_iiwa", "model.urdf")
+
+
 PANDA_FINGERS = {"panda_finger_joint1": 0.02, "panda_finger_joint2": 0.02}
 CASES = {
-    "ur5": ("ur_description/urdf/ur5_robot.urdf", {}),
-    "panda": ("panda_description/urdf/panda.urdf", PANDA_FINGERS),
-    "iiwa": ("iiwa_description/urdf/iiwa.urdf", {}),
+    "ur5": (lambda: os.path.join(robots_dir(), "ur_description/urdf/ur5_robot.urdf"), {}),
+    "panda": (lambda: os.path.join(robots_dir(), "panda_description/urdf/panda.urdf"), PANDA_FINGERS),
+    "iiwa": (iiwa_urdf, {}),
 }
 
 
 @pytest.fixture(params=list(CASES), scope="module")
 def pair(request):
-    rel, locked = CASES[request.param]
-    path = os.path.join(robots_dir(), rel)
-    if not os.path.exists(path):
-        pytest.skip(f"example-robot-data has no {request.param} URDF ({rel})")
+    where, locked = CASES[request.param]
+    path = where()
+    assert os.path.exists(path), path
     robot = kd.Robot.from_urdf(path)
     model = pin.buildModelFromUrdf(path)
     if locked:
