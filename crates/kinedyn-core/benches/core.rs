@@ -13,9 +13,7 @@ fn bench(c: &mut Criterion) {
     for (name, model) in models::all() {
         let n = model.n;
         let mut data = Data::new(&model);
-        let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.7 * i as f64).collect();
-        let qd: Vec<f64> = (0..n).map(|i| 1.1 - 0.4 * i as f64).collect();
-        let qdd: Vec<f64> = (0..n).map(|i| -0.5 + 0.3 * i as f64).collect();
+        let (q, qd, qdd) = models::state(n);
         let tau = alg::rnea(&model, &mut data, &q, &qd, &qdd, None).to_vec();
         let mut out = vec![0.0; 10 * n * n];
         let mut g = c.benchmark_group(name);

@@ -55,9 +55,7 @@ fn main() {
     for (name, model) in models::all() {
         let n = model.n;
         let mut data = Data::new(&model);
-        let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.7 * i as f64).collect();
-        let qd: Vec<f64> = (0..n).map(|i| 1.1 - 0.4 * i as f64).collect();
-        let qdd: Vec<f64> = (0..n).map(|i| -0.5 + 0.3 * i as f64).collect();
+        let (q, qd, qdd) = models::state(n);
         let tau = alg::rnea(&model, &mut data, &q, &qd, &qdd, None).to_vec();
         let d = &mut data;
         let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {

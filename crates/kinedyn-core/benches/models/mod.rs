@@ -58,3 +58,11 @@ pub fn panda() -> Model {
 pub fn all() -> [(&'static str, Model); 2] {
     [("ur5", ur5()), ("panda", panda())]
 }
+
+/// The benchmark state `(q, qd, qdd)` of an n-joint model (the C++ harness uses the same numbers).
+pub fn state(n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let q = (0..n).map(|i| 0.3 + 0.7 * i as f64).collect();
+    let qd = (0..n).map(|i| 1.1 - 0.4 * i as f64).collect();
+    let qdd = (0..n).map(|i| -0.5 + 0.3 * i as f64).collect();
+    (q, qd, qdd)
+}
