@@ -491,10 +491,11 @@ class Robot:
 
     def inverse_dynamics_derivatives(self, q, qd, qdd, f_ext=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dtau/dq, dtau/dqd, dtau/dqdd = M)`` of :meth:`inverse_dynamics`, each (n, n) (or
-        (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical, by differentiating the recursive
-        Newton-Euler algorithm along each coordinate (exact, O(n^2); Pinocchio's
-        ``computeRNEADerivatives``). ``f_ext`` is held fixed in base axes and applied at the link-frame
-        origins, which move with q. Coulomb friction contributes its derivative zero (qd != 0)."""
+        (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical and exact, O(n^2), from one pass
+        in world coordinates (Pinocchio's ``computeRNEADerivatives``; the derivation is in the
+        core's ``derivatives.rs``). ``f_ext`` is held fixed in base axes and applied at the
+        link-frame origins, which move with q. Coulomb friction contributes its derivative, zero
+        (qd != 0)."""
         if f_ext is None:
             return self._model.inverse_dynamics_derivatives(q, qd, qdd)
         q = self._state(q)
