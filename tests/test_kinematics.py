@@ -267,3 +267,10 @@ def test_native_model_rejects_bad_arrays_without_panicking():
     for what, (change, message) in cases.items():
         with pytest.raises(ValueError, match=message):
             _core.Model(**{**good, **change})
+
+
+def test_frame_poses_of_no_frames_is_an_empty_array():
+    """An empty result per state (no frames asked for) is an empty array, for one state or a batch."""
+    robot = kd.robots.ur5()
+    assert robot.frame_poses(np.zeros(6), []).shape == (0, 4, 4)
+    assert robot.frame_poses(np.zeros((3, 6)), []).shape == (3, 0, 4, 4)

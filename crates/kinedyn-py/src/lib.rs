@@ -226,17 +226,18 @@ impl<'a> Batch<'a> {
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
-        let per_state: usize = out_shape.iter().product::<usize>().max(1);
+        // numbers per state (1 for a scalar result, 0 for an empty one such as no frames)
+        let per_state: usize = out_shape.iter().product();
         // the outputs' shape, [N,] + out_shape, in a fixed array (ndarray keeps up to 4 dims inline)
         let (mut dims, mut rank) = ([0usize; 5], 0);
         for d in self.batch.iter().chain(out_shape) {
             dims[rank] = *d;
             rank += 1;
         }
-        // SAFETY: uninitialised memory, not zeros (a 10k-state M batch spent 10 % of its time in the
-        // memset): every kernel writes its whole output slices (its contract, see `kernel` above),
-        // and on an error the arrays are dropped unread. Created here, nothing else refers to them.
-        // (or the caller's checked `out` arrays)
+        // the caller's checked `out` arrays, or fresh ones. SAFETY: fresh arrays are uninitialised
+        // memory, not zeros (a 10k-state M batch spent 10 % of its time in the memset): every kernel
+        // writes its whole output slices (its contract, see `run`), and on an error they are dropped
+        // unread. Created here, nothing else refers to them.
         let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = given.map(|g| g.unwrap_or_else(|| unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) }));
         let total = self.batch.unwrap_or(1) * per_state;
         let mut bases = [OutputBase(std::ptr::null_mut()); K];
