@@ -1,5 +1,4 @@
 use super::Vec3;
-use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 /// A spatial force (wrench) about a frame's origin, in its axes: `lin` is the force, `ang` the
 /// moment about the origin.
@@ -28,45 +27,4 @@ impl Force {
     }
 }
 
-impl Add for Force {
-    type Output = Force;
-    #[inline]
-    fn add(self, o: Force) -> Force {
-        Force::new(self.lin + o.lin, self.ang + o.ang)
-    }
-}
-impl AddAssign for Force {
-    #[inline]
-    fn add_assign(&mut self, o: Force) {
-        self.lin += o.lin;
-        self.ang += o.ang;
-    }
-}
-impl Sub for Force {
-    type Output = Force;
-    #[inline]
-    fn sub(self, o: Force) -> Force {
-        Force::new(self.lin - o.lin, self.ang - o.ang)
-    }
-}
-impl SubAssign for Force {
-    #[inline]
-    fn sub_assign(&mut self, o: Force) {
-        self.lin -= o.lin;
-        self.ang -= o.ang;
-    }
-}
-impl Neg for Force {
-    type Output = Force;
-    #[inline]
-    fn neg(self) -> Force {
-        Force::new(-self.lin, -self.ang)
-    }
-}
-impl Mul<f64> for Force {
-    type Output = Force;
-    #[inline]
-    fn mul(self, s: f64) -> Force {
-        Force::new(self.lin * s, self.ang * s)
-    }
-}
+super::vector_ops!(Force);

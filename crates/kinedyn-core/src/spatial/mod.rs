@@ -13,6 +13,56 @@
 //! | `v x`, `v x*` | `Motion::cross_motion`, `cross_force` | spatial cross products          |
 //! | `I^A`       | `ArticulatedInertia`         | articulated-body inertia (3x3 blocks)     |
 
+/// The vector-space operations shared by `Motion` and `Force` (two `Vec3` halves, `lin` and `ang`):
+/// `+`, `+=`, `-`, `-=`, unary `-` and `* f64`, component by component.
+macro_rules! vector_ops {
+    ($t:ident) => {
+        impl std::ops::Add for $t {
+            type Output = $t;
+            #[inline]
+            fn add(self, o: $t) -> $t {
+                $t::new(self.lin + o.lin, self.ang + o.ang)
+            }
+        }
+        impl std::ops::AddAssign for $t {
+            #[inline]
+            fn add_assign(&mut self, o: $t) {
+                self.lin += o.lin;
+                self.ang += o.ang;
+            }
+        }
+        impl std::ops::Sub for $t {
+            type Output = $t;
+            #[inline]
+            fn sub(self, o: $t) -> $t {
+                $t::new(self.lin - o.lin, self.ang - o.ang)
+            }
+        }
+        impl std::ops::SubAssign for $t {
+            #[inline]
+            fn sub_assign(&mut self, o: $t) {
+                self.lin -= o.lin;
+                self.ang -= o.ang;
+            }
+        }
+        impl std::ops::Neg for $t {
+            type Output = $t;
+            #[inline]
+            fn neg(self) -> $t {
+                $t::new(-self.lin, -self.ang)
+            }
+        }
+        impl std::ops::Mul<f64> for $t {
+            type Output = $t;
+            #[inline]
+            fn mul(self, s: f64) -> $t {
+                $t::new(self.lin * s, self.ang * s)
+            }
+        }
+    };
+}
+use vector_ops;
+
 mod articulated;
 mod axis_rotation;
 mod force;

@@ -1,5 +1,4 @@
 use super::{Force, Vec3};
-use std::ops::{Add, AddAssign, Mul, Neg, Sub};
 
 /// A spatial motion vector (twist, acceleration or joint axis) at a frame's origin, in its axes:
 /// `lin` is the velocity of the body point at the origin, `ang` the angular velocity.
@@ -44,38 +43,4 @@ impl Motion {
     }
 }
 
-impl Add for Motion {
-    type Output = Motion;
-    #[inline]
-    fn add(self, o: Motion) -> Motion {
-        Motion::new(self.lin + o.lin, self.ang + o.ang)
-    }
-}
-impl AddAssign for Motion {
-    #[inline]
-    fn add_assign(&mut self, o: Motion) {
-        self.lin += o.lin;
-        self.ang += o.ang;
-    }
-}
-impl Sub for Motion {
-    type Output = Motion;
-    #[inline]
-    fn sub(self, o: Motion) -> Motion {
-        Motion::new(self.lin - o.lin, self.ang - o.ang)
-    }
-}
-impl Neg for Motion {
-    type Output = Motion;
-    #[inline]
-    fn neg(self) -> Motion {
-        Motion::new(-self.lin, -self.ang)
-    }
-}
-impl Mul<f64> for Motion {
-    type Output = Motion;
-    #[inline]
-    fn mul(self, s: f64) -> Motion {
-        Motion::new(self.lin * s, self.ang * s)
-    }
-}
+super::vector_ops!(Motion);
