@@ -66,17 +66,17 @@ def cmd_identify(args) -> int:
 
 
 def add_analysis_commands(subparsers) -> None:
+    from ..cli import _robot_arg
+
     p = subparsers.add_parser("check", help="properties of the equations of motion, each with its residual (Spong §9.5)")
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
+    _robot_arg(p)
     p.add_argument("--samples", type=int, default=200, help="random states (default 200)")
     p.add_argument("--t", type=float, default=2.0, help="length of the passivity trajectory in seconds (default 2)")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=cmd_check)
 
     p = subparsers.add_parser("identify", help="identify the base inertial parameters from a simulated Fourier excitation")
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
+    _robot_arg(p)
     p.add_argument("--noise", type=float, default=0.0, help="torque noise standard deviation, N m (default 0)")
     p.add_argument("--harmonics", type=int, default=5)
     p.add_argument("--period", type=float, default=10.0, help="period of the excitation, s (default 10)")

@@ -72,9 +72,10 @@ def cmd_simulate(args) -> int:
 
 
 def add_simulate_commands(subparsers) -> None:
+    from ..cli import _robot_arg
+
     p = subparsers.add_parser("simulate", help="simulate a robot under a controller (RK4 in the native core by default)")
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
+    _robot_arg(p)
     p.add_argument("--t", type=float, default=5.0, help="simulated time in seconds (default 5)")
     p.add_argument("--dt", type=float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
     p.add_argument("--method", default="rk4", help="rk4, semi_implicit, euler, rk45, rk23, dop853, radau, bdf, lsoda (default rk4)")
