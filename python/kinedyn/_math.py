@@ -52,8 +52,10 @@ def as_value(x: Any) -> Any:
     """A scalar as a float when it is a plain number, else as a SymPy expression."""
     if isinstance(x, sp.Basic):
         return float(x) if x.is_number and x.is_real is not False and not x.free_symbols else x
-    if isinstance(x, str):
-        return sp.sympify(x)
+    if isinstance(x, str):  # read as data by kinedyn's own parser, never evaluated as Python
+        from .description.expressions import parse_expression
+
+        return parse_expression(x)
     return float(x)
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import reprlib
 import tomllib
 from typing import Any, Optional
 
@@ -26,6 +27,7 @@ import yaml
 
 from .._math import as_value, is_symbolic, matmul, pose_inverse, rpy_to_matrix, translation
 from .dh import DHRow, links_from_dh
+from .expressions import parse_expression
 from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
@@ -44,9 +46,14 @@ _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _POSE_KEYS = {"xyz", "rpy"}
 _FRAME_KEYS = {"name", "link", "origin"}
 _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-# names SymPy would otherwise read as constants or functions (I = sqrt(-1), E, S, N, O, Q, beta...)
-_LOCALS = {n: sp.Symbol(n) for n in ("I", "E", "S", "N", "O", "Q", "beta", "gamma", "zeta")}
-_EXPRESSION = re.compile(r"^[A-Za-z0-9_.+\-*/() ]+$")
+
+# Bounds on a robot file, so that a small hostile file cannot ask for unbounded time or memory
+MAX_FILE_BYTES = 16 * 2**20  # a robot file is text a person writes: 16 MiB is far beyond any robot
+MAX_NESTING = 32  # mappings and lists inside each other (a robot file needs 5)
+MAX_NODES = 1_000_000  # YAML nodes composed, counting every use of an alias as the nodes it repeats
+MAX_TEXT = 1000  # characters of a name or other text field
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 40, 40, 4, 4
 
 
 # ============================================================================ public functions
@@ -61,11 +68,7 @@ def load(path, **kwargs):
         return robot_from_urdf(path, **kwargs)
     if ext not in (".yaml", ".yml", ".toml"):
         raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .yaml, .yml or .toml)")
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except OSError as e:
-        raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None
+    text = _read_text(path)
     data = _parse_toml(text, path) if ext == ".toml" else _parse_yaml(text, path)
     robot = robot_from_mapping(data, where=path)
     return robot.replace(**kwargs) if kwargs else robot
@@ -86,62 +89,249 @@ def save(robot, path) -> None:
         f.write(text)
 
 
-def _parse_yaml(text: str, where: str):
+def _read_text(path: str) -> str:
+    """The file's text, refusing files too large to be a robot description before reading them."""
     try:
-        return yaml.safe_load(text)
+        with open(path, "rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)
+    except OSError as e:
+        raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ValueError(f"{path}: the file is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot file")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{path}: the file is not UTF-8 text (byte {e.start})") from None
+
+
+# ---------------------------------------------------------------- YAML, bounded
+class _LineDict(dict):
+    """A mapping read from YAML that remembers the line of each key (1-based), for messages."""
+
+    lines: dict
+
+
+class _LineList(list):
+    """A list read from YAML that remembers the line of each item (1-based), for messages."""
+
+    lines: list
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """PyYAML's safe loader (plain data only: no Python objects) with three changes:
+
+    - nesting deeper than ``MAX_NESTING`` is an error (PyYAML's composer recurses);
+    - the size of the document is bounded with every alias counted as the nodes it repeats, so a
+      small file of aliases to aliases (a "billion laughs") fails at once instead of filling memory;
+    - a key given twice in one mapping is an error (YAML 1.2 forbids it; PyYAML keeps the last).
+    """
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+        self._expanded = 0  # nodes composed so far, aliases counted as what they repeat
+        self._size_of: dict = {}  # id(anchored node) -> its expanded size
+
+    def _refuse(self, problem: str, mark):
+        raise yaml.composer.ComposerError(None, None, problem, mark)
+
+    def compose_node(self, parent, index):
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            node = self.anchors.get(event.anchor)
+            if node is not None:
+                if id(node) not in self._size_of:
+                    self._refuse(f"the alias *{event.anchor} refers to a node that contains it", event.start_mark)
+                self._count(self._size_of[id(node)], event.start_mark)
+            return super().compose_node(parent, index)
+        self._depth += 1
+        if self._depth > MAX_NESTING:
+            self._refuse(f"mappings and lists are nested more than {MAX_NESTING} deep", event.start_mark)
+        before = self._expanded
+        self._count(1, event.start_mark)
+        node = super().compose_node(parent, index)
+        self._depth -= 1
+        self._size_of[id(node)] = self._expanded - before
+        return node
+
+    def _count(self, nodes: int, mark):
+        self._expanded += nodes
+        if self._expanded > MAX_NODES:
+            self._refuse(f"the document expands to more than {MAX_NODES} values (aliases counted as what they repeat)", mark)
+
+    def construct_line_mapping(self, node):
+        data = _LineDict()
+        data.lines = {}
+        yield data
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":  # "<<: *anchor": merged keys may be overridden
+                continue
+            key = self.construct_object(key_node, deep=True)
+            try:
+                repeated = key in data.lines
+            except TypeError:
+                raise yaml.constructor.ConstructorError(None, None, "a mapping key must be a plain value", key_node.start_mark) from None
+            if repeated:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {_REPR.repr(key)} appears twice in one mapping (first on line {data.lines[key]})", key_node.start_mark
+                )
+            data.lines[key] = key_node.start_mark.line + 1
+        data.update(self.construct_mapping(node, deep=True))
+
+    def construct_line_sequence(self, node):
+        data = _LineList()
+        data.lines = [item.start_mark.line + 1 for item in node.value]
+        yield data
+        data.extend(self.construct_sequence(node, deep=True))
+
+
+_BoundedLoader.add_constructor("tag:yaml.org,2002:map", _BoundedLoader.construct_line_mapping)
+_BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct_line_sequence)
+
+
+def _parse_yaml(text: str, where: str):
+    loader = _BoundedLoader(text)
+    try:
+        return loader.get_single_data()
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
         line = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
         raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
     except yaml.YAMLError as e:
         raise ValueError(f"{where}: invalid YAML: {e}") from None
+    finally:
+        loader.dispose()
+
+
+_TOML_STRING_OR_COMMENT = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*')
+_TOML_KEY = re.compile(r"(?:^|[{,])([^={},\[\]\n]*)=|^\s*\[\[?([^\]\n]*)\]", re.M)
+
+
+def _toml_key_depth(text: str) -> int:
+    """The most parts of one dotted key (``a.b.c`` has 3) in TOML text. tomllib's time grows with the
+    square of a key's parts, so this linear scan runs first; strings and comments are blanked so
+    that their dots do not count, and a float's dot is never in a key position."""
+    bare = _TOML_STRING_OR_COMMENT.sub("s", text)
+    return max((1 + (m.group(1) or m.group(2) or "").count(".") for m in _TOML_KEY.finditer(bare)), default=0)
 
 
 def _parse_toml(text: str, where: str):
+    depth = _toml_key_depth(text)
+    if depth > MAX_NESTING:
+        raise ValueError(f"{where}: a dotted key has {depth} parts, tables nested more than {MAX_NESTING} deep")
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:  # the message ends with "(at line L, column C)"
         raise ValueError(f"{where}: invalid TOML: {e}") from None
+    except (RecursionError, MemoryError):  # tomllib recurses into nested arrays and inline tables
+        raise ValueError(f"{where}: invalid TOML: arrays or tables nested too deep") from None
+    depth = _nesting(data)
+    if depth > MAX_NESTING:
+        raise ValueError(f"{where}: tables and arrays are nested {depth} deep (at most {MAX_NESTING})")
+    return data
+
+
+def _nesting(data) -> int:
+    """How deep mappings and lists nest in ``data`` (iterative: the data may be deeper than the stack)."""
+    deepest, stack = 0, [(data, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, (dict, list)):
+            deepest = max(deepest, depth)
+            if depth > MAX_NESTING:
+                break
+            stack.extend((v, depth + 1) for v in (item.values() if isinstance(item, dict) else item))
+    return deepest
 
 
 # ============================================================================ reading a mapping
 class _Reader:
-    """Converts values of one robot file, knowing where it is (for messages) and its angle unit."""
+    """Converts values of one robot file, knowing where it is (for messages), the line of each field
+    (YAML) and the file's angle unit."""
 
     def __init__(self, where: str):
         self.where = where
         self.deg = False
+        self.lines: dict = {}  # field path (as in messages) -> line, where the parser knew it
 
     def fail(self, ctx: str, message: str):
-        raise ValueError(f"{self.where}: {ctx}: {message}")
+        line = self.line_of(ctx)
+        at = f", line {line}" if line else ""
+        raise ValueError(f"{self.where}{at}: {ctx}: {message}")
+
+    def line_of(self, ctx: str) -> Optional[int]:
+        """The line of field ``ctx`` or of the nearest field that holds it."""
+        while ctx:
+            if ctx in self.lines:
+                return self.lines[ctx]
+            cut = max(ctx.rfind("."), ctx.rfind("["))
+            if cut <= 0:
+                return None
+            ctx = ctx[:cut]
+        return None
+
+    def remember_lines(self, container, ctx: str, keys=None) -> None:
+        """Note the lines of a YAML mapping's keys (``ctx.key``) or a list's items (``ctx[i]``)."""
+        if isinstance(container, _LineDict):
+            for key, line in container.lines.items():
+                self.lines.setdefault(f"{ctx}.{key}" if ctx else str(key), line)
+        elif isinstance(container, _LineList):
+            for i, line in enumerate(container.lines):
+                self.lines.setdefault(f"{ctx}[{i}]", line)
+                if keys is not None:
+                    self.lines.setdefault(keys(i), line)
 
     def check_keys(self, mapping, known: set, ctx: str) -> dict:
         if not isinstance(mapping, dict):
-            self.fail(ctx, f"expected a mapping, got {type(mapping).__name__}")
+            self.fail(ctx, f"expected a mapping, got {_kind(mapping)}")
+        self.remember_lines(mapping, "" if ctx == "top level" else ctx)
         for key in mapping:
             if key not in known:
-                self.fail(ctx, f"unknown key '{key}' (known keys: {', '.join(sorted(known))})")
+                self.fail(ctx, f"unknown key {_REPR.repr(key)} (known keys: {', '.join(sorted(known))})")
         return mapping
 
-    def value(self, raw, ctx: str):
-        """A float, or a SymPy expression for a string that is not a number."""
+    def items(self, raw, ctx: str, what: str, row_ctx) -> list:
+        """A list from the file (``what`` says what it should hold), its items' lines noted under
+        ``row_ctx(i)``, the context each item is read in."""
+        if not isinstance(raw, list):
+            self.fail(ctx, f"expected a list of {what}, got {_kind(raw)}")
+        self.remember_lines(raw, ctx, row_ctx)
+        return raw
+
+    def text(self, raw, ctx: str) -> str:
+        """A name or other short text (numbers are read as their text)."""
+        if isinstance(raw, bool) or not isinstance(raw, (str, int, float)):
+            self.fail(ctx, f"expected a name (text), got {_kind(raw)}")
+        out = str(raw)
+        if not out or len(out) > MAX_TEXT:
+            self.fail(ctx, f"expected a name of 1 to {MAX_TEXT} characters, got {len(out)}")
+        return out
+
+    def value(self, raw, ctx: str, infinite: bool = False):
+        """A finite float, or a SymPy expression for a string that is not a number (read by kinedyn's
+        own parser: numbers, names, arithmetic and a fixed table of functions, never evaluated as
+        code). ``infinite``: +-inf is allowed (a limit that is not set)."""
         if isinstance(raw, bool) or raw is None:
             self.fail(ctx, f"expected a number or an expression, got {raw!r}")
-        if isinstance(raw, (int, float)):
-            return float(raw)
+        if isinstance(raw, int):
+            if raw.bit_length() > 1000:
+                self.fail(ctx, f"the integer has about {int(raw.bit_length() * math.log10(2))} digits, too large for a robot's parameter")
+            raw = float(raw)
+        if isinstance(raw, float):
+            if math.isnan(raw) or (math.isinf(raw) and not infinite):
+                self.fail(ctx, f"must be a finite number, got {raw}")
+            return raw
         if isinstance(raw, str):
-            if not _EXPRESSION.match(raw) or "__" in raw:
-                self.fail(ctx, f"'{raw}' is not a number or an arithmetic expression of symbols")
             try:
-                return as_value(sp.sympify(raw, locals=_LOCALS))
-            except (sp.SympifyError, SyntaxError, TypeError) as e:
-                self.fail(ctx, f"cannot read '{raw}' as a number or expression ({e})")
-        self.fail(ctx, f"expected a number or an expression, got {type(raw).__name__}")
+                return parse_expression(raw)
+            except ValueError as e:
+                self.fail(ctx, str(e))
+        self.fail(ctx, f"expected a number or an expression, got {_kind(raw)}")
 
-    def number(self, raw, ctx: str) -> float:
-        v = self.value(raw, ctx)
+    def number(self, raw, ctx: str, infinite: bool = False) -> float:
+        v = self.value(raw, ctx, infinite)
         if isinstance(v, sp.Basic):
-            self.fail(ctx, f"must be a number, got the expression '{raw}'")
+            self.fail(ctx, f"must be a number, got the expression '{_REPR.repr(raw)[1:-1]}'")
         return v
 
     def angle(self, raw, ctx: str):
@@ -152,7 +342,8 @@ class _Reader:
 
     def vector(self, raw, ctx: str, n: int = 3, angles: bool = False) -> tuple:
         if not isinstance(raw, (list, tuple)) or len(raw) != n:
-            self.fail(ctx, f"expected a list of {n} values, got {raw!r}")
+            self.fail(ctx, f"expected a list of {n} values, got {_REPR.repr(raw)}")
+        self.remember_lines(raw, ctx)
         f = self.angle if angles else self.value
         return tuple(f(v, f"{ctx}[{i}]") for i, v in enumerate(raw))
 
@@ -168,10 +359,10 @@ class _Reader:
         out = {}
         for key, field in (("lower", "lower"), ("upper", "upper"), ("velocity", "velocity_limit")):
             if key in raw:
-                v = self.number(raw[key], f"{ctx}.{key}")
+                v = self.number(raw[key], f"{ctx}.{key}", infinite=True)
                 out[field] = v * math.pi / 180 if (revolute and self.deg) else v
         if "effort" in raw:
-            out["effort_limit"] = self.number(raw["effort"], f"{ctx}.effort")
+            out["effort_limit"] = self.number(raw["effort"], f"{ctx}.effort", infinite=True)
         return out
 
     def inertia(self, raw: dict, ctx: str) -> Inertia:
@@ -207,12 +398,12 @@ def robot_from_mapping(data, where: str = "<robot mapping>"):
     r.check_keys(data, _TOP_DH if dh else _TOP_TREE, "top level")
     units = r.check_keys(data.get("units", {}), {"angle"}, "units")
     if units.get("angle", "rad") not in ("deg", "rad"):
-        r.fail("units.angle", f"must be 'deg' or 'rad', got {units['angle']!r}")
+        r.fail("units.angle", f"must be 'deg' or 'rad', got {_REPR.repr(units['angle'])}")
     r.deg = units.get("angle") == "deg"
     common = {
         "gravity": r.vector(data.get("gravity", [0, 0, -9.81]), "gravity"),
-        "name": str(data.get("name", "robot")),
-        "source": str(data.get("source", where)),
+        "name": r.text(data.get("name", "robot"), "name"),
+        "source": r.text(data.get("source", where), "source"),
     }
     frames = _frames(r, data.get("frames", []))
     try:
@@ -224,16 +415,15 @@ def robot_from_mapping(data, where: str = "<robot mapping>"):
 
 
 def _frames(r: _Reader, raw) -> list:
-    if not isinstance(raw, list):
-        r.fail("frames", "expected a list of {name, link, origin}")
     out = []
-    for i, f in enumerate(raw):
+    for i, f in enumerate(r.items(raw, "frames", "{name, link, origin}", lambda i: f"frames[{i}]")):
         ctx = f"frames[{i}]"
         f = r.check_keys(f, _FRAME_KEYS, ctx)
         if "name" not in f:
             r.fail(ctx, "a frame needs a 'name'")
         origin = r.pose(f["origin"], f"{ctx}.origin") if "origin" in f else np.eye(4)
-        out.append(Frame(str(f["name"]), f.get("link"), origin))
+        link = r.text(f["link"], f"{ctx}.link") if f.get("link") is not None else None
+        out.append(Frame(r.text(f["name"], f"{ctx}.name"), link, origin))
     return out
 
 
@@ -242,15 +432,17 @@ def _dh_robot(r: _Reader, data: dict, common: dict, frames: list):
 
     convention = data.get("convention", "standard")
     if convention not in ("standard", "modified"):
-        r.fail("convention", f"must be 'standard' or 'modified', got {convention!r}")
-    if not isinstance(data["joints"], list) or not data["joints"]:
+        r.fail("convention", f"must be 'standard' or 'modified', got {_REPR.repr(convention)}")
+    joints = r.items(data["joints"], "joints", "DH rows", lambda i: f"joints row {i + 1}")
+    if not joints:
         r.fail("joints", "expected a non-empty list of DH rows")
-    rows = [_dh_row(r, row, i) for i, row in enumerate(data["joints"])]
+    rows = [_dh_row(r, row, i) for i, row in enumerate(joints)]
     base_pose = r.pose(data["base_pose"], "base_pose") if "base_pose" in data else None
     tool = r.pose(data["tool"], "tool") if "tool" in data else None
     robot = Robot.from_dh(rows, convention, base_pose=base_pose, tool=tool, **common)
     if frames or "tool_frame" in data:
-        robot = robot.replace(frames=robot.frames + tuple(frames), tool=data.get("tool_frame", "tool"))
+        tool_frame = r.text(data["tool_frame"], "tool_frame") if "tool_frame" in data else "tool"
+        robot = robot.replace(frames=robot.frames + tuple(frames), tool=tool_frame)
     return robot
 
 
@@ -259,7 +451,7 @@ def _dh_row(r: _Reader, row, i: int) -> DHRow:
     row = r.check_keys(row, _ROW_KEYS, ctx)
     kind = row.get("type", "revolute")
     if kind not in ("revolute", "prismatic"):
-        r.fail(f"{ctx}.type", f"must be 'revolute' or 'prismatic', got {kind!r}")
+        r.fail(f"{ctx}.type", f"must be 'revolute' or 'prismatic', got {_REPR.repr(kind)}")
     limits = r.limits(row.get("limits", {}), kind == "revolute", f"{ctx}.limits")
     return DHRow(
         theta=r.angle(row.get("theta", 0.0), f"{ctx}.theta"),
@@ -267,7 +459,7 @@ def _dh_row(r: _Reader, row, i: int) -> DHRow:
         a=r.value(row.get("a", 0.0), f"{ctx}.a"),
         alpha=r.angle(row.get("alpha", 0.0), f"{ctx}.alpha"),
         kind=kind,
-        name=None if row.get("name") is None else str(row["name"]),
+        name=None if row.get("name") is None else r.text(row["name"], f"{ctx}.name"),
         inertia=r.inertia(row, ctx),
         **limits,
         **r.drive(row, ctx),
@@ -277,13 +469,14 @@ def _dh_row(r: _Reader, row, i: int) -> DHRow:
 def _tree_robot(r: _Reader, data: dict, common: dict, frames: list):
     from ..robot import Robot
 
-    if not isinstance(data["links"], list) or not data["links"]:
+    raw_links = r.items(data["links"], "links", "links", lambda i: f"links row {i + 1}")
+    if not raw_links:
         r.fail("links", "expected a non-empty list of links")
-    links = [_tree_link(r, link, i) for i, link in enumerate(data["links"])]
+    links = [_tree_link(r, link, i) for i, link in enumerate(raw_links)]
     tool = data.get("tool")
     if tool is not None and not isinstance(tool, str):
         r.fail("tool", "in a tree-based file 'tool' names a frame or link")
-    return Robot(links, frames, base=str(data.get("base", "base")), tool=tool, **common)
+    return Robot(links, frames, base=r.text(data.get("base", "base"), "base"), tool=tool, **common)
 
 
 def _tree_link(r: _Reader, raw, i: int) -> Link:
@@ -291,15 +484,20 @@ def _tree_link(r: _Reader, raw, i: int) -> Link:
     raw = r.check_keys(raw, _LINK_KEYS, ctx)
     if "name" not in raw:
         r.fail(ctx, "a link needs a 'name'")
-    ctx = f"{ctx} ('{raw['name']}')"
+    name = r.text(raw["name"], f"{ctx}.name")
+    row_line = r.line_of(ctx)
+    ctx = f"{ctx} ('{name}')"
+    if row_line:
+        r.lines[ctx] = row_line
+    r.remember_lines(raw, ctx)
     j = r.check_keys(raw.get("joint", {"type": "fixed"}), _JOINT_KEYS, f"{ctx}.joint")
     kind = j.get("type", "revolute")
     if kind not in ("revolute", "continuous", "prismatic", "fixed"):
-        r.fail(f"{ctx}.joint.type", f"must be revolute, continuous, prismatic or fixed, got {kind!r}")
+        r.fail(f"{ctx}.joint.type", f"must be revolute, continuous, prismatic or fixed, got {_REPR.repr(kind)}")
     revolute = kind in ("revolute", "continuous")
     offset_reader = r.angle if revolute else r.value
     joint = Joint(
-        name=str(j.get("name", f"{raw['name']}_joint")),
+        name=r.text(j.get("name", f"{name}_joint"), f"{ctx}.joint.name"),
         kind=kind,
         axis=r.vector(j.get("axis", [0, 0, 1]), f"{ctx}.joint.axis"),
         offset=offset_reader(j.get("offset", 0.0), f"{ctx}.joint.offset"),
@@ -309,7 +507,8 @@ def _tree_link(r: _Reader, raw, i: int) -> Link:
     placement = r.pose(j["origin"], f"{ctx}.joint.origin") if "origin" in j else np.eye(4)
     post = r.pose(raw["post"], f"{ctx}.post") if "post" in raw else np.eye(4)
     inertial = r.check_keys(raw.get("inertial", {}), _INERTIAL_KEYS, f"{ctx}.inertial")
-    return Link(str(raw["name"]), raw.get("parent"), joint, placement, post, r.inertia(inertial, f"{ctx}.inertial"))
+    parent = r.text(raw["parent"], f"{ctx}.parent") if raw.get("parent") is not None else None
+    return Link(name, parent, joint, placement, post, r.inertia(inertial, f"{ctx}.inertial"))
 
 
 # ============================================================================ writing a mapping
@@ -467,3 +666,8 @@ def _tree_mapping(robot) -> dict:
     if robot.frames:
         out["frames"] = _frames_mapping(robot.frames)
     return out
+
+
+def _kind(raw) -> str:
+    """A short description of a value from a file, for messages (never its whole text)."""
+    return f"{type(raw).__name__} {_REPR.repr(raw)}"

@@ -21,6 +21,7 @@ from typing import Sequence
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
+from ..description.expressions import parse_expression
 from .eom import EquationsOfMotion, Step
 from .render import lagrangian, name, of_q
 from .simplify import simplify_trig
@@ -64,9 +65,10 @@ def _scalar(value, what: str, names: dict) -> sp.Expr:
     """One scalar SymPy expression from an expression, a number or a string, or a ValueError naming
     ``what``; in a string the coordinate and velocity names are the system's own symbols (``names``)."""
     try:
-        e = sp.sympify(value, locals=names) if isinstance(value, str) else sp.sympify(value)
-    except (sp.SympifyError, TypeError) as err:
-        raise ValueError(f"{what} could not be read as an expression: {value!r} ({err.__class__.__name__})") from None
+        e = parse_expression(value, names) if isinstance(value, str) else sp.sympify(value)
+    except (sp.SympifyError, TypeError, ValueError) as err:
+        raise ValueError(f"{what} could not be read as an expression: {value!r} ({err})") from None
+    e = sp.sympify(e)
     if isinstance(e, sp.MatrixBase) and e.shape == (1, 1):
         e = e[0, 0]
     if not isinstance(e, sp.Expr):
@@ -173,7 +175,7 @@ class LagrangianSystem:
         rep, fun_rep = self._rep
         if isinstance(e, (list, tuple)):
             return [self._sub(x) for x in e]
-        e = sp.sympify(e, locals=self._names) if isinstance(e, str) else sp.sympify(e)
+        e = sp.sympify(parse_expression(e, self._names)) if isinstance(e, str) else sp.sympify(e)
         if rep:
             e = e.xreplace(rep).xreplace(fun_rep) if not isinstance(e, sp.MatrixBase) else e.xreplace(rep).xreplace(fun_rep)
         return e
