@@ -249,3 +249,16 @@ def test_parse_number_refuses_names_and_reads_constants():
         parse_number("2*l1")
     with pytest.raises(ValueError, match="'sin' is a function"):
         parse_expression("sin")
+
+
+def test_values_given_as_text_to_subs_are_parsed_not_evaluated(tmp_path):
+    robot = kd.load(os.path.join(ROOT, "examples", "robots", "two_link_symbolic.yaml"))
+    name = sorted(map(str, robot.symbols))[0]
+    marker = tmp_path / "code-ran"
+    with pytest.raises(ValueError, match="not a known function"):
+        robot.subs({name: "exec(chr(49))"})
+    with pytest.raises(ValueError):
+        robot.subs({name: _exec_expression(marker)})
+    assert not marker.exists()
+    numeric = robot.subs({s: "pi/4" for s in map(str, robot.symbols)})
+    assert not numeric.symbols

@@ -182,6 +182,7 @@ def by_name(mapping, symbols) -> dict:
     """``{symbol: value}`` from a mapping keyed by SymPy symbols or by names. A name is matched to the
     symbol of that name among ``symbols`` whatever its assumptions (``"m1"`` finds
     ``Symbol("m1", positive=True)``, which ``Symbol("m1")`` would not equal); other names become plain
-    symbols."""
+    symbols. A value given as text is read by kinedyn's expression parser (SymPy's ``subs`` would
+    hand it to ``eval``)."""
     named = {s.name: s for s in symbols if isinstance(s, sp.Symbol)}
-    return {(named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): v for k, v in dict(mapping).items()}
+    return {(named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): (as_value(v) if isinstance(v, str) else v) for k, v in dict(mapping).items()}
