@@ -670,4 +670,5 @@ def _tree_mapping(robot) -> dict:
 
 def _kind(raw) -> str:
     """A short description of a value from a file, for messages (never its whole text)."""
-    return f"{type(raw).__name__} {_REPR.repr(raw)}"
+    kind = "mapping" if isinstance(raw, dict) else "list" if isinstance(raw, list) else type(raw).__name__
+    return f"{kind} {_REPR.repr(dict(raw) if isinstance(raw, dict) else list(raw) if isinstance(raw, list) else raw)}"
