@@ -17,7 +17,8 @@ import sympy as sp
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.joint import Joint
-from .description.link import Frame, KinematicTree, Link, build_tree
+from .description.checks import vector
+from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
 
 __all__ = ["Robot"]
 
@@ -54,15 +55,15 @@ class Robot:
         dh: Optional[Sequence[DHRow]] = None,
         dh_convention: Optional[str] = None,
         source: str = "",
+        inertia: str = "warn",
     ):
         self.name = name
-        self.links = tuple(links)
+        # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
+        self.links, self.nonphysical = judge_inertias(links, inertia)
+        self.inertia_policy = inertia
         self.frames = tuple(frames)
         self.base = base
-        g = tuple(as_value(v) for v in gravity)
-        if len(g) != 3:
-            raise ValueError(f"gravity must have 3 components, got {len(g)}")
-        self.gravity = g
+        self.gravity = vector(gravity, 3, "gravity")
         self.dh = tuple(dh) if dh is not None else None
         self.dh_convention = dh_convention
         self.source = source
@@ -104,11 +105,14 @@ class Robot:
         return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source)
 
     @classmethod
-    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None) -> "Robot":
-        """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`)."""
+    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+        """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
+        ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
+        ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
+        or ``"strict"`` (ValueError); see docs/model-files.md."""
         from .description.urdf import robot_from_urdf
 
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
@@ -122,6 +126,7 @@ class Robot:
             dh=self.dh,
             dh_convention=self.dh_convention,
             source=self.source,
+            inertia=self.inertia_policy,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
@@ -446,6 +451,9 @@ class Robot:
         if match and int(match.group(1)) < self.n:
             name = self.joint_names[int(match.group(1))]
             message = message.replace(match.group(0), f"{match.group(0)} ('{name}')", 1)
+        if self.nonphysical:
+            bad = "; ".join(f"link '{k}': {v}" for k, v in self.nonphysical.items())
+            message += f" (this robot has inertias no rigid body has, kept by inertia='warn': {bad}; load it with inertia='repair')"
         return RuntimeError(f"robot '{self.name}': {message}")
 
     @staticmethod
@@ -600,10 +608,12 @@ class Robot:
         lo = self.lower_limits.copy()
         hi = self.upper_limits.copy()
         for i, j in enumerate(self.joints):
+            # an infinite side is replaced by one span beyond the finite side (or -span..span):
+            # a one-sided limit such as lower=5 (upper inf) must not give lo > hi
             span = math.pi if j.kind == "revolute" else 1.0
             if not math.isfinite(lo[i]):
-                lo[i] = -span
+                lo[i] = min(-span, hi[i] - 2 * span) if math.isfinite(hi[i]) else -span
             if not math.isfinite(hi[i]):
-                hi[i] = span
+                hi[i] = max(span, lo[i] + 2 * span)
         shape = (self.n,) if size is None else (size, self.n)
         return rng.uniform(lo, hi, size=shape)
