@@ -449,12 +449,25 @@ class Robot:
         message = str(error)
         match = re.search(r"joint (\d+)", message)
         if match and int(match.group(1)) < self.n:
-            name = self.joint_names[int(match.group(1))]
+            joint = int(match.group(1))
+            name = self.joint_names[joint]
             message = message.replace(match.group(0), f"{match.group(0)} ('{name}')", 1)
-        if self.nonphysical:
-            bad = "; ".join(f"link '{k}': {v}" for k, v in self.nonphysical.items())
-            message += f" (this robot has inertias no rigid body has, kept by inertia='warn': {bad}; load it with inertia='repair')"
+            message += self._nonphysical_note(joint)
         return RuntimeError(f"robot '{self.name}': {message}")
+
+    def _nonphysical_note(self, joint: int) -> str:
+        """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
+        positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
+        subtree = {joint}
+        for i in range(joint + 1, self.n):  # parent[i] < i
+            if self.parents[i] in subtree:
+                subtree.add(i)
+        bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
+               if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive]
+        if not bad:
+            return ""
+        return (f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
+                f"{', '.join(bad)}; load the robot with inertia='repair'")
 
     @staticmethod
     def _scalar(x):

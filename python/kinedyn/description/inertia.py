@@ -307,8 +307,9 @@ def judge(inertia: Inertia, policy: str, what: str) -> Inertia:
             _WARNED.add(key)
         return repaired
     if key not in _WARNED:
-        hint = "" if policy == "strict" else "; forward dynamics and simulation may fail or be wrong (inertia='repair' fixes it)"
-        warnings.warn(f"{what}: {check.describe()}: no rigid body has this inertia (kept as given{hint})",
+        hint = "" if policy == "strict" or check.positive else (
+            "; forward dynamics, M^-1 and simulation may fail (inertia='repair' projects it onto a consistent one)")
+        warnings.warn(f"{what}: {check.describe()}: no rigid body has this inertia, kept as given{hint}",
                       PhysicalConsistencyWarning, stacklevel=3)
         _WARNED.add(key)
     return inertia

@@ -129,7 +129,7 @@ def judge_inertias(links, policy: str) -> tuple:
     """``(links, nonphysical)``: each link's inertia judged by the inertia policy (``"warn"``,
     ``"repair"``, ``"strict"``: see :func:`kinedyn.description.inertia.judge`), repaired links
     replaced; ``nonphysical`` maps the name of each link kept with an inertia no rigid body has to
-    the reason (for the errors of forward dynamics and simulation)."""
+    its :class:`~kinedyn.description.inertia.Consistency` (for the errors of forward dynamics)."""
     out, nonphysical = [], {}
     for link in links:
         inertia = judge(link.inertia, policy, f"link '{link.name}'")
@@ -137,7 +137,7 @@ def judge_inertias(links, policy: str) -> tuple:
             link = Link(link.name, link.parent, link.joint, link.placement, link.post, inertia)
         check = inertia.consistency()
         if check is not None and not check.ok:
-            nonphysical[link.name] = check.describe()
+            nonphysical[link.name] = check
         out.append(link)
     return tuple(out), nonphysical
 

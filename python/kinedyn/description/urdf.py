@@ -93,8 +93,19 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
         message = str(w.message)
         if issubclass(w.category, PhysicalConsistencyWarning):
             message = f"{src.at(_line_of(message, lines))}: {message}"
-        warnings.warn(message, w.category, stacklevel=2)
+        warnings.warn(message, w.category, stacklevel=_caller_level())
     return robot
+
+
+def _caller_level() -> int:
+    """The stacklevel of the first frame outside kinedyn (so a warning points at the user's call)."""
+    import sys
+
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def _line_of(message: str, lines: dict) -> Optional[int]:
