@@ -37,7 +37,13 @@ def _pose(value, what: str):
     if is_symbolic(value):
         T = sp.Matrix(value)
     else:
-        T = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value, dtype=float)
+        raw = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value)
+        if raw.dtype.kind == "c" or raw.dtype == object and any(isinstance(v, complex) or getattr(v, "is_real", True) is False for v in raw.flat):
+            raise ValueError(f"{what} must be real, got complex values")
+        try:
+            T = raw.astype(float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{what} must be a 4x4 array of numbers") from None
     if tuple(T.shape) != (4, 4):
         raise ValueError(f"{what} must be a 4x4 homogeneous transform, got shape {tuple(T.shape)}")
     if not is_symbolic(T):
