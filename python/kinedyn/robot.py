@@ -89,20 +89,21 @@ class Robot:
         tool=None,
         name: str = "dh_robot",
         source: str = "",
+        inertia: str = "warn",
     ) -> "Robot":
         """A serial arm from a DH table (see :mod:`kinedyn.description.dh` for the conventions).
 
         ``rows``: DHRow objects, mappings with keys theta/d/a/alpha/kind/inertia/limits..., or tuples
         ``(theta, d, a, alpha[, kind])``. ``base_pose``: the 4x4 pose of DH frame 0 in the world.
         ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always
-        added; identity if not given).
+        added; identity if not given). ``inertia``: the inertia policy (as :meth:`from_urdf`).
         """
         links, dh_rows = links_from_dh(rows, convention)
         if base_pose is not None:
             first = links[0]
             links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
         frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
-        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source)
+        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
     def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
