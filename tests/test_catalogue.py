@@ -152,8 +152,9 @@ def test_puma_published_inertias_are_kept_with_a_warning():
         warnings.simplefilter("error")
         kd.robots.puma560()  # documented in its docstring: no warning for the catalogue robot
     inertia._WARNED.clear()
-    with pytest.warns(PhysicalConsistencyWarning, match="triangle inequality"):
-        kd.Inertia(4.8, (0, 0, 0), np.diag(industrial.PUMA560_INERTIAS[2]))  # a user's copy warns
+    with pytest.warns(PhysicalConsistencyWarning, match="link 'l3': inertia tensor violates the triangle inequality"):
+        body = kd.Inertia(4.8, (0, 0, 0), np.diag(industrial.PUMA560_INERTIAS[2]))
+        kd.Robot([kd.Link("l3", None, kd.Joint("j3"), inertia=body)])  # a user's robot with a copy warns
 
 
 def test_puma_motor_and_friction_options():

@@ -4,6 +4,7 @@ Joint validation, Link poses, tree building (fixed-joint merging, errors), lock_
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -76,11 +77,22 @@ def test_negative_mass():
         Inertia(-1.0)
 
 
+def _one_link_robot(body, **kwargs):
+    return kd.Robot([Link("a", None, Joint("j"), inertia=body)], **kwargs)
+
+
 def test_non_psd_inertia():
-    with pytest.raises(ValueError, match="not positive semi-definite"):
-        Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, -0.1]))
-    with pytest.raises(ValueError, match="not positive semi-definite"):
-        Inertia.from_urdf(1.0, 1.0, 2.0, 0.0, 1.0, 0.0, 1.0)  # |ixy| > ixx, iyy
+    """An inertia is a value; whether a rigid body can have it is judged where a robot is assembled,
+    by the inertia policy: strict raises, warn (the default) warns (docs/model-files.md)."""
+    from kinedyn.description.inertia import _WARNED, PhysicalConsistencyWarning
+
+    for bad in (Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, -0.1])), Inertia.from_urdf(1.0, 1.0, 2.0, 0.0, 1.0, 0.0, 1.0)):
+        assert not bad.consistency().positive  # |ixy| > ixx, iyy in the second
+        with pytest.raises(ValueError, match="link 'a': inertia tensor is not positive semi-definite"):
+            _one_link_robot(bad, inertia="strict")
+        _WARNED.clear()
+        with pytest.warns(PhysicalConsistencyWarning, match="link 'a': inertia tensor is not positive semi-definite"):
+            _one_link_robot(bad)
 
 
 def test_triangle_inequality():
@@ -88,8 +100,10 @@ def test_triangle_inequality():
 
     _WARNED.clear()
     with pytest.warns(PhysicalConsistencyWarning, match="triangle inequality"):
-        Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, 3.0]))
-    Inertia(1.0, (0, 0, 0), np.diag([1.0, 2.0, 3.0]))  # the equality case is a flat plate: allowed
+        _one_link_robot(Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, 3.0])), inertia="strict")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _one_link_robot(Inertia(1.0, (0, 0, 0), np.diag([1.0, 2.0, 3.0])))  # the equality case is a flat plate: allowed
 
 
 def test_asymmetric_and_nonfinite_inertia():

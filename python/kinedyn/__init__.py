@@ -1,6 +1,7 @@
 """kinedyn: robot kinematics and dynamics, symbolic for people and numeric (Rust) for programs."""
 
 from .description import DHRow, Frame, Inertia, Joint, Link
+from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 from . import robots
 from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
@@ -22,7 +23,9 @@ def __getattr__(name):
 
 
 def load(path, **kwargs) -> Robot:
-    """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension."""
+    """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension.
+    ``inertia="warn"|"repair"|"strict"``: the policy for an inertia no rigid body can have
+    (docs/model-files.md); other keywords as :meth:`Robot.from_urdf` or the Robot constructor."""
     from .description.files import load as _load
 
     return _load(path, **kwargs)
@@ -30,5 +33,5 @@ def load(path, **kwargs) -> Robot:
 
 __all__ = [
     "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "__version__", *_SUBMODULES,
+    "Trajectory", "PhysicalConsistencyWarning", "__version__", *_SUBMODULES,
 ]

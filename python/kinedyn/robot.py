@@ -17,7 +17,8 @@ import sympy as sp
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.joint import Joint
-from .description.link import Frame, KinematicTree, Link, build_tree
+from .description.checks import vector
+from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
 
 __all__ = ["Robot"]
 
@@ -54,15 +55,15 @@ class Robot:
         dh: Optional[Sequence[DHRow]] = None,
         dh_convention: Optional[str] = None,
         source: str = "",
+        inertia: str = "warn",
     ):
         self.name = name
-        self.links = tuple(links)
+        # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
+        self.links, self.nonphysical = judge_inertias(links, inertia)
+        self.inertia_policy = inertia
         self.frames = tuple(frames)
         self.base = base
-        g = tuple(as_value(v) for v in gravity)
-        if len(g) != 3:
-            raise ValueError(f"gravity must have 3 components, got {len(g)}")
-        self.gravity = g
+        self.gravity = vector(gravity, 3, "gravity")
         self.dh = tuple(dh) if dh is not None else None
         self.dh_convention = dh_convention
         self.source = source
@@ -88,27 +89,31 @@ class Robot:
         tool=None,
         name: str = "dh_robot",
         source: str = "",
+        inertia: str = "warn",
     ) -> "Robot":
         """A serial arm from a DH table (see :mod:`kinedyn.description.dh` for the conventions).
 
         ``rows``: DHRow objects, mappings with keys theta/d/a/alpha/kind/inertia/limits..., or tuples
         ``(theta, d, a, alpha[, kind])``. ``base_pose``: the 4x4 pose of DH frame 0 in the world.
         ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always
-        added; identity if not given).
+        added; identity if not given). ``inertia``: the inertia policy (as :meth:`from_urdf`).
         """
         links, dh_rows = links_from_dh(rows, convention)
         if base_pose is not None:
             first = links[0]
             links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
         frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
-        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source)
+        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
-    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None) -> "Robot":
-        """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`)."""
+    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+        """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
+        ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
+        ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
+        or ``"strict"`` (ValueError); see docs/model-files.md."""
         from .description.urdf import robot_from_urdf
 
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
@@ -122,6 +127,7 @@ class Robot:
             dh=self.dh,
             dh_convention=self.dh_convention,
             source=self.source,
+            inertia=self.inertia_policy,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
@@ -444,9 +450,25 @@ class Robot:
         message = str(error)
         match = re.search(r"joint (\d+)", message)
         if match and int(match.group(1)) < self.n:
-            name = self.joint_names[int(match.group(1))]
+            joint = int(match.group(1))
+            name = self.joint_names[joint]
             message = message.replace(match.group(0), f"{match.group(0)} ('{name}')", 1)
+            message += self._nonphysical_note(joint)
         return RuntimeError(f"robot '{self.name}': {message}")
+
+    def _nonphysical_note(self, joint: int) -> str:
+        """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
+        positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
+        subtree = {joint}
+        for i in range(joint + 1, self.n):  # parent[i] < i
+            if self.parents[i] in subtree:
+                subtree.add(i)
+        bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
+               if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive]
+        if not bad:
+            return ""
+        return (f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
+                f"{', '.join(bad)}; load the robot with inertia='repair'")
 
     @staticmethod
     def _scalar(x):
@@ -600,10 +622,12 @@ class Robot:
         lo = self.lower_limits.copy()
         hi = self.upper_limits.copy()
         for i, j in enumerate(self.joints):
+            # an infinite side is replaced by one span beyond the finite side (or -span..span):
+            # a one-sided limit such as lower=5 (upper inf) must not give lo > hi
             span = math.pi if j.kind == "revolute" else 1.0
             if not math.isfinite(lo[i]):
-                lo[i] = -span
+                lo[i] = min(-span, hi[i] - 2 * span) if math.isfinite(hi[i]) else -span
             if not math.isfinite(hi[i]):
-                hi[i] = span
+                hi[i] = max(span, lo[i] + 2 * span)
         shape = (self.n,) if size is None else (size, self.n)
         return rng.uniform(lo, hi, size=shape)

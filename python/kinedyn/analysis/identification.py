@@ -225,6 +225,9 @@ def with_inertial_parameters(robot, pi):
                         body_inertia = Inertia(m, tuple(c), 0.5 * (Ic + Ic.T))
                     except ValueError as e:
                         raise ValueError(f"body '{link.name}': {e}") from None
+            check = body_inertia.consistency()
+            if check is not None and not check.positive:  # a Robot would only warn (inertia policy)
+                raise ValueError(f"body '{link.name}': {check.describe()}")
             post = np.asarray(link.post, dtype=float)
             inv = np.eye(4)
             inv[:3, :3] = post[:3, :3].T

@@ -12,10 +12,13 @@ For a revolute joint ``theta`` is the joint offset (joint angle = q + theta); fo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Optional
 
+import sympy as sp
+
 from .._math import matmul, rot_x, rot_z, translation
+from .checks import number
 from .inertia import Inertia
 from .joint import Joint
 from .link import Link
@@ -84,6 +87,10 @@ def links_from_dh(rows, convention: str = "standard"):
     for i, r in enumerate(rows, start=1):
         if r.kind not in ("revolute", "prismatic"):
             raise ValueError(f"DH row {i}: kind must be 'revolute' or 'prismatic', got '{r.kind}'")
+        # real, finite, sane numbers (or symbols) before they enter the transforms; exact SymPy
+        # numbers (pi / 2) stay exact, so symbolic DH robots keep their exact zeros
+        checked = {key: number(getattr(r, key), f"DH row {i}: {key}") for key in ("theta", "d", "a", "alpha")}
+        r = replace(r, **{k: v for k, v in checked.items() if not isinstance(getattr(r, k), sp.Basic)})
         revolute = r.kind == "revolute"
         joint = Joint(
             name=r.name or f"q{i}",

@@ -15,21 +15,26 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 import sympy as sp
 
-from .._math import as_value, is_symbolic
+from .._math import is_symbolic
+from .checks import number, real_array, vector
 
-__all__ = ["Inertia", "PhysicalConsistencyWarning", "skew"]
+__all__ = ["Inertia", "Consistency", "PhysicalConsistencyWarning", "INERTIA_POLICIES", "judge", "skew"]
 
 
 class PhysicalConsistencyWarning(UserWarning):
-    """Inertial data that no rigid body can have, kept as given (e.g. a published table)."""
+    """Inertial data that no rigid body can have (a tensor that is not positive semi-definite, or
+    principal moments that fail the triangle inequality), loaded anyway or repaired; the message
+    names the link, the principal moments and, when repaired, the change."""
 
 
-_WARNED: set = set()
+INERTIA_POLICIES = ("warn", "repair", "strict")
+
+_WARNED: set = set()  # (link name, policy, Inertia) already reported: derived robots do not repeat it
 
 
 def skew(v):
@@ -38,74 +43,118 @@ def skew(v):
     return [[0, -z, y], [z, 0, -x], [-y, x, 0]]
 
 
-def _mat3(value) -> tuple:
-    rows = [list(r) for r in (value.tolist() if hasattr(value, "tolist") else value)]
+def _mat3(value, what: str) -> tuple:
+    try:
+        rows = [list(r) for r in (value.tolist() if hasattr(value, "tolist") else value)]
+    except TypeError:
+        raise ValueError(f"{what} must be a 3x3 matrix, got {value!r}") from None
     if len(rows) != 3 or any(len(r) != 3 for r in rows):
-        raise ValueError(f"an inertia tensor must be 3x3, got {np.shape(rows)}")
-    return tuple(tuple(as_value(e) for e in r) for r in rows)
+        raise ValueError(f"{what} must be 3x3, got {len(rows)} rows of lengths {[len(r) for r in rows]}")
+    return tuple(tuple(number(e, f"{what}[{i}][{j}]") for j, e in enumerate(r)) for i, r in enumerate(rows))
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """Physical consistency of a numeric inertia: ``moments`` are the principal moments about the
+    centre of mass (ascending); ``positive``: the tensor is positive semi-definite; ``triangle``:
+    each moment is at most the sum of the other two (true of every rigid body: the second moments
+    of its mass distribution, ``(J_y + J_z - J_x) / 2`` etc., are >= 0). A tensor with a single
+    non-zero moment (the planar textbook idealisation, only ``Izz`` given) counts as consistent."""
+
+    moments: tuple
+    positive: bool
+    triangle: bool
+
+    @property
+    def ok(self) -> bool:
+        return self.positive and self.triangle
+
+    def describe(self) -> str:
+        moments = ", ".join(f"{m:.6g}" for m in self.moments)
+        if not self.positive:
+            return f"inertia tensor is not positive semi-definite (eigenvalues {moments})"
+        a, b, c = self.moments
+        return (
+            f"inertia tensor violates the triangle inequality of principal moments ({moments}: "
+            f"{a:.6g} + {b:.6g} < {c:.6g})"
+        )
 
 
 @dataclass(frozen=True)
 class Inertia:
-    """Mass properties of a rigid body (see module docstring for frames)."""
+    """Mass properties of a rigid body (see module docstring for frames).
+
+    Construction checks the values (real, finite, at most ``LARGEST`` in magnitude, ``m >= 0``, a
+    symmetric 3x3 tensor); whether a rigid body can have them (:meth:`consistency`) is judged where
+    a robot is assembled, by its inertia policy (:func:`judge`)."""
 
     mass: Any = 0.0
     com: tuple = (0.0, 0.0, 0.0)
     inertia: tuple = field(default=((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
 
     def __post_init__(self):
-        object.__setattr__(self, "mass", as_value(self.mass))
-        com = tuple(as_value(c) for c in self.com)
-        if len(com) != 3:
-            raise ValueError(f"centre of mass must have 3 coordinates, got {len(com)}")
+        object.__setattr__(self, "mass", number(self.mass, "mass"))
+        com, tensor = real_array(self.com, (3,)), real_array(self.inertia, (3, 3))
+        # plain numbers take the fast path; anything else is checked entry by entry
+        slow = com is None or tensor is None
+        com = vector(self.com, 3, "centre of mass", "coordinates") if com is None else tuple(com.tolist())
+        tensor = _mat3(self.inertia, "inertia tensor") if tensor is None else tuple(map(tuple, tensor.tolist()))
         object.__setattr__(self, "com", com)
-        object.__setattr__(self, "inertia", _mat3(self.inertia))
+        object.__setattr__(self, "inertia", tensor)
+        object.__setattr__(self, "_symbolic", is_symbolic(self.mass) or (slow and is_symbolic(com, tensor)))
         self.validate()
 
     # ---- checks ---------------------------------------------------------------------------
     @property
     def is_symbolic(self) -> bool:
-        return is_symbolic(self.mass, self.com, self.inertia)
+        return self._symbolic
 
     def validate(self, where: str = "") -> None:
-        """Physical consistency of numeric values: m >= 0, I symmetric and PSD (errors); the triangle
-        inequality of principal moments (a warning)."""
+        """The values of a numeric inertia: m >= 0 and a symmetric tensor (ValueError otherwise).
+        Physical consistency is :meth:`consistency`'s."""
         where = f" of {where}" if where else ""
-        if is_symbolic(self.mass, self.com, self.inertia):
+        if self.is_symbolic:
             return
         m = float(self.mass)
-        if not np.isfinite(m):
-            raise ValueError(f"mass{where} is not finite: {m}")
         if m < 0:
             raise ValueError(f"mass{where} is negative: {m}")
-        c = np.array(self.com, dtype=float)
-        if not np.all(np.isfinite(c)):
-            raise ValueError(f"centre of mass{where} is not finite: {c}")
         I = np.array(self.inertia, dtype=float)
-        if not np.all(np.isfinite(I)):
-            raise ValueError(f"inertia tensor{where} is not finite")
-        if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
+        if np.abs(I - I.T).max() > 1e-12 * max(1.0, np.abs(I).max()):
             raise ValueError(f"inertia tensor{where} is not symmetric:\n{I}")
-        eig = np.linalg.eigvalsh(I)
-        tol = 1e-12 * max(1.0, np.abs(I).max())
-        if eig[0] < -tol:
-            raise ValueError(
-                f"inertia tensor{where} is not positive semi-definite (eigenvalues {eig}); "
-                "check the signs of the products of inertia (URDF uses +ixy for the tensor entry)"
-            )
-        # a real body's principal moments satisfy the triangle inequality; published tables (the
-        # PUMA 560's) and CAD exports sometimes do not: warn, since M stays positive definite
-        key = tuple(np.round(eig, 12))
-        # one nonzero principal moment is the planar textbook idealisation (only Izz given): no warning
-        planar = eig[1] <= tol
-        if eig[0] + eig[1] < eig[2] - max(tol, 1e-9 * eig[2]) and not planar and key not in _WARNED:
-            _WARNED.add(key)  # once per body: rotated copies made while compiling share eigenvalues
-            warnings.warn(
-                f"inertia tensor{where} violates the triangle inequality of principal moments "
-                f"({eig}): no rigid body has this inertia (kept as given)",
-                PhysicalConsistencyWarning,
-                stacklevel=3,
-            )
+
+    def consistency(self) -> Optional[Consistency]:
+        """The principal moments and whether a rigid body can have them (None when symbolic)."""
+        if self.is_symbolic:
+            return None
+        I = np.array(self.inertia, dtype=float)
+        eig = np.linalg.eigvalsh(0.5 * (I + I.T))
+        tol = 1e-12 * max(1.0, float(np.abs(I).max()))
+        positive = bool(eig[0] >= -tol)
+        planar = eig[1] <= tol  # one non-zero moment: the planar idealisation
+        triangle = bool(planar or eig[0] + eig[1] >= eig[2] - max(tol, 1e-9 * eig[2]))
+        return Consistency(tuple(float(e) for e in eig), positive, triangle)
+
+    def nearest_consistent(self) -> "Inertia":
+        """The nearest physically consistent inertia (same mass and centre of mass), or ``self``
+        when it is consistent already.
+
+        Projection (Wensing, Kim & Slotine, "Linear matrix inequalities for physically consistent
+        inertial parameter identification", RA-L 2018): a tensor ``I`` is a rigid body's iff its
+        second-moment matrix ``Sigma = tr(I)/2 E - I`` is positive semi-definite. ``Sigma`` shares
+        ``I``'s principal axes, with moments ``sigma_x = (I_y + I_z - I_x) / 2`` etc.; negative
+        ``sigma`` are set to 0 (the Frobenius-nearest PSD ``Sigma``) and ``I' = tr(Sigma') E -
+        Sigma'``. Principal axes are kept, the result satisfies non-negativity and the triangle
+        inequalities (with equality where a ``sigma`` was clipped: a flat body), and the map is
+        idempotent."""
+        check = self.consistency()
+        if check is None or check.ok:
+            return self
+        I = np.array(self.inertia, dtype=float)
+        lam, R = np.linalg.eigh(0.5 * (I + I.T))
+        sigma = np.maximum(0.5 * (lam.sum() - 2 * lam), 0.0)  # sigma_i = (sum - 2 lam_i) / 2
+        lam_new = sigma.sum() - sigma  # I_i = sigma_j + sigma_k
+        tensor = (R * lam_new) @ R.T
+        return Inertia(self.mass, self.com, 0.5 * (tensor + tensor.T))
 
     # ---- named constructors -------------------------------------------------------------------
     @classmethod
@@ -222,3 +271,45 @@ class Inertia:
     def subs(self, mapping) -> "Inertia":
         f = lambda e: sp.sympify(e).subs(mapping) if isinstance(e, sp.Basic) else e
         return Inertia(f(self.mass), tuple(f(c) for c in self.com), tuple(tuple(f(e) for e in r) for r in self.inertia))
+
+
+def judge(inertia: Inertia, policy: str, what: str) -> Inertia:
+    """Apply an inertia policy to one link's inertia (``what`` names the link in messages).
+
+    ``"warn"``: kept as given, with a :class:`PhysicalConsistencyWarning` naming the link and the
+    principal moments; ``"repair"``: replaced by :meth:`Inertia.nearest_consistent`, with a warning
+    giving the old and new moments and the size of the change (Frobenius norm of the tensor
+    difference); ``"strict"``: a tensor that is not positive semi-definite is a ValueError, a
+    triangle-inequality violation (published tables such as the PUMA 560's) a warning. Each
+    (link, tensor) is reported once per process."""
+    if policy not in INERTIA_POLICIES:
+        raise ValueError(f"inertia policy must be one of {INERTIA_POLICIES}, got {policy!r}")
+    check = inertia.consistency()
+    if check is None or check.ok:
+        return inertia
+    if policy == "strict" and not check.positive:
+        raise ValueError(
+            f"{what}: {check.describe()}; no rigid body has this inertia (check the signs of the products "
+            "of inertia: URDF's ixy is the tensor entry); load with inertia='warn' or 'repair' to accept it"
+        )
+    key = (what, policy, inertia)
+    if policy == "repair":
+        repaired = inertia.nearest_consistent()
+        if key not in _WARNED:
+            change = float(np.linalg.norm(np.array(repaired.inertia) - np.array(inertia.inertia)))
+            new = ", ".join(f"{m:.6g}" for m in repaired.consistency().moments)
+            warnings.warn(
+                f"{what}: {check.describe()}; repaired to the nearest physically consistent tensor "
+                f"(principal moments {new}; change {change:.3g} kg m^2 in Frobenius norm)",
+                PhysicalConsistencyWarning,
+                stacklevel=3,
+            )
+            _WARNED.add(key)
+        return repaired
+    if key not in _WARNED:
+        hint = "" if policy == "strict" or check.positive else (
+            "; forward dynamics, M^-1 and simulation may fail (inertia='repair' projects it onto a consistent one)")
+        warnings.warn(f"{what}: {check.describe()}: no rigid body has this inertia, kept as given{hint}",
+                      PhysicalConsistencyWarning, stacklevel=3)
+        _WARNED.add(key)
+    return inertia

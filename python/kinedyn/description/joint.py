@@ -13,7 +13,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .._math import as_value, is_symbolic
+from .._math import is_symbolic
+from .checks import number, real, vector
 
 __all__ = ["Joint", "JOINT_KINDS"]
 
@@ -36,37 +37,41 @@ class Joint:
     coulomb: Any = 0.0
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"a joint's name must be a non-empty string, got {self.name!r}")
+        what = f"joint '{self.name}'"
         if self.kind == "continuous":
             object.__setattr__(self, "kind", "revolute")
         if self.kind not in JOINT_KINDS:
-            raise ValueError(f"joint '{self.name}': unknown kind '{self.kind}' (expected one of {JOINT_KINDS})")
-        axis = tuple(as_value(a) for a in self.axis)
-        if len(axis) != 3:
-            raise ValueError(f"joint '{self.name}': axis must have 3 components, got {len(axis)}")
+            raise ValueError(f"{what}: unknown kind '{self.kind}' (expected one of {JOINT_KINDS})")
+        axis = vector(self.axis, 3, f"{what}: axis")
         if not is_symbolic(axis):
             norm = math.sqrt(sum(a * a for a in axis))
-            if not math.isfinite(norm) or norm < 1e-12:
+            if norm < 1e-12:
                 if self.kind != "fixed":
-                    raise ValueError(f"joint '{self.name}': axis {axis} has zero or non-finite length")
+                    raise ValueError(f"{what}: axis {axis} has zero or non-finite length")
             else:
                 axis = tuple(a / norm for a in axis)
         object.__setattr__(self, "axis", axis)
+        # offset, drive train and friction: numbers (checked: real, finite, sane size) or symbols
         for name in ("offset", "gear_ratio", "rotor_inertia", "viscous", "coulomb"):
-            object.__setattr__(self, name, as_value(getattr(self, name)))
-        for name in ("lower", "upper", "velocity_limit", "effort_limit"):
-            v = float(getattr(self, name))
-            if math.isnan(v):
-                raise ValueError(f"joint '{self.name}': {name} is NaN")
-            object.__setattr__(self, name, v)
-        if self.lower > self.upper:
-            raise ValueError(f"joint '{self.name}': lower limit {self.lower} exceeds upper limit {self.upper}")
-        for name in ("velocity_limit", "effort_limit"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"joint '{self.name}': {name} is negative")
+            object.__setattr__(self, name, number(getattr(self, name), f"{what}: {name}"))
+        if not is_symbolic(self.gear_ratio) and self.gear_ratio == 0:
+            raise ValueError(f"{what}: gear_ratio must be non-zero")
         for name in ("rotor_inertia", "viscous", "coulomb"):
             v = getattr(self, name)
             if not is_symbolic(v) and v < 0:
-                raise ValueError(f"joint '{self.name}': {name} must be >= 0, got {v}")
+                raise ValueError(f"{what}: {name} must be >= 0, got {v}")
+        # limits: numbers, +-inf allowed (no limit), never NaN
+        for name in ("lower", "upper", "velocity_limit", "effort_limit"):
+            object.__setattr__(self, name, real(getattr(self, name), f"{what}: {name}", infinite=True))
+        if self.lower > self.upper:
+            raise ValueError(f"{what}: lower limit {self.lower} exceeds upper limit {self.upper}")
+        if self.lower == math.inf or self.upper == -math.inf:
+            raise ValueError(f"{what}: limits [{self.lower}, {self.upper}] admit no position")
+        for name in ("velocity_limit", "effort_limit"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{what}: {name} is negative")
 
     @property
     def is_moving(self) -> bool:

@@ -26,24 +26,33 @@ import numpy as np
 import sympy as sp
 
 from .._math import identity, is_symbolic, matmul
-from .inertia import Inertia
+from .checks import LARGEST
+from .inertia import Inertia, judge
 from .joint import Joint
 
-__all__ = ["Link", "Frame", "Body", "NamedFrame", "KinematicTree", "build_tree"]
+__all__ = ["Link", "Frame", "Body", "NamedFrame", "KinematicTree", "build_tree", "judge_inertias"]
 
 
 def _pose(value, what: str):
     if is_symbolic(value):
         T = sp.Matrix(value)
     else:
-        T = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value, dtype=float)
+        raw = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value)
+        if raw.dtype.kind == "c" or raw.dtype == object and any(isinstance(v, complex) or getattr(v, "is_real", True) is False for v in raw.flat):
+            raise ValueError(f"{what} must be real, got complex values")
+        try:
+            T = raw.astype(float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{what} must be a 4x4 array of numbers") from None
     if tuple(T.shape) != (4, 4):
         raise ValueError(f"{what} must be a 4x4 homogeneous transform, got shape {tuple(T.shape)}")
     if not is_symbolic(T):
         if not np.all(np.isfinite(T)):
             raise ValueError(f"{what} contains non-finite values")
+        if np.abs(T).max() > LARGEST:
+            raise ValueError(f"{what} has a translation larger in magnitude than {LARGEST:g}")
         R = T[:3, :3]
-        if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0 or not np.allclose(T[3], [0, 0, 0, 1]):
+        if np.abs(R @ R.T - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0 or np.abs(T[3] - (0, 0, 0, 1)).max() > 1e-8:
             raise ValueError(f"{what} is not a rigid transform (rotation part not orthonormal or last row not 0 0 0 1)")
     return T
 
@@ -58,10 +67,16 @@ class Link:
     inertia: Inertia = field(default_factory=Inertia)
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"a link's name must be a non-empty string, got {self.name!r}")
+        if not isinstance(self.joint, Joint):
+            raise ValueError(f"link '{self.name}': joint must be a Joint, got {type(self.joint).__name__}")
         object.__setattr__(self, "placement", _pose(self.placement, f"placement of link '{self.name}'"))
         object.__setattr__(self, "post", _pose(self.post, f"post transform of link '{self.name}'"))
         if self.inertia is None:
             object.__setattr__(self, "inertia", Inertia())
+        if not isinstance(self.inertia, Inertia):
+            raise ValueError(f"link '{self.name}': inertia must be an Inertia, got {type(self.inertia).__name__}")
         self.inertia.validate(f"link '{self.name}'")
 
 
@@ -116,13 +131,30 @@ class KinematicTree:
         raise KeyError(name)
 
 
+def judge_inertias(links, policy: str) -> tuple:
+    """``(links, nonphysical)``: each link's inertia judged by the inertia policy (``"warn"``,
+    ``"repair"``, ``"strict"``: see :func:`kinedyn.description.inertia.judge`), repaired links
+    replaced; ``nonphysical`` maps the name of each link kept with an inertia no rigid body has to
+    its :class:`~kinedyn.description.inertia.Consistency` (for the errors of forward dynamics)."""
+    out, nonphysical = [], {}
+    for link in links:
+        inertia = judge(link.inertia, policy, f"link '{link.name}'")
+        if inertia is not link.inertia:
+            link = Link(link.name, link.parent, link.joint, link.placement, link.post, inertia)
+        check = inertia.consistency()
+        if check is not None and not check.ok:
+            nonphysical[link.name] = check
+        out.append(link)
+    return tuple(out), nonphysical
+
+
 def build_tree(links, frames, base: str) -> KinematicTree:
     """Compile links into bodies (fixed joints merged) and named frames; check the tree's shape."""
-    names = [base]
+    names = {base}  # a set: membership tests stay O(1) for robots of thousands of links
     for link in links:
         if link.name in names:
             raise ValueError(f"link name '{link.name}' is used twice")
-        names.append(link.name)
+        names.add(link.name)
     children: dict = {base: []}
     for link in links:
         children.setdefault(link.name, [])
@@ -169,7 +201,7 @@ def build_tree(links, frames, base: str) -> KinematicTree:
             raise ValueError(f"frame '{frame.name}' is attached to unknown link '{owner}'")
         if frame.name in names:
             raise ValueError(f"frame name '{frame.name}' is already the name of a link or frame")
-        names.append(frame.name)
+        names.add(frame.name)
         body, body_from_link = carriers[owner]
         named.append(NamedFrame(frame.name, body, matmul(body_from_link, frame.placement)))
     return KinematicTree(tuple(bodies), tuple(named), base)

@@ -27,212 +27,324 @@ from __future__ import annotations
 
 import math
 import os
+import re
+import warnings
 import xml.etree.ElementTree as ET
 from typing import Optional
+from xml.parsers import expat
 
 from .._math import matmul, rpy_to_matrix, translation
-from .inertia import Inertia
+from .checks import LARGEST
+from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Link
 
-__all__ = ["robot_from_urdf"]
+__all__ = ["robot_from_urdf", "MAX_DEPTH"]
 
 _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
-def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None):
+def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn"):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
     A string whose first non-blank character is ``<`` is parsed as XML, anything else is a path.
     ``gravity``: the gravity vector in base (root link) coordinates. ``tool``: the name of the frame
     used as ``robot.tool``; by default the last link, in depth-first order, that moves with the last
     joint (e.g. ``tool0`` of a UR arm). The root link's inertia is ignored (fixed base).
+    ``inertia``: the policy for an inertia no rigid body can have, ``"warn"`` (default), ``"repair"``
+    or ``"strict"`` (see :func:`kinedyn.description.inertia.judge` and docs/model-files.md).
+
+    Every problem with the file is a ValueError naming the file, the line, and the link, joint or
+    attribute. The XML may not declare entities (no DOCTYPE with an internal subset or an external
+    DTD: entity expansion is unbounded work) nor nest elements deeper than ``MAX_DEPTH``; the work is
+    linear in the size of the file.
     """
     from ..robot import Robot
 
-    root, where = _parse(path_or_string)
+    src, root = _parse(path_or_string)
     if root.tag != "robot":
-        raise ValueError(f"{where}: the root element is <{root.tag}>, expected <robot>")
-    link_elements = _links(root, where)
-    joints = [_joint(j, where) for j in root.findall("joint")]
-    base, ordered = _order(joints, list(link_elements), where)
-    links = [
-        Link(j["child"], j["parent"], j["joint"], j["placement"], inertia=_inertial(link_elements[j["child"]], where))
-        for j in ordered
-    ]
+        raise src.error(root, f"the root element is <{root.tag}>, expected <robot>")
+    link_elements = _links(root, src)
+    joints = [_joint(j, src) for j in root.iterfind("joint")]
+    base, ordered = _order(joints, list(link_elements), src)
+    links = []
+    for j in ordered:
+        element = link_elements[j["child"]]
+        body = _inertial(element, src)
+        try:
+            links.append(Link(j["child"], j["parent"], j["joint"], j["placement"], inertia=body))
+        except ValueError as e:
+            raise src.error(j["element"], str(e)) from None
     if tool is None:
         tool = _default_tool(links, base)
     name = root.get("name") or "urdf_robot"
-    source = where if not where.startswith("<") else "URDF string"
-    return Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source)
+    source = src.label if not src.label.startswith("<") else "URDF string"
+    # the Robot judges the inertias (policy) and checks the tree: its errors and warnings name a
+    # link or joint, to which the file and line are added here, once
+    lines = {**{n: src.line(e) for n, e in link_elements.items()}, **{j["name"]: src.line(j["element"]) for j in joints}}
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", PhysicalConsistencyWarning)
+            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia)
+    except ValueError as e:
+        raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None
+    for w in caught:
+        message = str(w.message)
+        if issubclass(w.category, PhysicalConsistencyWarning):
+            message = f"{src.at(_line_of(message, lines))}: {message}"
+        warnings.warn(message, w.category, stacklevel=_caller_level())
+    return robot
+
+
+def _caller_level() -> int:
+    """The stacklevel of the first frame outside kinedyn (so a warning points at the user's call)."""
+    import sys
+
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def _line_of(message: str, lines: dict) -> Optional[int]:
+    """The line of the link or joint a description-layer message starts with ("link 'x': ...")."""
+    match = re.match(r"(?:link|joint) '([^']*)'", message)
+    return lines.get(match.group(1)) if match else None
 
 
 # ---------------------------------------------------------------------------------------- parsing
+class _Source:
+    """Where the XML came from (a path or "<URDF string>") and the line of each element."""
+
+    def __init__(self, label: str):
+        self.label = label
+        self.lines: dict = {}  # id(element) -> line of its start tag
+
+    def line(self, element) -> Optional[int]:
+        return self.lines.get(id(element))
+
+    def at(self, line: Optional[int]) -> str:
+        return self.label if line is None else f"{self.label}:{line}"
+
+    def error(self, element, message: str) -> ValueError:
+        return ValueError(f"{self.at(self.line(element))}: {message}")
+
+
 def _parse(path_or_string):
-    """(root element, a description of where it came from for error messages)."""
+    """(source, root element): the XML parsed by expat with line numbers, no entity declarations
+    (billion laughs, external entities) and a bounded nesting depth."""
     text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
     if isinstance(text, bytes):
-        text = text.decode()
+        text = text.decode("utf-8", errors="replace") if text.lstrip().startswith(b"<") else os.fsdecode(text)
     if not isinstance(text, str):
         raise TypeError(f"robot_from_urdf expects a path or an XML string, got {type(path_or_string).__name__}")
     if text.lstrip().startswith("<"):
-        where, xml = "<URDF string>", text
+        src, data = _Source("<URDF string>"), text
     else:
-        where = text
+        src = _Source(text)
         try:
-            with open(text, encoding="utf-8") as f:
-                xml = f.read()
+            with open(text, "rb") as f:
+                data = f.read()  # bytes: expat honours the file's encoding declaration
         except OSError as e:
-            raise ValueError(f"{where}: cannot read URDF file ({e.strerror or e})") from None
+            raise ValueError(f"{text}: cannot read URDF file ({e.strerror or e})") from None
+    builder = ET.TreeBuilder()
+    parser = expat.ParserCreate()
+    depth = 0
+
+    def start(tag, attributes):
+        nonlocal depth
+        depth += 1
+        if depth > MAX_DEPTH:
+            raise ValueError(f"{src.label}:{parser.CurrentLineNumber}: elements nested deeper than {MAX_DEPTH} levels")
+        src.lines[id(builder.start(tag, attributes))] = parser.CurrentLineNumber
+
+    def end(tag):
+        nonlocal depth
+        depth -= 1
+        builder.end(tag)
+
+    def doctype(name, system_id, public_id, has_internal_subset):
+        if has_internal_subset or system_id or public_id:
+            raise ValueError(
+                f"{src.label}:{parser.CurrentLineNumber}: a DOCTYPE with declarations or an external DTD is not "
+                "accepted in a URDF (entity expansion is unbounded work); remove it"
+            )
+
+    def entity(name, *args):
+        raise ValueError(f"{src.label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in a URDF")
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.StartDoctypeDeclHandler = doctype
+    parser.EntityDeclHandler = entity
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
     try:
-        return ET.fromstring(xml), where
-    except ET.ParseError as e:
-        line, column = e.position
-        raise ValueError(f"{where}: malformed XML at line {line}, column {column + 1}: {e}") from None
+        parser.Parse(data, True)
+    except expat.ExpatError as e:
+        raise ValueError(
+            f"{src.label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}"
+        ) from None
+    return src, builder.close()
 
 
-def _floats(text: Optional[str], n: int, default, what: str, where: str) -> tuple:
+def _floats(text: Optional[str], n: int, default, what: str, element, src: _Source) -> tuple:
     if text is None:
         return tuple(default)
+    parts = text.split()
     try:
-        values = tuple(float(v) for v in text.split())
+        values = tuple(float(v) for v in parts)
     except ValueError:
-        raise ValueError(f"{where}: {what} must be {n} numbers, got '{text}'") from None
-    if len(values) != n or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{where}: {what} must be {n} finite numbers, got '{text}'")
+        raise src.error(element, f"{what} must be {n} numbers, got '{_short(text)}'") from None
+    if len(values) != n:
+        raise src.error(element, f"{what} must be {n} numbers, got {len(values)}: '{_short(text)}'")
+    for v in values:
+        if not math.isfinite(v):
+            raise src.error(element, f"{what} must be {n} finite numbers, got '{_short(text)}'")
+        if abs(v) > LARGEST:
+            raise src.error(element, f"{what} has {v:g}, larger in magnitude than {LARGEST:g}, the most a description number may be")
     return values
 
 
-def _float(element, attribute: str, default, what: str, where: str) -> float:
+def _short(text: str) -> str:
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _float(element, attribute: str, default, what: str, src: _Source) -> float:
     text = element.get(attribute)
     if text is None:
         if default is None:
-            raise ValueError(f"{where}: {what} has no '{attribute}' attribute")
+            raise src.error(element, f"{what} has no '{attribute}' attribute")
         return default
-    return _floats(text, 1, (), f"{what} attribute '{attribute}'", where)[0]
+    return _floats(text, 1, (), f"{what} attribute '{attribute}'", element, src)[0]
 
 
-def _origin(element, what: str, where: str):
+def _origin(element, what: str, src: _Source):
     """The pose of an ``<origin xyz rpy>`` child (identity when absent)."""
     origin = element.find("origin")
     if origin is None:
         return translation(0.0, 0.0, 0.0)
-    xyz = _floats(origin.get("xyz"), 3, (0, 0, 0), f"{what} origin xyz", where)
-    rpy = _floats(origin.get("rpy"), 3, (0, 0, 0), f"{what} origin rpy", where)
+    xyz = _floats(origin.get("xyz"), 3, (0, 0, 0), f"{what} origin xyz", origin, src)
+    rpy = _floats(origin.get("rpy"), 3, (0, 0, 0), f"{what} origin rpy", origin, src)
     return matmul(translation(*xyz), rpy_to_matrix(*rpy))
 
 
-def _links(root, where: str) -> dict:
+def _links(root, src: _Source) -> dict:
     """Link elements by name, in document order."""
     links: dict = {}
-    for element in root.findall("link"):
+    for element in root.iterfind("link"):
         name = element.get("name")
         if not name:
-            raise ValueError(f"{where}: a <link> has no name")
+            raise src.error(element, "a <link> has no name")
         if name in links:
-            raise ValueError(f"{where}: link '{name}' is defined twice")
+            raise src.error(element, f"link '{name}' is defined twice (first at line {src.line(links[name])})")
         links[name] = element
     if not links:
-        raise ValueError(f"{where}: the URDF has no <link>")
+        raise src.error(root, "the URDF has no <link>")
     return links
 
 
-def _joint(element, where: str) -> dict:
-    """One ``<joint>`` as {name, parent, child, placement, joint}."""
+def _joint(element, src: _Source) -> dict:
+    """One ``<joint>`` as {name, parent, child, placement, joint, element}."""
     name = element.get("name")
     if not name:
-        raise ValueError(f"{where}: a <joint> has no name")
+        raise src.error(element, "a <joint> has no name")
     kind = element.get("type")
     what = f"joint '{name}'"
     if kind not in _SUPPORTED:
-        raise ValueError(
-            f"{where}: {what} has type '{kind}', which is not supported "
-            f"(supported: {', '.join(_SUPPORTED)}; kinedyn robots have a fixed base and 1-DOF joints)"
+        raise src.error(
+            element,
+            f"{what} has type '{kind}', which is not supported "
+            f"(supported: {', '.join(_SUPPORTED)}; kinedyn robots have a fixed base and 1-DOF joints)",
         )
     ends = {}
     for end in ("parent", "child"):
         e = element.find(end)
         if e is None or not e.get("link"):
-            raise ValueError(f"{where}: {what} has no <{end} link=...>")
+            raise src.error(element, f"{what} has no <{end} link=...>")
         ends[end] = e.get("link")
     axis = (1.0, 0.0, 0.0)
-    if element.find("axis") is not None:
-        axis = _floats(element.find("axis").get("xyz"), 3, axis, f"{what} axis", where)
-    limits = _limits(element.find("limit"), kind, what, where)
-    friction = _dynamics(element.find("dynamics"), what, where)
+    axis_element = element.find("axis")
+    if axis_element is not None:
+        axis = _floats(axis_element.get("xyz"), 3, axis, f"{what} axis", axis_element, src)
+    limits = _limits(element.find("limit"), kind, what, src)
+    friction = _dynamics(element.find("dynamics"), what, src)
     try:
         joint = Joint(name, "revolute" if kind == "continuous" else kind, axis, **limits, **friction)
     except ValueError as e:
-        raise ValueError(f"{where}: {e}") from None
-    return {"name": name, **ends, "placement": _origin(element, what, where), "joint": joint}
+        raise src.error(element, str(e)) from None
+    return {"name": name, **ends, "placement": _origin(element, what, src), "joint": joint, "element": element}
 
 
-def _limits(limit, kind: str, what: str, where: str) -> dict:
+def _limits(limit, kind: str, what: str, src: _Source) -> dict:
     if limit is None or kind == "fixed":
         return {}
     out = {
-        "velocity_limit": _float(limit, "velocity", math.inf, f"{what} <limit>", where),
-        "effort_limit": _float(limit, "effort", math.inf, f"{what} <limit>", where),
+        "velocity_limit": _float(limit, "velocity", math.inf, f"{what} <limit>", src),
+        "effort_limit": _float(limit, "effort", math.inf, f"{what} <limit>", src),
     }
     if kind != "continuous":
-        out["lower"] = _float(limit, "lower", 0.0, f"{what} <limit>", where)
-        out["upper"] = _float(limit, "upper", 0.0, f"{what} <limit>", where)
+        out["lower"] = _float(limit, "lower", 0.0, f"{what} <limit>", src)
+        out["upper"] = _float(limit, "upper", 0.0, f"{what} <limit>", src)
     return out
 
 
-def _dynamics(dynamics, what: str, where: str) -> dict:
+def _dynamics(dynamics, what: str, src: _Source) -> dict:
     if dynamics is None:
         return {}
     return {
-        "viscous": _float(dynamics, "damping", 0.0, f"{what} <dynamics>", where),
-        "coulomb": _float(dynamics, "friction", 0.0, f"{what} <dynamics>", where),
+        "viscous": _float(dynamics, "damping", 0.0, f"{what} <dynamics>", src),
+        "coulomb": _float(dynamics, "friction", 0.0, f"{what} <dynamics>", src),
     }
 
 
-def _inertial(link, where: str) -> Inertia:
+def _inertial(link, src: _Source) -> Inertia:
     """The link's inertia in the link frame (massless when there is no ``<inertial>``)."""
     inertial = link.find("inertial")
     if inertial is None:
         return Inertia()
     what = f"link '{link.get('name')}' <inertial>"
     mass_el, tensor_el = inertial.find("mass"), inertial.find("inertia")
-    mass = 0.0 if mass_el is None else _float(mass_el, "value", None, f"{what} <mass>", where)
+    mass = 0.0 if mass_el is None else _float(mass_el, "value", None, f"{what} <mass>", src)
     keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-    entries = [0.0] * 6 if tensor_el is None else [_float(tensor_el, k, 0.0, f"{what} <inertia>", where) for k in keys]
+    entries = [0.0] * 6 if tensor_el is None else [_float(tensor_el, k, 0.0, f"{what} <inertia>", src) for k in keys]
+    # the tensor is given in the centre-of-mass frame <origin xyz rpy>: rotate/shift into the link
+    com_frame = _origin(inertial, what, src)
     try:
-        about_com = Inertia.from_urdf(mass, *entries)
-        # the tensor is given in the centre-of-mass frame <origin xyz rpy>: rotate/shift into the link
-        return about_com.transformed(_origin(inertial, what, where))
+        return Inertia.from_urdf(mass, *entries).transformed(com_frame)
     except ValueError as e:
-        raise ValueError(f"{where}: {what}: {e}") from None
+        raise src.error(inertial, f"{what}: {e}") from None
 
 
 # --------------------------------------------------------------------------------- tree structure
-def _order(joints: list, link_names: list, where: str):
+def _order(joints: list, link_names: list, src: _Source):
     """(root link, joints in depth-first order with children in file order); checks the tree."""
     known = set(link_names)
     parent_joint: dict = {}
     children: dict = {name: [] for name in link_names}
-    names = set()
+    names: dict = {}
     for j in joints:
         if j["name"] in names:
-            raise ValueError(f"{where}: joint '{j['name']}' is defined twice")
-        names.add(j["name"])
+            raise src.error(j["element"], f"joint '{j['name']}' is defined twice (first at line {src.line(names[j['name']])})")
+        names[j["name"]] = j["element"]
         for end in ("parent", "child"):
             if j[end] not in known:
-                raise ValueError(f"{where}: joint '{j['name']}' names {end} link '{j[end]}', which is not defined")
+                raise src.error(j["element"], f"joint '{j['name']}' names {end} link '{j[end]}', which is not defined")
         if j["child"] in parent_joint:
-            raise ValueError(
-                f"{where}: link '{j['child']}' is the child of two joints, '{parent_joint[j['child']]['name']}' "
-                f"and '{j['name']}' (a URDF must be a tree)"
+            raise src.error(
+                j["element"],
+                f"link '{j['child']}' is the child of two joints, '{parent_joint[j['child']]['name']}' "
+                f"and '{j['name']}' (a URDF must be a tree)",
             )
         parent_joint[j["child"]] = j
         children[j["parent"]].append(j)
     roots = [name for name in link_names if name not in parent_joint]
     if len(roots) > 1:
-        raise ValueError(f"{where}: the URDF has several root links {roots}; connect them with joints to one root")
+        shown = roots if len(roots) <= 10 else roots[:10] + [f"... {len(roots) - 10} more"]
+        raise ValueError(f"{src.label}: the URDF has several root links {shown}; connect them with joints to one root")
     if not roots:
-        raise ValueError(f"{where}: the URDF has no root link: its joints form a cycle ({_cycle(parent_joint)})")
+        raise ValueError(f"{src.label}: the URDF has no root link: its joints form a cycle ({_cycle(parent_joint)})")
     ordered = []
     stack = list(reversed(children[roots[0]]))
     while stack:
@@ -242,36 +354,36 @@ def _order(joints: list, link_names: list, where: str):
     if len(ordered) != len(joints):
         reached = {j["name"] for j in ordered}
         cyclic = [j["name"] for j in joints if j["name"] not in reached]
-        raise ValueError(f"{where}: joints {cyclic} form a cycle not connected to the root link '{roots[0]}'")
+        shown = cyclic if len(cyclic) <= 10 else cyclic[:10] + [f"... {len(cyclic) - 10} more"]
+        raise ValueError(f"{src.label}: joints {shown} form a cycle not connected to the root link '{roots[0]}'")
     return roots[0], ordered
 
 
 def _cycle(parent_joint: dict) -> str:
-    """A readable cycle 'a -> b -> a' by following parents from any link."""
+    """A readable cycle 'a <- b <- a' by following parents from any link (linear time)."""
     link = next(iter(parent_joint))
-    path = [link]
+    path, position = [link], {link: 0}
     while True:
         link = parent_joint[link]["parent"]
-        if link in path:
-            return " <- ".join(path[path.index(link):] + [link])
+        if link in position:
+            cycle = path[position[link]:] + [link]
+            if len(cycle) > 12:
+                cycle = cycle[:5] + [f"... {len(cycle) - 10} more ..."] + cycle[-5:]
+            return " <- ".join(cycle)
+        position[link] = len(path)
         path.append(link)
 
 
 def _default_tool(links: list, base: str) -> str:
-    """The last link, in depth-first order, carried by the last moving joint."""
-    moving = [l.name for l in links if l.joint.is_moving]
-    if not moving:
+    """The last link, in depth-first order, carried by the last moving joint: a link is carried by
+    the nearest moving joint on its path to the root (its own, if it moves). One pass over the
+    links, which come in depth-first order (parents before children)."""
+    carrier = {base: None}
+    last_moving = None
+    for link in links:
+        carrier[link.name] = link.name if link.joint.is_moving else carrier[link.parent]
+        if link.joint.is_moving:
+            last_moving = link.name
+    if last_moving is None:
         return base
-    parent = {l.name: l.parent for l in links}
-
-    def carried_by_last(name: str) -> bool:
-        while name != moving[-1]:
-            if name not in parent:
-                return False
-            link = next(l for l in links if l.name == name)
-            if link.joint.is_moving:
-                return False
-            name = parent[name]
-        return True
-
-    return [l.name for l in links if carried_by_last(l.name)][-1]
+    return [link.name for link in links if carrier[link.name] == last_moving][-1]
