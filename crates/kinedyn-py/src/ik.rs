@@ -12,6 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
+use crate::guard::{self, guarded};
 use crate::PyModel;
 
 /// One target: a pose (4x4) or a position (3,), checked.
@@ -39,14 +40,16 @@ fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResul
 }
 
 /// The numbers of a float64 array in C order, copied.
-fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> Vec<f64> {
+fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
     // SAFETY: read while this thread holds the GIL and runs no Python code, so nothing writes to
     // the array meanwhile (a plain type check instead of rust-numpy's borrow tracking, ~0.4 us each)
     let view = unsafe { a.as_array() };
+    let mut v = guard::try_vec("inverse kinematics: copying an input", view.len())?;
     match view.as_slice() {
-        Some(s) => s.to_vec(),
-        None => view.iter().copied().collect(),
+        Some(s) => v.extend_from_slice(s),
+        None => v.extend(view.iter().copied()),
     }
+    Ok(v)
 }
 
 /// Targets (4, 4) / (N, 4, 4) or positions (3,) / (N, 3): (transforms, batch size, position-only).
@@ -63,7 +66,7 @@ fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transfo
             )))
         }
     };
-    let flat = numbers(targets);
+    let flat = numbers(targets)?;
     let width = if position { 3 } else { 16 };
     let list = flat
         .chunks(width)
@@ -77,7 +80,7 @@ fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Ve
     if a.shape() != [len] {
         return Err(PyValueError::new_err(format!("{name} must have shape ({len},), got {:?}", a.shape())));
     }
-    Ok(numbers(a))
+    numbers(a)
 }
 
 fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
@@ -114,6 +117,7 @@ pub fn solve_ik<'py>(
     max_step: f64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyAny>> {
+    guarded("solve_ik", || {
     let m: &Model = &model.model;
     let n = m.n;
     let frame = model.frame(frame)?;
@@ -131,7 +135,7 @@ pub fn solve_ik<'py>(
         weights[3..].fill(0.0);
     }
     let q0_shape = q0.shape().to_vec();
-    let q0s: Vec<f64> = numbers(&q0);
+    let q0s: Vec<f64> = numbers(&q0)?;
     let per_target = match (q0_shape.as_slice(), batch) {
         ([k], _) if *k == n => false,
         ([b, k], Some(nb)) if *k == n && *b == nb => true,
@@ -148,13 +152,21 @@ pub fn solve_ik<'py>(
     };
     let outcomes: Vec<ik::Outcome> = py.detach(|| {
         if count <= 4 {
-            let mut data = model.data.lock().unwrap_or_else(|e| e.into_inner());
-            (0..count).map(|k| solve_one(&mut data, k)).collect()
+            // the model's cached Data, unless another thread holds it (then a fresh one: a lock
+            // held by a thread of the parent at a fork would otherwise never be released)
+            match model.data.try_lock() {
+                Ok(mut data) => Ok((0..count).map(|k| solve_one(&mut data, k)).collect()),
+                Err(_) => {
+                    let mut data = Data::new(m);
+                    Ok((0..count).map(|k| solve_one(&mut data, k)).collect())
+                }
+            }
         } else {
-            (0..count).into_par_iter().map_init(|| Data::new(m), |data, k| solve_one(data, k)).collect()
+            guard::install(|| (0..count).into_par_iter().map_init(|| Data::new(m), |data, k| solve_one(data, k)).collect())
         }
-    });
-    let mut q = Vec::with_capacity(count * n);
+    })?;
+    guard::check_size("solve_ik", 1, &[count, n])?;
+    let mut q = guard::try_vec("solve_ik", count * n)?;
     for o in &outcomes {
         q.extend_from_slice(&o.q);
     }
@@ -180,6 +192,7 @@ pub fn solve_ik<'py>(
         ),
     };
     Ok(result.into_pyobject(py)?.into_any())
+    })
 }
 
 /// A closed-form solver detected from a model's geometry (`None` from `detect` when there is none).
@@ -198,6 +211,7 @@ impl PyAnalyticIk {
     /// The solver of `frame`'s chain, or None if its geometry has no closed form here.
     #[staticmethod]
     fn detect(model: &PyModel, frame: i64, lower: Bound<'_, PyArrayDyn<f64>>, upper: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Option<Self>> {
+        guarded("AnalyticIk.detect", || {
         let frame = model.frame(frame)?;
         let m = model.model.clone();
         let lower = vector("lower", &lower, m.n)?;
@@ -205,6 +219,7 @@ impl PyAnalyticIk {
         check_limits(&lower, &upper)?;
         let mut data = Data::new(&m);
         Ok(ik::detect_analytic(&m, &mut data, frame).map(|solver| Self { solver, model: m, data: Mutex::new(data), frame, lower, upper }))
+        })
     }
 
     /// Name of the detected structure (e.g. "spherical_wrist").
@@ -238,6 +253,7 @@ impl PyAnalyticIk {
         respect_limits: bool,
         tolerance: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, usize, bool)> {
+        guarded("AnalyticIk.solve", || {
         let n = self.model.n;
         let (targets, batch, position) = gather_targets(&target)?;
         if batch.is_some() {
@@ -257,6 +273,7 @@ impl PyAnalyticIk {
             out.found,
             out.singular,
         ))
+        })
     }
 
     /// The solution nearest each reference for a batch of targets: (q (N, n), success (N,),
@@ -271,15 +288,16 @@ impl PyAnalyticIk {
         respect_limits: bool,
         tolerance: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        guarded("AnalyticIk.solve_nearest", || {
         let n = self.model.n;
         let (targets, _, position) = gather_targets(&targets)?;
         let count = targets.len();
-        let refs: Vec<f64> = numbers(&references);
+        let refs: Vec<f64> = numbers(&references)?;
         if references.shape() != [count, n] {
             return Err(PyValueError::new_err(format!("references must have shape ({count}, {n}), got {:?}", references.shape())));
         }
         let results: Vec<(Vec<f64>, bool, f64, f64)> = py.detach(|| {
-            (0..count)
+            guard::install(|| (0..count)
                 .into_par_iter()
                 .map_init(
                     || Data::new(&self.model),
@@ -292,9 +310,10 @@ impl PyAnalyticIk {
                         }
                     },
                 )
-                .collect()
-        });
-        let mut q = Vec::with_capacity(count * n);
+                .collect())
+        })?;
+        guard::check_size("AnalyticIk.solve_nearest", 1, &[count, n])?;
+        let mut q = guard::try_vec("AnalyticIk.solve_nearest", count * n)?;
         for r in &results {
             q.extend_from_slice(&r.0);
         }
@@ -304,6 +323,7 @@ impl PyAnalyticIk {
             PyArray1::from_vec(py, results.iter().map(|r| r.2).collect()),
             PyArray1::from_vec(py, results.iter().map(|r| r.3).collect()),
         ))
+        })
     }
 }
 
