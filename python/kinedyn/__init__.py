@@ -1,5 +1,6 @@
 """kinedyn: robot kinematics and dynamics, symbolic for people and numeric (Rust) for programs."""
 
+from ._core import NonFiniteResultError
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .robot import Robot
 from . import robots
@@ -30,5 +31,5 @@ def load(path, **kwargs) -> Robot:
 
 __all__ = [
     "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "__version__", *_SUBMODULES,
+    "Trajectory", "NonFiniteResultError", "__version__", *_SUBMODULES,
 ]

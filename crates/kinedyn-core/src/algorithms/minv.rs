@@ -60,7 +60,7 @@ fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> Stri
     } else if mkk <= EPS_D * scale {
         format!(
             "{head}; M[{k}, {k}] = {mkk:e} is {:.1e} times M[{largest}, {largest}] = {scale:e}: the inertias of the subtrees of \
-             joints {k} and {largest} differ by more than float64 can resolve (check the inertia of joint {largest}'s body and its \
+             joint {k} and joint {largest} differ by more than float64 can resolve (check the inertia of joint {largest}'s body and its \
              children for a wrong unit or a huge value, and joint {k}'s for a missing mass)",
             mkk / scale
         )
