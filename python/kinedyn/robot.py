@@ -146,11 +146,12 @@ class Robot:
             if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
                 raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
+        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
+        if unknown:
+            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names})")
         values = {}
         for key, value in items:
             if isinstance(key, str):
-                if key not in names:
-                    raise ValueError(f"lock_joints: unknown joint '{key}' (moving joints: {names})")
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
                 if not -self.n <= key < self.n:
