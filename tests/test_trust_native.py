@@ -89,6 +89,7 @@ def test_batches_under_an_address_space_limit_raise_memory_error():
         robot = kd.robots.puma560()
         N = 1_000_000
         q = np.random.default_rng(0).uniform(-1, 1, (N, 6))
+        targets = np.random.default_rng(0).uniform(-0.3, 0.3, (4 * N, 3))  # batch IK: 384 MB of poses
         robot.mass_matrix(q[:1000]); robot.inverse_kinematics(robot.pose(q[:8]), method="numeric")  # pools started
         def vm():
             for line in open("/proc/self/status"):
@@ -104,6 +105,7 @@ def test_batches_under_an_address_space_limit_raise_memory_error():
             "forward_kinematics": lambda: robot.forward_kinematics(q),
             "jacobian": lambda: robot.jacobian(q),
             "simulate": lambda: kd.simulate(robot, (0, 10), np.zeros(12), dt=1e-5, method="rk4"),
+            "inverse_kinematics": lambda: robot.inverse_kinematics(targets, method="numeric"),
         }
         for name, call in calls.items():
             try:
@@ -119,7 +121,7 @@ def test_batches_under_an_address_space_limit_raise_memory_error():
     assert "PanicException" not in result.stdout + result.stderr
     lines = result.stdout.splitlines()
     assert lines[-1] == "alive"
-    for name in ("mass_matrix", "christoffel", "regressor", "inverse_dynamics_derivatives", "forward_kinematics", "jacobian", "simulate"):
+    for name in ("mass_matrix", "christoffel", "regressor", "inverse_dynamics_derivatives", "forward_kinematics", "jacobian", "simulate", "inverse_kinematics"):
         assert f"{name} MemoryError" in result.stdout, result.stdout
 
 

@@ -116,15 +116,16 @@ fn out_of_memory(py: Python<'_>, what: &str, shape: &[usize], detail: Option<PyE
     ))
 }
 
-/// A fresh C-ordered float64 array, uninitialised (`zeroed = false`) or zeros; MemoryError naming
+/// A fresh C-ordered array (float64 for results; the size check counts 8 bytes per element, an
+/// upper bound for bool and int64 too), uninitialised (`zeroed = false`) or zeros; MemoryError naming
 /// `what` and the size when it cannot be had (rust-numpy's `PyArray::new` / `zeros` panic then).
-fn allocate<'py>(py: Python<'py>, what: &str, shape: &[usize], zeroed: bool) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+fn allocate<'py, T: Element>(py: Python<'py>, what: &str, shape: &[usize], zeroed: bool) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     check_size(what, 1, shape)?;
     let mut dims: Vec<npy_intp> = shape.iter().map(|&d| d as npy_intp).collect();
     // SAFETY: the NumPy C API with a valid descriptor (its reference is stolen by the call) and
     // `dims.len()` dimensions; a NULL result leaves a Python error set, fetched below.
     unsafe {
-        let descr = f64::get_dtype(py).into_dtype_ptr();
+        let descr = T::get_dtype(py).into_dtype_ptr();
         let ptr = if zeroed {
             PY_ARRAY_API.PyArray_Zeros(py, dims.len() as i32, dims.as_mut_ptr(), descr, 0)
         } else {
@@ -147,13 +148,13 @@ fn allocate<'py>(py: Python<'py>, what: &str, shape: &[usize], zeroed: bool) -> 
     }
 }
 
-/// An uninitialised float64 array of `shape` (see [`allocate`]).
-pub fn empty<'py>(py: Python<'py>, what: &str, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+/// An uninitialised array of `shape` (see [`allocate`]).
+pub fn empty<'py, T: Element>(py: Python<'py>, what: &str, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     allocate(py, what, shape, false)
 }
 
-/// A float64 array of zeros of `shape` (see [`allocate`]).
-pub fn zeros<'py>(py: Python<'py>, what: &str, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+/// An array of zeros (false) of `shape` (see [`allocate`]).
+pub fn zeros<'py, T: Element>(py: Python<'py>, what: &str, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     allocate(py, what, shape, true)
 }
 
