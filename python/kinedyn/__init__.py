@@ -1,5 +1,6 @@
 """kinedyn: robot kinematics and dynamics, symbolic for people and numeric (Rust) for programs."""
 
+from ._core import NonFiniteResultError
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
@@ -33,5 +34,5 @@ def load(path, **kwargs) -> Robot:
 
 __all__ = [
     "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "PhysicalConsistencyWarning", "__version__", *_SUBMODULES,
+    "Trajectory", "PhysicalConsistencyWarning", "NonFiniteResultError", "__version__", *_SUBMODULES,
 ]

@@ -2,7 +2,11 @@
 
 Every state argument (q, qd, qdd, tau) is a float64 array of shape (n,) or a batch (N, n); a batch
 returns the stacked results, computed in one native call with the GIL released. Shapes and finiteness
-are checked at the boundary and reported as ValueError naming the argument.
+are checked at the boundary and reported as ValueError naming the argument (complex numbers and text:
+TypeError). Finite inputs with a non-finite result raise NonFiniteResultError naming the quantity (and
+the state of a batch); a result that cannot be allocated raises MemoryError naming its bytes; a panic
+of the native code (a bug) raises RuntimeError naming the binding, never pyo3's PanicException.
+Batches run in a thread pool rebuilt in a forked child, so they work after ``fork``.
 ``reference``: 0 = "world" (LOCAL_WORLD_ALIGNED), 1 = "local", 2 = "spatial" (WORLD).
 """
 
@@ -55,3 +59,14 @@ class Model:
     def regressor(self, q: F64, qd: F64, qdd: F64) -> F64: ...  # (n, 10 n) | (N, n, 10 n)
     def center_of_mass(self, q: F64) -> F64: ...  # (3,) | (N, 3)
     def momentum(self, q: F64, qd: F64) -> F64: ...  # (6,) | (N, 6), [p; L about the base origin]
+
+class NonFiniteResultError(FloatingPointError, ValueError):
+    """Finite inputs gave a non-finite result (the numbers overflowed float64)."""
+
+def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
+    """TEST-ONLY: panics inside a guarded binding (on a batch worker thread if ``in_worker``), to
+    check that a panic reaches Python as a RuntimeError."""
+
+def _set_check_finite(on: bool) -> bool:
+    """BENCHMARK-ONLY: turns the non-finite scan of batch results on or off; returns the previous
+    setting (benches/bench_finite_check.py)."""

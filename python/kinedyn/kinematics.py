@@ -13,6 +13,8 @@ from typing import Optional, Sequence, Union
 
 import numpy as np
 
+from ._arrays import finite_result, real_array
+
 __all__ = [
     "task_rows",
     "task_jacobian",
@@ -57,7 +59,7 @@ def task_jacobian(robot, q, frame: Optional[str] = None, task: Task = "full", re
 
 def _vector(x, size: int, what: str, J: np.ndarray) -> np.ndarray:
     """``x`` as (size,) or, next to a batch of Jacobians (N, m, n) or alone, as a batch (N, size)."""
-    v = np.asarray(x, dtype=float)
+    v = real_array(x, what)
     batch = J.shape[0] if J.ndim == 3 else None
     if v.shape != (size,) and not (v.ndim == 2 and v.shape[1] == size and (batch is None or v.shape[0] == batch)):
         want = f"({size},)" + (f" or ({batch}, {size})" if batch is not None else f" or (N, {size})")
@@ -75,7 +77,9 @@ def _mul(A: np.ndarray, v: np.ndarray) -> np.ndarray:
 def tool_velocity(robot, q, qd, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
     """Tool twist (selected rows) ``J(q) qd``; (N, m) for a batch of q and/or qd."""
     J = task_jacobian(robot, q, frame, task, reference)
-    return _mul(J, _vector(qd, robot.n, "qd", J))
+    with np.errstate(over="ignore", invalid="ignore"):
+        v = _mul(J, _vector(qd, robot.n, "qd", J))
+    return finite_result(v, "tool_velocity: v", v.ndim - 1)
 
 
 def joint_torques(robot, q, wrench, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
@@ -86,7 +90,9 @@ def joint_torques(robot, q, wrench, frame: Optional[str] = None, task: Task = "f
     environment (equivalently, the joint torques caused by F applied to the tool, with a sign flip).
     """
     J = task_jacobian(robot, q, frame, task, reference)
-    return _mul(np.swapaxes(J, -1, -2), _vector(wrench, J.shape[-2], "wrench", J))
+    with np.errstate(over="ignore", invalid="ignore"):
+        tau = _mul(np.swapaxes(J, -1, -2), _vector(wrench, J.shape[-2], "wrench", J))
+    return finite_result(tau, "joint_torques: tau", tau.ndim - 1)
 
 
 def joint_velocities(
@@ -102,7 +108,12 @@ def joint_velocities(
     """Joint rates producing a tool velocity: ``qd = J^-1 v`` (``method="inverse"``, square and
     non-singular J only), the Moore-Penrose pseudo-inverse (``"pinv"``: least-squares, minimum norm)
     or damped least squares (``"dls"``: ``J^T (J J^T + lambda^2 I)^-1 v``, Nakamura & Hanafusa 1986;
-    Wampler 1986), which stays bounded near singularities. (N, n) for a batch of q and/or v."""
+    Wampler 1986), which stays bounded near singularities. (N, n) for a batch of q and/or v.
+
+    Both ``"pinv"`` and ``"dls"`` are computed from the SVD ``J = U S V^T`` as
+    ``V diag(s_i / (s_i^2 + lambda^2)) U^T v`` (Wampler 1986, eq. 13; ``lambda = 0`` for pinv), so
+    that ``damping=0`` is the minimum-norm least-squares answer even at a singularity: singular
+    values below ``max(m, n) eps s_max`` (NumPy's ``matrix_rank`` tolerance) count as zero."""
     if method not in ("inverse", "pinv", "dls"):
         raise ValueError(f"method must be 'inverse', 'pinv' or 'dls', got '{method}'")
     J = task_jacobian(robot, q, frame, task, reference)
@@ -116,14 +127,23 @@ def joint_velocities(
             if report.singular:
                 where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
                 raise ValueError(f"the Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}: {report.summary()}")
-        return np.linalg.solve(J, v[..., None])[..., 0]
-    if method == "pinv":
-        return _mul(np.linalg.pinv(J), v)
-    if not (damping >= 0 and np.isfinite(damping)):
-        raise ValueError(f"damping must be a finite number >= 0, got {damping}")
-    JT = np.swapaxes(J, -1, -2)
-    m = J.shape[-2]
-    return _mul(JT, np.linalg.solve(J @ JT + damping**2 * np.eye(m), v[..., None])[..., 0])
+        with np.errstate(over="ignore", invalid="ignore"):
+            qd = np.linalg.solve(J, v[..., None])[..., 0]
+        return finite_result(qd, "joint_velocities: qd", qd.ndim - 1)
+    damping = 0.0 if method == "pinv" else damping
+    if isinstance(damping, (complex, np.complexfloating)) or not (np.isreal(damping) and damping >= 0 and np.isfinite(damping)):
+        raise ValueError(f"damping must be a finite number >= 0, got {damping!r}")
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    lam2 = float(damping) ** 2
+    denominator = s * s + lam2
+    if lam2 == 0.0:
+        keep = s > max(J.shape[-2:]) * np.finfo(float).eps * s[..., :1]
+    else:
+        keep = denominator > 0
+    gain = np.divide(s, denominator, out=np.zeros_like(s), where=keep)
+    with np.errstate(over="ignore", invalid="ignore"):
+        qd = _mul(np.swapaxes(Vt, -1, -2), gain * _mul(np.swapaxes(U, -1, -2), v))
+    return finite_result(qd, "joint_velocities: qd", qd.ndim - 1)
 
 
 def singular_values(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:

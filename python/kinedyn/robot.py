@@ -14,6 +14,7 @@ from typing import Mapping, Optional, Sequence
 import numpy as np
 import sympy as sp
 
+from ._arrays import finite_result, real_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.joint import Joint
@@ -132,24 +133,69 @@ class Robot:
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
 
-    def lock_joints(self, values: Mapping[str, float]) -> "Robot":
-        """A new robot with the named joints fixed at the given values (e.g. a gripper's fingers)."""
+    def lock_joints(self, joints, at=None) -> "Robot":
+        """A new robot with some joints fixed (e.g. a gripper's fingers).
+
+        ``joints``: a mapping ``{joint: value}``, or a sequence (list, tuple, set, array) of joints
+        locked at their value in ``at`` (a configuration (n,); default: zero, the joint's offset
+        position). A joint is named by its name (``robot.joint_names``) or its index in ``q``.
+        """
         from ._math import rot_axis, translation
 
-        names = {l.joint.name for l in self.links if l.joint.is_moving}
-        unknown = set(values) - names
+        names = self.joint_names
+        if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
+            raise TypeError(f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}")
+        if isinstance(joints, Mapping):
+            items = list(joints.items())
+        else:
+            q_at = np.zeros(self.n) if at is None else real_array(at, "at")
+            if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
+                raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
+            items = [(j, None) for j in joints]
+        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
         if unknown:
-            raise ValueError(f"lock_joints: unknown joints {sorted(unknown)} (moving joints: {sorted(names)})")
+            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names})")
+        values = {}
+        for key, value in items:
+            if isinstance(key, str):
+                i = names.index(key)
+            elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+                if not -self.n <= key < self.n:
+                    raise ValueError(f"lock_joints: joint index {key} is out of range for {self.n} joints")
+                i = int(key) % self.n
+            else:
+                raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
+            if value is None:
+                value = q_at[i]
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}") from None
+            if not math.isfinite(v):
+                raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
+            values[names[i]] = v
         links = []
         for link in self.links:
             j = link.joint
-            if j.name in values:
+            if j.name in values and j.is_moving:
                 x = values[j.name] + j.offset
                 motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
                 fixed = Joint(j.name, "fixed", j.axis)
                 link = Link(link.name, link.parent, fixed, matmul(link.placement, motion), link.post, link.inertia)
             links.append(link)
         return self.replace(links=links, dh=None)
+
+    # ------------------------------------------------------------------ pickling
+    # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
+    # pickled or copied, and built again on first use on the other side (DESIGN.md: "a Robot
+    # pickles"). Everything else is the frozen description: numbers, NumPy arrays, SymPy objects.
+    _NATIVE_STATE = ("_model", "_ik_chains")
+
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in self.__dict__.items() if k not in self._NATIVE_STATE}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
 
     # ------------------------------------------------------------------ description queries
     @property
@@ -211,12 +257,14 @@ class Robot:
 
     def friction_torque(self, qd) -> np.ndarray:
         """viscous * qd + coulomb * sign(qd), (n,) or (N, n)."""
-        qd = np.asarray(qd, dtype=float)
+        qd = real_array(qd, "qd")
         if qd.shape[-1:] != (self.n,) or qd.ndim > 2:
             raise ValueError(f"qd must have shape ({self.n},) or a batch (N, {self.n}), got {qd.shape}")
         if not np.all(np.isfinite(qd)):
             raise ValueError("qd contains a non-finite value (NaN or inf)")
-        return self.viscous * qd + self.coulomb * np.sign(qd)
+        with np.errstate(over="ignore"):
+            tau = self.viscous * qd + self.coulomb * np.sign(qd)
+        return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
     @property
     def is_symbolic(self) -> bool:
@@ -340,11 +388,12 @@ class Robot:
         return np.array([self.frame_index(name) for name in self.body_names], dtype=np.int64)
 
     @staticmethod
-    def _state(x) -> np.ndarray:
-        # float64 arrays pass through (the core reads any layout); anything else is converted
+    def _state(x, name: str = "q") -> np.ndarray:
+        # float64 arrays pass through (the core reads any layout); anything else is converted,
+        # complex numbers and text refused (TypeError naming the argument)
         if type(x) is np.ndarray and x.dtype is _F64:
             return x
-        return np.ascontiguousarray(x, dtype=np.float64)
+        return real_array(x, name)
 
     def _reference(self, reference: str) -> int:
         try:
@@ -355,7 +404,7 @@ class Robot:
     def _point(self, point) -> Optional[np.ndarray]:
         if point is None:
             return None
-        p = np.ascontiguousarray(point, dtype=np.float64)
+        p = real_array(point, "point")
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"point must be 3 finite coordinates in the frame's axes, got {point!r}")
         return p
@@ -402,11 +451,11 @@ class Robot:
 
     def frame_velocity(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
-        return self._model.frame_velocity(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+        return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
     def jacobian_dot_qd(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
-        return self._model.jdot_qd(self._state(q), self._state(qd), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+        return self._model.jdot_qd(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
     def inverse_kinematics(self, target, q0=None, mask=None, method: str = "auto", respect_limits: bool = True, **kwargs):
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
@@ -433,9 +482,12 @@ class Robot:
         ``n_body = n_link + (p_link - p_body) x f``, ``p_link - p_body = R_link R_bl^T t_bl``."""
         if f_ext is None:
             return None
-        f = np.ascontiguousarray(f_ext, dtype=np.float64)
+        f = real_array(f_ext, "f_ext")
+        if f.shape == (self.n, 6) and np.ndim(q) == 2:
+            # one set of wrenches for every state of a batch
+            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), self.n, 6)))
         u = self._link_origin_in_body
-        if u is None or f.shape[-2:] != (self.n, 6):
+        if u is None or f.shape[-2:] != (self.n, 6) or f.ndim != np.ndim(q) + 1:
             return f  # (wrong shapes are reported by the core)
         R = self.forward_kinematics(q)[..., :3, :3]
         d = np.einsum("...ij,...j->...i", R, u)
@@ -448,12 +500,19 @@ class Robot:
         import re
 
         message = str(error)
-        match = re.search(r"joint (\d+)", message)
-        if match and int(match.group(1)) < self.n:
-            joint = int(match.group(1))
-            name = self.joint_names[joint]
-            message = message.replace(match.group(0), f"{match.group(0)} ('{name}')", 1)
-            message += self._nonphysical_note(joint)
+
+        seen = set()
+
+        def named(match):
+            i = int(match.group(1))
+            if i >= self.n or i in seen:
+                return match.group(0)
+            seen.add(i)
+            return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
+
+        message = re.sub(r"\bjoint (\d+)", named, message)
+        if seen:
+            message += self._nonphysical_note(min(seen))
         return RuntimeError(f"robot '{self.name}': {message}")
 
     def _nonphysical_note(self, joint: int) -> str:

@@ -12,6 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
+use crate::guard::{self, guarded};
 use crate::PyModel;
 
 /// One target: a pose (4x4) or a position (3,), checked.
@@ -39,14 +40,16 @@ fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResul
 }
 
 /// The numbers of a float64 array in C order, copied.
-fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> Vec<f64> {
+fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
     // SAFETY: read while this thread holds the GIL and runs no Python code, so nothing writes to
     // the array meanwhile (a plain type check instead of rust-numpy's borrow tracking, ~0.4 us each)
     let view = unsafe { a.as_array() };
+    let mut v = guard::try_vec("inverse kinematics: copying an input", view.len())?;
     match view.as_slice() {
-        Some(s) => s.to_vec(),
-        None => view.iter().copied().collect(),
+        Some(s) => v.extend_from_slice(s),
+        None => v.extend(view.iter().copied()),
     }
+    Ok(v)
 }
 
 /// Targets (4, 4) / (N, 4, 4) or positions (3,) / (N, 3): (transforms, batch size, position-only).
@@ -63,13 +66,12 @@ fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transfo
             )))
         }
     };
-    let flat = numbers(targets);
+    let flat = numbers(targets)?;
     let width = if position { 3 } else { 16 };
-    let list = flat
-        .chunks(width)
-        .enumerate()
-        .map(|(k, c)| parse_target(c, position, batch.map(|_| k)))
-        .collect::<PyResult<Vec<_>>>()?;
+    let mut list = guard::try_vec("inverse kinematics: the targets", flat.len() / width)?;
+    for (k, c) in flat.chunks(width).enumerate() {
+        list.push(parse_target(c, position, batch.map(|_| k))?);
+    }
     Ok((list, batch, position))
 }
 
@@ -77,7 +79,7 @@ fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Ve
     if a.shape() != [len] {
         return Err(PyValueError::new_err(format!("{name} must have shape ({len},), got {:?}", a.shape())));
     }
-    Ok(numbers(a))
+    numbers(a)
 }
 
 fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
@@ -114,6 +116,7 @@ pub fn solve_ik<'py>(
     max_step: f64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyAny>> {
+    guarded("solve_ik", || {
     let m: &Model = &model.model;
     let n = m.n;
     let frame = model.frame(frame)?;
@@ -131,7 +134,7 @@ pub fn solve_ik<'py>(
         weights[3..].fill(0.0);
     }
     let q0_shape = q0.shape().to_vec();
-    let q0s: Vec<f64> = numbers(&q0);
+    let q0s: Vec<f64> = numbers(&q0)?;
     let per_target = match (q0_shape.as_slice(), batch) {
         ([k], _) if *k == n => false,
         ([b, k], Some(nb)) if *k == n && *b == nb => true,
@@ -146,40 +149,58 @@ pub fn solve_ik<'py>(
         // a seed per target: results do not depend on how the batch is split among threads
         ik::numeric_ik(m, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(k as u64))
     };
-    let outcomes: Vec<ik::Outcome> = py.detach(|| {
+    // the results, allocated fallibly before the work (MemoryError, not an abort), each target
+    // writing its own row
+    let q = guard::empty::<f64>(py, "solve_ik", &[count, n])?;
+    let success = guard::zeros::<bool>(py, "solve_ik", &[count])?; // (zeros: no invalid bools)
+    let [pe, oe] = [guard::empty::<f64>(py, "solve_ik", &[count])?, guard::empty::<f64>(py, "solve_ik", &[count])?];
+    let it = guard::empty::<i64>(py, "solve_ik", &[count])?;
+    // SAFETY: fresh arrays, referenced by nothing else until returned
+    let (q_out, s_out, pe_out, oe_out, it_out) = unsafe { (q.as_slice_mut()?, success.as_slice_mut()?, pe.as_slice_mut()?, oe.as_slice_mut()?, it.as_slice_mut()?) };
+    let write = |data: &mut Data, k: usize, qk: &mut [f64], s: &mut bool, p: &mut f64, o: &mut f64, i: &mut i64| {
+        let out = solve_one(data, k);
+        qk.copy_from_slice(&out.q);
+        (*s, *p, *o, *i) = (out.success, out.position_error, out.orientation_error, out.iterations as i64);
+    };
+    py.detach(|| {
+        let rows = q_out.chunks_mut(n).zip(s_out.iter_mut()).zip(pe_out.iter_mut()).zip(oe_out.iter_mut()).zip(it_out.iter_mut());
         if count <= 4 {
-            let mut data = model.data.lock().unwrap_or_else(|e| e.into_inner());
-            (0..count).map(|k| solve_one(&mut data, k)).collect()
+            // the model's cached Data, unless another thread holds it (then a fresh one: a lock
+            // held by a thread of the parent at a fork would otherwise never be released)
+            let mut fresh;
+            let mut cached = model.data.try_lock();
+            let data: &mut Data = match cached.as_deref_mut() {
+                Ok(d) => d,
+                Err(_) => {
+                    fresh = Data::new(m);
+                    &mut fresh
+                }
+            };
+            for (k, ((((qk, s), p), o), i)) in rows.enumerate() {
+                write(data, k, qk, s, p, o, i);
+            }
+            Ok(())
         } else {
-            (0..count).into_par_iter().map_init(|| Data::new(m), |data, k| solve_one(data, k)).collect()
+            guard::install(|| {
+                q_out.par_chunks_mut(n).zip(s_out.par_iter_mut()).zip(pe_out.par_iter_mut()).zip(oe_out.par_iter_mut()).zip(it_out.par_iter_mut()).enumerate().for_each_init(
+                    || Data::new(m),
+                    |data, (k, ((((qk, s), p), o), i))| write(data, k, qk, s, p, o, i),
+                )
+            })
         }
-    });
-    let mut q = Vec::with_capacity(count * n);
-    for o in &outcomes {
-        q.extend_from_slice(&o.q);
-    }
-    let success: Vec<bool> = outcomes.iter().map(|o| o.success).collect();
-    let pe: Vec<f64> = outcomes.iter().map(|o| o.position_error).collect();
-    let oe: Vec<f64> = outcomes.iter().map(|o| o.orientation_error).collect();
-    let it: Vec<i64> = outcomes.iter().map(|o| o.iterations as i64).collect();
-    let q = PyArray1::from_vec(py, q);
+    })?;
     let result = match batch {
-        Some(b) => (
-            q.reshape([b, n])?.into_any(),
-            PyArray1::from_vec(py, success).into_any(),
-            PyArray1::from_vec(py, pe).into_any(),
-            PyArray1::from_vec(py, oe).into_any(),
-            PyArray1::from_vec(py, it).into_any(),
-        ),
+        Some(_) => (q.into_any(), success.into_any(), pe.into_any(), oe.into_any(), it.into_any()),
         None => (
-            q.into_any(),
-            success[0].into_pyobject(py)?.to_owned().into_any(),
-            pe[0].into_pyobject(py)?.into_any(),
-            oe[0].into_pyobject(py)?.into_any(),
-            it[0].into_pyobject(py)?.into_any(),
+            q.reshape([n])?.into_any(),
+            s_out[0].into_pyobject(py)?.to_owned().into_any(),
+            pe_out[0].into_pyobject(py)?.into_any(),
+            oe_out[0].into_pyobject(py)?.into_any(),
+            it_out[0].into_pyobject(py)?.into_any(),
         ),
     };
     Ok(result.into_pyobject(py)?.into_any())
+    })
 }
 
 /// A closed-form solver detected from a model's geometry (`None` from `detect` when there is none).
@@ -198,6 +219,7 @@ impl PyAnalyticIk {
     /// The solver of `frame`'s chain, or None if its geometry has no closed form here.
     #[staticmethod]
     fn detect(model: &PyModel, frame: i64, lower: Bound<'_, PyArrayDyn<f64>>, upper: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Option<Self>> {
+        guarded("AnalyticIk.detect", || {
         let frame = model.frame(frame)?;
         let m = model.model.clone();
         let lower = vector("lower", &lower, m.n)?;
@@ -205,6 +227,7 @@ impl PyAnalyticIk {
         check_limits(&lower, &upper)?;
         let mut data = Data::new(&m);
         Ok(ik::detect_analytic(&m, &mut data, frame).map(|solver| Self { solver, model: m, data: Mutex::new(data), frame, lower, upper }))
+        })
     }
 
     /// Name of the detected structure (e.g. "spherical_wrist").
@@ -238,6 +261,7 @@ impl PyAnalyticIk {
         respect_limits: bool,
         tolerance: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, usize, bool)> {
+        guarded("AnalyticIk.solve", || {
         let n = self.model.n;
         let (targets, batch, position) = gather_targets(&target)?;
         if batch.is_some() {
@@ -257,6 +281,7 @@ impl PyAnalyticIk {
             out.found,
             out.singular,
         ))
+        })
     }
 
     /// The solution nearest each reference for a batch of targets: (q (N, n), success (N,),
@@ -271,39 +296,44 @@ impl PyAnalyticIk {
         respect_limits: bool,
         tolerance: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        guarded("AnalyticIk.solve_nearest", || {
         let n = self.model.n;
         let (targets, _, position) = gather_targets(&targets)?;
         let count = targets.len();
-        let refs: Vec<f64> = numbers(&references);
+        let refs: Vec<f64> = numbers(&references)?;
         if references.shape() != [count, n] {
             return Err(PyValueError::new_err(format!("references must have shape ({count}, {n}), got {:?}", references.shape())));
         }
-        let results: Vec<(Vec<f64>, bool, f64, f64)> = py.detach(|| {
-            (0..count)
-                .into_par_iter()
-                .map_init(
+        // the results, allocated fallibly before the work, each target writing its own row
+        const WHAT: &str = "AnalyticIk.solve_nearest";
+        let q = guard::empty::<f64>(py, WHAT, &[count, n])?;
+        let success = guard::zeros::<bool>(py, WHAT, &[count])?;
+        let [pe, oe] = [guard::empty::<f64>(py, WHAT, &[count])?, guard::empty::<f64>(py, WHAT, &[count])?];
+        // SAFETY: fresh arrays, referenced by nothing else until returned
+        let (q_out, s_out, pe_out, oe_out) = unsafe { (q.as_slice_mut()?, success.as_slice_mut()?, pe.as_slice_mut()?, oe.as_slice_mut()?) };
+        py.detach(|| {
+            guard::install(|| {
+                q_out.par_chunks_mut(n).zip(s_out.par_iter_mut()).zip(pe_out.par_iter_mut()).zip(oe_out.par_iter_mut()).enumerate().for_each_init(
                     || Data::new(&self.model),
-                    |data, k| {
+                    |data, (k, (((qk, s), p), o))| {
                         let r = &refs[k * n..(k + 1) * n];
                         let out = ik::analytic_solutions(&self.model, data, &self.solver, self.frame, &targets[k], position, r, &self.lower, &self.upper, respect_limits, tolerance);
                         match out.solutions.first() {
-                            Some(q) => (q.clone(), true, out.position_error[0], out.orientation_error[0]),
-                            None => (vec![f64::NAN; n], false, f64::NAN, f64::NAN),
+                            Some(best) => {
+                                qk.copy_from_slice(best);
+                                (*s, *p, *o) = (true, out.position_error[0], out.orientation_error[0]);
+                            }
+                            None => {
+                                qk.fill(f64::NAN);
+                                (*s, *p, *o) = (false, f64::NAN, f64::NAN);
+                            }
                         }
                     },
                 )
-                .collect()
-        });
-        let mut q = Vec::with_capacity(count * n);
-        for r in &results {
-            q.extend_from_slice(&r.0);
-        }
-        Ok((
-            PyArray1::from_vec(py, q).reshape([count, n])?,
-            PyArray1::from_vec(py, results.iter().map(|r| r.1).collect()),
-            PyArray1::from_vec(py, results.iter().map(|r| r.2).collect()),
-            PyArray1::from_vec(py, results.iter().map(|r| r.3).collect()),
-        ))
+            })
+        })?;
+        Ok((q.cast_into::<PyArray2<f64>>()?, success.cast_into::<PyArray1<bool>>()?, pe.cast_into::<PyArray1<f64>>()?, oe.cast_into::<PyArray1<f64>>()?))
+        })
     }
 }
 

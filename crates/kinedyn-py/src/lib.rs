@@ -5,14 +5,18 @@
 
 use std::borrow::Cow;
 
+mod guard;
 mod ik;
 mod simulate;
+use std::sync::atomic::Ordering;
 use std::sync::Mutex;
+
+use guard::{guarded, shape_text};
 
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
@@ -31,14 +35,6 @@ fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
     x.get(k).copied().filter(|v| !v.is_empty())
 }
 
-/// A shape as Python prints it: `(5,)`, `(2, 3)`.
-fn shape_text(shape: &[usize]) -> String {
-    match shape {
-        [one] => format!("({one},)"),
-        _ => format!("({})", shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
-    }
-}
-
 fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
     let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
     let one = if expected.len() == 1 { "," } else { "" };
@@ -50,19 +46,27 @@ fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
 /// only), which the hot dynamics methods take.
 trait StateArray<'a> {
     fn dims(&self) -> &[usize];
-    /// The numbers in C order; `batch`: the call will release the GIL.
-    fn numbers(&'a self, batch: bool) -> Cow<'a, [f64]>;
+    /// The numbers in C order; `batch`: the call will release the GIL. A copy is allocated
+    /// fallibly (MemoryError, not an abort, when it cannot be had).
+    fn numbers(&'a self, name: &str, batch: bool) -> PyResult<Cow<'a, [f64]>>;
+}
+
+/// The elements of an array view in C order, in a fallibly allocated Vec.
+fn collect_c_order<'v>(name: &str, view: impl Iterator<Item = &'v f64> + ExactSizeIterator) -> PyResult<Vec<f64>> {
+    let mut v = guard::try_vec(&format!("copying {name}"), view.len())?;
+    v.extend(view.copied());
+    Ok(v)
 }
 
 impl<'a> StateArray<'a> for PyReadonlyArrayDyn<'_, f64> {
     fn dims(&self) -> &[usize] {
         self.shape()
     }
-    fn numbers(&'a self, _batch: bool) -> Cow<'a, [f64]> {
+    fn numbers(&'a self, name: &str, _batch: bool) -> PyResult<Cow<'a, [f64]>> {
         // as_slice() also accepts Fortran order (memory order != logical order): C order only
         match self.as_slice() {
-            Ok(s) if self.is_c_contiguous() => Cow::Borrowed(s),
-            _ => Cow::Owned(self.as_array().iter().copied().collect()),
+            Ok(s) if self.is_c_contiguous() => Ok(Cow::Borrowed(s)),
+            _ => Ok(Cow::Owned(collect_c_order(name, self.as_array().iter())?)),
         }
     }
 }
@@ -71,32 +75,48 @@ impl<'a> StateArray<'a> for Bound<'_, PyArrayDyn<f64>> {
     fn dims(&self) -> &[usize] {
         self.shape()
     }
-    fn numbers(&'a self, batch: bool) -> Cow<'a, [f64]> {
+    fn numbers(&'a self, name: &str, batch: bool) -> PyResult<Cow<'a, [f64]>> {
         // SAFETY: a single state is read while this thread holds the GIL and runs no Python code,
         // so nothing writes to the array meanwhile; a batch (run with the GIL released) is copied
         // here, under the GIL, first.
         if self.is_c_contiguous() {
             if let Ok(s) = unsafe { self.as_slice() } {
                 // a batch is copied with one memcpy (ndarray's element iterator was 4 % of a batch)
-                return if batch { Cow::Owned(s.to_vec()) } else { Cow::Borrowed(s) };
+                return Ok(if batch { Cow::Owned(guard::try_copy(&format!("copying {name}"), s)?) } else { Cow::Borrowed(s) });
             }
         }
-        Cow::Owned(unsafe { self.as_array() }.iter().copied().collect())
+        Ok(Cow::Owned(collect_c_order(name, unsafe { self.as_array() }.iter())?))
     }
 }
 
 /// `x` as a float64 NumPy array: itself when it is one (a type check), else
-/// `numpy.asarray(x, dtype=float64)` (lists, integer or float32 arrays), so that every method takes
-/// what NumPy would.
-fn f64_array<'py>(x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+/// `numpy.asarray(x, dtype=float64)` (lists, integer, boolean or float32 arrays), so that every
+/// method takes what NumPy would, except what NumPy would convert by losing information: complex
+/// numbers (their imaginary part), strings, dates. Those raise a TypeError naming the argument.
+fn f64_array<'py>(name: &str, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(array) = x.cast::<PyArrayDyn<f64>>() {
         return Ok(array.clone());
     }
     static ASARRAY: pyo3::sync::PyOnceLock<Py<PyAny>> = pyo3::sync::PyOnceLock::new();
     let py = x.py();
-    let asarray = ASARRAY.get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?;
+    let asarray = ASARRAY.get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?.bind(py);
+    // an array (or what NumPy makes of a list) of what dtype?
+    let array = match x.cast::<numpy::PyUntypedArray>() {
+        Ok(a) => a.clone(),
+        Err(_) => asarray.call1((x,))?.cast_into::<numpy::PyUntypedArray>()?,
+    };
+    let dtype = array.dtype();
+    let kind = dtype.kind();
+    if !matches!(kind, b'f' | b'i' | b'u' | b'b' | b'O') {
+        let what = if kind == b'c' { "complex numbers (the imaginary part would be lost)".to_string() } else { format!("an array of dtype {dtype}") };
+        return Err(PyTypeError::new_err(format!("{name} must be real numbers, got {what}")));
+    }
     let kwargs = [("dtype", "float64")].into_py_dict(py)?;
-    Ok(asarray.bind(py).call((x,), Some(&kwargs))?.cast_into::<PyArrayDyn<f64>>()?)
+    let converted = asarray.call((&array,), Some(&kwargs)).map_err(|e| {
+        // an object array holding something that is not a real number (complex, None, text ...)
+        PyTypeError::new_err(format!("{name} must be real numbers: {}", e.value(py)))
+    })?;
+    Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
 }
 
 /// The most arrays a method takes per state (q, qd, qdd, f_ext).
@@ -142,7 +162,7 @@ impl<'a> Batch<'a> {
                 }
                 _ => {}
             }
-            let data = array.numbers(this.is_some());
+            let data = array.numbers(name, this.is_some())?;
             let w: usize = shape.iter().product();
             if let Some(k) = data.iter().position(|x| !x.is_finite()) {
                 let state = if w > 0 { k / w } else { 0 };
@@ -172,22 +192,27 @@ impl<'a> Batch<'a> {
     /// zeroed first). A single state runs with the cached `Data`, keeping the GIL (the
     /// call is shorter than releasing it); a batch runs with the GIL released, in parallel
     /// chunks of 64 states, each rayon job reusing one `Data` over its chunks.
-    fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    ///
+    /// `what` names the call and its result (`Output`) for the errors: a result that cannot be
+    /// allocated (MemoryError) and a non-finite number in a result of finite inputs
+    /// (`NonFiniteResultError`: every output of every state is scanned right after its kernel
+    /// wrote it, while it is in cache).
+    fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
-        self.run_out(py, m, out_shape, None, kernel)
+        self.run_out(py, m, what, out_shape, None, kernel)
     }
 
     /// `run` writing into the caller's array `out` when given (NumPy's `out=`: no allocation per
     /// call), after checking that it is a writeable, C-contiguous float64 array of the result's
     /// shape that shares no memory with the inputs.
-    fn run_out<'py, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    fn run_out<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
         let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
-        let [array] = self.run_many::<1, _>(py, m, out_shape, [given], |model, data, x, [out]| kernel(model, data, x, out))?;
+        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], |model, data, x, [out]| kernel(model, data, x, out))?;
         Ok(array)
     }
 
@@ -222,7 +247,7 @@ impl<'a> Batch<'a> {
     }
 
     /// `run` for kernels with K outputs of the same per-state shape, returned as K arrays.
-    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
+    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, what: Outputs<K>, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
@@ -234,11 +259,20 @@ impl<'a> Batch<'a> {
             dims[rank] = *d;
             rank += 1;
         }
-        // the caller's checked `out` arrays, or fresh ones. SAFETY: fresh arrays are uninitialised
+        // the caller's checked `out` arrays, or fresh ones. Fresh arrays are uninitialised
         // memory, not zeros (a 10k-state M batch spent 10 % of its time in the memset): every kernel
         // writes its whole output slices (its contract, see `run`), and on an error they are dropped
-        // unread. Created here, nothing else refers to them.
-        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = given.map(|g| g.unwrap_or_else(|| unsafe { PyArrayDyn::<f64>::new(py, &dims[..rank], false) }));
+        // unread. Created here, nothing else refers to them. Their size is checked first and a
+        // failed allocation is a MemoryError naming the method.
+        guard::check_size(what.0, K, &dims[..rank])?;
+        let mut arrays: [Option<Bound<'py, PyArrayDyn<f64>>>; K] = std::array::from_fn(|_| None);
+        for (slot, g) in arrays.iter_mut().zip(given) {
+            *slot = Some(match g {
+                Some(g) => g,
+                None => guard::empty(py, what.0, &dims[..rank])?,
+            });
+        }
+        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = arrays.map(|a| a.expect("every slot was filled above"));
         let total = self.batch.unwrap_or(1) * per_state;
         let mut bases = [OutputBase(std::ptr::null_mut()); K];
         for (base, array) in bases.iter_mut().zip(&arrays) {
@@ -247,30 +281,100 @@ impl<'a> Batch<'a> {
             base.0 = slice.as_mut_ptr();
         }
         // SAFETY (both paths): state k's outputs are the disjoint ranges [k per_state, (k + 1)
-        // per_state) of the arrays, each written by exactly one kernel call.
+        // per_state) of the arrays, each written by exactly one kernel call (and read back by the
+        // scan right after it, by the same thread).
         let outputs = |k: usize| bases.map(|b| unsafe { std::slice::from_raw_parts_mut(b.0.add(k * per_state), per_state) });
-        let model = &m.model;
-        let result: Result<(), CoreError> = match self.batch {
+        let check = guard::CHECK_FINITE.load(Ordering::Relaxed);
+        // state k: the kernel, then the scan of what it wrote
+        let one = |data: &mut Data, k: usize| -> Result<(), Fault> {
+            kernel(&m.model, data, &self.state(k), outputs(k))?;
+            if check {
+                for (o, out) in outputs(k).iter().enumerate() {
+                    if let Some(index) = first_non_finite(out) {
+                        return Err(Fault::NonFinite { state: k, output: o, index, value: out[index] });
+                    }
+                }
+            }
+            Ok(())
+        };
+        let result: Result<(), Fault> = match self.batch {
             None => {
                 let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-                kernel(model, &mut guard, &self.state(0), outputs(0))
+                one(&mut guard, 0)
             }
             Some(states) => py.detach(|| {
                 const CHUNK: usize = 64;
                 // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
-                (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
-                    || Data::new(model),
-                    |data, c| {
-                        for k in c * CHUNK..((c + 1) * CHUNK).min(states) {
-                            kernel(model, data, &self.state(k), outputs(k))?;
-                        }
-                        Ok(())
-                    },
-                )
+                guard::install(|| {
+                    (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
+                        || Data::new(&m.model),
+                        |data, c| (c * CHUNK..((c + 1) * CHUNK).min(states)).try_for_each(|k| one(data, k)),
+                    )
+                })
+                .unwrap_or_else(|e| Err(Fault::Py(e)))
             }),
         };
-        result.map_err(core_err)?;
-        Ok(arrays)
+        match result {
+            Ok(()) => Ok(arrays),
+            Err(Fault::Core(e)) => Err(core_err(e)),
+            Err(Fault::Py(e)) => Err(e),
+            Err(Fault::NonFinite { state, output, index, value }) => Err(self.non_finite(py, what.0, what.1[output], out_shape, state, index, value)),
+        }
+    }
+
+    /// The error of a non-finite result of finite inputs (every input was checked by `gather`).
+    #[allow(clippy::too_many_arguments)]
+    fn non_finite(&self, py: Python<'_>, method: &str, quantity: &str, out_shape: &[usize], state: usize, index: usize, value: f64) -> PyErr {
+        // the element as an index of the per-state result: tau[2], M[1, 3]
+        let mut rest = index;
+        let mut idx = vec![0; out_shape.len()];
+        for (slot, d) in idx.iter_mut().zip(out_shape).rev() {
+            *slot = rest % d.max(&1);
+            rest /= d.max(&1);
+        }
+        let element = if idx.is_empty() { quantity.to_string() } else { format!("{quantity}[{}]", idx.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")) };
+        let at = match self.batch {
+            Some(_) => format!(" at state {state} of the batch"),
+            None => String::new(),
+        };
+        let largest = self.state(state).iter().flat_map(|x| x.iter()).fold(0.0f64, |a, x| a.max(x.abs()));
+        guard::non_finite_error(
+            py,
+            format!(
+                "{method}: {element} is {value}{at}, although every input is finite (the largest input magnitude is {largest:.3e}): \
+                 the computation overflowed float64; the inputs are outside the range this model can be evaluated in"
+            ),
+        )
+    }
+}
+
+/// Names of a call and of its result(s), for error messages: ("mass_matrix", "M").
+type Output = (&'static str, &'static str);
+type Outputs<const K: usize> = (&'static str, [&'static str; K]);
+
+/// Why a state of a batch failed.
+enum Fault {
+    Core(CoreError),
+    Py(PyErr),
+    NonFinite { state: usize, output: usize, index: usize, value: f64 },
+}
+
+impl From<CoreError> for Fault {
+    fn from(e: CoreError) -> Self {
+        Fault::Core(e)
+    }
+}
+
+/// The index of the first NaN or infinity in `x`, if any: a branch-free scan of the exponent bits
+/// (all ones for NaN and inf) that the compiler vectorises, then a search only when one is found.
+#[inline]
+fn first_non_finite(x: &[f64]) -> Option<usize> {
+    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+    let any = x.iter().fold(false, |acc, v| acc | (v.to_bits() & EXPONENT == EXPONENT));
+    if any {
+        x.iter().position(|v| !v.is_finite())
+    } else {
+        None
     }
 }
 
@@ -352,51 +456,53 @@ impl PyModel {
         frame_body: Vec<i64>,
         frame_placement: PyReadonlyArrayDyn<f64>,
     ) -> PyResult<Self> {
-        let n = parent.len();
-        let nf = frame_body.len();
-        let axis = vec_of("axis", &axis, &[n, 3])?;
-        let placement = vec_of("placement", &placement, &[n, 4, 4])?;
-        let inertia = vec_of("inertia", &inertia, &[n, 10])?;
-        let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
-        if kind.len() != n {
-            return Err(PyValueError::new_err(format!("kind has {} entries for {n} bodies", kind.len())));
-        }
-        if gravity.len() != 3 {
-            return Err(PyValueError::new_err(format!("gravity must have 3 components, got {}", gravity.len())));
-        }
-        let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
-            match p {
-                -1 => Ok(None),
-                p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
-                p => Err(PyValueError::new_err(format!("{what} {k}: body index {p} is out of range (-1..{n})"))),
+        guarded("Model.__new__", || {
+            let n = parent.len();
+            let nf = frame_body.len();
+            let axis = vec_of("axis", &axis, &[n, 3])?;
+            let placement = vec_of("placement", &placement, &[n, 4, 4])?;
+            let inertia = vec_of("inertia", &inertia, &[n, 10])?;
+            let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
+            if kind.len() != n {
+                return Err(PyValueError::new_err(format!("kind has {} entries for {n} bodies", kind.len())));
             }
-        };
-        let parent = parent.iter().enumerate().map(|(i, &p)| body_index("parent of body", i, p)).collect::<PyResult<Vec<_>>>()?;
-        let joints = kind
-            .iter()
-            .enumerate()
-            .map(|(i, &k)| {
-                let kind = match k {
-                    0 => JointKind::Revolute,
-                    1 => JointKind::Prismatic,
-                    _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
-                };
-                Ok(Joint { kind, axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]) })
-            })
-            .collect::<PyResult<Vec<_>>>()?;
-        let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
-        let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
-        let frames = frame_body
-            .iter()
-            .enumerate()
-            .map(|(k, &b)| {
-                Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
-            })
-            .collect::<PyResult<Vec<_>>>()?;
-        let model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
-            .map_err(core_err)?;
-        let data = Mutex::new(Data::new(&model));
-        Ok(Self { model, data })
+            if gravity.len() != 3 {
+                return Err(PyValueError::new_err(format!("gravity must have 3 components, got {}", gravity.len())));
+            }
+            let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
+                match p {
+                    -1 => Ok(None),
+                    p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
+                    p => Err(PyValueError::new_err(format!("{what} {k}: body index {p} is out of range (-1..{n})"))),
+                }
+            };
+            let parent = parent.iter().enumerate().map(|(i, &p)| body_index("parent of body", i, p)).collect::<PyResult<Vec<_>>>()?;
+            let joints = kind
+                .iter()
+                .enumerate()
+                .map(|(i, &k)| {
+                    let kind = match k {
+                        0 => JointKind::Revolute,
+                        1 => JointKind::Prismatic,
+                        _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
+                    };
+                    Ok(Joint { kind, axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]) })
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
+            let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
+            let frames = frame_body
+                .iter()
+                .enumerate()
+                .map(|(k, &b)| {
+                    Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            let model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
+                .map_err(core_err)?;
+            let data = Mutex::new(Data::new(&model));
+            Ok(Self { model, data })
+        })
     }
 
     #[getter(n)]
@@ -411,52 +517,60 @@ impl PyModel {
 
     /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
     fn frame_poses<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frames: Bound<'py, PyArray1<i64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
-        let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[ids.len(), 4, 4], |model, data, x, out| {
-            algorithms::forward_kinematics(model, data, x[0]);
-            for (k, &f) in ids.iter().enumerate() {
-                out[16 * k..16 * k + 16].copy_from_slice(&algorithms::frame_pose(model, data, f).to_homogeneous());
-            }
-            Ok(())
+        guarded("Model.frame_poses", || {
+            // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
+            let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("frame_poses", "pose"), &[ids.len(), 4, 4], |model, data, x, out| {
+                algorithms::forward_kinematics(model, data, x[0]);
+                for (k, &f) in ids.iter().enumerate() {
+                    out[16 * k..16 * k + 16].copy_from_slice(&algorithms::frame_pose(model, data, f).to_homogeneous());
+                }
+                Ok(())
+            })
         })
     }
 
     /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
     #[pyo3(signature = (q, frame, reference, point=None))]
     fn jacobian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[6, n], |model, data, x, out| {
-            algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
-            Ok(())
+        guarded("Model.jacobian", || {
+            let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("jacobian", "J"), &[6, n], |model, data, x, out| {
+                algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
+                Ok(())
+            })
         })
     }
 
     /// Twist J qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
     fn frame_velocity<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[6], |model, data, x, out| {
-            out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
-            Ok(())
+        guarded("Model.frame_velocity", || {
+            let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run(py, self, ("frame_velocity", "twist"), &[6], |model, data, x, out| {
+                out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+                Ok(())
+            })
         })
     }
 
     /// Acceleration drift dJ/dt qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
     fn jdot_qd<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[6], |model, data, x, out| {
-            out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
-            Ok(())
+        guarded("Model.jdot_qd", || {
+            let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run(py, self, ("jdot_qd", "dJ/dt qd"), &[6], |model, data, x, out| {
+                out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+                Ok(())
+            })
         })
     }
 
@@ -465,205 +579,235 @@ impl PyModel {
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
     #[pyo3(signature = (q, qd, qdd, f_ext=None, out=None))]
     fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let qdd = f64_array(&qdd)?;
-        let n = self.n();
-        let (s1, s6) = ([n], [n, 6]);
-        let batch = match f_ext.as_ref() {
-            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
-            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
-        };
-        batch.run_out(py, self, &[n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
-            Ok(())
+        guarded("Model.inverse_dynamics", || {
+            let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let qdd = f64_array("qdd", &qdd)?;
+            let n = self.n();
+            let (s1, s6) = ([n], [n, 6]);
+            let batch = match f_ext.as_ref() {
+                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+            };
+            batch.run_out(py, self, ("inverse_dynamics", "tau"), &[n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
+                Ok(())
+            })
         })
     }
 
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
     #[pyo3(signature = (q, out=None))]
     fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::crba(model, data, x[0]));
-            Ok(())
+        guarded("Model.mass_matrix", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run_out(py, self, ("mass_matrix", "M"), &[n, n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::crba(model, data, x[0]));
+                Ok(())
+            })
         })
     }
 
     /// M^-1 (n, n) | (N, n, n).
     #[pyo3(signature = (q, out=None))]
     fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
-            Ok(())
+        guarded("Model.mass_matrix_inverse", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run_out(py, self, ("mass_matrix_inverse", "M^-1"), &[n, n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
+                Ok(())
+            })
         })
     }
 
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
     #[pyo3(signature = (q, qd, tau, f_ext=None, out=None))]
     fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let tau = f64_array(&tau)?;
-        let n = self.n();
-        let (s1, s6) = ([n], [n, 6]);
-        let batch = match f_ext.as_ref() {
-            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
-            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
-        };
-        batch.run_out(py, self, &[n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
-            Ok(())
+        guarded("Model.forward_dynamics", || {
+            let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let tau = f64_array("tau", &tau)?;
+            let n = self.n();
+            let (s1, s6) = ([n], [n, 6]);
+            let batch = match f_ext.as_ref() {
+                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+            };
+            batch.run_out(py, self, ("forward_dynamics", "qdd"), &[n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
+                Ok(())
+            })
         })
     }
 
     /// (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
     fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
-        let (q, qd, qdd) = (f64_array(&q)?, f64_array(&qd)?, f64_array(&qdd)?);
-        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let n = self.n();
-        let (s1, s6) = ([n], [n, 6]);
-        let batch = match f_ext.as_ref() {
-            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
-            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
-        };
-        let [dq, dqd, m] = batch.run_many::<3, _>(py, self, &[n, n], [None, None, None], |model, data, x, [dq, dqd, m]| {
-            algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
-            Ok(())
-        })?;
-        Ok((dq, dqd, m))
+        guarded("Model.inverse_dynamics_derivatives", || {
+            let (q, qd, qdd) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("qdd", &qdd)?);
+            let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+            let n = self.n();
+            let (s1, s6) = ([n], [n, 6]);
+            let batch = match f_ext.as_ref() {
+                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+            };
+            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, m]| {
+                algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
+                Ok(())
+            })?;
+            Ok((dq, dqd, m))
+        })
     }
 
     /// (dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1), each (n, n) | (N, n, n): derivatives of the ABA.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
     fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
-        let (q, qd, tau) = (f64_array(&q)?, f64_array(&qd)?, f64_array(&tau)?);
-        let f_ext = f_ext.map(|f| f64_array(&f)).transpose()?;
-        let n = self.n();
-        let (s1, s6) = ([n], [n, 6]);
-        let batch = match f_ext.as_ref() {
-            Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
-            None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
-        };
-        let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, &[n, n], [None, None, None], |model, data, x, [dq, dqd, dtau]| {
-            algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
-        })?;
-        Ok((dq, dqd, dtau))
+        guarded("Model.forward_dynamics_derivatives", || {
+            let (q, qd, tau) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("tau", &tau)?);
+            let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+            let n = self.n();
+            let (s1, s6) = ([n], [n, 6]);
+            let batch = match f_ext.as_ref() {
+                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+            };
+            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, dtau]| {
+                algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
+            })?;
+            Ok((dq, dqd, dtau))
+        })
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
     #[pyo3(signature = (q, qd, out=None))]
     fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run_out(py, self, &[n, n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
-            Ok(())
+        guarded("Model.coriolis_matrix", || {
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run_out(py, self, ("coriolis_matrix", "C"), &[n, n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
+                Ok(())
+            })
         })
     }
 
     /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
     fn christoffel<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[n, n, n], |model, data, x, out| {
-            algorithms::christoffel(model, data, x[0], out);
-            Ok(())
+        guarded("Model.christoffel", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("christoffel", "c"), &[n, n, n], |model, data, x, out| {
+                algorithms::christoffel(model, data, x[0], out);
+                Ok(())
+            })
         })
     }
 
     /// g (n,) | (N, n).
     #[pyo3(signature = (q, out=None))]
     fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run_out(py, self, &[n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
-            Ok(())
+        guarded("Model.gravity_torque", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run_out(py, self, ("gravity_torque", "g"), &[n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
+                Ok(())
+            })
         })
     }
 
     /// C qd + g (n,) | (N, n), without friction.
     #[pyo3(signature = (q, qd, out=None))]
     fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run_out(py, self, &[n], out, |model, data, x, out| {
-            out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
-            Ok(())
+        guarded("Model.bias_torque", || {
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run_out(py, self, ("bias_torque", "bias"), &[n], out, |model, data, x, out| {
+                out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
+                Ok(())
+            })
         })
     }
 
     /// K () | (N,).
     fn kinetic_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[], |model, data, x, out| {
-            out[0] = algorithms::kinetic_energy(model, data, x[0], x[1]);
-            Ok(())
+        guarded("Model.kinetic_energy", || {
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run(py, self, ("kinetic_energy", "K"), &[], |model, data, x, out| {
+                out[0] = algorithms::kinetic_energy(model, data, x[0], x[1]);
+                Ok(())
+            })
         })
     }
 
     /// P () | (N,).
     fn potential_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[], |model, data, x, out| {
-            out[0] = algorithms::potential_energy(model, data, x[0]);
-            Ok(())
+        guarded("Model.potential_energy", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("potential_energy", "P"), &[], |model, data, x, out| {
+                out[0] = algorithms::potential_energy(model, data, x[0]);
+                Ok(())
+            })
         })
     }
 
     /// Y (n, 10 n) | (N, n, 10 n).
     fn regressor<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let qdd = f64_array(&qdd)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
-        batch.run(py, self, &[n, 10 * n], |model, data, x, out| {
-            algorithms::regressor(model, data, x[0], x[1], x[2], out);
-            Ok(())
+        guarded("Model.regressor", || {
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let qdd = f64_array("qdd", &qdd)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
+            batch.run(py, self, ("regressor", "Y"), &[n, 10 * n], |model, data, x, out| {
+                algorithms::regressor(model, data, x[0], x[1], x[2], out);
+                Ok(())
+            })
         })
     }
 
     /// Centre of mass (3,) | (N, 3) in base coordinates.
     fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n])])?;
-        batch.run(py, self, &[3], |model, data, x, out| {
-            out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
-            Ok(())
+        guarded("Model.center_of_mass", || {
+            let q = f64_array("q", &q)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("center_of_mass", "com"), &[3], |model, data, x, out| {
+                out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
+                Ok(())
+            })
         })
     }
 
     /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
     fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let q = f64_array(&q)?;
-        let qd = f64_array(&qd)?;
-        let n = self.n();
-        let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
-        batch.run(py, self, &[6], |model, data, x, out| {
-            out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
-            Ok(())
+        guarded("Model.momentum", || {
+            let q = f64_array("q", &q)?;
+            let qd = f64_array("qd", &qd)?;
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            batch.run(py, self, ("momentum", "h"), &[6], |model, data, x, out| {
+                out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
+                Ok(())
+            })
         })
     }
 }
@@ -671,6 +815,7 @@ impl PyModel {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
+    guard::register(m)?;
     ik::register(m)?;
     simulate::register(m)?;
     Ok(())

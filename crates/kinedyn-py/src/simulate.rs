@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use rayon::prelude::*;
 
+use crate::guard::{self, guarded};
 use crate::{core_err, PyModel};
 
 fn method(name: &str) -> PyResult<Method> {
@@ -28,7 +29,9 @@ fn method(name: &str) -> PyResult<Method> {
 }
 
 fn flat(name: &str, a: &PyReadonlyArrayDyn<f64>) -> PyResult<Vec<f64>> {
-    let v: Vec<f64> = a.as_array().iter().copied().collect();
+    let view = a.as_array();
+    let mut v = guard::try_vec(&format!("simulate: copying {name}"), view.len())?;
+    v.extend(view.iter().copied());
     if let Some(k) = v.iter().position(|x| !x.is_finite()) {
         return Err(PyValueError::new_err(format!("{name} contains a non-finite value (NaN or inf) at flat index {k}")));
     }
@@ -53,13 +56,16 @@ fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict
     Ok(d)
 }
 
-/// Fresh output arrays `(batch?, samples, n)` x 4.
-fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize) -> [Bound<'py, PyArrayDyn<f64>>; 4] {
+/// Fresh output arrays `(batch?, samples, n)` x 4 (q, qd, qdd, tau), their total size checked
+/// first: a MemoryError naming the bytes when they cannot be had (e.g. a tiny dt over a long span).
+fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; 4]> {
     let shape: Vec<usize> = match batch {
         Some(b) => vec![b, samples, n],
         None => vec![samples, n],
     };
-    std::array::from_fn(|_| PyArrayDyn::<f64>::zeros(py, shape.clone(), false))
+    const WHAT: &str = "simulate (the recorded q, qd, qdd and tau)";
+    guard::check_size(WHAT, 4, &shape)?;
+    Ok([guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?])
 }
 
 fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcomes: &[Outcome]) -> PyResult<Bound<'py, PyTuple>> {
@@ -109,6 +115,7 @@ pub fn integrate_fixed<'py>(
     record_every: usize,
     max_speed: f64,
 ) -> PyResult<Bound<'py, PyTuple>> {
+    guarded("integrate_fixed", || {
     let m = model.get();
     let n = m.model.n;
     let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed };
@@ -144,7 +151,7 @@ pub fn integrate_fixed<'py>(
         }
     };
     let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n);
+    let arrays = outputs(py, batch, samples, n)?;
     // SAFETY: the arrays were created above; nothing else refers to them yet.
     let mut views = Vec::with_capacity(4);
     for a in arrays.iter() {
@@ -168,18 +175,21 @@ pub fn integrate_fixed<'py>(
     let outcomes: Vec<Outcome> = py
         .detach(|| {
             if count == 1 {
-                return Ok(vec![run_one(0, oq, oqd, oqdd, otau)?]);
+                return Ok(run_one(0, oq, oqd, oqdd, otau).map(|o| vec![o]));
             }
-            oq.par_chunks_mut(per)
-                .zip(oqd.par_chunks_mut(per))
-                .zip(oqdd.par_chunks_mut(per))
-                .zip(otau.par_chunks_mut(per))
-                .enumerate()
-                .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
-                .collect::<Result<Vec<_>, _>>()
-        })
+            guard::install(|| {
+                oq.par_chunks_mut(per)
+                    .zip(oqd.par_chunks_mut(per))
+                    .zip(oqdd.par_chunks_mut(per))
+                    .zip(otau.par_chunks_mut(per))
+                    .enumerate()
+                    .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+        })?
         .map_err(core_err)?;
     result(py, arrays, &outcomes)
+    })
 }
 
 /// Integrate with the torque from `callback(step, t, q, qd) -> tau` (a Python callable returning n
@@ -203,6 +213,7 @@ pub fn integrate_callback<'py>(
     record_every: usize,
     max_speed: f64,
 ) -> PyResult<Bound<'py, PyTuple>> {
+    guarded("integrate_callback", || {
     let m = model.get();
     let n = m.model.n;
     let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed };
@@ -215,7 +226,7 @@ pub fn integrate_callback<'py>(
     let (batch, q0, qd0) = initial_states(n, &q0, &qd0)?;
     let count = batch.unwrap_or(1);
     let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n);
+    let arrays = outputs(py, batch, samples, n)?;
     let mut views = Vec::with_capacity(4);
     for a in arrays.iter() {
         views.push(unsafe { a.as_slice_mut()? });
@@ -264,6 +275,7 @@ pub fn integrate_callback<'py>(
         outcomes.push(outcome);
     }
     result(py, arrays, &outcomes)
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

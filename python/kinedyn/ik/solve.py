@@ -16,6 +16,8 @@ from typing import Optional
 
 import numpy as np
 
+from .._arrays import real_array, whole_number
+
 __all__ = ["IKResult", "IKBatchResult", "inverse_kinematics", "analytic_structure", "METHODS"]
 
 METHODS = ("auto", "analytic", "numeric")
@@ -163,7 +165,7 @@ def _target(target) -> tuple:
         t = target
     else:
         try:
-            t = np.asarray(target, dtype=float)
+            t = real_array(target, "target")
         except (TypeError, ValueError) as e:
             raise ValueError(f"target must be numbers (a 4x4 pose or a 3-vector position), got {type(target).__name__}: {e}") from None
     shape = t.shape
@@ -182,7 +184,7 @@ def _mask(mask) -> Optional[tuple]:
     if mask is None:
         return None
     try:
-        m = np.asarray(mask, dtype=float).ravel()
+        m = real_array(mask, "mask").ravel()
     except (TypeError, ValueError):
         raise ValueError(f"mask must be 6 weights for [x, y, z, rx, ry, rz], got {mask!r}") from None
     if m.shape != (6,):
@@ -195,7 +197,7 @@ def _mask(mask) -> Optional[tuple]:
 def _q0(q0, chain: _Chain, batch: Optional[int]) -> np.ndarray:
     if q0 is None:
         return chain.start
-    q = np.ascontiguousarray(q0, dtype=float)
+    q = real_array(q0, "q0")
     n = chain.n
     if q.shape != (n,) and not (batch is not None and q.shape == (batch, n)):
         want = f"({n},)" + (f" or ({batch}, {n})" if batch is not None else "")
@@ -234,8 +236,9 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
-    if not 0.0 < tolerance < np.inf or max_iterations < 0 or restarts < 0 or seed < 0:
-        _check_settings(tolerance, max_iterations, restarts, seed)
+    if type(max_iterations) is not int or type(restarts) is not int or type(seed) is not int or not 0 <= max_iterations <= _MAX_INT \
+            or not 0 <= restarts <= _MAX_INT or not 0 <= seed < 2**64 or type(tolerance) is not float or not 0.0 < tolerance < np.inf:
+        max_iterations, restarts, seed, tolerance = _check_settings(tolerance, max_iterations, restarts, seed)
     chain = _chain(robot, frame)
     # fast path: one float64 target, closed form, no mask (checks of the target happen natively)
     if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype is _F64 and chain.solver is not None:
@@ -269,12 +272,24 @@ def inverse_kinematics(
     return _numeric(robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed)
 
 
-def _check_settings(tolerance, max_iterations, restarts, seed) -> None:
-    if not 0.0 < tolerance < np.inf:
+_MAX_INT = 2**31 - 1
+
+
+def _check_settings(tolerance, max_iterations, restarts, seed) -> tuple:
+    """The numeric settings checked at the boundary (ValueError naming the argument, never the
+    OverflowError of a conversion to a native integer): (max_iterations, restarts, seed, tolerance)."""
+    try:
+        tol = float(tolerance)
+    except (TypeError, ValueError):
+        raise ValueError(f"tolerance must be a positive number (m and rad), got {tolerance!r}") from None
+    if isinstance(tolerance, (bool, complex)) or not 0.0 < tol < np.inf:
         raise ValueError(f"tolerance must be a positive number (m and rad), got {tolerance!r}")
-    for what, value in (("max_iterations", max_iterations), ("restarts", restarts), ("seed", seed)):
-        if value < 0:
-            raise ValueError(f"{what} must be a whole number >= 0, got {value!r}")
+    return (
+        whole_number(max_iterations, "max_iterations", 0, _MAX_INT),
+        whole_number(restarts, "restarts", 0, _MAX_INT),
+        whole_number(seed, "seed", 0, 2**64 - 1),
+        tol,
+    )
 
 
 def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:

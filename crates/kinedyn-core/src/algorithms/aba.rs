@@ -66,8 +66,20 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         let u_f = ia.times_s(joint);
         let d = joint.project(&u_f) + model.armature[i];
         if !(d > EPS_D * (ia.trace() + model.armature[i])) || !d.is_finite() {
+            let trace = ia.trace() + model.armature[i];
+            let why = if !d.is_finite() || !trace.is_finite() {
+                "an inertia or a state too large for float64".to_string()
+            } else if d <= 0.0 || trace <= 0.0 {
+                "a massless or inertia-free subtree: no inertia about the axis and no rotor inertia".to_string()
+            } else {
+                format!(
+                    "{:.1e} times the trace {trace:e} of the subtree's articulated inertia: its inertia about this axis is \
+                     negligible next to the rest (a missing mass, or a huge inertia elsewhere in the subtree: check the units)",
+                    d / trace
+                )
+            };
             return Err(Error::SingularMassMatrix(format!(
-                "joint {i} has articulated inertia D = {d:e} about its axis (a massless or inertia-free subtree); forward dynamics is undefined"
+                "joint {i} has articulated inertia D = {d:e} about its axis ({why}); forward dynamics is undefined"
             )));
         }
         let d_inv = 1.0 / d;

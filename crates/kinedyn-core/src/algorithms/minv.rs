@@ -28,9 +28,7 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
     for k in (0..n).rev() {
         let hkk = h[k * n + k];
         if !(hkk > EPS_D * scale) || !hkk.is_finite() {
-            return Err(Error::SingularMassMatrix(format!(
-                "joint {k} has pivot D = {hkk:e} in the L^T D L factorisation of M (a massless or inertia-free subtree)"
-            )));
+            return Err(Error::SingularMassMatrix(singular_pivot(data, n, k, hkk, scale)));
         }
         // for i = λ(k) up the tree: a = H_ki / H_kk ; H_ij -= a H_kj for j = i, λ(i), ... ; H_ki = a
         let mut i = model.parent[k];
@@ -46,6 +44,33 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// What a pivot `D_k` of `M` below `EPS_D` times its largest diagonal entry means: the joint's
+/// subtree has no inertia about its axis (massless, no rotor inertia), or the inertias are so far
+/// apart (more than `1 / EPS_D`) that `M` is singular in float64, or M is not positive definite.
+fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> String {
+    let mkk = data.m[k * n + k];
+    let largest = (0..n).fold(0, |b, i| if data.m[i * n + i] > data.m[b * n + b] { i } else { b });
+    let head = format!("M is not positive definite to float64 precision at joint {k}: its pivot D = {hkk:e} in the L^T D L factorisation");
+    if !hkk.is_finite() || !scale.is_finite() {
+        format!("{head}; M has a non-finite entry (an inertia or a configuration too large for float64)")
+    } else if mkk <= 0.0 {
+        format!("{head}; M[{k}, {k}] = {mkk:e}: the subtree of joint {k} has no inertia about the joint's axis (massless, no rotor inertia)")
+    } else if mkk <= EPS_D * scale {
+        format!(
+            "{head}; M[{k}, {k}] = {mkk:e} is {:.1e} times M[{largest}, {largest}] = {scale:e}: the inertias of the subtrees of \
+             joint {k} and joint {largest} differ by more than float64 can resolve (check the inertia of joint {largest}'s body and its \
+             children for a wrong unit or a huge value, and joint {k}'s for a missing mass)",
+            mkk / scale
+        )
+    } else {
+        format!(
+            "{head}, {:.1e} times the largest diagonal entry M[{largest}, {largest}] = {scale:e}: M is numerically singular here \
+             (the subtree inertias are not positive definite, or differ by more than float64 can resolve)",
+            hkk / scale
+        )
+    }
 }
 
 /// `M(q)^-1` written row-major to `data.m` (n x n); `data.m2` holds the factors of `M`.
