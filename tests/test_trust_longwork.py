@@ -184,11 +184,15 @@ def test_the_report_on_talos_is_bounded_and_says_when_it_cut_the_simulation(tmp_
 
 # ------------------------------------------------------------------ command line
 def test_cli_per_joint_gains_and_limits(capsys):
-    code, text, err = run(capsys, "simulate", "puma560", "--t", "3", "--controller", "pdg", "--goal", "0.3", "-0.5", "0.4", "0", "0", "0",
-                          "--kp", "400", "300", "300", "50", "50", "50", "--kd", "40", "--json")
+    # PD without gravity compensation settles where Kp e = g(q): each joint's own gain shows
+    goal, kp = np.array([0.3, -0.5, 0.4, 0, 0, 0]), np.array([400, 300, 300, 50, 50, 50])
+    code, text, err = run(capsys, "simulate", "puma560", "--t", "6", "--controller", "pd", "--goal", *map(str, goal),
+                          "--kp", *map(str, kp), "--kd", "40", "--json")
     assert code == 0, err
     d = json.loads(text)  # nothing else on stdout: no progress bar
-    assert np.abs(np.array(d["q_final"]) - [0.3, -0.5, 0.4, 0, 0, 0]).max() < 1e-2
+    q = np.array(d["q_final"])
+    np.testing.assert_allclose(kp * (goal - q), kd.robots.puma560().gravity_torque(q), atol=1e-3)
+    assert np.abs(d["qd_final"]).max() < 1e-4
     code, _, err = run(capsys, "simulate", "puma560", "--kp", "1", "2")
     assert code == 1 and "--kp takes one gain for every joint or one per joint (6" in err
     code, _, err = run(capsys, "simulate", "puma560", "--joint-limits", "--method", "rk45")
