@@ -8,7 +8,7 @@
 
 use std::cell::RefCell;
 
-use kinedyn_core::algorithms::integrate::{self, Failure, FailureKind, Method, Outcome, Record, Sampled, Settings};
+use kinedyn_core::algorithms::integrate::{self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn};
 use kinedyn_core::Data;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -24,7 +24,26 @@ fn method(name: &str) -> PyResult<Method> {
         "rk4" => Ok(Method::Rk4),
         "semi_implicit" | "semi_implicit_euler" | "symplectic_euler" => Ok(Method::SemiImplicitEuler),
         "euler" => Ok(Method::Euler),
-        _ => Err(PyValueError::new_err(format!("unknown fixed-step method '{name}' (rk4, semi_implicit, euler)"))),
+        "implicit" | "implicit_euler" => Ok(Method::Implicit),
+        _ => Err(PyValueError::new_err(format!("unknown fixed-step method '{name}' (rk4, semi_implicit, euler, implicit)"))),
+    }
+}
+
+/// Joint limits from `lower`, `upper` ((n,) each, or both None): checked, flattened.
+fn limits(n: usize, lower: Option<&PyReadonlyArrayDyn<f64>>, upper: Option<&PyReadonlyArrayDyn<f64>>) -> PyResult<Option<(Vec<f64>, Vec<f64>)>> {
+    match (lower, upper) {
+        (None, None) => Ok(None),
+        (Some(lo), Some(hi)) => {
+            let (lo, hi): (Vec<f64>, Vec<f64>) = (lo.as_array().iter().copied().collect(), hi.as_array().iter().copied().collect());
+            if lo.len() != n || hi.len() != n {
+                return Err(PyValueError::new_err(format!("lower and upper limits need {n} values each, got {} and {}", lo.len(), hi.len())));
+            }
+            if let Some(j) = (0..n).find(|&j| lo[j].is_nan() || hi[j].is_nan() || lo[j] > hi[j]) {
+                return Err(PyValueError::new_err(format!("joint {j} has limits [{}, {}]: lower must not exceed upper", lo[j], hi[j])));
+            }
+            Ok(Some((lo, hi)))
+        }
+        _ => Err(PyValueError::new_err("give both lower and upper joint limits, or neither")),
     }
 }
 
@@ -99,7 +118,7 @@ fn initial_states(n: usize, q0: &PyReadonlyArrayDyn<f64>, qd0: &PyReadonlyArrayD
 /// S = 1 is a constant, else samples at `t0 + k dt` held over each step (`linear=False`, S >= steps)
 /// or interpolated (`linear=True`, S >= steps + 1). A batch runs in parallel without the GIL.
 #[pyfunction]
-#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6))]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6, lower=None, upper=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_fixed<'py>(
     py: Python<'py>,
@@ -114,11 +133,15 @@ pub fn integrate_fixed<'py>(
     linear: bool,
     record_every: usize,
     max_speed: f64,
+    lower: Option<PyReadonlyArrayDyn<'py, f64>>,
+    upper: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_fixed", || {
     let m = model.get();
     let n = m.model.n;
-    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed };
+    let bounds = limits(n, lower.as_ref(), upper.as_ref())?;
+    let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
+    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed, limits };
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
     }
@@ -192,12 +215,43 @@ pub fn integrate_fixed<'py>(
     })
 }
 
+/// A torque source made of Python callables: `torque(k, t, q, qd, out)` and, for the implicit
+/// method, `jacobian(k, t, q, qd, dtau_dq, dtau_dqd) -> known`.
+struct CallbackSource<T, J> {
+    torque: T,
+    jacobian: J,
+}
+
+impl<T, J> TorqueFn for CallbackSource<T, J>
+where
+    T: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> Result<(), String>,
+    J: FnMut(usize, f64, &[f64], &[f64], &mut [f64], &mut [f64]) -> Result<bool, String>,
+{
+    fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<(), String> {
+        (self.torque)(step, t, q, qd, out)
+    }
+    fn jacobian(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], dq: &mut [f64], dqd: &mut [f64]) -> Result<bool, String> {
+        (self.jacobian)(step, t, q, qd, dq, dqd)
+    }
+}
+
+/// Copy an (n, n) array returned by Python into `out` (row-major).
+fn matrix_into(value: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut [f64]) -> PyResult<()> {
+    let a: PyReadonlyArrayDyn<f64> = value.extract()?;
+    if a.shape() != [n, n] {
+        return Err(PyValueError::new_err(format!("{what} must have shape ({n}, {n}), got {:?}", a.shape())));
+    }
+    out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
+    Ok(())
+}
+
 /// Integrate with the torque from `callback(step, t, q, qd) -> tau` (a Python callable returning n
 /// numbers; `step` is the index k of the step [t_k, t_k + dt] being taken), called by the core's loop at every stage (`hold=False`) or once per step, held
 /// (`hold=True`). A batch (N, n) runs its trajectories one after the other. An exception raised by
-/// the callback propagates unchanged.
+/// the callback propagates unchanged. `jacobian(step, t, q, qd) -> (dtau_dq, dtau_dqd)` ((n, n)
+/// each) or None: the torque's derivatives, used by the implicit method.
 #[pyfunction]
-#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6))]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6, jacobian=None, lower=None, upper=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_callback<'py>(
     py: Python<'py>,
@@ -212,11 +266,16 @@ pub fn integrate_callback<'py>(
     hold: bool,
     record_every: usize,
     max_speed: f64,
+    jacobian: Option<Bound<'py, PyAny>>,
+    lower: Option<PyReadonlyArrayDyn<'py, f64>>,
+    upper: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_callback", || {
     let m = model.get();
     let n = m.model.n;
-    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed };
+    let bounds = limits(n, lower.as_ref(), upper.as_ref())?;
+    let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
+    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed, limits };
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
     }
@@ -234,7 +293,7 @@ pub fn integrate_callback<'py>(
     let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
     let per = samples * n;
     let error: RefCell<Option<PyErr>> = RefCell::new(None);
-    let mut source = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
+    let torque = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
         let mut call = || -> PyResult<()> {
             let qa = PyArray1::from_slice(py, q);
             let qda = PyArray1::from_slice(py, qd);
@@ -262,6 +321,25 @@ pub fn integrate_callback<'py>(
             message
         })
     };
+    let derivatives = |k: usize, t: f64, q: &[f64], qd: &[f64], dq: &mut [f64], dqd: &mut [f64]| -> Result<bool, String> {
+        let Some(f) = jacobian.as_ref() else { return Ok(false) };
+        let mut call = || -> PyResult<bool> {
+            let value = f.call1((k, t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)))?;
+            if value.is_none() {
+                return Ok(false);
+            }
+            let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) = value.extract()?;
+            matrix_into(&a, n, "dtau/dq", dq)?;
+            matrix_into(&b, n, "dtau/dqd", dqd)?;
+            Ok(true)
+        };
+        call().map_err(|e| {
+            let message = e.to_string();
+            *error.borrow_mut() = Some(e);
+            message
+        })
+    };
+    let mut source = CallbackSource { torque, jacobian: derivatives };
     let mut outcomes = Vec::with_capacity(count);
     let mut data = Data::new(&m.model);
     for i in 0..count {

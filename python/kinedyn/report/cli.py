@@ -42,17 +42,28 @@ def cmd_report(args) -> int:
     out = Path(args.output)
     if out.parent and not out.parent.exists():
         raise ValueError(f"cannot write '{out}': the folder '{out.parent}' does not exist")
-    data = collect(robot, q, qd, name=spec, t_end=args.t, eom_joints=args.eom_joints)
-    public = {k: v for k, v in data.items() if not k.startswith("_")}
-    from .html import build_report
+    if args.time_budget is not None and not (args.time_budget > 0 and math.isfinite(args.time_budget)):
+        raise ValueError(f"--time-budget must be a positive number of seconds, got {args.time_budget}")
+    from ..progress import Steps
+    from .html import SIMULATION_BUDGET, build_report
 
     # the tutorial's arm (the default robot) gets the tutorial worked step by step
     tutorial = spec == robots.DEFAULT and not args.no_tutorial
-    out.write_text(build_report(robot, q, qd, name=spec, data=data, tutorial=tutorial), encoding="utf-8")
+    progress = False if args.json else None  # a bar on stderr on a terminal; never with --json
+    budget = SIMULATION_BUDGET if args.time_budget is None else args.time_budget
+    with Steps("report", 6 + (len(_questions()) if tutorial else 0), progress) as steps:
+        data = collect(robot, q, qd, name=spec, t_end=args.t, eom_joints=args.eom_joints, time_budget=budget, progress=progress, steps=steps)
+        public = {k: v for k, v in data.items() if not k.startswith("_")}
+        from .html import _build_report
+
+        page = _build_report(robot, q, qd, spec, args.t, args.eom_joints, data, tutorial, progress, budget, steps)
+    out.write_text(page, encoding="utf-8")
     payload = {"path": str(out.resolve()), **public}
     payload.pop("simulation", None)
     if "simulation" in data:
         payload["simulation_energy_drift"] = data["simulation"]["energy_drift"]
+        payload["simulation_method"] = data["simulation"]["method"]
+        payload["simulation_note"] = data["simulation"]["note"]
 
     def render():
         c = console()
@@ -61,9 +72,17 @@ def cmd_report(args) -> int:
         if data.get("properties"):
             bad = [p["property"] for p in data["properties"] if not p["ok"]]
             c.print("  properties: " + ("[green]all hold[/green]" if not bad else f"[bold red]failing: {', '.join(bad)}[/bold red]"))
+        if data.get("simulation", {}).get("note"):
+            c.print(f"  [bold yellow]simulation[/bold yellow]: {data['simulation']['note']}")
 
     emit(args, payload, render)
     return 0
+
+
+def _questions():
+    from .tutorial import QUESTIONS
+
+    return QUESTIONS
 
 
 def add_report_commands(subparsers) -> None:
@@ -83,6 +102,8 @@ def add_report_commands(subparsers) -> None:
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--t", type=float, default=3.0, help="simulated seconds of free motion (default 3)")
     p.add_argument("--eom-joints", type=int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
+    p.add_argument("--time-budget", dest="time_budget", type=float, default=None, metavar="S",
+                   help="wall-clock seconds the free-motion simulation may take; a run cut short says so in the report (default 30)")
     p.add_argument("--no-tutorial", action="store_true", help="leave out the worked tutorial (included for the default robot, the tutorial's arm)")
     p.add_argument("--json", action="store_true", help="print the report's numbers as one JSON document")
     p.set_defaults(func=cmd_report)

@@ -83,31 +83,41 @@ def _model_for_view(robot, q) -> dict:
     }
 
 
-def _simulate(robot, q0, qd0, t_end: float, samples: int = 241) -> Dict[str, np.ndarray]:
-    """Free motion (tau = 0) from (q0, qd0): kd.simulate where this kinedyn has it, else SciPy's solve_ivp
-    (DOP853, tight tolerances) on robot.forward_dynamics."""
+#: Wall-clock seconds the report's free-motion simulation may take (the rest of a report takes a few
+#: seconds at most; the symbolic equations are derived only for small arms, see ``eom_joints``).
+SIMULATION_BUDGET = 30.0
+
+
+def _simulate(robot, q0, qd0, t_end: float, samples: int = 241, time_budget: Optional[float] = SIMULATION_BUDGET, progress: Optional[bool] = False) -> Dict[str, object]:
+    """Free motion (tau = 0) from (q0, qd0) with kd.simulate (method "auto": RK4, or implicit Euler
+    for a stiff robot), about ``samples`` samples kept, bounded by ``time_budget`` wall-clock seconds.
+    A run cut short (the budget, or a blow-up) keeps its samples and says why in "note"."""
+    import warnings
+
     import kinedyn as kd
+    from ..simulate import SimulationError, SimulationTruncatedWarning
 
-    t_eval = np.linspace(0.0, t_end, samples)
+    dt = 1e-3
+    steps = max(1, int(math.ceil(t_end / dt - 1e-9)))
+    every = max(1, steps // max(samples - 1, 1))
     x0 = np.concatenate([q0, qd0])
-    if hasattr(kd, "simulate"):
-        traj = kd.simulate(robot, (0.0, t_end), x0, method="rk45")
-        t, q, qd = np.asarray(traj.t), np.asarray(traj.q), np.asarray(traj.qd)
-        how = "kd.simulate(robot, (0, T), x0, method='rk45')"
-    else:
-        from scipy.integrate import solve_ivp
-
-        n = robot.n
-        zero = np.zeros(n)
-        f = lambda _t, x: np.concatenate([x[n:], robot.forward_dynamics(x[:n], x[n:], zero)])
-        sol = solve_ivp(f, (0.0, t_end), x0, method="DOP853", t_eval=t_eval, rtol=1e-10, atol=1e-10)
-        if not sol.success:
-            raise RuntimeError(f"simulation failed: {sol.message}")
-        t, q, qd = sol.t, sol.y[:n].T, sol.y[n:].T
-        how = "scipy.integrate.solve_ivp (DOP853, rtol = atol = 1e-10) on robot.forward_dynamics"
+    note = None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SimulationTruncatedWarning)  # said in the report instead
+            traj = kd.simulate(robot, (0.0, t_end), x0, dt=dt, record_every=every, time_budget=time_budget, progress=progress)
+        if traj.info.get("truncated"):
+            note = f"The simulation was cut short: {traj.info['truncated']}."
+    except SimulationError as e:
+        traj = e.trajectory
+        note = f"The simulation stopped early: {e}"
+    info = traj.info
+    how = f"kd.simulate(robot, (0, T), x0, dt = {dt:g} s): {info.get('method_choice') or traj.method}"
+    t, q, qd = np.asarray(traj.t), np.asarray(traj.q), np.asarray(traj.qd)
     K = np.asarray(robot.kinetic_energy(q, qd), dtype=float)
     P = np.asarray(robot.potential_energy(q), dtype=float)
-    return {"t": t, "q": q, "qd": qd, "K": K, "P": P, "H": K + P, "method": how}
+    return {"t": t, "q": q, "qd": qd, "K": K, "P": P, "H": K + P, "method": how, "integrator": traj.method, "t_end_requested": float(t_end),
+            "note": note, "wall_time": float(info.get("wall_time", 0.0))}
 
 
 def _properties(robot, q, qd, rng) -> List[dict]:
@@ -166,9 +176,26 @@ def _symbolic_eom(robot, name: Optional[str], max_joints: int):
     return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
 
 
-def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, seed: int = 0) -> dict:
-    """Every number of the report (JSON-friendly, plus the symbolic equations under "_eom")."""
+def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, seed: int = 0,
+            time_budget: Optional[float] = SIMULATION_BUDGET, progress: Optional[bool] = False, steps=None) -> dict:
+    """Every number of the report (JSON-friendly, plus the symbolic equations under "_eom").
+    ``time_budget``: wall-clock seconds for the simulation (None: unbounded); ``progress``: a progress
+    bar on stderr (None: on a terminal); ``steps``: a :class:`kinedyn.progress.Steps` to advance."""
+    from ..progress import Steps
+
+    own = steps is None
+    steps = Steps("report", 4, progress) if own else steps
+    try:
+        return _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress, steps)
+    finally:
+        if own:
+            steps.close()
+
+
+def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress, steps) -> dict:
     from ..kinematics import singularity_report
+
+    steps.step("kinematics")
 
     q = default_configuration(robot) if q is None else np.asarray(q, dtype=float)
     qd = np.zeros(robot.n) if qd is None else np.asarray(qd, dtype=float)
@@ -201,6 +228,7 @@ def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float 
         "bodies": [{"link": b.name, "mass": float(b.inertia.mass), "com": [float(c) for c in b.inertia.com]} for b in robot.tree.bodies],
     }
     data["dynamics"] = _has_dynamics(robot)
+    steps.step("dynamics and properties")
     if data["dynamics"]:
         qd_check = qd if np.any(qd) else rng.uniform(-1, 1, robot.n)
         data["mass_matrix"] = robot.mass_matrix(q).tolist()
@@ -208,13 +236,18 @@ def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float 
         data["gravity_torque"] = robot.gravity_torque(q).tolist()
         data["properties_qd"] = qd_check.tolist()
         data["properties"] = _properties(robot, q, qd_check, rng)
-        sim = _simulate(robot, q, qd, t_end)
+        steps.step("simulation")
+        sim = _simulate(robot, q, qd, t_end, time_budget=time_budget, progress=progress)
         data["simulation"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in sim.items()}
         H = sim["H"]
         data["simulation"]["energy_drift"] = float(np.max(np.abs(H - H[0])))
-        data["properties"].append({"property": "energy conserved (tau = 0, no friction)", "measure": f"max |H(t) - H(0)| over the {t_end:g} s simulation",
-                                   "value": data["simulation"]["energy_drift"], "ok": data["simulation"]["energy_drift"] <= 1e-6 * max(1.0, float(np.max(np.abs(H))))
-                                   or any(float(j.viscous) or float(j.coulomb) for j in robot.joints)})
+        friction = any(float(j.viscous) or float(j.coulomb) for j in robot.joints)
+        # energy is a property check only where the integrator conserves it (RK4; implicit Euler damps)
+        if sim["integrator"] == "rk4" and not sim["note"]:
+            data["properties"].append({"property": "energy conserved (tau = 0, no friction)", "measure": f"max |H(t) - H(0)| over the {t_end:g} s simulation",
+                                       "value": data["simulation"]["energy_drift"], "ok": data["simulation"]["energy_drift"] <= 1e-6 * max(1.0, float(np.max(np.abs(H))))
+                                       or friction})
+    steps.step("equations of motion")
     eom, note = _symbolic_eom(robot, name, eom_joints)
     data["_eom"] = eom
     data["eom_note"] = note
@@ -323,14 +356,30 @@ def _json_script(obj, element_id: str) -> str:
 
 
 def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, data: Optional[dict] = None,
-                 tutorial: bool = False) -> str:
+                 tutorial: bool = False, progress: Optional[bool] = False, time_budget: Optional[float] = SIMULATION_BUDGET) -> str:
     """The report as one HTML string (see the module docstring); ``tutorial``: add the seed
-    tutorial's questions worked step by step (its arm is the default robot, planar_2r)."""
+    tutorial's questions worked step by step (its arm is the default robot, planar_2r).
+    ``progress``: a progress bar of the steps on stderr (None: on a terminal)."""
+    from ..progress import Steps
+
+    total = (0 if data is not None else 4) + 2 + (len(_tutorial_questions()) if tutorial else 0)
+    with Steps("report", total, progress) as steps:
+        return _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, steps)
+
+
+def _tutorial_questions():
+    from .tutorial import QUESTIONS
+
+    return QUESTIONS
+
+
+def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, bar) -> str:
     from ..cli import _jsonable
 
     import kinedyn
 
-    d = data if data is not None else collect(robot, q, qd, name=name, t_end=t_end, eom_joints=eom_joints)
+    d = data if data is not None else collect(robot, q, qd, name=name, t_end=t_end, eom_joints=eom_joints, time_budget=time_budget, progress=progress, steps=bar)
+    bar.step("3-D view and tables")
     q = np.asarray(d["q"])
     eom = d.pop("_eom", None)
     parts: List[str] = []
@@ -371,6 +420,7 @@ def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: f
     view_html = "".join(view)
 
     # --- equations of motion
+    bar.step("equations (MathML)")
     eq = ["<section id='equations'><h2>Equations of motion</h2>",
           "<p>M(q) q̈ + C(q, q̇) q̇ + g(q) = τ, derived symbolically by Lagrange's method (robot.equations_of_motion()).</p>"]
     if eom is not None:
@@ -411,8 +461,11 @@ def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: f
         plots = [svg_plot(t, [(nm, qs[:, k]) for k, nm in enumerate(d["joint_names"])], "joint positions", "t [s]", "q [rad or m]"),
                  svg_plot(t, [("kinetic K", s["K"]), ("potential P", s["P"]), ("total H", s["H"])], "energy", "t [s]", "energy [J]")]
         dyn.append(f"<h3>Free motion under gravity (τ = 0) for {_f(t[-1], 3)} s from q, q̇ = 0</h3>")
+        if s.get("note"):
+            dyn.append(f"<p class='bad' id='simulation-cut-short'>{html.escape(s['note'])}</p>")
         dyn.append("<div class='plots'>" + "".join(plots) + "</div>")
-        dyn.append(f"<p class='note'>integrated with {html.escape(s['method'])}; the total energy changes by at most {_f(s['energy_drift'], 3)} J.</p></section>")
+        damping = " (implicit Euler damps energy numerically at O(dt), so the energy is not a property check here)" if s.get("integrator") == "implicit" else ""
+        dyn.append(f"<p class='note'>integrated with {html.escape(s['method'])}; the total energy changes by at most {_f(s['energy_drift'], 3)} J{damping}.</p></section>")
         dyn_html = "".join(dyn)
     else:
         dyn_html = "<section id='dynamics'><h2>Dynamics</h2><p class='note'>This build of kinedyn has no numeric dynamics (robot.mass_matrix); the properties check and the simulation appear once it does.</p></section>"
@@ -421,7 +474,11 @@ def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: f
     if tutorial:
         from . import tutorial as worked
 
-        tutorial_html = worked.render_html(worked.work())
+        answers = []
+        for question in worked.QUESTIONS:
+            bar.step(f"tutorial {question}")
+            answers.append(worked.answer(question))
+        tutorial_html = worked.render_html(answers)
 
     public = _jsonable({k: v for k, v in d.items() if not k.startswith("_")})
     title = f"kinedyn report: {d['robot']}"

@@ -7,19 +7,44 @@ import numpy as np
 __all__ = ["add_simulate_commands", "cmd_simulate"]
 
 
+def _gains(values, robot, flag: str):
+    """``--kp 100`` (one for every joint) or ``--kp 100 50 ...`` (one per joint): None, a number or (n,)."""
+    if values is None:
+        return None
+    g = np.array(values, dtype=float)
+    if g.size not in (1, robot.n):
+        raise ValueError(f"{flag} takes one gain for every joint or one per joint ({robot.n} for robot '{robot.name}': {', '.join(robot.joint_names)}), got {g.size}")
+    if not np.all(np.isfinite(g)) or np.any(g < 0):
+        raise ValueError(f"{flag} gains must be finite and non-negative, got {np.array2string(g)}")
+    return float(g[0]) if g.size == 1 else g
+
+
 def cmd_simulate(args) -> int:
     from ..cli import console, emit, load_robot, parse_q
     from .. import robots
     from .control import make_controller
-    from .core import simulate
+    from .core import ADAPTIVE_METHODS, simulate
 
     robot = load_robot(args.robot or robots.DEFAULT)
-    q0 = parse_q(args.q, robot, args.deg)
-    qd0 = parse_q(args.qd, robot, args.deg)
-    goal = parse_q(args.goal, robot, args.deg) if args.goal is not None else np.zeros(robot.n)
-    controller = None if args.controller == "none" else make_controller(robot, args.controller, q_goal=goal, kp=args.kp, kd=args.kd, T=min(args.t, args.t_move), q0=q0)
-    traj = simulate(robot, args.t, np.concatenate([q0, qd0]), controller=controller, method=args.method, dt=args.dt,
-                    record_every=args.record_every, progress=None if not args.json else False)
+    q0 = parse_q(args.q, robot, args.deg, flag="--q")
+    qd0 = parse_q(args.qd, robot, args.deg, flag="--qd")
+    goal = parse_q(args.goal, robot, args.deg, flag="--goal") if args.goal is not None else np.zeros(robot.n)
+    kp, kd = _gains(args.kp, robot, "--kp"), _gains(args.kd, robot, "--kd")
+    method = str(args.method).lower()
+    if args.joint_limits and method in ADAPTIVE_METHODS:
+        raise ValueError(f"--joint-limits needs a fixed-step --method (auto, rk4, implicit, semi_implicit, euler), not '{args.method}'")
+    if args.time_budget is not None and not args.time_budget > 0:
+        raise ValueError(f"--time-budget must be a positive number of seconds, got {args.time_budget}")
+    controller = None if args.controller == "none" else make_controller(robot, args.controller, q_goal=goal, kp=kp, kd=kd, T=min(args.t, args.t_move), q0=q0)
+    import warnings
+
+    from .core import SimulationTruncatedWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SimulationTruncatedWarning)  # said in the output below
+        traj = simulate(robot, args.t, np.concatenate([q0, qd0]), controller=controller, method=args.method, dt=args.dt,
+                        record_every=args.record_every, progress=None if not args.json else False, joint_limits=args.joint_limits,
+                        time_budget=args.time_budget)
     H = traj.H
     files = {}
     if args.plot:
@@ -54,6 +79,9 @@ def cmd_simulate(args) -> int:
         "energy_final": float(H[-1]),
         "energy_drift_relative": float(np.abs(H - H[0]).max() / max(abs(H[0]), 1e-300)),
         "wall_time_s": traj.info.get("wall_time"),
+        "method_choice": traj.info.get("method_choice"),
+        "joint_limits": bool(args.joint_limits),
+        "truncated": traj.info.get("truncated"),
         "files": files,
     }
 
@@ -61,6 +89,10 @@ def cmd_simulate(args) -> int:
         c = console()
         c.print(f"[bold]{robot.name}[/bold]: {args.t:g} s with {traj.method} (dt = {args.dt:g} s), controller {payload['controller']}, "
                 f"{len(traj)} samples in {payload['wall_time_s']:.3g} s")
+        if payload["method_choice"]:
+            c.print(f"  method {payload['method_choice']}")
+        if payload["truncated"]:
+            c.print(f"  [bold yellow]cut short[/bold yellow]: {payload['truncated']}")
         c.print(f"  q(T)  = {np.array2string(traj.q[-1], precision=5)}")
         c.print(f"  qd(T) = {np.array2string(traj.qd[-1], precision=5)}")
         c.print(f"  energy H: {H[0]:.8g} J -> {H[-1]:.8g} J (max relative change {payload['energy_drift_relative']:.3g})")
@@ -78,12 +110,16 @@ def add_simulate_commands(subparsers) -> None:
     _robot_arg(p)
     p.add_argument("--t", type=float, default=5.0, help="simulated time in seconds (default 5)")
     p.add_argument("--dt", type=float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
-    p.add_argument("--method", default="rk4", help="rk4, semi_implicit, euler, rk45, rk23, dop853, radau, bdf, lsoda (default rk4)")
+    p.add_argument("--method", default="auto",
+                   help="auto (default: rk4, or implicit where rk4 would be unstable at --dt), rk4, implicit, semi_implicit, euler, rk45, rk23, dop853, radau, bdf, lsoda")
     p.add_argument("--controller", default="none", choices=["none", "pd", "pdg", "ct"],
                    help="none (free motion), pd, pdg (PD + gravity compensation), ct (computed torque along a quintic to --goal)")
     p.add_argument("--goal", nargs="+", type=float, metavar="Q", help="set point / end of the quintic (default zeros)")
-    p.add_argument("--kp", type=float, default=None, help="proportional gain (default 100)")
-    p.add_argument("--kd", type=float, default=None, help="derivative gain (default 20)")
+    p.add_argument("--kp", nargs="+", type=float, default=None, metavar="KP", help="proportional gain: one for every joint or one per joint (default 100)")
+    p.add_argument("--kd", nargs="+", type=float, default=None, metavar="KD", help="derivative gain: one for every joint or one per joint (default 20)")
+    p.add_argument("--joint-limits", dest="joint_limits", action="store_true", help="honour the joint position limits (inelastic stops); default: free motion passes through them")
+    p.add_argument("--time-budget", dest="time_budget", type=float, default=None, metavar="S",
+                   help="stop after S seconds of wall-clock time and report the samples so far (default: no limit)")
     p.add_argument("--t-move", dest="t_move", type=float, default=2.0, help="duration of the computed-torque quintic (default 2 s)")
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="initial joint values (default zeros)")
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="initial joint velocities (default zeros)")

@@ -229,6 +229,11 @@ class PD(Controller):
         e, ed, _ = self.errors(t, q, qd)
         return e @ self.Kp.T + ed @ self.Kd.T
 
+    def jacobian(self, t, q, qd):
+        """``(dtau/dq, dtau/dqd) = (-Kp, -Kd)`` at one state: what the implicit integrator needs to
+        stay stable under stiff gains."""
+        return -self.Kp, -self.Kd
+
 
 class PDGravity(PD):
     """``tau = Kp e + Kd ed + g(q)`` with ``g`` from ``robot`` (or ``model``, another robot)."""
@@ -241,6 +246,12 @@ class PDGravity(PD):
 
     def __call__(self, t, q, qd):
         return super().__call__(t, q, qd) + self.model.gravity_torque(q)
+
+    def jacobian(self, t, q, qd):
+        """``(-Kp + dg/dq, -Kd)``; ``dg/dq`` is the analytical ``dtau/dq`` of inverse dynamics at rest."""
+        zero = np.zeros_like(np.asarray(q, dtype=float))
+        dg = self.model.inverse_dynamics_derivatives(q, zero, zero)[0]
+        return dg - self.Kp, -self.Kd
 
 
 class ComputedTorque(PD):
@@ -257,6 +268,14 @@ class ComputedTorque(PD):
         a = qddr + e @ self.Kp.T + ed @ self.Kd.T
         a = np.broadcast_to(a, np.shape(q))
         return self.model.inverse_dynamics(q, qd, np.ascontiguousarray(a))
+
+    def jacobian(self, t, q, qd):
+        """``tau = rnea(q, qd, a)`` with ``a = qdd_d + Kd (qd_d - qd) + Kp (q_d - q)``:
+        ``dtau/dq = drnea/dq - M Kp``, ``dtau/dqd = drnea/dqd - M Kd`` (analytical derivatives)."""
+        e, ed, qddr = self.errors(t, q, qd)
+        a = np.ascontiguousarray(qddr + e @ self.Kp.T + ed @ self.Kd.T)
+        dq, dqd, M = self.model.inverse_dynamics_derivatives(q, qd, a)
+        return dq - M @ self.Kp, dqd - M @ self.Kd
 
 
 class FunctionController(Controller):

@@ -36,11 +36,17 @@ import numpy as np
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
 
-__all__ = ["simulate", "SimulationError", "NonFiniteTorqueError", "FIXED_METHODS", "ADAPTIVE_METHODS"]
+__all__ = ["simulate", "SimulationError", "NonFiniteTorqueError", "SimulationTruncatedWarning", "FIXED_METHODS", "ADAPTIVE_METHODS", "RK4_STABLE"]
 
-FIXED_METHODS = ("rk4", "semi_implicit", "euler")
+FIXED_METHODS = ("rk4", "semi_implicit", "euler", "implicit")
 ADAPTIVE_METHODS = {"rk45": "RK45", "rk23": "RK23", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF", "lsoda": "LSODA"}
-_ALIASES = {"semi_implicit_euler": "semi_implicit", "symplectic_euler": "semi_implicit", "symplectic": "semi_implicit"}
+_ALIASES = {"semi_implicit_euler": "semi_implicit", "symplectic_euler": "semi_implicit", "symplectic": "semi_implicit", "implicit_euler": "implicit"}
+
+#: ``method="auto"`` keeps RK4 while ``dt`` times the largest eigenvalue modulus of the linearised
+#: dynamics stays below this; RK4's stability region reaches 2.79 on the negative real axis and 2.83
+#: on the imaginary axis (Hairer & Wanner, *Solving ODEs II*, §IV.2, Fig. 2.1), so this leaves a margin
+#: for the stiffness growing along the run.
+RK4_STABLE = 2.0
 
 
 class SimulationError(RuntimeError):
@@ -54,6 +60,11 @@ class SimulationError(RuntimeError):
 
 class NonFiniteTorqueError(SimulationError, ValueError):
     """The controller or torque input produced NaN or infinity."""
+
+
+class SimulationTruncatedWarning(RuntimeWarning):
+    """A simulation reached its ``time_budget`` (wall-clock seconds) and returned the samples it had;
+    ``traj.info["truncated"]`` says where it stopped."""
 
 
 # ------------------------------------------------------------------ helpers
@@ -205,9 +216,121 @@ def _raise_failure(system, names, failures, steps_done, traj_factory, steps):
             raise cls(message, t=f["t"], step=f["step"], joint=f.get("joint"), index=index if len(failures) > 1 else None, kind=f["kind"], trajectory=partial)
 
 
+# ------------------------------------------------------------------ stiffness and the implicit step
+def _choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
+    """``method="auto"``: RK4 unless ``dt |lambda|max`` of the linearised dynamics
+    ``J = [[0, I], [dqdd/dq, dqdd/dqd]]`` (analytical derivatives; the controller's gains included
+    when it has ``jacobian``) exceeds :data:`RK4_STABLE` at an initial state, else the implicit
+    step. Returns (method, reason)."""
+    states = [(q0, qd0)] if q0.ndim == 1 else list(zip(q0[:16], qd0[:16]))
+    n = q0.shape[-1]
+    worst, joint = 0.0, None
+    for q, qd in states:
+        try:
+            A_q, A_v, Minv = robot.forward_dynamics_derivatives(q, qd, np.zeros(n))
+        except (RuntimeError, ValueError):
+            return "rk4", "auto: rk4 (the linearised dynamics are not available at the initial state)"
+        if jacobian is not None:
+            K = jacobian(t0, q, qd)
+            if K is not None:
+                A_q, A_v = A_q + Minv @ K[0], A_v + Minv @ K[1]
+        J = np.block([[np.zeros((n, n)), np.eye(n)], [A_q, A_v]])
+        lam, vec = np.linalg.eig(J)
+        i = int(np.argmax(np.abs(lam)))
+        if abs(lam[i]) > worst:
+            worst = float(abs(lam[i]))
+            joint = int(np.argmax(np.abs(vec[:n, i]) + np.abs(vec[n:, i]) / max(worst, 1e-300)))
+    stiffness = dt * worst
+    if stiffness <= RK4_STABLE:
+        return "rk4", f"auto: rk4 (dt |lambda|max = {stiffness:.3g} <= {RK4_STABLE:g}, inside RK4's stability region)"
+    return "implicit", (
+        f"auto: implicit Euler, because RK4 at dt = {dt:g} s would be unstable: dt |lambda|max = {stiffness:.3g} > {RK4_STABLE:g} "
+        f"(stiffest mode at joint '{names[joint]}'; |lambda|max = {worst:.3g} 1/s); RK4 would need dt < {RK4_STABLE / worst:.2g} s"
+    )
+
+
+def _implicit_step(q, qd, a, h, A_q, A_v, Minv, coulomb):
+    """The linearly implicit Euler step of integrate.rs (``Method::Implicit``) in NumPy: returns the
+    new (q, qd). ``a``: the acceleration at (q, qd) (Coulomb friction included), ``coulomb``: (n,)
+    or None."""
+    n = q.size
+    A = np.eye(n) - h * A_v - h * h * A_q
+    lu = _lu(A)
+    a0 = a if coulomb is None else a + Minv @ (coulomb * np.sign(qd))
+    v0 = qd + _solve(lu, h * (a0 + h * (A_q @ qd)))
+    if coulomb is None:
+        v = v0
+    else:
+        v = v0 + _solve(lu, -h * (Minv @ (coulomb * np.sign(v0))))
+        v = np.where((coulomb != 0) & (v * v0 < 0), 0.0, v)
+    return q + h * v, v
+
+
+def _lu(A):
+    from scipy.linalg import lu_factor
+
+    return lu_factor(A)
+
+
+def _solve(lu, b):
+    from scipy.linalg import lu_solve
+
+    return lu_solve(lu, b)
+
+
+def _derivatives_fn(target, robot, fext_fn):
+    """(t, q, qd, tau) -> (dqdd/dq, dqdd/dqd, M^-1): analytical for robots, central differences of
+    the accelerations for other mechanical systems."""
+    if robot:
+        if fext_fn is None:
+            return lambda t, q, qd, tau: target.forward_dynamics_derivatives(q, qd, tau)
+        return lambda t, q, qd, tau: target.forward_dynamics_derivatives(q, qd, tau, fext_fn(t, q, qd))
+    accel = _accel_fn(target, robot, fext_fn)
+
+    def numeric(t, q, qd, tau):
+        n = q.size
+        out = []
+        for which in range(3):
+            D = np.zeros((n, n))
+            for j in range(n):
+                args = [q.copy(), qd.copy(), np.array(tau, dtype=float)]
+                h = 1e-6 * max(1.0, abs(args[which][j]))
+                args[which][j] += h
+                plus = accel(t, *args)
+                args[which][j] -= 2 * h
+                D[:, j] = (plus - accel(t, *args)) / (2 * h)
+            out.append(D)
+        return tuple(out)
+
+    return numeric
+
+
+def _clamp_to_limits(q, qd, lower, upper):
+    """Inelastic stops (integrate.rs ``apply_limits``)."""
+    low, high = q <= lower, q >= upper
+    q = np.where(low, lower, np.where(high, upper, q))
+    qd = np.where(low, np.maximum(qd, 0.0), np.where(high, np.minimum(qd, 0.0), qd))
+    return q, qd
+
+
+class _Deadline:
+    """A wall-clock budget shared by the trajectories of a run: ``expired()`` once it is spent; the
+    first trajectory to stop sets ``step``, and the others stop there too."""
+
+    def __init__(self, budget):
+        self.budget = budget
+        self.end = None if budget is None else time.perf_counter() + budget
+        self.step = None
+
+    def expired(self) -> bool:
+        return self.end is not None and time.perf_counter() > self.end
+
+
 # ------------------------------------------------------------------ the Python fixed-step loop
-def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, max_speed, hold, progress):
-    """One trajectory with the schemes of integrate.rs, the dynamics called from Python."""
+def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, max_speed, hold, progress, implicit=None, limits=None, deadline=None):
+    """One trajectory with the schemes of integrate.rs, the dynamics called from Python.
+    ``implicit``: (derivatives(t, q, qd, tau), jacobian(t, q, qd) or None, coulomb or None) for the
+    implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`_Deadline`."""
     n = q0.size
     samples = -(-steps // record_every) + 1
     Q, QD, QDD, TAU = (np.zeros((samples, n)) for _ in range(4))
@@ -223,18 +346,29 @@ def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, m
         return tau, accel(t, q, qd, tau)
 
     k = 0
+    last = steps if deadline is None or deadline.step is None else min(steps, deadline.step)
     try:
-        for k in range(steps + 1):
+        for k in range(last + 1):
             t = t0 + k * dt
             tau, a1 = evaluate(k, t, q, qd)
-            if k % record_every == 0 or k == steps:
+            if k % record_every == 0 or k == last:
                 Q[s], QD[s], QDD[s], TAU[s] = q, qd, a1, tau
                 s += 1
                 if progress is not None and s % 50 == 0:
                     progress.update(t)
-            if k == steps:
+                if k < last and deadline is not None and k % record_every == 0 and deadline.expired():
+                    deadline.step = k
+                    break
+            if k == last:
                 break
-            if method == "euler":
+            if method == "implicit":
+                derivatives, jacobian, coulomb = implicit
+                A_q, A_v, Minv = derivatives(t, q, qd, tau)
+                K = jacobian(t, q, qd) if jacobian is not None else None
+                if K is not None:
+                    A_q, A_v = A_q + Minv @ K[0], A_v + Minv @ K[1]
+                q, qd = _implicit_step(q, qd, a1, dt, A_q, A_v, Minv, coulomb)
+            elif method == "euler":
                 q, qd = q + dt * qd, qd + dt * a1
             elif method == "semi_implicit":
                 qd = qd + dt * a1
@@ -249,6 +383,8 @@ def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, m
                 a4 = f(t + dt, q4, v4)
                 q = q + dt / 6 * (qd + 2 * v2 + 2 * v3 + v4)
                 qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            if limits is not None:
+                q, qd = _clamp_to_limits(q, qd, *limits)
             bad = np.flatnonzero(~(np.isfinite(q) & np.isfinite(qd)))
             if bad.size:
                 raise _Stop(dict(step=k, t=t, joint=int(bad[0]), kind="non_finite", value=None, message=""))
@@ -263,7 +399,7 @@ def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, m
         if "singular" not in str(e):
             raise
         failure = dict(step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=str(e))
-    return Q, QD, QDD, TAU, (k if failure else steps), s, failure
+    return Q, QD, QDD, TAU, (k if failure or k < steps else steps), s, failure
 
 
 class _Stop(Exception):
@@ -279,7 +415,7 @@ def simulate(
     x0,
     u=None,
     controller: Optional[Callable] = None,
-    method: str = "rk4",
+    method: str = "auto",
     dt: Optional[float] = None,
     f_ext=None,
     rtol: float = 1e-8,
@@ -292,6 +428,8 @@ def simulate(
     max_speed: float = 1e6,
     baumgarte=None,
     points=None,
+    joint_limits: bool = False,
+    time_budget: Optional[float] = None,
 ) -> Trajectory:
     """Simulate ``system`` from ``x0 = concatenate([q0, qd0])`` over ``t_span`` (T or (t0, t1)).
 
@@ -306,17 +444,27 @@ def simulate(
     ``(t, q, qd) -> tau`` (see :mod:`kinedyn.simulate.control`). Python callables are evaluated at
     every integrator stage, or once per step with ``hold=True``.
 
-    ``method``: ``rk4`` (default), ``semi_implicit`` (symplectic Euler), ``euler`` (fixed step
-    ``dt``, default 1 ms) or ``rk45``, ``rk23``, ``dop853``, ``radau``, ``bdf``, ``lsoda`` (SciPy,
-    adaptive, ``rtol``/``atol``; samples every ``dt``). ``f_ext``: external wrenches on a robot's links,
+    ``method``: ``auto`` (default: ``rk4``, or ``implicit`` where RK4 at this ``dt`` would be
+    unstable — stiff robots such as fingers of tiny inertia under PD gains; the choice and its reason
+    are in ``traj.method`` and ``traj.info["method_choice"]``), ``rk4``, ``implicit`` (linearly
+    implicit Euler with the analytical derivatives of the dynamics and of the controller where it
+    has ``jacobian(t, q, qd)``, stable at any step), ``semi_implicit`` (symplectic Euler), ``euler``
+    (fixed step ``dt``, default 1 ms) or ``rk45``, ``rk23``, ``dop853``, ``radau``, ``bdf``,
+    ``lsoda`` (SciPy, adaptive, ``rtol``/``atol``; samples every ``dt``). ``f_ext``: external wrenches on a robot's links,
     (n, 6) constant or a function ``f(t, q, qd) -> (n, 6)`` (see :meth:`Robot.forward_dynamics`).
     ``record_every``: keep every k-th step (fixed-step methods). ``progress``: a progress bar on
     stderr (None: only on a terminal and for long runs). ``max_speed``: a joint speed above this is a
-    blow-up (:class:`SimulationError`).
+    blow-up (:class:`SimulationError`). ``joint_limits``: honour the robot's joint position limits
+    (an inelastic stop: the position is put back on the limit and the velocity into it zeroed;
+    fixed-step methods). ``time_budget``: wall-clock seconds; a run that reaches it stops and returns
+    the samples it has, with ``traj.info["truncated"]`` saying where, and a
+    :class:`SimulationTruncatedWarning`.
     """
     method = _ALIASES.get(str(method).lower(), str(method).lower())
-    if method not in FIXED_METHODS and method not in ADAPTIVE_METHODS:
-        raise ValueError(f"unknown method '{method}': fixed-step {', '.join(FIXED_METHODS)}; adaptive {', '.join(ADAPTIVE_METHODS)}")
+    if method != "auto" and method not in FIXED_METHODS and method not in ADAPTIVE_METHODS:
+        raise ValueError(f"unknown method '{method}': auto; fixed-step {', '.join(FIXED_METHODS)}; adaptive {', '.join(ADAPTIVE_METHODS)}")
+    if time_budget is not None and not (time_budget > 0):
+        raise ValueError(f"time_budget must be a positive number of seconds, got {time_budget!r}")
     if int(record_every) < 1:
         raise ValueError(f"record_every must be >= 1, got {record_every}")
     record_every = int(record_every)
@@ -338,6 +486,19 @@ def simulate(
     q0, qd0 = _split_state(x0, n, name)
     batch = q0.shape[0] if q0.ndim == 2 else None
     t0, t1, dt, steps = _time_grid(t_span, dt, method)
+    jac = getattr(controller, "jacobian", None) if controller is not None else None
+    jac = jac if callable(jac) else None
+    choice = None
+    if method == "auto":
+        method, choice = _choose_method(system, q0, qd0, t0, dt, jac, names) if robot else ("rk4", "auto: rk4 (a mechanical system given as equations)")
+    if joint_limits:
+        if not robot:
+            raise ValueError("joint_limits applies to robots (their joints' lower and upper limits)")
+        if method in ADAPTIVE_METHODS:
+            raise ValueError(f"joint_limits needs a fixed-step method (auto, {', '.join(FIXED_METHODS)}), not '{method}'")
+        limits = (np.asarray(system.lower_limits, dtype=float), np.asarray(system.upper_limits, dtype=float))
+    else:
+        limits = None
     if method in ADAPTIVE_METHODS:
         record_every = 1
     if callable(u):
@@ -357,7 +518,7 @@ def simulate(
     else:
         fext_fn = None
     count = batch or 1
-    work = steps * count * (4 if method == "rk4" else 1)
+    work = steps * count * (4 if method == "rk4" else 1) * (max(1, n // 6) if method == "implicit" else 1)
     native = robot and method in FIXED_METHODS and fext_fn is None
     pure_native = native and u_fn is None and controller is None
     if progress is None:
@@ -395,21 +556,40 @@ def simulate(
         return torque
 
     info = dict(method=method, steps=steps, batch=batch, native=native)
+    if choice is not None:
+        info["method_choice"] = choice
+    if joint_limits:
+        info["joint_limits"] = True
+    deadline = _Deadline(time_budget)
     start = time.perf_counter()
     try:
         if native:
-            out = _run_native(system, method, q0, qd0, t0, dt, steps, u_data, linear, None if pure_native else torque_for, hold, record_every, max_speed, bar, batch)
-            t = _sample_times(t0, dt, steps, record_every)
+            out = _run_native(system, method, q0, qd0, t0, dt, steps, u_data, linear, None if pure_native else torque_for, hold, record_every, max_speed, bar, batch,
+                              jac, limits, deadline)
         elif method in FIXED_METHODS:
-            out = _run_python(system if robot else mech, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, record_every, max_speed, bar, batch)
-            t = _sample_times(t0, dt, steps, record_every)
+            out = _run_python(system if robot else mech, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, record_every, max_speed, bar, batch,
+                              jac, limits, deadline)
         else:
-            out, t, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol, max_speed, bar, batch)
+            out, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol,
+                                      max_speed, bar, batch, deadline)
             info["nfev"] = nfev
     finally:
         bar.close()
     info["wall_time"] = time.perf_counter() - start
     Q, QD, QDD, TAU, steps_done, failures = out
+    every = record_every if method in FIXED_METHODS else 1
+    t = _sample_times(t0, dt, steps, every)
+    if deadline.step is not None and not any(f is not None for f in failures):
+        # the wall-clock budget ran out at step K: every trajectory keeps its samples up to K
+        K = deadline.step
+        t = _sample_times(t0, dt, K, every)
+        Q, QD, QDD, TAU = (a[..., : t.size, :] for a in (Q, QD, QDD, TAU))
+        info["truncated"] = (f"stopped by its time budget of {time_budget:g} s (wall clock) at t = {t[-1]:.6g} s, step {K} of {steps}; "
+                             f"the run was to end at t = {t0 + steps * dt:.6g} s")
+        info["steps_done"] = K
+        import warnings
+
+        warnings.warn(f"simulation of '{name}' {info['truncated']}", SimulationTruncatedWarning, stacklevel=3)
 
     def partial(index, done):
         k = done // record_every + 1 if method in FIXED_METHODS else done + 1
@@ -423,20 +603,23 @@ def simulate(
 
 
 def _sample_times(t0, dt, steps, every):
-    ks = np.arange(0, steps + 1, every)
+    ks = np.arange(0, steps + 1, max(every, 1))
     if ks[-1] != steps:
         ks = np.append(ks, steps)
     return t0 + ks * dt
 
 
-def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_for, hold, every, max_speed, bar, batch):
-    """The core's integrator, in chunks when a progress bar is shown (chunk boundaries on recorded
-    steps, so the samples are the same as in one call)."""
+def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_for, hold, every, max_speed, bar, batch, jac=None, limits=None, deadline=None):
+    """The core's integrator, in chunks when a progress bar is shown or a time budget is set
+    (chunk boundaries on recorded steps, so the samples are the same as in one call)."""
     from .. import _core
 
     model = robot._model
-    chunks = 1 if bar.bar is None else min(50, max(1, steps // every))
+    bounded = deadline is not None and deadline.end is not None
+    chunks = 1 if (bar.bar is None and not bounded) else min(200 if bounded else 50, max(1, steps // every))
     per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
+    lower, upper = limits if limits is not None else (None, None)
+    jacobian = None if jac is None or method != "implicit" else (lambda k, t, q, qd: jac(t, q, qd))
     parts = []
     k0, q, qd = 0, q0, qd0
     while True:
@@ -449,14 +632,14 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
                     tau = u_data
                 else:
                     tau = np.ascontiguousarray(u_data[..., k0 : k0 + m + (1 if linear else 0), :])
-            res = _core.integrate_fixed(model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed)
+            res = _core.integrate_fixed(model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper)
         else:
             if batch is None:
                 cb = _offset(torque_for(0), k0)
-                res = _core.integrate_callback(model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed)
+                res = _core.integrate_callback(model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper)
             else:
                 results = [
-                    _core.integrate_callback(model, method, q[i], qd[i], t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every, max_speed)
+                    _core.integrate_callback(model, method, q[i], qd[i], t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every, max_speed, jacobian, lower, upper)
                     for i in range(batch)
                 ]
                 res = tuple(np.stack([r[j] for r in results]) for j in range(4)) + (
@@ -468,6 +651,9 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
         k0 += m
         bar.update(t0 + k0 * dt)
         if any(f is not None for f in failures) or k0 >= steps:
+            break
+        if deadline is not None and deadline.expired():
+            deadline.step = k0
             break
         q = np.ascontiguousarray(Qc[..., -1, :])
         qd = np.ascontiguousarray(QDc[..., -1, :])
@@ -487,12 +673,16 @@ def _accel_fn(target, robot, fext_fn):
     return lambda t, q, qd, tau: target.accelerations(q, qd, tau)[0]
 
 
-def _run_python(target, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, every, max_speed, bar, batch):
+def _run_python(target, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, every, max_speed, bar, batch, jac=None, limits=None, deadline=None):
     accel = _accel_fn(target, robot, fext_fn)
+    implicit = None
+    if method == "implicit":
+        coulomb = np.array([float(j.coulomb) for j in target.joints]) if robot else None
+        implicit = (_derivatives_fn(target, robot, fext_fn), jac, coulomb if coulomb is not None and np.any(coulomb) else None)
     results = []
     for i in range(batch or 1):
         qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
-        results.append(_fixed_python(accel, torque_for(i), method, t0, dt, steps, qi, qdi, every, max_speed, hold, bar))
+        results.append(_fixed_python(accel, torque_for(i), method, t0, dt, steps, qi, qdi, every, max_speed, hold, bar, implicit, limits, deadline))
     return _stack(results, batch)
 
 
@@ -503,18 +693,26 @@ def _stack(results, batch):
     return (pick(0), pick(1), pick(2), pick(3), np.array([r[4] for r in results]), [r[6] for r in results])
 
 
-def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch):
+class _Budget(Exception):
+    """The wall-clock budget ran out inside an adaptive solve."""
+
+
+def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None):
+    """SciPy's solve_ivp per trajectory; with a time budget, over segments of the sample grid (a run
+    that runs out of time keeps the segments it finished)."""
     from scipy.integrate import solve_ivp
 
     accel = _accel_fn(target, robot, fext_fn)
     t_eval = t0 + np.arange(steps + 1) * dt
     t_eval[-1] = min(t_eval[-1], t1)
     n = q0.shape[-1]
+    bounded = deadline is not None and deadline.end is not None
     results = []
     nfev = 0
     for i in range(batch or 1):
         torque = torque_for(i)
         qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
+        last = steps if not bounded or deadline.step is None else deadline.step
 
         def step_of(t):
             return int(min(max(math.floor((t - t0) / dt + 1e-9), 0), steps))
@@ -525,6 +723,8 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
             bad = np.flatnonzero(~np.isfinite(tau))
             if bad.size:
                 raise _Stop(dict(step=step_of(t), t=t, joint=int(bad[0]), kind="torque", value=float(tau[bad[0]]), message=""))
+            if bounded and deadline.expired():
+                raise _Budget()
             bar.update(t)
             return np.concatenate([qd, accel(t, q, qd, tau)])
 
@@ -533,22 +733,33 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
 
         too_fast.terminal = True
         failure = None
+        pieces = [np.concatenate([qi, qdi])[None, :]]
+        edges = np.unique(np.linspace(0, last, min(last, 20) + 1).round().astype(int)) if bounded else np.array([0, last])
         try:
-            sol = solve_ivp(rhs, (t0, t1), np.concatenate([qi, qdi]), method=scipy_method, t_eval=t_eval, rtol=rtol, atol=atol, events=too_fast)
-            nfev += sol.nfev
-            X = sol.y.T
-            if sol.status == 1:  # the speed event
-                te = float(sol.t_events[0][0])
-                xe = sol.y_events[0][0]
-                j = int(np.argmax(np.abs(xe[n:])))
-                failure = dict(step=step_of(te), t=te, joint=j, kind="diverged", value=float(xe[n + j]), message="")
-            elif sol.status < 0 or not np.all(np.isfinite(X)):
-                failure = dict(step=step_of(sol.t[-1] if sol.t.size else t0), t=float(sol.t[-1]) if sol.t.size else t0, joint=None, kind="non_finite", value=None,
-                               message=f"the adaptive solver failed: {sol.message}")
+            for a, b in zip(edges[:-1], edges[1:]):
+                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast)
+                nfev += sol.nfev
+                X = sol.y.T
+                pieces.append(X[1:])
+                if sol.status == 1:  # the speed event
+                    te = float(sol.t_events[0][0])
+                    xe = sol.y_events[0][0]
+                    j = int(np.argmax(np.abs(xe[n:])))
+                    failure = dict(step=step_of(te), t=te, joint=j, kind="diverged", value=float(xe[n + j]), message="")
+                elif sol.status < 0 or not np.all(np.isfinite(X)):
+                    failure = dict(step=step_of(sol.t[-1] if sol.t.size else t0), t=float(sol.t[-1]) if sol.t.size else t0, joint=None, kind="non_finite", value=None,
+                                   message=f"the adaptive solver failed: {sol.message}")
+                if failure is not None:
+                    break
         except _Stop as stop:
             failure = stop.failure
-            X = np.zeros((0, 2 * n))
+            pieces = [np.zeros((0, 2 * n))]
+        except _Budget:
+            pass
+        X = np.concatenate(pieces)
         S = X.shape[0]
+        if bounded and failure is None and S - 1 < last:
+            deadline.step = S - 1
         Q, QD = X[:, :n].copy(), X[:, n:].copy()
         QDD, TAU = np.zeros((steps + 1, n)), np.zeros((steps + 1, n))
         for k in range(S):
@@ -557,4 +768,4 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
         full = [np.zeros((steps + 1, n)) for _ in range(2)]
         full[0][:S], full[1][:S] = Q, QD
         results.append((full[0], full[1], QDD, TAU, max(S - 1, 0), S, failure))
-    return _stack(results, batch), t_eval, nfev
+    return _stack(results, batch), nfev

@@ -13,6 +13,25 @@
 //!   Integration*, §VI.3): `qd_{k+1} = qd_k + h qdd(q_k, qd_k)`, `q_{k+1} = q_k + h qd_{k+1}`;
 //!   first order, but the energy of a conservative system stays bounded instead of drifting.
 //! - `Euler` (explicit): `x_{k+1} = x_k + h f(t_k, x_k)`; first order, energy grows. For comparison.
+//! - `Implicit`, the linearly implicit (Rosenbrock-) Euler step (Hairer & Wanner, *Solving ODEs II*,
+//!   §IV.7, eq. 7.4 with gamma = 1): `x_{k+1} = x_k + (I - h J)^-1 h f(t_k, x_k)`, `J = df/dx` from the
+//!   analytical derivatives of the articulated-body algorithm ([`aba_derivatives`]: `A_q = dqdd/dq`,
+//!   `A_v = dqdd/dqd`) plus, when the torque source knows them ([`TorqueFn::jacobian`], e.g. a PD
+//!   law: `dtau/dq = -Kp`, `dtau/dqd = -Kd`), the controller's gains through `dqdd/dtau = M^-1`.
+//!   With `J = [[0, I], [A_q, A_v]]` the 2n x 2n solve reduces to one n x n solve for the velocity
+//!   increment, `(I - h A_v - h^2 A_q) dv = h (qdd_k + h A_q qd_k)`, then `qd_{k+1} = qd_k + dv`,
+//!   `q_{k+1} = q_k + h qd_{k+1}`. First order, but exact for linear dynamics' stability: stable
+//!   for any step on damped and spring-like (PD) terms however stiff (MuJoCo's `implicit`
+//!   integrator linearises the damping the same way; this one also linearises the springs). It
+//!   dissipates energy at O(h) (numerical damping), so free motion loses energy slowly.
+//!   Coulomb friction `coulomb sign(qd)` is not differentiable: it is applied in the direction
+//!   of the velocity the step predicts without it, through the same matrix, and it may stop a joint
+//!   but not reverse it within one step (stiction, a per-joint approximation of the set-valued law
+//!   of time-stepping schemes such as Stewart & Trinkle 1996).
+//!
+//! Joint limits (`settings.limits`): after every step a joint beyond a limit is put back on it
+//! and its velocity into the limit set to zero (an inelastic stop; a projection, first order at the
+//! impact).
 //!
 //! Recorded per sample `k` (every `record_every` steps, and the last): `q_k`, `qd_k`, the torque
 //! applied at `t_k` and `qdd_k = aba(q_k, qd_k, tau_k)`. A step that produces a non-finite state or a
@@ -27,6 +46,7 @@
 //! | `tau`       | `tau`                 | joint torque at a stage, length `n`              |
 
 use super::aba::aba;
+use super::derivatives::aba_derivatives;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -37,6 +57,7 @@ pub enum Method {
     Rk4,
     SemiImplicitEuler,
     Euler,
+    Implicit,
 }
 
 impl Method {
@@ -44,14 +65,21 @@ impl Method {
     pub fn stages(self) -> usize {
         match self {
             Method::Rk4 => 4,
-            Method::SemiImplicitEuler | Method::Euler => 1,
+            Method::SemiImplicitEuler | Method::Euler | Method::Implicit => 1,
         }
     }
 }
 
+/// Joint position limits, each length `n` (infinite for an unlimited joint).
+#[derive(Clone, Copy, Debug)]
+pub struct Limits<'a> {
+    pub lower: &'a [f64],
+    pub upper: &'a [f64],
+}
+
 /// Step size, length and stop conditions of a run.
 #[derive(Clone, Copy, Debug)]
-pub struct Settings {
+pub struct Settings<'a> {
     pub method: Method,
     /// Step `h` (s), > 0.
     pub dt: f64,
@@ -67,9 +95,11 @@ pub struct Settings {
     pub hold: bool,
     /// A joint speed above this (rad/s or m/s) counts as a blow-up.
     pub max_speed: f64,
+    /// Joint position limits to honour (inelastic stops), or None: free motion passes through.
+    pub limits: Option<Limits<'a>>,
 }
 
-impl Settings {
+impl Settings<'_> {
     pub fn samples(&self) -> usize {
         self.steps.div_ceil(self.record_every.max(1)) + 1
     }
@@ -110,6 +140,13 @@ pub struct Outcome {
 /// The torque source: `tau(t, q, qd, out)`; an `Err` stops the run with [`FailureKind::Source`].
 pub trait TorqueFn {
     fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String>;
+
+    /// `dtau/dq` and `dtau/dqd` (row-major n x n, `[i * n + j] = dtau_i / dx_j`) at a state, for
+    /// the implicit method; `Ok(false)` (the default) when the torque does not depend on the state
+    /// or its derivatives are unknown (they are then left out of the step's Jacobian).
+    fn jacobian(&mut self, _step: usize, _t: f64, _q: &[f64], _qd: &[f64], _dtau_dq: &mut [f64], _dtau_dqd: &mut [f64]) -> std::result::Result<bool, String> {
+        Ok(false)
+    }
 }
 
 impl<F: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> std::result::Result<(), String>> TorqueFn for F {
@@ -169,6 +206,174 @@ struct Stage {
     tau: Vec<f64>,
     kq: [Vec<f64>; 4],
     kv: [Vec<f64>; 4],
+}
+
+/// Scratch of the implicit step (n x n matrices row-major, allocated once per trajectory).
+struct ImplicitScratch {
+    a_q: Vec<f64>,
+    a_v: Vec<f64>,
+    minv: Vec<f64>,
+    k_q: Vec<f64>,
+    k_v: Vec<f64>,
+    lu: Vec<f64>,
+    pivot: Vec<usize>,
+    rhs: Vec<f64>,
+    v0: Vec<f64>,
+}
+
+impl ImplicitScratch {
+    fn new(n: usize) -> Self {
+        let m = || vec![0.0; n * n];
+        ImplicitScratch { a_q: m(), a_v: m(), minv: m(), k_q: m(), k_v: m(), lu: m(), pivot: vec![0; n], rhs: vec![0.0; n], v0: vec![0.0; n] }
+    }
+}
+
+/// LU factorisation with partial pivoting of the row-major n x n `a`, in place (Golub & Van Loan,
+/// *Matrix Computations*, 4th ed., Algorithm 3.4.1): `P a = L U`, `pivot[k]` the row swapped into
+/// row k. `Err(k)` if column k has no usable pivot (the matrix is singular).
+fn lu_factor(a: &mut [f64], n: usize, pivot: &mut [usize]) -> std::result::Result<(), usize> {
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for k in 0..n {
+        let p = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs())).unwrap_or(k);
+        pivot[k] = p;
+        if !(a[p * n + k].abs() > 1e-300_f64.max(1e-15 * scale)) {
+            return Err(k);
+        }
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+        }
+        // below the pivot: l_ik = a_ik / a_kk ; a_ij -= l_ik a_kj
+        let akk = a[k * n + k];
+        for i in k + 1..n {
+            let l = a[i * n + k] / akk;
+            a[i * n + k] = l;
+            if l != 0.0 {
+                for j in k + 1..n {
+                    a[i * n + j] -= l * a[k * n + j];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solve `a x = b` in place in `b` with the factors of [`lu_factor`].
+fn lu_solve(lu: &[f64], n: usize, pivot: &[usize], b: &mut [f64]) {
+    for k in 0..n {
+        b.swap(k, pivot[k]);
+    }
+    // L y = P b (unit lower) ; U x = y
+    for i in 0..n {
+        let s: f64 = (0..i).map(|j| lu[i * n + j] * b[j]).sum();
+        b[i] -= s;
+    }
+    for i in (0..n).rev() {
+        let s: f64 = (i + 1..n).map(|j| lu[i * n + j] * b[j]).sum();
+        b[i] = (b[i] - s) / lu[i * n + i];
+    }
+}
+
+/// `out += a b` for row-major n x n matrices.
+fn add_product(out: &mut [f64], a: &[f64], b: &[f64], n: usize) {
+    for r in 0..n {
+        for k in 0..n {
+            let c = a[r * n + k];
+            if c != 0.0 {
+                for j in 0..n {
+                    out[r * n + j] += c * b[k * n + j];
+                }
+            }
+        }
+    }
+}
+
+/// One linearly implicit Euler step from `(q, qd)` at `t` (see the module header), `qdd` the ABA's
+/// acceleration there and `tau` the torque applied; `q`, `qd` are overwritten with the new state.
+#[allow(clippy::too_many_arguments)]
+fn implicit_step(
+    model: &Model,
+    data: &mut Data,
+    source: &mut dyn TorqueFn,
+    s: &mut ImplicitScratch,
+    step: usize,
+    t: f64,
+    h: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    qdd: &[f64],
+    tau: &[f64],
+) -> std::result::Result<(), Failure> {
+    let n = model.n;
+    let fail = |joint, kind| Failure { step, t, joint, kind };
+    // A_q = dqdd/dq, A_v = dqdd/dqd, M^-1 at (q, qd, tau)
+    aba_derivatives(model, data, q, qd, tau, None, &mut s.a_q, &mut s.a_v, &mut s.minv).map_err(|e| fail(singular_joint(&e), FailureKind::Singular(e.to_string())))?;
+    // the torque's own dependence on the state: A_q += M^-1 dtau/dq ; A_v += M^-1 dtau/dqd
+    let known = source.jacobian(step, t, q, qd, &mut s.k_q, &mut s.k_v).map_err(|m| fail(None, FailureKind::Source(m)))?;
+    if known {
+        if let Some(j) = s.k_q.iter().chain(s.k_v.iter()).position(|x| !x.is_finite()) {
+            return Err(fail(Some((j % (n * n)) / n.max(1)), FailureKind::Source("the torque's Jacobian has a non-finite entry".into())));
+        }
+        add_product(&mut s.a_q, &s.minv, &s.k_q, n);
+        add_product(&mut s.a_v, &s.minv, &s.k_v, n);
+    }
+    // LU of I - h A_v - h^2 A_q
+    for r in 0..n {
+        for c in 0..n {
+            let identity = if r == c { 1.0 } else { 0.0 };
+            s.lu[r * n + c] = identity - h * s.a_v[r * n + c] - h * h * s.a_q[r * n + c];
+        }
+    }
+    lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| fail(Some(k), FailureKind::Singular(format!("the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"))))?;
+    // without Coulomb friction: a0 = qdd + M^-1 (coulomb sign(qd)) (the ABA's qdd includes it)
+    let coulomb = model.coulomb.iter().any(|c| *c != 0.0);
+    // dv0 = (I - h A_v - h^2 A_q)^-1 h (a0 + h A_q qd)
+    for r in 0..n {
+        let mut a0 = qdd[r];
+        if coulomb {
+            a0 += (0..n).map(|k| s.minv[r * n + k] * model.coulomb[k] * super::rnea::sign(qd[k])).sum::<f64>();
+        }
+        let spring: f64 = (0..n).map(|k| s.a_q[r * n + k] * qd[k]).sum();
+        s.rhs[r] = h * (a0 + h * spring);
+    }
+    lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
+    for j in 0..n {
+        s.v0[j] = qd[j] + s.rhs[j];
+    }
+    if coulomb {
+        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb sign(v0))
+        for r in 0..n {
+            s.rhs[r] = -h * (0..n).map(|k| s.minv[r * n + k] * model.coulomb[k] * super::rnea::sign(s.v0[k])).sum::<f64>();
+        }
+        lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
+        for j in 0..n {
+            let v1 = s.v0[j] + s.rhs[j];
+            // friction stops a joint, it does not reverse it
+            qd[j] = if model.coulomb[j] != 0.0 && v1 * s.v0[j] < 0.0 { 0.0 } else { v1 };
+        }
+    } else {
+        qd.copy_from_slice(&s.v0);
+    }
+    // q_{k+1} = q_k + h qd_{k+1}
+    for j in 0..n {
+        q[j] += h * qd[j];
+    }
+    Ok(())
+}
+
+/// Inelastic stops: a joint beyond a limit goes back on it, and a joint on a limit loses its
+/// velocity into the limit.
+fn apply_limits(limits: &Limits<'_>, q: &mut [f64], qd: &mut [f64]) {
+    for j in 0..q.len() {
+        if q[j] <= limits.lower[j] {
+            q[j] = limits.lower[j];
+            qd[j] = qd[j].max(0.0);
+        } else if q[j] >= limits.upper[j] {
+            q[j] = limits.upper[j];
+            qd[j] = qd[j].min(0.0);
+        }
+    }
 }
 
 /// `qdd = aba(q, qd, tau(t, q, qd))` into `kv`, with the torque into `tau` unless `hold`.
@@ -242,6 +447,14 @@ pub fn integrate(
     if q0.len() != n || qd0.len() != n {
         return Err(Error::InvalidInput(format!("q0 and qd0 must have {n} entries, got {} and {}", q0.len(), qd0.len())));
     }
+    if let Some(l) = &settings.limits {
+        if l.lower.len() != n || l.upper.len() != n {
+            return Err(Error::InvalidInput(format!("joint limits must have {n} lower and upper values, got {} and {}", l.lower.len(), l.upper.len())));
+        }
+        if let Some(j) = (0..n).find(|&j| l.lower[j].is_nan() || l.upper[j].is_nan() || l.lower[j] > l.upper[j]) {
+            return Err(Error::InvalidInput(format!("joint {j} has limits [{}, {}]: lower must not exceed upper", l.lower[j], l.upper[j])));
+        }
+    }
     let need = settings.samples() * n;
     if out.q.len() < need || out.qd.len() < need || out.qdd.len() < need || out.tau.len() < need {
         return Err(Error::InvalidInput(format!("output arrays must hold {} samples of {n} values", settings.samples())));
@@ -250,6 +463,7 @@ pub fn integrate(
     let mut qd = qd0.to_vec();
     let zeros = || vec![0.0; n];
     let mut s = Stage { q: zeros(), qd: zeros(), tau: zeros(), kq: [zeros(), zeros(), zeros(), zeros()], kv: [zeros(), zeros(), zeros(), zeros()] };
+    let mut implicit = (settings.method == Method::Implicit).then(|| ImplicitScratch::new(n));
     let mut samples = 0;
     let t_of = |k: usize| settings.t0 + k as f64 * h;
 
@@ -297,6 +511,10 @@ pub fn integrate(
                 }
                 Ok(())
             }
+            Method::Implicit => {
+                let scratch = implicit.as_mut().expect("allocated for the implicit method");
+                implicit_step(model, data, source, scratch, k, t, h, &mut q, &mut qd, &kv0[0], &s.tau)
+            }
             Method::Rk4 => (|| {
                 let kq = &mut s.kq;
                 kq[0].copy_from_slice(&qd);
@@ -318,6 +536,9 @@ pub fn integrate(
                 Ok(())
             })(),
         };
+        if let (Ok(()), Some(limits)) = (&step, &settings.limits) {
+            apply_limits(limits, &mut q, &mut qd);
+        }
         let checked = step.and_then(|_| check_state(&q, &qd, settings.max_speed, k, t));
         if let Err(f) = checked {
             return Ok(Outcome { steps: k, samples, failure: Some(f) });
@@ -333,7 +554,7 @@ mod tests {
 
     fn run(model: &Model, method: Method, dt: f64, steps: usize, q0: &[f64], qd0: &[f64]) -> (Outcome, Vec<f64>, Vec<f64>) {
         let n = model.n;
-        let settings = Settings { method, dt, steps, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6 };
+        let settings = Settings { method, dt, steps, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut data = Data::new(model);
@@ -413,7 +634,7 @@ mod tests {
     fn blow_up_is_reported_with_step_and_joint() {
         let model = pendulum();
         let n = model.n;
-        let settings = Settings { method: Method::Rk4, dt: 1e-3, steps: 100, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6 };
+        let settings = Settings { method: Method::Rk4, dt: 1e-3, steps: 100, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut data = Data::new(&model);
@@ -440,10 +661,115 @@ mod tests {
     #[test]
     fn invalid_inputs_are_errors() {
         let model = pendulum();
-        let settings = Settings { method: Method::Rk4, dt: 0.0, steps: 10, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6 };
+        let settings = Settings { method: Method::Rk4, dt: 0.0, steps: 10, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
         let mut v = vec![0.0; 11];
         let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
         let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1.0, linear: false };
+        let r = integrate(&model, &mut Data::new(&model), &settings, &[0.0], &[0.0], &mut zero, Record { q: &mut v, qd: &mut a, qdd: &mut b, tau: &mut c });
+        assert!(matches!(r, Err(Error::InvalidInput(_))));
+    }
+    #[test]
+    fn implicit_euler_is_first_order_on_a_pendulum() {
+        let model = pendulum();
+        let (_, q_ref, _) = run(&model, Method::Rk4, 1e-4, 20_000, &[1.0], &[0.0]);
+        let reference = *q_ref.last().unwrap();
+        let err = |dt: f64| {
+            let steps = (2.0 / dt).round() as usize;
+            let (o, q, _) = run(&model, Method::Implicit, dt, steps, &[1.0], &[0.0]);
+            assert!(o.failure.is_none());
+            (q[steps] - reference).abs()
+        };
+        let ratio = err(0.002) / err(0.001);
+        assert!((ratio - 2.0).abs() < 0.3, "implicit Euler error ratio {ratio}");
+    }
+
+    /// A stiff PD law as a torque source that knows its Jacobian.
+    struct StiffPd {
+        kp: f64,
+        kd: f64,
+        goal: f64,
+        tell_jacobian: bool,
+    }
+
+    impl TorqueFn for StiffPd {
+        fn torque(&mut self, _k: usize, _t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String> {
+            out[0] = self.kp * (self.goal - q[0]) - self.kd * qd[0];
+            Ok(())
+        }
+        fn jacobian(&mut self, _k: usize, _t: f64, _q: &[f64], _qd: &[f64], dq: &mut [f64], dqd: &mut [f64]) -> std::result::Result<bool, String> {
+            dq[0] = -self.kp;
+            dqd[0] = -self.kd;
+            Ok(self.tell_jacobian)
+        }
+    }
+
+    fn run_with(model: &Model, method: Method, dt: f64, steps: usize, source: &mut dyn TorqueFn, limits: Option<Limits<'_>>, q0: f64) -> (Outcome, Vec<f64>, Vec<f64>) {
+        let settings = Settings { method, dt, steps, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits };
+        let m = settings.samples();
+        let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        let out = integrate(model, &mut Data::new(model), &settings, &[q0], &[0.0], source, Record { q: &mut q, qd: &mut qd, qdd: &mut qdd, tau: &mut tau }).unwrap();
+        (out, q, qd)
+    }
+
+    #[test]
+    fn implicit_euler_is_stable_on_stiff_damping_and_gains() {
+        // viscous damping 10 N m s on an inertia of 1e-4 kg m^2 (pendulum scaled): h b / I = 100
+        let mut model = pendulum();
+        // mass 1e-4 at (1, 0, 0): first moment (1e-4, 0, 0), inertia about the joint diag(0, 1e-4, 1e-4)
+        model.inertia[0] = crate::spatial::Inertia::new(1e-4, crate::spatial::Vec3::new(1e-4, 0.0, 0.0), crate::spatial::Mat3::from_diagonal(&crate::spatial::Vec3::new(0.0, 1e-4, 1e-4)));
+        model.viscous[0] = 10.0;
+        let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+        let (o, _, _) = run_with(&model, Method::Rk4, 1e-3, 100, &mut zero, None, 1.0);
+        assert!(o.failure.is_some(), "RK4 must blow up here (the test's premise)");
+        let (o, q, qd) = run_with(&model, Method::Implicit, 1e-3, 2000, &mut zero, None, 1.0);
+        assert!(o.failure.is_none(), "{:?}", o.failure);
+        // overdamped: it creeps at the speed where damping balances gravity, b qd = -m g l cos q
+        let creep = -1e-4 * 9.81 * q[2000].cos() / 10.0;
+        assert!((qd[2000] - creep).abs() < 1e-3 * creep.abs(), "qd(T) = {}, creep speed {creep}", qd[2000]);
+        // a stiff PD law (kp = 1e4, kd = 1e2 on the same tiny inertia) converges to its set point;
+        // without the gains in the Jacobian the same step is unstable
+        let mut model = model.clone();
+        model.viscous[0] = 0.0;
+        model.gravity = crate::spatial::Vec3::zeros();
+        let mut pd = StiffPd { kp: 1e4, kd: 1e2, goal: 0.5, tell_jacobian: true };
+        let (o, q, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut pd, None, 0.0);
+        assert!(o.failure.is_none() && (q[500] - 0.5).abs() < 1e-6, "{:?} q = {}", o.failure, q[500]);
+        let mut pd = StiffPd { kp: 1e4, kd: 1e2, goal: 0.5, tell_jacobian: false };
+        let (o, _, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut pd, None, 0.0);
+        assert!(o.failure.is_some(), "without the controller's Jacobian the stiff PD law must blow up");
+    }
+
+    #[test]
+    fn coulomb_friction_holds_a_joint_that_it_can_hold() {
+        // gravity torque at q = 0: m g l = 9.81 N m; Coulomb 20 N m holds it, 5 N m does not
+        for (coulomb, holds) in [(20.0, true), (5.0, false)] {
+            let mut model = pendulum();
+            model.coulomb[0] = coulomb;
+            let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+            let (o, q, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut zero, None, 0.0);
+            assert!(o.failure.is_none());
+            assert_eq!(q[500].abs() < 1e-9, holds, "coulomb {coulomb}: q(T) = {}", q[500]);
+        }
+    }
+
+    #[test]
+    fn joint_limits_stop_a_falling_pendulum() {
+        let model = pendulum();
+        let (lower, upper) = ([-0.3], [0.3]);
+        for method in [Method::Rk4, Method::SemiImplicitEuler, Method::Euler, Method::Implicit] {
+            let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+            let (o, q, qd) = run_with(&model, method, 1e-3, 1000, &mut zero, Some(Limits { lower: &lower, upper: &upper }), 0.0);
+            assert!(o.failure.is_none());
+            assert!(q.iter().all(|x| (-0.3..=0.3).contains(x)), "{method:?} left its limits");
+            // it falls onto the lower stop and rests there
+            assert!((q[1000] + 0.3).abs() < 1e-12 && qd[1000] == 0.0, "{method:?}: q(T) = {}, qd(T) = {}", q[1000], qd[1000]);
+            let (_, q, _) = run_with(&model, method, 1e-3, 1000, &mut zero, None, 0.0);
+            assert!(q.iter().any(|x| *x < -0.3), "{method:?} without limits passes through");
+        }
+        let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+        let settings = Settings { method: Method::Rk4, dt: 1e-3, steps: 1, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: Some(Limits { lower: &[1.0], upper: &[0.0] }) };
+        let mut v = vec![0.0; 2];
+        let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
         let r = integrate(&model, &mut Data::new(&model), &settings, &[0.0], &[0.0], &mut zero, Record { q: &mut v, qd: &mut a, qdd: &mut b, tau: &mut c });
         assert!(matches!(r, Err(Error::InvalidInput(_))));
     }
