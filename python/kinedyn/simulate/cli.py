@@ -15,8 +15,8 @@ def cmd_simulate(args) -> int:
 
     robot = load_robot(args.robot or robots.DEFAULT)
     q0 = parse_q(args.q, robot, args.deg)
-    qd0 = parse_q(args.qd, robot, args.deg)
-    goal = parse_q(args.goal, robot, args.deg) if args.goal is not None else np.zeros(robot.n)
+    qd0 = parse_q(args.qd, robot, args.deg, "--qd")
+    goal = parse_q(args.goal, robot, args.deg, "--goal") if args.goal is not None else np.zeros(robot.n)
     controller = None if args.controller == "none" else make_controller(robot, args.controller, q_goal=goal, kp=args.kp, kd=args.kd, T=min(args.t, args.t_move), q0=q0)
     traj = simulate(robot, args.t, np.concatenate([q0, qd0]), controller=controller, method=args.method, dt=args.dt,
                     record_every=args.record_every, progress=None if not args.json else False)
@@ -72,25 +72,25 @@ def cmd_simulate(args) -> int:
 
 
 def add_simulate_commands(subparsers) -> None:
-    from ..cli import _robot_arg
+    from ..cli import OutputPath, _robot_arg, positive_float, positive_int
 
     p = subparsers.add_parser("simulate", help="simulate a robot under a controller (RK4 in the native core by default)")
     _robot_arg(p)
-    p.add_argument("--t", type=float, default=5.0, help="simulated time in seconds (default 5)")
-    p.add_argument("--dt", type=float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
+    p.add_argument("--t", type=positive_float, default=5.0, help="simulated time in seconds (default 5)")
+    p.add_argument("--dt", type=positive_float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
     p.add_argument("--method", default="rk4", help="rk4, semi_implicit, euler, rk45, rk23, dop853, radau, bdf, lsoda (default rk4)")
     p.add_argument("--controller", default="none", choices=["none", "pd", "pdg", "ct"],
                    help="none (free motion), pd, pdg (PD + gravity compensation), ct (computed torque along a quintic to --goal)")
     p.add_argument("--goal", nargs="+", type=float, metavar="Q", help="set point / end of the quintic (default zeros)")
     p.add_argument("--kp", type=float, default=None, help="proportional gain (default 100)")
     p.add_argument("--kd", type=float, default=None, help="derivative gain (default 20)")
-    p.add_argument("--t-move", dest="t_move", type=float, default=2.0, help="duration of the computed-torque quintic (default 2 s)")
+    p.add_argument("--t-move", dest="t_move", type=positive_float, default=2.0, help="duration of the computed-torque quintic (default 2 s)")
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="initial joint values (default zeros)")
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="initial joint velocities (default zeros)")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
-    p.add_argument("--record-every", dest="record_every", type=int, default=1, help="keep every k-th step (default 1)")
-    p.add_argument("--plot", metavar="PNG", help="write joints, torques and energy plots")
-    p.add_argument("--animate", metavar="GIF|HTML", help="write a stick-figure animation")
-    p.add_argument("--csv", metavar="CSV", help="write the samples as CSV")
-    p.add_argument("--npz", metavar="NPZ", help="write the samples as a NumPy .npz")
+    p.add_argument("--record-every", dest="record_every", type=positive_int, default=1, help="keep every k-th step (default 1)")
+    p.add_argument("--plot", metavar="PNG", action=OutputPath, help="write joints, torques and energy plots")
+    p.add_argument("--animate", metavar="GIF|HTML", action=OutputPath, help="write a stick-figure animation")
+    p.add_argument("--csv", metavar="CSV", action=OutputPath, help="write the samples as CSV")
+    p.add_argument("--npz", metavar="NPZ", action=OutputPath, help="write the samples as a NumPy .npz")
     p.set_defaults(func=cmd_simulate)
