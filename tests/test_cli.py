@@ -114,8 +114,8 @@ def test_derive_rejects_symbolic_for_a_robot_without_symbols(capsys):
     "argv, message",
     [
         (["check", "no_such_robot"], "neither a built-in"),
-        (["identify", "planar_2r", "--noise", "-1"], "noise standard deviations must be >= 0"),
-        (["simulate", "planar_2r", "--t", "1", "--dt", "0"], "dt must be a positive"),
+        (["identify", "planar_2r", "--noise", "-1"], "argument --noise: must be a number >= 0"),
+        (["simulate", "planar_2r", "--t", "1", "--dt", "0"], "argument --dt: must be a positive number"),
         (["ik", "elbow_3r", "--xyz", "1", "0.2", "nan"], "NaN"),
         (["derive", "no_such_robot"], "neither a built-in"),
         (["dynamics", "planar_2r", "--q", "0", "0", "--qd", "1"], "--qd needs 2 values"),

@@ -112,7 +112,7 @@ def test_report_json_and_options(capsys, tmp_path):
     [
         (["report", "planar_2r", "--q", "1", "2", "3"], "needs 2 values"),
         (["report", "no_such_robot"], "neither a built-in"),
-        (["report", "planar_2r", "--t", "-1"], "--t must be a positive"),
+        (["report", "planar_2r", "--t", "-1"], "argument --t: must be a positive number"),
         (["report", "planar_2r", "-o", "/no/such/folder/r.html"], "does not exist"),
     ],
 )

@@ -3,36 +3,265 @@
 ROBOT is a built-in name (``kinedyn robots`` lists them) or a robot file (.urdf, .yaml, .toml).
 Every command prints readable tables (colour on a terminal) or, with ``--json``, one JSON document.
 Each capability module registers its commands with ``add_<name>_command(s)(subparsers)``.
+
+A mistake of the user (a bad robot file, a bad argument, an output path that cannot be written) is
+one line on stderr, ``kinedyn COMMAND: error: ...``, and exit status 1; ``--debug`` adds the
+traceback. Exit statuses: 0 done; 1 the user's mistake; 2 the command ran and its answer is "no"
+(``ik``: no solution, ``check``: a property fails); 70 an internal error (a bug in kinedyn);
+130 interrupted (Ctrl-C).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import contextvars
 import json
 import math
+import os
+import re
 import sys
+import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Optional, Sequence
+from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["main", "load_robot", "parse_q", "emit", "console"]
+__all__ = ["main", "load_robot", "parse_q", "emit", "console", "check_output_path", "OutputPath", "ROBOT_FILE_EXTENSIONS",
+           "EXIT_OK", "EXIT_ERROR", "EXIT_NO", "EXIT_INTERNAL", "EXIT_INTERRUPTED"]
+
+EXIT_OK = 0
+EXIT_ERROR = 1  # the user's mistake: bad argument, bad robot file, unwritable output
+EXIT_NO = 2  # the command ran and its answer is "no": ik found no solution, check found a failing property
+EXIT_INTERNAL = 70  # a bug in kinedyn (BSD sysexits' EX_SOFTWARE)
+EXIT_INTERRUPTED = 130  # Ctrl-C (128 + SIGINT, as shells report it)
 
 
 # ------------------------------------------------------------------ shared helpers
-def load_robot(spec: str):
-    """A built-in robot by name, or a robot file by path."""
+# The robot file extensions kinedyn.load reads (kinedyn.description.files.load dispatches on these).
+ROBOT_FILE_EXTENSIONS = (".urdf", ".yaml", ".yml", ".toml")
+
+
+@dataclass
+class _Invocation:
+    """What the running command was given beyond its own arguments: the ``--set`` values, and whether
+    it needs a numeric robot (every command but ``derive`` and ``info``)."""
+
+    command: str
+    values: Dict[str, float] = field(default_factory=dict)
+    numeric: bool = True
+
+
+_INVOCATION: contextvars.ContextVar[Optional[_Invocation]] = contextvars.ContextVar("kinedyn_cli_invocation", default=None)
+
+# commands that show a robot with symbolic parameters as it is (the others need numbers)
+SYMBOLIC_COMMANDS = {"derive", "info"}
+
+
+def load_robot(spec: str, *, values: Optional[Dict[str, float]] = None, numeric: Optional[bool] = None):
+    """A built-in robot by name, or a robot file by path, with parameter ``values`` substituted
+    (``--set name=value``: a built-in's keyword parameters, or a robot file's symbols). ``numeric``:
+    refuse a robot that still has symbolic parameters, naming them and the ``--set`` that gives them.
+    Inside :func:`main` both default to the running command's ``--set`` values and needs."""
+    from . import robots
+
+    run = _INVOCATION.get()
+    if values is None:
+        values = run.values if run is not None else {}
+    if numeric is None:
+        numeric = run.numeric if run is not None else False
+    if spec in robots.CATALOGUE:
+        robot = _builtin(spec, values)
+    else:
+        robot = _substitute(_robot_file(spec), values, spec)
+    if numeric and robot.is_symbolic:
+        missing = sorted(str(s) for s in robot.symbols)
+        raise ValueError(
+            f"robot '{robot.name}' ({spec}) has parameters without values: {', '.join(missing)}; this command needs numbers: "
+            f"add {' '.join(f'--set {m}=...' for m in missing)}"
+        )
+    return robot
+
+
+def _robot_file(spec: str):
     from . import robots
     from .description.files import load
 
-    if spec in robots.CATALOGUE:
-        return robots.get(spec)
     path = Path(spec)
-    if path.suffix.lower() in (".urdf", ".yaml", ".yml", ".toml", ".xml"):
-        if not path.exists():
-            raise ValueError(f"robot file '{spec}' does not exist")
+    ext = path.suffix.lower()
+    if ext not in ROBOT_FILE_EXTENSIONS:
+        why = f"robot files end in {', '.join(ROBOT_FILE_EXTENSIONS)}" + (f", not '{ext}'" if ext else "")
+        raise ValueError(f"'{spec}' is neither a built-in robot ({', '.join(robots.names())}) nor a robot file ({why})")
+    if not path.exists():
+        raise ValueError(f"robot file '{spec}' does not exist")
+    if path.is_dir():
+        raise ValueError(f"robot file '{spec}' is a folder")
+    try:
         return load(path)
-    raise ValueError(f"'{spec}' is neither a built-in robot ({', '.join(robots.names())}) nor a robot file (.urdf, .yaml, .toml)")
+    except (ValueError, OSError, MemoryError, KeyboardInterrupt):
+        raise
+    except Exception as e:  # a loader should raise only ValueError: say which file it was reading
+        e.kinedyn_context = f"while loading robot file '{spec}'"
+        raise
+
+
+def _builtin(name: str, values: Dict[str, float]):
+    """A built-in with ``values`` for its numeric keyword parameters (``planar_2r --set l1=2``)."""
+    import inspect
+
+    from . import robots
+
+    if not values:
+        return robots.get(name)
+    params = inspect.signature(robots.CATALOGUE[name]).parameters
+    numeric = [p for p, v in params.items() if v.default is None or (isinstance(v.default, (int, float)) and not isinstance(v.default, bool))]
+    unknown = [k for k in values if k not in numeric]
+    if unknown:
+        raise ValueError(f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})")
+    return robots.get(name, **values)
+
+
+def set_values() -> Dict[str, float]:
+    """The running command's ``--set`` values (empty outside :func:`main`)."""
+    run = _INVOCATION.get()
+    return dict(run.values) if run is not None else {}
+
+
+def _substitute(robot, values: Dict[str, float], spec: str):
+    """The file's robot with its symbols replaced by ``values`` (names checked first)."""
+    if not values:
+        return robot
+    known = sorted(str(s) for s in robot.symbols)
+    unknown = [k for k in values if k not in known]
+    if unknown:
+        has = f"its parameters: {', '.join(known)}" if known else "it has no symbolic parameters: every value is a number"
+        raise ValueError(f"--set {unknown[0]}: robot '{spec}' has no parameter '{unknown[0]}' ({has})")
+    return robot.subs(values)
+
+
+def _parse_set_value(text: str) -> float:
+    """The value of ``--set name=VALUE``: a finite number (a float literal)."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"'{text}' is not a finite number")
+    return value
+
+
+def _parse_set(text: str):
+    """``--set name=value`` as (name, value); argparse reports the error with the flag."""
+    name, eq, value = text.partition("=")
+    name = name.strip()
+    if not eq or not name.isidentifier():
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE (e.g. --set l1=0.5), got '{text}'")
+    try:
+        return name, _parse_set_value(value.strip())
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(f"{name}: the value must be a number, got '{value.strip()}'" + ("" if "could not convert" in str(e) else f" ({e})")) from None
+
+
+def _set_values(pairs) -> Dict[str, float]:
+    values: Dict[str, float] = {}
+    for name, value in pairs or []:
+        if name in values:
+            raise ValueError(f"--set {name} is given twice")
+        values[name] = value
+    return values
+
+
+# ------------------------------------------------------------------ output paths
+class OutputPath(argparse.Action):
+    """argparse action for an option that names a file to write: :func:`main` checks every such
+    path with :func:`check_output_path` before the command starts its work."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+
+
+def check_output_path(path, flag: str = "output") -> Path:
+    """``path`` if a file can be written there, else ValueError naming ``flag`` and the reason:
+    the path is a folder, its folder is missing or is not a folder, it lies in /proc or /sys (the
+    kernel's virtual files), or there is no permission to write it."""
+    text = os.fspath(path)
+    where = f"{flag}: cannot write '{text}'"
+    if not text.strip():
+        raise ValueError(f"{flag}: the file name is empty")
+    p = Path(text).expanduser()
+    full = Path(os.path.abspath(p))
+    real = full.resolve()
+    for virtual in ("/proc", "/sys"):
+        if any(x == Path(virtual) or Path(virtual) in x.parents for x in (full, real)):
+            raise ValueError(f"{where}: it is in {virtual}, the kernel's virtual files, not a place for output")
+    if real.is_dir():
+        raise ValueError(f"{where}: it is a folder; give a file name, e.g. '{p / 'out'}'")
+    parent = real.parent
+    if not parent.exists():
+        raise ValueError(f"{where}: the folder '{full.parent}' does not exist")
+    if not parent.is_dir():
+        raise ValueError(f"{where}: '{full.parent}' is not a folder")
+    if real.exists():
+        if not os.access(real, os.W_OK):
+            raise ValueError(f"{where}: no permission to write the file")
+    elif not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{where}: no permission to create a file in '{full.parent}'")
+    return p
+
+
+def _check_outputs(args) -> None:
+    """Every OutputPath option of the command, checked before the work starts; an output that would
+    overwrite the robot file it reads is refused too."""
+    parser = getattr(args, "_command_parser", None)
+    if parser is None:
+        return
+    robot = getattr(args, "robot", None)
+    robot_file = Path(robot).resolve() if robot and Path(robot).suffix.lower() in ROBOT_FILE_EXTENSIONS and Path(robot).exists() else None
+    seen: Dict[Path, str] = {}
+    for action in parser._actions:
+        if not isinstance(action, OutputPath):
+            continue
+        value = getattr(args, action.dest, None)
+        if value is None:
+            continue
+        flag = "/".join(action.option_strings)
+        path = check_output_path(value, flag).resolve()
+        if robot_file is not None and path == robot_file:
+            raise ValueError(f"{flag}: '{value}' is the robot file this command reads; write somewhere else")
+        if path in seen:
+            raise ValueError(f"{flag}: '{value}' is also the file of {seen[path]}; give each output its own file")
+        seen[path] = flag
+
+
+# ------------------------------------------------------------------ argument values
+def _number_type(kind, test, what: str):
+    """An argparse type: ``kind(text)`` (float or int) that passes ``test``, else the error
+    '<what>, got TEXT', which argparse prefixes with the flag."""
+
+    def convert(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{what}, got '{text}'") from None
+        if not (math.isfinite(value) and test(value)):
+            raise argparse.ArgumentTypeError(f"{what}, got '{text}'")
+        return value
+
+    convert.__name__ = what  # argparse's fallback message names the type by this
+    return convert
+
+
+positive_float = _number_type(float, lambda v: v > 0, "must be a positive number")
+nonnegative_float = _number_type(float, lambda v: v >= 0, "must be a number >= 0")
+finite_float = _number_type(float, lambda v: True, "must be a finite number (not NaN or inf)")
+positive_int = _number_type(int, lambda v: v >= 1, "must be a whole number >= 1")
+nonnegative_int = _number_type(int, lambda v: v >= 0, "must be a whole number >= 0")
+
+
+def in_cli_terms(text: str, phrases: Optional[Dict[str, str]]) -> str:
+    """``text`` (a library message) with the Python argument names in ``phrases`` replaced by the
+    command line flags that set them (``respect_limits=False`` -> ``--ignore-limits``)."""
+    for python, flag in (phrases or {}).items():
+        text = re.sub(rf"(?<![\w-]){re.escape(python)}(?![\w=])", flag, text)
+    return text
 
 
 def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, flag: str = "--q") -> np.ndarray:
@@ -43,6 +272,9 @@ def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, fla
     q = np.array(values, dtype=float)
     if q.shape != (robot.n,):
         raise ValueError(f"{flag} needs {robot.n} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}), got {q.size}")
+    bad = np.flatnonzero(~np.isfinite(q))
+    if bad.size:
+        raise ValueError(f"{flag}: value {bad[0] + 1} ({robot.joint_names[bad[0]]}) is {q[bad[0]]}, not a finite number")
     if degrees:
         q = np.array([math.radians(v) if j.kind == "revolute" else v for v, j in zip(q, robot.joints)])
     return q
@@ -135,6 +367,15 @@ def cmd_robots(args) -> int:
     return 0
 
 
+def _value(v):
+    """A parameter for display: a float, or the text of a symbolic expression (``info`` shows a
+    robot file with symbols as it is)."""
+    try:
+        return float(v)
+    except TypeError:
+        return str(v)
+
+
 def cmd_info(args) -> int:
     robot = _robot(args)
     joints = []
@@ -146,37 +387,39 @@ def cmd_info(args) -> int:
                 "link": b.name,
                 "type": j.kind,
                 "parent": robot.tree.bodies[b.parent].name if b.parent >= 0 else robot.base,
-                "axis": [float(a) for a in j.axis],
-                "offset": float(j.offset),
+                "axis": [_value(a) for a in j.axis],
+                "offset": _value(j.offset),
                 "lower": j.lower,
                 "upper": j.upper,
                 "velocity_limit": j.velocity_limit,
                 "effort_limit": j.effort_limit,
-                "gear_ratio": float(j.gear_ratio),
-                "rotor_inertia": float(j.rotor_inertia),
-                "viscous": float(j.viscous),
-                "coulomb": float(j.coulomb),
+                "gear_ratio": _value(j.gear_ratio),
+                "rotor_inertia": _value(j.rotor_inertia),
+                "viscous": _value(j.viscous),
+                "coulomb": _value(j.coulomb),
             }
         )
     bodies = [
-        {"link": b.name, "mass": float(b.inertia.mass), "com": [float(c) for c in b.inertia.com], "inertia_about_com": np.array(b.inertia.inertia, dtype=float)}
+        {"link": b.name, "mass": _value(b.inertia.mass), "com": [_value(c) for c in b.inertia.com],
+         "inertia_about_com": [[_value(x) for x in row] for row in np.asarray(b.inertia.inertia, dtype=object).tolist()]}
         for b in robot.tree.bodies
     ]
     dh = None
     if robot.dh is not None:
-        dh = [{"theta": float(r.theta), "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha), "type": r.kind} for r in robot.dh]
+        dh = [{"theta": _value(r.theta), "d": _value(r.d), "a": _value(r.a), "alpha": _value(r.alpha), "type": r.kind} for r in robot.dh]
     payload = {
         "name": robot.name,
         "n": robot.n,
         "source": robot.source,
-        "gravity": [float(g) for g in robot.gravity],
+        "gravity": [_value(g) for g in robot.gravity],
         "tool": robot.tool,
         "frames": robot.frame_names,
         "joints": joints,
         "dh_convention": robot.dh_convention,
         "dh": dh,
         "bodies": bodies,
-        "total_mass": float(sum(b["mass"] for b in bodies)),
+        "total_mass": _value(sum(b.inertia.mass for b in robot.tree.bodies)),
+        "symbols": sorted(str(s) for s in robot.symbols),
     }
 
     def render():
@@ -206,7 +449,7 @@ def cmd_info(args) -> int:
                     str(i),
                     f"q{i} + {_fmt(r['theta'])}" if var == "q" else _fmt(r["theta"]),
                     f"q{i} + {_fmt(r['d'])}" if var == "d" else _fmt(r["d"]),
-                    _fmt(r["a"]), f"{_fmt(math.degrees(r['alpha']))} deg", r["type"],
+                    _fmt(r["a"]), f"{_fmt(math.degrees(r['alpha']))} deg" if isinstance(r["alpha"], float) else f"{r['alpha']} rad", r["type"],
                 )
             c.print(t)
         t = Table(title="mass properties (body frames = joint frames)", title_justify="left")
@@ -217,6 +460,8 @@ def cmd_info(args) -> int:
             t.add_row(b["link"], _fmt(b["mass"]), " ".join(_fmt(x) for x in b["com"]), " ".join(_fmt(I[k][k]) for k in range(3)))
         c.print(t)
         c.print(f"total moving mass: {_fmt(payload['total_mass'])} kg")
+        if payload["symbols"]:
+            c.print(f"symbolic parameters: {', '.join(payload['symbols'])} (numeric commands take their values: --set NAME=VALUE)")
 
     emit(args, payload, render)
     return 0
@@ -340,12 +585,38 @@ def _command_modules() -> list:
     ]
 
 
+class _UsageError(Exception):
+    """A command line that argparse rejects (raised instead of argparse's print-usage-and-exit)."""
+
+    def __init__(self, prog: str, message: str):
+        super().__init__(message)
+        self.prog = prog
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``kinedyn fk: error: argument --q: ...``, through main()."""
+
+    def error(self, message):
+        raise _UsageError(self.prog, f"{message} (see '{self.prog} --help')")
+
+
+def _common_options(p: argparse.ArgumentParser, global_: bool = False) -> None:
+    """--debug on every command, --set on those that read a robot; given to the main parser too, so
+    that ``kinedyn --debug fk ...`` and ``kinedyn fk ... --debug`` both work."""
+    default = False if global_ else argparse.SUPPRESS
+    p.add_argument("--debug", action="store_true", default=default, help="on an error, show the Python traceback")
+    if global_ or any(a.dest == "robot" for a in p._actions):
+        p.add_argument("--set", dest="set_global" if global_ else "set", action="append", type=_parse_set, default=None if global_ else argparse.SUPPRESS,
+                       metavar="NAME=VALUE", help="give a robot parameter a value (repeatable): a symbol of a robot file, or a keyword of a built-in (e.g. --set l1=0.5)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     import importlib
 
-    parser = argparse.ArgumentParser(prog="kinedyn", description="Robot kinematics and dynamics, symbolic and numeric.")
+    parser = _Parser(prog="kinedyn", description="Robot kinematics and dynamics, symbolic and numeric.")
     parser.add_argument("--version", action="version", version=f"kinedyn {__import__('kinedyn').__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    _common_options(parser, global_=True)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("robots", help="list the built-in robots")
     p.add_argument("--json", action="store_true")
@@ -380,24 +651,103 @@ def build_parser() -> argparse.ArgumentParser:
 
     for module, function in _command_modules():
         getattr(importlib.import_module(module), function)(sub)
+    for p in sub.choices.values():
+        _common_options(p)
+        p.set_defaults(_command_parser=p)
     return parser
 
 
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _message(e: BaseException) -> str:
+    """The text of an exception for the user: a KeyError's key message without quotes, an OSError's
+    file and reason."""
+    if isinstance(e, KeyError) and e.args:
+        text = str(e.args[0])
+    elif isinstance(e, OSError) and e.strerror:
+        text = f"'{e.filename}': {e.strerror}" if e.filename else e.strerror
+    else:
+        text = str(e)
+    return text or type(e).__name__
+
+
+# exceptions that mean "the input was wrong" (or the environment: a missing file, a missing program);
+# anything else reaching main() is a bug in kinedyn. RecursionError is a RuntimeError but always a bug
+# (a description nested too deep for a parser that should have bounded it).
+_USER_ERRORS = (ValueError, KeyError, OSError, RuntimeError)
+_BUGS = (RecursionError,)
+
+
+def _report(command: str, e: BaseException, debug: bool, phrases: Optional[Dict[str, str]]) -> int:
+    """Print ``e`` as one line (and its traceback with --debug); return the exit status."""
+    import traceback
+
+    if debug:
+        traceback.print_exception(type(e), e, e.__traceback__, file=sys.stderr)
+    head = f"kinedyn {command}" if command else "kinedyn"
+    if isinstance(e, MemoryError):
+        detail = _message(e) if str(e) else "the work needs more memory than this machine has"
+        print(_one_line(f"{head}: error: out of memory: {detail} (ask for less: fewer samples or states, a larger step, a shorter time)"), file=sys.stderr)
+        return EXIT_ERROR
+    if isinstance(e, _USER_ERRORS) and not isinstance(e, _BUGS):
+        print(_one_line(f"{head}: error: {in_cli_terms(_message(e), phrases)}"), file=sys.stderr)
+        return EXIT_ERROR
+    context = getattr(e, "kinedyn_context", None)
+    print(_one_line(f"{head}: internal error{' ' + context if context else ''}: {type(e).__name__}: {_message(e)}. "
+                    f"This is a bug in kinedyn: rerun with --debug to see the traceback, and please report it"), file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+def _warning_line(command: str):
+    """warnings.showwarning that prints one line per warning: ``kinedyn fk: warning: ...``."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(_one_line(f"kinedyn {command}: warning: {message}"), file=file or sys.stderr)
+
+    return show
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 0
+    """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit status (see the
+    module docstring). Never lets an exception out, but SystemExit from --help and --version."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
+    command, phrases = "", None
     try:
-        return int(args.func(args) or 0)
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+        except _UsageError as e:
+            print(_one_line(f"{e.prog}: error: {e}"), file=sys.stderr)
+            return EXIT_ERROR
+        if not getattr(args, "func", None):
+            parser.print_help()
+            return EXIT_OK
+        command = args.command
+        debug = bool(args.debug)
+        phrases = getattr(args, "_flag_phrases", None)
+        run = _Invocation(command, _set_values((args.set_global or []) + (getattr(args, "set", None) or [])), command not in SYMBOLIC_COMMANDS)
+        token = _INVOCATION.set(run)
+        try:
+            with warnings.catch_warnings():
+                if not debug:
+                    warnings.showwarning = _warning_line(command)
+                _check_outputs(args)
+                return int(args.func(args) or 0)
+        finally:
+            _INVOCATION.reset(token)
     except BrokenPipeError:  # e.g. `kinedyn derive | head`: the reader left, nothing to report
-        sys.stderr.close()
-        return 0
-    except (ValueError, KeyError, FileNotFoundError, RuntimeError) as e:
-        message = e.args[0] if isinstance(e, KeyError) and e.args else e
-        print(f"kinedyn {args.command}: error: {message}", file=sys.stderr)
-        return 1
+        with contextlib.suppress(Exception):  # the interpreter's flush at exit must not fail again (Python docs, signal: SIGPIPE)
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+    except SystemExit:
+        raise
+    except BaseException as e:  # noqa: B036 - the boundary: PanicException from the core is a BaseException
+        return _report(command, e, debug, phrases)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -66,23 +66,23 @@ def cmd_identify(args) -> int:
 
 
 def add_analysis_commands(subparsers) -> None:
-    from ..cli import _robot_arg
+    from ..cli import _robot_arg, nonnegative_float, nonnegative_int, positive_float, positive_int
 
     p = subparsers.add_parser("check", help="properties of the equations of motion, each with its residual (Spong §9.5)")
     _robot_arg(p)
-    p.add_argument("--samples", type=int, default=200, help="random states (default 200)")
-    p.add_argument("--t", type=float, default=2.0, help="length of the passivity trajectory in seconds (default 2)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--samples", type=positive_int, default=200, help="random states (default 200)")
+    p.add_argument("--t", type=positive_float, default=2.0, help="length of the passivity trajectory in seconds (default 2)")
+    p.add_argument("--seed", type=nonnegative_int, default=0)
     p.set_defaults(func=cmd_check)
 
     p = subparsers.add_parser("identify", help="identify the base inertial parameters from a simulated Fourier excitation")
     _robot_arg(p)
-    p.add_argument("--noise", type=float, default=0.0, help="torque noise standard deviation, N m (default 0)")
-    p.add_argument("--harmonics", type=int, default=5)
-    p.add_argument("--period", type=float, default=10.0, help="period of the excitation, s (default 10)")
-    p.add_argument("--periods", type=float, default=2.0, help="measured periods (default 2)")
-    p.add_argument("--amplitude", type=float, default=0.6, help="joint excursion, rad or m (default 0.6)")
-    p.add_argument("--rate", type=float, default=100.0, help="sample rate, Hz (default 100)")
+    p.add_argument("--noise", type=nonnegative_float, default=0.0, help="torque noise standard deviation, N m (default 0)")
+    p.add_argument("--harmonics", type=positive_int, default=5)
+    p.add_argument("--period", type=positive_float, default=10.0, help="period of the excitation, s (default 10)")
+    p.add_argument("--periods", type=positive_float, default=2.0, help="measured periods (default 2)")
+    p.add_argument("--amplitude", type=nonnegative_float, default=0.6, help="joint excursion, rad or m (default 0.6)")
+    p.add_argument("--rate", type=positive_float, default=100.0, help="sample rate, Hz (default 100)")
     p.add_argument("--weighted", action="store_true", help="weighted least squares (per-joint noise levels)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=nonnegative_int, default=0)
     p.set_defaults(func=cmd_identify)

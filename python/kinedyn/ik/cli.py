@@ -14,6 +14,10 @@ from .solve import METHODS, inverse_kinematics
 
 __all__ = ["add_ik_command", "run_ik", "target_from_args"]
 
+# the solver's messages name its Python arguments; on the command line they are these flags
+FLAG_PHRASES = {"respect_limits=False": "--ignore-limits", "method='numeric'": "--method numeric", "method='analytic'": "--method analytic",
+                "a 4x4 pose": "a pose (--rpy)", "q0": "--q0"}
+
 
 def add_ik_command(subparsers):
     """Register the ``ik`` subcommand on an argparse ``subparsers`` object; returns its parser."""
@@ -28,8 +32,10 @@ def add_ik_command(subparsers):
         ),
     )
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument("--xyz", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"), help="target position of the frame origin (m)")
-    p.add_argument("--rpy", nargs=3, type=float, metavar=("ROLL", "PITCH", "YAW"),
+    from ..cli import finite_float
+
+    p.add_argument("--xyz", nargs=3, type=finite_float, required=True, metavar=("X", "Y", "Z"), help="target position of the frame origin (m)")
+    p.add_argument("--rpy", nargs=3, type=finite_float, metavar=("ROLL", "PITCH", "YAW"),
                    help="target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) (radians; degrees with --deg); omit for a position-only target")
     p.add_argument("--all", action="store_true", help="print every solution (default: only the one nearest q0)")
     p.add_argument("--q0", nargs="+", type=float, metavar="Q", help="reference / start joint values (default zeros)")
@@ -38,7 +44,7 @@ def add_ik_command(subparsers):
     p.add_argument("--method", default="auto", choices=METHODS, help="closed form, numeric, or auto (default)")
     p.add_argument("--ignore-limits", action="store_true", help="keep solutions outside the joint limits")
     p.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-    p.set_defaults(func=run_ik)
+    p.set_defaults(func=run_ik, _flag_phrases=FLAG_PHRASES)
     return p
 
 
@@ -72,7 +78,7 @@ def run_ik(args) -> int:
     if args.q0 is not None:
         from ..cli import parse_q
 
-        q0 = parse_q(args.q0, robot, args.deg)
+        q0 = parse_q(args.q0, robot, args.deg, "--q0")
     result = inverse_kinematics(robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame)
     shown = result.solutions if args.all else result.solutions[:1]
     revolute = np.array([j.kind == "revolute" for j in robot.joints])
@@ -91,11 +97,15 @@ def run_ik(args) -> int:
         "orientation_error": result.orientation_error[: len(shown)],
         "count": len(result.solutions),
     }
+    if "message" in payload:
+        from ..cli import in_cli_terms
+
+        payload["message"] = in_cli_terms(payload["message"], FLAG_PHRASES)
     if payload["nearest_q"] is not None:
         payload["nearest_q"] = angles(result.nearest_q)
 
     def render():
-        from ..cli import console
+        from ..cli import console, in_cli_terms
         from rich.table import Table
 
         c = console()
@@ -117,7 +127,7 @@ def run_ik(args) -> int:
             if robot.joint_names != [f"q{k + 1}" for k in range(robot.n)]:
                 c.print("joints: " + ", ".join(f"q{k + 1} = {name}" for k, name in enumerate(robot.joint_names)))
         style = "green" if result.success else "bold red"
-        c.print(f"[{style}]{result.message}[/{style}]")
+        c.print(f"[{style}]{in_cli_terms(result.message, FLAG_PHRASES)}[/{style}]")
 
     from ..cli import emit
 

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
-from ..cli import console, emit, load_robot, parse_q
+from ..cli import OutputPath, console, emit, load_robot, nonnegative_int, parse_q, positive_float
 
 __all__ = ["add_report_commands"]
 
@@ -36,14 +35,8 @@ def cmd_report(args) -> int:
     spec = args.robot or robots.DEFAULT
     robot = load_robot(spec)
     q = parse_q(args.q, robot, args.deg) if args.q is not None else default_configuration(robot)
-    qd = parse_q(args.qd, robot, args.deg) if args.qd is not None else None
-    if not (args.t > 0 and math.isfinite(args.t)):
-        raise ValueError(f"--t must be a positive number of seconds, got {args.t}")
-    out = Path(args.output)
-    if out.parent and not out.parent.exists():
-        raise ValueError(f"cannot write '{out}': the folder '{out.parent}' does not exist")
-    if args.time_budget is not None and not (args.time_budget > 0 and math.isfinite(args.time_budget)):
-        raise ValueError(f"--time-budget must be a positive number of seconds, got {args.time_budget}")
+    qd = parse_q(args.qd, robot, args.deg, "--qd") if args.qd is not None else None
+    out = Path(args.output)  # checked (with --t, --time-budget) before the command started: kinedyn.cli.check_output_path
     from ..progress import Steps
     from .html import SIMULATION_BUDGET, build_report
 
@@ -96,13 +89,13 @@ def add_report_commands(subparsers) -> None:
 
     p = subparsers.add_parser("report", help="one self-contained HTML report of a robot: 3-D view, Jacobian, equations of motion, properties, simulation")
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
-    p.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default: report.html)")
+    p.add_argument("-o", "--output", default="report.html", action=OutputPath, help="the HTML file to write (default: report.html)")
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="joint values (default: a generic, non-singular configuration)")
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="joint velocities at the start of the simulation (default zeros)")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
-    p.add_argument("--t", type=float, default=3.0, help="simulated seconds of free motion (default 3)")
-    p.add_argument("--eom-joints", type=int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
-    p.add_argument("--time-budget", dest="time_budget", type=float, default=None, metavar="S",
+    p.add_argument("--t", type=positive_float, default=3.0, help="simulated seconds of free motion (default 3)")
+    p.add_argument("--eom-joints", type=nonnegative_int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
+    p.add_argument("--time-budget", dest="time_budget", type=positive_float, default=None, metavar="S",
                    help="wall-clock seconds the free-motion simulation may take; a run cut short says so in the report (default 30)")
     p.add_argument("--no-tutorial", action="store_true", help="leave out the worked tutorial (included for the default robot, the tutorial's arm)")
     p.add_argument("--json", action="store_true", help="print the report's numbers as one JSON document")

@@ -350,9 +350,28 @@ def _asset(name: str) -> str:
     return resources.files("kinedyn.report").joinpath("assets", name).read_text(encoding="utf-8")
 
 
+# Characters that may not appear raw in JSON embedded in a <script> element, with their JSON escapes.
+# Inside a script element the HTML tokenizer looks for "</script" and also enters its "escaped" states
+# on "<!--" (after which "<script" makes it ignore the next "</script>": the rest of the page becomes
+# script text), so no "<" may reach it; ">" and "&" are escaped too so that the text means the same in
+# an XHTML/XML parser, and U+2028/U+2029 because they end a line in JavaScript before ES2019
+# (HTML Standard 4.12.1.3 "Restrictions for contents of script elements"; the same set as Django's
+# json_script and Go's html/template).
+_SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+_SCRIPT_UNSAFE = re.compile("[<>&\u2028\u2029]")
+
+
+def script_json(obj) -> str:
+    """``obj`` as JSON text that is safe as the content of an HTML ``<script>`` element, whatever
+    strings it holds: the characters above become JSON's ``\\uXXXX`` escapes (valid only inside JSON
+    strings, which is the only place JSON text can hold them), so ``JSON.parse`` returns ``obj``."""
+    text = json.dumps(obj, allow_nan=False)
+    return _SCRIPT_UNSAFE.sub(lambda m: _SCRIPT_ESCAPES[m.group(0)], text)
+
+
 def _json_script(obj, element_id: str) -> str:
-    text = json.dumps(obj, allow_nan=False).replace("</", "<\\/")
-    return f'<script type="application/json" id="{element_id}">{text}</script>'
+    """A ``<script type="application/json">`` block holding ``obj`` (read back by viewer.js)."""
+    return f'<script type="application/json" id="{html.escape(element_id)}">{script_json(obj)}</script>'
 
 
 def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, data: Optional[dict] = None,

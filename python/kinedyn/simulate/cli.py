@@ -33,8 +33,6 @@ def cmd_simulate(args) -> int:
     method = str(args.method).lower()
     if args.joint_limits and method in ADAPTIVE_METHODS:
         raise ValueError(f"--joint-limits needs a fixed-step --method (auto, rk4, implicit, semi_implicit, euler), not '{args.method}'")
-    if args.time_budget is not None and not args.time_budget > 0:
-        raise ValueError(f"--time-budget must be a positive number of seconds, got {args.time_budget}")
     controller = None if args.controller == "none" else make_controller(robot, args.controller, q_goal=goal, kp=kp, kd=kd, T=min(args.t, args.t_move), q0=q0)
     import warnings
 
@@ -104,12 +102,12 @@ def cmd_simulate(args) -> int:
 
 
 def add_simulate_commands(subparsers) -> None:
-    from ..cli import _robot_arg
+    from ..cli import OutputPath, _robot_arg, positive_float, positive_int
 
     p = subparsers.add_parser("simulate", help="simulate a robot under a controller (RK4 in the native core by default)")
     _robot_arg(p)
-    p.add_argument("--t", type=float, default=5.0, help="simulated time in seconds (default 5)")
-    p.add_argument("--dt", type=float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
+    p.add_argument("--t", type=positive_float, default=5.0, help="simulated time in seconds (default 5)")
+    p.add_argument("--dt", type=positive_float, default=1e-3, help="step (fixed-step methods) or sample spacing (adaptive), s (default 1e-3)")
     p.add_argument("--method", default="auto",
                    help="auto (default: rk4, or implicit where rk4 would be unstable at --dt), rk4, implicit, semi_implicit, euler, rk45, rk23, dop853, radau, bdf, lsoda")
     p.add_argument("--controller", default="none", choices=["none", "pd", "pdg", "ct"],
@@ -118,15 +116,15 @@ def add_simulate_commands(subparsers) -> None:
     p.add_argument("--kp", nargs="+", type=float, default=None, metavar="KP", help="proportional gain: one for every joint or one per joint (default 100)")
     p.add_argument("--kd", nargs="+", type=float, default=None, metavar="KD", help="derivative gain: one for every joint or one per joint (default 20)")
     p.add_argument("--joint-limits", dest="joint_limits", action="store_true", help="honour the joint position limits (inelastic stops); default: free motion passes through them")
-    p.add_argument("--time-budget", dest="time_budget", type=float, default=None, metavar="S",
+    p.add_argument("--time-budget", dest="time_budget", type=positive_float, default=None, metavar="S",
                    help="stop after S seconds of wall-clock time and report the samples so far (default: no limit)")
-    p.add_argument("--t-move", dest="t_move", type=float, default=2.0, help="duration of the computed-torque quintic (default 2 s)")
+    p.add_argument("--t-move", dest="t_move", type=positive_float, default=2.0, help="duration of the computed-torque quintic (default 2 s)")
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="initial joint values (default zeros)")
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="initial joint velocities (default zeros)")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
-    p.add_argument("--record-every", dest="record_every", type=int, default=1, help="keep every k-th step (default 1)")
-    p.add_argument("--plot", metavar="PNG", help="write joints, torques and energy plots")
-    p.add_argument("--animate", metavar="GIF|HTML", help="write a stick-figure animation")
-    p.add_argument("--csv", metavar="CSV", help="write the samples as CSV")
-    p.add_argument("--npz", metavar="NPZ", help="write the samples as a NumPy .npz")
+    p.add_argument("--record-every", dest="record_every", type=positive_int, default=1, help="keep every k-th step (default 1)")
+    p.add_argument("--plot", metavar="PNG", action=OutputPath, help="write joints, torques and energy plots")
+    p.add_argument("--animate", metavar="GIF|HTML", action=OutputPath, help="write a stick-figure animation")
+    p.add_argument("--csv", metavar="CSV", action=OutputPath, help="write the samples as CSV")
+    p.add_argument("--npz", metavar="NPZ", action=OutputPath, help="write the samples as a NumPy .npz")
     p.set_defaults(func=cmd_simulate)

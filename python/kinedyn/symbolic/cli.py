@@ -10,7 +10,7 @@ FORMATS = ("text", "latex", "markdown", "mathml", "python", "numpy", "c")
 
 def _robot(args):
     from .. import robots
-    from ..cli import load_robot
+    from ..cli import _substitute, load_robot, set_values
 
     name = args.robot or robots.DEFAULT
     if args.symbolic:
@@ -18,7 +18,7 @@ def _robot(args):
         if factory is None or "symbolic" not in inspect.signature(factory).parameters:
             symbolic = [n for n, f in robots.CATALOGUE.items() if "symbolic" in inspect.signature(f).parameters]
             raise ValueError(f"--symbolic needs a built-in with symbolic parameters ({', '.join(symbolic)}); got '{name}'")
-        return factory(symbolic=True)
+        return _substitute(factory(symbolic=True), set_values(), name)
     return load_robot(name)
 
 
@@ -67,6 +67,8 @@ def cmd_derive(args) -> int:
 
 
 def add_derive_command(subparsers) -> None:
+    from ..cli import OutputPath
+
     p = subparsers.add_parser("derive", help="symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)")
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
     p.add_argument("--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)")
@@ -74,6 +76,6 @@ def add_derive_command(subparsers) -> None:
     p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
     p.add_argument("--format", default="text", choices=FORMATS)
     p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
-    p.add_argument("-o", "--output", help="write to this file instead of the terminal")
+    p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
     p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
     p.set_defaults(func=cmd_derive)
