@@ -2,7 +2,7 @@
 run in a worker subprocess under a time and a memory limit, and not one defect.
 
 The cases are drawn by Hypothesis from a fixed seed, so a failure here is reproducible with
-``scripts/fuzz --seed 11 --cases 520 --timeout 10`` (which also writes the failing inputs to a
+``scripts/fuzz --seed 11 --cases 520 --timeout 5`` (which also writes the failing inputs to a
 folder). Defect classes: see :mod:`fuzz.worker`; docs/testing.md explains the figures.
 """
 
@@ -16,7 +16,7 @@ from fuzz.worker import CLASSES, DEFECTS
 
 SEED = 11
 CASES = 520  # ~60 s on 2 cores with --jobs 2 (generation ~6 s)
-TIMEOUT = 10.0  # seconds per case; every loader and call should answer in milliseconds
+TIMEOUT = 5.0  # seconds per case; every loader and call should answer in milliseconds
 MEMORY = 2 << 30  # bytes of address space per worker
 JOBS = max(1, min(2, os.cpu_count() or 1))
 

@@ -35,13 +35,17 @@ SHARES = {"urdf": 0.35, "yaml": 0.25, "toml": 0.15, "arrays": 0.25}
 
 
 # ============================================================================ generating
-def generate(kind: str, count: int, seed: int = 0) -> list:
+def generate(kind: str, count: int, seed: int = 0, issue: bool = True) -> list:
     """``count`` cases of ``kind`` ("urdf", "yaml", "toml", "arrays" or "all") drawn by Hypothesis
-    from a fixed seed: the same arguments give the same cases on every run."""
+    from a fixed seed: the same arguments give the same cases on every run; ``issue``: preceded by
+    the reproducers of issue 11 of that kind (:func:`fuzz.strategies.issue_cases`)."""
+    first = [c for c in strategies.issue_cases() if kind in ("all", c.kind)] if issue else []
+    for i, case in enumerate(first):
+        case.index = 90000 + i  # ids issue-90000... apart from the drawn cases
     if kind == "all":
-        out = []
+        out = first
         for k in KINDS:
-            out += generate(k, max(1, round(count * SHARES[k])), seed)
+            out += generate(k, max(1, round(count * SHARES[k])), seed, issue=False)
         return out
     out: list = []
 
@@ -55,11 +59,11 @@ def generate(kind: str, count: int, seed: int = 0) -> list:
     collect()
     for i, case in enumerate(out):
         case.index = i
-    return out
+    return first + out
 
 
 def case_id(case: Case) -> str:
-    return f"{case.kind}-{case.index:05d}"
+    return f"{'issue' if case.seed == 'issue 11' else case.kind}-{case.index:05d}"
 
 
 # ============================================================================ running
@@ -209,7 +213,8 @@ ROWS = (
     ("messages without the file name", "no_filename"),
     ("messages repeating the file name", "repeated_name"),
     ("errors deferred past load", "deferred"),
-    ("bad input accepted (complex, NaN/inf)", "bad_input_accepted"),
+    ("bad input accepted (complex, NaN, dup. keys)", "bad_input_accepted"),
+    ("valid input rejected", "valid_rejected"),
 )
 
 

@@ -38,10 +38,11 @@ CODE_EXEC = "code_exec"  # the canary ran: a file's expression executed Python
 NO_FILENAME = "no_filename"  # a loader's ValueError that does not name the file
 REPEATED_NAME = "repeated_name"  # a loader's message that repeats the file name (a doubled prefix)
 DEFERRED = "deferred"  # a file that loaded but failed at its first numeric call (the error belongs at load)
-BAD_INPUT_ACCEPTED = "bad_input_accepted"  # complex (non-zero imaginary part) or NaN/inf input accepted without error
+BAD_INPUT_ACCEPTED = "bad_input_accepted"  # complex (non-zero imaginary part) or NaN/inf input, or duplicate YAML keys, accepted
+VALID_REJECTED = "valid_rejected"  # an input valid as documented (an unmutated seed, a valid call) raised an error
 
 CLASSES = (CLEAN, SUCCESS, PANIC, CRASH, HANG, MEMORY, NONFINITE, BAD_EXCEPTION, CODE_EXEC, NO_FILENAME, REPEATED_NAME,
-           DEFERRED, BAD_INPUT_ACCEPTED)
+           DEFERRED, BAD_INPUT_ACCEPTED, VALID_REJECTED)
 DEFECTS = CLASSES[2:]
 FILE_NAME = "fuzzcase"  # basename (without extension) of the file each file case is written to
 
@@ -107,10 +108,14 @@ def _probe(robot):
     """The first numeric calls a user makes on a loaded numeric robot, at the neutral configuration."""
     if robot.is_symbolic:
         return SUCCESS, "loaded (symbolic)"
+    inverted = [name for name, lo, hi in zip(robot.joint_names, robot.lower_limits, robot.upper_limits) if lo > hi]
+    if inverted:  # accepted at load, wrong later (random_configuration, simulation with limits)
+        return DEFERRED, f"loaded with lower > upper limits for joints {inverted}"
     q = robot.neutral()
     z = np.zeros(robot.n)
     calls = (("forward_kinematics", lambda: robot.forward_kinematics(q)), ("mass_matrix", lambda: robot.mass_matrix(q)),
-             ("inverse_dynamics", lambda: robot.inverse_dynamics(q, z, z)), ("gravity_torque", lambda: robot.gravity_torque(q)))
+             ("inverse_dynamics", lambda: robot.inverse_dynamics(q, z, z)), ("gravity_torque", lambda: robot.gravity_torque(q)),
+             ("random_configuration", lambda: robot.random_configuration(0)))
     for name, call in calls:
         try:
             out = call()
@@ -146,9 +151,37 @@ def run_file(case: Case, folder: str):
         return MEMORY, _describe(e)
     except BaseException as e:
         return (PANIC if _is_panic(e) else BAD_EXCEPTION), _describe(e)
+    if case.kind == "yaml":
+        duplicate = _duplicate_yaml_key(case.data)
+        if duplicate:
+            return BAD_INPUT_ACCEPTED, f"loaded although the YAML repeats the key {duplicate!r}"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return _probe(robot)
+
+
+def _duplicate_yaml_key(data):
+    """The first key that a YAML mapping of ``data`` repeats, or None (the text has loaded already,
+    so it is neither malformed nor a bomb)."""
+    import yaml
+
+    found = []
+
+    class Strict(yaml.SafeLoader):
+        def construct_mapping(self, node, deep=False):
+            seen = set()
+            for key_node, _ in node.value:
+                key = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
+                if key is not None and key in seen and not found:
+                    found.append(key)
+                seen.add(key)
+            return super().construct_mapping(node, deep)
+
+    try:
+        yaml.load(data, Loader=Strict)
+    except Exception:
+        return None
+    return found[0] if found else None
 
 
 # ============================================================================ array cases
@@ -169,6 +202,8 @@ def run_call(case: Case):
     problem = _input_problem(list(args) + [v for k, v in kwargs.items() if k != "out"])  # out= is written, not read
     if problem:
         return BAD_INPUT_ACCEPTED, f"{problem} input accepted; the result is{'' if nonfinite(out) else ' not'} finite"
+    if method == "lock_joints":  # a Robot; its limits may be infinite by design
+        return SUCCESS, f"a robot with {out.n} joints"
     if nonfinite(out):
         return NONFINITE, "finite input, non-finite result"
     return SUCCESS, "finite result"
@@ -208,6 +243,8 @@ def run_case(case: Case, folder: str, marker: str):
             outcome, detail = MEMORY, _describe(e)
     else:
         outcome, detail = run_file(case, folder) if case.kind != "arrays" else run_call(case)
+    if case.valid and outcome == CLEAN:
+        outcome, detail = VALID_REJECTED, f"a valid input was rejected: {detail}"
     if os.environ.pop(CANARY_ENV, None) is not None or os.path.exists(marker):
         detail = f"the canary ran (was: {outcome}: {detail})"
         outcome = CODE_EXEC
@@ -231,7 +268,31 @@ def write_frame(stream, obj) -> None:
     stream.flush()
 
 
+def _exit_with_parent() -> None:
+    """A daemon thread that ends the worker when the parent is gone (killed, or Ctrl-C), even in
+    the middle of a hanging case. On Linux the kernel does it (PR_SET_PDEATHSIG), also while a case
+    holds the GIL in a long C call; the thread is the fallback elsewhere."""
+    import threading
+
+    parent = os.getppid()
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, 9, 0, 0, 0)  # PR_SET_PDEATHSIG = 1, SIGKILL = 9
+    except (OSError, AttributeError):
+        pass
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(3)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
 def main() -> None:
+    _exit_with_parent()
     proto_in = sys.stdin.buffer
     proto_out = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)  # prints of the library go to stderr, never into the protocol
