@@ -366,6 +366,14 @@ def _slots(obj, path=()):
 _ALIAS = re.compile(r"(^|[\s\[,{:])[&*][^\s,\]}]")
 
 
+def _joint_rows(obj) -> list:
+    """The joint mappings of a parsed robot file (DH rows or the links' joints), whatever an earlier
+    mutation did to its structure."""
+    joints, links = obj.get("joints"), obj.get("links")
+    rows = joints if isinstance(joints, list) else [l.get("joint") for l in links if isinstance(l, dict)] if isinstance(links, list) else []
+    return [r for r in rows if isinstance(r, dict)]
+
+
 def op_mapping(draw, data, kind):
     # a text with YAML anchors/aliases (an alias bomb from an earlier mutation) is not expanded here
     if kind == "yaml" and _ALIAS.search(_as_text(data)):
@@ -399,8 +407,7 @@ def op_mapping(draw, data, kind):
         else:
             return data, None
     elif how == "joint-type":
-        rows = obj.get("joints") or [l.get("joint") for l in obj.get("links") or [] if isinstance(l, dict)]
-        rows = [r for r in rows if isinstance(r, dict)]
+        rows = _joint_rows(obj)
         if not rows:
             return data, None
         row = rows[_pick(draw, len(rows), "joint")]
@@ -408,7 +415,7 @@ def op_mapping(draw, data, kind):
         row["type"] = new
         desc = f"joint '{row.get('name')}' type -> {new!r}"
     elif how == "cycle":
-        links = [l for l in obj.get("links") or [] if isinstance(l, dict)]
+        links = [l for l in obj.get("links") if isinstance(l, dict)] if isinstance(obj.get("links"), list) else []
         if len(links) < 2:
             return data, None
         i = _pick(draw, len(links), "link")
@@ -416,8 +423,7 @@ def op_mapping(draw, data, kind):
         links[i]["parent"] = links[j].get("name")
         desc = f"links[{i}].parent -> '{links[j].get('name')}' (links[{j}], itself or below it)"
     elif how in ("add-field", "swap-limits"):
-        rows = obj.get("joints") or [l.get("joint") for l in obj.get("links") or [] if isinstance(l, dict)]
-        rows = [r for r in rows if isinstance(r, dict)]
+        rows = _joint_rows(obj)
         if not rows:
             return data, None
         row = rows[_pick(draw, len(rows), "joint")]
@@ -511,6 +517,9 @@ def file_cases(draw, kind: str) -> Case:
         try:
             new, desc = op(draw, data, kind)
         except RecursionError:  # parsing a deeply nested text made by an earlier mutation
+            new, desc = data, None
+        except (TypeError, AttributeError, KeyError, IndexError, ValueError):
+            # a structure an earlier mutation broke in a way this one does not expect: skip it
             new, desc = data, None
         if desc is not None:
             data = new
