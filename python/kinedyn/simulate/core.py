@@ -199,7 +199,7 @@ def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/
     if kind == "diverged":
         return SimulationError, (
             f"simulation of '{system_name}' blew up at {at}{which}: speed {f['value']:.3g} {unit_speed}{where} exceeds "
-            f"max_speed; the samples before it are in error.trajectory (reduce dt, check the gains / inputs)"
+            f"max_speed; the samples before it are in error.trajectory (reduce dt, use method='implicit' for a stiff robot, check the gains / inputs)"
         )
     if kind == "non_finite":
         return SimulationError, f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory"
@@ -571,7 +571,7 @@ def simulate(
                               jac, limits, deadline)
         else:
             out, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol,
-                                      max_speed, bar, batch, deadline)
+                                      max_speed, bar, batch, deadline, jac if u_fn is None else None)
             info["nfev"] = nfev
     finally:
         bar.close()
@@ -697,9 +697,11 @@ class _Budget(Exception):
     """The wall-clock budget ran out inside an adaptive solve."""
 
 
-def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None):
+def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None, controller_jac=None):
     """SciPy's solve_ivp per trajectory; with a time budget, over segments of the sample grid (a run
-    that runs out of time keeps the segments it finished)."""
+    that runs out of time keeps the segments it finished). The implicit methods (Radau, BDF, LSODA)
+    of a robot get the analytical Jacobian ``[[0, I], [dqdd/dq, dqdd/dqd]]`` (the controller's
+    gains included when it has ``jacobian``) instead of finite differences."""
     from scipy.integrate import solve_ivp
 
     accel = _accel_fn(target, robot, fext_fn)
@@ -732,12 +734,25 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
             return max_speed - np.abs(x[n:]).max()
 
         too_fast.terminal = True
+        options = {}
+        if robot and scipy_method in ("Radau", "BDF", "LSODA"):
+            derivatives = _derivatives_fn(target, robot, fext_fn)
+
+            def jacobian(t, x):
+                q, qd = x[:n], x[n:]
+                A_q, A_v, Minv = derivatives(t, q, qd, torque(step_of(t), t, q, qd))
+                K = controller_jac(t, q, qd) if controller_jac is not None else None
+                if K is not None:
+                    A_q, A_v = A_q + Minv @ K[0], A_v + Minv @ K[1]
+                return np.block([[np.zeros((n, n)), np.eye(n)], [A_q, A_v]])
+
+            options["jac"] = jacobian
         failure = None
         pieces = [np.concatenate([qi, qdi])[None, :]]
         edges = np.unique(np.linspace(0, last, min(last, 20) + 1).round().astype(int)) if bounded else np.array([0, last])
         try:
             for a, b in zip(edges[:-1], edges[1:]):
-                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast)
+                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast, **options)
                 nfev += sol.nfev
                 X = sol.y.T
                 pieces.append(X[1:])
