@@ -69,27 +69,39 @@ class SimulationTruncatedWarning(RuntimeWarning):
 
 # ------------------------------------------------------------------ helpers
 class _Progress:
-    """A rich progress bar over simulated time, on stderr when it is a terminal."""
+    """A rich progress bar over simulated time, on stderr. ``delay``: start showing it only once the
+    run has taken that many seconds (so short runs stay silent)."""
 
-    def __init__(self, enabled: bool, t0: float, t1: float, label: str):
+    def __init__(self, enabled: bool, t0: float, t1: float, label: str, delay: float = 0.0):
         self.bar = None
-        self.t0, self.t1 = t0, t1
+        self.enabled = enabled
+        self.t0, self.t1, self.label = t0, t1, label
+        self.start = time.perf_counter()
+        self.delay = delay
         self.last = 0.0
-        if enabled:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-            from rich.console import Console
+        if enabled and delay <= 0:
+            self._show()
 
-            self.bar = Progress(TextColumn(label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
-                                console=Console(file=sys.stderr), transient=True)
-            self.task = self.bar.add_task(label, total=t1 - t0)
-            self.bar.start()
+    def _show(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+        self.bar = Progress(TextColumn(self.label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
+                            console=Console(file=sys.stderr), transient=True)
+        self.task = self.bar.add_task(self.label, total=self.t1 - self.t0)
+        self.bar.start()
 
     def update(self, t: float) -> None:
-        if self.bar is not None:
-            now = time.perf_counter()
-            if now - self.last > 0.05 or t >= self.t1:
-                self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
-                self.last = now
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self.start < self.delay or t >= self.t1:
+                return
+            self._show()
+        if now - self.last > 0.05 or t >= self.t1:
+            self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
+            self.last = now
 
     def close(self) -> None:
         if self.bar is not None:
@@ -518,13 +530,15 @@ def simulate(
     else:
         fext_fn = None
     count = batch or 1
-    work = steps * count * (4 if method == "rk4" else 1) * (max(1, n // 6) if method == "implicit" else 1)
+    work = steps * count * (4 if method == "rk4" else 1)
     native = robot and method in FIXED_METHODS and fext_fn is None
     pure_native = native and u_fn is None and controller is None
+    delay = 0.0
     if progress is None:
-        long = work > (2_000_000 if pure_native else 20_000)
-        progress = bool(long and sys.stderr.isatty())
-    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}")
+        # on a terminal, a bar appears once a run has taken a second (runs over ~2 s show progress)
+        progress = bool(work > 1000 and getattr(sys.stderr, "isatty", lambda: False)())
+        delay = 1.0
+    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}", delay=delay)
     if hasattr(controller, "reset"):
         controller.reset()
 
@@ -616,7 +630,7 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
 
     model = robot._model
     bounded = deadline is not None and deadline.end is not None
-    chunks = 1 if (bar.bar is None and not bounded) else min(200 if bounded else 50, max(1, steps // every))
+    chunks = 1 if (not bar.enabled and not bounded) else min(200 if bounded else 50, max(1, steps // every))
     per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
     lower, upper = limits if limits is not None else (None, None)
     jacobian = None if jac is None or method != "implicit" else (lambda k, t, q, qd: jac(t, q, qd))
