@@ -2,7 +2,10 @@
 
 Where the work happens (DESIGN.md: Rust does every hot loop):
 
-- A robot, a fixed-step method (``rk4``, ``semi_implicit``, ``euler``) and torques given as data (none,
+- ``method="auto"`` (the default) is ``rk4``, or ``implicit`` (linearly implicit Euler with the
+  analytical derivatives of the dynamics and of a PD-type controller) where RK4 would be unstable at
+  ``dt`` (:func:`_choose_method`; the choice and why in ``traj.info["method_choice"]``).
+- A robot, a fixed-step method (``rk4``, ``implicit``, ``semi_implicit``, ``euler``) and torques given as data (none,
   a constant, or samples per step): the whole trajectory, or a batch of initial states (in
   parallel), is one native call (``kinedyn._core.integrate_fixed``; the scheme is in
   ``crates/kinedyn-core/src/algorithms/integrate.rs``).
@@ -21,7 +24,10 @@ Where the work happens (DESIGN.md: Rust does every hot loop):
   ``scipy.integrate.solve_ivp`` with ``rtol``/``atol``; the samples are at multiples of ``dt``.
 
 Blow-ups stop the run with :class:`SimulationError` (when, where, which joint; the samples before
-it are in ``error.trajectory``) instead of returning NaN arrays.
+it are in ``error.trajectory``) instead of returning NaN arrays. ``joint_limits=True`` makes the
+limits inelastic stops; ``time_budget`` bounds the wall-clock time (a run cut short says so in
+``traj.info["truncated"]`` and with a :class:`SimulationTruncatedWarning`); on a terminal a progress
+bar on stderr appears once a run has taken a second.
 """
 
 from __future__ import annotations
