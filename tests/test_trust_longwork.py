@@ -195,6 +195,8 @@ def test_cli_per_joint_gains_and_limits(capsys):
     assert np.abs(d["qd_final"]).max() < 1e-4
     code, _, err = run(capsys, "simulate", "puma560", "--kp", "1", "2")
     assert code == 1 and "--kp takes one gain for every joint or one per joint (6" in err
+    code, _, err = run(capsys, "simulate", "puma560", "--method", "rk4", "--controller", "pd", "--kp", "1e7", "--t", "0.1")
+    assert code == 1 and "blew up" in err and "reduce --dt, use --method implicit" in err and "error.trajectory" not in err
     code, _, err = run(capsys, "simulate", "puma560", "--joint-limits", "--method", "rk45")
     assert code == 1 and "--joint-limits needs a fixed-step --method" in err
     code, text, err = run(capsys, "simulate", "puma560", "--t", "2", "--q", "0", "1.2", "0", "0", "0", "0", "--joint-limits", "--json")
@@ -224,3 +226,16 @@ def test_progress_is_on_stderr_only_when_asked_or_on_a_terminal(capsys, puma):
         warnings.simplefilter("error")
         kd.simulate(puma, 0.2, np.zeros(12))
     assert capsys.readouterr().err == ""
+
+
+def test_stiff_scipy_methods_get_the_analytical_jacobian(panda):
+    """Radau/BDF on the stiff Panda: the Jacobian comes from the analytical derivatives and the
+    controller's own jacobian (called), and the run converges like the implicit fixed step."""
+    ctl = PDGravity(panda, 100.0, 20.0, PANDA_GOAL)
+    calls = []
+    inner = ctl.jacobian
+    ctl.jacobian = lambda t, q, qd: calls.append(t) or inner(t, q, qd)
+    traj = kd.simulate(panda, 2.0, np.zeros(2 * panda.n), controller=ctl, method="bdf", dt=1e-2, rtol=1e-8, atol=1e-10)
+    assert calls, "the controller's Jacobian was not used"
+    implicit = kd.simulate(panda, 2.0, np.zeros(2 * panda.n), controller=PDGravity(panda, 100.0, 20.0, PANDA_GOAL), dt=1e-4, record_every=100)
+    np.testing.assert_allclose(traj.q, implicit.q, atol=2e-3)

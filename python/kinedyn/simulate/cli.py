@@ -38,11 +38,17 @@ def cmd_simulate(args) -> int:
 
     from .core import SimulationTruncatedWarning
 
+    from .core import SimulationError
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SimulationTruncatedWarning)  # said in the output below
-        traj = simulate(robot, args.t, np.concatenate([q0, qd0]), controller=controller, method=args.method, dt=args.dt,
-                        record_every=args.record_every, progress=None if not args.json else False, joint_limits=args.joint_limits,
-                        time_budget=args.time_budget)
+        try:
+            traj = simulate(robot, args.t, np.concatenate([q0, qd0]), controller=controller, method=args.method, dt=args.dt,
+                            record_every=args.record_every, progress=None if not args.json else False, joint_limits=args.joint_limits,
+                            time_budget=args.time_budget)
+        except SimulationError as e:  # name the command line's flags, not the Python arguments
+            message = str(e).replace("(reduce dt, use method='implicit'", "(reduce --dt, use --method implicit").replace("exceeds max_speed", "exceeds the speed limit 1e6")
+            raise SimulationError(message.replace("the samples before it are in error.trajectory", "no samples were written")) from None
     H = traj.H
     files = {}
     if args.plot:

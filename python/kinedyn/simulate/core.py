@@ -2,7 +2,10 @@
 
 Where the work happens (DESIGN.md: Rust does every hot loop):
 
-- A robot, a fixed-step method (``rk4``, ``semi_implicit``, ``euler``) and torques given as data (none,
+- ``method="auto"`` (the default) is ``rk4``, or ``implicit`` (linearly implicit Euler with the
+  analytical derivatives of the dynamics and of a PD-type controller) where RK4 would be unstable at
+  ``dt`` (:func:`_choose_method`; the choice and why in ``traj.info["method_choice"]``).
+- A robot, a fixed-step method (``rk4``, ``implicit``, ``semi_implicit``, ``euler``) and torques given as data (none,
   a constant, or samples per step): the whole trajectory, or a batch of initial states (in
   parallel), is one native call (``kinedyn._core.integrate_fixed``; the scheme is in
   ``crates/kinedyn-core/src/algorithms/integrate.rs``).
@@ -21,7 +24,10 @@ Where the work happens (DESIGN.md: Rust does every hot loop):
   ``scipy.integrate.solve_ivp`` with ``rtol``/``atol``; the samples are at multiples of ``dt``.
 
 Blow-ups stop the run with :class:`SimulationError` (when, where, which joint; the samples before
-it are in ``error.trajectory``) instead of returning NaN arrays.
+it are in ``error.trajectory``) instead of returning NaN arrays. ``joint_limits=True`` makes the
+limits inelastic stops; ``time_budget`` bounds the wall-clock time (a run cut short says so in
+``traj.info["truncated"]`` and with a :class:`SimulationTruncatedWarning`); on a terminal a progress
+bar on stderr appears once a run has taken a second.
 """
 
 from __future__ import annotations
@@ -69,27 +75,39 @@ class SimulationTruncatedWarning(RuntimeWarning):
 
 # ------------------------------------------------------------------ helpers
 class _Progress:
-    """A rich progress bar over simulated time, on stderr when it is a terminal."""
+    """A rich progress bar over simulated time, on stderr. ``delay``: start showing it only once the
+    run has taken that many seconds (so short runs stay silent)."""
 
-    def __init__(self, enabled: bool, t0: float, t1: float, label: str):
+    def __init__(self, enabled: bool, t0: float, t1: float, label: str, delay: float = 0.0):
         self.bar = None
-        self.t0, self.t1 = t0, t1
+        self.enabled = enabled
+        self.t0, self.t1, self.label = t0, t1, label
+        self.start = time.perf_counter()
+        self.delay = delay
         self.last = 0.0
-        if enabled:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-            from rich.console import Console
+        if enabled and delay <= 0:
+            self._show()
 
-            self.bar = Progress(TextColumn(label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
-                                console=Console(file=sys.stderr), transient=True)
-            self.task = self.bar.add_task(label, total=t1 - t0)
-            self.bar.start()
+    def _show(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+        self.bar = Progress(TextColumn(self.label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
+                            console=Console(file=sys.stderr), transient=True)
+        self.task = self.bar.add_task(self.label, total=self.t1 - self.t0)
+        self.bar.start()
 
     def update(self, t: float) -> None:
-        if self.bar is not None:
-            now = time.perf_counter()
-            if now - self.last > 0.05 or t >= self.t1:
-                self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
-                self.last = now
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self.start < self.delay or t >= self.t1:
+                return
+            self._show()
+        if now - self.last > 0.05 or t >= self.t1:
+            self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
+            self.last = now
 
     def close(self) -> None:
         if self.bar is not None:
@@ -199,7 +217,7 @@ def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/
     if kind == "diverged":
         return SimulationError, (
             f"simulation of '{system_name}' blew up at {at}{which}: speed {f['value']:.3g} {unit_speed}{where} exceeds "
-            f"max_speed; the samples before it are in error.trajectory (reduce dt, check the gains / inputs)"
+            f"max_speed; the samples before it are in error.trajectory (reduce dt, use method='implicit' for a stiff robot, check the gains / inputs)"
         )
     if kind == "non_finite":
         return SimulationError, f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory"
@@ -518,13 +536,15 @@ def simulate(
     else:
         fext_fn = None
     count = batch or 1
-    work = steps * count * (4 if method == "rk4" else 1) * (max(1, n // 6) if method == "implicit" else 1)
+    work = steps * count * (4 if method == "rk4" else 1)
     native = robot and method in FIXED_METHODS and fext_fn is None
     pure_native = native and u_fn is None and controller is None
+    delay = 0.0
     if progress is None:
-        long = work > (2_000_000 if pure_native else 20_000)
-        progress = bool(long and sys.stderr.isatty())
-    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}")
+        # on a terminal, a bar appears once a run has taken a second (runs over ~2 s show progress)
+        progress = bool(work > 1000 and getattr(sys.stderr, "isatty", lambda: False)())
+        delay = 1.0
+    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}", delay=delay)
     if hasattr(controller, "reset"):
         controller.reset()
 
@@ -571,7 +591,7 @@ def simulate(
                               jac, limits, deadline)
         else:
             out, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol,
-                                      max_speed, bar, batch, deadline)
+                                      max_speed, bar, batch, deadline, jac if u_fn is None else None)
             info["nfev"] = nfev
     finally:
         bar.close()
@@ -616,7 +636,7 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
 
     model = robot._model
     bounded = deadline is not None and deadline.end is not None
-    chunks = 1 if (bar.bar is None and not bounded) else min(200 if bounded else 50, max(1, steps // every))
+    chunks = 1 if (not bar.enabled and not bounded) else min(200 if bounded else 50, max(1, steps // every))
     per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
     lower, upper = limits if limits is not None else (None, None)
     jacobian = None if jac is None or method != "implicit" else (lambda k, t, q, qd: jac(t, q, qd))
@@ -697,9 +717,11 @@ class _Budget(Exception):
     """The wall-clock budget ran out inside an adaptive solve."""
 
 
-def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None):
+def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None, controller_jac=None):
     """SciPy's solve_ivp per trajectory; with a time budget, over segments of the sample grid (a run
-    that runs out of time keeps the segments it finished)."""
+    that runs out of time keeps the segments it finished). The implicit methods (Radau, BDF, LSODA)
+    of a robot get the analytical Jacobian ``[[0, I], [dqdd/dq, dqdd/dqd]]`` (the controller's
+    gains included when it has ``jacobian``) instead of finite differences."""
     from scipy.integrate import solve_ivp
 
     accel = _accel_fn(target, robot, fext_fn)
@@ -732,12 +754,25 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
             return max_speed - np.abs(x[n:]).max()
 
         too_fast.terminal = True
+        options = {}
+        if robot and scipy_method in ("Radau", "BDF", "LSODA"):
+            derivatives = _derivatives_fn(target, robot, fext_fn)
+
+            def jacobian(t, x):
+                q, qd = x[:n], x[n:]
+                A_q, A_v, Minv = derivatives(t, q, qd, torque(step_of(t), t, q, qd))
+                K = controller_jac(t, q, qd) if controller_jac is not None else None
+                if K is not None:
+                    A_q, A_v = A_q + Minv @ K[0], A_v + Minv @ K[1]
+                return np.block([[np.zeros((n, n)), np.eye(n)], [A_q, A_v]])
+
+            options["jac"] = jacobian
         failure = None
         pieces = [np.concatenate([qi, qdi])[None, :]]
         edges = np.unique(np.linspace(0, last, min(last, 20) + 1).round().astype(int)) if bounded else np.array([0, last])
         try:
             for a, b in zip(edges[:-1], edges[1:]):
-                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast)
+                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast, **options)
                 nfev += sol.nfev
                 X = sol.y.T
                 pieces.append(X[1:])
