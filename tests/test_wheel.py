@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _wheel() -> Path:
     given = os.environ.get("KINEDYN_WHEEL")
     if given:
-        path = Path(given)
+        path = Path(given).resolve()  # pip runs in a scratch folder
         assert path.is_file(), f"KINEDYN_WHEEL={given} is not a file"
         return path
     found = sorted((ROOT / "dist").glob("kinedyn-*.whl"))
