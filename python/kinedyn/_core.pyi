@@ -10,12 +10,12 @@ Batches run in a thread pool rebuilt in a forked child, so they work after ``for
 ``reference``: 0 = "world" (LOCAL_WORLD_ALIGNED), 1 = "local", 2 = "spatial" (WORLD).
 """
 
-from typing import Optional
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-F64 = NDArray[np.float64]
+F64 = NDArray[np.float64]  # stub-only type aliases (not in the compiled module)
 I64 = NDArray[np.int64]
 
 class Model:
@@ -46,16 +46,20 @@ class Model:
     # ---- dynamics (issue 3) ----
     # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the body origin.
     # A singular mass matrix (forward_dynamics, mass_matrix_inverse) raises RuntimeError naming the joint.
-    def inverse_dynamics(self, q: F64, qd: F64, qdd: F64, f_ext: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
-    def mass_matrix(self, q: F64) -> F64: ...  # (n, n) | (N, n, n)
-    def mass_matrix_inverse(self, q: F64) -> F64: ...  # (n, n) | (N, n, n)
-    def forward_dynamics(self, q: F64, qd: F64, tau: F64, f_ext: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
-    def coriolis_matrix(self, q: F64, qd: F64) -> F64: ...  # (n, n) | (N, n, n)
+    def inverse_dynamics(self, q: F64, qd: F64, qdd: F64, f_ext: Optional[F64] = None, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
+    def mass_matrix(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
+    def mass_matrix_inverse(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
+    def forward_dynamics(self, q: F64, qd: F64, tau: F64, f_ext: Optional[F64] = None, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
+    def coriolis_matrix(self, q: F64, qd: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
     def christoffel(self, q: F64) -> F64: ...  # (n, n, n) | (N, n, n, n), c[i, j, k]
-    def gravity_torque(self, q: F64) -> F64: ...  # (n,) | (N, n)
-    def bias_torque(self, q: F64, qd: F64) -> F64: ...  # (n,) | (N, n), C qd + g
+    def gravity_torque(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
+    def bias_torque(self, q: F64, qd: F64, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n), C qd + g
     def kinetic_energy(self, q: F64, qd: F64) -> F64: ...  # () | (N,)
     def potential_energy(self, q: F64) -> F64: ...  # () | (N,)
+    def inverse_dynamics_derivatives(self, q: F64, qd: F64, qdd: F64, f_ext: Optional[F64] = None) -> tuple[F64, F64, F64]: ...
+    # (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA
+    def forward_dynamics_derivatives(self, q: F64, qd: F64, tau: F64, f_ext: Optional[F64] = None) -> tuple[F64, F64, F64]: ...
+    # (dqdd/dq, dqdd/dqd, M^-1), each (n, n) | (N, n, n): derivatives of the ABA
     def regressor(self, q: F64, qd: F64, qdd: F64) -> F64: ...  # (n, 10 n) | (N, n, 10 n)
     def center_of_mass(self, q: F64) -> F64: ...  # (3,) | (N, 3)
     def momentum(self, q: F64, qd: F64) -> F64: ...  # (6,) | (N, 6), [p; L about the base origin]
@@ -70,3 +74,66 @@ def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
 def _set_check_finite(on: bool) -> bool:
     """BENCHMARK-ONLY: turns the non-finite scan of batch results on or off; returns the previous
     setting (benches/bench_finite_check.py)."""
+
+# ---- inverse kinematics (crates/kinedyn-py/src/ik.rs) ----
+def solve_ik(
+    model: Model,
+    frame: int,
+    targets: F64,  # (4, 4) pose or (3,) position, or a batch (N, 4, 4) | (N, 3)
+    q0: F64,  # (n,) | (N, n)
+    lower: F64,  # (n,)
+    upper: F64,  # (n,)
+    weights: F64,  # (6,) for [x, y, z, rx, ry, rz]
+    max_iterations: int = 50,
+    restarts: int = 50,
+    position_tolerance: float = 1e-10,
+    orientation_tolerance: float = 1e-10,
+    lambda_min: float = 1e-06,
+    max_step: float = 0.5,
+    seed: int = 0,
+) -> tuple[Any, Any, Any, Any, Any]: ...  # (q, success, position_error, orientation_error, iterations), leading N for a batch
+
+class AnalyticIk:
+    """A closed-form solver detected from a model's geometry (None from ``detect`` when there is none)."""
+    @staticmethod
+    def detect(model: Model, frame: int, lower: F64, upper: F64) -> Optional[AnalyticIk]: ...
+    @property
+    def structure(self) -> str: ...  # e.g. "spherical_wrist"
+    @property
+    def arm(self) -> Optional[str]: ...  # the arm of a spherical-wrist chain
+    @property
+    def solves_position(self) -> bool: ...  # whether (3,) position targets have a closed form
+    def solve(self, target: F64, reference: F64, respect_limits: bool = True, tolerance: float = 1e-09) -> tuple[F64, F64, F64, int, bool]: ...
+    # (solutions (m, n) nearest reference first, position errors (m,), orientation errors (m,), found before the limit filter, singular)
+    def solve_nearest(self, targets: F64, references: F64, respect_limits: bool = True, tolerance: float = 1e-09) -> tuple[F64, NDArray[np.bool_], F64, F64]: ...
+    # (q (N, n), success (N,), position errors (N,), orientation errors (N,)); q is NaN where no solution exists
+
+# ---- fixed-step integration (crates/kinedyn-py/src/simulate.rs) ----
+# Both return (q, qd, qdd, tau, steps, failures): arrays (samples, n) | (N, samples, n), steps (N,) int64,
+# failures a list with None or {"step", "t", "joint", "kind", "value", "message"} per trajectory.
+def integrate_fixed(
+    model: Model,
+    method_name: str,  # "rk4" | "semi_implicit" | "euler"
+    q0: F64,
+    qd0: F64,
+    t0: float,
+    dt: float,
+    steps: int,
+    tau: Optional[F64] = None,  # None, (S, n) or (N, S, n)
+    linear: bool = False,
+    record_every: int = 1,
+    max_speed: float = 1e6,
+) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
+def integrate_callback(
+    model: Model,
+    method_name: str,
+    q0: F64,
+    qd0: F64,
+    t0: float,
+    dt: float,
+    steps: int,
+    callback: Callable[[int, float, F64, F64], Sequence[float]],  # (step, t, q, qd) -> tau
+    hold: bool = False,
+    record_every: int = 1,
+    max_speed: float = 1e6,
+) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...

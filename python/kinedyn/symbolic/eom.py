@@ -155,7 +155,7 @@ class EquationsOfMotion:
 
     @property
     def christoffel(self):
-        """c[i][j][k] (Spong eq. 9.58), nested lists of SymPy expressions."""
+        """``c[i][j][k]`` (Spong eq. 9.58), nested lists of SymPy expressions."""
         self._christoffel = self._get(self._christoffel)
         return self._christoffel
 
