@@ -113,7 +113,7 @@ class AnalyticIk:
 # failures a list with None or {"step", "t", "joint", "kind", "value", "message"} per trajectory.
 def integrate_fixed(
     model: Model,
-    method_name: str,  # "rk4" | "semi_implicit" | "euler"
+    method_name: str,  # "rk4" | "implicit" | "semi_implicit" | "euler"
     q0: F64,
     qd0: F64,
     t0: float,
@@ -123,6 +123,8 @@ def integrate_fixed(
     linear: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
+    lower: Optional[F64] = None,  # (n,) joint position limits: inelastic stops when given
+    upper: Optional[F64] = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
 def integrate_callback(
     model: Model,
@@ -136,4 +138,7 @@ def integrate_callback(
     hold: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
+    jacobian: Optional[Callable[[float, F64, F64], tuple[F64, F64]]] = None,  # (t, q, qd) -> (dtau/dq, dtau/dqd) of the controller
+    lower: Optional[F64] = None,
+    upper: Optional[F64] = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
