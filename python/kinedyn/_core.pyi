@@ -138,7 +138,7 @@ def integrate_callback(
     hold: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
-    jacobian: Optional[Callable[[float, F64, F64], tuple[F64, F64]]] = None,  # (t, q, qd) -> (dtau/dq, dtau/dqd) of the controller
+    jacobian: Optional[Callable[[int, float, F64, F64], Any]] = None,  # (step, t, q, qd) -> (dtau/dq, dtau/dqd) (n, n) each, or None
     lower: Optional[F64] = None,
     upper: Optional[F64] = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
