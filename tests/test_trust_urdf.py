@@ -357,6 +357,14 @@ def test_tiago_loads_with_a_warning_naming_the_link_and_eigenvalues():
     assert issubclass(kd.PhysicalConsistencyWarning, Warning)
 
 
+def test_romeo_loads_with_warnings_naming_its_links():
+    path = erd(*ROMEO)
+    robot, caught = _warnings_of(lambda: kd.Robot.from_urdf(path))
+    named = {re.match(rf"{re.escape(path)}:\d+: link '(\w+)': ", str(w.message)).group(1) for w in caught}
+    assert {"body", "LHipPitch_link", "RHipPitch_link"} <= named == set(robot.nonphysical)
+    assert all("not positive semi-definite (eigenvalues" in str(w.message) or "triangle inequality" in str(w.message) for w in caught)
+
+
 @pytest.mark.parametrize("where", [TIAGO, ROMEO])
 def test_strict_raises_naming_file_line_and_link(where):
     path = erd(*where)
@@ -379,10 +387,11 @@ def test_repair_reports_the_change_and_passes_the_identities(where, locked):
     assert max(residuals.values()) < 1e-6, residuals
 
 
-def test_warned_tiago_agrees_with_pinocchio():
+@pytest.mark.parametrize("where", [TIAGO, ROMEO])
+def test_warned_robots_agree_with_pinocchio(where):
     """Kept as given, the tensors are those Pinocchio loads: same M and RNEA."""
     pin = pytest.importorskip("pinocchio")
-    path = erd(*TIAGO)
+    path = erd(*where)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
         robot = kd.load(path)
