@@ -217,6 +217,8 @@ def test_bad_value_names_file_line_and_field_once(tmp_path, case):
         ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='revolute'><child link='b'/></joint>\n</robot>",
          4, r"joint 'j' has no <parent link=...>"),
         ("<robot name='r'>\n<link/>\n</robot>", 2, r"a <link> has no name"),
+        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j'><parent link='a'/><child link='b'/></joint>\n</robot>",
+         4, r"joint 'j' has no type attribute"),
         ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint type='fixed'><parent link='a'/><child link='b'/></joint>\n</robot>", 4, r"a <joint> has no name"),
         ("<robot name='r'>\n<link name='a'/><link name='b'/>\n<joint name='j' type='revolute'><parent link='a'/><child link='b'/><limit lower='2'/></joint>\n</robot>",
          3, r"joint 'j': lower limit 2.0 exceeds upper limit 0.0"),  # URDF's upper defaults to 0

@@ -252,6 +252,8 @@ def _joint(element, src: _Source) -> dict:
         raise src.error(element, "a <joint> has no name")
     kind = element.get("type")
     what = f"joint '{name}'"
+    if kind is None:
+        raise src.error(element, f"{what} has no type attribute (supported: {', '.join(_SUPPORTED)})")
     if kind not in _SUPPORTED:
         raise src.error(
             element,
