@@ -508,3 +508,42 @@ def test_projection_of_tiago_antenna():
     expected = np.sort([sigma[1] + 0, sigma[0] + 0, sigma[0] + sigma[1]])
     np.testing.assert_allclose(fixed.moments, expected, rtol=1e-6)
     assert fixed.ok
+
+
+# ------------------------------------------------ mutated real URDFs: a robot or one clean ValueError
+TOKENS = ["nan", "inf", "-inf", "1e200", "1" * 400, "-1", "0", "x", "", "1 2", "1e-320", "&amp;", "<", '"',
+          "revolute", "fixed", "floating", "panda_link0", "\u00e9", "<link name='z'/>", "</robot>",
+          "<!DOCTYPE r [<!ENTITY a 'b'>]>", "<a>" * 200]
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_mutated_panda_loads_or_fails_with_one_clean_value_error(data):
+    text = open(erd("panda_description", "urdf", "panda.urdf")).read()
+    for _ in range(data.draw(st.integers(1, 4))):
+        pos = data.draw(st.integers(0, len(text) - 1))
+        op = data.draw(st.sampled_from(["attribute", "insert", "delete", "duplicate"]))
+        if op == "attribute":  # replace the next quoted value
+            q = text.find('"', pos)
+            q2 = text.find('"', q + 1)
+            if q >= 0 and q2 >= 0:
+                text = text[:q + 1] + data.draw(st.sampled_from(TOKENS)) + text[q2:]
+        elif op == "insert":
+            text = text[:pos] + data.draw(st.sampled_from(TOKENS)) + text[pos:]
+        elif op == "delete":
+            text = text[:pos] + text[pos + data.draw(st.integers(1, 200)):]
+        else:
+            start = data.draw(st.integers(0, len(text) - 1))
+            text = text[:pos] + text[start:start + data.draw(st.integers(1, 300))] + text[pos:]
+    began = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+            robot = robot_from_urdf(text)
+    except ValueError as e:
+        assert type(e) is ValueError
+        assert str(e).count("<URDF string>") == 1, str(e)
+    else:  # what loads gives finite numbers
+        q = robot.random_configuration(0)
+        assert np.all(np.isfinite(robot.mass_matrix(q))) and np.all(np.isfinite(robot.pose(q)))
+    assert time.perf_counter() - began < 5.0
