@@ -6,7 +6,8 @@ Generated URDFs of three shapes, each of N links: a fixed chain (one revolute jo
 links: the case whose default-tool search was cubic, 56 s for N = 2000), a moving chain (N revolute
 joints in series) and a wide tree (N revolute joints on the root). Prints the median load time
 (parse, checks, Robot construction; not the native model, built on first numeric call) and the
-time per link, whose staying flat as N doubles is the linearity claim. With ``--pinocchio``, the
+time per link, whose staying flat as N doubles is the linearity claim (the process CPU time per link
+beside it is steadier than wall time on a shared machine). With ``--pinocchio``, the
 same files through ``pinocchio.buildModelFromXML`` for scale, on chains of at most 2,000 links:
 Pinocchio 4.1 crashes the process (segmentation fault, a recursion through the chain) on a
 4,000-link chain, fixed or moving.
@@ -43,12 +44,12 @@ def urdf(shape: str, n: int) -> str:
     return '<robot name="bench">\n' + "\n".join(links + joints) + "\n</robot>\n"
 
 
-def median_time(fn, repeats: int) -> float:
+def median_time(fn, repeats: int, clock=time.perf_counter) -> float:
     times = []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start = clock()
         fn()
-        times.append(time.perf_counter() - start)
+        times.append(clock() - start)
     return statistics.median(times)
 
 
@@ -63,13 +64,14 @@ def main() -> None:
     if args.pinocchio:
         import pinocchio as pin
     warnings.simplefilter("ignore")
-    header = f"{'shape':<12} {'links':>6} {'kinedyn s':>10} {'us/link':>8}" + (f" {'pinocchio s':>12}" if pin else "")
+    header = f"{'shape':<12} {'links':>6} {'kinedyn s':>10} {'us/link':>8} {'CPU us/link':>12}" + (f" {'pinocchio s':>12}" if pin else "")
     print(header)
     for shape in ("fixed chain", "moving chain", "wide tree"):
         for n in sizes:
             xml = urdf(shape, n)
             t = median_time(lambda: kd.Robot.from_urdf(xml), args.repeats)
-            row = f"{shape:<12} {n:>6} {t:>10.3f} {1e6 * t / n:>8.0f}"
+            cpu = median_time(lambda: kd.Robot.from_urdf(xml), args.repeats, time.process_time)
+            row = f"{shape:<12} {n:>6} {t:>10.3f} {1e6 * t / n:>8.0f} {1e6 * cpu / n:>12.0f}"
             if pin and (shape == "wide tree" or n <= PIN_DEEPEST):
                 row += f" {median_time(lambda: pin.buildModelFromXML(xml), args.repeats):>12.3f}"
             elif pin:

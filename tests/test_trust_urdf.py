@@ -217,6 +217,8 @@ def test_bad_value_names_file_line_and_field_once(tmp_path, case):
         ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='revolute'><child link='b'/></joint>\n</robot>",
          4, r"joint 'j' has no <parent link=...>"),
         ("<robot name='r'>\n<link/>\n</robot>", 2, r"a <link> has no name"),
+        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j'><parent link='a'/><child link='b'/></joint>\n</robot>",
+         4, r"joint 'j' has no type attribute"),
         ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint type='fixed'><parent link='a'/><child link='b'/></joint>\n</robot>", 4, r"a <joint> has no name"),
         ("<robot name='r'>\n<link name='a'/><link name='b'/>\n<joint name='j' type='revolute'><parent link='a'/><child link='b'/><limit lower='2'/></joint>\n</robot>",
          3, r"joint 'j': lower limit 2.0 exceeds upper limit 0.0"),  # URDF's upper defaults to 0
@@ -357,6 +359,14 @@ def test_tiago_loads_with_a_warning_naming_the_link_and_eigenvalues():
     assert issubclass(kd.PhysicalConsistencyWarning, Warning)
 
 
+def test_romeo_loads_with_warnings_naming_its_links():
+    path = erd(*ROMEO)
+    robot, caught = _warnings_of(lambda: kd.Robot.from_urdf(path))
+    named = {re.match(rf"{re.escape(path)}:\d+: link '(\w+)': ", str(w.message)).group(1) for w in caught}
+    assert {"body", "LHipPitch_link", "RHipPitch_link"} <= named == set(robot.nonphysical)
+    assert all("not positive semi-definite (eigenvalues" in str(w.message) or "triangle inequality" in str(w.message) for w in caught)
+
+
 @pytest.mark.parametrize("where", [TIAGO, ROMEO])
 def test_strict_raises_naming_file_line_and_link(where):
     path = erd(*where)
@@ -379,10 +389,11 @@ def test_repair_reports_the_change_and_passes_the_identities(where, locked):
     assert max(residuals.values()) < 1e-6, residuals
 
 
-def test_warned_tiago_agrees_with_pinocchio():
+@pytest.mark.parametrize("where", [TIAGO, ROMEO])
+def test_warned_robots_agree_with_pinocchio(where):
     """Kept as given, the tensors are those Pinocchio loads: same M and RNEA."""
     pin = pytest.importorskip("pinocchio")
-    path = erd(*TIAGO)
+    path = erd(*where)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
         robot = kd.load(path)
@@ -497,3 +508,42 @@ def test_projection_of_tiago_antenna():
     expected = np.sort([sigma[1] + 0, sigma[0] + 0, sigma[0] + sigma[1]])
     np.testing.assert_allclose(fixed.moments, expected, rtol=1e-6)
     assert fixed.ok
+
+
+# ------------------------------------------------ mutated real URDFs: a robot or one clean ValueError
+TOKENS = ["nan", "inf", "-inf", "1e200", "1" * 400, "-1", "0", "x", "", "1 2", "1e-320", "&amp;", "<", '"',
+          "revolute", "fixed", "floating", "panda_link0", "\u00e9", "<link name='z'/>", "</robot>",
+          "<!DOCTYPE r [<!ENTITY a 'b'>]>", "<a>" * 200]
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_mutated_panda_loads_or_fails_with_one_clean_value_error(data):
+    text = open(erd("panda_description", "urdf", "panda.urdf")).read()
+    for _ in range(data.draw(st.integers(1, 4))):
+        pos = data.draw(st.integers(0, len(text) - 1))
+        op = data.draw(st.sampled_from(["attribute", "insert", "delete", "duplicate"]))
+        if op == "attribute":  # replace the next quoted value
+            q = text.find('"', pos)
+            q2 = text.find('"', q + 1)
+            if q >= 0 and q2 >= 0:
+                text = text[:q + 1] + data.draw(st.sampled_from(TOKENS)) + text[q2:]
+        elif op == "insert":
+            text = text[:pos] + data.draw(st.sampled_from(TOKENS)) + text[pos:]
+        elif op == "delete":
+            text = text[:pos] + text[pos + data.draw(st.integers(1, 200)):]
+        else:
+            start = data.draw(st.integers(0, len(text) - 1))
+            text = text[:pos] + text[start:start + data.draw(st.integers(1, 300))] + text[pos:]
+    began = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+            robot = robot_from_urdf(text)
+    except ValueError as e:
+        assert type(e) is ValueError
+        assert str(e).count("<URDF string>") == 1, str(e)
+    else:  # what loads gives finite numbers
+        q = robot.random_configuration(0)
+        assert np.all(np.isfinite(robot.mass_matrix(q))) and np.all(np.isfinite(robot.pose(q)))
+    assert time.perf_counter() - began < 5.0

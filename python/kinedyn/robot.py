@@ -518,9 +518,9 @@ class Robot:
     def _nonphysical_note(self, joint: int) -> str:
         """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
         positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
-        subtree = {joint}
+        subtree, parents = {joint}, self.parents
         for i in range(joint + 1, self.n):  # parent[i] < i
-            if self.parents[i] in subtree:
+            if parents[i] in subtree:
                 subtree.add(i)
         bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
                if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive]

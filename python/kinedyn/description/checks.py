@@ -82,28 +82,16 @@ def vector(values: Any, n: int, what: str, noun: str = "components") -> tuple:
 
 
 def real_array(value: Any, shape: tuple) -> Any:
-    """``value`` as a float array of ``shape`` when it plainly is one (real dtype, finite, at most
-    ``LARGEST`` in magnitude), else None: the caller then checks element by element, which gives
-    the precise error (or keeps SymPy expressions). A fast path for long robot files."""
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "fiu":
-            return None
-        a = value.astype(float)
-    else:
-        try:
-            a = np.array(value, dtype=float)
-        except (TypeError, ValueError, OverflowError):
-            return None
-        if any(isinstance(v, (complex, np.complexfloating, str, bool, sp.Basic)) for v in _flat(value)):
-            return None
-    if a.shape != shape or not np.all(np.abs(a) <= LARGEST):  # NaN fails the comparison too
+    """``value`` as a float array of ``shape`` when it plainly is one (an int or float dtype, finite,
+    at most ``LARGEST`` in magnitude), else None: the caller then checks element by element, which
+    gives the precise error (or keeps SymPy expressions). A fast path for long robot files."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if a.dtype.kind not in "fiu" or a.shape != shape:  # complex, bool, str, object (SymPy): slow path
+        return None
+    a = a.astype(float)
+    if not np.all(np.abs(a) <= LARGEST):  # NaN fails the comparison too
         return None
     return a
-
-
-def _flat(value):
-    if isinstance(value, (list, tuple)):
-        for v in value:
-            yield from _flat(v)
-    else:
-        yield value

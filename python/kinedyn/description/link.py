@@ -138,6 +138,8 @@ def judge_inertias(links, policy: str) -> tuple:
     its :class:`~kinedyn.description.inertia.Consistency` (for the errors of forward dynamics)."""
     out, nonphysical = [], {}
     for link in links:
+        if not isinstance(link, Link):
+            raise ValueError(f"a robot's links must be Link objects, got {type(link).__name__}")
         inertia = judge(link.inertia, policy, f"link '{link.name}'")
         if inertia is not link.inertia:
             link = Link(link.name, link.parent, link.joint, link.placement, link.post, inertia)

@@ -48,7 +48,7 @@ MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guard
 def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn"):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
-    A string whose first non-blank character is ``<`` is parsed as XML, anything else is a path.
+    A string holding ``<`` or a line break is parsed as XML, anything else is a path.
     ``gravity``: the gravity vector in base (root link) coordinates. ``tool``: the name of the frame
     used as ``robot.tool``; by default the last link, in depth-first order, that moves with the last
     joint (e.g. ``tool0`` of a UR arm). The root link's inertia is ignored (fixed base).
@@ -137,10 +137,10 @@ def _parse(path_or_string):
     (billion laughs, external entities) and a bounded nesting depth."""
     text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
     if isinstance(text, bytes):
-        text = text.decode("utf-8", errors="replace") if text.lstrip().startswith(b"<") else os.fsdecode(text)
+        text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
     if not isinstance(text, str):
         raise TypeError(f"robot_from_urdf expects a path or an XML string, got {type(path_or_string).__name__}")
-    if text.lstrip().startswith("<"):
+    if "<" in text or "\n" in text:  # XML (perhaps malformed), never a file name
         src, data = _Source("<URDF string>"), text
     else:
         src = _Source(text)
@@ -252,6 +252,8 @@ def _joint(element, src: _Source) -> dict:
         raise src.error(element, "a <joint> has no name")
     kind = element.get("type")
     what = f"joint '{name}'"
+    if kind is None:
+        raise src.error(element, f"{what} has no type attribute (supported: {', '.join(_SUPPORTED)})")
     if kind not in _SUPPORTED:
         raise src.error(
             element,
