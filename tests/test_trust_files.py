@@ -13,6 +13,7 @@ import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 import sympy as sp
 from hypothesis import given, settings
@@ -262,3 +263,21 @@ def test_values_given_as_text_to_subs_are_parsed_not_evaluated(tmp_path):
     assert not marker.exists()
     numeric = robot.subs({s: "pi/4" for s in map(str, robot.symbols)})
     assert not numeric.symbols
+
+
+@pytest.mark.parametrize("text", [
+    "joints:\n  - {a: 1, mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.1}}\n",
+    "links:\n  - {name: link1, joint: {type: revolute}, inertial: {mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.2}}}\n",
+])
+def test_the_inertia_policy_applies_to_robot_files(tmp_path, text):
+    path = _write(tmp_path, "arm.yaml", text)
+    with pytest.raises(ValueError, match=r"arm\.yaml: link 'link1': inertia tensor is not positive semi-definite"):
+        kd.load(path, inertia="strict")
+    with pytest.warns(kd.PhysicalConsistencyWarning, match="link 'link1'"):
+        kept = kd.load(path)
+    with pytest.warns(kd.PhysicalConsistencyWarning, match="repaired"):
+        repaired = kd.load(path, inertia="repair")
+    def smallest_moment(robot):
+        return min(np.linalg.eigvalsh(np.array(robot.tree.bodies[0].inertia.inertia, dtype=float)))
+
+    assert smallest_moment(kept) < 0 and smallest_moment(repaired) >= -1e-15

@@ -57,20 +57,22 @@ _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 
 
 
 # ============================================================================ public functions
-def load(path, **kwargs):
+def load(path, inertia: str = "warn", **kwargs):
     """A robot from ``.urdf`` (``kwargs``: gravity, tool), ``.yaml``/``.yml`` or ``.toml`` (``kwargs``
-    replace constructor arguments, e.g. ``gravity=``)."""
+    replace constructor arguments, e.g. ``gravity=``). ``inertia`` is the policy for inertia tensors
+    no rigid body has: "warn" (keep, with a PhysicalConsistencyWarning), "repair" (project onto the
+    nearest consistent tensor) or "strict" (raise); see docs/model-files.md."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
     if ext == ".urdf":
         from .urdf import robot_from_urdf
 
-        return robot_from_urdf(path, **kwargs)
+        return robot_from_urdf(path, inertia=inertia, **kwargs)
     if ext not in (".yaml", ".yml", ".toml"):
         raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .yaml, .yml or .toml)")
     text = _read_text(path)
     data = _parse_toml(text, path) if ext == ".toml" else _parse_yaml(text, path)
-    robot = robot_from_mapping(data, where=path)
+    robot = robot_from_mapping(data, where=path, inertia=inertia)
     return robot.replace(**kwargs) if kwargs else robot
 
 
@@ -387,7 +389,7 @@ class _Reader:
         return {k: self.value(raw[k], f"{ctx}.{k}") for k in ("gear_ratio", "rotor_inertia", "viscous", "coulomb") if k in raw}
 
 
-def robot_from_mapping(data, where: str = "<robot mapping>"):
+def robot_from_mapping(data, where: str = "<robot mapping>", inertia: str = "warn"):
     """A robot from the parsed contents of a YAML/TOML robot file (see docs/model-files.md)."""
     r = _Reader(where)
     if not isinstance(data, dict):
@@ -404,6 +406,7 @@ def robot_from_mapping(data, where: str = "<robot mapping>"):
         "gravity": r.vector(data.get("gravity", [0, 0, -9.81]), "gravity"),
         "name": r.text(data.get("name", "robot"), "name"),
         "source": r.text(data.get("source", where), "source"),
+        "inertia": inertia,
     }
     frames = _frames(r, data.get("frames", []))
     try:

@@ -269,7 +269,7 @@ class Inertia:
         return Inertia(m, c, Ic)
 
     def subs(self, mapping) -> "Inertia":
-        f = lambda e: sp.sympify(e).subs(mapping) if isinstance(e, sp.Basic) else e
+        f = lambda e: e.subs(mapping) if isinstance(e, sp.Basic) else e
         return Inertia(f(self.mass), tuple(f(c) for c in self.com), tuple(tuple(f(e) for e in r) for r in self.inertia))
 
 
