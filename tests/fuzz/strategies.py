@@ -707,7 +707,7 @@ def array_cases(draw) -> Case:
                 value, desc = draw(st.sampled_from(((None, "None"), (rng.uniform(-10, 10, shape), "valid"))))
         elif name == "out":
             out_shape = {"inverse_dynamics": state_shape, "forward_dynamics": state_shape, "mass_matrix": state_shape + (n,)}[method]
-            value, desc = _mutated_array(draw, rng, out_shape, 1.0, name) if bad else (np.empty(out_shape), "valid")
+            value, desc = _mutated_array(draw, rng, out_shape, 1.0, name) if bad else (np.zeros(out_shape), "valid")
         elif name == "target":
             R, _ = np.linalg.qr(rng.normal(size=(3, 3)))
             T = np.eye(4)
