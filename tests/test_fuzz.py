@@ -42,12 +42,40 @@ def test_the_harness_classifies_misbehaviour():
     assert "fuzzcase.yaml" in results[0]["detail"]  # the clean error names the file
 
 
+def _canonical(x) -> str:
+    """A text that is equal for equal values (arrays by dtype, shape and bytes), whatever objects are
+    shared (a pickle would differ with string interning)."""
+    import numpy as np
+
+    if isinstance(x, np.ndarray):
+        # (object arrays by value; long doubles too: their padding bytes are uninitialised)
+        data = _canonical(x.tolist()) if x.dtype in (object, np.longdouble) else x.tobytes().hex()
+        return f"array({x.dtype.str},{x.shape},{data})"
+    if isinstance(x, (list, tuple)):
+        return type(x).__name__ + "[" + ",".join(_canonical(v) for v in x) + "]"
+    if isinstance(x, dict):
+        return "{" + ",".join(f"{_canonical(k)}:{_canonical(v)}" for k, v in x.items()) + "}"
+    return repr(x)
+
+
+def _fingerprint(cases) -> str:
+    import hashlib
+
+    return hashlib.sha256(_canonical([(c.kind, c.seed, c.ops, c.data, c.call) for c in cases]).encode()).hexdigest()
+
+
 def test_the_cases_are_the_same_on_every_run():
-    a = runner.generate("all", 40, SEED)
-    b = runner.generate("all", 40, SEED)
-    assert [(c.kind, c.seed, c.ops) for c in a] == [(c.kind, c.seed, c.ops) for c in b]
+    """The same seed gives the same cases, arrays included, in this process and in a fresh one."""
+    import subprocess
+    import sys
+
+    a = runner.generate("all", 60, SEED)
+    assert _fingerprint(a) == _fingerprint(runner.generate("all", 60, SEED))
+    code = f"import sys; sys.path[:0] = {sys.path!r}; from fuzz import runner; import test_fuzz; print(test_fuzz._fingerprint(runner.generate('all', 60, {SEED})))"
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=os.path.dirname(__file__))
+    assert other.stdout.strip() == _fingerprint(a), other.stderr[-2000:]
     assert {c.kind for c in a} == {"urdf", "yaml", "toml", "arrays"}
-    assert len({c.ops for c in a}) > 30  # varied, not one mutation over and over
+    assert len({c.ops for c in a}) > 50  # varied, not one mutation over and over
 
 
 @pytest.mark.parametrize("defect", DEFECTS)
@@ -55,7 +83,8 @@ def test_no_defect(figures, defect):
     cases, results, table = figures
     bad = [(c, r) for c, r in zip(cases, results) if r["outcome"] == defect]
     examples = "\n\n".join(runner.describe(c, r) for c, r in bad[:5])
-    assert not bad, f"{len(bad)} cases of '{defect}':\n{runner.format_table(table)}\n\nfirst of them:\n{examples}"
+    if bad:  # (pytest.fail: the message without a repr of the cases)
+        pytest.fail(f"{len(bad)} cases of '{defect}':\n{runner.format_table(table)}\n\nfirst of them:\n{examples}", pytrace=False)
 
 
 def test_every_case_was_classified(figures):

@@ -8,6 +8,7 @@ the case and starts a fresh worker. ``--jobs`` workers run side by side, each fe
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import pickle
 import queue
@@ -287,7 +288,7 @@ def shrink(case: Case, outcome: str, timeout: float, memory: int, budget: int = 
     def same(data) -> bool:
         nonlocal tries
         tries += 1
-        trial = Case(kind=case.kind, seed=case.seed, ops=case.ops, data=data, index=case.index)
+        trial = dataclasses.replace(case, data=data)
         return worker.run(trial, timeout)["outcome"] == outcome
 
     try:
@@ -306,6 +307,6 @@ def shrink(case: Case, outcome: str, timeout: float, memory: int, budget: int = 
             if not removed:
                 chunk //= 2
         data = sep.join(parts)
-        return Case(kind=case.kind, seed=case.seed, ops=case.ops + (f"shrunk to {len(data)} characters",), data=data, index=case.index)
+        return dataclasses.replace(case, ops=case.ops + (f"shrunk to {len(data)} characters",), data=data)
     finally:
         worker.close()
