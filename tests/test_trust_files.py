@@ -281,3 +281,16 @@ def test_the_inertia_policy_applies_to_robot_files(tmp_path, text):
         return min(np.linalg.eigvalsh(np.array(robot.tree.bodies[0].inertia.inertia, dtype=float)))
 
     assert smallest_moment(kept) < 0 and smallest_moment(repaired) >= -1e-15
+
+
+def test_characters_and_encodings_the_formats_refuse_are_value_errors(tmp_path):
+    path = _write(tmp_path, "nul.yaml", "joints:\n  - {a: 1}\x00\n")
+    with pytest.raises(ValueError, match=r"nul\.yaml: invalid YAML at line 2: the character '\\x00' is not allowed"):
+        kd.load(path)
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(b"joints:\n  - {a: 1}\n# \xff\xfe\n")
+    with pytest.raises(ValueError, match=r"bad\.yaml: the file is not UTF-8 text"):
+        kd.load(path)
+    path = _write(tmp_path, "enc.urdf", '<?xml version="1.0" encoding="utf-nan"?><robot name="x"/>')
+    with pytest.raises(ValueError, match=r"enc\.urdf: the XML declaration names an unknown encoding"):
+        kd.load(path)

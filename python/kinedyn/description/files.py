@@ -192,17 +192,22 @@ _BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct
 
 
 def _parse_yaml(text: str, where: str):
-    loader = _BoundedLoader(text)
+    loader = None
     try:
+        loader = _BoundedLoader(text)  # its reader already refuses control characters
         return loader.get_single_data()
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
         line = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
         raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
+    except yaml.reader.ReaderError as e:  # a character YAML does not allow (NUL, other control characters)
+        line = text.count("\n", 0, e.position) + 1
+        raise ValueError(f"{where}: invalid YAML at line {line}: the character {e.character!r} is not allowed in YAML") from None
     except yaml.YAMLError as e:
         raise ValueError(f"{where}: invalid YAML: {e}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 _TOML_STRING_OR_COMMENT = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*')

@@ -186,6 +186,8 @@ def _parse(path_or_string):
         raise ValueError(
             f"{src.label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}"
         ) from None
+    except LookupError as e:  # an XML declaration naming an encoding Python does not know
+        raise ValueError(f"{src.label}: the XML declaration names an unknown encoding ({e})") from None
     return src, builder.close()
 
 
