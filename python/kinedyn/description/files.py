@@ -202,7 +202,8 @@ def _parse_yaml(text: str, where: str):
         raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
     except yaml.reader.ReaderError as e:  # a character YAML does not allow (NUL, other control characters)
         line = text.count("\n", 0, e.position) + 1
-        raise ValueError(f"{where}: invalid YAML at line {line}: the character {e.character!r} is not allowed in YAML") from None
+        character = chr(e.character) if isinstance(e.character, int) else e.character
+        raise ValueError(f"{where}: invalid YAML at line {line}: the character {character!r} is not allowed in YAML") from None
     except yaml.YAMLError as e:
         raise ValueError(f"{where}: invalid YAML: {e}") from None
     finally:
