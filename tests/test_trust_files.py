@@ -294,3 +294,9 @@ def test_characters_and_encodings_the_formats_refuse_are_value_errors(tmp_path):
     path = _write(tmp_path, "enc.urdf", '<?xml version="1.0" encoding="utf-nan"?><robot name="x"/>')
     with pytest.raises(ValueError, match=r"enc\.urdf: the XML declaration names an unknown encoding"):
         kd.load(path)
+
+
+def test_a_toml_integer_beyond_pythons_digit_limit_names_the_file(tmp_path):
+    path = _write(tmp_path, "big.toml", "name = " + "7" * 5000 + "\n[[joints]]\na = 1\n")
+    with pytest.raises(ValueError, match=r"big\.toml: invalid TOML: Exceeds the limit"):
+        kd.load(path)

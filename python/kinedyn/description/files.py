@@ -233,6 +233,8 @@ def _parse_toml(text: str, where: str):
         raise ValueError(f"{where}: invalid TOML: {e}") from None
     except (RecursionError, MemoryError):  # tomllib recurses into nested arrays and inline tables
         raise ValueError(f"{where}: invalid TOML: arrays or tables nested too deep") from None
+    except ValueError as e:  # e.g. Python's limit on the digits of an integer literal
+        raise ValueError(f"{where}: invalid TOML: {e}") from None
     depth = _nesting(data)
     if depth > MAX_NESTING:
         raise ValueError(f"{where}: tables and arrays are nested {depth} deep (at most {MAX_NESTING})")
