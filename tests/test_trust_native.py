@@ -415,31 +415,53 @@ def _bad_array(draw, shape):
     return base
 
 
-def _check_outcome(call):
-    """Run `call`: a clean exception (ValueError, TypeError, MemoryError) or finite numbers."""
+def _outcome(call) -> str:
+    """Run `call` and classify what it did: "clean error" (ValueError, TypeError, MemoryError, or
+    the documented singular-mass-matrix RuntimeError), "finite" (numbers, all finite), or a defect:
+    "non-finite result", "unclean <type>: <message>" (any other exception, a panic included)."""
     try:
         out = call()
     except (ValueError, TypeError, MemoryError):
-        return
+        return "clean error"
     except RuntimeError as e:  # only the documented singular-mass-matrix error
-        assert "not positive definite" in str(e) or "articulated inertia" in str(e), repr(e)
-        return
+        if "not positive definite" in str(e) or "articulated inertia" in str(e):
+            return "clean error"
+        return f"unclean RuntimeError: {e}"
+    except BaseException as e:  # noqa: BLE001 - pyo3's PanicException is a BaseException
+        if isinstance(e, (KeyboardInterrupt, SystemExit)):
+            raise
+        return f"unclean {type(e).__name__}: {e}"
     values = out.solutions if hasattr(out, "solutions") else getattr(out, "q", out)
     for v in values if isinstance(values, tuple) else (values,):
         a = np.asarray(v)
-        if a.dtype.kind in "fc" and a.size:
-            # (numeric IK reports failure with its best iterate; it must still be finite)
-            assert np.isfinite(a).all(), f"non-finite result {a!r}"
+        # (numeric IK reports failure with its best iterate; it must still be finite)
+        if a.dtype.kind in "fc" and a.size and not np.isfinite(a).all():
+            return "non-finite result"
+    return "finite"
+
+
+def _check_outcome(call):
+    """A clean exception (ValueError, TypeError, MemoryError) or finite numbers."""
+    outcome = _outcome(call)
+    assert outcome in ("clean error", "finite"), outcome
+
+
+def fuzz_case(robot, data, name):
+    """One generated call of method/function `name` with bad arrays drawn from `data`: its outcome
+    (see `_outcome`). Shared by the test below and benches/fuzz_arrays.py (thousands of cases)."""
+    if name in _ARGS:
+        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(_ARGS[name])]
+        return _outcome(lambda: getattr(robot, name)(*args))
+    fn, shapes = _FUNCTIONS[name]
+    args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
+    return _outcome(lambda: fn(robot, *args))
+
+
+FUZZ_NAMES = sorted(_ARGS) + sorted(_FUNCTIONS)
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-@given(data=st.data(), name=st.sampled_from(sorted(_ARGS) + sorted(_FUNCTIONS)))
+@given(data=st.data(), name=st.sampled_from(FUZZ_NAMES))
 def test_bad_arrays_give_clean_errors_or_finite_results(puma, data, name):
-    if name in _ARGS:
-        shapes = _ARGS[name]
-        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
-        _check_outcome(lambda: getattr(puma, name)(*args))
-    else:
-        fn, shapes = _FUNCTIONS[name]
-        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
-        _check_outcome(lambda: fn(puma, *args))
+    outcome = fuzz_case(puma, data, name)
+    assert outcome in ("clean error", "finite"), outcome
