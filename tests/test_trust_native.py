@@ -240,23 +240,38 @@ def test_finite_inputs_with_overflowing_results_raise(puma):
         viscous.friction_torque([1.7e308])
 
 
-def _heavy_link_robot(mass: float):
-    """planar 2R with a first link of mass `mass` and a 1 kg second link."""
+def _two_link(first, second):
+    """planar 2R (links of length 1, no gravity) with the given link inertias."""
     return kd.Robot.from_dh([
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": kd.Inertia.rod(mass, 1.0)},
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": kd.Inertia.rod(1.0, 1.0)},
+        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": first},
+        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": second},
     ], gravity=(0, 0, 0))
 
 
-def test_a_huge_inertia_is_not_called_massless():
-    robot = _heavy_link_robot(1e20)
+def test_bodies_of_very_different_sizes_invert_exactly():
+    # a 1e20 kg first link next to a 1 kg second link: M is well conditioned in its L^T D L factors
+    # (the old test of each pivot against the largest diagonal entry called link 2 "massless")
+    robot = _two_link(kd.Inertia.rod(1e20, 1.0), kd.Inertia.rod(1.0, 1.0))
+    q = [0.0, 0.5]
+    Minv = robot.mass_matrix_inverse(q)
+    np.testing.assert_allclose(Minv @ robot.mass_matrix(q), np.eye(2), atol=1e-12)
+    tau = np.array([1e20, 1.0])
+    np.testing.assert_allclose(robot.forward_dynamics(q, [0, 0], tau), Minv @ tau, rtol=1e-9)
+
+
+def test_a_numerically_singular_mass_matrix_says_what_is_wrong():
+    # a 1e20 kg point mass at the tip of link 2 with the arm stretched: M's determinant is lost in
+    # float64 (M = 1e20 [[4, 2], [2, 1]] + O(1)); the message says so instead of "massless"
+    robot = _two_link(kd.Inertia.rod(1.0, 1.0), kd.Inertia.point_mass(1e20))
     with pytest.raises(RuntimeError) as info:
-        robot.mass_matrix_inverse([0.0, 0.5])
+        robot.mass_matrix_inverse([0.0, 0.0])
     message = str(info.value)
     assert "massless" not in message
-    assert "differ by more than float64 can resolve" in message
-    assert "joint 0" in message and "joint 1" in message and "moving body" in message
-    # a body with no inertia about its axis is still called that
+    assert "numerically singular" in message and "differ by more than float64 can resolve" in message
+    assert "joint 0 ('q1', moving body 'link1')" in message
+    with pytest.raises(RuntimeError, match="negligible next to the rest") as info:
+        robot.forward_dynamics([0.0, 0.0], [0, 0], [1, 0])
+    # a subtree with no inertia about its axis is still called that
     empty = kd.Robot.from_dh([(0, 0, 1, 0), (0, 0, 1, 0)])
     with pytest.raises(RuntimeError, match="no inertia about the joint's axis"):
         empty.mass_matrix_inverse([0.0, 0.5])
