@@ -35,9 +35,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _run_script(code: str, timeout: float = 120) -> subprocess.CompletedProcess:
     """Run `code` in a fresh interpreter that imports this checkout's kinedyn; a hang fails the
-    test by the timeout instead of blocking the suite."""
+    test by the timeout instead of blocking the suite, and the script's whole process group (forked
+    workers included, which a hang would otherwise leave behind) is killed then."""
+    import signal
+
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"), RUST_BACKTRACE="0")
-    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout, env=env)
+    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        pytest.fail(f"the script did not finish in {timeout} s (a hang):\n{textwrap.dedent(code)}")
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +160,7 @@ def test_batches_in_forked_children_after_the_parent_used_the_pool():
         assert os.waitstatus_to_exitcode(status) == 0, status
         print("forked ok")
         """,
-        timeout=120,
+        timeout=60,
     )
     assert result.returncode == 0, result.stderr[-2000:]
     assert "forked ok" in result.stdout
