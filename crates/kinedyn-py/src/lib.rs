@@ -1,7 +1,10 @@
 //! `kinedyn._core`: PyO3 + rust-numpy glue around kinedyn-core, and nothing else.
 //!
 //! One place converts and checks shapes (`Batch::gather`), one place runs a per-state kernel over
-//! one state or a batch with the GIL released (`Batch::run`). Every kernel is a call into the core.
+//! one state or a batch with the GIL released (`Batch::run`) and checks that finite inputs gave
+//! finite results. Every kernel is a call into the core. Every binding runs inside
+//! `guard::guarded` (a panic is a RuntimeError), allocates its results through `guard` (a MemoryError
+//! naming the bytes, never an abort) and runs batches in `guard::install`'s fork-safe pool.
 
 use std::borrow::Cow;
 
@@ -195,8 +198,8 @@ impl<'a> Batch<'a> {
     ///
     /// `what` names the call and its result (`Output`) for the errors: a result that cannot be
     /// allocated (MemoryError) and a non-finite number in a result of finite inputs
-    /// (`NonFiniteResultError`: every output of every state is scanned right after its kernel
-    /// wrote it, while it is in cache).
+    /// (`NonFiniteResultError`: the outputs of each chunk of states are scanned right after its
+    /// kernels wrote them, while they are in cache).
     fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
