@@ -35,9 +35,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _run_script(code: str, timeout: float = 120) -> subprocess.CompletedProcess:
     """Run `code` in a fresh interpreter that imports this checkout's kinedyn; a hang fails the
-    test by the timeout instead of blocking the suite."""
+    test by the timeout instead of blocking the suite, and the script's whole process group (forked
+    workers included, which a hang would otherwise leave behind) is killed then."""
+    import signal
+
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"), RUST_BACKTRACE="0")
-    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout, env=env)
+    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        pytest.fail(f"the script did not finish in {timeout} s (a hang):\n{textwrap.dedent(code)}")
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +160,7 @@ def test_batches_in_forked_children_after_the_parent_used_the_pool():
         assert os.waitstatus_to_exitcode(status) == 0, status
         print("forked ok")
         """,
-        timeout=120,
+        timeout=60,
     )
     assert result.returncode == 0, result.stderr[-2000:]
     assert "forked ok" in result.stdout
@@ -240,23 +250,38 @@ def test_finite_inputs_with_overflowing_results_raise(puma):
         viscous.friction_torque([1.7e308])
 
 
-def _heavy_link_robot(mass: float):
-    """planar 2R with a first link of mass `mass` and a 1 kg second link."""
+def _two_link(first, second):
+    """planar 2R (links of length 1, no gravity) with the given link inertias."""
     return kd.Robot.from_dh([
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": kd.Inertia.rod(mass, 1.0)},
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": kd.Inertia.rod(1.0, 1.0)},
+        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": first},
+        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": second},
     ], gravity=(0, 0, 0))
 
 
-def test_a_huge_inertia_is_not_called_massless():
-    robot = _heavy_link_robot(1e20)
+def test_bodies_of_very_different_sizes_invert_exactly():
+    # a 1e20 kg first link next to a 1 kg second link: M is well conditioned in its L^T D L factors
+    # (the old test of each pivot against the largest diagonal entry called link 2 "massless")
+    robot = _two_link(kd.Inertia.rod(1e20, 1.0), kd.Inertia.rod(1.0, 1.0))
+    q = [0.0, 0.5]
+    Minv = robot.mass_matrix_inverse(q)
+    np.testing.assert_allclose(Minv @ robot.mass_matrix(q), np.eye(2), atol=1e-12)
+    tau = np.array([1e20, 1.0])
+    np.testing.assert_allclose(robot.forward_dynamics(q, [0, 0], tau), Minv @ tau, rtol=1e-9)
+
+
+def test_a_numerically_singular_mass_matrix_says_what_is_wrong():
+    # a 1e20 kg point mass at the tip of link 2 with the arm stretched: M's determinant is lost in
+    # float64 (M = 1e20 [[4, 2], [2, 1]] + O(1)); the message says so instead of "massless"
+    robot = _two_link(kd.Inertia.rod(1.0, 1.0), kd.Inertia.point_mass(1e20))
     with pytest.raises(RuntimeError) as info:
-        robot.mass_matrix_inverse([0.0, 0.5])
+        robot.mass_matrix_inverse([0.0, 0.0])
     message = str(info.value)
     assert "massless" not in message
-    assert "differ by more than float64 can resolve" in message
-    assert "joint 0" in message and "joint 1" in message and "moving body" in message
-    # a body with no inertia about its axis is still called that
+    assert "numerically singular" in message and "differ by more than float64 can resolve" in message
+    assert "joint 0 ('q1', moving body 'link1')" in message
+    with pytest.raises(RuntimeError, match="negligible next to the rest") as info:
+        robot.forward_dynamics([0.0, 0.0], [0, 0], [1, 0])
+    # a subtree with no inertia about its axis is still called that
     empty = kd.Robot.from_dh([(0, 0, 1, 0), (0, 0, 1, 0)])
     with pytest.raises(RuntimeError, match="no inertia about the joint's axis"):
         empty.mass_matrix_inverse([0.0, 0.5])
@@ -415,31 +440,53 @@ def _bad_array(draw, shape):
     return base
 
 
-def _check_outcome(call):
-    """Run `call`: a clean exception (ValueError, TypeError, MemoryError) or finite numbers."""
+def _outcome(call) -> str:
+    """Run `call` and classify what it did: "clean error" (ValueError, TypeError, MemoryError, or
+    the documented singular-mass-matrix RuntimeError), "finite" (numbers, all finite), or a defect:
+    "non-finite result", "unclean <type>: <message>" (any other exception, a panic included)."""
     try:
         out = call()
     except (ValueError, TypeError, MemoryError):
-        return
+        return "clean error"
     except RuntimeError as e:  # only the documented singular-mass-matrix error
-        assert "not positive definite" in str(e) or "articulated inertia" in str(e), repr(e)
-        return
+        if "not positive definite" in str(e) or "articulated inertia" in str(e):
+            return "clean error"
+        return f"unclean RuntimeError: {e}"
+    except BaseException as e:  # noqa: BLE001 - pyo3's PanicException is a BaseException
+        if isinstance(e, (KeyboardInterrupt, SystemExit)):
+            raise
+        return f"unclean {type(e).__name__}: {e}"
     values = out.solutions if hasattr(out, "solutions") else getattr(out, "q", out)
     for v in values if isinstance(values, tuple) else (values,):
         a = np.asarray(v)
-        if a.dtype.kind in "fc" and a.size:
-            # (numeric IK reports failure with its best iterate; it must still be finite)
-            assert np.isfinite(a).all(), f"non-finite result {a!r}"
+        # (numeric IK reports failure with its best iterate; it must still be finite)
+        if a.dtype.kind in "fc" and a.size and not np.isfinite(a).all():
+            return "non-finite result"
+    return "finite"
+
+
+def _check_outcome(call):
+    """A clean exception (ValueError, TypeError, MemoryError) or finite numbers."""
+    outcome = _outcome(call)
+    assert outcome in ("clean error", "finite"), outcome
+
+
+def fuzz_case(robot, data, name):
+    """One generated call of method/function `name` with bad arrays drawn from `data`: its outcome
+    (see `_outcome`). Shared by the test below and benches/fuzz_arrays.py (thousands of cases)."""
+    if name in _ARGS:
+        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(_ARGS[name])]
+        return _outcome(lambda: getattr(robot, name)(*args))
+    fn, shapes = _FUNCTIONS[name]
+    args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
+    return _outcome(lambda: fn(robot, *args))
+
+
+FUZZ_NAMES = sorted(_ARGS) + sorted(_FUNCTIONS)
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-@given(data=st.data(), name=st.sampled_from(sorted(_ARGS) + sorted(_FUNCTIONS)))
+@given(data=st.data(), name=st.sampled_from(FUZZ_NAMES))
 def test_bad_arrays_give_clean_errors_or_finite_results(puma, data, name):
-    if name in _ARGS:
-        shapes = _ARGS[name]
-        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
-        _check_outcome(lambda: getattr(puma, name)(*args))
-    else:
-        fn, shapes = _FUNCTIONS[name]
-        args = [data.draw(_bad_array(s), label=f"arg{i}") for i, s in enumerate(shapes)]
-        _check_outcome(lambda: fn(puma, *args))
+    outcome = fuzz_case(puma, data, name)
+    assert outcome in ("clean error", "finite"), outcome

@@ -1,7 +1,10 @@
 //! `kinedyn._core`: PyO3 + rust-numpy glue around kinedyn-core, and nothing else.
 //!
 //! One place converts and checks shapes (`Batch::gather`), one place runs a per-state kernel over
-//! one state or a batch with the GIL released (`Batch::run`). Every kernel is a call into the core.
+//! one state or a batch with the GIL released (`Batch::run`) and checks that finite inputs gave
+//! finite results. Every kernel is a call into the core. Every binding runs inside
+//! `guard::guarded` (a panic is a RuntimeError), allocates its results through `guard` (a MemoryError
+//! naming the bytes, never an abort) and runs batches in `guard::install`'s fork-safe pool.
 
 use std::borrow::Cow;
 
@@ -195,8 +198,8 @@ impl<'a> Batch<'a> {
     ///
     /// `what` names the call and its result (`Output`) for the errors: a result that cannot be
     /// allocated (MemoryError) and a non-finite number in a result of finite inputs
-    /// (`NonFiniteResultError`: every output of every state is scanned right after its kernel
-    /// wrote it, while it is in cache).
+    /// (`NonFiniteResultError`: the outputs of each chunk of states are scanned right after its
+    /// kernels wrote them, while they are in cache).
     fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
@@ -285,13 +288,19 @@ impl<'a> Batch<'a> {
         // scan right after it, by the same thread).
         let outputs = |k: usize| bases.map(|b| unsafe { std::slice::from_raw_parts_mut(b.0.add(k * per_state), per_state) });
         let check = guard::CHECK_FINITE.load(Ordering::Relaxed);
-        // state k: the kernel, then the scan of what it wrote
-        let one = |data: &mut Data, k: usize| -> Result<(), Fault> {
-            kernel(&m.model, data, &self.state(k), outputs(k))?;
-            if check {
-                for (o, out) in outputs(k).iter().enumerate() {
-                    if let Some(index) = first_non_finite(out) {
-                        return Err(Fault::NonFinite { state: k, output: o, index, value: out[index] });
+        // states [a, b): the kernel on each, then one scan of the outputs they wrote (contiguous,
+        // still in cache: a chunk of 64 states of M is 18 KiB for n = 6)
+        let states_range = |data: &mut Data, a: usize, b: usize| -> Result<(), Fault> {
+            for k in a..b {
+                kernel(&m.model, data, &self.state(k), outputs(k))?;
+            }
+            if check && per_state > 0 {
+                for (o, base) in bases.iter().enumerate() {
+                    // SAFETY: the range just written by this thread (see `outputs`)
+                    let written = unsafe { std::slice::from_raw_parts(base.0.add(a * per_state), (b - a) * per_state) };
+                    if any_non_finite(written) {
+                        let at = written.iter().position(|v| !v.is_finite()).unwrap_or(0);
+                        return Err(Fault::NonFinite { state: a + at / per_state, output: o, index: at % per_state, value: written[at] });
                     }
                 }
             }
@@ -300,7 +309,7 @@ impl<'a> Batch<'a> {
         let result: Result<(), Fault> = match self.batch {
             None => {
                 let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-                one(&mut guard, 0)
+                states_range(&mut guard, 0, 1)
             }
             Some(states) => py.detach(|| {
                 const CHUNK: usize = 64;
@@ -308,7 +317,7 @@ impl<'a> Batch<'a> {
                 guard::install(|| {
                     (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
                         || Data::new(&m.model),
-                        |data, c| (c * CHUNK..((c + 1) * CHUNK).min(states)).try_for_each(|k| one(data, k)),
+                        |data, c| states_range(data, c * CHUNK, ((c + 1) * CHUNK).min(states)),
                     )
                 })
                 .unwrap_or_else(|e| Err(Fault::Py(e)))
@@ -365,17 +374,24 @@ impl From<CoreError> for Fault {
     }
 }
 
-/// The index of the first NaN or infinity in `x`, if any: a branch-free scan of the exponent bits
-/// (all ones for NaN and inf) that the compiler vectorises, then a search only when one is found.
+/// Whether `x` holds a NaN or an infinity. Fast path: the numbers summed in 8 independent lanes
+/// (one vectorised add per number, no branch); a NaN or inf makes its lane non-finite, and finite
+/// numbers leave every lane finite unless a sum overflows, so only then are the numbers looked at
+/// one by one (the exact test).
 #[inline]
-fn first_non_finite(x: &[f64]) -> Option<usize> {
-    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
-    let any = x.iter().fold(false, |acc, v| acc | (v.to_bits() & EXPONENT == EXPONENT));
-    if any {
-        x.iter().position(|v| !v.is_finite())
-    } else {
-        None
+fn any_non_finite(x: &[f64]) -> bool {
+    let mut lanes = [0.0f64; 8];
+    let chunks = x.chunks_exact(8);
+    let tail = chunks.remainder();
+    for c in chunks {
+        for (lane, v) in lanes.iter_mut().zip(c) {
+            *lane += v;
+        }
     }
+    for (lane, v) in lanes.iter_mut().zip(tail) {
+        *lane += v;
+    }
+    !lanes.iter().all(|l| l.is_finite()) && x.iter().any(|v| !v.is_finite())
 }
 
 /// Three arrays returned as a Python tuple.

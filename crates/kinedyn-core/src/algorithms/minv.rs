@@ -16,8 +16,13 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 
-/// Relative size under which a pivot `D_k` counts as zero.
+/// Relative size under which a pivot `D_k` counts as zero: against its own diagonal entry `M_kk`
+/// (the factorisation cancelled the joint's inertia away: `M` is singular to working precision).
 const EPS_D: f64 = 1e-13;
+/// Relative size under which a diagonal entry `M_kk` counts as zero against the largest one: a
+/// subtree with no inertia about its joint's axis (the rounding of such an `M_kk` is ~1e-32 of the
+/// scale). Well above it, bodies of very different sizes (1e20 kg next to 1 kg) factor exactly.
+const EPS_M: f64 = 1e-26;
 
 /// Factor `data.m` (= M) into `data.m2` as `L^T D L` (RBDA Table 6.3).
 pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
@@ -26,8 +31,9 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
     h.copy_from_slice(&data.m[..n * n]);
     let scale: f64 = (0..n).map(|i| data.m[i * n + i]).fold(0.0, f64::max);
     for k in (0..n).rev() {
-        let hkk = h[k * n + k];
-        if !(hkk > EPS_D * scale) || !hkk.is_finite() {
+        let (hkk, mkk) = (h[k * n + k], data.m[k * n + k]);
+        // D_k must be a positive part of M_kk, and M_kk a positive part of the scale of M
+        if !(hkk > EPS_D * mkk && mkk > EPS_M * scale) || !hkk.is_finite() || !scale.is_finite() {
             return Err(Error::SingularMassMatrix(singular_pivot(data, n, k, hkk, scale)));
         }
         // for i = λ(k) up the tree: a = H_ki / H_kk ; H_ij -= a H_kj for j = i, λ(i), ... ; H_ki = a
@@ -55,20 +61,19 @@ fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> Stri
     let head = format!("M is not positive definite to float64 precision at joint {k}: its pivot D = {hkk:e} in the L^T D L factorisation");
     if !hkk.is_finite() || !scale.is_finite() {
         format!("{head}; M has a non-finite entry (an inertia or a configuration too large for float64)")
-    } else if mkk <= 0.0 {
-        format!("{head}; M[{k}, {k}] = {mkk:e}: the subtree of joint {k} has no inertia about the joint's axis (massless, no rotor inertia)")
-    } else if mkk <= EPS_D * scale {
+    } else if mkk <= EPS_M * scale {
         format!(
-            "{head}; M[{k}, {k}] = {mkk:e} is {:.1e} times M[{largest}, {largest}] = {scale:e}: the inertias of the subtrees of \
-             joint {k} and joint {largest} differ by more than float64 can resolve (check the inertia of joint {largest}'s body and its \
-             children for a wrong unit or a huge value, and joint {k}'s for a missing mass)",
-            mkk / scale
+            "{head}; M[{k}, {k}] = {mkk:e} ({:.1e} times the largest diagonal entry): the subtree of joint {k} has no inertia \
+             about the joint's axis (massless, or its masses on the axis, and no rotor inertia)",
+            if scale > 0.0 { mkk / scale } else { 0.0 }
         )
     } else {
         format!(
-            "{head}, {:.1e} times the largest diagonal entry M[{largest}, {largest}] = {scale:e}: M is numerically singular here \
-             (the subtree inertias are not positive definite, or differ by more than float64 can resolve)",
-            hkk / scale
+            "{head}, {:.1e} times M[{k}, {k}] = {mkk:e}: M is numerically singular here, the motion of joint {k} being (nearly) \
+             the same as that of the joints it is coupled to; with M[{largest}, {largest}] = {scale:e} the largest diagonal entry, \
+             check for inertias that differ by more than float64 can resolve (a wrong unit or a huge value) or for a \
+             configuration where the subtree's inertia about the axis vanishes",
+            hkk / mkk
         )
     }
 }
