@@ -99,7 +99,11 @@ def _robot_file(spec: str):
         raise ValueError(f"robot file '{spec}' is a folder")
     try:
         return load(path)
-    except (ValueError, OSError, MemoryError, KeyboardInterrupt):
+    except ValueError as e:  # the loader's own message; make sure it says which file
+        if spec in str(e) or str(path) in str(e):
+            raise
+        raise ValueError(f"robot file '{spec}': {e}") from e
+    except (OSError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as e:  # a loader should raise only ValueError: say which file it was reading
         e.kinedyn_context = f"while loading robot file '{spec}'"
@@ -115,7 +119,12 @@ def _builtin(name: str, values: Dict[str, float]):
     if not values:
         return robots.get(name)
     params = inspect.signature(robots.CATALOGUE[name]).parameters
-    numeric = [p for p, v in params.items() if v.default is None or (isinstance(v.default, (int, float)) and not isinstance(v.default, bool))]
+    def is_number(v: inspect.Parameter) -> bool:  # a number, or None standing for a computed number (planar_2r's lc1 = l1/2)
+        if v.default is None:
+            return v.annotation in (inspect.Parameter.empty, "float", "Optional[float]", float)
+        return isinstance(v.default, (int, float)) and not isinstance(v.default, bool)
+
+    numeric = [p for p, v in params.items() if is_number(v)]
     unknown = [k for k in values if k not in numeric]
     if unknown:
         raise ValueError(f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})")
