@@ -75,6 +75,13 @@ def test_every_robot_command_is_covered(tmp_path):
 
 
 # ------------------------------------------------------------------ bad robot files
+TREE_YAML = """name: tree
+links:
+  - {name: l1, parent: base, joint: {name: j1, type: revolute, axis: [0, 0, 1]}, inertial: {mass: 1, com: [0.5, 0, 0], inertia: {izz: 0.1}}}
+  - {name: l2, parent: l1, joint: {name: j2, type: revolute, axis: [0, 0, 1], origin: {xyz: [1, 0, 0]}}, inertial: {mass: 1}}
+"""
+
+
 def _mutations():
     """(file name, text or bytes) of robot files that are wrong in one way each."""
     yaml_text = (EXAMPLES / "tutorial_two_link.yaml").read_text()
@@ -96,6 +103,12 @@ def _mutations():
         "empty.yaml": "",
         "tabs.yaml": "name: x\n\tjoints: []\n",
         "invalid_utf8.yaml": yaml_text.encode() + b"\nname2: \xff\xfe\n",
+        # kinds the issue found giving tracebacks (a loader raising other than ValueError)
+        "attribute.yaml": yaml_text.replace("a: 2.0", "a: 'x.y'"),
+        "complex.yaml": yaml_text.replace("a: 2.0", "a: 'sqrt(-1)'"),
+        "huge_integer.yaml": yaml_text.replace("mass: 1.0", "mass: 1" + "0" * 400, 1),
+        "parent_list.yaml": TREE_YAML.replace("parent: l1", "parent: [1, 2]"),
+        "nested.yaml": yaml_text.replace("a: 2.0", "a: " + "[" * 3000 + "]" * 3000),
         # TOML
         "truncated.toml": toml_text[: toml_text.index("iyy = 0.33") + 6],
         "wrong_type.toml": toml_text.replace("d = 3.0", "d = [1, 2]"),
