@@ -531,3 +531,30 @@ def test_subprocess_ctrl_c_exits_130_without_a_traceback(tmp_path):
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "Traceback" not in err and "KeyboardInterrupt" not in err, err
+
+
+# ------------------------------------------------------------------ names that look like terminal markup
+MARKUP_ROBOT = """name: "[/bold] arm [red]"
+source: "[/x] source"
+convention: standard
+joints:
+  - {name: "[/q1]", a: 1.0, mass: 1}
+  - {name: "q2 [link=x]", a: 1.0, mass: 1}
+"""
+
+
+def test_names_that_look_like_rich_markup_are_printed_as_they_are(capsys, tmp_path, monkeypatch):
+    """rich reads '[/bold]' in printed text as a closing tag (MarkupError: a traceback before this
+    was fixed); names from a robot file are escaped wherever the commands print them."""
+    monkeypatch.setenv("COLUMNS", "200")  # wide enough that rich does not wrap the names in table cells
+    path = tmp_path / "markup.yaml"
+    path.write_text(MARKUP_ROBOT)
+    for command, extra in commands(tmp_path):
+        code, out, err = run(capsys, command, path, *extra)
+        assert code == 0 and err == "", (command, err)
+        if command != "derive":
+            assert "[/bold] arm [red]" in out, (command, out)
+    code, out, _ = run(capsys, "info", path)
+    assert "[/q1]" in out and "q2 [link=x]" in out and "[/x] source" in out
+    code, out, _ = run(capsys, "dynamics", path)
+    assert "[/q1]" in out
