@@ -272,6 +272,19 @@ def test_output_without_permission(capsys, tmp_path):
         locked.chmod(0o700)
 
 
+def test_output_without_permission_as_the_system_says(capsys, tmp_path, monkeypatch):
+    """The same check where root may write anywhere: os.access answers no for one folder."""
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    (locked / "old.txt").write_text("x")
+    real_access = os.access
+    monkeypatch.setattr(cli.os, "access", lambda p, mode: False if Path(p).parent == locked or Path(p) == locked else real_access(p, mode))
+    code, _, err = run(capsys, "derive", "planar_2r", "-o", locked / "eom.txt")
+    assert_one_line_error(code, err, "-o/--output", "no permission to create a file in")
+    code, _, err = run(capsys, "derive", "planar_2r", "-o", locked / "old.txt")
+    assert_one_line_error(code, err, "-o/--output", "no permission to write the file")
+
+
 def test_output_may_not_overwrite_the_robot_file_or_another_output(capsys, tmp_path):
     robot = tmp_path / "arm.yaml"
     robot.write_text((EXAMPLES / "tutorial_two_link.yaml").read_text())
@@ -291,6 +304,7 @@ def test_writable_outputs_still_work(capsys, tmp_path):
     assert code == 0, err
     assert json.loads(out)["files"]["csv"] == str(tmp_path / "s.csv") and (tmp_path / "s.csv").stat().st_size > 0
     assert cli.check_output_path("/dev/null", "-o") == Path("/dev/null")  # a device is a fine place to write
+    assert cli.check_output_path("/dev/stdout", "-o") == Path("/dev/stdout")  # a link into /proc, but written as /dev
 
 
 # ------------------------------------------------------------------ wrong counts and bad values name the flag

@@ -191,31 +191,31 @@ class OutputPath(argparse.Action):
 
 def check_output_path(path, flag: str = "output") -> Path:
     """``path`` if a file can be written there, else ValueError naming ``flag`` and the reason:
-    the path is a folder, its folder is missing or is not a folder, it lies in /proc or /sys (the
-    kernel's virtual files), or there is no permission to write it."""
+    the name is empty, the path lies in /proc or /sys (the kernel's virtual files), it is a folder,
+    its folder is missing or is not a folder, or there is no permission to write it. An existing
+    file or device (``/dev/null``, ``/dev/stdout``) needs only write permission."""
     text = os.fspath(path)
-    where = f"{flag}: cannot write '{text}'"
     if not text.strip():
         raise ValueError(f"{flag}: the file name is empty")
-    p = Path(text).expanduser()
-    full = Path(os.path.abspath(p))
-    real = full.resolve()
-    for virtual in ("/proc", "/sys"):
-        if any(x == Path(virtual) or Path(virtual) in x.parents for x in (full, real)):
+    where = f"{flag}: cannot write '{text}'"
+    full = Path(os.path.abspath(text))  # as written (not through symbolic links: /dev/stdout is a link into /proc)
+    for virtual in (Path("/proc"), Path("/sys")):
+        if full == virtual or virtual in full.parents:
             raise ValueError(f"{where}: it is in {virtual}, the kernel's virtual files, not a place for output")
-    if real.is_dir():
-        raise ValueError(f"{where}: it is a folder; give a file name, e.g. '{p / 'out'}'")
-    parent = real.parent
-    if not parent.exists():
-        raise ValueError(f"{where}: the folder '{full.parent}' does not exist")
-    if not parent.is_dir():
-        raise ValueError(f"{where}: '{full.parent}' is not a folder")
-    if real.exists():
-        if not os.access(real, os.W_OK):
+    if full.is_dir():
+        raise ValueError(f"{where}: it is a folder; give a file name, e.g. '{Path(text) / 'out'}'")
+    if full.exists():
+        if not os.access(full, os.W_OK):
             raise ValueError(f"{where}: no permission to write the file")
-    elif not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"{where}: no permission to create a file in '{full.parent}'")
-    return p
+        return Path(text)
+    parent = full.parent
+    if not parent.exists():
+        raise ValueError(f"{where}: the folder '{parent}' does not exist")
+    if not parent.is_dir():
+        raise ValueError(f"{where}: '{parent}' is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{where}: no permission to create a file in '{parent}'")
+    return Path(text)
 
 
 def _check_outputs(args) -> None:
