@@ -421,4 +421,4 @@ def test_cli_simulate_json_and_files(tmp_path, capsys):
     ref = kd.simulate(robot, 1.0, np.zeros(4), controller=PDGravity(robot, 100.0, 20.0, [0.5, -0.3]))
     np.testing.assert_allclose(doc["q_final"], ref.q[-1], rtol=0, atol=1e-14)
     code = main(["simulate", "planar_2r", "--dt", "0"])
-    assert code == 1 and "--dt: must be a positive" in capsys.readouterr().err
+    assert code == 1 and "argument --dt: must be a positive" in capsys.readouterr().err

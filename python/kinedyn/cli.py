@@ -77,8 +77,9 @@ def load_robot(spec: str, *, values: Optional[Dict[str, float]] = None, numeric:
         robot = _substitute(_robot_file(spec), values, spec)
     if numeric and robot.is_symbolic:
         missing = sorted(str(s) for s in robot.symbols)
+        needs = f"'kinedyn {run.command}'" if run is not None else "this computation"
         raise ValueError(
-            f"robot '{robot.name}' ({spec}) has parameters without values: {', '.join(missing)}; this command needs numbers: "
+            f"robot '{robot.name}' ({spec}) has parameters without values: {', '.join(missing)}; {needs} needs numbers: "
             f"add {' '.join(f'--set {m}=...' for m in missing)}"
         )
     return robot
@@ -99,7 +100,11 @@ def _robot_file(spec: str):
         raise ValueError(f"robot file '{spec}' is a folder")
     try:
         return load(path)
-    except (ValueError, OSError, MemoryError, KeyboardInterrupt):
+    except ValueError as e:  # the loader's own message; make sure it says which file
+        if spec in str(e) or str(path) in str(e):
+            raise
+        raise ValueError(f"robot file '{spec}': {e}") from e
+    except (OSError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as e:  # a loader should raise only ValueError: say which file it was reading
         e.kinedyn_context = f"while loading robot file '{spec}'"
@@ -115,7 +120,13 @@ def _builtin(name: str, values: Dict[str, float]):
     if not values:
         return robots.get(name)
     params = inspect.signature(robots.CATALOGUE[name]).parameters
-    numeric = [p for p, v in params.items() if v.default is None or (isinstance(v.default, (int, float)) and not isinstance(v.default, bool))]
+
+    def is_number(v: inspect.Parameter) -> bool:  # a number, or None standing for a computed number (planar_2r's lc1 = l1/2)
+        if v.default is None:
+            return v.annotation in (inspect.Parameter.empty, "float", "Optional[float]", float)
+        return isinstance(v.default, (int, float)) and not isinstance(v.default, bool)
+
+    numeric = [p for p, v in params.items() if is_number(v)]
     unknown = [k for k in values if k not in numeric]
     if unknown:
         raise ValueError(f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})")
@@ -180,31 +191,31 @@ class OutputPath(argparse.Action):
 
 def check_output_path(path, flag: str = "output") -> Path:
     """``path`` if a file can be written there, else ValueError naming ``flag`` and the reason:
-    the path is a folder, its folder is missing or is not a folder, it lies in /proc or /sys (the
-    kernel's virtual files), or there is no permission to write it."""
+    the name is empty, the path lies in /proc or /sys (the kernel's virtual files), it is a folder,
+    its folder is missing or is not a folder, or there is no permission to write it. An existing
+    file or device (``/dev/null``, ``/dev/stdout``) needs only write permission."""
     text = os.fspath(path)
-    where = f"{flag}: cannot write '{text}'"
     if not text.strip():
         raise ValueError(f"{flag}: the file name is empty")
-    p = Path(text).expanduser()
-    full = Path(os.path.abspath(p))
-    real = full.resolve()
-    for virtual in ("/proc", "/sys"):
-        if any(x == Path(virtual) or Path(virtual) in x.parents for x in (full, real)):
+    where = f"{flag}: cannot write '{text}'"
+    full = Path(os.path.abspath(text))  # as written (not through symbolic links: /dev/stdout is a link into /proc)
+    for virtual in (Path("/proc"), Path("/sys")):
+        if full == virtual or virtual in full.parents:
             raise ValueError(f"{where}: it is in {virtual}, the kernel's virtual files, not a place for output")
-    if real.is_dir():
-        raise ValueError(f"{where}: it is a folder; give a file name, e.g. '{p / 'out'}'")
-    parent = real.parent
-    if not parent.exists():
-        raise ValueError(f"{where}: the folder '{full.parent}' does not exist")
-    if not parent.is_dir():
-        raise ValueError(f"{where}: '{full.parent}' is not a folder")
-    if real.exists():
-        if not os.access(real, os.W_OK):
+    if full.is_dir():
+        raise ValueError(f"{where}: it is a folder; give a file name, e.g. '{Path(text) / 'out'}'")
+    if full.exists():
+        if not os.access(full, os.W_OK):
             raise ValueError(f"{where}: no permission to write the file")
-    elif not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"{where}: no permission to create a file in '{full.parent}'")
-    return p
+        return Path(text)
+    parent = full.parent
+    if not parent.exists():
+        raise ValueError(f"{where}: the folder '{parent}' does not exist")
+    if not parent.is_dir():
+        raise ValueError(f"{where}: '{parent}' is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{where}: no permission to create a file in '{parent}'")
+    return Path(text)
 
 
 def _check_outputs(args) -> None:
@@ -280,6 +291,15 @@ def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, fla
     return q
 
 
+def esc(text) -> str:
+    """``text`` (a name from a robot file, a path, a library message) safe inside rich markup: a
+    ``[`` that would open a tag (``[/bold]``, ``[red]``) is escaped, so the terminal shows it as it
+    is. Everything printed with console().print that is not kinedyn's own markup goes through this."""
+    from rich.markup import escape
+
+    return escape(str(text))
+
+
 def console():
     from rich.console import Console
 
@@ -311,12 +331,12 @@ def emit(args, payload: dict, render: Callable[[], None]) -> None:
 def matrix_table(title: str, M: np.ndarray, rows: Sequence[str], cols: Sequence[str], digits: int = 6):
     from rich.table import Table
 
-    table = Table(title=title, title_justify="left")
+    table = Table(title=esc(title), title_justify="left")
     table.add_column("")
     for c in cols:
-        table.add_column(c, justify="right")
+        table.add_column(esc(c), justify="right")
     for name, row in zip(rows, np.atleast_2d(M)):
-        table.add_row(name, *(f"{v: .{digits}g}" for v in row))
+        table.add_row(esc(name), *(f"{v: .{digits}g}" for v in row))
     return table
 
 
@@ -426,16 +446,16 @@ def cmd_info(args) -> int:
         from rich.table import Table
 
         c = console()
-        c.print(f"[bold]{robot.name}[/bold]: {robot.n} joints, tool frame '{robot.tool}', gravity {payload['gravity']} m/s^2")
+        c.print(f"[bold]{esc(robot.name)}[/bold]: {robot.n} joints, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2")
         if robot.source:
-            c.print(f"source: {robot.source}")
+            c.print(f"source: {esc(robot.source)}")
         t = Table(title="joints", title_justify="left")
         for col in ("#", "joint", "type", "parent -> link", "axis", "offset", "limits", "vel / effort"):
             t.add_column(col)
         for i, j in enumerate(joints, 1):
             unit = "rad" if j["type"] == "revolute" else "m"
             t.add_row(
-                str(i), j["name"], j["type"], f"{j['parent']} -> {j['link']}", " ".join(_fmt(a) for a in j["axis"]), _fmt(j["offset"]),
+                str(i), esc(j["name"]), j["type"], esc(f"{j['parent']} -> {j['link']}"), esc(" ".join(_fmt(a) for a in j["axis"])), esc(_fmt(j["offset"])),
                 f"[{_fmt(j['lower'])}, {_fmt(j['upper'])}] {unit}", f"{_fmt(j['velocity_limit'])} / {_fmt(j['effort_limit'])}",
             )
         c.print(t)
@@ -447,9 +467,9 @@ def cmd_info(args) -> int:
                 var = "q" if r["type"] == "revolute" else "d"
                 t.add_row(
                     str(i),
-                    f"q{i} + {_fmt(r['theta'])}" if var == "q" else _fmt(r["theta"]),
-                    f"q{i} + {_fmt(r['d'])}" if var == "d" else _fmt(r["d"]),
-                    _fmt(r["a"]), f"{_fmt(math.degrees(r['alpha']))} deg" if isinstance(r["alpha"], float) else f"{r['alpha']} rad", r["type"],
+                    esc(f"q{i} + {_fmt(r['theta'])}" if var == "q" else _fmt(r["theta"])),
+                    esc(f"q{i} + {_fmt(r['d'])}" if var == "d" else _fmt(r["d"])),
+                    esc(_fmt(r["a"])), f"{_fmt(math.degrees(r['alpha']))} deg" if isinstance(r["alpha"], float) else esc(f"{r['alpha']} rad"), r["type"],
                 )
             c.print(t)
         t = Table(title="mass properties (body frames = joint frames)", title_justify="left")
@@ -457,9 +477,9 @@ def cmd_info(args) -> int:
             t.add_column(col)
         for b in bodies:
             I = b["inertia_about_com"]
-            t.add_row(b["link"], _fmt(b["mass"]), " ".join(_fmt(x) for x in b["com"]), " ".join(_fmt(I[k][k]) for k in range(3)))
+            t.add_row(esc(b["link"]), esc(_fmt(b["mass"])), esc(" ".join(_fmt(x) for x in b["com"])), esc(" ".join(_fmt(I[k][k]) for k in range(3))))
         c.print(t)
-        c.print(f"total moving mass: {_fmt(payload['total_mass'])} kg")
+        c.print(f"total moving mass: {esc(_fmt(payload['total_mass']))} kg")
         if payload["symbols"]:
             c.print(f"symbolic parameters: {', '.join(payload['symbols'])} (numeric commands take their values: --set NAME=VALUE)")
 
@@ -484,7 +504,7 @@ def cmd_fk(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{robot.name}[/bold] at q = {np.array2string(q, precision=6)} rad/m")
+        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)} rad/m")
         for f, T in zip(frames, poses):
             c.print(matrix_table(f"pose of '{f}' in '{robot.base}'", T, ["", "", "", ""], ["", "", "", ""]))
             rpy = _rpy(T[:3, :3])
@@ -520,12 +540,12 @@ def cmd_jacobian(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{robot.name}[/bold] at q = {np.array2string(q, precision=6)}; frame '{payload['frame']}', reference '{args.reference}'")
+        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}; frame '{esc(payload['frame'])}', reference '{args.reference}'")
         c.print(matrix_table("Jacobian", J, names, robot.joint_names))
         c.print(f"singular values: {np.array2string(report.singular_values, precision=6)}")
         c.print(f"manipulability sqrt(det J J^T): {payload['manipulability']:.6g}")
         style = "bold red" if report.singular else "green"
-        c.print(f"[{style}]{report.summary()}[/{style}]")
+        c.print(f"[{style}]{esc(report.summary())}[/{style}]")
 
     emit(args, payload, render)
     return 0
@@ -559,7 +579,7 @@ def cmd_dynamics(args) -> int:
     def render():
         c = console()
         names = robot.joint_names
-        c.print(f"[bold]{robot.name}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}")
+        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}")
         c.print(matrix_table("M(q), mass matrix", M, names, names))
         c.print(matrix_table("C(q, qd), Coriolis matrix (Christoffel symbols)", C, names, names))
         c.print(matrix_table("g(q), gravity torque and tau = M qdd + C qd + g + friction", np.column_stack([g, payload["tau"]]), names, ["g", "tau"]))

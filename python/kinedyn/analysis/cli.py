@@ -9,7 +9,7 @@ __all__ = ["add_analysis_commands", "cmd_check", "cmd_identify"]
 
 
 def cmd_check(args) -> int:
-    from ..cli import console, emit, load_robot
+    from ..cli import console, emit, esc, load_robot
     from .. import robots
     from .properties import check_properties
 
@@ -20,12 +20,12 @@ def cmd_check(args) -> int:
         from rich.table import Table
 
         c = console()
-        t = Table(title=f"properties of {robot.name} ({args.samples} sampled states, {args.t:g} s trajectory)", title_justify="left")
+        t = Table(title=f"properties of {esc(robot.name)} ({args.samples} sampled states, {args.t:g} s trajectory)", title_justify="left")
         for col in ("", "property", "residual", "tolerance", "measured"):
             t.add_column(col)
         for chk in report.checks:
             mark = "[green]ok[/green]" if chk.passed else "[bold red]FAIL[/bold red]"
-            t.add_row(mark, chk.name, f"{chk.residual:.3g}", f"{chk.tolerance:.3g}", chk.detail)
+            t.add_row(mark, esc(chk.name), f"{chk.residual:.3g}", f"{chk.tolerance:.3g}", esc(chk.detail))
         c.print(t)
 
     emit(args, report.to_dict(), render)
@@ -33,7 +33,7 @@ def cmd_check(args) -> int:
 
 
 def cmd_identify(args) -> int:
-    from ..cli import console, emit, load_robot
+    from ..cli import console, emit, esc, load_robot
     from .. import robots
     from .identification import excitation, identify, simulate_measurements
 
@@ -47,7 +47,7 @@ def cmd_identify(args) -> int:
         from rich.table import Table
 
         c = console()
-        c.print(f"[bold]{robot.name}[/bold]: {len(result.names)} base parameters from {len(data.t)} samples "
+        c.print(f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters from {len(data.t)} samples "
                 f"({args.periods:g} periods of a {args.harmonics}-harmonic Fourier excitation, noise {args.noise:g}); "
                 f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares")
         t = Table(title_justify="left")
@@ -55,11 +55,11 @@ def cmd_identify(args) -> int:
             t.add_column(col, justify="right")
         for k, nm in enumerate(result.names):
             e = result.errors[k]
-            t.add_row(nm, f"{result.estimates[k]:.8g}", f"{result.std[k]:.2g}", f"{result.true_values[k]:.8g}", f"{e:.2g}",
+            t.add_row(esc(nm), f"{result.estimates[k]:.8g}", f"{result.std[k]:.2g}", f"{result.true_values[k]:.8g}", f"{e:.2g}",
                       f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-")
         c.print(t)
         if result.dropped:
-            c.print(f"not excited (zero regressor columns on the data): {', '.join(result.dropped)}")
+            c.print(f"not excited (zero regressor columns on the data): {esc(', '.join(result.dropped))}")
 
     emit(args, payload, render)
     return 0

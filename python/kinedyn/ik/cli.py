@@ -105,13 +105,13 @@ def run_ik(args) -> int:
         payload["nearest_q"] = angles(result.nearest_q)
 
     def render():
-        from ..cli import console, in_cli_terms
+        from ..cli import console, esc, in_cli_terms
         from rich.table import Table
 
         c = console()
         what = f"position {np.array2string(target, precision=6)}" if target.shape == (3,) else \
             f"pose at {np.array2string(target[:3, 3], precision=6)}, rpy {np.array2string(np.asarray(args.rpy), precision=6)}{' deg' if args.deg else ' rad'}"
-        c.print(f"[bold]{robot.name}[/bold]: '{payload['frame']}' to {what}; solver {result.solver}")
+        c.print(f"[bold]{esc(robot.name)}[/bold]: '{esc(payload['frame'])}' to {what}; solver {result.solver}")
         if len(shown):
             unit = "deg" if args.deg else "rad"
             c.width = max(c.width, 12 * (robot.n + 3))  # never truncate the numbers
@@ -125,9 +125,9 @@ def run_ik(args) -> int:
                 table.add_row(str(k + 1), *(f"{v:.4f}" for v in angles(q)), f"{result.position_error[k]:.0e}", f"{result.orientation_error[k]:.0e}")
             c.print(table)
             if robot.joint_names != [f"q{k + 1}" for k in range(robot.n)]:
-                c.print("joints: " + ", ".join(f"q{k + 1} = {name}" for k, name in enumerate(robot.joint_names)))
+                c.print("joints: " + ", ".join(f"q{k + 1} = {esc(name)}" for k, name in enumerate(robot.joint_names)))
         style = "green" if result.success else "bold red"
-        c.print(f"[{style}]{in_cli_terms(result.message, FLAG_PHRASES)}[/{style}]")
+        c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
 
     from ..cli import emit
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cli import OutputPath, console, emit, load_robot, nonnegative_int, parse_q, positive_float
+from ..cli import OutputPath, console, emit, esc, load_robot, nonnegative_int, parse_q, positive_float
 
 __all__ = ["add_report_commands"]
 
@@ -60,8 +60,8 @@ def cmd_report(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{robot.name}[/bold]: report written to [cyan]{out}[/cyan] ({out.stat().st_size / 1024:.0f} KiB, self-contained; open it in a browser)")
-        c.print(f"  q = {np.array2string(np.asarray(q), precision=4)}, Jacobian rank {data['rank']} ({data['singularity']})")
+        c.print(f"[bold]{esc(robot.name)}[/bold]: report written to [cyan]{esc(out)}[/cyan] ({out.stat().st_size / 1024:.0f} KiB, self-contained; open it in a browser)")
+        c.print(f"  q = {np.array2string(np.asarray(q), precision=4)}, Jacobian rank {data['rank']} ({esc(data['singularity'])})")
         if data.get("properties"):
             bad = [p["property"] for p in data["properties"] if not p["ok"]]
             c.print("  properties: " + ("[green]all hold[/green]" if not bad else f"[bold red]failing: {', '.join(bad)}[/bold red]"))

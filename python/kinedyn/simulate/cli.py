@@ -20,7 +20,7 @@ def _gains(values, robot, flag: str):
 
 
 def cmd_simulate(args) -> int:
-    from ..cli import console, emit, load_robot, parse_q
+    from ..cli import console, emit, esc, load_robot, parse_q
     from .. import robots
     from .control import make_controller
     from .core import ADAPTIVE_METHODS, simulate
@@ -91,7 +91,7 @@ def cmd_simulate(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{robot.name}[/bold]: {args.t:g} s with {traj.method} (dt = {args.dt:g} s), controller {payload['controller']}, "
+        c.print(f"[bold]{esc(robot.name)}[/bold]: {args.t:g} s with {traj.method} (dt = {args.dt:g} s), controller {payload['controller']}, "
                 f"{len(traj)} samples in {payload['wall_time_s']:.3g} s")
         if payload["method_choice"]:
             c.print(f"  method {payload['method_choice']}")
@@ -101,7 +101,7 @@ def cmd_simulate(args) -> int:
         c.print(f"  qd(T) = {np.array2string(traj.qd[-1], precision=5)}")
         c.print(f"  energy H: {H[0]:.8g} J -> {H[-1]:.8g} J (max relative change {payload['energy_drift_relative']:.3g})")
         for k, v in files.items():
-            c.print(f"  {k}: {v}")
+            c.print(f"  {k}: {esc(v)}")
 
     emit(args, payload, render)
     return 0

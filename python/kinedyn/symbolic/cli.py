@@ -23,7 +23,7 @@ def _robot(args):
 
 
 def cmd_derive(args) -> int:
-    from ..cli import console, emit
+    from ..cli import console, emit, esc
 
     robot = _robot(args)
     eom = robot.equations_of_motion(
@@ -58,7 +58,7 @@ def cmd_derive(args) -> int:
 
     def render():
         if args.output:
-            console().print(f"wrote the {fmt} equations of motion of '{robot.name}' to {args.output}")
+            console().print(f"wrote the {fmt} equations of motion of '{esc(robot.name)}' to {esc(args.output)}")
         else:
             print(text)
 
