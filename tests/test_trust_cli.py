@@ -438,6 +438,8 @@ def test_set_on_built_ins_and_bad_set_values(capsys):
         (["fk", "planar_2r", "--set", "l1"], "argument --set: expected NAME=VALUE", "l1"),
         (["fk", "planar_2r", "--set", "l1=abc"], "argument --set: l1: the value must be a number", "abc"),
         (["fk", "planar_2r", "--set", "l1=inf"], "argument --set: l1: the value must be a number", "inf"),
+        (["fk", "planar_2r", "--set", "l1=exec(chr(49))"], "argument --set: l1: the value must be a number", "'exec' is not a known function"),
+        (["fk", "planar_2r", "--set", "l1=9**9**9"], "argument --set: l1: the value must be a number", "exponent"),
         (["fk", "planar_2r", "--set", "=1"], "argument --set: expected NAME=VALUE", "=1"),
         (["fk", "planar_2r", "--set", "l1=1", "--set", "l1=2"], "--set l1 is given twice", ""),
         (["derive", "--symbolic", "--set", "nope=1"], "--set nope", "l1"),
@@ -589,3 +591,10 @@ def test_output_into_a_closed_pipe_is_quiet(capsys, monkeypatch):
     monkeypatch.setattr(cli, "cmd_fk", closed)
     code, _, err = run(capsys, "fk", "planar_2r")
     assert code == 0 and err == ""
+
+
+def test_set_reads_arithmetic_on_numbers(capsys):
+    """--set values go through kinedyn's expression parser: arithmetic on numbers, never eval."""
+    _, by_expression, _ = main_json(capsys, "fk", "planar_2r", "--set", "l1=sqrt(2)/2", "--set", "l2=pi/4", "--q", "0", "0")
+    _, by_number, _ = main_json(capsys, "fk", "planar_2r", "--set", f"l1={2 ** 0.5 / 2!r}", "--set", f"l2={3.141592653589793 / 4!r}", "--q", "0", "0")
+    assert by_expression == by_number

@@ -152,11 +152,11 @@ def _substitute(robot, values: Dict[str, float], spec: str):
 
 
 def _parse_set_value(text: str) -> float:
-    """The value of ``--set name=VALUE``: a finite number (a float literal)."""
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError(f"'{text}' is not a finite number")
-    return value
+    """The value of ``--set name=VALUE``: a finite number, written as a number or as arithmetic on
+    numbers (``0.5``, ``pi/2``, ``sqrt(2)/2``), read by kinedyn's expression parser (never eval)."""
+    from .description.expressions import parse_number
+
+    return parse_number(text)
 
 
 def _parse_set(text: str):
@@ -168,7 +168,7 @@ def _parse_set(text: str):
     try:
         return name, _parse_set_value(value.strip())
     except ValueError as e:
-        raise argparse.ArgumentTypeError(f"{name}: the value must be a number, got '{value.strip()}'" + ("" if "could not convert" in str(e) else f" ({e})")) from None
+        raise argparse.ArgumentTypeError(f"{name}: the value must be a number, got '{value.strip()}' ({e})") from None
 
 
 def _set_values(pairs) -> Dict[str, float]:
