@@ -490,3 +490,8 @@ FUZZ_NAMES = sorted(_ARGS) + sorted(_FUNCTIONS)
 def test_bad_arrays_give_clean_errors_or_finite_results(puma, data, name):
     outcome = fuzz_case(puma, data, name)
     assert outcome in ("clean error", "finite"), outcome
+
+
+def test_a_simulation_longer_than_float64_can_count_is_a_value_error(puma):
+    with pytest.raises(ValueError, match=r"more than 2\*\*53"):
+        kd.simulate(puma, (0, 1e300), np.zeros(12), dt=0.01)
