@@ -495,8 +495,9 @@ class Robot:
         f[..., 3:] += np.cross(d, f[..., :3])
         return f
 
-    def _singular(self, error: RuntimeError) -> RuntimeError:
-        """The core's singular-mass-matrix error with the joint's name added."""
+    def _singular(self, error: RuntimeError) -> Exception:
+        """The core's singular-mass-matrix error with the joint's name added: a RuntimeError, or a
+        NonFiniteResultError (a ValueError) when the core found numbers too large for float64."""
         import re
 
         message = str(error)
@@ -511,6 +512,10 @@ class Robot:
             return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
 
         message = re.sub(r"\bjoint (\d+)", named, message)
+        if "too large for float64" in message:  # finite inputs, but the numbers overflowed on the way (§8)
+            from ._core import NonFiniteResultError
+
+            return NonFiniteResultError(f"robot '{self.name}': {message}")
         if seen:
             message += self._nonphysical_note(min(seen))
         return RuntimeError(f"robot '{self.name}': {message}")

@@ -69,7 +69,11 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
             let trace = ia.trace() + model.armature[i];
             let why = if !d.is_finite() || !trace.is_finite() {
                 "an inertia or a state too large for float64".to_string()
-            } else if d <= 0.0 || trace <= 0.0 {
+            } else if d < 0.0 {
+                "a negative inertia about the axis: M is indefinite, so some body of the subtree has an inertia \
+                 no rigid body has (check the signs of the products of inertia)"
+                    .to_string()
+            } else if d == 0.0 || trace <= 0.0 {
                 "a massless or inertia-free subtree: no inertia about the axis and no rotor inertia".to_string()
             } else {
                 format!(

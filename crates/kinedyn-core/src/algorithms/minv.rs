@@ -61,6 +61,11 @@ fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> Stri
     let head = format!("M is not positive definite to float64 precision at joint {k}: its pivot D = {hkk:e} in the L^T D L factorisation");
     if !hkk.is_finite() || !scale.is_finite() {
         format!("{head}; M has a non-finite entry (an inertia or a configuration too large for float64)")
+    } else if hkk < 0.0 && hkk.abs() > EPS_M * scale {
+        format!(
+            "{head}: a clearly negative pivot, so M is indefinite: some body that joint {k} moves has an inertia no rigid \
+             body has (check the signs of the products of inertia)"
+        )
     } else if mkk <= EPS_M * scale {
         format!(
             "{head}; M[{k}, {k}] = {mkk:e} ({:.1e} times the largest diagonal entry): the subtree of joint {k} has no inertia \
