@@ -547,3 +547,14 @@ def test_mutated_panda_loads_or_fails_with_one_clean_value_error(data):
         q = robot.random_configuration(0)
         assert np.all(np.isfinite(robot.mass_matrix(q))) and np.all(np.isfinite(robot.pose(q)))
     assert time.perf_counter() - began < 5.0
+
+
+@pytest.mark.parametrize("method", ["rk4", "implicit"])
+def test_a_simulation_stopped_by_a_nonphysical_body_names_it(method):
+    bad = Inertia(1.0, (0, 0, 0), np.diag([-0.1, 1.0, 1.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+        robot = kd.Robot([Link("a", None, Joint("j", axis=(1, 0, 0)), inertia=bad)])
+    with pytest.raises(kd.simulate.SimulationError if hasattr(kd.simulate, "SimulationError") else RuntimeError,
+                       match=r"stopped at t = 0 s.*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'"):
+        kd.simulate(robot, 0.1, np.zeros(2), method=method)

@@ -233,6 +233,8 @@ def _raise_failure(system, names, failures, steps_done, traj_factory, steps):
     for index, f in enumerate(failures):
         if f is not None:
             cls, message = _failure_message(getattr(system, "name", "system"), names, f, index if len(failures) > 1 else None, steps)
+            if f["kind"] == "singular" and isinstance(f.get("joint"), int) and hasattr(system, "_nonphysical_note"):
+                message += system._nonphysical_note(f["joint"])  # a kept non-physical inertia can make M singular
             partial = traj_factory(index, int(steps_done[index]))
             raise cls(message, t=f["t"], step=f["step"], joint=f.get("joint"), index=index if len(failures) > 1 else None, kind=f["kind"], trajectory=partial)
 
