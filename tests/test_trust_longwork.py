@@ -239,3 +239,20 @@ def test_stiff_scipy_methods_get_the_analytical_jacobian(panda):
     assert calls, "the controller's Jacobian was not used"
     implicit = kd.simulate(panda, 2.0, np.zeros(2 * panda.n), controller=PDGravity(panda, 100.0, 20.0, PANDA_GOAL), dt=1e-4, record_every=100)
     np.testing.assert_allclose(traj.q, implicit.q, atol=2e-3)
+
+
+def test_a_batch_ik_with_progress_gives_the_same_answers(monkeypatch, capsys):
+    """Progress sends a numeric IK batch to the core in chunks; each target's random restarts follow
+    from the seed and its index in the whole batch, so the answers are those of one call."""
+    from kinedyn.ik import solve as ik_solve
+
+    robot = kd.robots.ur5()
+    targets = robot.forward_kinematics(robot.random_configuration(rng=3, size=250))[:, -1]
+    settings = dict(method="numeric", max_iterations=12, restarts=6, seed=7)  # few iterations: the restarts decide
+    whole = robot.inverse_kinematics(targets, progress=False, **settings)
+    monkeypatch.setattr(ik_solve, "IK_CHUNK", 64)
+    chunked = robot.inverse_kinematics(targets, progress=True, **settings)
+    assert 0 < whole.success.sum() < len(targets)  # some targets need their restarts
+    np.testing.assert_array_equal(chunked.q, whole.q)
+    np.testing.assert_array_equal(chunked.success, whole.success)
+    assert capsys.readouterr().out == ""  # the bar is on stderr

@@ -91,6 +91,7 @@ def solve_ik(
     lambda_min: float = 1e-06,
     max_step: float = 0.5,
     seed: int = 0,
+    first_index: int = 0,  # index of targets[0] in the whole batch (each target's random restarts follow from seed and its index)
 ) -> tuple[Any, Any, Any, Any, Any]: ...  # (q, success, position_error, orientation_error, iterations), leading N for a batch
 
 class AnalyticIk:

@@ -1,15 +1,19 @@
 """Progress for long work on a terminal: a rich progress bar on stderr, shown only when stderr is a
 terminal (or when asked), never on stdout, transient (it disappears when the work is done).
 
-``Steps`` counts named steps (the report's sections, the tutorial's questions); the simulation has
-its own bar over simulated time (``kinedyn.simulate.core``)."""
+``Steps`` counts named steps (the report's sections, the tutorial's questions); ``Delayed`` is a bar
+over an amount of work (simulated time, targets of a batch) that appears only once the work has
+taken ``delay`` seconds, so that short runs stay silent."""
 
 from __future__ import annotations
 
 import sys
+import time
 from typing import Optional
 
-__all__ = ["Steps", "wanted"]
+__all__ = ["Steps", "Delayed", "wanted"]
+
+SHOW_AFTER = 1.0  # seconds: work that runs longer shows a bar (so runs over ~2 s show progress)
 
 
 def wanted(progress: Optional[bool]) -> bool:
@@ -56,3 +60,44 @@ class Steps:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+class Delayed:
+    """A bar over ``total`` units of work on stderr, shown once the work has run ``delay`` seconds
+    (at once for ``delay=0``); ``text`` formats the amount (rich's ``{task.completed}``,
+    ``{task.total}``). Does nothing when ``enabled`` is false."""
+
+    def __init__(self, enabled: bool, total: float, label: str, text: str = "{task.completed:.0f} / {task.total:.0f}", delay: float = 0.0):
+        self.enabled, self.total, self.label, self.text, self.delay = enabled, total, label, text, delay
+        self.bar = None
+        self.start = time.perf_counter()
+        self.last = 0.0
+        if enabled and delay <= 0:
+            self._show()
+
+    def _show(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+        self.bar = Progress(TextColumn(self.label), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
+                            console=Console(file=sys.stderr), transient=True)
+        self.task = self.bar.add_task(self.label, total=self.total)
+        self.bar.start()
+
+    def update(self, done: float) -> None:
+        """``done`` units of the total are finished."""
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self.start < self.delay or done >= self.total:
+                return
+            self._show()
+        if now - self.last > 0.05 or done >= self.total:
+            self.bar.update(self.task, completed=min(done, self.total))
+            self.last = now
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None

@@ -97,7 +97,7 @@ fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
 /// q0: (n,) or (N, n); lower, upper: (n,); weights: (6,) for [x, y, z, rx, ry, rz].
 /// Returns (q, success, position_error, orientation_error, iterations) with a leading N for a batch.
 #[pyfunction]
-#[pyo3(signature = (model, frame, targets, q0, lower, upper, weights, max_iterations=50, restarts=50, position_tolerance=1e-10, orientation_tolerance=1e-10, lambda_min=1e-6, max_step=0.5, seed=0))]
+#[pyo3(signature = (model, frame, targets, q0, lower, upper, weights, max_iterations=50, restarts=50, position_tolerance=1e-10, orientation_tolerance=1e-10, lambda_min=1e-6, max_step=0.5, seed=0, first_index=0))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn solve_ik<'py>(
     py: Python<'py>,
@@ -115,6 +115,7 @@ pub fn solve_ik<'py>(
     lambda_min: f64,
     max_step: f64,
     seed: u64,
+    first_index: u64,
 ) -> PyResult<Bound<'py, PyAny>> {
     guarded("solve_ik", || {
     let m: &Model = &model.model;
@@ -146,8 +147,10 @@ pub fn solve_ik<'py>(
     let settings = Settings { weights, max_iterations, restarts, position_tolerance, orientation_tolerance, lambda_min, max_step };
     let solve_one = |data: &mut Data, k: usize| {
         let start = if per_target { &q0s[k * n..(k + 1) * n] } else { &q0s[..] };
-        // a seed per target: results do not depend on how the batch is split among threads
-        ik::numeric_ik(m, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(k as u64))
+        // a seed per target, from its index in the whole batch (`first_index` + k when the caller
+        // sends the batch in chunks): results do not depend on how the batch is split
+        let index = first_index.wrapping_add(k as u64);
+        ik::numeric_ik(m, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(index))
     };
     // the results, allocated fallibly before the work (MemoryError, not an abort), each target
     // writing its own row

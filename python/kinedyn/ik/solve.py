@@ -221,6 +221,7 @@ def inverse_kinematics(
     max_iterations: int = 50,
     restarts: int = 50,
     seed: int = 0,
+    progress: Optional[bool] = None,
 ):
     """Joint vectors that put ``frame`` (default: the tool) at ``target``.
 
@@ -233,6 +234,8 @@ def inverse_kinematics(
     or ``"numeric"``. ``respect_limits``: drop (closed form) or never leave (numeric) joint limits.
     ``tolerance``: largest position (m) and orientation (rad) residual accepted.
     ``max_iterations``/``restarts``/``seed``: numeric solver (iterations per attempt, random restarts).
+    ``progress``: a bar on stderr for a numeric batch that runs over a second (default: when stderr
+    is a terminal); the answers are the same with or without it.
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
@@ -266,7 +269,7 @@ def inverse_kinematics(
     nb = len(t) if batch else None
     q_start = _q0(q0, chain, nb)
     if batch:
-        return _batch(robot, chain, t, q_start, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed)
+        return _batch(robot, chain, t, q_start, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress)
     if use_analytic:
         return _analytic(robot, chain, t, q_start, position, respect_limits, tolerance, seed)
     return _numeric(robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed)
@@ -333,14 +336,36 @@ def _nearest(robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> Non
     result.message = f"target out of reach: no solution exists; the nearest reachable point is {np.array2string(result.nearest, precision=6)} ({d:.6g} m away)"
 
 
-def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> tuple:
+def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int,
+                         progress: Optional[bool] = False) -> tuple:
     """The core's LM solver for one target or a batch: (q, converged, position error, orientation
-    error, iterations), revolute angles wrapped when the limits are not kept."""
+    error, iterations), revolute angles wrapped when the limits are not kept. With progress, a batch
+    goes to the core in chunks (each target's restarts follow from the seed and its index in the
+    whole batch, so the answers do not change)."""
     from .. import _core
+    from ..progress import SHOW_AFTER, Delayed, wanted
 
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
     tol = min(tolerance, 1e-10)
-    q, ok, pe, oe, it = _core.solve_ik(chain.model, chain.frame, t, q0, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed)
+
+    def solve(first: int, stop: Optional[int]):
+        tk = t if stop is None else t[first:stop]
+        qk = q0 if (stop is None or q0.ndim == 1) else q0[first:stop]
+        return _core.solve_ik(chain.model, chain.frame, tk, qk, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed, first)
+
+    count = len(t) if t.ndim == 3 or (t.ndim == 2 and t.shape[1] == 3) else 0  # a batch: (N, 4, 4) poses or (N, 3) points
+    if count <= IK_CHUNK or not wanted(progress):
+        q, ok, pe, oe, it = solve(0, None)
+    else:
+        bar = Delayed(True, count, "inverse kinematics", "{task.completed:.0f} / {task.total:.0f} targets", SHOW_AFTER if progress is None else 0.0)
+        parts = []
+        try:
+            for first in range(0, count, IK_CHUNK):
+                parts.append(solve(first, min(first + IK_CHUNK, count)))
+                bar.update(min(first + IK_CHUNK, count))
+        finally:
+            bar.close()
+        q, ok, pe, oe, it = (np.concatenate(arrays) for arrays in zip(*parts))
     if not respect_limits:
         q = _wrap(q, chain)
     return q, ok, pe, oe, it
@@ -376,13 +401,16 @@ def _is_singular(robot, chain: _Chain, q, weights) -> bool:
     return bool(len(s) < J.shape[0] or s[-1] < 1e-6 * max(1.0, s[0]))
 
 
-def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed) -> IKBatchResult:
+IK_CHUNK = 256  # targets per native call when a batch shows progress
+
+
+def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress) -> IKBatchResult:
     N = len(t)
     if use_analytic:
         refs = np.ascontiguousarray(np.broadcast_to(q0, (N, chain.n)))
         q, ok, pe, oe = chain.solver.solve_nearest(t, refs, respect_limits, tolerance)
         return IKBatchResult(q, ok, pe, oe, np.zeros(N, dtype=np.int64), "analytic:" + chain.solver.structure)
     w = np.asarray(weights if weights is not None else _FULL_MASK)
-    q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed)
+    q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed, progress)
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")

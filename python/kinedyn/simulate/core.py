@@ -39,6 +39,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from ..progress import SHOW_AFTER, Delayed
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
 
@@ -74,44 +75,15 @@ class SimulationTruncatedWarning(RuntimeWarning):
 
 
 # ------------------------------------------------------------------ helpers
-class _Progress:
-    """A rich progress bar over simulated time, on stderr. ``delay``: start showing it only once the
-    run has taken that many seconds (so short runs stay silent)."""
+class _TimeBar(Delayed):
+    """Progress over simulated time: ``update(t)`` with the time reached."""
 
-    def __init__(self, enabled: bool, t0: float, t1: float, label: str, delay: float = 0.0):
-        self.bar = None
-        self.enabled = enabled
-        self.t0, self.t1, self.label = t0, t1, label
-        self.start = time.perf_counter()
-        self.delay = delay
-        self.last = 0.0
-        if enabled and delay <= 0:
-            self._show()
-
-    def _show(self) -> None:
-        from rich.console import Console
-        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
-        self.bar = Progress(TextColumn(self.label), BarColumn(), TextColumn("t = {task.completed:.3g} / {task.total:.3g} s"), TimeRemainingColumn(),
-                            console=Console(file=sys.stderr), transient=True)
-        self.task = self.bar.add_task(self.label, total=self.t1 - self.t0)
-        self.bar.start()
+    def __init__(self, enabled: bool, t0: float, t1: float, label: str, delay: float):
+        self.t0 = t0
+        super().__init__(enabled, t1 - t0, label, "t = {task.completed:.3g} / {task.total:.3g} s", delay)
 
     def update(self, t: float) -> None:
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        if self.bar is None:
-            if now - self.start < self.delay or t >= self.t1:
-                return
-            self._show()
-        if now - self.last > 0.05 or t >= self.t1:
-            self.bar.update(self.task, completed=min(t, self.t1) - self.t0)
-            self.last = now
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
+        super().update(t - self.t0)
 
 
 def _is_robot(system) -> bool:
@@ -548,8 +520,8 @@ def simulate(
     if progress is None:
         # on a terminal, a bar appears once a run has taken a second (runs over ~2 s show progress)
         progress = bool(work > 1000 and getattr(sys.stderr, "isatty", lambda: False)())
-        delay = 1.0
-    bar = _Progress(bool(progress), t0, t0 + steps * dt, f"simulate {name}", delay=delay)
+        delay = SHOW_AFTER
+    bar = _TimeBar(bool(progress), t0, t0 + steps * dt, f"simulate {name}", delay)
     if hasattr(controller, "reset"):
         controller.reset()
 
