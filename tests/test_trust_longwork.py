@@ -256,3 +256,36 @@ def test_a_batch_ik_with_progress_gives_the_same_answers(monkeypatch, capsys):
     np.testing.assert_array_equal(chunked.q, whole.q)
     np.testing.assert_array_equal(chunked.success, whole.success)
     assert capsys.readouterr().out == ""  # the bar is on stderr
+
+
+@pytest.mark.parametrize("name", ["[/bold] arm", "a[red]b", "x[/]"])
+def test_progress_shows_names_that_look_like_markup(name, monkeypatch, capsys):
+    """Progress labels carry robot names; rich would read '[/bold]' as markup and fail."""
+    from kinedyn import progress
+
+    bar = progress.Delayed(True, 10, f"simulate {name}")
+    bar.update(5)
+    bar.close()
+    with progress.Steps(f"report {name}", 2, True) as steps:
+        steps.step(f"simulation of {name}")
+    with progress.busy(f"deriving {name}", True):
+        pass
+    assert capsys.readouterr().out == ""
+
+
+def test_derive_runs_under_a_spinner_on_a_terminal(monkeypatch, capsys):
+    from kinedyn import progress
+
+    labels = []
+    real_busy = progress.busy
+
+    def recording(label, progress=None):
+        labels.append((label, progress))
+        return real_busy(label, False)
+
+    monkeypatch.setattr(progress, "busy", recording)
+    assert main(["derive", "planar_2r", "--format", "text"]) == 0
+    assert main(["derive", "planar_2r", "--json"]) == 0
+    capsys.readouterr()
+    assert labels == [("deriving the equations of motion of 'planar_2r' (lagrange)", None),
+                      ("deriving the equations of motion of 'planar_2r' (lagrange)", False)]

@@ -7,11 +7,12 @@ taken ``delay`` seconds, so that short runs stay silent."""
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
-from typing import Optional
+from typing import Iterator, Optional
 
-__all__ = ["Steps", "Delayed", "wanted"]
+__all__ = ["Steps", "Delayed", "busy", "wanted"]
 
 SHOW_AFTER = 1.0  # seconds: work that runs longer shows a bar (so runs over ~2 s show progress)
 
@@ -36,7 +37,9 @@ class Steps:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self.bar = Progress(TextColumn(f"{label}:"), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+            from rich.markup import escape
+
+            self.bar = Progress(TextColumn(f"{escape(label)}:"), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                                 console=Console(file=sys.stderr), transient=True)
             self.task = self.bar.add_task("", total=self.total)
             self.bar.start()
@@ -47,7 +50,9 @@ class Steps:
             done = self.bar.tasks[0].completed
             if self.bar.tasks[0].description:
                 done += 1
-            self.bar.update(self.task, description=description, completed=min(done, self.total))
+            from rich.markup import escape
+
+            self.bar.update(self.task, description=escape(description), completed=min(done, self.total))
 
     def close(self) -> None:
         if self.bar is not None:
@@ -79,7 +84,9 @@ class Delayed:
         from rich.console import Console
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-        self.bar = Progress(TextColumn(self.label), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
+        from rich.markup import escape
+
+        self.bar = Progress(TextColumn(escape(self.label)), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
                             console=Console(file=sys.stderr), transient=True)
         self.task = self.bar.add_task(self.label, total=self.total)
         self.bar.start()
@@ -101,3 +108,17 @@ class Delayed:
         if self.bar is not None:
             self.bar.stop()
             self.bar = None
+
+
+@contextlib.contextmanager
+def busy(label: str, progress: Optional[bool] = None) -> Iterator[None]:
+    """A spinner with ``label`` and the elapsed time on stderr while the block runs (for work that
+    cannot report its own progress, such as a SymPy derivation); nothing when progress is off."""
+    if not wanted(progress):
+        yield
+        return
+    from rich.console import Console
+    from rich.markup import escape
+
+    with Console(file=sys.stderr).status(escape(label)):
+        yield

@@ -24,22 +24,25 @@ def _robot(args):
 
 def cmd_derive(args) -> int:
     from ..cli import console, emit, esc
+    from ..progress import busy
 
     robot = _robot(args)
-    eom = robot.equations_of_motion(
-        method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None
-    )
-    fmt = args.format
-    if fmt == "latex":
-        text = eom.to_latex()
-    elif fmt == "markdown":
-        text = eom.to_markdown()
-    elif fmt == "mathml":
-        text = eom.to_mathml()
-    elif fmt == "text":
-        text = str(eom)
-    else:
-        text = eom.to_code(fmt)
+    with busy(f"deriving the equations of motion of '{robot.name}' ({args.method})", progress=False if args.json else None):
+        eom = robot.equations_of_motion(
+            method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None
+        )
+        fmt = args.format
+        if fmt == "latex":
+            text = eom.to_latex()
+        elif fmt == "markdown":
+            text = eom.to_markdown()
+        elif fmt == "mathml":
+            text = eom.to_mathml()
+        elif fmt == "text":
+            text = str(eom)
+        else:
+            text = eom.to_code(fmt)
+        op_count = eom.op_count()
     if args.output:
         Path(args.output).write_text(text)
     payload = {
@@ -51,7 +54,7 @@ def cmd_derive(args) -> int:
         "C": [[str(e) for e in row] for row in eom.C.tolist()],
         "g": [str(e) for e in eom.g],
         "tau": [str(e) for e in eom.tau],
-        "op_count": eom.op_count(),
+        "op_count": op_count,
         "output": args.output,
         "text": None if args.output else text,
     }
