@@ -44,7 +44,8 @@ def _load_in_child(path, seconds: float = 20.0, memory_gib: float = 2.0) -> tupl
         print(repr((outcome, time.perf_counter() - t)))
         """
     )
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(ROOT, "python"), os.environ.get("PYTHONPATH", "")]))
+    # the kinedyn this test imported (the working tree or an installed wheel), not necessarily ROOT/python
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(kd.__file__)), os.environ.get("PYTHONPATH", "")]))
     try:
         run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=seconds + 15, env=env)
     except subprocess.TimeoutExpired:

@@ -30,16 +30,16 @@ from hypothesis import strategies as st
 import kinedyn as kd
 from kinedyn import _core
 
-ROOT = Path(__file__).resolve().parents[1]
+PACKAGE_PARENT = Path(kd.__file__).resolve().parents[1]  # the kinedyn under test: the working tree's or an installed wheel's
 
 
 def _run_script(code: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    """Run `code` in a fresh interpreter that imports this checkout's kinedyn; a hang fails the
+    """Run `code` in a fresh interpreter that imports the kinedyn under test; a hang fails the
     test by the timeout instead of blocking the suite, and the script's whole process group (forked
     workers included, which a hang would otherwise leave behind) is killed then."""
     import signal
 
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"), RUST_BACKTRACE="0")
+    env = dict(os.environ, PYTHONPATH=str(PACKAGE_PARENT), RUST_BACKTRACE="0")
     proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
     try:
         out, err = proc.communicate(timeout=timeout)
@@ -177,7 +177,7 @@ def test_a_robot_goes_to_a_spawn_pool_worker(ur5):
     q = np.random.default_rng(2).uniform(-1, 1, (64, ur5.n))
     ur5.mass_matrix(q)  # native model built before pickling
     env_path = os.environ.get("PYTHONPATH")
-    os.environ["PYTHONPATH"] = str(ROOT / "python") + (os.pathsep + env_path if env_path else "")
+    os.environ["PYTHONPATH"] = str(PACKAGE_PARENT) + (os.pathsep + env_path if env_path else "")
     try:
         with mp.get_context("spawn").Pool(1) as pool:
             M, tau = pool.apply_async(_spawn_worker, ((ur5, q),)).get(timeout=120)
