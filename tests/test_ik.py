@@ -397,7 +397,10 @@ def test_batches():
     T_out = T.copy()
     T_out[0, :3, 3] = [5.0, 0.0, 0.0]
     partial = robot.inverse_kinematics(T_out[:3])
-    assert partial.success.tolist() == [False, True, True] and np.isnan(partial.q[0]).all()
+    assert partial.success.tolist() == [False, True, True]
+    # out of reach: the numeric solver's best attempt, finite, with its true residual (never a NaN row)
+    assert np.isfinite(partial.q[0]).all() and partial.position_error[0] > 1.0
+    assert partial.position_error[0] == pytest.approx(np.linalg.norm(robot.pose(partial.q[0])[:3, 3] - T_out[0, :3, 3]), rel=1e-9)
     elbow = kd.robots.elbow_3r()
     P = elbow.pose(elbow.random_configuration(rng, size=20))[:, :3, 3]
     pb = elbow.inverse_kinematics(P)

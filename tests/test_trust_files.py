@@ -147,6 +147,7 @@ BAD = {
     "parent is a list": ("links:\n  - {name: a, joint: {type: revolute}}\n  - {name: b,\n     parent: [1, 2], joint: {type: revolute}}\n", "links row 2 ('b').parent", 4),
     "name is a mapping": ("links:\n  - {name: {x: 1}, joint: {type: revolute}}\n", "links row 1.name", 2),
     "frames not a list": ("frames: 3\njoints: [{a: 1}]\n", "frames", 1),
+    "frame placed beyond any robot": ("frames:\n  - {name: camera, origin: {xyz: [1.0e+150, 0, 0]}}\njoints: [{a: 1}]\n", "frames[0]", 2),
     "duplicate key": ("joints:\n  - {a: 1}\njoints:\n  - {a: 2}\n", "appears twice", 3),
     "duplicate key in a row": ("joints:\n  - {a: 1, a: 2}\n", "appears twice", 2),
     "unknown function": ("joints:\n  - {a: 'gamma(3)'}\n", "joints row 1.a", 2),

@@ -497,12 +497,17 @@ def test_a_simulation_longer_than_float64_can_count_is_a_value_error(puma):
         kd.simulate(puma, (0, 1e300), np.zeros(12), dt=0.01)
 
 
-@pytest.mark.parametrize("name", ["stanford", "cartesian_2p"])
+@pytest.mark.parametrize("name", ["stanford", "cartesian_2p", "panda"])
 def test_a_factorisation_that_overflows_is_a_non_finite_result_error(name):
-    robot = kd.robots.get(name)
+    if name == "panda":  # finite M of 1e306 (the fingers at 1e154 m) beside a finger's 1.5e-2
+        from reference import PANDA, erd
+
+        robot = kd.Robot.from_urdf(erd(*PANDA))
+    else:
+        robot = kd.robots.get(name)
     q = np.full(robot.n, 1e154)  # finite, but prismatic offsets of 1e154 m square to more than float64 holds
     calls = [lambda: robot.forward_dynamics(q, np.zeros(robot.n), np.zeros(robot.n))]  # the ABA's spatial inertias overflow
-    if name == "stanford":  # M itself overflows (the Cartesian arm's M does not depend on q)
+    if name != "cartesian_2p":  # M overflows, or is too large to factor (the Cartesian arm's M does not depend on q)
         calls.append(lambda: robot.mass_matrix_inverse(q))
     for call in calls:
         with pytest.raises(kd.NonFiniteResultError, match="too large for float64"):

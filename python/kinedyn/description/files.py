@@ -434,7 +434,11 @@ def _frames(r: _Reader, raw) -> list:
             r.fail(ctx, "a frame needs a 'name'")
         origin = r.pose(f["origin"], f"{ctx}.origin") if "origin" in f else np.eye(4)
         link = r.text(f["link"], f"{ctx}.link") if f.get("link") is not None else None
-        out.append(Frame(r.text(f["name"], f"{ctx}.name"), link, origin))
+        name = r.text(f["name"], f"{ctx}.name")
+        try:
+            out.append(Frame(name, link, origin))
+        except ValueError as e:  # the description's own checks (finite, bounded placement)
+            r.fail(ctx, str(e))
     return out
 
 

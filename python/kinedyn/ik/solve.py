@@ -91,9 +91,10 @@ class IKResult:
 
 @dataclass(slots=True)
 class IKBatchResult:
-    """One answer per target of a batch: ``q`` (N, n) (the solution nearest each q0; NaN rows where a
-    closed form found none, the best iterate where the numeric solver failed), ``success`` (N,),
-    ``position_error``/``orientation_error`` (N,), ``iterations`` (N,), ``solver``."""
+    """One answer per target of a batch: ``q`` (N, n) (the solution nearest each q0; where a closed
+    form finds none or the numeric solver fails, the numeric solver's best iterate, with
+    ``success`` False and its residuals), ``success`` (N,), ``position_error``/``orientation_error``
+    (N,), ``iterations`` (N,), ``solver``."""
 
     q: np.ndarray
     success: np.ndarray
@@ -406,11 +407,18 @@ IK_CHUNK = 256  # targets per native call when a batch shows progress
 
 def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress) -> IKBatchResult:
     N = len(t)
+    w = np.asarray(weights if weights is not None else _FULL_MASK)
     if use_analytic:
         refs = np.ascontiguousarray(np.broadcast_to(q0, (N, chain.n)))
         q, ok, pe, oe = chain.solver.solve_nearest(t, refs, respect_limits, tolerance)
-        return IKBatchResult(q, ok, pe, oe, np.zeros(N, dtype=np.int64), "analytic:" + chain.solver.structure)
-    w = np.asarray(weights if weights is not None else _FULL_MASK)
+        it = np.zeros(N, dtype=np.int64)
+        none = ~ok
+        if none.any():  # no closed-form solution: the numeric solver's best attempt, never a NaN row (§8)
+            qn, okn, pen, oen, itn = _levenberg_marquardt(chain, np.ascontiguousarray(t[none]), np.ascontiguousarray(refs[none]), w, respect_limits,
+                                                          tolerance, max_iterations, restarts, seed)
+            q[none], pe[none], oe[none], it[none] = qn, pen, oen, itn
+            ok[none] = okn & (pen <= tolerance) & (oen <= tolerance)
+        return IKBatchResult(q, ok, pe, oe, it, "analytic:" + chain.solver.structure)
     q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed, progress)
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")

@@ -25,6 +25,9 @@ use crate::spatial::{ArticulatedInertia, Force, Motion};
 
 /// Relative size under which `D_i` counts as zero (`D_i <= EPS_D * trace(IA_i)`).
 const EPS_D: f64 = 1e-13;
+/// An articulated inertia whose trace exceeds this comes from a state or an inertia no robot has
+/// (the description refuses parameters over 1e100): a failed pivot then says float64 overflowed.
+const HUGE_TRACE: f64 = 1e200;
 
 /// `qdd = aba(q, qd, tau, f_ext)` written to `data.qdd`; `f_ext` as in [`super::rnea::rnea`].
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[f64], f_ext: Option<&[f64]>) -> Result<&'d [f64]> {
@@ -67,7 +70,7 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         let d = joint.project(&u_f) + model.armature[i];
         if !(d > EPS_D * (ia.trace() + model.armature[i])) || !d.is_finite() {
             let trace = ia.trace() + model.armature[i];
-            let why = if !d.is_finite() || !trace.is_finite() {
+            let why = if !d.is_finite() || !trace.is_finite() || trace.abs().max(d.abs()) > HUGE_TRACE {
                 "an inertia or a state too large for float64".to_string()
             } else if d < 0.0 {
                 "a negative inertia about the axis: M is indefinite, so some body of the subtree has an inertia \

@@ -23,6 +23,9 @@ const EPS_D: f64 = 1e-13;
 /// subtree with no inertia about its joint's axis (the rounding of such an `M_kk` is ~1e-32 of the
 /// scale). Well above it, bodies of very different sizes (1e20 kg next to 1 kg) factor exactly.
 const EPS_M: f64 = 1e-26;
+/// A diagonal entry of `M` beyond this (kg m^2) only comes from a configuration or an inertia no
+/// robot has (the description refuses parameters over 1e100): a failed pivot then says so.
+const HUGE_M: f64 = 1e200;
 
 /// Factor `data.m` (= M) into `data.m2` as `L^T D L` (RBDA Table 6.3).
 pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
@@ -61,6 +64,11 @@ fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> Stri
     let head = format!("M is not positive definite to float64 precision at joint {k}: its pivot D = {hkk:e} in the L^T D L factorisation");
     if !hkk.is_finite() || !scale.is_finite() {
         format!("{head}; M has a non-finite entry (an inertia or a configuration too large for float64)")
+    } else if scale > HUGE_M {
+        format!(
+            "{head}; M[{largest}, {largest}] = {scale:e}: an entry of M that large (a prismatic joint metres beyond any robot, \
+             or a huge inertia) leaves the other joints below float64's resolution (a configuration or inertia too large for float64)"
+        )
     } else if hkk < 0.0 && hkk.abs() > EPS_M * scale {
         format!(
             "{head}: a clearly negative pivot, so M is indefinite: some body that joint {k} moves has an inertia no rigid \
