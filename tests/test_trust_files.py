@@ -302,3 +302,10 @@ def test_a_toml_integer_beyond_pythons_digit_limit_names_the_file(tmp_path):
     path = _write(tmp_path, "big.toml", "name = " + "7" * 5000 + "\n[[joints]]\na = 1\n")
     with pytest.raises(ValueError, match=r"big\.toml: invalid TOML: Exceeds the limit"):
         kd.load(path)
+
+
+@pytest.mark.parametrize("value", ["2001-12-14", "!!timestamp 2001-12-14nan", "!!binary aGVsbG8=", "!!set {a: null}"])
+def test_yaml_types_a_robot_file_has_no_use_for_are_refused_with_their_line(tmp_path, value):
+    path = _write(tmp_path, "arm.yaml", f"name: arm\njoints:\n  - {{a: 1, d: {value}}}\n")
+    with pytest.raises(ValueError, match=r"arm\.yaml: invalid YAML at line 3, column \d+: the YAML type \w+ .*has no meaning in a robot file"):
+        kd.load(path)

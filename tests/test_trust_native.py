@@ -512,3 +512,14 @@ def test_a_factorisation_that_overflows_is_a_non_finite_result_error(name):
     for call in calls:
         with pytest.raises(kd.NonFiniteResultError, match="too large for float64"):
             call()
+
+
+def test_a_simulation_whose_state_overflows_float64_is_a_value_error(puma):
+    from kinedyn.simulate import SimulationError, SimulationOverflowError
+
+    robot = kd.robots.stanford()  # prismatic: its inertias at 1e154 m overflow
+    with pytest.raises(SimulationOverflowError, match="too large for float64") as info:
+        kd.simulate(robot, 0.02, np.concatenate([np.full(6, 1e154), np.zeros(6)]), method="rk4")
+    assert isinstance(info.value, (ValueError, kd.NonFiniteResultError, SimulationError))
+    with pytest.raises(ValueError, match="x0 holds an integer too large for float64"):
+        kd.simulate(robot, 0.02, 10**400)

@@ -28,12 +28,17 @@ def real_array(x, name: str) -> np.ndarray:
     or other non-real dtypes."""
     if type(x) is np.ndarray and x.dtype is _F64:
         return x if x.flags.c_contiguous else np.ascontiguousarray(x)
-    a = x if isinstance(x, np.ndarray) else np.asarray(x)
+    try:
+        a = x if isinstance(x, np.ndarray) else np.asarray(x)
+    except OverflowError:  # a Python integer beyond float64 (and int64)
+        raise ValueError(f"{name} holds an integer too large for float64") from None
     if a.dtype.kind not in _REAL_KINDS:
         what = "complex numbers (the imaginary part would be lost)" if a.dtype.kind == "c" else f"an array of dtype {a.dtype}"
         raise TypeError(f"{name} must be real numbers, got {what}")
     try:
         return np.ascontiguousarray(a, dtype=np.float64)
+    except OverflowError:  # an object array holding a Python integer beyond float64
+        raise ValueError(f"{name} holds an integer too large for float64") from None
     except (TypeError, ValueError) as e:
         raise TypeError(f"{name} must be real numbers: {e}") from None
 

@@ -187,6 +187,16 @@ class _BoundedLoader(yaml.SafeLoader):
         data.extend(self.construct_sequence(node, deep=True))
 
 
+def _refuse_tag(loader, node):
+    raise yaml.constructor.ConstructorError(
+        None, None, f"the YAML type {node.tag.rsplit(':', 1)[-1]} ({_REPR.repr(node.value) if isinstance(node.value, str) else '...'}) "
+        "has no meaning in a robot file (numbers, text, lists and mappings only)", node.start_mark)
+
+
+# a robot file holds numbers, text, lists and mappings: YAML's other types (dates, which PyYAML's
+# constructor can also fail on with an AttributeError, binary, sets, ordered pairs) are refused
+for _tag in ("timestamp", "binary", "set", "omap", "pairs"):
+    _BoundedLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:map", _BoundedLoader.construct_line_mapping)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct_line_sequence)
 

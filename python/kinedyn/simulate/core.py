@@ -39,6 +39,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from .._core import NonFiniteResultError
 from ..progress import SHOW_AFTER, Delayed
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
@@ -67,6 +68,11 @@ class SimulationError(RuntimeError):
 
 class NonFiniteTorqueError(SimulationError, ValueError):
     """The controller or torque input produced NaN or infinity."""
+
+
+class SimulationOverflowError(SimulationError, NonFiniteResultError):
+    """The state's numbers overflowed float64 (finite inputs, but a configuration or velocity far
+    beyond any robot's): also a ``kinedyn.NonFiniteResultError``, hence a ``ValueError``."""
 
 
 class SimulationTruncatedWarning(RuntimeWarning):
@@ -107,7 +113,9 @@ def _names(system) -> list:
 
 
 def _split_state(x0, n: int, name: str):
-    x = np.asarray(x0, dtype=float)
+    from .._arrays import real_array
+
+    x = real_array(x0, "x0")  # TypeError for complex, text or integers beyond float64
     if x.ndim not in (1, 2) or x.shape[-1] != 2 * n:
         raise ValueError(
             f"x0 must be concatenate([q0, qd0]) with 2 n = {2 * n} entries for '{name}' ({n} coordinates), "
@@ -197,7 +205,8 @@ def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/
     if kind == "non_finite":
         return SimulationError, f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory"
     if kind == "singular":
-        return SimulationError, f"simulation of '{system_name}' stopped at {at}{which}: {f['message']}"
+        cls = SimulationOverflowError if "too large for float64" in (f["message"] or "") else SimulationError
+        return cls, f"simulation of '{system_name}' stopped at {at}{which}: {f['message']}"
     return SimulationError, f"simulation of '{system_name}' stopped at {at}{which}: {f.get('message', '')}"
 
 
