@@ -523,3 +523,22 @@ def test_a_simulation_whose_state_overflows_float64_is_a_value_error(puma):
     assert isinstance(info.value, (ValueError, kd.NonFiniteResultError, SimulationError))
     with pytest.raises(ValueError, match="x0 holds an integer too large for float64"):
         kd.simulate(robot, 0.02, 10**400)
+
+
+def test_an_ik_target_beyond_any_reach_is_a_value_error(ur5):
+    for target in (np.full(3, -1e154), np.full((2, 3), 1e200)):
+        with pytest.raises(ValueError, match="beyond 1e\\+100 m"):
+            ur5.inverse_kinematics(target, method="numeric")
+    T = np.eye(4)
+    T[:3, 3] = 1e150
+    with pytest.raises(ValueError, match="target position is 1e\\+150 m from the base"):
+        ur5.inverse_kinematics(T[None], method="numeric")
+
+
+def test_a_step_longer_than_the_span_is_one_step_of_the_span():
+    robot = kd.robots.planar_2r()
+    x0 = np.array([0.3, -0.2, 0.0, 0.0])
+    once = kd.simulate(robot, 0.02, x0, dt=1e300, method="rk4")
+    reference = kd.simulate(robot, 0.02, x0, dt=0.02, method="rk4")
+    np.testing.assert_array_equal(once.q, reference.q)
+    assert once.t[-1] == pytest.approx(0.02)

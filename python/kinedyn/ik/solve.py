@@ -170,15 +170,22 @@ def _target(target) -> tuple:
         except (TypeError, ValueError) as e:
             raise ValueError(f"target must be numbers (a 4x4 pose or a 3-vector position), got {type(target).__name__}: {e}") from None
     shape = t.shape
-    if shape == (4, 4):
-        return t, False, False
-    if shape == (3,):
-        return t, True, False
-    if len(shape) == 3 and shape[1:] == (4, 4):
-        return t, False, True
-    if len(shape) == 2 and shape[1] == 3:
-        return t, True, True
-    raise ValueError(f"target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape}")
+    if shape == (4, 4) or (len(shape) == 3 and shape[1:] == (4, 4)):
+        position, batch = False, len(shape) == 3
+    elif shape == (3,) or (len(shape) == 2 and shape[1] == 3):
+        position, batch = True, len(shape) == 2
+    else:
+        raise ValueError(f"target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape}")
+    # a target so far away that the solver's squared residuals would overflow float64 (NaN and inf
+    # are checked natively)
+    reach = np.abs(t if position else t[..., :3, 3])
+    if np.isfinite(reach).all() and reach.max(initial=0.0) > MAX_REACH:
+        raise ValueError(f"target position is {reach.max():.3g} m from the base: beyond {MAX_REACH:g} m, no robot reaches it "
+                         "(and float64 cannot solve for it)")
+    return t, position, batch
+
+
+MAX_REACH = 1e100  # m: the description's own bound on any length
 
 
 def _mask(mask) -> Optional[tuple]:

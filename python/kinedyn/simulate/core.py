@@ -146,6 +146,7 @@ def _time_grid(t_span, dt, method):
         raise ValueError(f"dt must be a positive step in seconds, got {dt!r}") from None
     if not (dt > 0 and math.isfinite(dt)):
         raise ValueError(f"dt must be a positive step in seconds, got {dt}")
+    dt = min(dt, t1 - t0)  # a step longer than the span: one step of the span
     ratio = (t1 - t0) / dt
     if not ratio < 2.0**53:  # beyond this, t0 + k dt no longer advances in float64 (and no run ends)
         raise ValueError(f"t_span ({t0}, {t1}) with dt = {dt} asks for {ratio:.3g} steps: more than 2**53; raise dt or shorten t_span")
