@@ -23,6 +23,7 @@ import numpy as np
 
 import kinedyn as kd
 from kinedyn import _core
+from kinedyn.testing import example_robot_data_dir
 
 
 def per_call(fn, items, repeat=3) -> float:
@@ -37,7 +38,7 @@ def per_call(fn, items, repeat=3) -> float:
 
 
 def panda():
-    path = Path(np.__file__).resolve().parents[1] / "cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf"
+    path = Path(example_robot_data_dir() or "/nonexistent") / "panda_description/urdf/panda.urdf"
     if not path.exists():
         return None
     return kd.Robot.from_urdf(str(path)).lock_joints({"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0})

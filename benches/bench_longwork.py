@@ -8,7 +8,6 @@ budgets), and of the Panda PD + gravity run (docs/simulation.md) with the defaul
 from __future__ import annotations
 
 import os
-import site
 import subprocess
 import sys
 import tempfile
@@ -18,11 +17,9 @@ import numpy as np
 
 
 def _erd():
-    for d in site.getsitepackages():
-        p = os.path.join(d, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(p):
-            return p
-    return None
+    from kinedyn.testing import example_robot_data_dir
+
+    return example_robot_data_dir()
 
 
 def _report(args, out):

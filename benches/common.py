@@ -11,13 +11,12 @@ from pathlib import Path
 
 
 def erd_robots_dir() -> Path:
-    import site  # the example-robot-data wheel ships its URDFs under site-packages/cmeel.prefix
+    from kinedyn.testing import example_robot_data_dir
 
-    for base in site.getsitepackages():
-        p = Path(base) / "cmeel.prefix/share/example-robot-data/robots"
-        if p.exists():
-            return p
-    raise FileNotFoundError("example-robot-data's robots folder was not found")
+    folder = example_robot_data_dir()
+    if folder is None:
+        raise FileNotFoundError("example-robot-data's robots folder was not found")
+    return Path(folder)
 
 
 PEER_URDFS = {

@@ -12,7 +12,6 @@ out here with Rodrigues' formula rather than borrowed from kinedyn._math.
 from __future__ import annotations
 
 import os
-import site
 
 import numpy as np
 
@@ -92,11 +91,9 @@ PANDA = ("panda_description", "urdf", "panda.urdf")
 
 
 def _find_robots():
-    for sp_dir in site.getsitepackages():
-        candidate = os.path.join(sp_dir, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(candidate):
-            return candidate
-    return None
+    from kinedyn.testing import example_robot_data_dir
+
+    return example_robot_data_dir()
 
 
 def erd(*parts) -> str:

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import site
 
 import numpy as np
 import pytest
@@ -62,11 +61,9 @@ def with_drives(robot: kd.Robot, seed: int = 0) -> kd.Robot:
 
 
 def urdf_dir() -> str:
-    for root in site.getsitepackages() + [site.getusersitepackages()]:
-        d = os.path.join(root, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(d):
-            return d
-    return ""
+    from kinedyn.testing import example_robot_data_dir
+
+    return example_robot_data_dir() or ""
 
 
 def urdf_robots() -> dict:

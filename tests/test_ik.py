@@ -14,6 +14,7 @@ import pytest
 import kinedyn as kd
 from kinedyn import ik
 from kinedyn._math import rot_z, translation
+from kinedyn.testing import example_robot_data_dir
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
@@ -54,7 +55,7 @@ def check_all(robot, result, target, tol=1e-9, frame=None):
 
 
 def panda():
-    site = Path(np.__file__).resolve().parents[1] / "cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf"
+    site = Path(example_robot_data_dir() or "/nonexistent") / "panda_description/urdf/panda.urdf"
     if not site.exists():
         pytest.skip("example-robot-data is not installed (no panda.urdf): pip install example-robot-data")
     robot = kd.Robot.from_urdf(str(site))
@@ -286,7 +287,7 @@ def test_detection_reads_geometry_not_names():
 
 
 def test_urdf_ur5_gets_the_closed_form():
-    path = Path(np.__file__).resolve().parents[1] / "cmeel.prefix/share/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
+    path = Path(example_robot_data_dir() or "/nonexistent") / "ur_description/urdf/ur5_robot.urdf"
     if not path.exists():
         pytest.skip("example-robot-data is not installed")
     robot = kd.Robot.from_urdf(str(path), tool="tool0")

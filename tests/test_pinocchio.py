@@ -9,7 +9,6 @@ leave out; it is removed from kinedyn's results before comparing.
 from __future__ import annotations
 
 import os
-import site
 
 import numpy as np
 import pytest
@@ -23,11 +22,12 @@ TOL = 1e-9
 
 
 def robots_dir() -> str:
-    for root in site.getsitepackages() + [site.getusersitepackages()]:
-        d = os.path.join(root, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(d):
-            return d
-    pytest.skip("example-robot-data (pip install example-robot-data) is not installed")
+    from kinedyn.testing import example_robot_data_dir
+
+    folder = example_robot_data_dir()
+    if folder is None:
+        pytest.skip("example-robot-data (pip install example-robot-data) is not installed")
+    return folder
 
 
 def iiwa_urdf() -> str:

@@ -19,7 +19,20 @@ from .description.joint import Joint
 from .description.link import Frame, Link
 from .robot import Robot
 
-__all__ = ["random_robot", "random_inertia", "check_identities"]
+__all__ = ["random_robot", "random_inertia", "check_identities", "example_robot_data_dir"]
+
+
+def example_robot_data_dir() -> Optional[str]:
+    """The ``robots/`` folder of an installed example-robot-data (its wheel ships the URDFs and meshes
+    under ``site-packages/cmeel.prefix/share/example-robot-data/robots``), or None."""
+    import os
+    import site
+
+    for root in [*site.getsitepackages(), site.getusersitepackages()]:
+        folder = os.path.join(root, "cmeel.prefix", "share", "example-robot-data", "robots")
+        if os.path.isdir(folder):
+            return folder
+    return None
 
 
 def _unit(rng) -> np.ndarray:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import functools
 import os
-import site
 import tempfile
 from dataclasses import dataclass
 
@@ -94,11 +93,9 @@ class Seed:
 
 def erd_robots_dir():
     """example-robot-data's robots/ folder, or None when it is not installed."""
-    for sp_dir in site.getsitepackages():
-        candidate = os.path.join(sp_dir, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(candidate):
-            return candidate
-    return None
+    from kinedyn.testing import example_robot_data_dir
+
+    return example_robot_data_dir()
 
 
 def _read(path: str) -> str:
