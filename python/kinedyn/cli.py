@@ -107,7 +107,7 @@ def _robot_file(spec: str):
     except (OSError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as e:  # a loader should raise only ValueError: say which file it was reading
-        e.kinedyn_context = f"while loading robot file '{spec}'"
+        setattr(e, "kinedyn_context", f"while loading robot file '{spec}'")  # read by the error handler
         raise
 
 

@@ -10,7 +10,10 @@ from __future__ import annotations
 import contextlib
 import sys
 import time
-from typing import Iterator, Optional
+from typing import TYPE_CHECKING, Iterator, Optional
+
+if TYPE_CHECKING:
+    from rich.progress import Progress, TaskID
 
 __all__ = ["Steps", "Delayed", "busy", "wanted"]
 
@@ -31,8 +34,8 @@ class Steps:
     def __init__(self, label: str, total: int, progress: Optional[bool] = None):
         self.label = label
         self.total = max(int(total), 1)
-        self.bar = None
-        self.task = None
+        self.bar: Optional[Progress] = None
+        self.task: Optional[TaskID] = None
         if wanted(progress):
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -46,7 +49,7 @@ class Steps:
 
     def step(self, description: str) -> None:
         """Start the named step (the previous one is done)."""
-        if self.bar is not None:
+        if self.bar is not None and self.task is not None:
             done = self.bar.tasks[0].completed
             if self.bar.tasks[0].description:
                 done += 1
@@ -55,7 +58,7 @@ class Steps:
             self.bar.update(self.task, description=escape(description), completed=min(done, self.total))
 
     def close(self) -> None:
-        if self.bar is not None:
+        if self.bar is not None and self.task is not None:
             self.bar.update(self.task, completed=self.total)
             self.bar.stop()
             self.bar = None
@@ -74,7 +77,8 @@ class Delayed:
 
     def __init__(self, enabled: bool, total: float, label: str, text: str = "{task.completed:.0f} / {task.total:.0f}", delay: float = 0.0):
         self.enabled, self.total, self.label, self.text, self.delay = enabled, total, label, text, delay
-        self.bar = None
+        self.bar: Optional[Progress] = None
+        self.task: Optional[TaskID] = None
         self.start = time.perf_counter()
         self.last = 0.0
         if enabled and delay <= 0:
@@ -86,10 +90,10 @@ class Delayed:
 
         from rich.markup import escape
 
-        self.bar = Progress(TextColumn(escape(self.label)), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
-                            console=Console(file=sys.stderr), transient=True)
-        self.task = self.bar.add_task(self.label, total=self.total)
-        self.bar.start()
+        bar = Progress(TextColumn(escape(self.label)), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
+                       console=Console(file=sys.stderr), transient=True)
+        self.bar, self.task = bar, bar.add_task(self.label, total=self.total)
+        bar.start()
 
     def update(self, done: float) -> None:
         """``done`` units of the total are finished."""
@@ -100,7 +104,7 @@ class Delayed:
             if now - self.start < self.delay or done >= self.total:
                 return
             self._show()
-        if now - self.last > 0.05 or done >= self.total:
+        if self.bar is not None and self.task is not None and (now - self.last > 0.05 or done >= self.total):
             self.bar.update(self.task, completed=min(done, self.total))
             self.last = now
 

@@ -61,7 +61,7 @@ def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: 
     compile time). ``branching=True`` gives a tree (each link's parent is any earlier link)."""
     rng = np.random.default_rng(seed)
     links = []
-    names = []
+    names: list[str] = []
     for i in range(n + fixed):
         moving = i < n
         parent = None if i == 0 else (names[int(rng.integers(0, i))] if branching else names[-1])

@@ -17,12 +17,17 @@ import math
 import os
 import re
 import reprlib
-import tomllib
-from typing import Any, Optional
+import sys
+from typing import Any, NoReturn, Optional
 
 import numpy as np
 import sympy as sp
 import tomli_w
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard library since 3.11
+    import tomli as tomllib
 import yaml
 
 from .._math import as_value, is_symbolic, matmul, pose_inverse, rpy_to_matrix, translation
@@ -211,9 +216,9 @@ def _parse_yaml(text: str, where: str):
         line = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
         raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
     except yaml.reader.ReaderError as e:  # a character YAML does not allow (NUL, other control characters)
-        line = text.count("\n", 0, e.position) + 1
-        character = chr(e.character) if isinstance(e.character, int) else e.character
-        raise ValueError(f"{where}: invalid YAML at line {line}: the character {character!r} is not allowed in YAML") from None
+        line_no = text.count("\n", 0, e.position) + 1
+        shown = chr(e.character) if isinstance(e.character, int) else e.character
+        raise ValueError(f"{where}: invalid YAML at line {line_no}: the character {shown!r} is not allowed in YAML") from None
     except yaml.YAMLError as e:
         raise ValueError(f"{where}: invalid YAML: {e}") from None
     finally:
@@ -274,7 +279,7 @@ class _Reader:
         self.deg = False
         self.lines: dict = {}  # field path (as in messages) -> line, where the parser knew it
 
-    def fail(self, ctx: str, message: str):
+    def fail(self, ctx: str, message: str) -> NoReturn:
         line = self.line_of(ctx)
         at = f", line {line}" if line else ""
         raise ValueError(f"{self.where}{at}: {ctx}: {message}")

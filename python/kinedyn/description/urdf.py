@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import types
 import warnings
 import xml.etree.ElementTree as ET
 from typing import Optional
@@ -102,7 +103,8 @@ def _caller_level() -> int:
     import sys
 
     package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame, level = sys._getframe(1), 1
+    frame: Optional[types.FrameType] = sys._getframe(1)
+    level = 1
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
         frame, level = frame.f_back, level + 1
     return level
@@ -140,6 +142,7 @@ def _parse(path_or_string):
         text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
     if not isinstance(text, str):
         raise TypeError(f"robot_from_urdf expects a path or an XML string, got {type(path_or_string).__name__}")
+    data: str | bytes
     if "<" in text or "\n" in text:  # XML (perhaps malformed), never a file name
         src, data = _Source("<URDF string>"), text
     else:
