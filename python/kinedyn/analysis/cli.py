@@ -53,9 +53,11 @@ def cmd_identify(args) -> int:
         t = Table(title_justify="left")
         for col in ("parameter", "estimate", "std", "true", "error", "error / std"):
             t.add_column(col, justify="right")
+        true = result.true_values
+        assert true is not None  # identify() on a known robot always has the true values
         for k, nm in enumerate(result.names):
-            e = result.errors[k]
-            t.add_row(esc(nm), f"{result.estimates[k]:.8g}", f"{result.std[k]:.2g}", f"{result.true_values[k]:.8g}", f"{e:.2g}",
+            e = result.estimates[k] - true[k]
+            t.add_row(esc(nm), f"{result.estimates[k]:.8g}", f"{result.std[k]:.2g}", f"{true[k]:.8g}", f"{e:.2g}",
                       f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-")
         c.print(t)
         if result.dropped:

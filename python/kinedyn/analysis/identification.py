@@ -25,11 +25,15 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 from ..simulate.control import Fourier
+
+if TYPE_CHECKING:
+    from ..dynamics import BaseParameters
+    from ..robot import Robot
 
 __all__ = ["Measurements", "Identification", "excitation", "simulate_measurements", "identify", "with_inertial_parameters"]
 
@@ -59,12 +63,16 @@ class Identification:
     condition_number: float
     residual_rms: np.ndarray  # per joint
     weighted: bool
-    base: object = field(repr=False)
-    nominal: object = field(repr=False)
+    base: BaseParameters = field(repr=False)
+    nominal: Robot = field(repr=False)
     #: base parameters left out because their regressor columns vanish on the data (round-off level)
     dropped: tuple = ()
-    #: which rows of ``base`` the estimates are for
-    used: np.ndarray = field(default=None, repr=False)
+    #: which rows of ``base`` the estimates are for (None: all of them)
+    used: Optional[np.ndarray] = field(default=None, repr=False)
+
+    def _rows(self) -> np.ndarray:
+        """Indices of the rows of ``base`` the estimates are for."""
+        return np.arange(len(self.base.indices)) if self.used is None else self.used
 
     @property
     def errors(self) -> Optional[np.ndarray]:
@@ -75,17 +83,17 @@ class Identification:
     def relative_errors(self) -> Optional[np.ndarray]:
         if self.true_values is None:
             return None
-        return np.abs(self.errors) / np.maximum(np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max()))
+        return np.abs(self.estimates - self.true_values) / np.maximum(np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max()))
 
     def predict(self, q, qd, qdd) -> np.ndarray:
         """Torques of the identified model (base regressor times estimates plus the known drives)."""
-        Y = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self.used]]
+        Y = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self._rows()]]
         return Y @ self.estimates + self.nominal.armature * np.asarray(qdd) + self.nominal.friction_torque(qd)
 
     def robot(self):
         """A :class:`kinedyn.Robot` with these base parameters (see the module docstring). Raises
         ValueError if the corrected parameters are not physically valid (e.g. a negative mass)."""
-        G = self.base.grouping[self.used]
+        G = self.base.grouping[self._rows()]
         pi0 = self.nominal.inertial_parameters()
         pi = pi0 + np.linalg.pinv(G) @ (self.estimates - G @ pi0)
         return with_inertial_parameters(self.nominal, pi)
@@ -96,8 +104,9 @@ class Identification:
             residual_rms=self.residual_rms, weighted=self.weighted, dropped=list(self.dropped),
         )
         if self.true_values is not None:
-            d.update(true_values=self.true_values, errors=self.errors, max_abs_error=float(np.abs(self.errors).max()),
-                     max_error_in_std=float(np.abs(self.errors / self.std).max()) if np.all(self.std > 0) else None)
+            errors = self.estimates - self.true_values
+            d.update(true_values=self.true_values, errors=errors, max_abs_error=float(np.abs(errors).max()),
+                     max_error_in_std=float(np.abs(errors / self.std).max()) if np.all(self.std > 0) else None)
         return d
 
     def __str__(self) -> str:
@@ -105,7 +114,7 @@ class Identification:
         for k, nm in enumerate(self.names):
             s = f"  {nm:<22} {self.estimates[k]: .8g} +- {self.std[k]:.2g}"
             if self.true_values is not None:
-                s += f"   true {self.true_values[k]: .8g}   error {self.errors[k]: .2g}"
+                s += f"   true {self.true_values[k]: .8g}   error {self.estimates[k] - self.true_values[k]: .2g}"
             lines.append(s)
         return "\n".join(lines)
 

@@ -89,8 +89,9 @@ class Inertia:
     a robot is assembled, by its inertia policy (:func:`judge`)."""
 
     mass: Any = 0.0
-    com: tuple = (0.0, 0.0, 0.0)
-    inertia: tuple = field(default=((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+    com: Any = (0.0, 0.0, 0.0)  # any 3-vector on input; a tuple once constructed
+    inertia: Any = field(default=((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))  # 3x3 array-like; nested tuples once constructed
+    _symbolic: bool = field(default=False, init=False, repr=False, compare=False)  # set by __post_init__
 
     def __post_init__(self):
         object.__setattr__(self, "mass", number(self.mass, "mass"))
@@ -297,7 +298,9 @@ def judge(inertia: Inertia, policy: str, what: str) -> Inertia:
         repaired = inertia.nearest_consistent()
         if key not in _WARNED:
             change = float(np.linalg.norm(np.array(repaired.inertia) - np.array(inertia.inertia)))
-            new = ", ".join(f"{m:.6g}" for m in repaired.consistency().moments)
+            repaired_check = repaired.consistency()
+            assert repaired_check is not None  # a repaired inertia is numeric, so it has a consistency
+            new = ", ".join(f"{m:.6g}" for m in repaired_check.moments)
             warnings.warn(
                 f"{what}: {check.describe()}; repaired to the nearest physically consistent tensor "
                 f"(principal moments {new}; change {change:.3g} kg m^2 in Frobenius norm)",
