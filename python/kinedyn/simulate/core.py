@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -482,7 +482,7 @@ def simulate(
     robot = _is_robot(system)
     mech = None if robot else _as_mechanical(system, params, baumgarte, points)
     target = system if robot else mech
-    n = system.n if robot else mech.n
+    n = system.n if mech is None else mech.n
     name = getattr(system, "name", "system")
     names = _names(target)
     controller_n = getattr(controller, "n", None)
@@ -532,7 +532,7 @@ def simulate(
         progress = bool(work > 1000 and getattr(sys.stderr, "isatty", lambda: False)())
         delay = SHOW_AFTER
     bar = _TimeBar(bool(progress), t0, t0 + steps * dt, f"simulate {name}", delay)
-    if hasattr(controller, "reset"):
+    if controller is not None and hasattr(controller, "reset"):
         controller.reset()
 
     def u_data_for(index):
@@ -627,10 +627,11 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
     per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
     lower, upper = limits if limits is not None else (None, None)
     jacobian = None if jac is None or method != "implicit" else (lambda k, t, q, qd: jac(t, q, qd))
-    parts = []
+    parts: list[Any] = []
     k0, q, qd = 0, q0, qd0
     while True:
         m = min(per, steps - k0)
+        res: tuple[Any, ...]
         if torque_for is None:
             tau = None
             if u_data is not None:
@@ -645,7 +646,7 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
                 cb = _offset(torque_for(0), k0)
                 res = _core.integrate_callback(model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper)
             else:
-                results = [
+                results: list[tuple[Any, ...]] = [
                     _core.integrate_callback(model, method, q[i], qd[i], t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every, max_speed, jacobian, lower, upper)
                     for i in range(batch)
                 ]
@@ -740,7 +741,7 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
         def too_fast(t, x):
             return max_speed - np.abs(x[n:]).max()
 
-        too_fast.terminal = True
+        setattr(too_fast, "terminal", True)  # solve_ivp reads its event options from the function's attributes
         options = {}
         if robot and scipy_method in ("Radau", "BDF", "LSODA"):
             derivatives = _derivatives_fn(target, robot, fext_fn)

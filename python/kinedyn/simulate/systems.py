@@ -25,7 +25,7 @@ system (the KKT matrix of the constrained Euler-Lagrange equations ``M qdd + h +
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -75,7 +75,7 @@ class MechanicalSystem:
         else:
             M, h = self.mass_matrix(q), self.bias(q, qd)
             A = drift = phi = None
-            if self.constrained:
+            if self.constraint_jacobian is not None and self.constraint_drift is not None:  # both or neither
                 A, drift = self.constraint_jacobian(q), self.constraint_drift(q, qd)
                 phi = self.constraint(q) if self.constraint is not None else None
         M = np.asarray(M, dtype=float).reshape(self.n, self.n)
@@ -100,7 +100,7 @@ class MechanicalSystem:
     def constraint_residuals(self, q, qd) -> tuple:
         """(position residual |phi(q)|_inf or 0, velocity residual |A(q) qd|_inf) at one state."""
         pos = float(np.abs(np.atleast_1d(self.constraint(q))).max(initial=0.0)) if self.constraint is not None else 0.0
-        vel = float(np.abs(np.atleast_2d(self.constraint_jacobian(q)) @ qd).max(initial=0.0)) if self.constrained else 0.0
+        vel = float(np.abs(np.atleast_2d(self.constraint_jacobian(q)) @ qd).max(initial=0.0)) if self.constraint_jacobian is not None else 0.0
         return pos, vel
 
     # ------------------------------------------------------------------ from a LagrangianSystem
@@ -145,7 +145,7 @@ class MechanicalSystem:
         if missing:
             raise ValueError(f"{system.name or 'the Lagrangian system'}: give values for the parameters {sorted(missing)} (params={{'name': value}})")
 
-        kwargs = {}
+        kwargs: dict[str, Any] = {}
 
         def compile_(expr, shape):
             fn = sp.lambdify([q, qd], expr, modules="numpy", cse=True)

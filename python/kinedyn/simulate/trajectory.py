@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from functools import cached_property
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -188,7 +188,7 @@ class Trajectory:
     def to_npz(self, path) -> Path:
         """Arrays t, q, qd, qdd, tau, K, P, H and joint names in one compressed NumPy file."""
         path = Path(path)
-        arrays = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, names=np.array(self.names))
+        arrays: dict[str, Any] = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, names=np.array(self.names))
         for key in ("K", "P", "H"):
             try:
                 arrays[key] = getattr(self, key)
@@ -271,6 +271,10 @@ class Trajectory:
         lo, hi = P.reshape(-1, 3).min(axis=0), P.reshape(-1, 3).max(axis=0)
         centre, radius = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3) * 1.1
         fig = plt.figure(figsize=(5, 5))
+        # a 2-D Axes or an mplot3d Axes3D, whose text2D and Line3D.set_3d_properties are untyped
+        ax: Any
+        line: Any
+        path_line: Any
         if planar:
             ax = fig.add_subplot(111)
             ax.set_aspect("equal")
