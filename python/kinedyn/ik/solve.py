@@ -319,8 +319,10 @@ def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:
 
 
 def _analytic(robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int) -> IKResult:
-    sols, pe, oe, found, singular = chain.solver.solve(t, q_ref, respect_limits, tolerance)
-    name = "analytic:" + chain.solver.structure
+    solver = chain.solver
+    assert solver is not None  # callers take this route only for a chain with a closed form
+    sols, pe, oe, found, singular = solver.solve(t, q_ref, respect_limits, tolerance)
+    name = "analytic:" + solver.structure
     if len(sols):
         return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else ""))
     if found:
@@ -416,8 +418,10 @@ def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect
     N = len(t)
     w = np.asarray(weights if weights is not None else _FULL_MASK)
     if use_analytic:
+        solver = chain.solver
+        assert solver is not None  # use_analytic means the chain has a closed form
         refs = np.ascontiguousarray(np.broadcast_to(q0, (N, chain.n)))
-        q, ok, pe, oe = chain.solver.solve_nearest(t, refs, respect_limits, tolerance)
+        q, ok, pe, oe = solver.solve_nearest(t, refs, respect_limits, tolerance)
         it = np.zeros(N, dtype=np.int64)
         none = ~ok
         if none.any():  # no closed-form solution: the numeric solver's best attempt, never a NaN row (§8)
@@ -425,7 +429,7 @@ def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect
                                                           tolerance, max_iterations, restarts, seed)
             q[none], pe[none], oe[none], it[none] = qn, pen, oen, itn
             ok[none] = okn & (pen <= tolerance) & (oen <= tolerance)
-        return IKBatchResult(q, ok, pe, oe, it, "analytic:" + chain.solver.structure)
+        return IKBatchResult(q, ok, pe, oe, it, "analytic:" + solver.structure)
     q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed, progress)
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")

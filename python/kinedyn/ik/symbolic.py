@@ -136,11 +136,12 @@ def symbolic_elbow_solution(L1=None, L2=None, L3=None) -> ElbowSolution:
             up = (sign < 0) if front else (sign > 0)
             name = f"shoulder {'front' if front else 'back'}, elbow {'up' if up else 'down'}"
             branches.append({"name": name, "theta1": th1, "theta2": th2, "theta3": th3})
-    sol = ElbowSolution(x, y, z, s1, s2, s3, D, branches, steps, reachable=sp.Le(sp.Abs(D), 1))
+    reachable = sp.Le(sp.Abs(D), 1)
+    sol = ElbowSolution(x, y, z, s1, s2, s3, D, branches, steps, reachable=reachable)
     given = {k: v for k, v in ((s1, L1), (s2, L2), (s3, L3)) if v is not None}
     if given:
         sol.D = sol.D.subs(given)
         sol.branches = [{k: (v.subs(given) if isinstance(v, sp.Basic) else v) for k, v in b.items()} for b in branches]
         sol.steps = [(t, e.subs(given)) for t, e in steps]
-        sol.reachable = sol.reachable.subs(given)
+        sol.reachable = reachable.subs(given)
     return sol

@@ -183,10 +183,10 @@ def _c_callable(lib, prefix, name, shape, n, p):
         single = lambda q, qd, qdd, out: single_c(ptr(q), ptr(qd), ptr(qdd), pptr, ptr(out))
         batch = lambda N, q, qd, qdd, out: batch_c(N, ptr(q), ptr(qd), ptr(qdd), pptr, ptr(out))
 
-    def call(*xs):
-        if len(xs) != len(args):
-            raise TypeError(f"{name} takes {len(args)} arrays ({', '.join(args)}), got {len(xs)}")
-        xs = [np.ascontiguousarray(x, dtype=np.float64) for x in xs]
+    def call(*given):
+        if len(given) != len(args):
+            raise TypeError(f"{name} takes {len(args)} arrays ({', '.join(args)}), got {len(given)}")
+        xs = [np.ascontiguousarray(x, dtype=np.float64) for x in given]
         first = xs[0]
         if first.shape[-1] != n or first.ndim not in (1, 2):
             raise ValueError(f"{name}: expected arrays of shape ({n},) or (N, {n}), got {first.shape}")

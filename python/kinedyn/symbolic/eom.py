@@ -9,7 +9,7 @@ led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and gene
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence
 
 import sympy as sp
 
@@ -99,6 +99,8 @@ class EquationsOfMotion:
         self.program = program  # Newton-Euler customised model (kinedyn.symbolic.newton_euler.Program)
         self.model = model  # (RingModel, derivation dict) for robots
         self.extra = dict(extra or {})
+        #: robot equations: the Newton-Euler derivation, computed on first use (see robot_eom)
+        self._derived: Optional[Callable[[], Dict[str, Any]]] = None
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod

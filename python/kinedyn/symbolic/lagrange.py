@@ -168,7 +168,13 @@ class RingModel:
         ring, n = self.ring, self.n
         bodies = self.robot.tree.bodies
         zero = ring.zero
-        self.E, self.r, self.R, self.p, self.Jv, self.Jw = [], [], [], [], [], []
+        # per body: the ring's polynomial matrices and vectors (lists of lists of ring elements)
+        self.E: list = []
+        self.r: list = []
+        self.R: list = []
+        self.p: list = []
+        self.Jv: list = []
+        self.Jw: list = []
         for i, b in enumerate(bodies):
             P_R = [[self._c(x) for x in row] for row in self.place_R[i]]
             P_p = [self._c(x) for x in self.place_p[i]]

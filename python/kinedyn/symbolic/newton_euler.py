@@ -46,7 +46,7 @@ derivation can be shown step by step (:func:`newton_euler_steps`).
 
 from __future__ import annotations
 
-from typing import Dict, List
+from typing import Any, Dict, List
 
 import sympy as sp
 
@@ -331,7 +331,9 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             N[j] = [let(f"N{J}{_XYZ[k]}", Jwd[k] + c1[k] + c2[k]) for k in range(3)]
         prog.vectors[("F", j)], prog.vectors[("N", j)] = F[j], N[j]
     # ---- backward recursion: f_j = F_j + sum E_c f_c ; n_j = N_j + sum (E_c n_c + r_c x E_c f_c)
-    f, nn, tau = {}, {}, [None] * n
+    f: Dict[int, Any] = {}
+    nn: Dict[int, Any] = {}
+    tau: List[Any] = [None] * n
     for j in reversed(range(n)):
         J = j + 1
         prog.tag = ("backward", J)
@@ -360,7 +362,10 @@ def _let_tagged(prog, name, expr):
     """A grouped-parameter variable, tagged with its link (the digits of its name)."""
     import re
 
-    prog.tag = ("parameters", int(re.search(r"(\d+)$", name).group(1)))
+    link = re.search(r"(\d+)$", name)
+    if link is None:
+        raise ValueError(f"grouped-parameter name {name!r} does not end in its link's number")
+    prog.tag = ("parameters", int(link.group(1)))
     return prog.let(name, expr)
 
 

@@ -26,7 +26,7 @@ printed Theta3 and Theta5 differ).
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Dict, List
+from typing import Any, Dict, List
 
 import sympy as sp
 
@@ -36,6 +36,8 @@ __all__ = ["regressor", "base_parameters", "Regressor"]
 class Regressor(tuple):
     """``(Y, Theta)`` (unpacks as a pair) with ``Y * Theta + tau_known == tau`` (friction left out).
     ``tau_known``: the part of tau with no unknown parameter (an n x 1 SymPy matrix, often zero)."""
+
+    tau_known: Any
 
     def __new__(cls, Y, Theta, tau_known):
         obj = super().__new__(cls, (Y, Theta))

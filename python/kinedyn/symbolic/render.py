@@ -29,6 +29,9 @@ _GREEK = {"tau": "τ", "omega": "ω", "theta": "θ", "alpha": "α", "partial": "
 class Name(str):
     """LaTeX of a left-hand side, with ``.text`` and ``.mathml`` (see the module docstring)."""
 
+    text: str
+    mathml: str
+
     def __new__(cls, latex: str, text: str, mathml: str):
         obj = super().__new__(cls, latex)
         obj.text = text
@@ -169,8 +172,9 @@ class _Printer(MathMLPresentationPrinter):
         if sym in self._given:
             from xml.dom.minidom import parseString
 
-            node = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement.firstChild
-            return node
+            root = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement
+            assert root is not None  # a parsed document always has its root element
+            return root.firstChild
         return super()._print_Symbol(sym, style)
 
 

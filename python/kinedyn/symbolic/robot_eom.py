@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any, Dict
+
 import sympy as sp
 
 from .eom import EquationsOfMotion, Step
@@ -184,7 +186,7 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
     prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
     friction = _friction(robot, qd)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
-    cache = {}
+    cache: Dict[str, Any] = {}
 
     def derived():
         if not cache:

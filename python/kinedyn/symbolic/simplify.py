@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 from functools import lru_cache
-from typing import Dict, Iterable, Sequence, Tuple
+from typing import Any, Dict, Iterable, Sequence, Tuple
 
 import sympy as sp
 from sympy.polys.rings import PolyRing, sring
@@ -242,7 +242,7 @@ class TrigRing:
         sidx = list(self.s_idx.items())
         if all(m[j] < 2 for m in p.keys() for _, j in sidx):
             return p
-        clean = {}
+        clean: dict = {}
         dirty = self.zero
         for m, c in p.items():
             if all(m[j] < 2 for _, j in sidx):
@@ -330,7 +330,7 @@ class TrigRing:
         trig_js = sorted(list(self.c_idx.values()) + list(self.s_idx.values()))
         rev = sorted(self.c_idx)
         nparam = self.nparams
-        groups: Dict[tuple, Dict[tuple, object]] = {}
+        groups: Dict[tuple, Dict[tuple, Any]] = {}
         to_sym = self.domain.to_sympy
         for m, c in p.items():
             pm = m[:nparam]
@@ -402,9 +402,9 @@ def _mul_exp(poly, i, n, factor):
     out: dict = {}
     for k, (re, im) in poly.items():
         for shift, (fr, fi) in ((1, (pr, pi_)), (-1, (mr, mi))):
-            kk = list(k)
-            kk[i] += shift
-            kk = tuple(kk)
+            shifted = list(k)
+            shifted[i] += shift
+            kk = tuple(shifted)
             r0, i0 = out.get(kk, (Fraction(0), Fraction(0)))
             out[kk] = (r0 + re * fr - im * fi, i0 + re * fi + im * fr)
     return out

@@ -16,7 +16,7 @@ Spong §9.1-9.3), not only joint-coordinate robots.
 from __future__ import annotations
 
 import re
-from typing import Sequence
+from typing import Any, Sequence
 
 import sympy as sp
 from sympy.core.function import AppliedUndef
@@ -133,9 +133,15 @@ class LagrangianSystem:
             raise ValueError("give either K and P or L, not both")
         # in expressions given as strings, coordinate and velocity names are these symbols
         self._names = names = {v.name: v for v in [*coords, *qd, *self.qdd, self.t] if isinstance(v, sp.Symbol)}
-        self.K = sub(_scalar(K, "the kinetic energy K", names)) if K is not None else None
-        self.P = sub(_scalar(P, "the potential energy P", names)) if K is not None else None
-        self.L = sub(_scalar(L, "the Lagrangian L", names)) if L is not None else self.K - self.P
+        # SymPy expressions; K and P None when the Lagrangian was given
+        self.K: Any = None
+        self.P: Any = None
+        if K is not None:
+            self.K = sub(_scalar(K, "the kinetic energy K", names))
+            self.P = sub(_scalar(P, "the potential energy P", names))
+            self.L: Any = self.K - self.P
+        else:
+            self.L = sub(_scalar(L, "the Lagrangian L", names))
         for i, (c, v) in enumerate(zip(coords, qd)):
             if not self.L.has(v):
                 src = "kinetic energy K" if K is not None else "Lagrangian L"
