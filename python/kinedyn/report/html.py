@@ -17,7 +17,7 @@ import math
 import re
 from importlib import resources
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -88,14 +88,13 @@ def _model_for_view(robot, q) -> dict:
 SIMULATION_BUDGET = 30.0
 
 
-def _simulate(robot, q0, qd0, t_end: float, samples: int = 241, time_budget: Optional[float] = SIMULATION_BUDGET, progress: Optional[bool] = False) -> Dict[str, object]:
+def _simulate(robot, q0, qd0, t_end: float, samples: int = 241, time_budget: Optional[float] = SIMULATION_BUDGET, progress: Optional[bool] = False) -> Dict[str, Any]:
     """Free motion (tau = 0) from (q0, qd0) with kd.simulate (method "auto": RK4, or implicit Euler
     for a stiff robot), about ``samples`` samples kept, bounded by ``time_budget`` wall-clock seconds.
     A run cut short (the budget, or a blow-up) keeps its samples and says why in "note"."""
     import warnings
 
-    import kinedyn as kd
-    from ..simulate import SimulationError, SimulationTruncatedWarning
+    from ..simulate import SimulationError, SimulationTruncatedWarning, simulate
 
     dt = 1e-3
     steps = max(1, int(math.ceil(t_end / dt - 1e-9)))
@@ -105,7 +104,7 @@ def _simulate(robot, q0, qd0, t_end: float, samples: int = 241, time_budget: Opt
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SimulationTruncatedWarning)  # said in the report instead
-            traj = kd.simulate(robot, (0.0, t_end), x0, dt=dt, record_every=every, time_budget=time_budget, progress=progress)
+            traj = simulate(robot, (0.0, t_end), x0, dt=dt, record_every=every, time_budget=time_budget, progress=progress)
         if traj.info.get("truncated"):
             note = f"The simulation was cut short: {traj.info['truncated']}."
     except SimulationError as e:
@@ -347,7 +346,8 @@ def _matrix_table(M, rows: Sequence[str], cols: Sequence[str], cls: str) -> str:
 
 
 def _asset(name: str) -> str:
-    return resources.files("kinedyn.report").joinpath("assets", name).read_text(encoding="utf-8")
+    # one step per joinpath: Python 3.10's Traversable.joinpath takes a single name
+    return resources.files("kinedyn.report").joinpath("assets").joinpath(name).read_text(encoding="utf-8")
 
 
 # Characters that may not appear raw in JSON embedded in a <script> element, with their JSON escapes.

@@ -24,7 +24,7 @@ __all__ = ["QUESTIONS", "PRINTED", "QUESTION_DATA", "Answer", "Comparison", "ans
 QUESTIONS = ["1a", "1b", "2a", "2b", "3", "challenge"]
 
 # ------------------------------------------------------------------ the tutorial's inputs
-QUESTION_DATA = {
+QUESTION_DATA: Dict[str, Dict[str, Any]] = {
     "2a": {"l1": 2.0, "l2": 3.0, "theta_deg": (167.028, -156.44), "theta_decimals": (3, 2), "qd": (1.0, 3.0)},
     "2b": {"F": (30.0, -20.0)},
     "challenge": {"L1": 3.0, "L2": 2.0, "L3": 1.0, "tool": (1.0, 0.2, 0.5)},
@@ -35,7 +35,7 @@ QUESTION_DATA = {
 # strings in th1, th2 (joint angles), thd1, thd2 (rates), thdd1, thdd2, l1, l2, m1, m2, g; numbers are
 # strings so that the printed number of digits is kept. Never used as a source of truth: each is
 # compared with kinedyn and with an independent check.
-PRINTED = {
+PRINTED: Dict[str, Dict[str, Any]] = {
     "1a": {"J": "Matrix([[-l1*sin(th1) - l2*sin(th1 + th2), -l2*sin(th1 + th2)],"
                 " [l1*cos(th1) + l2*cos(th1 + th2), l2*cos(th1 + th2)]])"},
     "1b": {"J_inv": "Matrix([[l2*cos(th1 + th2), l2*sin(th1 + th2)],"
@@ -300,7 +300,7 @@ def _q_box(q_deg: Sequence[float], decimals: Sequence[int]) -> List[np.ndarray]:
     return corners
 
 
-def _agrees_within_rounding(printed_str: str, f: Callable[[np.ndarray], float], q_deg, decimals) -> bool:
+def _agrees_within_rounding(printed_str: str, f: Callable[..., float], q_deg, decimals) -> bool:
     """True when the printed number lies within kinedyn's value over the rounding of the tutorial's
     input angles, widened by half a unit in the printed number's last digit."""
     values = [f(q) for q in _q_box(q_deg, decimals)]
@@ -567,6 +567,7 @@ def _q3() -> Answer:
             ok_pr &= abs(vp - r) <= tol
             ok_kd &= abs(vk - r) <= tol
             shown = shown or (vp, vk, r)
+        assert shown is not None  # arms is a fixed, non-empty list of test arms
         diff = sp.simplify(sp.expand_trig(sp.expand(kd_expr - pr)))
         check = (f"finite differences of the geometric model at m1=1.3, m2=2.1, l1=1.7, l2=2.3, theta=(0.4, -1.1), thetadot=(0.9, 1.6), "
                  f"thetaddot=(0.7, -0.5): {_fmt(shown[2])}; printed expression: {_fmt(shown[0])}; kinedyn: {_fmt(shown[1])}")
@@ -636,8 +637,10 @@ def _challenge() -> Answer:
            "shoulder at height L1, joints 2 and 3 horizontal, zero pose with both arms along x0 (docs/seed-notes.md §3). "
            "The tutorial prints no solution, so nothing is compared; every result is checked instead.")
     robot = robots.elbow_3r(L1=d["L1"], L2=d["L2"], L3=d["L3"])
+    dh = robot.dh
+    assert dh is not None  # elbow_3r is built from its DH table
     rows = []
-    for i, r in enumerate(robot.dh, start=1):
+    for i, r in enumerate(dh, start=1):
         rows.append([str(i), f"theta{i}*", _fmt(r.d), _fmt(r.a), f"{_fmt(math.degrees(r.alpha))} deg"])
     a.table("DH table (standard: Rz(theta) Tz(d) Tx(a) Rx(alpha); * = joint variable)", ["link", "theta", "d [m]", "a [m]", "alpha"], rows)
     # symbolic FK and Jacobian from the symbolic robot
@@ -645,7 +648,7 @@ def _challenge() -> Answer:
 
     # the same DH table with the lengths as symbols
     Ls = sp.symbols("L1 L2 L3", positive=True)
-    sym = Robot.from_dh([(r.theta, Ls[0] if i == 0 else r.d, Ls[i] if i else r.a, r.alpha) for i, r in enumerate(robot.dh)])
+    sym = Robot.from_dh([(r.theta, Ls[0] if i == 0 else r.d, Ls[i] if i else r.a, r.alpha) for i, r in enumerate(dh)])
     t1, t2, t3 = sp.symbols("theta1 theta2 theta3", real=True)
     q = [t1, t2, t3]
     T = symbolic_frame_pose(sym, q)
@@ -694,7 +697,6 @@ def _challenge() -> Answer:
         a.text(f"kinedyn's inverse kinematics (robot.inverse_kinematics) returns {len(kd_solutions)} solutions; {matched} of the 4 above are among them.")
     # Jacobian
     Jv = o3.jacobian(q).applyfunc(sp.trigsimp)
-    z_axes = []
     poses = _body_axes(sym, q)
     Jw = sp.Matrix.hstack(*poses).applyfunc(_clean)
     J = sp.Matrix.vstack(Jv, Jw)
@@ -718,7 +720,7 @@ def _challenge() -> Answer:
             [[rn_, *row] for rn_, row in zip(["vx", "vy", "vz", "wx", "wy", "wz"], _mat_rows(jac[0], 7))])
     a.text(f"Check: the symbolic J evaluated at the four solutions equals the numeric engine's robot.jacobian(q): max difference {worst:.1e}.")
     a.result = {
-        "dh": [{"theta": f"theta{i}", "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha)} for i, r in enumerate(robot.dh, 1)],
+        "dh": [{"theta": f"theta{i}", "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha)} for i, r in enumerate(dh, 1)],
         "solutions_rad": sols.tolist(),
         "branches": names,
         "fk_residuals": residuals,
@@ -735,7 +737,7 @@ def _body_axes(robot, q) -> List[sp.Matrix]:
     """The joint axes in base coordinates (columns of J_w for revolute joints)."""
     from .._math import rot_axis, translation
 
-    poses = []
+    poses: List[Any] = []
     axes = []
     for i, b in enumerate(robot.tree.bodies):
         parent = sp.eye(4) if b.parent < 0 else poses[b.parent]
