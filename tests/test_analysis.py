@@ -147,3 +147,19 @@ def test_cli_check_and_identify(capsys):
     assert code == 0 and doc["max_abs_error"] < 1e-8
     base = kd.robots.planar_2r().base_parameters()
     np.testing.assert_allclose(doc["true_values"], base.values)
+
+
+def test_identification_without_used_rows_means_all_base_parameters():
+    """``Identification.used`` defaults to None: the estimates are for every base parameter (it
+    indexed the regressor with None before, adding an axis to the predicted torques)."""
+    from dataclasses import replace
+
+    robot = kd.robots.planar_2r()
+    data = an.simulate_measurements(robot, an.excitation(robot, harmonics=3, period=2.0), T=2.0, rate=50.0)
+    result = an.identify(robot, data)
+    assert result.dropped == ()
+    everything = replace(result, used=None)
+    rng = np.random.default_rng(3)
+    q, qd, qdd = rng.normal(size=(5, 2)), rng.normal(size=(5, 2)), rng.normal(size=(5, 2))
+    np.testing.assert_allclose(everything.predict(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
+    np.testing.assert_allclose(everything.robot().inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)

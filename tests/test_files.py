@@ -229,3 +229,28 @@ def test_unknown_extension_and_missing_file(tmp_path):
         load(tmp_path / "missing.yaml")
     with pytest.raises(ValueError, match=r"can only save robots as"):
         save(kd.robots.planar_2r(), tmp_path / "r.urdf")
+
+
+
+def test_toml_reader_imports_tomli_before_python_3_11(monkeypatch, tmp_path):
+    """requires-python is 3.10, where the standard library has no tomllib: the file reader takes
+    tomli (the same parser, a dependency there). Simulated here: the version says 3.10, tomllib
+    cannot be imported and tomllib itself stands in for tomli."""
+    import importlib.util
+    import sys
+    import tomllib
+
+    import kinedyn.description.files as files
+
+    path = tmp_path / "robot.toml"
+    save(kd.robots.planar_2r(), path)
+    monkeypatch.setattr(sys, "version_info", (3, 10, 14, "final", 0))
+    monkeypatch.setitem(sys.modules, "tomllib", None)  # import tomllib raises ImportError
+    monkeypatch.setitem(sys.modules, "tomli", tomllib)
+    name = "kinedyn.description._files_on_310"
+    spec = importlib.util.spec_from_file_location(name, files.__file__)
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, name, module)
+    spec.loader.exec_module(module)
+    assert module.tomllib is tomllib
+    assert module.load(path).n == 2
