@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from functools import cached_property
-from typing import Mapping, Optional, Sequence
+from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import sympy as sp
@@ -20,6 +20,11 @@ from .description.dh import DHRow, links_from_dh
 from .description.joint import Joint
 from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
+
+if TYPE_CHECKING:
+    from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
+    from .dynamics import BaseParameters
+    from .symbolic.eom import EquationsOfMotion
 
 __all__ = ["Robot"]
 
@@ -107,7 +112,7 @@ class Robot:
         return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
-    def from_urdf(cls, path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
@@ -255,7 +260,7 @@ class Robot:
         """Coulomb friction level per joint."""
         return np.array([float(j.coulomb) for j in self.joints])
 
-    def friction_torque(self, qd) -> np.ndarray:
+    def friction_torque(self, qd: ArrayLike) -> np.ndarray:
         """viscous * qd + coulomb * sign(qd), (n,) or (N, n)."""
         qd = real_array(qd, "qd")
         if qd.shape[-1:] != (self.n,) or qd.ndim > 2:
@@ -333,7 +338,7 @@ class Robot:
             ]
         return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
 
-    def save(self, path) -> None:
+    def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
         from .description.files import save
 
@@ -410,17 +415,17 @@ class Robot:
         return p
 
     # kinematics ---------------------------------------------------------------------------
-    def forward_kinematics(self, q) -> np.ndarray:
+    def forward_kinematics(self, q: ArrayLike) -> np.ndarray:
         """Poses of the moving links' frames in the base: (n, 4, 4), or (N, n, 4, 4) for a batch."""
         return self._model.frame_poses(self._state(q), self._link_frame_ids)
 
-    def frame_poses(self, q, frames: Optional[Sequence[str]] = None) -> np.ndarray:
+    def frame_poses(self, q: ArrayLike, frames: Optional[Sequence[str]] = None) -> np.ndarray:
         """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
         names = self.frame_names if frames is None else list(frames)
         ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
         return self._model.frame_poses(self._state(q), ids)
 
-    def pose(self, q, frame: Optional[str] = None) -> np.ndarray:
+    def pose(self, q: ArrayLike, frame: Optional[str] = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
         out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
         return out[0] if out.ndim == 3 else out[:, 0]
@@ -436,7 +441,7 @@ class Robot:
             ids = self._frame_id_arrays[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
         return ids
 
-    def jacobian(self, q, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+    def jacobian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Geometric Jacobian (6, n), rows [linear; angular] (see docs/conventions.md).
 
         ``reference="world"``: velocity of the frame origin (or of ``point``, given in the frame's
@@ -449,15 +454,15 @@ class Robot:
             fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
         return self._model.jacobian(self._state(q), fid, ref, point)
 
-    def frame_velocity(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+    def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
-    def jacobian_dot_qd(self, q, qd, frame: Optional[str] = None, reference: str = "world", point=None) -> np.ndarray:
+    def jacobian_dot_qd(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
         return self._model.jdot_qd(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
-    def inverse_kinematics(self, target, q0=None, mask=None, method: str = "auto", respect_limits: bool = True, **kwargs):
+    def inverse_kinematics(self, target: ArrayLike, q0: Optional[ArrayLike] = None, mask: Optional[ArrayLike] = None, method: str = "auto", respect_limits: bool = True, **kwargs):  # IKResult, or IKBatchResult for a batch of targets
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
@@ -538,7 +543,7 @@ class Robot:
     def _scalar(x):
         return float(x) if np.ndim(x) == 0 else x
 
-    def inverse_dynamics(self, q, qd, qdd, f_ext=None, out=None) -> np.ndarray:
+    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
         ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
@@ -550,20 +555,20 @@ class Robot:
         q = self._state(q)
         return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext), out)
 
-    def mass_matrix(self, q, out=None) -> np.ndarray:
+    def mass_matrix(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric.
         ``out``: a float64 array of the result's shape to write into instead of allocating one (as
         NumPy's ``out=``; also on the other per-step methods, for control loops)."""
         return self._model.mass_matrix(q, out)
 
-    def mass_matrix_inverse(self, q, out=None) -> np.ndarray:
+    def mass_matrix_inverse(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
             return self._model.mass_matrix_inverse(q, out)
         except RuntimeError as e:
             raise self._singular(e) from None
 
-    def forward_dynamics(self, q, qd, tau, f_ext=None, out=None) -> np.ndarray:
+    def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
         """qdd solving M qdd = tau - C qd - g - friction + sum_i J_i^T f_ext_i (articulated-body
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
@@ -575,7 +580,7 @@ class Robot:
         except RuntimeError as e:
             raise self._singular(e) from None
 
-    def inverse_dynamics_derivatives(self, q, qd, qdd, f_ext=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dtau/dq, dtau/dqd, dtau/dqdd = M)`` of :meth:`inverse_dynamics`, each (n, n) (or
         (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical and exact, O(n^2), from one pass
         in world coordinates (Pinocchio's ``computeRNEADerivatives``; the derivation is in the
@@ -589,7 +594,7 @@ class Robot:
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq + shift), dqd, M
 
-    def forward_dynamics_derivatives(self, q, qd, tau, f_ext=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
         (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
@@ -603,7 +608,7 @@ class Robot:
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq - Minv @ shift), dqd, Minv
 
-    def _moment_shift_derivative(self, q, f_ext) -> Optional[np.ndarray]:
+    def _moment_shift_derivative(self, q: ArrayLike, f_ext) -> Optional[np.ndarray]:
         """The part of dtau/dq the core does not see: :meth:`_f_ext` moves each moment to the body
         origin with ``d_i(q) x f_i``, and ``d_i = R_i u_i`` turns with the joints supporting body i,
         ``dd_i/dq_j = w_j x d_i`` (``w_j``: joint j's world axis, column j of body i's angular
@@ -620,45 +625,45 @@ class Robot:
         dm = np.cross(dd, f[..., :, None, :3])  # (w_j x d_b) x f_b
         return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
 
-    def coriolis_matrix(self, q, qd, out=None) -> np.ndarray:
+    def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         return self._model.coriolis_matrix(q, qd, out)
 
-    def christoffel(self, q) -> np.ndarray:
+    def christoffel(self, q: ArrayLike) -> np.ndarray:
         """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
         ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
         return self._model.christoffel(q)
 
-    def gravity_torque(self, q, out=None) -> np.ndarray:
+    def gravity_torque(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """g(q) = dP/dq."""
         return self._model.gravity_torque(q, out)
 
-    def bias_torque(self, q, qd, out=None) -> np.ndarray:
+    def bias_torque(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
         return self._model.bias_torque(q, qd, out)
 
-    def kinetic_energy(self, q, qd):
+    def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> FloatOrArray:
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
         return self._scalar(self._model.kinetic_energy(q, qd))
 
-    def potential_energy(self, q):
+    def potential_energy(self, q: ArrayLike) -> FloatOrArray:
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
         return self._scalar(self._model.potential_energy(q))
 
-    def center_of_mass(self, q) -> np.ndarray:
+    def center_of_mass(self, q: ArrayLike) -> np.ndarray:
         """Centre of mass of the moving links in base coordinates, (3,) or (N, 3)."""
         return self._model.center_of_mass(q)
 
-    def momentum(self, q, qd) -> np.ndarray:
+    def momentum(self, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
         """Spatial momentum of the robot, (6,) or (N, 6): [linear momentum; angular momentum about
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
-    def regressor(self, q, qd, qdd) -> np.ndarray:
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         return self._model.regressor(q, qd, qdd)
 
-    def base_parameters(self, samples: int = 200, rng=0, tol: float = 1e-9):
+    def base_parameters(self, samples: int = 200, rng: SeedLike = 0, tol: float = 1e-9) -> BaseParameters:
         """A minimal identifiable parameter set (:class:`kinedyn.dynamics.BaseParameters`): column
         indices of the regressor kept, the grouping matrix with ``pi_base = grouping @ pi``, and
         ``pi_base`` of this robot, so that ``Y[:, indices] @ pi_base == Y @ pi``. Found by QR with
@@ -668,7 +673,7 @@ class Robot:
         return base_parameters(self, samples=samples, rng=rng, tol=tol)
 
     # symbolic engine ----------------------------------------------------------------------
-    def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs):
+    def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs) -> EquationsOfMotion:
         """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
         from .symbolic import equations_of_motion
 
@@ -678,7 +683,7 @@ class Robot:
         """The zero configuration (n,)."""
         return np.zeros(self.n)
 
-    def random_configuration(self, rng=None, size=None) -> np.ndarray:
+    def random_configuration(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
         """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
         if size is not None and not (isinstance(size, (int, np.integer)) and size >= 0):
             raise ValueError(f"size must be a whole number of configurations >= 0 (or None for one), got {size!r}")
