@@ -15,9 +15,15 @@ numerical rank) are independent columns ``W_1``, the rest satisfy ``W_2 = W_1 be
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Optional
+
 from dataclasses import dataclass
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ._typing import ArrayLike, SeedLike
+    from .robot import Robot
 
 __all__ = ["BaseParameters", "base_parameters", "linearize"]
 
@@ -50,7 +56,7 @@ class BaseParameters:
 PARAMETER_NAMES = ("m", "m cx", "m cy", "m cz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 
 
-def base_parameters(robot, samples: int = 200, rng=0, tol: float = 1e-9) -> BaseParameters:
+def base_parameters(robot: Robot, samples: int = 200, rng: SeedLike = 0, tol: float = 1e-9) -> BaseParameters:
     """Base parameters of ``robot`` from ``samples`` random states (seeded by ``rng``).
 
     ``tol``: a pivot ``|R_kk| <= tol |R_00|`` ends the independent set (numerical rank).
@@ -91,7 +97,7 @@ def base_parameters(robot, samples: int = 200, rng=0, tol: float = 1e-9) -> Base
     return BaseParameters(indices=indices, grouping=grouping, values=grouping @ robot.inertial_parameters(), names=names)
 
 
-def linearize(robot, q, qd=None, tau=None):
+def linearize(robot: Robot, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray]:
     """``(A, B)`` of ``d/dt [dq; dqd] = A [dq; dqd] + B dtau``: the equations of motion
     ``qdd = FD(q, qd, tau)`` linearised about ``(q, qd, tau)`` with the analytical derivatives
     (:meth:`kinedyn.Robot.forward_dynamics_derivatives`)::

@@ -9,11 +9,15 @@ Jacobians of :meth:`kinedyn.Robot.jacobian` (default "world": base axes, textboo
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Sequence, Union
+from typing import Optional, Sequence, TYPE_CHECKING, Union
 
 import numpy as np
 
 from ._arrays import finite_result, real_array
+
+if TYPE_CHECKING:
+    from ._typing import ArrayLike
+    from .robot import Robot
 
 __all__ = [
     "task_rows",
@@ -52,7 +56,7 @@ def task_rows(task: Task) -> list:
     return rows
 
 
-def task_jacobian(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def task_jacobian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
     """The selected rows of the frame Jacobian: (m, n), or (N, m, n) for a batch of q."""
     return robot.jacobian(q, frame, reference)[..., task_rows(task), :]
 
@@ -74,7 +78,7 @@ def _mul(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (A @ v[..., None])[..., 0]
 
 
-def tool_velocity(robot, q, qd, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def tool_velocity(robot: Robot, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
     """Tool twist (selected rows) ``J(q) qd``; (N, m) for a batch of q and/or qd."""
     J = task_jacobian(robot, q, frame, task, reference)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -82,7 +86,7 @@ def tool_velocity(robot, q, qd, frame: Optional[str] = None, task: Task = "full"
     return finite_result(v, "tool_velocity: v", v.ndim - 1)
 
 
-def joint_torques(robot, q, wrench, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def joint_torques(robot: Robot, q: ArrayLike, wrench: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
     """Static joint torques balancing a tool wrench: ``tau = J^T F`` (Spong §4.10); (N, n) for a batch.
 
     ``wrench`` has one entry per task row (e.g. (Fx, Fy) with ``task="planar"``; [force; moment]
@@ -146,12 +150,12 @@ def joint_velocities(
     return finite_result(qd, "joint_velocities: qd", qd.ndim - 1)
 
 
-def singular_values(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def singular_values(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
     """Singular values of the task Jacobian, descending; (N, k) for a batch."""
     return np.linalg.svd(task_jacobian(robot, q, frame, task, reference), compute_uv=False)
 
 
-def manipulability(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world"):
+def manipulability(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> Union[float, np.ndarray]:
     """Yoshikawa's measure ``w = sqrt(det(J J^T))`` = the product of the singular values."""
     s = singular_values(robot, q, frame, task, reference)
     m = len(task_rows(task))
@@ -190,7 +194,7 @@ class SingularityReport:
         return f"rank {self.rank} < {min(self.rows, self.n_joints)}: the tool cannot move along {dirs}"
 
 
-def singularity_report(robot, q, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> SingularityReport:
+def singularity_report(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> SingularityReport:
     """Rank, singular values and the lost task directions of the Jacobian at one configuration.
 
     A singular value below ``tol * max(1, sigma_max)`` counts as zero."""

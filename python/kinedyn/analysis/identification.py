@@ -32,6 +32,7 @@ import numpy as np
 from ..simulate.control import Fourier
 
 if TYPE_CHECKING:
+    from .._typing import ArrayLike
     from ..dynamics import BaseParameters
     from ..robot import Robot
 
@@ -85,7 +86,7 @@ class Identification:
             return None
         return np.abs(self.estimates - self.true_values) / np.maximum(np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max()))
 
-    def predict(self, q, qd, qdd) -> np.ndarray:
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Torques of the identified model (base regressor times estimates plus the known drives)."""
         Y = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self._rows()]]
         return Y @ self.estimates + self.nominal.armature * np.asarray(qdd) + self.nominal.friction_torque(qd)
@@ -119,7 +120,7 @@ class Identification:
         return "\n".join(lines)
 
 
-def excitation(robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0=None, seed: int = 0) -> Fourier:
+def excitation(robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0: Optional[ArrayLike] = None, seed: int = 0) -> Fourier:
     """A random Fourier excitation for ``robot`` (Swevers et al. 1997): ``harmonics`` harmonics of
     the base frequency 2 pi / period, each joint's excursion ``amplitude`` about ``q0`` (default: the
     middle of finite joint limits, else 0)."""
@@ -131,7 +132,7 @@ def excitation(robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q
     return Fourier.random(robot.n, harmonics=harmonics, wf=2 * np.pi / period, amplitude=amplitude, q0=q0, seed=seed)
 
 
-def simulate_measurements(robot, reference, T: Optional[float] = None, rate: float = 100.0, noise=0.0, seed: int = 0) -> Measurements:
+def simulate_measurements(robot: Robot, reference, T: Optional[float] = None, rate: float = 100.0, noise=0.0, seed: int = 0) -> Measurements:
     """Sample ``reference`` at ``rate`` Hz over ``T`` seconds (default: two periods of a Fourier
     reference) and measure torques by inverse dynamics (one native batch call) plus Gaussian noise of
     standard deviation ``noise`` (scalar or per joint, N m / N)."""
@@ -150,7 +151,7 @@ def simulate_measurements(robot, reference, T: Optional[float] = None, rate: flo
     return Measurements(t, q, qd, qdd, tau, tau_true, sigma)
 
 
-def identify(robot, data: Measurements, weighted: bool = False, base=None) -> Identification:
+def identify(robot: Robot, data: Measurements, weighted: bool = False, base=None) -> Identification:
     """Least-squares estimates of ``robot``'s base parameters from ``data`` (``robot`` gives the
     kinematics, the known drive terms and, for comparison, the true values)."""
     base = robot.base_parameters() if base is None else base
@@ -195,7 +196,7 @@ def identify(robot, data: Measurements, weighted: bool = False, base=None) -> Id
     )
 
 
-def with_inertial_parameters(robot, pi):
+def with_inertial_parameters(robot: Robot, pi: ArrayLike) -> Robot:
     """A copy of ``robot`` whose moving bodies have the standard parameters ``pi`` (10 n, about each
     body-frame origin, as :meth:`Robot.inertial_parameters`); fixed links merged into a moving body
     carry zero inertia in the copy. ValueError for physically invalid parameters."""

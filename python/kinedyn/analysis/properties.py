@@ -17,9 +17,12 @@ each measured with its residual.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..robot import Robot
 
 __all__ = ["Check", "PropertiesReport", "check_properties"]
 
@@ -67,7 +70,7 @@ class PropertiesReport:
         return "\n".join(lines)
 
 
-def check_properties(robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
+def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
     """Measure every property on ``samples`` random states (seeded) and one simulated trajectory of
     ``T`` seconds (RK4, step ``dt``, PD + gravity compensation towards a random set point, gains
     ``Kp = wn^2 M_ii``, ``Kd = 2 wn M_ii`` with wn = 5 rad/s)."""

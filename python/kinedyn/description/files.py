@@ -18,7 +18,7 @@ import os
 import re
 import reprlib
 import sys
-from typing import Any, NoReturn, Optional
+from typing import TYPE_CHECKING, Any, NoReturn, Optional
 
 import numpy as np
 import sympy as sp
@@ -36,6 +36,10 @@ from .expressions import parse_expression
 from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
+
+if TYPE_CHECKING:
+    from .._typing import PathLike
+    from ..robot import Robot
 
 __all__ = ["load", "save", "robot_from_mapping", "robot_to_mapping"]
 
@@ -62,7 +66,7 @@ _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 
 
 
 # ============================================================================ public functions
-def load(path, inertia: str = "warn", **kwargs):
+def load(path: PathLike, inertia: str = "warn", **kwargs) -> Robot:
     """A robot from ``.urdf`` (``kwargs``: gravity, tool), ``.yaml``/``.yml`` or ``.toml`` (``kwargs``
     replace constructor arguments, e.g. ``gravity=``). ``inertia`` is the policy for inertia tensors
     no rigid body has: "warn" (keep, with a PhysicalConsistencyWarning), "repair" (project onto the
@@ -81,7 +85,7 @@ def load(path, inertia: str = "warn", **kwargs):
     return robot.replace(**kwargs) if kwargs else robot
 
 
-def save(robot, path) -> None:
+def save(robot: Robot, path: PathLike) -> None:
     """Write ``robot`` to a ``.yaml``/``.yml`` or ``.toml`` robot file (angles in radians)."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
@@ -542,7 +546,7 @@ def _tree_link(r: _Reader, raw, i: int) -> Link:
 
 
 # ============================================================================ writing a mapping
-def robot_to_mapping(robot) -> dict:
+def robot_to_mapping(robot: Robot) -> dict:
     """The YAML/TOML contents for ``robot``: DH flavour when it has a consistent DH table."""
     data: dict = {"name": robot.name, "gravity": [_dump(g) for g in robot.gravity]}
     if robot.source:
@@ -592,7 +596,7 @@ def _same_pose(A, B) -> bool:
     return np.allclose(np.asarray(A, dtype=float), np.asarray(B, dtype=float), atol=1e-12)
 
 
-def _dh_base_pose(robot):
+def _dh_base_pose(robot: Robot):
     """The base pose of the DH table if ``robot.links`` are exactly what its DH table gives, else None."""
     if robot.dh is None or robot.dh_convention is None:
         return None
@@ -643,7 +647,7 @@ def _frames_mapping(frames) -> list:
     return out
 
 
-def _dh_mapping(robot, base_pose) -> dict:
+def _dh_mapping(robot: Robot, base_pose) -> dict:
     out: dict = {"convention": robot.dh_convention, "units": {"angle": "rad"}}
     if not _is_identity(base_pose):
         out["base_pose"] = _pose_mapping(base_pose, "the base pose")
@@ -656,6 +660,7 @@ def _dh_mapping(robot, base_pose) -> dict:
         out["frames"] = _frames_mapping(extra)
     if robot.tool != "tool":
         out["tool_frame"] = robot.tool
+    assert robot.dh is not None  # robot_to_mapping writes a DH table only for a robot that has one
     rows = []
     for k, (row, link) in enumerate(zip(robot.dh, robot.links)):
         entry: dict = {"name": link.joint.name, "type": row.kind}
@@ -670,7 +675,7 @@ def _dh_mapping(robot, base_pose) -> dict:
     return out
 
 
-def _tree_mapping(robot) -> dict:
+def _tree_mapping(robot: Robot) -> dict:
     out: dict = {"base": robot.base, "tool": robot.tool, "units": {"angle": "rad"}}
     links = []
     for link in robot.links:

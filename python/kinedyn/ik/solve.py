@@ -12,11 +12,15 @@ Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 from .._arrays import real_array, whole_number
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+    from ..robot import Robot
 
 __all__ = ["IKResult", "IKBatchResult", "inverse_kinematics", "analytic_structure", "METHODS"]
 
@@ -122,7 +126,7 @@ class _Chain:
 
     __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute", "position_ok")
 
-    def __init__(self, robot, frame: str):
+    def __init__(self, robot: Robot, frame: str):
         from .. import _core
 
         self.frame = robot.frame_index(frame)
@@ -140,7 +144,7 @@ class _Chain:
         self.position_ok = self.solver is not None and self.solver.solves_position
 
 
-def _chain(robot, frame: Optional[str]) -> _Chain:
+def _chain(robot: Robot, frame: Optional[str]) -> _Chain:
     cache = robot.__dict__.get("_ik_chains")
     if cache is None:
         cache = robot.__dict__["_ik_chains"] = {}
@@ -151,7 +155,7 @@ def _chain(robot, frame: Optional[str]) -> _Chain:
     return chain
 
 
-def analytic_structure(robot, frame: Optional[str] = None) -> Optional[str]:
+def analytic_structure(robot: Robot, frame: Optional[str] = None) -> Optional[str]:
     """Name of the closed-form structure detected from the robot's geometry for ``frame``
     (``"planar_2r"``, ``"planar_3r"``, ``"arm_intersecting_shoulder"``, ``"arm_parallel_elbow"``,
     ``"spherical_wrist"``, ``"three_parallel"``), or None."""
@@ -160,7 +164,7 @@ def analytic_structure(robot, frame: Optional[str] = None) -> Optional[str]:
 
 
 # ------------------------------------------------------------------ input checks
-def _target(target) -> tuple:
+def _target(target: ArrayLike) -> tuple:
     """(array, position_only, batch)."""
     if isinstance(target, np.ndarray) and target.dtype == np.float64:
         t = target
@@ -303,7 +307,7 @@ def _check_settings(tolerance, max_iterations, restarts, seed) -> tuple:
     )
 
 
-def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:
+def _why_not_analytic(robot: Robot, chain: _Chain, position: bool, weights) -> str:
     if chain.solver is None:
         return (
             f"robot '{robot.name}' has no closed-form inverse kinematics here: its axes match none of the "
@@ -318,7 +322,7 @@ def _why_not_analytic(robot, chain: _Chain, position: bool, weights) -> str:
     )
 
 
-def _analytic(robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int) -> IKResult:
+def _analytic(robot: Robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int) -> IKResult:
     solver = chain.solver
     assert solver is not None  # callers take this route only for a chain with a closed form
     sols, pe, oe, found, singular = solver.solve(t, q_ref, respect_limits, tolerance)
@@ -335,7 +339,7 @@ def _analytic(robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bo
     return result
 
 
-def _nearest(robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> None:
+def _nearest(robot: Robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> None:
     """The reachable point nearest an unreachable position (least squares by LM with restarts)."""
     from .. import _core
 
@@ -381,7 +385,7 @@ def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, toleranc
     return q, ok, pe, oe, it
 
 
-def _numeric(robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
+def _numeric(robot: Robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
     w = np.asarray(weights if weights is not None else _FULL_MASK)
     q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed)
     ok = bool(ok) and pe <= tolerance and oe <= tolerance
@@ -405,7 +409,7 @@ def _wrap(q: np.ndarray, chain: _Chain) -> np.ndarray:
     return out
 
 
-def _is_singular(robot, chain: _Chain, q, weights) -> bool:
+def _is_singular(robot: Robot, chain: _Chain, q: ArrayLike, weights) -> bool:
     J = robot.jacobian(q, robot.frame_names[chain.frame])[np.asarray(weights) > 0]
     s = np.linalg.svd(J, compute_uv=False)
     return bool(len(s) < J.shape[0] or s[-1] < 1e-6 * max(1.0, s[0]))
@@ -414,7 +418,7 @@ def _is_singular(robot, chain: _Chain, q, weights) -> bool:
 IK_CHUNK = 256  # targets per native call when a batch shows progress
 
 
-def _batch(robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress) -> IKBatchResult:
+def _batch(robot: Robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress) -> IKBatchResult:
     N = len(t)
     w = np.asarray(weights if weights is not None else _FULL_MASK)
     if use_analytic:

@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union, cast
 
 import numpy as np
 
@@ -43,6 +43,11 @@ from .._core import NonFiniteResultError
 from ..progress import SHOW_AFTER, Delayed
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+    from ..robot import Robot
+    from ..symbolic.system import LagrangianSystem
 
 __all__ = ["simulate", "SimulationError", "NonFiniteTorqueError", "SimulationTruncatedWarning", "FIXED_METHODS", "ADAPTIVE_METHODS", "RK4_STABLE"]
 
@@ -415,14 +420,14 @@ class _Stop(Exception):
 
 # ------------------------------------------------------------------ simulate
 def simulate(
-    system,
-    t_span,
-    x0,
-    u=None,
+    system: Union[Robot, LagrangianSystem, MechanicalSystem],
+    t_span: Union[float, tuple[float, float]],
+    x0: ArrayLike,
+    u: Union[None, ArrayLike, Callable] = None,
     controller: Optional[Callable] = None,
     method: str = "auto",
     dt: Optional[float] = None,
-    f_ext=None,
+    f_ext: Union[None, ArrayLike, Callable] = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     progress: Optional[bool] = None,
@@ -431,8 +436,8 @@ def simulate(
     hold: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
-    baumgarte=None,
-    points=None,
+    baumgarte: Optional[tuple[float, float]] = None,
+    points: Optional[Callable] = None,
     joint_limits: bool = False,
     time_budget: Optional[float] = None,
 ) -> Trajectory:
@@ -501,7 +506,8 @@ def simulate(
             raise ValueError("joint_limits applies to robots (their joints' lower and upper limits)")
         if method in ADAPTIVE_METHODS:
             raise ValueError(f"joint_limits needs a fixed-step method (auto, {', '.join(FIXED_METHODS)}), not '{method}'")
-        limits = (np.asarray(system.lower_limits, dtype=float), np.asarray(system.upper_limits, dtype=float))
+        arm = cast("Robot", system)  # a robot: checked just above
+        limits = (np.asarray(arm.lower_limits, dtype=float), np.asarray(arm.upper_limits, dtype=float))
     else:
         limits = None
     if method in ADAPTIVE_METHODS:
