@@ -1,11 +1,22 @@
 """kinedyn: robot kinematics and dynamics, symbolic for people and numeric (Rust) for programs."""
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ._core import NonFiniteResultError
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 from . import robots
-from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
+if TYPE_CHECKING:
+    # what type checkers and IDEs see: kd.simulate is the function and still holds the package's
+    # names (kd.simulate.PD); the lazily loaded submodules are the modules themselves
+    from . import analysis, dynamics, ik, kinematics, symbolic, testing
+    from ._typing import PathLike
+    from .simulate._callable import simulate
+else:
+    from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
 from .simulate import Trajectory
 from .symbolic import LagrangianSystem
 
@@ -23,7 +34,7 @@ def __getattr__(name):
     raise AttributeError(f"module 'kinedyn' has no attribute '{name}'")
 
 
-def load(path, **kwargs) -> Robot:
+def load(path: PathLike, **kwargs) -> Robot:
     """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension.
     ``inertia="warn"|"repair"|"strict"``: the policy for an inertia no rigid body can have
     (docs/model-files.md); other keywords as :meth:`Robot.from_urdf` or the Robot constructor."""
