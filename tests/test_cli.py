@@ -153,3 +153,14 @@ def test_dynamics_json_equals_the_library(capsys):
     assert doc["kinetic_energy"] == pytest.approx(robot.kinetic_energy(q, qd))
     code, text, _ = run(capsys, *args)
     assert code == 0 and "mass matrix" in text and "dtau/dq" in text
+
+
+def test_jsonable_converts_every_numpy_scalar():
+    import json as _json
+
+    from kinedyn.cli import _jsonable
+
+    payload = {"b": np.bool_(True), "i": np.int32(3), "f": np.float32(0.5), "nan": np.float64("nan"),
+               "inf": np.float64("inf"), "c": np.complex128(1 + 2j), "a": np.array([np.True_, np.False_])}
+    back = _json.loads(_json.dumps(_jsonable(payload)))
+    assert back == {"b": True, "i": 3, "f": 0.5, "nan": None, "inf": "inf", "c": [1.0, 2.0], "a": [True, False]}

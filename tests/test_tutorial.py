@@ -161,3 +161,11 @@ def test_bad_question(capsys):
     assert "argument --question/-q: invalid choice" in capsys.readouterr().err
     with pytest.raises(ValueError, match="unknown question"):
         tutorial.answer("9")
+
+
+def test_whole_tutorial_json(capsys):
+    """`kinedyn tutorial --json` (every question) prints valid JSON: it once exited 1 on a numpy.bool."""
+    code, out, err = run(capsys, "tutorial", "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    assert {"1a", "1b", "2a", "2b"} <= set(d["questions"])

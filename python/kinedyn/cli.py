@@ -309,8 +309,12 @@ def console():
 def _jsonable(x):
     if isinstance(x, np.ndarray):
         return _jsonable(x.tolist())
-    if isinstance(x, (np.floating, np.integer)):
-        return x.item()
+    if isinstance(x, np.generic):
+        # every NumPy scalar (np.bool_, integers, floats, complex): its Python value, converted in turn
+        # (a non-finite float, a complex) -- json knows none of NumPy's scalar types
+        return _jsonable(x.item())
+    if isinstance(x, complex):
+        return [_jsonable(x.real), _jsonable(x.imag)]
     if isinstance(x, float) and not math.isfinite(x):
         return None if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if isinstance(x, dict):
