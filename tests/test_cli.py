@@ -164,3 +164,32 @@ def test_jsonable_converts_every_numpy_scalar():
                "inf": np.float64("inf"), "c": np.complex128(1 + 2j), "a": np.array([np.True_, np.False_])}
     back = _json.loads(_json.dumps(_jsonable(payload)))
     assert back == {"b": True, "i": 3, "f": 0.5, "nan": None, "inf": "inf", "c": [1.0, 2.0], "a": [True, False]}
+
+
+def test_simulate_energy_drift_has_a_scale_when_H0_is_zero(capsys):
+    """planar_2r from rest at q = 0 has H(0) = 0: the relative drift was max|H - H(0)| / 1e-300 = 3e290.
+    It is now relative to the energy the run exchanges, max K + range of P, recomputed here."""
+    assert main(["simulate", "planar_2r", "--t", "1", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["energy_initial"] == 0.0
+    robot = kd.robots.planar_2r()
+    traj = kd.simulate(robot, 1.0, np.zeros(2 * robot.n))
+    K = np.array([robot.kinetic_energy(q, qd) for q, qd in zip(traj.q, traj.qd)])
+    P = np.array([robot.potential_energy(q) for q in traj.q])
+    scale = K.max() + P.max() - P.min()
+    assert scale > 1.0 and d["energy_scale"] == pytest.approx(scale, rel=1e-9)
+    assert d["energy_drift"] == pytest.approx(np.abs(K + P).max(), rel=1e-6, abs=1e-14)
+    assert d["energy_drift_relative"] == pytest.approx(d["energy_drift"] / scale) and d["energy_drift_relative"] < 1e-9
+    assert main(["simulate", "planar_2r", "--t", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "energy scale" in out and "max K + (max P - min P)" in out and "e+2" not in out
+
+
+def test_simulate_energy_drift_at_rest_has_no_relative_value():
+    from types import SimpleNamespace
+
+    from kinedyn.simulate.cli import _energy_drift
+
+    still = SimpleNamespace(H=np.full(5, -3.0), K=np.zeros(5), P=np.full(5, -3.0))
+    assert _energy_drift(still) == {"energy_drift": 0.0, "energy_scale": 0.0, "energy_scale_basis": "max K + (max P - min P) over the run",
+                                    "energy_drift_relative": None}

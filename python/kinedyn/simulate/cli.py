@@ -19,6 +19,24 @@ def _gains(values, robot, flag: str):
     return float(g[0]) if g.size == 1 else g
 
 
+ENERGY_SCALE_BASIS = "max K + (max P - min P) over the run"
+
+
+def _energy_drift(traj) -> dict:
+    """The energy change of a run, absolute and relative to an energy scale of the run itself.
+
+    H(0) is no scale: the zero of the potential energy is arbitrary (H(0) = 0 for an arm starting at
+    rest in its zero configuration, and "max |H - H(0)| / |H(0)|" was 1e290). The scale used is the
+    energy the motion exchanges, max K + (max P - min P) over the samples, which does not depend on
+    where P is zero. ``energy_drift_relative`` is None when that scale is 0 (nothing moves)."""
+    H = traj.H
+    drift = float(np.abs(H - H[0]).max(initial=0.0))
+    K, P = traj.K, traj.P
+    scale = float(np.max(K) + np.ptp(P)) if len(H) else 0.0
+    return {"energy_drift": drift, "energy_scale": scale, "energy_scale_basis": ENERGY_SCALE_BASIS,
+            "energy_drift_relative": drift / scale if scale > 0 else None}
+
+
 def cmd_simulate(args) -> int:
     from ..cli import console, emit, esc, load_robot, parse_q
     from .. import robots
@@ -81,7 +99,7 @@ def cmd_simulate(args) -> int:
         "goal": goal if controller is not None else None,
         "energy_initial": float(H[0]),
         "energy_final": float(H[-1]),
-        "energy_drift_relative": float(np.abs(H - H[0]).max() / max(abs(H[0]), 1e-300)),
+        **_energy_drift(traj),
         "wall_time_s": traj.info.get("wall_time"),
         "method_choice": traj.info.get("method_choice"),
         "joint_limits": bool(args.joint_limits),
@@ -99,7 +117,10 @@ def cmd_simulate(args) -> int:
             c.print(f"  [bold yellow]cut short[/bold yellow]: {payload['truncated']}")
         c.print(f"  q(T)  = {np.array2string(traj.q[-1], precision=5)}")
         c.print(f"  qd(T) = {np.array2string(traj.qd[-1], precision=5)}")
-        c.print(f"  energy H: {H[0]:.8g} J -> {H[-1]:.8g} J (max relative change {payload['energy_drift_relative']:.3g})")
+        rel = payload["energy_drift_relative"]
+        c.print(f"  energy H: {H[0]:.8g} J -> {H[-1]:.8g} J, max |H - H(0)| = {payload['energy_drift']:.3g} J"
+                + (f" = {rel:.3g} x the energy scale {payload['energy_scale']:.4g} J ({payload['energy_scale_basis']})" if rel is not None
+                   else " (the arm does not move: no energy scale)"))
         for k, v in files.items():
             c.print(f"  {k}: {esc(v)}")
 
