@@ -587,3 +587,16 @@ def test_set_reads_arithmetic_on_numbers(capsys):
     _, by_expression, _ = main_json(capsys, "fk", "planar_2r", "--set", "l1=sqrt(2)/2", "--set", "l2=pi/4", "--q", "0", "0")
     _, by_number, _ = main_json(capsys, "fk", "planar_2r", "--set", f"l1={2 ** 0.5 / 2!r}", "--set", f"l2={3.141592653589793 / 4!r}", "--q", "0", "0")
     assert by_expression == by_number
+
+
+def test_info_of_the_symbolic_example_file(capsys):
+    """`kinedyn info examples/robots/two_link_symbolic.yaml` ended in a traceback (issue 12): it prints the
+    robot with its parameters as symbols, in text and in JSON."""
+    code, out, err = run(capsys, "info", SYMBOLIC)
+    assert code == 0, err
+    assert "Traceback" not in out + err
+    assert "symbolic parameters: I1, I2, g, l1, l2, lc1, lc2, m1, m2" in " ".join(out.split())
+    code, out, err = run(capsys, "info", SYMBOLIC, "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["n"] == 2 and d["gravity"] == [0.0, "-g", 0.0]
