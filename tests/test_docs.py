@@ -32,3 +32,51 @@ def test_code_blocks_run(page, tmp_path, monkeypatch):
         if code.startswith("# doctest: skip-run"):
             continue
         exec(compiled, namespace)
+
+
+INLINE_CALL = re.compile(r"`((?:kd|Inertia)\.[A-Za-z_][\w.]*)\(([^`]*)\)`")
+
+
+def _inline_calls() -> list:
+    # from-pinocchio.md's `Inertia.` is Pinocchio's class, set beside kinedyn's
+    return [(page.name, m.group(1), m.group(2)) for page in PAGES if page.exists() for m in INLINE_CALL.finditer(page.read_text())
+            if not (page.name == "from-pinocchio.md" and m.group(1).startswith("Inertia."))]
+
+
+def test_inline_calls_match_the_signatures():
+    """A call written in running text (`Inertia.box(m, a, b, c)`, `kd.load("arm.urdf")`) binds to the
+    signature of what it names: the same number of positional arguments and known keywords (a trailing
+    `...` stands for more arguments). docs/seed-notes.md once documented Inertia.box(m, a, b, c) for
+    Inertia.box(mass, size)."""
+    import ast
+    import inspect
+
+    import kinedyn as kd
+
+    calls = _inline_calls()
+    assert len(calls) >= 10
+    bad = []
+    for page, name, args in calls:
+        parts = name.split(".")
+        obj = kd if parts[0] == "kd" else kd.Inertia
+        owner = None
+        for part in parts[1:]:
+            owner, obj = obj, getattr(obj, part)
+        fn = obj.__init__ if inspect.isclass(obj) else obj
+        sig = inspect.signature(fn)
+        if args.strip() == "...":  # "some arguments": nothing to check
+            continue
+        text = re.sub(r"=\s*(?=[,)\]]|$)", "=...", args)  # `d=,` written as a placeholder
+        more = re.search(r",\s*\.\.\.\s*$", text) is not None  # a trailing `...`: "and more"
+        if more:
+            text = re.sub(r",\s*\.\.\.\s*$", "", text)
+        call = ast.parse(f"f({text})", mode="eval").body
+        assert isinstance(call, ast.Call)
+        positional = list(call.args)
+        extra = 1 if (inspect.isclass(obj) or (inspect.isclass(owner) and inspect.isfunction(inspect.getattr_static(owner, parts[-1])))) else 0
+        try:
+            bound = sig.bind_partial if more else sig.bind
+            bound(*([None] * (len(positional) + extra)), **{k.arg: None for k in call.keywords if k.arg})
+        except TypeError as e:
+            bad.append(f"{page}: {name}({args}): {e}")
+    assert not bad, "\n".join(bad)
