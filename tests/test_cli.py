@@ -193,3 +193,46 @@ def test_simulate_energy_drift_at_rest_has_no_relative_value():
     still = SimpleNamespace(H=np.full(5, -3.0), K=np.zeros(5), P=np.full(5, -3.0))
     assert _energy_drift(still) == {"energy_drift": 0.0, "energy_scale": 0.0, "energy_scale_basis": "max K + (max P - min P) over the run",
                                     "energy_drift_relative": None}
+
+
+def _elbow_linear_jacobian(q, L2=2.0, L3=1.0):
+    """The elbow arm's linear Jacobian, derived by hand: p = (c1 r, s1 r, L1 + z), r = L2 c2 + L3 c23, z = L2 s2 + L3 s23."""
+    c1, s1 = math.cos(q[0]), math.sin(q[0])
+    r = L2 * math.cos(q[1]) + L3 * math.cos(q[1] + q[2])
+    z = L2 * math.sin(q[1]) + L3 * math.sin(q[1] + q[2])
+    s23, c23 = math.sin(q[1] + q[2]), math.cos(q[1] + q[2])
+    return np.array([[-s1 * r, -c1 * z, -L3 * c1 * s23], [c1 * r, -s1 * z, -L3 * s1 * s23], [0.0, r, L3 * c23]])
+
+
+def test_jacobian_manipulability_of_a_positioning_arm_uses_the_rows_it_spans(capsys):
+    """elbow_3r printed 'manipulability 0' beside 'full rank 3': w used all six rows of a 3-joint arm.
+    It now uses vx, vy, vz, says so, and equals |det Jv| of the hand-derived Jv (= L2 L3 |s3| r)."""
+    q = [0.3, 0.5, -1.0]
+    assert main(["jacobian", "elbow_3r", "--q", *map(str, q), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    Jv = _elbow_linear_jacobian(q)
+    assert d["analysis_rows"] == ["vx", "vy", "vz"] and "spans" in d["analysis_rows_basis"]
+    assert d["manipulability"] == pytest.approx(abs(np.linalg.det(Jv)), rel=1e-9) and d["manipulability"] > 1
+    assert d["rank"] == 3 and not d["singular"]
+    assert len(d["rows"]) == 6  # the table still shows the whole Jacobian
+    # stretched out (q3 = 0) the arm is singular in position, and the report says so
+    assert main(["jacobian", "elbow_3r", "--q", "0.3", "0.5", "0", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["rank"] == 2 and d["singular"] and d["manipulability"] == pytest.approx(0, abs=1e-12)
+    # the planar arm: vx, vy, w = l1 l2 |s2|
+    assert main(["jacobian", "planar_2r", "--q", "0.2", "1.1", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    r = kd.robots.planar_2r()
+    elbow, tip = (float(np.linalg.norm(r.frame_poses(np.zeros(2), [f])[0][:3, 3])) for f in ("link1", r.tool))
+    l1, l2 = elbow, tip - elbow  # stretched out along x at q = 0
+    assert d["analysis_rows"] == ["vx", "vy"]
+    assert d["manipulability"] == pytest.approx(l1 * l2 * math.sin(1.1), rel=1e-9)
+    # the human view names the rows
+    assert main(["jacobian", "elbow_3r", "--q", *map(str, q)]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "over rows vx, vy, vz" in out and "full rank 3" in out
+    # a six-joint arm keeps all six rows; --task chooses explicitly
+    assert main(["jacobian", "puma560", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["analysis_rows"] == ["vx", "vy", "vz", "wx", "wy", "wz"]
+    assert main(["jacobian", "elbow_3r", "--q", *map(str, q), "--task", "orientation", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["analysis_rows"] == ["wx", "wy", "wz"]

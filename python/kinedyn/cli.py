@@ -518,15 +518,61 @@ def cmd_fk(args) -> int:
     return 0
 
 
+ROW_NAMES = ["vx", "vy", "vz", "wx", "wy", "wz"]
+
+
+def spanned_rows(robot, frame=None, reference: str = "world", samples: int = 8, seed: int = 0):
+    """The task rows an arm with fewer than six joints can span, for its manipulability: the linear rows
+    that move at some configuration, then the angular ones, kept when there are at most n of them and
+    they have rank min(rows, n) at a generic configuration; None when no such subset exists (then the
+    measure is taken in the Jacobian's column space, sqrt(det J^T J)).
+
+    Rows are tested at ``samples`` seeded random configurations inside the finite joint limits, so
+    the choice is deterministic (elbow_3r: vx, vy, vz; planar_2r: vx, vy; a SCARA: vx, vy, vz, wz)."""
+    rng = np.random.default_rng(seed)
+    lo = np.where(np.isfinite(robot.lower_limits), robot.lower_limits, -np.pi)
+    hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
+    Js = np.array([robot.jacobian(lo + (hi - lo) * rng.random(robot.n), frame, reference) for _ in range(samples)])
+    scale = max(1.0, float(np.abs(Js).max(initial=0.0)))
+    moving = [r for r in range(6) if np.abs(Js[:, r, :]).max() > 1e-9 * scale]
+    linear, angular = [r for r in moving if r < 3], [r for r in moving if r >= 3]
+    rows = linear if len(linear) >= robot.n else linear + angular
+    if not rows or len(rows) > robot.n:
+        return None
+    if max(np.linalg.matrix_rank(J[rows], tol=1e-9 * scale) for J in Js) < len(rows):
+        return None
+    return rows
+
+
+def _analysis_rows(robot, rows, explicit: bool, frame, reference):
+    """(rows, basis) on which ``jacobian`` measures rank and manipulability: the --task rows when given;
+    otherwise all six for n >= 6, or the rows an arm with fewer joints spans (``spanned_rows``)."""
+    if explicit:
+        return rows, "the --task rows" + (f"; {len(rows)} rows > {robot.n} joints, so J J^T is singular by construction" if len(rows) > robot.n else "")
+    if len(rows) <= robot.n:
+        return rows, "all six rows"
+    chosen = spanned_rows(robot, frame, reference)
+    if chosen is None:
+        return rows, "all six rows; sqrt(det J^T J), the volume in the Jacobian's column space"
+    return chosen, f"the rows a {robot.n}-joint arm spans; choose others with --task"
+
+
 def cmd_jacobian(args) -> int:
     from . import kinematics as kin
 
     robot = _robot(args)
     q = parse_q(args.q, robot, args.deg)
-    rows = kin.task_rows(args.task)
+    explicit = args.task is not None
+    rows = kin.task_rows(args.task if explicit else "full")
     J = kin.task_jacobian(robot, q, args.frame, rows, args.reference)
-    report = kin.singularity_report(robot, q, args.frame, rows, args.reference)
-    names = report.row_names
+    names = [ROW_NAMES[r] for r in rows]
+    a_rows, basis = _analysis_rows(robot, rows, explicit, args.frame, args.reference)
+    report = kin.singularity_report(robot, q, args.frame, a_rows, args.reference)
+    if len(a_rows) > robot.n and a_rows is rows and not explicit:
+        w = float(np.prod(report.singular_values))  # sqrt(det J^T J): the column-space volume
+    else:
+        w = float(kin.manipulability(robot, q, args.frame, a_rows, args.reference))
+    w_rows = report.row_names
     payload = {
         "robot": robot.name,
         "q": q,
@@ -537,7 +583,9 @@ def cmd_jacobian(args) -> int:
         "singular_values": report.singular_values,
         "rank": report.rank,
         "singular": report.singular,
-        "manipulability": float(np.prod(report.singular_values)) if len(rows) <= robot.n else 0.0,
+        "manipulability": w,
+        "analysis_rows": w_rows,
+        "analysis_rows_basis": basis,
         "condition_number": report.condition_number,
         "lost_directions": report.lost_directions,
     }
@@ -546,8 +594,9 @@ def cmd_jacobian(args) -> int:
         c = console()
         c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}; frame '{esc(payload['frame'])}', reference '{args.reference}'")
         c.print(matrix_table("Jacobian", J, names, robot.joint_names))
+        c.print(f"rank, singular values and manipulability over rows {', '.join(w_rows)} ({basis})")
         c.print(f"singular values: {np.array2string(report.singular_values, precision=6)}")
-        c.print(f"manipulability sqrt(det J J^T): {payload['manipulability']:.6g}")
+        c.print(f"manipulability sqrt(det J J^T): {w:.6g}")
         style = "bold red" if report.singular else "green"
         c.print(f"[{style}]{esc(report.summary())}[/{style}]")
 
@@ -662,7 +711,8 @@ def build_parser() -> argparse.ArgumentParser:
     _state_args(p)
     p.add_argument("--frame", help="frame name (default: the tool)")
     p.add_argument("--reference", default="world", choices=["world", "local", "spatial"])
-    p.add_argument("--task", default="full", help="rows: full, position, orientation, planar, planar_pose (default full)")
+    p.add_argument("--task", default=None, help="rows: full, position, orientation, planar, planar_pose (default full; the manipulability "
+                   "of an arm with fewer than six joints then uses the rows it spans, e.g. vx vy vz for elbow_3r)")
     p.set_defaults(func=cmd_jacobian)
 
     p = sub.add_parser("dynamics", help="M, C, g and tau at a state (Rust core); forward dynamics with --tau; derivatives")
