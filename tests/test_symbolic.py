@@ -416,3 +416,32 @@ def test_hamiltons_equations_reproduce_the_lagrangian_equations():
     Mdot = sum((sp.diff(eom.M, qi) * vi for qi, vi in zip(eom.q, qd)), sp.zeros(eom.n, eom.n)).subs(values)
     expected = np.array(Mdot, dtype=float) @ qd + np.array(M, dtype=float) @ qdd
     np.testing.assert_allclose(np.array(pdot.subs(at_p), dtype=float).ravel(), expected, atol=1e-10)
+
+
+# ------------------------------------------------------------------ symbolic=True keeps the values given
+def _numeric_M_g(eom, subs, q):
+    values = {**subs, **dict(zip(eom.q, q))}
+    M = np.array(eom.M.subs(values).evalf(), dtype=float)
+    g = np.array(sp.Matrix(eom.g).subs(values).evalf(), dtype=float).ravel()
+    return M, g
+
+
+@pytest.mark.parametrize("build, given, rest", [
+    (kd.robots.planar_2r, {"lc1": 0.7, "I1": 0.4, "m2": 2.5}, {"l1": 2.0, "l2": 3.0, "m1": 1.0, "lc2": 1.2, "I2": 0.9, "g": 9.81}),
+    (kd.robots.elbow_3r, {"L2": 1.5, "m3": 0.8}, {"L1": 3.0, "L3": 1.0, "m1": 1.0, "m2": 1.2, "g": 9.81}),
+])
+def test_symbolic_builtin_keeps_the_values_given(build, given, rest):
+    """planar_2r(symbolic=True, lc1=..., I1=...) once ignored the values (every parameter became a symbol):
+    the given ones must not appear as symbols, the rest must, and M, g with the rest substituted equal
+    the numeric robot built with all the values, at random states."""
+    robot = build(symbolic=True, **given)
+    eom = robot.equations_of_motion()
+    names = {str(s) for s in (eom.M.free_symbols | sp.Matrix(eom.g).free_symbols)} - {str(q) for q in eom.q}
+    assert not names & set(given) and names <= set(rest) and names
+    numeric = build(**given, **rest)
+    rng = np.random.default_rng(3)
+    subs = {s: rest[str(s)] for s in (eom.M.free_symbols | sp.Matrix(eom.g).free_symbols) if str(s) in rest}
+    for q in rng.uniform(-np.pi, np.pi, (3, numeric.n)):
+        M, g = _numeric_M_g(eom, subs, q)
+        np.testing.assert_allclose(M, numeric.mass_matrix(q), atol=1e-12)
+        np.testing.assert_allclose(g, numeric.gravity_torque(q), atol=1e-12)

@@ -6,7 +6,10 @@ the symbolic engine derives the textbook's general formulas.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
+from typing import Callable, TypeVar, cast
 
 import sympy as sp
 
@@ -17,6 +20,32 @@ from ..robot import Robot
 __all__ = ["planar_2r", "planar_3r", "elbow_3r", "cartesian_2p"]
 
 
+_F = TypeVar("_F", bound=Callable[..., Robot])
+
+
+def _symbolic_defaults(names: str) -> Callable[[_F], _F]:
+    """With ``symbolic=True``, every parameter in ``names`` that the caller did not give becomes the
+    positive SymPy symbol of its name; a value given (``planar_2r(symbolic=True, lc1=1.0)``) is kept.
+    (The functions used to overwrite every parameter with its symbol, so given values were ignored.)"""
+    symbols = names.split()
+
+    def decorate(fn: _F) -> _F:
+        signature = inspect.signature(fn)
+
+        @functools.wraps(fn)
+        def wrapper(*args, **kwargs):
+            given = signature.bind(*args, **kwargs).arguments
+            if given.get("symbolic"):
+                for name in symbols:
+                    if name not in given or given[name] is None:
+                        kwargs[name] = sp.Symbol(name, positive=True)
+            return fn(*args, **kwargs)
+
+        return cast(_F, wrapper)
+
+    return decorate
+
+
 def _rod_x(m, length, lc, I):
     """A link along its DH frame's -x axis (frame i sits at the far end of link i, standard DH):
     centre of mass lc from the joint, i.e. at x = lc - length; inertia I about the z axis
@@ -24,16 +53,15 @@ def _rod_x(m, length, lc, I):
     return Inertia(m, (lc - length, 0, 0), ((0, 0, 0), (0, I, 0), (0, 0, I)))
 
 
+@_symbolic_defaults("l1 l2 lc1 lc2 m1 m2 I1 I2 g")
 def planar_2r(l1=2.0, l2=3.0, m1=1.0, m2=1.0, lc1=None, lc2=None, I1=None, I2=None, g=9.81, symbolic=False) -> Robot:
     """The tutorial's two-link planar arm (Spong §9.4.2's planar elbow): joints about z, links along x,
     gravity -g along y, tool at the end of link 2.
 
     Defaults: l1 = 2 m, l2 = 3 m (tutorial Q2), uniform rods of m1 = m2 = 1 kg with the centre of mass
     at mid-length and I = m l^2 / 12 about it. ``symbolic=True`` uses symbols l1, l2, lc1, lc2, m1, m2,
-    I1, I2, g instead (any keyword given explicitly keeps its value).
+    I1, I2, g instead; any keyword given explicitly keeps its value (``symbolic=True, lc1=1.0``).
     """
-    if symbolic:
-        l1, l2, lc1, lc2, m1, m2, I1, I2, g = sp.symbols("l1 l2 lc1 lc2 m1 m2 I1 I2 g", positive=True)
     lc1 = l1 / 2 if lc1 is None else lc1
     lc2 = l2 / 2 if lc2 is None else lc2
     I1 = m1 * l1**2 / 12 if I1 is None else I1
@@ -45,14 +73,15 @@ def planar_2r(l1=2.0, l2=3.0, m1=1.0, m2=1.0, lc1=None, lc2=None, I1=None, I2=No
     return Robot.from_dh(rows, gravity=(0, -g, 0), name="planar_2r", source="METR4202 Tutorial 4 Q1-Q3; Spong, Hutchinson & Vidyasagar, Robot Modeling and Control, §9.4.2")
 
 
+@_symbolic_defaults("l1 l2 l3 m1 m2 m3 g")
 def planar_3r(l1=1.0, l2=1.0, l3=0.5, m1=1.0, m2=1.0, m3=0.5, g=9.81, symbolic=False) -> Robot:
-    """A planar 3R arm (uniform rods), joints about z, gravity -g along y."""
-    if symbolic:
-        l1, l2, l3, m1, m2, m3, g = sp.symbols("l1 l2 l3 m1 m2 m3 g", positive=True)
+    """A planar 3R arm (uniform rods), joints about z, gravity -g along y. ``symbolic=True`` uses
+    symbols l1, l2, l3, m1, m2, m3, g for the parameters not given (a keyword given keeps its value)."""
     rows = [DHRow(a=l, inertia=_rod_x(m, l, l / 2, m * l**2 / 12)) for l, m in ((l1, m1), (l2, m2), (l3, m3))]
     return Robot.from_dh(rows, gravity=(0, -g, 0), name="planar_3r", source="textbook planar 3R arm")
 
 
+@_symbolic_defaults("L1 L2 L3 m1 m2 m3 g")
 def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, symbolic=False) -> Robot:
     """The tutorial's challenge arm: an elbow (articulated, RRR) manipulator, Spong's DH (Table 3.3):
 
@@ -65,10 +94,9 @@ def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, symbolic=Fa
 
     Base yaw about the vertical z0, shoulder and elbow pitch about horizontal axes; at q = 0 the upper
     arm and forearm point along x0 (Spong's zero pose). Links are uniform rods of m_i = 1 kg
-    (the tutorial gives no masses), gravity -g along z0.
+    (the tutorial gives no masses), gravity -g along z0. ``symbolic=True`` uses symbols L1, L2, L3,
+    m1, m2, m3, g for the parameters not given (a keyword given keeps its value).
     """
-    if symbolic:
-        L1, L2, L3, m1, m2, m3, g = sp.symbols("L1 L2 L3 m1 m2 m3 g", positive=True)
     half_pi = sp.pi / 2 if symbolic else math.pi / 2
     # link 1 runs from the base up to frame 1 (along -y1 in frame 1 after Rx(+90 deg))
     link1 = Inertia(m1, (0, -L1 / 2, 0), ((m1 * L1**2 / 12, 0, 0), (0, 0, 0), (0, 0, m1 * L1**2 / 12)))
@@ -80,11 +108,10 @@ def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, symbolic=Fa
     return Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_3r", source="METR4202 Tutorial 4 challenge; Spong et al., Robot Modeling and Control, Example 3.5 / Table 3.3")
 
 
+@_symbolic_defaults("m1 m2 g")
 def cartesian_2p(m1=1.0, m2=1.0, g=9.81, symbolic=False) -> Robot:
     """Spong §9.4.1's two-link Cartesian manipulator: joint 1 slides vertically (along z0, against
     gravity), joint 2 slides horizontally (along y0) and is carried by link 1."""
-    if symbolic:
-        m1, m2, g = sp.symbols("m1 m2 g", positive=True)
     minus_half_pi = -sp.pi / 2 if symbolic else -math.pi / 2
     rows = [
         DHRow(alpha=minus_half_pi, kind="prismatic", inertia=Inertia(m1)),
