@@ -12,6 +12,7 @@ import sympy as sp
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
+import kinedyn as kd  # noqa: E402
 from kinedyn.cli import main  # noqa: E402
 from kinedyn.report import tutorial  # noqa: E402
 
@@ -169,3 +170,48 @@ def test_whole_tutorial_json(capsys):
     assert code == 0, err
     d = json.loads(out)
     assert {"1a", "1b", "2a", "2b"} <= set(d["questions"])
+
+
+def _branch_by_hand(t, target, L1, L2):
+    """Front: the arm's plane faces the target; elbow up: the elbow (c1 L2 c2, s1 L2 c2, L1 + L2 s2) lies
+    above the shoulder-target line, measured in the arm's vertical plane by its signed radial coordinate."""
+    x, y, z = target
+    heading = math.atan2(y, x)
+    front = math.cos(t[0] - heading) > 0
+    r_target = math.hypot(x, y)  # the target's radial coordinate along the heading
+    r_elbow = L2 * math.cos(t[1]) * math.cos(t[0] - heading)  # the elbow's, along the same heading
+    z_elbow = L1 + L2 * math.sin(t[1])
+    z_line = L1 + (z - L1) * r_elbow / r_target
+    return f"{'front' if front else 'back'}, elbow {'up' if z_elbow > z_line else 'down'}"
+
+
+def _symbolic_name(t, target, L1, L2, L3):
+    """The label kd.ik.symbolic_elbow_solution gives the branch whose angles are t."""
+    sol = kd.ik.symbolic_elbow_solution(L1, L2, L3)
+    wrap = lambda a: (a + math.pi) % (2 * math.pi) - math.pi
+    xyz = dict(zip((sol.x, sol.y, sol.z), target))
+    for b in sol.branches:
+        angles = [float(b[k].subs(xyz).evalf()) for k in ("theta1", "theta2", "theta3")]
+        if all(abs(wrap(a - v)) < 1e-9 for a, v in zip(angles, t)):
+            return b["name"].replace("shoulder ", "")
+    raise AssertionError(f"no symbolic branch at {t}")
+
+
+def test_challenge_branch_labels_are_geometric(doc):
+    """The tutorial once labelled the back-shoulder branches the other way round (its 'back, elbow down'
+    put the elbow where 'front, elbow up' does). Every branch's label equals the geometric test written
+    here and symbolic_elbow_solution's label, at the tutorial's target and at random reachable targets."""
+    res = doc["challenge"]["result"]
+    L1, L2, L3 = 3.0, 2.0, 1.0
+    target = (1.0, 0.2, 0.5)
+    names = res["branches"]
+    assert sorted(names) == ["back, elbow down", "back, elbow up", "front, elbow down", "front, elbow up"]
+    for name, t in zip(names, res["solutions_rad"]):
+        assert name == _branch_by_hand(t, target, L1, L2) == _symbolic_name(t, target, L1, L2, L3)
+    robot = kd.robots.elbow_3r(L1=L1, L2=L2, L3=L3)
+    rng = np.random.default_rng(12)
+    for _ in range(4):
+        q = rng.uniform(-math.pi, math.pi, 3)
+        p = robot.pose(q)[:3, 3]
+        for t in tutorial.elbow_ik(*p, L1, L2, L3):
+            assert tutorial.elbow_branch_name(robot, t) == _branch_by_hand(t, p, L1, L2) == _symbolic_name(t, p, L1, L2, L3)

@@ -628,6 +628,20 @@ def elbow_ik(x: float, y: float, z: float, L1: float, L2: float, L3: float) -> n
     return np.array(out)
 
 
+def elbow_branch_name(robot, q) -> str:
+    """The IK branch of the elbow arm at ``q``, decided geometrically (not by the order in which
+    ``elbow_ik`` lists its solutions): the shoulder is in "front" when the arm's vertical plane faces the
+    tool (the upper arm's horizontal direction (cos theta1, sin theta1) points towards the tool's
+    horizontal position), and the elbow is "up" when it lies above the shoulder-tool line, i.e. on the
+    side of that line that the upward vertical points to, in the arm's plane."""
+    shoulder, elbow, tool = (T[:3, 3] for T in robot.frame_poses(np.asarray(q, dtype=float), [robot.frame_names[1], robot.frame_names[2], robot.tool]))
+    front = math.cos(q[0]) * tool[0] + math.sin(q[0]) * tool[1] > 0
+    line = (tool - shoulder) / np.linalg.norm(tool - shoulder)
+    up_normal = np.array([0.0, 0.0, 1.0]) - line[2] * line  # the vertical, less its part along the line
+    up = float(np.dot(elbow - shoulder, up_normal)) > 0
+    return f"{'front' if front else 'back'}, elbow {'up' if up else 'down'}"
+
+
 def _challenge() -> Answer:
     from .. import robots
 
@@ -673,7 +687,7 @@ def _challenge() -> Answer:
     a.eq("at (1.0, 0.2, 0.5) m: r, s, sqrt(r^2 + s^2), D", f"{_fmt(rn)}, {_fmt(sn)}, {_fmt(math.hypot(rn, sn))}, {_fmt(Dn)}")
     sols = elbow_ik(X, Y, Z, d["L1"], d["L2"], d["L3"])
     target = np.array(d["tool"])
-    names = ["front, elbow down", "front, elbow up", "back, elbow down", "back, elbow up"]
+    names = [elbow_branch_name(robot, qv) for qv in sols]  # labelled by where the elbow is, not by list order
     tab_deg, tab_rad = [], []
     residuals = []
     for name, qv in zip(names, sols):
@@ -716,7 +730,7 @@ def _challenge() -> Answer:
         Jn = robot.jacobian(qv)
         worst = max(worst, float(np.max(np.abs(np.asarray(fJ(*qv), dtype=float) - Jn))))
         jac.append(Jn)
-    a.table("J at the first solution (front, elbow down), kinedyn robot.jacobian(q)", ["", "theta1", "theta2", "theta3"],
+    a.table(f"J at the first solution ({names[0]}), kinedyn robot.jacobian(q)", ["", "theta1", "theta2", "theta3"],
             [[rn_, *row] for rn_, row in zip(["vx", "vy", "vz", "wx", "wy", "wz"], _mat_rows(jac[0], 7))])
     a.text(f"Check: the symbolic J evaluated at the four solutions equals the numeric engine's robot.jacobian(q): max difference {worst:.1e}.")
     a.result = {
