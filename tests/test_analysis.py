@@ -4,6 +4,8 @@ with noise, estimates usable as a model)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -163,3 +165,30 @@ def test_identification_without_used_rows_means_all_base_parameters():
     q, qd, qdd = rng.normal(size=(5, 2)), rng.normal(size=(5, 2)), rng.normal(size=(5, 2))
     np.testing.assert_allclose(everything.predict(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
     np.testing.assert_allclose(everything.robot().inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
+
+
+# ------------------------------------------------------------------ elbow_3r upright; check deterministic
+@pytest.mark.parametrize("q3", [0.0, math.pi])
+def test_elbow_inertia_is_regular_when_upright(q3):
+    """elbow_3r's links were thin rods with no inertia about their own axes, so M(q) was singular with
+    the arm upright (both links on z0). Upright, turning about z0 turns every link about its own axis:
+    M11 = (m1 + m2 + m3) r^2 / 2 for solid cylinders of radius r, derived here; radius=0 is the
+    textbook's thin rods, singular exactly there."""
+    for q2 in (math.pi / 2, -math.pi / 2):
+        q = np.array([0.4, q2, q3])
+        robot = kd.robots.elbow_3r(m1=1.0, m2=1.5, m3=0.5, radius=0.05)
+        M = robot.mass_matrix(q)
+        assert M[0, 0] == pytest.approx((1.0 + 1.5 + 0.5) * 0.05**2 / 2, rel=1e-9)
+        assert np.linalg.eigvalsh(M)[0] > 1e-3
+        thin = kd.robots.elbow_3r(radius=0).mass_matrix(q)
+        assert abs(np.linalg.eigvalsh(thin)[0]) < 1e-12
+
+
+def test_check_passivity_does_not_depend_on_the_sample_count():
+    """`kinedyn check elbow_3r` passed or failed passivity with the number of samples: the trajectory
+    was drawn from the same random stream after the samples. It now depends on the seed only."""
+    robot = kd.robots.elbow_3r()
+    reports = [kd.analysis.check_properties(robot, samples=s, seed=0) for s in (20, 1000)]
+    passivity = [[c for c in r.checks if c.name.startswith("passivity")][0] for r in reports]
+    assert passivity[0].residual == passivity[1].residual and passivity[0].detail == passivity[1].detail
+    assert all(c.passed for r in reports for c in r.checks), [c.name for r in reports for c in r.checks if not c.passed]

@@ -428,7 +428,7 @@ def _numeric_M_g(eom, subs, q):
 
 @pytest.mark.parametrize("build, given, rest", [
     (kd.robots.planar_2r, {"lc1": 0.7, "I1": 0.4, "m2": 2.5}, {"l1": 2.0, "l2": 3.0, "m1": 1.0, "lc2": 1.2, "I2": 0.9, "g": 9.81}),
-    (kd.robots.elbow_3r, {"L2": 1.5, "m3": 0.8}, {"L1": 3.0, "L3": 1.0, "m1": 1.0, "m2": 1.2, "g": 9.81}),
+    (kd.robots.elbow_3r, {"L2": 1.5, "m3": 0.8}, {"L1": 3.0, "L3": 1.0, "m1": 1.0, "m2": 1.2, "g": 9.81, "radius": 0.07}),
 ])
 def test_symbolic_builtin_keeps_the_values_given(build, given, rest):
     """planar_2r(symbolic=True, lc1=..., I1=...) once ignored the values (every parameter became a symbol):

@@ -46,11 +46,11 @@ def _symbolic_defaults(names: str) -> Callable[[_F], _F]:
     return decorate
 
 
-def _rod_x(m, length, lc, I):
+def _rod_x(m, length, lc, I, I_axial=0):
     """A link along its DH frame's -x axis (frame i sits at the far end of link i, standard DH):
     centre of mass lc from the joint, i.e. at x = lc - length; inertia I about the z axis
-    (and about y, for a thin rod), none about the rod's own axis."""
-    return Inertia(m, (lc - length, 0, 0), ((0, 0, 0), (0, I, 0), (0, 0, I)))
+    (and about y), ``I_axial`` about the rod's own axis (none for a thin rod)."""
+    return Inertia(m, (lc - length, 0, 0), ((I_axial, 0, 0), (0, I, 0), (0, 0, I)))
 
 
 @_symbolic_defaults("l1 l2 lc1 lc2 m1 m2 I1 I2 g")
@@ -81,8 +81,8 @@ def planar_3r(l1=1.0, l2=1.0, l3=0.5, m1=1.0, m2=1.0, m3=0.5, g=9.81, symbolic=F
     return Robot.from_dh(rows, gravity=(0, -g, 0), name="planar_3r", source="textbook planar 3R arm")
 
 
-@_symbolic_defaults("L1 L2 L3 m1 m2 m3 g")
-def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, symbolic=False) -> Robot:
+@_symbolic_defaults("L1 L2 L3 m1 m2 m3 g radius")
+def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, radius=0.05, symbolic=False) -> Robot:
     """The tutorial's challenge arm: an elbow (articulated, RRR) manipulator, Spong's DH (Table 3.3):
 
     ====  =====  ====  ===  =====
@@ -93,17 +93,28 @@ def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, symbolic=Fa
     ====  =====  ====  ===  =====
 
     Base yaw about the vertical z0, shoulder and elbow pitch about horizontal axes; at q = 0 the upper
-    arm and forearm point along x0 (Spong's zero pose). Links are uniform rods of m_i = 1 kg
-    (the tutorial gives no masses), gravity -g along z0. ``symbolic=True`` uses symbols L1, L2, L3,
-    m1, m2, m3, g for the parameters not given (a keyword given keeps its value).
+    arm and forearm point along x0 (Spong's zero pose). Links are uniform solid cylinders of m_i = 1 kg
+    (the tutorial gives no masses) and radius ``radius`` = 0.05 m, gravity -g along z0.
+
+    Inertia of each link about its centre (a solid cylinder of mass m, length L, radius r; e.g. Meriam &
+    Kraige, Engineering Mechanics: Dynamics, Appendix D): m r^2 / 2 about its own axis and
+    m (3 r^2 + L^2) / 12 about the two transverse axes. The radius is kinedyn's choice (the tutorial gives
+    none): 5 cm, thin beside the 1-3 m links, so M(q) is within 0.1 % of the thin-rod textbook model, but
+    not zero about the rods' own axes. With ``radius=0`` (thin rods, the textbook's m L^2 / 12) M(q) is
+    singular wherever the upper arm and forearm both lie on the vertical z0 axis (q2 = +-90 deg, q3 = 0 or
+    180 deg): turning about z0 then moves no mass. ``symbolic=True`` uses symbols L1, L2, L3, m1, m2, m3,
+    g, radius for the parameters not given (a keyword given keeps its value; ``radius=0`` for the
+    textbook's thin rods).
     """
     half_pi = sp.pi / 2 if symbolic else math.pi / 2
-    # link 1 runs from the base up to frame 1 (along -y1 in frame 1 after Rx(+90 deg))
-    link1 = Inertia(m1, (0, -L1 / 2, 0), ((m1 * L1**2 / 12, 0, 0), (0, 0, 0), (0, 0, m1 * L1**2 / 12)))
+    axial = lambda m: m * radius**2 / 2  # noqa: E731
+    transverse = lambda m, L: m * (3 * radius**2 + L**2) / 12  # noqa: E731
+    # link 1 runs from the base up to frame 1 (along -y1 in frame 1 after Rx(+90 deg)): its own axis is y1
+    link1 = Inertia(m1, (0, -L1 / 2, 0), ((transverse(m1, L1), 0, 0), (0, axial(m1), 0), (0, 0, transverse(m1, L1))))
     rows = [
         DHRow(d=L1, alpha=half_pi, inertia=link1),
-        DHRow(a=L2, inertia=_rod_x(m2, L2, L2 / 2, m2 * L2**2 / 12)),
-        DHRow(a=L3, inertia=_rod_x(m3, L3, L3 / 2, m3 * L3**2 / 12)),
+        DHRow(a=L2, inertia=_rod_x(m2, L2, L2 / 2, transverse(m2, L2), axial(m2))),
+        DHRow(a=L3, inertia=_rod_x(m3, L3, L3 / 2, transverse(m3, L3), axial(m3))),
     ]
     return Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_3r", source="METR4202 Tutorial 4 challenge; Spong et al., Robot Modeling and Control, Example 3.5 / Table 3.3")
 
