@@ -56,10 +56,12 @@ def test_builtin_tree_matches_its_dh_table(name):
     robot = kd.robots.get(name)
     rows = [(float(r.theta), float(r.d), float(r.a), float(r.alpha)) for r in robot.dh]
     kinds = [r.kind for r in robot.dh]
+    # the tool transform, fixed to the last link (the identity, or the Stanford arm's published transl(0, 0, 0.263))
+    tool = [np.asarray(f.placement, dtype=float) for f in robot.frames if f.name == robot.tool][0]
     rng = np.random.default_rng(7)
     for _ in range(3):
         q = random_q(robot, rng)
-        np.testing.assert_allclose(frame_pose(robot, q), standard_dh_tool(rows, q, kinds), atol=1e-12)
+        np.testing.assert_allclose(frame_pose(robot, q), standard_dh_tool(rows, q, kinds) @ tool, atol=1e-12)
 
 
 def test_unknown_builtin():
@@ -222,3 +224,37 @@ def test_symbolic_builtins_carry_symbols_and_agree_with_numbers(name):
     q = numeric.random_configuration(np.random.default_rng(1))
     np.testing.assert_allclose(substituted.pose(q), numeric.pose(q), atol=1e-12)
     np.testing.assert_allclose(substituted.inertial_parameters(), numeric.inertial_parameters(), atol=1e-12)
+
+
+def test_stanford_follows_the_published_model():
+    """Corke's mdl_stanford.m (the table the docstring cites) has d6 = 0 and the 0.263 m wrist-to-tool
+    distance in tool = transl(0, 0, 0.263); link 6's centre of mass (0, 0, 1.554) is measured from the
+    wrist centre. The built-in once moved 0.263 into d6 and kept the centre of mass relative to the moved
+    frame (M, g, C off by up to 0.65, 1.25, 0.50). Here the published model is built from the table's own
+    numbers (transcribed below) and compared: tool pose, M, g, C at random states."""
+    from kinedyn.description.dh import DHRow
+    from kinedyn.description.inertia import Inertia
+
+    table = [  # theta, d, a, alpha, kind ; m ; r ; I diag ; Jm
+        (0.0, 0.412, 0.0, -math.pi / 2, "revolute", 9.29, (0, 0.0175, -0.1105), (0.276, 0.255, 0.071), 0.953),
+        (0.0, 0.154, 0.0, math.pi / 2, "revolute", 5.01, (0, -1.054, 0), (0.108, 0.018, 0.100), 2.193),
+        (-math.pi / 2, 0.0, 0.0, 0.0, "prismatic", 4.25, (0, 0, -6.447), (2.51, 2.51, 0.006), 0.782),
+        (0.0, 0.0, 0.0, -math.pi / 2, "revolute", 1.08, (0, 0.092, -0.054), (0.002, 0.001, 0.001), 0.106),
+        (0.0, 0.0, 0.0, math.pi / 2, "revolute", 0.630, (0, 0.566, 0.003), (0.003, 0.0004, 0.0), 0.097),
+        (0.0, 0.0, 0.0, 0.0, "revolute", 0.51, (0, 0, 1.554), (0.013, 0.013, 0.0003), 0.020),
+    ]
+    rows = [DHRow(theta=th, d=d, a=a, alpha=al, kind=kind, inertia=Inertia(m, r, np.diag(I)), rotor_inertia=jm)
+            for th, d, a, al, kind, m, r, I, jm in table]
+    tool = np.eye(4)
+    tool[2, 3] = 0.263
+    published = kd.Robot.from_dh(rows, gravity=(0, 0, -9.81), tool=tool)
+    robot = kd.robots.stanford()
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q = rng.uniform(-1.5, 1.5, 6)
+        q[2] = rng.uniform(0.4, 1.2)
+        qd = rng.uniform(-1, 1, 6)
+        np.testing.assert_allclose(robot.pose(q), published.pose(q), atol=1e-12)
+        np.testing.assert_allclose(robot.mass_matrix(q), published.mass_matrix(q), atol=1e-10)
+        np.testing.assert_allclose(robot.gravity_torque(q), published.gravity_torque(q), atol=1e-10)
+        np.testing.assert_allclose(robot.coriolis_matrix(q, qd), published.coriolis_matrix(q, qd), atol=1e-10)

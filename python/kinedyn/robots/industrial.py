@@ -231,8 +231,14 @@ def stanford(
     3     -90 deg    q3    0    0        (prismatic)
     4     q4         0     0    -90 deg
     5     q5         0     0    +90 deg
-    6     q6         d6    0    0
+    6     q6         0     0    0
     ====  =========  ====  ===  =======
+
+    and the tool d6 = 0.263 m along z6 from the wrist centre, in a tool transform, as the published
+    model has it (Corke's ``mdl_stanford.m``: link 6 with d = 0 and ``tool = transl(0, 0, 0.263)``),
+    so link 6's centre of mass (0, 0, 1.554) is measured from the wrist centre, as tabulated.
+    (Putting 0.263 m into d6 instead would move link 6's frame, and with it its centre of mass,
+    changing M, g and C.)
 
     Sources: kinematics d1 = 0.412, d2 = 0.154, d6 = 0.263 m from Stanford AIM-177 Fig. 2.3;
     joint limits (+-170 deg, wrist pitch +-90 deg) from Dobrotin & Scheinman (1973), IJCAI, and the
@@ -254,7 +260,7 @@ def stanford(
         (-math.pi / 2, 0.0, 0.0, 0.0, "prismatic"),
         (0.0, 0.0, 0.0, -math.pi / 2, "revolute"),
         (0.0, 0.0, 0.0, math.pi / 2, "revolute"),
-        (0.0, d6, 0.0, 0.0, "revolute"),
+        (0.0, 0.0, 0.0, 0.0, "revolute"),  # d6 = 0: frame 6 at the wrist centre, as published
     ]
     limits = [(lo, hi, math.inf, math.inf) for lo, hi in STANFORD_LIMITS]
     drive = [(1.0, jm if motors else 0.0, 0.0, 0.0) for jm in STANFORD_ROTOR_INERTIAS]
@@ -263,8 +269,10 @@ def stanford(
         _pick(masses, STANFORD_MASSES, "masses"), _pick(coms, STANFORD_COMS, "coms"),
         _pick(inertias, STANFORD_INERTIAS, "inertias"), drive, [f"q{i}" for i in range(1, 7)],
     )
+    tool = np.eye(4)
+    tool[2, 3] = d6  # the published tool transform, transl(0, 0, 0.263)
     return Robot.from_dh(
-        rows, gravity=gravity, name="stanford",
+        rows, gravity=gravity, name="stanford", tool=tool,
         source="Stanford AIM-177; Paul 1981 Tables 6.5-6.6; Corke RTB mdl_stanford.m",
     )
 
