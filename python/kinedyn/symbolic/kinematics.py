@@ -70,7 +70,14 @@ def _book(model: RingModel, e, factor: bool = True):
     if len(sp.Add.make_args(sp.expand(prod))) > 12:
         return f
     g = sp.factor_terms(sp.trigsimp(sp.factor_terms(prod)))
-    return g if sp.count_ops(g) < sp.count_ops(f) else f
+    return _unminus(g if sp.count_ops(g) < sp.count_ops(f) else f)
+
+
+def _unminus(e):
+    """-(a + b) -> -a - b, as the book writes a sum."""
+    if e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Add:
+        return sp.Add(*[-a for a in e.args[1].args])
+    return e
 
 
 def _matrix(model, rows, simplify: bool) -> sp.Matrix:
