@@ -67,14 +67,17 @@ def _book(model: RingModel, e, factor: bool = True):
     if len(sp.Add.make_args(f)) <= 1:
         return f
     prod = ring.to_product_form(ring.chop(e))
-    if len(sp.Add.make_args(sp.expand(prod))) > 12:
+    if len(sp.Add.make_args(sp.expand(prod))) > 8:  # trigsimp grows fast: long entries stay in Fourier form
         return f
     g = sp.factor_terms(sp.trigsimp(sp.factor_terms(prod)))
     return _unminus(g if sp.count_ops(g) < sp.count_ops(f) else f)
 
 
 def _unminus(e):
-    """-(a + b) -> -a - b, as the book writes a sum."""
+    """-(a + b) -> -a - b, as the book writes a sum; 1.0*q3 -> q3 (whole floats of a numeric robot)."""
+    floats = {f: sp.Integer(int(f)) for f in e.atoms(sp.Float) if float(f).is_integer()}
+    if floats:
+        e = e.xreplace(floats)
     if e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Add:
         return sp.Add(*[-a for a in e.args[1].args])
     return e
