@@ -547,7 +547,7 @@ def cmd_symbolic_kinematics(args, what: str) -> int:
 def _symbolic_args(p) -> None:
     p.add_argument("--symbolic", action="store_true", help="the result as formulas in the joint symbols (kinedyn.symbolic), with the robot's parameter symbols")
     p.add_argument("--format", default="text", choices=["text", "latex", "markdown", "json"], help="with --symbolic: output format (default text)")
-    p.add_argument("--abbreviate", action="store_true", help="with --symbolic: write cos(q1 + q2) as c12, sin(q2) as s2")
+    p.add_argument("--abbreviate", action="store_true", help="with --symbolic: cos(q1 + q2) shown as c12, sin(q2) as s2")
 
 
 def cmd_fk(args) -> int:
