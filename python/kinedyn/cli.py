@@ -499,7 +499,64 @@ def _rpy(R: np.ndarray) -> list:
     return [roll, pitch, yaw]
 
 
+def _symbolic_robot(args):
+    """The robot for ``--symbolic``: a built-in with symbolic parameters in its symbolic form (l1, l2,
+    ...; other built-ins keep their numbers), a robot file with its symbols; --set values substituted."""
+    import inspect
+
+    from . import robots
+
+    name = args.robot or robots.DEFAULT
+    factory = robots.CATALOGUE.get(name)
+    if factory is not None and "symbolic" in inspect.signature(factory).parameters:
+        return _substitute(factory(symbolic=True), set_values(), name)
+    return load_robot(name, numeric=False)
+
+
+def cmd_symbolic_kinematics(args, what: str) -> int:
+    """``kinedyn fk|jacobian ROBOT --symbolic``: the pose or the Jacobian as formulas (kinedyn.symbolic)."""
+    import sympy as sp
+
+    from . import symbolic as ks
+
+    robot = _symbolic_robot(args)
+    frame = args.frame or robot.tool
+    q = ks.joint_symbols(robot)
+    if what == "fk":
+        M = ks.pose(robot, frame)
+        label, latex_label = f"T_{frame}(q)", rf"T_{{\mathrm{{{frame}}}}}(q)"
+    else:
+        M = ks.jacobian(robot, frame, reference=args.reference)
+        label, latex_label = f"J_{frame}(q) [{args.reference}]", rf"J_{{\mathrm{{{frame}}}}}(q)"
+    shown = ks.abbreviate(M, q) if args.abbreviate else M
+    fmt = "json" if args.json else args.format
+    title = f"{'pose' if what == 'fk' else 'geometric Jacobian (rows [v; w], ' + args.reference + ')'} of '{frame}' of {robot.name} in q = ({', '.join(map(str, q))})"
+    if fmt == "json":
+        payload = {"robot": robot.name, "frame": frame, "q": [str(s) for s in q],
+                   "parameters": sorted(str(s) for s in robot.symbols), ("pose" if what == "fk" else "jacobian"): [[str(e) for e in row] for row in M.tolist()]}
+        if what == "jacobian":
+            payload["reference"] = args.reference
+        print(json.dumps(payload, indent=2))
+        return 0
+    if fmt == "latex":
+        print(f"% {title}\n{latex_label} = {sp.latex(shown)}")
+    elif fmt == "markdown":
+        print(f"{title}:\n\n$$\n{latex_label} = {sp.latex(shown)}\n$$")
+    else:
+        print(f"{title}:\n{label} =")
+        print("\n".join("  [" + ", ".join(str(e) for e in row) + "]" for row in shown.tolist()))
+    return 0
+
+
+def _symbolic_args(p) -> None:
+    p.add_argument("--symbolic", action="store_true", help="the result as formulas in the joint symbols (kinedyn.symbolic), with the robot's parameter symbols")
+    p.add_argument("--format", default="text", choices=["text", "latex", "markdown", "json"], help="with --symbolic: output format (default text)")
+    p.add_argument("--abbreviate", action="store_true", help="with --symbolic: cos(q1 + q2) shown as c12, sin(q2) as s2")
+
+
 def cmd_fk(args) -> int:
+    if args.symbolic:
+        return cmd_symbolic_kinematics(args, "fk")
     robot = _robot(args)
     q = parse_q(args.q, robot, args.deg)
     frames = robot.frame_names if args.all else [args.frame or robot.tool]
@@ -560,6 +617,8 @@ def _analysis_rows(robot, rows, explicit: bool, frame, reference):
 def cmd_jacobian(args) -> int:
     from . import kinematics as kin
 
+    if args.symbolic:
+        return cmd_symbolic_kinematics(args, "jacobian")
     robot = _robot(args)
     q = parse_q(args.q, robot, args.deg)
     explicit = args.task is not None
@@ -704,6 +763,7 @@ def build_parser() -> argparse.ArgumentParser:
     _state_args(p)
     p.add_argument("--frame", help="frame name (default: the tool)")
     p.add_argument("--all", action="store_true", help="every frame of the robot")
+    _symbolic_args(p)
     p.set_defaults(func=cmd_fk)
 
     p = sub.add_parser("jacobian", help="geometric Jacobian at q, its singular values and singularities")
@@ -713,6 +773,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reference", default="world", choices=["world", "local", "spatial"])
     p.add_argument("--task", default=None, help="rows: full, position, orientation, planar, planar_pose (default full; the manipulability "
                    "of an arm with fewer than six joints then uses the rows it spans, e.g. vx vy vz for elbow_3r)")
+    _symbolic_args(p)
     p.set_defaults(func=cmd_jacobian)
 
     p = sub.add_parser("dynamics", help="M, C, g and tau at a state (Rust core); forward dynamics with --tau; derivatives")

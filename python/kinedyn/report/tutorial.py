@@ -146,26 +146,18 @@ def _half_unit(s: str) -> float:
 
 
 def symbolic_frame_pose(robot, q: Sequence[sp.Symbol], frame: Optional[str] = None) -> sp.Matrix:
-    """The pose of a frame as a SymPy matrix in the joint symbols ``q``, multiplied out from the robot's
-    description (T_body = T_parent * placement * joint motion(q + offset); frame = T_body * placement)."""
-    from .._math import rot_axis, translation
+    """The pose of a frame as a SymPy matrix in the joint symbols ``q``: kinedyn.symbolic.pose with the
+    robot's joint symbols renamed to ``q``."""
+    from .. import symbolic as ks
 
-    tree = robot.tree
-    poses: List[sp.Matrix] = []
-    for i, b in enumerate(tree.bodies):
-        x = q[i] + b.joint.offset
-        motion = rot_axis(b.joint.axis, x) if b.joint.kind == "revolute" else translation(*(a * x for a in b.joint.axis))
-        parent = sp.eye(4) if b.parent < 0 else poses[b.parent]
-        poses.append(parent * sp.Matrix(b.placement) * sp.Matrix(motion))
-    f = tree.frames[robot.frame_index(frame or robot.tool)]
-    T = (sp.eye(4) if f.body < 0 else poses[f.body]) * sp.Matrix(f.placement)
-    return T.applyfunc(sp.trigsimp)
+    return ks.pose(robot, frame).xreplace(dict(zip(ks.joint_symbols(robot), q)))
 
 
-def _clean(e):
-    """Round float artefacts like 1.0*x and 6.1e-17 from DH products with alpha = pi/2 given as floats."""
-    e = sp.nsimplify(e, tolerance=1e-12, rational=True) if e.atoms(sp.Float) else e
-    return sp.trigsimp(sp.expand_trig(e)) if e.has(sp.sin, sp.cos) else e
+def symbolic_jacobian(robot, q: Sequence[sp.Symbol], frame: Optional[str] = None) -> sp.Matrix:
+    """kinedyn.symbolic.jacobian (rows [v; w], base axes) in the joint symbols ``q``."""
+    from .. import symbolic as ks
+
+    return ks.jacobian(robot, frame).xreplace(dict(zip(ks.joint_symbols(robot), q)))
 
 
 def _abbreviate(expr, q: Sequence[sp.Symbol], prefix=("C", "S")):
@@ -221,8 +213,11 @@ def _q1_jacobian():
     robot = _arm_2r_symbolic()
     rl1, rl2 = sp.Symbol("l1", positive=True), sp.Symbol("l2", positive=True)
     T = symbolic_frame_pose(robot, [th1, th2])
-    p = T[:2, 3].xreplace({rl1: l1, rl2: l2}).applyfunc(_clean)
-    J = p.jacobian([th1, th2]).applyfunc(lambda e: sp.trigsimp(e))
+    p = T[:2, 3].xreplace({rl1: l1, rl2: l2})
+    # rows 0-1 of kinedyn.symbolic.jacobian, = dp/dtheta (the derivative is the check)
+    J = symbolic_jacobian(robot, [th1, th2])[:2, :].xreplace({rl1: l1, rl2: l2})
+    if not _same(J - p.jacobian([th1, th2]), sp.zeros(2, 2), [th1, th2, l1, l2]):
+        raise RuntimeError("internal error: the symbolic Jacobian is not dp/dtheta")
     return robot, p, J
 
 
@@ -255,13 +250,16 @@ def _q1a() -> Answer:
 
 def _q1b() -> Answer:
     a = Answer("1b", "Inverse Jacobian", "Calculate the inverse Jacobian relating tool-point velocities to joint velocities.")
+    from .. import symbolic as ks
+
     _, _, J = _q1_jacobian()
-    det = sp.trigsimp(sp.expand_trig(J.det()))
+    inverse = ks.jacobian_inverse(J, coordinates=[th1, th2])
+    det = inverse.determinant
     a.text("The determinant of the 2 x 2 Jacobian:")
     a.eq("det J", det)
     a.text("so J is invertible except where sin(theta2) = 0 (arm stretched out or folded back). "
            "The inverse is the adjugate divided by the determinant, thetadot = J^-1 (xdot, ydot):")
-    adj = J.adjugate().applyfunc(sp.trigsimp)
+    adj = inverse.adjugate
     Jinv = adj / det
     a.eq("J^-1", sp.MatMul(1 / det, adj, evaluate=False))
     prod = (J * Jinv).applyfunc(lambda e: sp.simplify(sp.expand_trig(e)))
@@ -666,7 +664,7 @@ def _challenge() -> Answer:
     t1, t2, t3 = sp.symbols("theta1 theta2 theta3", real=True)
     q = [t1, t2, t3]
     T = symbolic_frame_pose(sym, q)
-    o3 = T[:3, 3].applyfunc(_clean)
+    o3 = T[:3, 3]
     a.text("Forward kinematics (kinedyn: the DH products of this table multiplied out, with the lengths as symbols):")
     a.eq("o3 = (x, y, z)", o3)
     x, y, z = sp.symbols("x y z", real=True)
@@ -710,10 +708,10 @@ def _challenge() -> Answer:
         matched = sum(any(np.allclose(wrap(s - k), 0, atol=1e-8) for k in kd_solutions) for s in sols)
         a.text(f"kinedyn's inverse kinematics (robot.inverse_kinematics) returns {len(kd_solutions)} solutions; {matched} of the 4 above are among them.")
     # Jacobian
-    Jv = o3.jacobian(q).applyfunc(sp.trigsimp)
-    poses = _body_axes(sym, q)
-    Jw = sp.Matrix.hstack(*poses).applyfunc(_clean)
-    J = sp.Matrix.vstack(Jv, Jw)
+    J = symbolic_jacobian(sym, q)
+    Jv = J[:3, :]
+    if not _same(Jv - o3.jacobian(q), sp.zeros(3, 3), [t1, t2, t3, L1s, L2s, L3s]):
+        raise RuntimeError("internal error: the symbolic Jacobian is not d o3 / d theta")
     a.text("Jacobian [J_v; J_w] in base axes: J_v = d o3 / d theta, column i of J_w = the joint axis z_(i-1):")
     a.eq("J", J)
     detJ = -L2s * L3s * sp.sin(t3) * (L2s * sp.cos(t2) + L3s * sp.cos(t2 + t3))
@@ -745,22 +743,6 @@ def _challenge() -> Answer:
     if kd_solutions is not None:
         a.result["kinedyn_ik_solutions_rad"] = kd_solutions.tolist()
     return a
-
-
-def _body_axes(robot, q) -> List[sp.Matrix]:
-    """The joint axes in base coordinates (columns of J_w for revolute joints)."""
-    from .._math import rot_axis, translation
-
-    poses: List[Any] = []
-    axes = []
-    for i, b in enumerate(robot.tree.bodies):
-        parent = sp.eye(4) if b.parent < 0 else poses[b.parent]
-        joint_frame = parent * sp.Matrix(b.placement)
-        axes.append(joint_frame[:3, :3] * sp.Matrix(b.joint.axis) if b.joint.kind == "revolute" else sp.zeros(3, 1))
-        x = q[i] + b.joint.offset
-        motion = rot_axis(b.joint.axis, x) if b.joint.kind == "revolute" else translation(*(c * x for c in b.joint.axis))
-        poses.append(joint_frame * sp.Matrix(motion))
-    return axes
 
 
 # ------------------------------------------------------------------ entry points

@@ -4,12 +4,16 @@
   (Spong ch. 9) or the customised symbolic Newton-Euler model (Khalil & Dombre).
 - :class:`EquationsOfMotion`: M, C, g, tau, Christoffel symbols, K, P, L, H, steps, regressor,
   LaTeX/Markdown/MathML, generated code.
+- :func:`pose`, :func:`jacobian`: a frame's symbolic pose and geometric Jacobian in the joint symbols
+  of the equations of motion; :func:`jacobian_inverse`, :func:`tool_velocity`, :func:`joint_torques`.
 - :class:`LagrangianSystem`: equations from K and P, from bodies, or from L directly, with generalised
   and non-conservative forces, holonomic and Pfaffian constraints (LaValle §13.4), Hamiltonian form.
 """
 
 from .eom import EquationsOfMotion, Step, equations_of_motion
+from .kinematics import JacobianInverse, abbreviate, jacobian, jacobian_inverse, joint_symbols, joint_torques, pose, tool_velocity
 from .simplify import simplify_trig
 from .system import LagrangianSystem, coordinates
 
-__all__ = ["equations_of_motion", "EquationsOfMotion", "LagrangianSystem", "Step", "coordinates", "simplify_trig"]
+__all__ = ["equations_of_motion", "EquationsOfMotion", "LagrangianSystem", "Step", "coordinates", "simplify_trig",
+           "pose", "jacobian", "jacobian_inverse", "JacobianInverse", "tool_velocity", "joint_torques", "abbreviate", "joint_symbols"]

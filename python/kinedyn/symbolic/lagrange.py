@@ -99,7 +99,9 @@ def latex_names(q, qd, qdd) -> dict:
 class RingModel:
     """The robot's kinematics and energies in the exact trigonometric ring (see module docstring)."""
 
-    def __init__(self, robot, q, qd, qdd, inertias=None):
+    def __init__(self, robot, q, qd, qdd, inertias=None, extra_leaves=()):
+        """``extra_leaves``: further parameter expressions the ring must hold (a frame's placement, a
+        point given with symbols) for :mod:`kinedyn.symbolic.kinematics`."""
         self.robot = robot
         bodies = robot.tree.bodies
         self.n = n = len(bodies)
@@ -128,6 +130,7 @@ class RingModel:
                 leaves.append(off)
         self.gravity = [_exact(g) for g in robot.gravity]
         leaves += self.gravity
+        leaves += [_exact(x) for x in extra_leaves]
         self.leaves = leaves
         kinds = [b.joint.kind for b in bodies]
         self.ring = TrigRing(list(zip(q, kinds)), qd, qdd, leaves)
