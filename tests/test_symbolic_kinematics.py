@@ -222,8 +222,10 @@ def test_bad_arguments():
 
 # ------------------------------------------------------------------ CLI
 def _cli(*args):
+    # the kinedyn under test (the working tree's or the installed wheel's), not necessarily ROOT/python
+    package_parent = str(Path(kd.__file__).resolve().parents[1])
     return subprocess.run([sys.executable, "-m", "kinedyn", *args], capture_output=True, text=True, cwd=ROOT,
-                          env={"PYTHONPATH": str(ROOT / "python"), "PATH": "/usr/bin:/bin"})
+                          env={"PYTHONPATH": package_parent, "PATH": "/usr/bin:/bin"})
 
 
 def test_cli_fk_and_jacobian_symbolic():
