@@ -10,7 +10,6 @@ import json
 import math
 import os
 import re
-import shutil
 
 import numpy as np
 import pytest
@@ -122,30 +121,6 @@ def test_report_bad_input(capsys, argv, message):
 
 
 # ------------------------------------------------------------------ in a real browser
-def _chromium():
-    for name in ("chromium", "chromium-browser", "google-chrome"):
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
-
-
-@pytest.fixture(scope="module")
-def browser():
-    sync_api = pytest.importorskip("playwright.sync_api", reason="Playwright (test extra) is not installed")
-    exe = _chromium()
-    if exe is None:
-        pytest.skip("no Chromium on this machine (.ci/run installs Debian's chromium package where apt can)")
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(
-            executable_path=exe,
-            args=["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-                  "--disable-component-update", "--disable-sync"],
-        )
-        yield b
-        b.close()
-
-
 def nonblank(png: bytes) -> float:
     """Fraction of pixels that differ from the image's most common colour."""
     from PIL import Image

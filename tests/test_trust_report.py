@@ -12,7 +12,6 @@ from __future__ import annotations
 import io
 import json
 import re
-import shutil
 
 import numpy as np
 import pytest
@@ -172,14 +171,7 @@ def test_the_reported_breaker(tmp_path):
     check_report(robot, shown=True)
 
 
-# ------------------------------------------------------------------ in a real browser
-def _chromium():
-    for name in ("chromium", "chromium-browser", "google-chrome"):
-        if shutil.which(name):
-            return shutil.which(name)
-    return None
-
-
+# ------------------------------------------------------------------ in a real browser (tests/conftest.py's browser)
 def nonblank(png: bytes) -> float:
     """Fraction of pixels that differ from the image's most common colour."""
     from PIL import Image
@@ -187,19 +179,6 @@ def nonblank(png: bytes) -> float:
     im = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).reshape(-1, 3)
     colours, counts = np.unique(im, axis=0, return_counts=True)
     return float(np.mean(np.any(np.abs(im.astype(int) - colours[np.argmax(counts)]) > 24, axis=1)))
-
-
-@pytest.fixture(scope="module")
-def browser():
-    sync_api = pytest.importorskip("playwright.sync_api", reason="Playwright (test extra) is not installed")
-    exe = _chromium()
-    if exe is None:
-        pytest.skip("no Chromium on this machine (.ci/run installs Debian's chromium package where apt can)")
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=exe, args=["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-                                                          "--disable-background-networking", "--disable-component-update", "--disable-sync"])
-        yield b
-        b.close()
 
 
 def test_report_with_a_hostile_name_in_chromium(browser, tmp_path):
