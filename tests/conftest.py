@@ -1,11 +1,18 @@
 """Fixtures shared by test files: a headless Chromium for the tests that look at the report as a
-browser shows it."""
+browser shows it; and the Hypothesis profile (KINEDYN_HYPOTHESIS=ci in .ci/run: the same examples
+on every CI run, so a red CI names a change, not a draw; local runs draw fresh examples, and
+scripts/fuzz explores further)."""
 
 from __future__ import annotations
 
+import os
 import shutil
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True)
+settings.load_profile(os.environ.get("KINEDYN_HYPOTHESIS", "default"))
 
 
 def chromium_path():
