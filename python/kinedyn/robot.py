@@ -78,7 +78,9 @@ class Robot:
             raise ValueError(f"robot '{name}' has no moving joint")
         names = [f.name for f in self.tree.frames]
         if tool is None:
-            tool = "tool" if "tool" in names else self.tree.bodies[-1].name
+            from .description.tool import default_tool
+
+            tool = "tool" if "tool" in names else default_tool(self.links, base)
         if tool not in names:
             raise ValueError(f"tool frame '{tool}' is not a frame of robot '{name}' (frames: {names})")
         self.tool = tool
