@@ -364,6 +364,17 @@ class Robot:
     def __repr__(self) -> str:
         return f"Robot(name={self.name!r}, n={self.n}, joints={self.joint_names}, tool={self.tool!r})"
 
+    # notebooks (kinedyn.display): joint table, mass, gravity, tool and a small stick figure
+    def _repr_html_(self) -> str:
+        from .display import robot_html
+
+        return robot_html(self)
+
+    def _repr_markdown_(self) -> str:
+        from .display import robot_markdown
+
+        return robot_markdown(self)
+
     # ------------------------------------------------------------------ numeric engine
     @cached_property
     def _model(self):

@@ -60,7 +60,7 @@ def fit_table(table, width: int, console) -> List:
         return [table]
     key, rest = table.columns[0], table.columns[1:]
 
-    def part(columns) -> object:
+    def part(columns):
         t = copy.copy(table)
         t.columns = [copy.copy(c) for c in [key, *columns]]
         return t
@@ -90,7 +90,7 @@ def console():
     from rich.table import Table
 
     class _Console(Console):
-        def print(self, *objects, **kwargs):  # type: ignore[override]
+        def print(self, *objects, **kwargs):
             parts: list = []
             for obj in objects:
                 parts.extend(fit_table(obj, self.width, self) if isinstance(obj, Table) else [obj])
