@@ -89,11 +89,15 @@ def _gravity(robot) -> str:
 
 
 def stick_figure_svg(robot, q=None, size: int = 220) -> Optional[str]:
-    """The robot at ``q`` (default: zeros, clipped to the limits) as a small inline SVG drawing: a line
+    """The robot at ``q`` (default: the report's generic configuration) as a small inline SVG drawing: a line
     from each link frame to its parent's and to each extra frame, seen from the front-right and above
     the base (up = against gravity), the tool frame in red. None for a robot whose geometry is symbolic."""
     try:
-        q = np.clip(np.zeros(robot.n), robot.lower_limits, robot.upper_limits) if q is None else np.asarray(q, dtype=float)
+        if q is None:  # the report's generic pose (0.5, -0.7, ... rad): the structure shows, unlike at a singular q = 0
+            from .report.html import default_configuration
+
+            q = default_configuration(robot)
+        q = np.asarray(q, dtype=float)
         poses = np.asarray(robot.frame_poses(q), dtype=float)
     except (TypeError, ValueError, AttributeError):
         return None
@@ -123,7 +127,7 @@ def stick_figure_svg(robot, q=None, size: int = 220) -> Optional[str]:
         return size / 2 + scale * u[0], size / 2 - scale * u[1]
 
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}" role="img" '
-           f'aria-label="{html.escape(robot.name)} at q = 0" style="background:#fafaf7;border:1px solid #ddd">']
+           f'aria-label="{html.escape(robot.name)} at q" style="background:#fafaf7;border:1px solid #ddd">']
     for a, b in edges:
         (x1, y1), (x2, y2) = xy(at[a]), xy(at[b])
         out.append(f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" stroke="#5f6b73" stroke-width="3" stroke-linecap="round"/>')
