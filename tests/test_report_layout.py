@@ -168,3 +168,35 @@ def test_gravity_prints_as_a_vector(reports):
     assert "['0'" not in page
     g = kd.robots.planar_2r().gravity
     assert re.search(r"gravity g = \(" + ", ".join(re.escape(f"{v:g}") for v in g) + r"\) m/s²", page), re.findall(r"gravity[^<]*", page)
+
+
+def test_report_frame_option_and_the_pandas_default_tool(tmp_path, capsys):
+    """Issue 13 §5: the Panda's report showed a finger's Jacobian; its default tool is now panda_hand_tcp,
+    and --frame shows another frame."""
+    import json
+
+    path = erd(*PANDA)
+    robot = kd.Robot.from_urdf(path)
+    for argv, frame in ((["report", path], "panda_hand_tcp"), (["report", path, "--frame", "panda_link7"], "panda_link7")):
+        assert main([*argv, "-o", str(tmp_path / "p.html"), "--t", "0.1", "--json"]) == 0
+        d = json.loads(capsys.readouterr().out)
+        assert d["tool"] == frame
+        np.testing.assert_allclose(d["jacobian"], robot.jacobian(np.array(d["q"]), frame), atol=1e-12)
+    assert main(["report", path, "--frame", "no_such_frame", "-o", str(tmp_path / "p.html")]) == 1
+    assert "tool frame 'no_such_frame' is not a frame of robot 'panda'" in capsys.readouterr().err
+
+
+def test_panda_ik_moves_the_arm_not_the_fingers():
+    robot = kd.Robot.from_urdf(erd(*PANDA))
+    q_target = np.array([0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.4, 0.02, 0.03])
+    q0 = np.array([0.0, -0.3, 0.0, -1.8, 0.0, 1.5, 0.3, 0.01, 0.01])
+    result = robot.inverse_kinematics(robot.pose(q_target), q0=q0)
+    assert result.success
+    np.testing.assert_allclose(result.q[7:], q0[7:], atol=1e-12)  # the fingers do not move the tool
+    np.testing.assert_allclose(robot.pose(result.q), robot.pose(q_target), atol=1e-6)
+
+
+def test_talos_report_with_default_options_finishes_in_under_60_s(tmp_path):
+    start = time.perf_counter()
+    assert main(["report", erd(*TALOS), "-o", str(tmp_path / "talos.html")]) == 0
+    assert time.perf_counter() - start < 60  # issue 13 §5's bound; ~3-10 s here under load
