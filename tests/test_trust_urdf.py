@@ -52,24 +52,26 @@ def test_2000_fixed_links_after_the_last_joint_load_quickly():
     assert robot.tree.bodies[0].inertia.mass == pytest.approx(1 + 0.0 + 2000 * 1.0)
 
 
-def _old_default_tool(links, base):
-    """The previous (cubic) search, kept as the reference for what the tool frame should be."""
+def _reference_default_tool(links, base):
+    """The default tool by brute force (quadratic), for names that are no tool name: the end of the
+    longest chain -- the deepest moving link (most moving joints down from the base; the later one in
+    the file of equal ones), then the later link it carries through fixed joints."""
+    by_name = {l.name: l for l in links}
+
+    def chain(name):  # the links from `name` up to the base
+        out = []
+        while name in by_name:
+            out.append(by_name[name])
+            name = by_name[name].parent
+        return out
+
+    depth = {l.name: sum(x.joint.is_moving for x in chain(l.name)) for l in links}
     moving = [l.name for l in links if l.joint.is_moving]
     if not moving:
         return base
-    parent = {l.name: l.parent for l in links}
-
-    def carried_by_last(name):
-        while name != moving[-1]:
-            if name not in parent:
-                return False
-            link = next(l for l in links if l.name == name)
-            if link.joint.is_moving:
-                return False
-            name = parent[name]
-        return True
-
-    return [l.name for l in links if carried_by_last(l.name)][-1]
+    deepest = max(moving, key=lambda name: (depth[name], moving.index(name)))
+    carried = [l.name for l in links if next((x.name for x in chain(l.name) if x.joint.is_moving), None) == deepest]
+    return carried[-1]
 
 
 @st.composite
@@ -93,16 +95,18 @@ def random_trees(draw):
 
 @settings(max_examples=60, deadline=None)
 @given(random_trees())
-def test_default_tool_is_the_one_the_old_search_found(xml):
+def test_default_tool_is_the_end_of_the_longest_chain(xml):
     robot = robot_from_urdf(xml)
-    assert robot.tool == _old_default_tool(list(robot.links), robot.base)
+    assert robot.tool == _reference_default_tool(list(robot.links), robot.base)
 
 
-@pytest.mark.parametrize("name", ["ur_description/urdf/ur5_robot.urdf", "panda_description/urdf/panda.urdf",
-                                  "talos_data/robots/talos_full_v2.urdf", "romeo_description/urdf/romeo.urdf"])
-def test_default_tool_of_real_robots_unchanged(name):
+@pytest.mark.parametrize("name, tool", [("ur_description/urdf/ur5_robot.urdf", "tool0"),  # REP 199's name
+                                        ("panda_description/urdf/panda.urdf", "panda_hand_tcp"),  # not a finger (issue 13 §5)
+                                        ("talos_data/robots/talos_full_v2.urdf", "wrist_right_ft_tool_link"),  # not a sole
+                                        ("romeo_description/urdf/romeo.urdf", "RThumb3Link")])  # no tool name: longest chain
+def test_default_tool_of_real_robots(name, tool):
     robot = robot_from_urdf(erd(*name.split("/")))
-    assert robot.tool == _old_default_tool(list(robot.links), robot.base)
+    assert robot.tool == tool
 
 
 BILLION_LAUGHS = """<?xml version="1.0"?>

@@ -301,3 +301,37 @@ def test_bad_numbers_and_inertia():
     no_robot = "<model name='x'/>"
     with pytest.raises(ValueError, match=r"root element is <model>"):
         robot_from_urdf(no_robot)
+
+
+def _gripper_urdf(tool_link: str, extra: str = "") -> str:  # extra: more XML inside <robot>
+    """A 2-joint arm whose hand carries a fixed `tool_link` and two sliding fingers (the longer chains)."""
+    body = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
+    links = ["base", "l1", "l2", tool_link, "finger_a", "finger_b"]
+    joints = [("j1", "revolute", "base", "l1"), ("j2", "revolute", "l1", "l2"), ("jt", "fixed", "l2", tool_link),
+              ("fa", "prismatic", "l2", "finger_a"), ("fb", "prismatic", "l2", "finger_b")]
+    xml = "".join(f'<link name="{n}">{body}</link>' for n in links) + extra
+    xml += "".join(f'<joint name="{j}" type="{k}"><parent link="{p}"/><child link="{c}"/><origin xyz="0 0 0.1"/>'
+                   f'<axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>' for j, k, p, c in joints)
+    return f'<robot name="gripper">{xml}</robot>'
+
+
+@pytest.mark.parametrize("tool_link", ["tcp", "tool0", "ee_link", "arm_hand_tcp", "arm_hand", "flange"])
+def test_default_tool_prefers_a_named_tool_over_a_finger(tool_link):
+    """Issue 13 §5: the Panda's default tool was a finger (the end of the last branch); a link named
+    as a tool wins over the longer finger chains."""
+    assert robot_from_urdf(_gripper_urdf(tool_link)).tool == tool_link
+
+
+def test_default_tool_without_a_tool_name_is_the_end_of_the_longest_chain():
+    assert robot_from_urdf(_gripper_urdf("wrist_plate")).tool == "finger_b"  # two chains of 3: the later one
+    # a better-ranked name wins over a worse-ranked one (a *_tcp over a *_hand), wherever it is in the file
+    hand = '<link name="panda_hand"/><joint name="jh" type="fixed"><parent link="l2"/><child link="panda_hand"/></joint>'
+    assert robot_from_urdf(_gripper_urdf("panda_hand_tcp", hand)).tool == "panda_hand_tcp"
+    assert robot_from_urdf(_gripper_urdf("wrist_plate", hand)).tool == "panda_hand"
+
+
+def test_default_tool_of_the_panda_is_its_tcp():
+    robot = robot_from_urdf(erd(*PANDA))
+    assert robot.tool == "panda_hand_tcp"
+    J = robot.jacobian(np.zeros(robot.n))
+    np.testing.assert_allclose(J[:, 7:], 0.0, atol=1e-12)  # the fingers do not move the tool

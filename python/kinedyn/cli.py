@@ -301,9 +301,10 @@ def esc(text) -> str:
 
 
 def console():
-    from rich.console import Console
+    """The console every command prints with: tables keep their numbers whole (kinedyn.terminal)."""
+    from .terminal import console as terminal_console
 
-    return Console(highlight=False, soft_wrap=True)
+    return terminal_console()
 
 
 def _jsonable(x):

@@ -78,7 +78,9 @@ class Robot:
             raise ValueError(f"robot '{name}' has no moving joint")
         names = [f.name for f in self.tree.frames]
         if tool is None:
-            tool = "tool" if "tool" in names else self.tree.bodies[-1].name
+            from .description.tool import default_tool
+
+            tool = "tool" if "tool" in names else default_tool(self.links, base)
         if tool not in names:
             raise ValueError(f"tool frame '{tool}' is not a frame of robot '{name}' (frames: {names})")
         self.tool = tool
@@ -361,6 +363,17 @@ class Robot:
 
     def __repr__(self) -> str:
         return f"Robot(name={self.name!r}, n={self.n}, joints={self.joint_names}, tool={self.tool!r})"
+
+    # notebooks (kinedyn.display): joint table, mass, gravity, tool and a small stick figure
+    def _repr_html_(self) -> str:
+        from .display import robot_html
+
+        return robot_html(self)
+
+    def _repr_markdown_(self) -> str:
+        from .display import robot_markdown
+
+        return robot_markdown(self)
 
     # ------------------------------------------------------------------ numeric engine
     @cached_property

@@ -110,6 +110,11 @@ class Identification:
                      max_error_in_std=float(np.abs(errors / self.std).max()) if np.all(self.std > 0) else None)
         return d
 
+    def _repr_html_(self) -> str:  # notebooks: estimates, std and errors as a table (kinedyn.display)
+        from ..display import identification_html
+
+        return identification_html(self)
+
     def __str__(self) -> str:
         lines = [f"{len(self.names)} base parameters, cond(W) = {self.condition_number:.4g}, {'weighted' if self.weighted else 'ordinary'} least squares"]
         for k, nm in enumerate(self.names):

@@ -62,6 +62,11 @@ class PropertiesReport:
     def to_dict(self) -> dict:
         return dict(robot=self.robot, samples=self.samples, passed=self.passed, checks=[c.to_dict() for c in self.checks])
 
+    def _repr_html_(self) -> str:  # notebooks: the checks as a table (kinedyn.display)
+        from ..display import properties_html
+
+        return properties_html(self)
+
     def __str__(self) -> str:
         lines = [f"properties of '{self.robot}' over {self.samples} sampled states:"]
         for c in self.checks:

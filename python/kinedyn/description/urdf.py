@@ -39,6 +39,7 @@ from .checks import LARGEST
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Link
+from .tool import default_tool
 
 __all__ = ["robot_from_urdf", "MAX_DEPTH"]
 
@@ -51,8 +52,9 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
     ``gravity``: the gravity vector in base (root link) coordinates. ``tool``: the name of the frame
-    used as ``robot.tool``; by default the last link, in depth-first order, that moves with the last
-    joint (e.g. ``tool0`` of a UR arm). The root link's inertia is ignored (fixed base).
+    used as ``robot.tool``; by default a link the file names as its tool (``tool0`` of a UR arm,
+    ``panda_hand_tcp`` of the Panda), else the end of the longest chain
+    (:func:`kinedyn.description.tool.default_tool`). The root link's inertia is ignored (fixed base).
     ``inertia``: the policy for an inertia no rigid body can have, ``"warn"`` (default), ``"repair"``
     or ``"strict"`` (see :func:`kinedyn.description.inertia.judge` and docs/model-files.md).
 
@@ -78,7 +80,7 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
         except ValueError as e:
             raise src.error(j["element"], str(e)) from None
     if tool is None:
-        tool = _default_tool(links, base)
+        tool = default_tool(links, base)
     name = root.get("name") or "urdf_robot"
     source = src.label if not src.label.startswith("<") else "URDF string"
     # the Robot judges the inertias (policy) and checks the tree: its errors and warnings name a
@@ -381,16 +383,3 @@ def _cycle(parent_joint: dict) -> str:
         path.append(link)
 
 
-def _default_tool(links: list, base: str) -> str:
-    """The last link, in depth-first order, carried by the last moving joint: a link is carried by
-    the nearest moving joint on its path to the root (its own, if it moves). One pass over the
-    links, which come in depth-first order (parents before children)."""
-    carrier = {base: None}
-    last_moving = None
-    for link in links:
-        carrier[link.name] = link.name if link.joint.is_moving else carrier[link.parent]
-        if link.joint.is_moving:
-            last_moving = link.name
-    if last_moving is None:
-        return base
-    return [link.name for link in links if carrier[link.name] == last_moving][-1]

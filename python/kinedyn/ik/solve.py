@@ -92,6 +92,16 @@ class IKResult:
             f"message={self.message!r})"
         )
 
+    def _repr_html_(self) -> str:  # notebooks: the solutions table (kinedyn.display)
+        from ..display import ik_html
+
+        return ik_html(self)
+
+    def _repr_markdown_(self) -> str:
+        from ..display import ik_markdown
+
+        return ik_markdown(self)
+
 
 @dataclass(slots=True)
 class IKBatchResult:

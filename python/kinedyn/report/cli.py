@@ -34,6 +34,8 @@ def cmd_report(args) -> int:
 
     spec = args.robot or robots.DEFAULT
     robot = load_robot(spec)
+    if args.frame is not None and args.frame != robot.tool:
+        robot = robot.replace(tool=args.frame)  # a ValueError naming the robot's frames if it has none such
     q = parse_q(args.q, robot, args.deg) if args.q is not None else default_configuration(robot)
     qd = parse_q(args.qd, robot, args.deg, "--qd") if args.qd is not None else None
     out = Path(args.output)  # checked (with --t, --time-budget) before the command started: kinedyn.cli.check_output_path
@@ -91,6 +93,8 @@ def add_report_commands(subparsers) -> None:
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
     p.add_argument("-o", "--output", default="report.html", action=OutputPath, help="the HTML file to write (default: report.html)")
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="joint values (default: a generic, non-singular configuration)")
+    p.add_argument("--frame", help="the tool frame whose pose and Jacobian the report shows (default: the robot's tool, e.g. a URDF's "
+                   "tool0/*_tcp link, else the end of its longest chain)")
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="joint velocities at the start of the simulation (default zeros)")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--t", type=positive_float, default=3.0, help="simulated seconds of free motion (default 3)")

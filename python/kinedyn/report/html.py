@@ -280,8 +280,27 @@ def _ticks(lo: float, hi: float, n: int = 5) -> List[float]:
     return [start + k * step for k in range(int((hi - start) / step + 1e-9) + 1)]
 
 
+_DASHES = ["", "6 3", "2 2", "8 3 2 3"]  # after the colours run out: the same colours dashed
+
+
+def _legend_rows(labels: Sequence[str], width: float, left: float, right: float) -> List[List[tuple]]:
+    """Legend entries laid out in rows that fit between ``left`` and ``width - right``: each entry is
+    (x, label), 26 px of line sample and gap plus ~6.6 px per character of 11-px text, 14 px apart."""
+    rows: List[List[tuple]] = [[]]
+    x = left + 4
+    for label in labels:
+        w = 26 + 6.6 * len(label)
+        if rows[-1] and x + w > width - right:
+            rows.append([])
+            x = left + 4
+        rows[-1].append((x, label))
+        x += w + 14
+    return rows
+
+
 def svg_plot(x, series: Sequence[tuple], title: str, xlabel: str, ylabel: str, width: int = 520, height: int = 270) -> str:
-    """A line plot as inline SVG: ``series`` = [(label, y), ...]."""
+    """A line plot as inline SVG: ``series`` = [(label, y), ...]. The legend names every series, in as
+    many rows as it needs (the plot grows taller to keep its area); colours repeat dashed after seven."""
     x = np.asarray(x, dtype=float)
     ys = [np.asarray(y, dtype=float) for _, y in series]
     ylo = min(float(np.min(y)) for y in ys)
@@ -290,7 +309,10 @@ def svg_plot(x, series: Sequence[tuple], title: str, xlabel: str, ylabel: str, w
         ylo, yhi = ylo - 1.0, yhi + 1.0
     pad = 0.06 * (yhi - ylo)
     ylo, yhi = ylo - pad, yhi + pad
-    L, R, Tp, B = 62, 14, 46, 44
+    L, R, B = 62, 14, 44
+    legend = _legend_rows([str(label) for label, _ in series], width, L, R)
+    Tp = 32 + 14 * len(legend)
+    height += Tp - 46
     W, H = width - L - R, height - Tp - B
     px = lambda v: L + W * (v - x[0]) / (x[-1] - x[0] if x[-1] > x[0] else 1.0)
     py = lambda v: Tp + H * (1 - (v - ylo) / (yhi - ylo))
@@ -303,12 +325,15 @@ def svg_plot(x, series: Sequence[tuple], title: str, xlabel: str, ylabel: str, w
         out.append(f'<line y1="{Tp}" y2="{Tp + H}" x1="{px(v):.1f}" x2="{px(v):.1f}" stroke="#f1f2ee"/>')
         out.append(f'<text y="{Tp + H + 16}" x="{px(v):.1f}" text-anchor="middle" font-size="11" fill="#5f6b73">{v:.4g}</text>')
     out.append(f'<rect x="{L}" y="{Tp}" width="{W}" height="{H}" fill="none" stroke="#9aa5aa"/>')
-    for k, ((label, _), y) in enumerate(zip(series, ys)):
+    places = [(32 + 14 * r, x0) for r, row in enumerate(legend) for x0, _ in row]
+    for k, ((label, _), y, (ly, lx)) in enumerate(zip(series, ys, places)):
         pts = " ".join(f"{px(a):.1f},{py(b):.1f}" for a, b in zip(x, y))
         c = _COLOURS[k % len(_COLOURS)]
-        out.append(f'<polyline points="{pts}" fill="none" stroke="{c}" stroke-width="1.8"/>')
-        out.append(f'<line x1="{L + 4 + 95 * k}" x2="{L + 22 + 95 * k}" y1="{Tp - 10}" y2="{Tp - 10}" stroke="{c}" stroke-width="2.5"/>'
-                   f'<text x="{L + 26 + 95 * k}" y="{Tp - 6}" font-size="11" fill="#243238">{html.escape(label)}</text>')
+        dash = _DASHES[(k // len(_COLOURS)) % len(_DASHES)]
+        dash_attr = f' stroke-dasharray="{dash}"' if dash else ""
+        out.append(f'<polyline points="{pts}" fill="none" stroke="{c}" stroke-width="1.8"{dash_attr}/>')
+        out.append(f'<line x1="{lx:.1f}" x2="{lx + 18:.1f}" y1="{ly - 4}" y2="{ly - 4}" stroke="{c}" stroke-width="2.5"{dash_attr}/>'
+                   f'<text x="{lx + 22:.1f}" y="{ly}" font-size="11" fill="#243238">{html.escape(label)}</text>')
     out.append(f'<text x="{L + W / 2}" y="{height - 8}" text-anchor="middle" font-size="12" fill="#36454c">{html.escape(xlabel)}</text>')
     out.append(f'<text transform="translate(14 {Tp + H / 2}) rotate(-90)" text-anchor="middle" font-size="12" fill="#36454c">{html.escape(ylabel)}</text>')
     out.append("</svg>")
@@ -334,7 +359,10 @@ def _table(headers: Sequence[str], rows: Sequence[Sequence], numeric_from: int =
             css = ' class="num"' if k >= numeric_from else ""
             cells.append(f"<td{css}>{c if isinstance(c, _Raw) else html.escape(str(c))}</td>")
         body.append("<tr>" + "".join(cells) + "</tr>")
-    return f'<table class="{cls}"><thead><tr>{h}</tr></thead><tbody>{"".join(body)}</tbody></table>'
+    # a box that scrolls when the table is wider than its card (a 44-joint Jacobian), and taller than
+    # about a screen for a long one (the Talos joint table); its first column and header stay in view
+    tall = " tall" if len(rows) > 16 else ""
+    return f'<div class="table-box{tall}"><table class="{cls}"><thead><tr>{h}</tr></thead><tbody>{"".join(body)}</tbody></table></div>'
 
 
 class _Raw(str):
@@ -342,7 +370,11 @@ class _Raw(str):
 
 
 def _matrix_table(M, rows: Sequence[str], cols: Sequence[str], cls: str) -> str:
-    return _table(["", *cols], [[r, *(_f(v) for v in row)] for r, row in zip(rows, np.atleast_2d(M))], cls=cls)
+    values = np.atleast_2d(M)
+    if not any(rows) and not any(cols):  # a bare matrix (the tool pose): no label column or header row to take room
+        body = "".join("<tr>" + "".join(f'<td class="num">{_f(v)}</td>' for v in row) + "</tr>" for row in values)
+        return f'<div class="table-box"><table class="{cls} bare"><tbody>{body}</tbody></table></div>'
+    return _table(["", *cols], [[r, *(_f(v) for v in row)] for r, row in zip(rows, values)], cls=cls)
 
 
 def _asset(name: str) -> str:
@@ -418,7 +450,7 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
         sec.append(_table(["link", "θ", "d [m]", "a [m]", "α"], dh_rows, cls="dh"))
     sec.append("<h3>Mass properties</h3>")
     sec.append(_table(["link", "mass [kg]", "centre of mass in the link frame [m]"], [[b["link"], _f(b["mass"]), " ".join(_f(c) for c in b["com"])] for b in d["bodies"]], cls="bodies"))
-    sec.append(f"<p class='note'>gravity {html.escape(str([_f(g) for g in d['gravity']]))} m/s²</p></section>")
+    sec.append(f"<p class='note'>gravity g = ({', '.join(_f(g) for g in d['gravity'])}) m/s² in base axes</p></section>")
     description = "".join(sec)
 
     # --- 3-D view and kinematics

@@ -81,6 +81,11 @@ class Trajectory:
         b = f", batch={self.batch}" if self.batch is not None else ""
         return f"Trajectory(system={getattr(self.system, 'name', '?')!r}, samples={len(self)}, t=[{self.t[0]:g}, {self.t[-1]:g}] s, method={self.method!r}{b})"
 
+    def _repr_html_(self) -> str:  # notebooks: q(t) plotted as inline SVG (kinedyn.display)
+        from ..display import trajectory_html
+
+        return trajectory_html(self)
+
     # ------------------------------------------------------------------ energies
     def _flat(self, a):
         return a.reshape(-1, a.shape[-1])

@@ -30,6 +30,22 @@ class Step:
             lines.append(f"{lhs} = {sp.latex(value, symbol_names=names or {})}")
         return " \\\\\n".join(lines)
 
+    # notebooks (kinedyn.display); a step of an EquationsOfMotion prints q̇, q̈ with its names
+    def _repr_html_(self) -> str:
+        from ..display import step_html
+
+        return step_html(self)
+
+    def _repr_latex_(self) -> str:
+        from ..display import step_latex
+
+        return step_latex(self)
+
+    def _repr_markdown_(self) -> str:
+        from ..display import step_markdown
+
+        return step_markdown(self)
+
 
 def _ops(exprs) -> Dict[str, int]:
     """Counts of multiplications, additions (subtractions and negations included), divisions and
@@ -172,6 +188,8 @@ class EquationsOfMotion:
     @property
     def steps(self) -> List[Step]:
         self._steps = self._get(self._steps)
+        for step in self._steps or []:
+            step._eom = self  # its notebook display prints q̇, q̈ by self's names
         return self._steps or []
 
     # ------------------------------------------------------------------ derived forms
@@ -341,6 +359,22 @@ class EquationsOfMotion:
 
     def __repr__(self) -> str:
         return f"EquationsOfMotion(name={self.name!r}, n={self.n}, method={self.method!r})"
+
+    # notebooks (kinedyn.display): the result typeset, the steps under a fold
+    def _repr_html_(self) -> str:
+        from ..display import eom_html
+
+        return eom_html(self)
+
+    def _repr_latex_(self) -> str:
+        from ..display import eom_latex
+
+        return eom_latex(self)
+
+    def _repr_markdown_(self) -> str:
+        from ..display import eom_markdown
+
+        return eom_markdown(self)
 
 
 def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None) -> EquationsOfMotion:
