@@ -11,6 +11,10 @@ Spong §9.1-9.3), not only joint-coordinate robots.
     (LaValle's eqs. 13.180 / 13.184 leave out the (dA/dt) qd term, which is not zero when A depends
     on q — for the particle on a sphere it is 2 |qd|^2 — and 13.180 also drops g; both kept here.)
     Hamiltonian form: p = dL/dqd (= M qd), H = p.qd - L, qdot = dH/dp, pdot = -dH/dq + u - B.
+Numerically (``numeric``, ``numeric_accelerations``) the multipliers are never formed symbolically:
+M, h, A and (dA/dt) qd are compiled entry by entry and the KKT system
+    [M A^T; A 0] [qdd; lambda] = [u - h - B; -(dA/dt) qd]
+is solved per evaluation (closed chains such as SymPy's four-bar in seconds, not hours).
 """
 
 from __future__ import annotations
@@ -356,11 +360,78 @@ class LagrangianSystem:
         pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B
         return p, H, qdot, pdot
 
-    def numeric(self, params=None, u=None):
-        """A NumPy right-hand side f(t, x) for scipy.integrate.solve_ivp (x = (q, qd)), with the
-        parameters and forces substituted from ``params`` / ``u`` (default forces zero)."""
+    def _has_time(self) -> bool:
+        return any(sp.sympify(e).has(self.t) for e in [self.L, *self.B, *self.A, *self.holonomic])
+
+    def numeric_accelerations(self, params=None, u=None, baumgarte=None):
+        """``accelerations(t, q, qd) -> (qdd, lambda)``: the constrained equations of motion solved
+        numerically at each call, never inverted symbolically (so closed chains such as SymPy's
+        four-bar take milliseconds to set up). The symbolic parts are formed entry by entry and
+        compiled with ``lambdify`` (common subexpressions shared): M = d2L/dqd2, the bias
+        h = (d/dt dL/dqd - dL/dq)|qdd=0 + B, the constraint Jacobian A and its drift (dA/dt) qd; then
+        NumPy solves the KKT system of ``M qdd + h + A^T lambda = u`` with ``A qdd + (dA/dt) qd = 0``::
+
+            [ M  A^T ] [ qdd    ]   [ u - h                                    ]
+            [ A  0   ] [ lambda ] = [ -(dA/dt) qd - 2 alpha A qd - beta^2 g_c  ]
+
+        ``baumgarte = (alpha, beta)`` adds Baumgarte's stabilisation (constraint errors decay as
+        e'' + 2 alpha e' + beta^2 e = 0 instead of drifting; g_c only for the holonomic rows); the
+        default ``None`` is (0, 0): the exact constrained dynamics, the same q̈ and λ as
+        :meth:`phase_space` and :meth:`multipliers`. ``u``: generalised forces, expressions of t, q,
+        qd (default zero). Parameters are matched by name from ``params``. Time-dependent
+        Lagrangians or constraints are not handled here (a ValueError says so)."""
         import numpy as np
 
+        from ..simulate.systems import MechanicalSystem
+
+        if self._has_time():
+            raise ValueError("numeric_accelerations() handles time-invariant Lagrangians and constraints; this system's L, B or constraints depend on t")
+        values = {str(k): v for k, v in dict(params or {}).items()}
+        alpha, beta = (0.0, 0.0) if baumgarte is None else baumgarte
+        mech = MechanicalSystem.from_lagrangian(self, values, baumgarte=(float(alpha), float(beta)))
+        forces = sp.zeros(self.n, 1) if u is None else sp.Matrix(_as_list(self._sub(u), "forces"))
+        if len(forces) != self.n:
+            raise ValueError(f"forces u must have {self.n} entries (one per coordinate), got {len(forces)}")
+        forces = forces.xreplace({s: values[str(s)] for s in forces.free_symbols if str(s) in values})
+        left = forces.free_symbols - set(self.q) - set(self.qd) - {self.t}
+        if left:
+            raise ValueError(f"give values for the parameters {sorted(map(str, left))} of the forces u")
+        u_fn = sp.lambdify([self.t, list(self.q), list(self.qd)], list(forces), "numpy")
+        n = self.n
+
+        def accelerations(t, q, qd):
+            q = np.asarray(q, dtype=float).reshape(n)
+            qd = np.asarray(qd, dtype=float).reshape(n)
+            try:
+                return mech.accelerations(q, qd, np.asarray(u_fn(t, q, qd), dtype=float).reshape(n))
+            except np.linalg.LinAlgError:
+                raise ValueError(
+                    f"{self.name or 'the Lagrangian system'}: the constrained equations are singular at q = {q.tolist()} "
+                    "(M singular, or the constraint Jacobian A loses rank: a singular configuration of the mechanism)"
+                ) from None
+
+        return accelerations
+
+    def numeric(self, params=None, u=None, baumgarte=None):
+        """A NumPy right-hand side f(t, x) for scipy.integrate.solve_ivp (x = (q, qd)), with the
+        parameters and forces substituted from ``params`` / ``u`` (default forces zero).
+
+        Time-invariant systems (constrained ones included) are solved numerically per call through
+        :meth:`numeric_accelerations` (KKT system, optional Baumgarte stabilisation); systems whose
+        Lagrangian depends on t use the symbolic :meth:`phase_space`."""
+        import numpy as np
+
+        if not self._has_time():
+            accelerations = self.numeric_accelerations(params, u, baumgarte)
+            n = self.n
+
+            def rhs(t, y):
+                y = np.asarray(y, dtype=float)
+                return np.concatenate([y[n:], accelerations(t, y[:n], y[n:])[0]])
+
+            return rhs
+        if baumgarte is not None:
+            raise ValueError("Baumgarte stabilisation needs a time-invariant system (see numeric_accelerations)")
         params = {sp.Symbol(k, real=True) if isinstance(k, str) else k: v for k, v in dict(params or {}).items()}
         # match parameter symbols by name (users may create them without assumptions)
         free = {}
