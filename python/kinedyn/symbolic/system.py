@@ -322,21 +322,30 @@ class LagrangianSystem:
         if bias is None:
             bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
         Ad = self.A.applyfunc(self._dt)
-        Minv = M.inv()
-        S = self.A * Minv * self.A.T
-        rhs = self.A * Minv * (u - bias - self.B) + Ad * sp.Matrix(self.qd)
+        # M^-1 applied by LU solves, never by forming the inverse (M.inv() of a closed chain's M hangs)
+        Minv_AT = M.LUsolve(self.A.T)
+        S = self.A * Minv_AT
+        rhs = Minv_AT.T * (u - bias - self.B) + Ad * sp.Matrix(self.qd)
         return S.LUsolve(rhs)
 
     def phase_space(self, u=None, simplify: bool = False):
         """(x, f): x = (q, qd), x' = f(x) = (qd, M^-1 (u - h - B - A^T lambda)) with the multipliers
-        eliminated (LaValle 13.148 generalised)."""
+        eliminated (LaValle 13.148 generalised). Constrained systems: f is the qdd part of the KKT
+        system's symbolic solution, correct but large for closed chains (SymPy's four-bar: ~4e5
+        operations per entry); to simulate, use :meth:`numeric`, which solves it per evaluation."""
         u = self.u if u is None else sp.Matrix(u)
         M = sp.hessian(self.L, self.qd)
         bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
         rhs = u - bias - self.B
-        if self.A.shape[0]:
-            rhs = rhs - self.A.T * self.multipliers(u, M, bias)
-        qdd = M.LUsolve(rhs)
+        k = self.A.shape[0]
+        if k:
+            # the KKT system [M A^T; A 0] [qdd; lambda] = [u - h - B; -(dA/dt) qd] solved by one LU
+            # elimination (unsimplified; ~3 s for SymPy's four-bar, where inverting M did not finish)
+            drift = self.A.applyfunc(self._dt) * sp.Matrix(self.qd)
+            kkt = sp.Matrix.vstack(sp.Matrix.hstack(M, self.A.T), sp.Matrix.hstack(self.A, sp.zeros(k, k)))
+            qdd = kkt.LUsolve(sp.Matrix.vstack(rhs, -drift))[: self.n, :]
+        else:
+            qdd = M.LUsolve(rhs)
         if simplify:
             qdd = qdd.applyfunc(sp.simplify)
         return sp.Matrix.vstack(sp.Matrix(self.q), sp.Matrix(self.qd)), sp.Matrix.vstack(sp.Matrix(self.qd), qdd)
