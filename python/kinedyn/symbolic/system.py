@@ -456,5 +456,12 @@ class LagrangianSystem:
         fn = sp.lambdify([self.t, list(x)], list(f), "numpy")
         return lambda t, y: np.array(fn(t, y), dtype=float)
 
+    def check_properties(self, params=None, **kwargs):
+        """M symmetric and dM/dt - 2C skew-symmetric proven by exact simplification, M positive
+        definite and passivity measured: :func:`kinedyn.analysis.check_system_properties`."""
+        from ..analysis.system_properties import check_system_properties
+
+        return check_system_properties(self, params, **kwargs)
+
     def __repr__(self) -> str:
         return f"LagrangianSystem(q={self.q}, constraints={self.A.shape[0]})"
