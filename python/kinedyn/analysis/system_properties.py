@@ -28,7 +28,7 @@ the motion stays on the manifold (|g_c(q)| and |A qd| along the trajectory).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 import sympy as sp
@@ -145,8 +145,9 @@ def check_system_properties(system: "LagrangianSystem", params: Optional[dict] =
     H_fn = sp.lambdify([q_sym, qd_sym], sub(system.energy()), "numpy")
     k = system.A.shape[0]
     k_h = len(system.holonomic)
-    A_fn = sp.lambdify([q_sym], sub(system.A), "numpy") if k else None
-    phi_fn = sp.lambdify([q_sym], [sub(e) for e in system.holonomic], "numpy") if k_h else None
+    # constraint Jacobian A(q) (k x n; 0 x n without constraints) and holonomic residuals g_c(q)
+    A_fn: Callable = sp.lambdify([q_sym], sub(system.A) if k else sp.zeros(1, n), "numpy")
+    phi_fn: Callable = sp.lambdify([q_sym], [sub(e) for e in system.holonomic] or [0], "numpy")
     q0, qd0 = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
     if k:
         q0, qd0 = _on_manifold(q0, qd0, A_fn, phi_fn, k_h)
