@@ -203,3 +203,14 @@ def test_four_bar_symbolic_phase_space_and_multipliers_finish_and_agree():
     got = np.array(evaluate(list(values.values())), dtype=float)
     qdd, multipliers = system.numeric_accelerations(PARAMS)(0.0, q, qd)
     np.testing.assert_allclose(got, np.r_[qdd, multipliers], rtol=1e-8, atol=1e-12)
+
+
+def test_four_bar_example_is_the_mechanism_derived_here():
+    from kinedyn.symbolic import examples
+
+    example, here = examples.four_bar_linkage(), four_bar()
+    rename = {sp.Symbol(k, positive=True): sp.Symbol(k) for k in PARAMS} | dict(zip(example.qd, here.qd))
+    assert sp.expand(example.L.xreplace(rename) - here.L) == 0
+    assert [sp.expand(a.xreplace(rename) - b) for a, b in zip(example.holonomic, here.holonomic)] == [0, 0]
+    q, qd = _consistent_states(1, seed=2)[0]
+    np.testing.assert_allclose(example.numeric_accelerations(PARAMS)(0.0, q, qd)[0], here.numeric_accelerations(PARAMS)(0.0, q, qd)[0], rtol=1e-12)

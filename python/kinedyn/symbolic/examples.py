@@ -9,6 +9,8 @@ seed's printed formulas are not copied, several carry misprints — see docs/sym
   when m3 l2 lc3 = m4 l1 lc4 (bodies written here); :func:`five_bar_chains` /
   :func:`five_bar_from_chains`: the same assembled from two serial Robots and the loop closure
   (:func:`kinedyn.symbolic.mechanisms.closed_chain`).
+- :func:`four_bar_linkage`: SymPy mechanics' four-bar (3 relative joint angles, 2 loop-closure
+  constraints), solved numerically per evaluation by :meth:`LagrangianSystem.numeric`.
 - :func:`sphere_particle`: LaValle Example 13.14, a particle on the unit sphere (holonomic constraint).
 - :func:`falling_particle`: LaValle Example 13.11.
 - :func:`simple_variational`: LaValle Example 13.10, L = x^3 + xd^2.
@@ -22,7 +24,7 @@ import sympy as sp
 
 from .system import LagrangianSystem, coordinates
 
-__all__ = ["remotely_driven_arm", "remotely_driven_arm_from_robot", "five_bar", "five_bar_chains", "five_bar_from_chains", "sphere_particle", "falling_particle", "simple_variational", "geared_link", "geared_link_robot"]
+__all__ = ["remotely_driven_arm", "remotely_driven_arm_from_robot", "five_bar", "five_bar_chains", "five_bar_from_chains", "four_bar_linkage", "sphere_particle", "falling_particle", "simple_variational", "geared_link", "geared_link_robot"]
 
 
 def _u(angle):
@@ -108,6 +110,25 @@ def five_bar() -> LagrangianSystem:
     omegas = [qd1, qd2, qd1, qd2]
     bodies = [dict(mass=m[i], position=positions[i], inertia=I[i], angular_velocity=omegas[i]) for i in range(4)]
     return LagrangianSystem.from_bodies([q1, q2], bodies, gravity=(0, -g), qd=[qd1, qd2], name="five-bar linkage")
+
+
+def four_bar_linkage() -> LagrangianSystem:
+    """The four-bar of SymPy mechanics' ``test_four_bar_linkage_with_manual_constraints``: uniform
+    links of lengths l1..l4 and density rho (mass rho l, inertia rho l^3 / 12 about the centre), link
+    1 fixed along x with its centre at the origin, relative joint angles q1, q2, q3 (absolute angles
+    q1, q1 + q2, q1 + q2 + q3), no gravity; the loop closes when link 4's far end reaches link 1's
+    other end: l1 + sum_k l_k cos(a_k) = 0, sum_k l_k sin(a_k) = 0 (k = 2, 3, 4)."""
+    (q1, q2, q3), (qd1, qd2, qd3) = coordinates("q1 q2 q3")
+    l1, l2, l3, l4, rho = sp.symbols("l1:5 rho", positive=True)
+    absolute = [q1, q1 + q2, q1 + q2 + q3]
+    rates = [qd1, qd1 + qd2, qd1 + qd2 + qd3]
+    joint = sp.Matrix([l1 / 2, 0])
+    bodies = []
+    for length, angle, rate in zip((l2, l3, l4), absolute, rates):
+        bodies.append(dict(mass=rho * length, position=joint + length / 2 * _u(angle), inertia=rho * length**3 / 12, angular_velocity=rate))
+        joint = joint + length * _u(angle)
+    closure = joint - sp.Matrix([-l1 / 2, 0])
+    return LagrangianSystem.from_bodies([q1, q2, q3], bodies, qd=[qd1, qd2, qd3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar linkage")
 
 
 def sphere_particle(m=2) -> LagrangianSystem:

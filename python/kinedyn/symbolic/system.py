@@ -372,6 +372,48 @@ class LagrangianSystem:
     def _has_time(self) -> bool:
         return any(sp.sympify(e).has(self.t) for e in [self.L, *self.B, *self.A, *self.holonomic])
 
+    def _kkt_system(self, values: dict, baumgarte: tuple):
+        """The numeric pieces of the KKT system in one compiled function (shared subexpressions):
+        M = d2L/dqd2, h = sum_j d2L/dqd dq_j qd_j - dL/dq + B (the Euler-Lagrange bias of a
+        time-invariant L, without forming its qdd terms), A, (dA/dt) qd = d(A qd)/dq qd, g_c."""
+        import numpy as np
+
+        from ..simulate.systems import MechanicalSystem
+
+        q, qd = list(self.q), list(self.qd)
+        n, k, k_h = self.n, self.A.shape[0], len(self.holonomic)
+        dL_dqd = sp.Matrix([sp.diff(self.L, v) for v in qd])
+        M = dL_dqd.jacobian(qd)
+        h = dL_dqd.jacobian(q) * sp.Matrix(qd) - sp.Matrix([sp.diff(self.L, c) for c in q]) + self.B
+        drift = (self.A * sp.Matrix(qd)).jacobian(q) * sp.Matrix(qd) if k else sp.zeros(0, 1)
+        phi = sp.Matrix(self.holonomic) if k_h else sp.zeros(0, 1)
+        parts = [M, h, self.A, drift, phi]
+        state = set(q) | set(qd)
+        free = set().union(*(m.free_symbols for m in parts)) - state
+        missing = sorted(str(s) for s in free if str(s) not in values)
+        if missing:
+            raise ValueError(f"{self.name or 'the Lagrangian system'}: give values for the parameters {missing} (params={{'name': value}})")
+        numbers = {s: values[str(s)] for s in free}
+        parts = [m.xreplace(numbers) for m in parts]
+        if parts[0].free_symbols & set(qd):
+            raise ValueError("the mass matrix d2L/dqd2 depends on the velocities: numeric() needs L quadratic in qd")
+        together = sp.lambdify([q, qd], parts, modules="numpy", cse=True)
+
+        def terms(qv, qdv):
+            M_, h_, A_, d_, p_ = together(qv, qdv)
+            return (np.asarray(M_, dtype=float).reshape(n, n), np.asarray(h_, dtype=float).reshape(n),
+                    np.asarray(A_, dtype=float).reshape(k, n), np.asarray(d_, dtype=float).reshape(k),
+                    np.asarray(p_, dtype=float).reshape(k_h) if k_h else None)
+
+        zero = np.zeros(n)
+        constraint: dict = {}
+        if k:
+            constraint = dict(constraint_jacobian=lambda x: terms(x, zero)[2], constraint_drift=lambda x, v: terms(x, v)[3])
+            if k_h:
+                constraint["constraint"] = lambda x: terms(x, zero)[4]
+        return MechanicalSystem(n=n, mass_matrix=lambda x: terms(x, zero)[0], bias=lambda x, v: terms(x, v)[1], terms=terms,
+                                names=tuple(c.name for c in q), name=self.name or "Lagrangian system", baumgarte=baumgarte, **constraint)
+
     def numeric_accelerations(self, params=None, u=None, baumgarte=None):
         """``accelerations(t, q, qd) -> (qdd, lambda)``: the constrained equations of motion solved
         numerically at each call, never inverted symbolically (so closed chains such as SymPy's
@@ -391,13 +433,11 @@ class LagrangianSystem:
         Lagrangians or constraints are not handled here (a ValueError says so)."""
         import numpy as np
 
-        from ..simulate.systems import MechanicalSystem
-
         if self._has_time():
             raise ValueError("numeric_accelerations() handles time-invariant Lagrangians and constraints; this system's L, B or constraints depend on t")
         values = {str(k): v for k, v in dict(params or {}).items()}
         alpha, beta = (0.0, 0.0) if baumgarte is None else baumgarte
-        mech = MechanicalSystem.from_lagrangian(self, values, baumgarte=(float(alpha), float(beta)))
+        mech = self._kkt_system(values, (float(alpha), float(beta)))
         forces = sp.zeros(self.n, 1) if u is None else sp.Matrix(_as_list(self._sub(u), "forces"))
         if len(forces) != self.n:
             raise ValueError(f"forces u must have {self.n} entries (one per coordinate), got {len(forces)}")
