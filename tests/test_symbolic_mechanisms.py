@@ -196,3 +196,40 @@ def test_closed_chain_rejects_a_branch_that_does_not_close_the_loop():
         closed_chain(chains, closure, independent=[q1, q2], solution={phi4: q2 - q1})
     with pytest.raises(ValueError, match="not a coordinate"):
         closed_chain(chains, closure, independent=["q1", "x"], solution={phi4: q2 - q1, phi3: q1 - q2})
+
+
+# ----------------------------------------------------------------------------- LagrangianSystem.change_coordinates
+def test_lagrangian_system_change_of_coordinates_back_to_joint_angles():
+    """The hand-written remotely driven arm (absolute angles p) taken back to joint angles
+    (p = A^-1 q, p1 = q1, p2 = q1 + q2) is the planar elbow Robot's model; forces map by A^T."""
+    remote = ex.remotely_driven_arm()
+    joint = remote.change_coordinates([[1, 0], [1, 1]], coordinates="q1 q2")
+    eom = joint.equations_of_motion()
+    arm = kd.robots.planar_2r(symbolic=True).equations_of_motion(steps=False)
+    assert [c.name for c in joint.q] == ["q1", "q2"] and [c.name for c in joint.qd] == ["qd1", "qd2"]
+    rename = dict(zip(arm.q, eom.q)) | dict(zip(arm.qd, eom.qd))
+    assert _same(eom.M, arm.M.xreplace(rename))
+    assert _same(eom.C, arm.C.xreplace(rename))
+    assert _same(eom.g, arm.g.xreplace(rename))
+    u1, u2 = remote.u
+    assert list(joint.u) == [u1 + u2, u2]  # A^T u
+
+
+def test_lagrangian_system_change_of_coordinates_keeps_constraints():
+    """The particle on the sphere in scaled, mixed coordinates still moves on the sphere."""
+    from scipy.integrate import solve_ivp
+
+    A = np.array([[2.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 3.0]])
+    system = ex.sphere_particle().change_coordinates(sp.Matrix(A).applyfunc(sp.nsimplify))
+    assert len(system.holonomic) == 1
+    q0 = np.array([1.0, 0.0, 0.0])
+    v0 = np.array([0.0, 0.6, 0.8])
+    p0, pd0 = np.linalg.solve(A, q0), np.linalg.solve(A, v0)
+    sol = solve_ivp(system.numeric(), (0, 3.0), np.r_[p0, pd0], rtol=1e-10, atol=1e-12)
+    Q = A @ sol.y[:3]
+    np.testing.assert_allclose(np.linalg.norm(Q, axis=0), 1.0, atol=1e-7)  # on the sphere
+    np.testing.assert_allclose(np.cross(q0, v0) @ Q, 0.0, atol=1e-7)  # on the great circle through q0 along v0
+    np.testing.assert_allclose(np.linalg.norm(A @ sol.y[3:], axis=0), 1.0, rtol=1e-7)  # at constant speed
+    assert np.ptp(Q[0]) > 1.0  # it travelled
+    with pytest.raises(ValueError, match="singular"):
+        ex.sphere_particle().change_coordinates([[1, 0, 0], [0, 1, 0], [1, 1, 0]])

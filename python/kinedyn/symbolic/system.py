@@ -496,6 +496,42 @@ class LagrangianSystem:
         fn = sp.lambdify([self.t, list(x)], list(f), "numpy")
         return lambda t, y: np.array(fn(t, y), dtype=float)
 
+    def change_coordinates(self, A, coordinates=None, name: str = "") -> "LagrangianSystem":
+        """The same system in coordinates p with q = A p (A constant, n x n, invertible; qd = A pd):
+        L_p(p, pd) = L(A p, A pd); generalised forces and B map by A^T (virtual work:
+        u . dq = (A^T u) . dp); holonomic constraints g_c(A p) and Pfaffian rows A_c(A p) A.
+        ``coordinates``: names of p (default p1..pn). See also
+        :func:`kinedyn.symbolic.mechanisms.change_coordinates` for a robot's equations of motion."""
+        n = self.n
+        A = sp.Matrix(A)
+        if A.shape != (n, n):
+            raise ValueError(f"the map q = A p needs a square A of shape ({n}, {n}) for {n} coordinates, got {A.shape}")
+        if A.free_symbols & (set(self.q) | set(self.qd) | {self.t}):
+            raise ValueError("A must be constant (no coordinates, velocities or time in it)")
+        if sp.simplify(A.det()) == 0:
+            raise ValueError(f"A = {A.tolist()} is singular: the new coordinates would not determine q")
+        if coordinates is None:
+            coordinates = [f"p{i + 1}" for i in range(n)]
+        elif isinstance(coordinates, str):
+            coordinates = coordinates.replace(",", " ").split()
+        p = [sp.Symbol(c, real=True) if isinstance(c, str) else c for c in coordinates]
+        pd = [sp.Symbol(_rate_names(c.name)[0], real=True) for c in p]
+        if len(p) != n:
+            raise ValueError(f"coordinates must name {n} coordinates, got {len(p)}")
+        taken = {s.name for e in [self.L, *self.u, *self.B, *self.A] for s in sp.sympify(e).free_symbols} - {c.name for c in self.q + self.qd}
+        clash = sorted({s.name for s in p + pd} & taken)
+        if clash:
+            raise ValueError(f"the new coordinates' names {clash} are already symbols of the system: choose other names")
+        rep = {**dict(zip(self.q, A * sp.Matrix(p))), **dict(zip(self.qd, A * sp.Matrix(pd)))}
+        pfaffian = None
+        if self.A.shape[0] > len(self.holonomic):
+            pfaffian = self.A[len(self.holonomic):, :].xreplace(rep) * A
+        return LagrangianSystem(
+            p, L=sp.expand(self.L.xreplace(rep)), qd=pd, t=self.t, forces=list(A.T * self.u.xreplace(rep)),
+            B=list(A.T * self.B.xreplace(rep)), holonomic=[sp.expand(e.xreplace(rep)) for e in self.holonomic] or None,
+            pfaffian=pfaffian, name=name or f"{self.name} in coordinates {', '.join(c.name for c in p)}",
+        )
+
     def check_properties(self, params=None, **kwargs):
         """M symmetric and dM/dt - 2C skew-symmetric proven by exact simplification, M positive
         definite and passivity measured: :func:`kinedyn.analysis.check_system_properties`."""
