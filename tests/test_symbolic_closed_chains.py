@@ -214,3 +214,12 @@ def test_four_bar_example_is_the_mechanism_derived_here():
     assert [sp.expand(a.xreplace(rename) - b) for a, b in zip(example.holonomic, here.holonomic)] == [0, 0]
     q, qd = _consistent_states(1, seed=2)[0]
     np.testing.assert_allclose(example.numeric_accelerations(PARAMS)(0.0, q, qd)[0], here.numeric_accelerations(PARAMS)(0.0, q, qd)[0], rtol=1e-12)
+
+
+def test_numeric_handles_a_lagrangian_not_quadratic_in_the_velocities():
+    """L = xd^4 / 12 - x^2 / 2: M = xd^2 depends on the velocity; the Euler-Lagrange equation
+    xd^2 xdd + x = 0 (derived here) gives xdd = -x / xd^2."""
+    (x,), (xd,) = coordinates("x")
+    system = LagrangianSystem([x], L=xd**4 / 12 - x**2 / 2, qd=[xd], forces=[0])
+    f = system.numeric()
+    np.testing.assert_allclose(f(0.0, [0.3, 1.5]), [1.5, -0.3 / 1.5**2], rtol=1e-12)

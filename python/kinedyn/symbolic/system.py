@@ -374,7 +374,8 @@ class LagrangianSystem:
 
     def _kkt_system(self, values: dict, baumgarte: tuple):
         """The numeric pieces of the KKT system in one compiled function (shared subexpressions):
-        M = d2L/dqd2, h = sum_j d2L/dqd dq_j qd_j - dL/dq + B (the Euler-Lagrange bias of a
+        M = d2L/dqd2 (evaluated at the state: it may depend on qd for a Lagrangian that is not
+        quadratic), h = sum_j d2L/dqd dq_j qd_j - dL/dq + B (the Euler-Lagrange bias of a
         time-invariant L, without forming its qdd terms), A, (dA/dt) qd = d(A qd)/dq qd, g_c."""
         import numpy as np
 
@@ -395,8 +396,6 @@ class LagrangianSystem:
             raise ValueError(f"{self.name or 'the Lagrangian system'}: give values for the parameters {missing} (params={{'name': value}})")
         numbers = {s: values[str(s)] for s in free}
         parts = [m.xreplace(numbers) for m in parts]
-        if parts[0].free_symbols & set(qd):
-            raise ValueError("the mass matrix d2L/dqd2 depends on the velocities: numeric() needs L quadratic in qd")
         together = sp.lambdify([q, qd], parts, modules="numpy", cse=True)
 
         def terms(qv, qdv):
