@@ -4,9 +4,11 @@ excitation data (:func:`identify`). See docs/analysis.md."""
 
 from .identification import Identification, Measurements, excitation, identify, simulate_measurements, with_inertial_parameters
 from .properties import Check, PropertiesReport, check_properties
+from .system_properties import check_system_properties
 
 __all__ = [
     "check_properties",
+    "check_system_properties",
     "PropertiesReport",
     "Check",
     "excitation",

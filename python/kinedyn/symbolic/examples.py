@@ -2,9 +2,15 @@
 seed's printed formulas are not copied, several carry misprints — see docs/symbolic.md).
 
 - :func:`remotely_driven_arm`: Spong §9.4, planar elbow with the second joint driven from the base
-  through a belt: coordinates p1, p2 are the absolute link angles, not joint angles.
+  through a belt: coordinates p1, p2 are the absolute link angles, not joint angles (bodies written
+  here); :func:`remotely_driven_arm_from_robot`: the same from the planar-elbow Robot and its drive
+  map q = A p (:func:`kinedyn.symbolic.mechanisms.change_coordinates`).
 - :func:`five_bar`: Spong §9.4, the parallelogram five-bar linkage; D is diagonal and constant exactly
-  when m3 l2 lc3 = m4 l1 lc4.
+  when m3 l2 lc3 = m4 l1 lc4 (bodies written here); :func:`five_bar_chains` /
+  :func:`five_bar_from_chains`: the same assembled from two serial Robots and the loop closure
+  (:func:`kinedyn.symbolic.mechanisms.closed_chain`).
+- :func:`four_bar_linkage`: SymPy mechanics' four-bar (3 relative joint angles, 2 loop-closure
+  constraints), solved numerically per evaluation by :meth:`LagrangianSystem.numeric`.
 - :func:`sphere_particle`: LaValle Example 13.14, a particle on the unit sphere (holonomic constraint).
 - :func:`falling_particle`: LaValle Example 13.11.
 - :func:`simple_variational`: LaValle Example 13.10, L = x^3 + xd^2.
@@ -18,7 +24,7 @@ import sympy as sp
 
 from .system import LagrangianSystem, coordinates
 
-__all__ = ["remotely_driven_arm", "five_bar", "sphere_particle", "falling_particle", "simple_variational", "geared_link", "geared_link_robot"]
+__all__ = ["remotely_driven_arm", "remotely_driven_arm_from_robot", "five_bar", "five_bar_chains", "five_bar_from_chains", "four_bar_linkage", "sphere_particle", "falling_particle", "simple_variational", "geared_link", "geared_link_robot"]
 
 
 def _u(angle):
@@ -38,6 +44,58 @@ def remotely_driven_arm() -> LagrangianSystem:
     return LagrangianSystem.from_bodies([p1, p2], bodies, gravity=(0, -g), qd=[pd1, pd2], name="remotely driven two-link arm")
 
 
+def remotely_driven_arm_from_robot():
+    """The remotely driven arm from the planar elbow Robot (``planar_2r(symbolic=True)``, joint
+    angles q1, q2) and its drive map: the belt sets link 2's absolute angle p2 = q1 + q2, so
+    q = A p with A = [[1, 0], [-1, 1]] (p1 = q1). Returns EquationsOfMotion in p1, p2 (D_p = A^T D_q A;
+    the same symbols as :func:`remotely_driven_arm`)."""
+    from ..robots import planar_2r
+    from .mechanisms import change_coordinates
+
+    eom = planar_2r(symbolic=True).equations_of_motion(steps=False)
+    return change_coordinates(eom, [[1, 0], [-1, 1]], coordinates="p1 p2", name="remotely driven two-link arm (from planar_2r)")
+
+
+def five_bar_chains():
+    """The five-bar of :func:`five_bar` cut open at its far vertex into two serial planar arms (DH
+    Robots, joints about z, gravity -g along y), each ending at that vertex:
+
+    - chain a: link 1 (joint q1 at the base, length l1, centre of mass lc1 along it) and link 4
+      (joint phi4 at the tip of link 1, relative angle; it reaches the far vertex l2 along it, its
+      centre of mass lc4 from the hinge on the other side);
+    - chain b: link 2 (joint q2 at the base, length l2, centre of mass lc2) and link 3 (joint phi3
+      at the tip of link 2; it reaches the far vertex l1 along it, centre of mass lc3 from the hinge).
+    """
+    from ..description.dh import DHRow
+    from ..description.inertia import Inertia
+    from ..robot import Robot
+
+    l1, l2, lc1, lc2, lc3, lc4, g = sp.symbols("l1 l2 lc1 lc2 lc3 lc4 g", positive=True)
+    m = sp.symbols("m1:5", positive=True)
+    I = sp.symbols("I1:5", positive=True)
+
+    def link(mass, x_com, inertia):  # centre of mass on the DH x axis (frame i at link i's far end)
+        return Inertia(mass, (x_com, 0, 0), ((0, 0, 0), (0, inertia, 0), (0, 0, inertia)))
+
+    chain_a = Robot.from_dh([DHRow(a=l1, name="q1", inertia=link(m[0], lc1 - l1, I[0])),
+                             DHRow(a=l2, name="phi4", inertia=link(m[3], -l2 - lc4, I[3]))], gravity=(0, -g, 0), name="five-bar chain a (links 1, 4)")
+    chain_b = Robot.from_dh([DHRow(a=l2, name="q2", inertia=link(m[1], lc2 - l2, I[1])),
+                             DHRow(a=l1, name="phi3", inertia=link(m[2], lc3 - l1, I[2]))], gravity=(0, -g, 0), name="five-bar chain b (links 2, 3)")
+    return chain_a, chain_b
+
+
+def five_bar_from_chains():
+    """The five-bar's reduced equations in q1, q2 from :func:`five_bar_chains` and the loop closure
+    (their tool points coincide), on the parallelogram branch phi4 = q2 - q1, phi3 = q1 - q2 (links
+    4 and 3 parallel to links 2 and 1)."""
+    from .mechanisms import closed_chain, loop_closure
+
+    chain_a, chain_b = five_bar_chains()
+    closure = loop_closure(chain_a, chain_b)
+    q1, phi4, q2, phi3 = sp.symbols("q1 phi4 q2 phi3", real=True)
+    return closed_chain([chain_a, chain_b], closure, independent=[q1, q2], solution={phi4: q2 - q1, phi3: q1 - q2}, name="five-bar linkage (from two chains)")
+
+
 def five_bar() -> LagrangianSystem:
     """Parallelogram linkage with vertices O, A = l1 u(q1), B = l2 u(q2), A + l2 u(q2) (u(a) = (cos a, sin a)).
     Link 1 (O to A) turns with q1, link 2 (O to B) with q2; link 3 joins B to the far vertex, parallel
@@ -52,6 +110,25 @@ def five_bar() -> LagrangianSystem:
     omegas = [qd1, qd2, qd1, qd2]
     bodies = [dict(mass=m[i], position=positions[i], inertia=I[i], angular_velocity=omegas[i]) for i in range(4)]
     return LagrangianSystem.from_bodies([q1, q2], bodies, gravity=(0, -g), qd=[qd1, qd2], name="five-bar linkage")
+
+
+def four_bar_linkage() -> LagrangianSystem:
+    """The four-bar of SymPy mechanics' ``test_four_bar_linkage_with_manual_constraints``: uniform
+    links of lengths l1..l4 and density rho (mass rho l, inertia rho l^3 / 12 about the centre), link
+    1 fixed along x with its centre at the origin, relative joint angles q1, q2, q3 (absolute angles
+    q1, q1 + q2, q1 + q2 + q3), no gravity; the loop closes when link 4's far end reaches link 1's
+    other end: l1 + sum_k l_k cos(a_k) = 0, sum_k l_k sin(a_k) = 0 (k = 2, 3, 4)."""
+    (q1, q2, q3), (qd1, qd2, qd3) = coordinates("q1 q2 q3")
+    l1, l2, l3, l4, rho = sp.symbols("l1:5 rho", positive=True)
+    absolute = [q1, q1 + q2, q1 + q2 + q3]
+    rates = [qd1, qd1 + qd2, qd1 + qd2 + qd3]
+    joint = sp.Matrix([l1 / 2, 0])
+    bodies = []
+    for length, angle, rate in zip((l2, l3, l4), absolute, rates):
+        bodies.append(dict(mass=rho * length, position=joint + length / 2 * _u(angle), inertia=rho * length**3 / 12, angular_velocity=rate))
+        joint = joint + length * _u(angle)
+    closure = joint - sp.Matrix([-l1 / 2, 0])
+    return LagrangianSystem.from_bodies([q1, q2, q3], bodies, qd=[qd1, qd2, qd3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar linkage")
 
 
 def sphere_particle(m=2) -> LagrangianSystem:

@@ -11,6 +11,10 @@ Spong §9.1-9.3), not only joint-coordinate robots.
     (LaValle's eqs. 13.180 / 13.184 leave out the (dA/dt) qd term, which is not zero when A depends
     on q — for the particle on a sphere it is 2 |qd|^2 — and 13.180 also drops g; both kept here.)
     Hamiltonian form: p = dL/dqd (= M qd), H = p.qd - L, qdot = dH/dp, pdot = -dH/dq + u - B.
+Numerically (``numeric``, ``numeric_accelerations``) the multipliers are never formed symbolically:
+M, h, A and (dA/dt) qd are compiled entry by entry and the KKT system
+    [M A^T; A 0] [qdd; lambda] = [u - h - B; -(dA/dt) qd]
+is solved per evaluation (closed chains such as SymPy's four-bar in seconds, not hours).
 """
 
 from __future__ import annotations
@@ -318,21 +322,30 @@ class LagrangianSystem:
         if bias is None:
             bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
         Ad = self.A.applyfunc(self._dt)
-        Minv = M.inv()
-        S = self.A * Minv * self.A.T
-        rhs = self.A * Minv * (u - bias - self.B) + Ad * sp.Matrix(self.qd)
+        # M^-1 applied by LU solves, never by forming the inverse (M.inv() of a closed chain's M hangs)
+        Minv_AT = M.LUsolve(self.A.T)
+        S = self.A * Minv_AT
+        rhs = Minv_AT.T * (u - bias - self.B) + Ad * sp.Matrix(self.qd)
         return S.LUsolve(rhs)
 
     def phase_space(self, u=None, simplify: bool = False):
         """(x, f): x = (q, qd), x' = f(x) = (qd, M^-1 (u - h - B - A^T lambda)) with the multipliers
-        eliminated (LaValle 13.148 generalised)."""
+        eliminated (LaValle 13.148 generalised). Constrained systems: f is the qdd part of the KKT
+        system's symbolic solution, correct but large for closed chains (SymPy's four-bar: ~4e5
+        operations per entry); to simulate, use :meth:`numeric`, which solves it per evaluation."""
         u = self.u if u is None else sp.Matrix(u)
         M = sp.hessian(self.L, self.qd)
         bias = sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])
         rhs = u - bias - self.B
-        if self.A.shape[0]:
-            rhs = rhs - self.A.T * self.multipliers(u, M, bias)
-        qdd = M.LUsolve(rhs)
+        k = self.A.shape[0]
+        if k:
+            # the KKT system [M A^T; A 0] [qdd; lambda] = [u - h - B; -(dA/dt) qd] solved by one LU
+            # elimination (unsimplified; ~3 s for SymPy's four-bar, where inverting M did not finish)
+            drift = self.A.applyfunc(self._dt) * sp.Matrix(self.qd)
+            kkt = sp.Matrix.vstack(sp.Matrix.hstack(M, self.A.T), sp.Matrix.hstack(self.A, sp.zeros(k, k)))
+            qdd = kkt.LUsolve(sp.Matrix.vstack(rhs, -drift))[: self.n, :]
+        else:
+            qdd = M.LUsolve(rhs)
         if simplify:
             qdd = qdd.applyfunc(sp.simplify)
         return sp.Matrix.vstack(sp.Matrix(self.q), sp.Matrix(self.qd)), sp.Matrix.vstack(sp.Matrix(self.qd), qdd)
@@ -356,11 +369,117 @@ class LagrangianSystem:
         pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B
         return p, H, qdot, pdot
 
-    def numeric(self, params=None, u=None):
-        """A NumPy right-hand side f(t, x) for scipy.integrate.solve_ivp (x = (q, qd)), with the
-        parameters and forces substituted from ``params`` / ``u`` (default forces zero)."""
+    def _has_time(self) -> bool:
+        return any(sp.sympify(e).has(self.t) for e in [self.L, *self.B, *self.A, *self.holonomic])
+
+    def _kkt_system(self, values: dict, baumgarte: tuple):
+        """The numeric pieces of the KKT system in one compiled function (shared subexpressions):
+        M = d2L/dqd2 (evaluated at the state: it may depend on qd for a Lagrangian that is not
+        quadratic), h = sum_j d2L/dqd dq_j qd_j - dL/dq + B (the Euler-Lagrange bias of a
+        time-invariant L, without forming its qdd terms), A, (dA/dt) qd = d(A qd)/dq qd, g_c."""
         import numpy as np
 
+        from ..simulate.systems import MechanicalSystem
+
+        q, qd = list(self.q), list(self.qd)
+        n, k, k_h = self.n, self.A.shape[0], len(self.holonomic)
+        dL_dqd = sp.Matrix([sp.diff(self.L, v) for v in qd])
+        M = dL_dqd.jacobian(qd)
+        h = dL_dqd.jacobian(q) * sp.Matrix(qd) - sp.Matrix([sp.diff(self.L, c) for c in q]) + self.B
+        drift = (self.A * sp.Matrix(qd)).jacobian(q) * sp.Matrix(qd) if k else sp.zeros(0, 1)
+        phi = sp.Matrix(self.holonomic) if k_h else sp.zeros(0, 1)
+        parts = [M, h, self.A, drift, phi]
+        state = set(q) | set(qd)
+        free = set().union(*(m.free_symbols for m in parts)) - state
+        missing = sorted(str(s) for s in free if str(s) not in values)
+        if missing:
+            raise ValueError(f"{self.name or 'the Lagrangian system'}: give values for the parameters {missing} (params={{'name': value}})")
+        numbers = {s: values[str(s)] for s in free}
+        parts = [m.xreplace(numbers) for m in parts]
+        together = sp.lambdify([q, qd], parts, modules="numpy", cse=True)
+
+        def terms(qv, qdv):
+            M_, h_, A_, d_, p_ = together(qv, qdv)
+            return (np.asarray(M_, dtype=float).reshape(n, n), np.asarray(h_, dtype=float).reshape(n),
+                    np.asarray(A_, dtype=float).reshape(k, n), np.asarray(d_, dtype=float).reshape(k),
+                    np.asarray(p_, dtype=float).reshape(k_h) if k_h else None)
+
+        zero = np.zeros(n)
+        constraint: dict = {}
+        if k:
+            constraint = dict(constraint_jacobian=lambda x: terms(x, zero)[2], constraint_drift=lambda x, v: terms(x, v)[3])
+            if k_h:
+                constraint["constraint"] = lambda x: terms(x, zero)[4]
+        return MechanicalSystem(n=n, mass_matrix=lambda x: terms(x, zero)[0], bias=lambda x, v: terms(x, v)[1], terms=terms,
+                                names=tuple(c.name for c in q), name=self.name or "Lagrangian system", baumgarte=baumgarte, **constraint)
+
+    def numeric_accelerations(self, params=None, u=None, baumgarte=None):
+        """``accelerations(t, q, qd) -> (qdd, lambda)``: the constrained equations of motion solved
+        numerically at each call, never inverted symbolically (so closed chains such as SymPy's
+        four-bar take milliseconds to set up). The symbolic parts are formed entry by entry and
+        compiled with ``lambdify`` (common subexpressions shared): M = d2L/dqd2, the bias
+        h = (d/dt dL/dqd - dL/dq)|qdd=0 + B, the constraint Jacobian A and its drift (dA/dt) qd; then
+        NumPy solves the KKT system of ``M qdd + h + A^T lambda = u`` with ``A qdd + (dA/dt) qd = 0``::
+
+            [ M  A^T ] [ qdd    ]   [ u - h                                    ]
+            [ A  0   ] [ lambda ] = [ -(dA/dt) qd - 2 alpha A qd - beta^2 g_c  ]
+
+        ``baumgarte = (alpha, beta)`` adds Baumgarte's stabilisation (constraint errors decay as
+        e'' + 2 alpha e' + beta^2 e = 0 instead of drifting; g_c only for the holonomic rows); the
+        default ``None`` is (0, 0): the exact constrained dynamics, the same q̈ and λ as
+        :meth:`phase_space` and :meth:`multipliers`. ``u``: generalised forces, expressions of t, q,
+        qd (default zero). Parameters are matched by name from ``params``. Time-dependent
+        Lagrangians or constraints are not handled here (a ValueError says so)."""
+        import numpy as np
+
+        if self._has_time():
+            raise ValueError("numeric_accelerations() handles time-invariant Lagrangians and constraints; this system's L, B or constraints depend on t")
+        values = {str(k): v for k, v in dict(params or {}).items()}
+        alpha, beta = (0.0, 0.0) if baumgarte is None else baumgarte
+        mech = self._kkt_system(values, (float(alpha), float(beta)))
+        forces = sp.zeros(self.n, 1) if u is None else sp.Matrix(_as_list(self._sub(u), "forces"))
+        if len(forces) != self.n:
+            raise ValueError(f"forces u must have {self.n} entries (one per coordinate), got {len(forces)}")
+        forces = forces.xreplace({s: values[str(s)] for s in forces.free_symbols if str(s) in values})
+        left = forces.free_symbols - set(self.q) - set(self.qd) - {self.t}
+        if left:
+            raise ValueError(f"give values for the parameters {sorted(map(str, left))} of the forces u")
+        u_fn = sp.lambdify([self.t, list(self.q), list(self.qd)], list(forces), "numpy")
+        n = self.n
+
+        def accelerations(t, q, qd):
+            q = np.asarray(q, dtype=float).reshape(n)
+            qd = np.asarray(qd, dtype=float).reshape(n)
+            try:
+                return mech.accelerations(q, qd, np.asarray(u_fn(t, q, qd), dtype=float).reshape(n))
+            except np.linalg.LinAlgError:
+                raise ValueError(
+                    f"{self.name or 'the Lagrangian system'}: the constrained equations are singular at q = {q.tolist()} "
+                    "(M singular, or the constraint Jacobian A loses rank: a singular configuration of the mechanism)"
+                ) from None
+
+        return accelerations
+
+    def numeric(self, params=None, u=None, baumgarte=None):
+        """A NumPy right-hand side f(t, x) for scipy.integrate.solve_ivp (x = (q, qd)), with the
+        parameters and forces substituted from ``params`` / ``u`` (default forces zero).
+
+        Time-invariant systems (constrained ones included) are solved numerically per call through
+        :meth:`numeric_accelerations` (KKT system, optional Baumgarte stabilisation); systems whose
+        Lagrangian depends on t use the symbolic :meth:`phase_space`."""
+        import numpy as np
+
+        if not self._has_time():
+            accelerations = self.numeric_accelerations(params, u, baumgarte)
+            n = self.n
+
+            def rhs(t, y):
+                y = np.asarray(y, dtype=float)
+                return np.concatenate([y[n:], accelerations(t, y[:n], y[n:])[0]])
+
+            return rhs
+        if baumgarte is not None:
+            raise ValueError("Baumgarte stabilisation needs a time-invariant system (see numeric_accelerations)")
         params = {sp.Symbol(k, real=True) if isinstance(k, str) else k: v for k, v in dict(params or {}).items()}
         # match parameter symbols by name (users may create them without assumptions)
         free = {}
@@ -375,6 +494,49 @@ class LagrangianSystem:
             raise ValueError(f"give values for the parameters {sorted(map(str, left))}")
         fn = sp.lambdify([self.t, list(x)], list(f), "numpy")
         return lambda t, y: np.array(fn(t, y), dtype=float)
+
+    def change_coordinates(self, A, coordinates=None, name: str = "") -> "LagrangianSystem":
+        """The same system in coordinates p with q = A p (A constant, n x n, invertible; qd = A pd):
+        L_p(p, pd) = L(A p, A pd); generalised forces and B map by A^T (virtual work:
+        u . dq = (A^T u) . dp); holonomic constraints g_c(A p) and Pfaffian rows A_c(A p) A.
+        ``coordinates``: names of p (default p1..pn). See also
+        :func:`kinedyn.symbolic.mechanisms.change_coordinates` for a robot's equations of motion."""
+        n = self.n
+        A = sp.Matrix(A)
+        if A.shape != (n, n):
+            raise ValueError(f"the map q = A p needs a square A of shape ({n}, {n}) for {n} coordinates, got {A.shape}")
+        if A.free_symbols & (set(self.q) | set(self.qd) | {self.t}):
+            raise ValueError("A must be constant (no coordinates, velocities or time in it)")
+        if sp.simplify(A.det()) == 0:
+            raise ValueError(f"A = {A.tolist()} is singular: the new coordinates would not determine q")
+        if coordinates is None:
+            coordinates = [f"p{i + 1}" for i in range(n)]
+        elif isinstance(coordinates, str):
+            coordinates = coordinates.replace(",", " ").split()
+        p = [sp.Symbol(c, real=True) if isinstance(c, str) else c for c in coordinates]
+        pd = [sp.Symbol(_rate_names(c.name)[0], real=True) for c in p]
+        if len(p) != n:
+            raise ValueError(f"coordinates must name {n} coordinates, got {len(p)}")
+        taken = {s.name for e in [self.L, *self.u, *self.B, *self.A] for s in sp.sympify(e).free_symbols} - {c.name for c in self.q + self.qd}
+        clash = sorted({s.name for s in p + pd} & taken)
+        if clash:
+            raise ValueError(f"the new coordinates' names {clash} are already symbols of the system: choose other names")
+        rep = {**dict(zip(self.q, A * sp.Matrix(p))), **dict(zip(self.qd, A * sp.Matrix(pd)))}
+        pfaffian = None
+        if self.A.shape[0] > len(self.holonomic):
+            pfaffian = self.A[len(self.holonomic):, :].xreplace(rep) * A
+        return LagrangianSystem(
+            p, L=sp.expand(self.L.xreplace(rep)), qd=pd, t=self.t, forces=list(A.T * self.u.xreplace(rep)),
+            B=list(A.T * self.B.xreplace(rep)), holonomic=[sp.expand(e.xreplace(rep)) for e in self.holonomic] or None,
+            pfaffian=pfaffian, name=name or f"{self.name} in coordinates {', '.join(c.name for c in p)}",
+        )
+
+    def check_properties(self, params=None, **kwargs):
+        """M symmetric and dM/dt - 2C skew-symmetric proven by exact simplification, M positive
+        definite and passivity measured: :func:`kinedyn.analysis.check_system_properties`."""
+        from ..analysis.system_properties import check_system_properties
+
+        return check_system_properties(self, params, **kwargs)
 
     def __repr__(self) -> str:
         return f"LagrangianSystem(q={self.q}, constraints={self.A.shape[0]})"
