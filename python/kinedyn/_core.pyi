@@ -41,6 +41,7 @@ class Model:
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
     def jacobian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6, n) | (N, 6, n)
+    def jacobian_hessian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (n, 6, n) | (N, n, 6, n), H[i, r, j] = dJ[r, j]/dq_i
     def frame_velocity(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
     def jdot_qd(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----

@@ -454,6 +454,20 @@ class Robot:
             fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
         return self._model.jacobian(self._state(q), fid, ref, point)
 
+    def jacobian_hessian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+        """Kinematic Hessian ``dJ/dq`` of :meth:`jacobian` (same frame, reference and point):
+        (n, 6, n), or (N, n, 6, n) for a batch, with ``H[i, :, j] = dJ[:, j]/dq_i`` (Robotics
+        Toolbox's layout: ``H[i]`` is the derivative of the whole Jacobian along joint i).
+
+        ``reference="world"`` is RTB's ``hessian0``; ``sum_ij H[i, :, j] qd_i qd_j`` equals
+        :meth:`jacobian_dot_qd` in every reference. RTB's ``hessiane`` is ``hessian0`` with its rows
+        turned into the frame's axes (not the derivative of the ``"local"`` Jacobian):
+        :func:`kinedyn.kinematics.hessian_in_frame_axes`. Computed in the native core from the
+        Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
+        """
+        fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
+        return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
+
     def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))

@@ -562,6 +562,20 @@ impl PyModel {
         })
     }
 
+    /// Kinematic Hessian dJ/dq (n, 6, n) or (N, n, 6, n): `H[i, r, j] = dJ[r, j]/dq_i`.
+    #[pyo3(signature = (q, frame, reference, point=None))]
+    fn jacobian_hessian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        guarded("Model.jacobian_hessian", || {
+            let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("jacobian_hessian", "dJ/dq"), &[n, 6, n], |model, data, x, out| {
+                algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
+                Ok(())
+            })
+        })
+    }
+
     /// Twist J qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
     fn frame_velocity<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
