@@ -458,6 +458,7 @@ impl PyModel {
 impl PyModel {
     #[new]
     #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None))]
     fn new(
         parent: Vec<i64>,
         kind: Vec<i64>,
@@ -471,6 +472,7 @@ impl PyModel {
         gravity: Vec<f64>,
         frame_body: Vec<i64>,
         frame_placement: PyReadonlyArrayDyn<f64>,
+        coulomb_negative: Option<Vec<f64>>,
     ) -> PyResult<Self> {
         guarded("Model.__new__", || {
             let n = parent.len();
@@ -514,8 +516,11 @@ impl PyModel {
                     Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
                 })
                 .collect::<PyResult<Vec<_>>>()?;
-            let model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
+            let mut model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
                 .map_err(core_err)?;
+            if let Some(levels) = coulomb_negative {
+                model = model.with_coulomb_negative(levels).map_err(core_err)?;
+            }
             let data = Mutex::new(Data::new(&model));
             Ok(Self { model, data })
         })
