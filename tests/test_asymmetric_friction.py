@@ -172,3 +172,15 @@ def test_removing_friction_takes_both_levels():
     j = kd.robots.puma560(friction=True).joints[0]
     assert dataclasses.replace(j, coulomb=0.0).coulomb_levels[1] > 0
     assert dataclasses.replace(j, coulomb=0.0, coulomb_negative=None).coulomb_levels == (0.0, 0.0)
+
+
+def test_cli_info_shows_both_levels(capsys, tmp_path):
+    import json
+
+    from kinedyn.cli import main
+
+    path = tmp_path / "r.yaml"
+    path.write_text("name: r\njoints:\n  - {a: 1.0, coulomb: [0.4, 0.3]}\n  - {a: 1.0, coulomb: 0.2}\n")
+    assert main(["info", str(path), "--json"]) == 0
+    joints = json.loads(capsys.readouterr().out)["joints"]
+    assert [(j["coulomb"], j["coulomb_negative"]) for j in joints] == [(0.4, 0.3), (0.2, 0.2)]
