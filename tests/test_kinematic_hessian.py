@@ -198,3 +198,34 @@ def test_manipulability_jacobian_batches_singularities_and_wide_tasks():
     s = np.linalg.svd(arm.jacobian(q)[:3], compute_uv=False)
     assert np.sum(s < 1e-9) == 2
     np.testing.assert_allclose(kin.manipulability_jacobian(arm, q, task="position"), np.zeros(3), atol=1e-12)
+
+
+def test_hessian_equals_pinocchios_kinematic_hessian():
+    """Pinocchio (an optional oracle) stores H[:, :, i] = dJ/dq_i of a joint frame, (6, n, n), for
+    WORLD (our "spatial"), LOCAL ("local") and LOCAL_WORLD_ALIGNED ("world"). pin 4.1's binding hands
+    the column-major tensor over as a C-ordered array; the test reads the buffer both ways and
+    requires one reading to equal ours to rounding (a fixed binding reads the other way)."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) is an optional test oracle")
+    path = erd(*PANDA)
+    locked = {"panda_finger_joint1": 0.02, "panda_finger_joint2": 0.02}
+    robot = kd.Robot.from_urdf(path).lock_joints(locked)
+    model = pin.buildModelFromUrdf(path)
+    q_ref = pin.neutral(model)
+    for name, value in locked.items():
+        q_ref[model.joints[model.getJointId(name)].idx_q] = value
+    model = pin.buildReducedModel(model, [model.getJointId(name) for name in locked], q_ref)
+    data = model.createData()
+    n = robot.n
+    assert model.nv == n == 7
+    q = robot.random_configuration(RNG)
+    pin.computeJointJacobians(model, data, q)
+    pin.computeJointKinematicHessians(model, data, q)
+    for jid in (3, n):  # a mid-chain joint frame and the last
+        body = robot.tree.bodies[jid - 1].name
+        assert model.names[jid] == robot.tree.bodies[jid - 1].joint.name
+        for reference, frame in (("spatial", pin.WORLD), ("local", pin.LOCAL), ("world", pin.LOCAL_WORLD_ALIGNED)):
+            raw = np.asarray(pin.getJointKinematicHessian(model, data, jid, frame))
+            readings = [raw.reshape(-1).reshape((6, n, n), order=order) for order in ("F", "C")]
+            ours = np.transpose(robot.jacobian_hessian(q, body, reference), (1, 2, 0))  # [r, j, i]
+            errors = [np.abs(h - ours).max() for h in readings]
+            assert min(errors) < 1e-10, f"joint {jid} {reference}: {errors}"
