@@ -137,6 +137,10 @@ def test_symbolic_equations_carry_both_levels():
     values = dict(zip(list(e.q) + list(e.qd) + list(e.qdd), list(q) + list(qd_v) + list(qdd)))
     numeric = np.array([float(x.evalf(subs=values)) for x in tau])
     np.testing.assert_allclose(numeric, puma.inverse_dynamics(q, qd_v, qdd), rtol=1e-9, atol=1e-9)
+    # generated code (NumPy backend) for a batch of rates of both signs
+    compiled = e.compile(("friction",), backend="numpy")
+    rates = rng.normal(size=(20, 6))
+    np.testing.assert_allclose(compiled.friction(rates), puma.friction_torque(rates), atol=1e-12)
 
 
 @pytest.mark.parametrize("ext", ["yaml", "toml"])
