@@ -138,6 +138,8 @@ def test_hessian_bad_inputs_give_clear_errors():
         robot.jacobian_hessian([0, 0, 0])
     with pytest.raises(ValueError, match="q"):
         robot.jacobian_hessian([0, np.nan])
+    # a frame fixed to the base does not move: its Jacobian and Hessian are zero
+    np.testing.assert_array_equal(robot.jacobian_hessian([0.3, 0.4], "base"), np.zeros((2, 6, 2)))
 
 
 # ------------------------------------------------------------------ manipulability Jacobian (RTB's jacobm)

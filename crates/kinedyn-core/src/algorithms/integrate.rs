@@ -326,7 +326,7 @@ fn implicit_step(
         }
     }
     lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| fail(Some(k), FailureKind::Singular(format!("the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"))))?;
-    // without Coulomb friction: a0 = qdd + M^-1 (coulomb sign(qd)) (the ABA's qdd includes it)
+    // without Coulomb friction: a0 = qdd + M^-1 coulomb_torque(qd) (the ABA's qdd includes it)
     let coulomb = (0..n).any(|k| model.has_coulomb(k));
     // dv0 = (I - h A_v - h^2 A_q)^-1 h (a0 + h A_q qd)
     for r in 0..n {
@@ -342,7 +342,7 @@ fn implicit_step(
         s.v0[j] = qd[j] + s.rhs[j];
     }
     if coulomb {
-        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb sign(v0))
+        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb_torque(v0))
         for r in 0..n {
             s.rhs[r] = -h * (0..n).map(|k| s.minv[r * n + k] * model.coulomb_torque(k, s.v0[k])).sum::<f64>();
         }
