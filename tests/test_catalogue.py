@@ -167,8 +167,15 @@ def test_puma_motor_and_friction_options():
     j1 = robot.joints[0]
     assert j1.armature == pytest.approx(gear**2 * jm)
     assert j1.viscous == pytest.approx(b * gear**2)
-    assert j1.coulomb == pytest.approx(abs(gear) * (tp - tn) / 2)
+    # Corke's model (RTB Link.friction): |G| Tc+ against qd > 0, |G| |Tc-| against qd < 0 (tn < 0)
+    assert j1.coulomb == pytest.approx(abs(gear) * tp)
+    assert j1.coulomb_negative == pytest.approx(abs(gear) * -tn)
+    assert j1.coulomb_levels == (j1.coulomb, j1.coulomb_negative)
+    mean = kd.robots.puma560(friction="symmetric").joints[0]
+    assert mean.coulomb == pytest.approx(abs(gear) * (tp - tn) / 2) and mean.coulomb_negative is None
     assert kd.robots.puma560().joints[0].viscous == 0.0
+    with pytest.raises(ValueError, match="friction must be True"):
+        kd.robots.puma560(friction="yes")
 
 
 def test_puma_limits_in_degrees():

@@ -199,7 +199,7 @@ def test_passivity_integral_equals_the_energy_change(puma):
     import dataclasses
 
     rough = kd.robots.puma560(friction=True)
-    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, coulomb=0.0)) for l in rough.links]
+    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, coulomb=0.0, coulomb_negative=None)) for l in rough.links]
     rough = rough.replace(links=links)
     assert rough.joints[0].viscous > 0
     traj = kd.simulate(rough, 1.0, X0_PUMA, controller=PDGravity(rough, 60.0, 8.0, np.zeros(6)), dt=1e-3)

@@ -29,10 +29,11 @@ class Model:
         inertia: F64,  # (n, 10) [m, mc, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the body-frame origin
         armature: F64,  # (n,) reflected rotor inertia r^2 J_m
         viscous: F64,  # (n,)
-        coulomb: F64,  # (n,)
+        coulomb: F64,  # (n,) Coulomb level (for qd > 0 when coulomb_negative is given)
         gravity: F64,  # (3,) in base coordinates
         frame_body: I64,  # (nf,) body of each named frame, -1 = base
         frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
+        coulomb_negative: Optional[F64] = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
     ) -> None: ...
     @property
     def n(self) -> int: ...
@@ -41,6 +42,7 @@ class Model:
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
     def jacobian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6, n) | (N, 6, n)
+    def jacobian_hessian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (n, 6, n) | (N, n, 6, n), H[i, r, j] = dJ[r, j]/dq_i
     def frame_velocity(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
     def jdot_qd(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----

@@ -422,6 +422,7 @@ def cmd_info(args) -> int:
                 "rotor_inertia": _value(j.rotor_inertia),
                 "viscous": _value(j.viscous),
                 "coulomb": _value(j.coulomb),
+                "coulomb_negative": _value(j.coulomb_levels[1]),  # the level for qd < 0 (= coulomb if symmetric)
             }
         )
     bodies = [

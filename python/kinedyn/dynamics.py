@@ -11,6 +11,12 @@ inertial parameters of robots", J. Robotic Systems 8(4), 1991): stack ``Y`` at r
 ``W``, take a QR decomposition with column pivoting ``W P = Q R``; the first ``b`` pivots (``b`` the
 numerical rank) are independent columns ``W_1``, the rest satisfy ``W_2 = W_1 beta`` with
 ``beta = R_11^-1 R_12``. Then ``W pi = W_1 (pi_1 + beta pi_2)``: ``pi_base = grouping @ pi``.
+
+Operational space (Khatib, "A unified approach for motion and force control of robot manipulators:
+the operational space formulation", IEEE J. Robotics and Automation 3(1), 1987): the inertia a
+frame presents to forces along the task rows, ``Lambda = (J M^-1 J^T)^-1``
+(:func:`operational_space_inertia`), and the dynamically consistent generalised inverse
+``J_bar = M^-1 J^T Lambda`` (:func:`dynamically_consistent_inverse`).
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ if TYPE_CHECKING:
     from ._typing import ArrayLike, SeedLike
     from .robot import Robot
 
-__all__ = ["BaseParameters", "base_parameters", "linearize"]
+__all__ = ["BaseParameters", "base_parameters", "linearize", "operational_space_inertia", "dynamically_consistent_inverse"]
 
 
 @dataclass(frozen=True)
@@ -120,3 +126,85 @@ def linearize(robot: Robot, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: O
     B = np.zeros(batch + (2 * n, n))
     B[..., n:, :] = minv
     return A, B
+
+
+def _task_mobility(robot: Robot, q, frame, task, reference) -> tuple:
+    """``(J, Minv, A)``: the task Jacobian (..., m, n), ``M^-1`` (..., n, n) and the inverse
+    operational-space inertia ``A = J M^-1 J^T`` (..., m, m), symmetrised."""
+    from .kinematics import task_jacobian
+
+    J = task_jacobian(robot, q, frame, task, reference)
+    Minv = robot.mass_matrix_inverse(q)
+    A = J @ Minv @ np.swapaxes(J, -1, -2)
+    return J, Minv, (A + np.swapaxes(A, -1, -2)) / 2
+
+
+def _check_task_rank(robot: Robot, q, J: np.ndarray, task, tol: float, what: str) -> None:
+    """ValueError naming the configuration and the lost task direction if J has rank < its rows."""
+    from .kinematics import _report, task_rows
+
+    rows = task_rows(task)
+    m, n = J.shape[-2:]
+    if m > n:
+        raise ValueError(
+            f"{what}: the task has {m} rows but the robot only {n} joints, so J M^-1 J^T ({m}x{m}) is singular "
+            "everywhere; choose at most n rows with task=..., or method='pinv'"
+        )
+    s = np.linalg.svd(J, compute_uv=False)
+    deficient = s[..., -1] <= tol * np.maximum(1.0, s[..., 0])
+    if np.any(deficient):
+        k = int(np.argmax(np.reshape(deficient, -1)))
+        qs = np.asarray(q, dtype=float).reshape(-1, n)
+        where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
+        report = _report(J.reshape(-1, m, n)[k], rows, n, tol)
+        raise ValueError(
+            f"{what}: the task Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}, so "
+            f"J M^-1 J^T has no inverse ({report.summary()}); method='pinv' gives the pseudo-inverse"
+        )
+
+
+def _lambda(A: np.ndarray, method: str, tol: float) -> np.ndarray:
+    if method == "inverse":
+        return np.linalg.inv(A)
+    # symmetric pseudo-inverse: eigenvalues below tol * max(1, largest) count as zero
+    w, V = np.linalg.eigh(A)
+    keep = w > tol * np.maximum(1.0, w[..., -1:])
+    inv_w = np.divide(1.0, w, out=np.zeros_like(w), where=keep)
+    return (V * inv_w[..., None, :]) @ np.swapaxes(V, -1, -2)
+
+
+def operational_space_inertia(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task="full", reference: str = "world", method: str = "inverse", tol: float = 1e-9) -> np.ndarray:
+    """Khatib's operational-space (task-space) inertia ``Lambda(q) = (J M^-1 J^T)^-1`` of ``frame``
+    (default the tool) on the task rows (``task`` as in :mod:`kinedyn.kinematics`, Jacobian in
+    ``reference``): (m, m), or (N, m, m) for a batch. The tool then obeys ``Lambda a + mu + p = F``.
+
+    ``method="inverse"`` (default): ValueError naming the configuration and the direction the tool
+    cannot move in where the task Jacobian loses rank (a singular value below ``tol * max(1, s_max)``)
+    or the task has more rows than the robot has joints. ``method="pinv"``: the Moore-Penrose
+    pseudo-inverse of ``J M^-1 J^T`` (eigenvalues below ``tol * max(1, largest)`` count as zero):
+    finite everywhere, the inertia felt along the directions the tool can move, zero along the lost
+    ones. ``M`` includes the reflected rotor inertia."""
+    if method not in ("inverse", "pinv"):
+        raise ValueError(f"method must be 'inverse' or 'pinv', got '{method}'")
+    J, _, A = _task_mobility(robot, q, frame, task, reference)
+    if method == "inverse":
+        _check_task_rank(robot, q, J, task, tol, "operational_space_inertia")
+    L = _lambda(A, method, tol)
+    return (L + np.swapaxes(L, -1, -2)) / 2
+
+
+def dynamically_consistent_inverse(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task="full", reference: str = "world", method: str = "inverse", tol: float = 1e-9) -> np.ndarray:
+    """Khatib's dynamically consistent generalised inverse ``J_bar = M^-1 J^T Lambda`` (n, m), or
+    (N, n, m) for a batch, with ``Lambda`` from :func:`operational_space_inertia` (same arguments).
+
+    ``J J_bar = I`` (a right inverse of J), and it is the inverse weighted by the mass matrix: the
+    null-space torques ``(I - J^T J_bar^T) tau_0`` cause no tool acceleration (Khatib 1987, the dynamically consistent null space).
+    With ``method="pinv"`` at a singular configuration, ``J J_bar`` is the projector onto the
+    directions the tool can move in instead of I."""
+    if method not in ("inverse", "pinv"):
+        raise ValueError(f"method must be 'inverse' or 'pinv', got '{method}'")
+    J, Minv, A = _task_mobility(robot, q, frame, task, reference)
+    if method == "inverse":
+        _check_task_rank(robot, q, J, task, tol, "dynamically_consistent_inverse")
+    L = _lambda(A, method, tol)
+    return Minv @ np.swapaxes(J, -1, -2) @ ((L + np.swapaxes(L, -1, -2)) / 2)

@@ -4,6 +4,10 @@ All functions take the task rows to use: ``task="full"`` (6 rows [v; w]), ``"pos
 rows of the linear velocity), ``"orientation"``, ``"planar"`` (rows x, y: the tutorial's 2x2
 Jacobian of a planar arm) or an explicit list of row indices. Jacobians are the ``reference``
 Jacobians of :meth:`kinedyn.Robot.jacobian` (default "world": base axes, textbook J = [J_v; J_w]).
+
+Second order: the kinematic Hessian ``dJ/dq`` (:func:`jacobian_hessian`, Robotics Toolbox's
+``hessian0``; :func:`hessian_in_frame_axes`, its ``hessiane``) and the gradient of Yoshikawa's
+manipulability (:func:`manipulability_jacobian`, RTB's ``jacobm``).
 """
 
 from __future__ import annotations
@@ -26,6 +30,9 @@ __all__ = [
     "joint_torques",
     "joint_velocities",
     "manipulability",
+    "manipulability_jacobian",
+    "jacobian_hessian",
+    "hessian_in_frame_axes",
     "singular_values",
     "SingularityReport",
     "singularity_report",
@@ -162,6 +169,74 @@ def manipulability(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task
     if m > robot.n:  # J J^T is rank deficient by construction
         return np.zeros(s.shape[:-1]) if s.ndim > 1 else 0.0
     return np.prod(s, axis=-1)
+
+
+def jacobian_hessian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+    """``dJ/dq`` of the task rows of the Jacobian: (n, m, n), or (N, n, m, n) for a batch, with
+    ``H[i, :, j] = dJ[:, j]/dq_i`` (:meth:`kinedyn.Robot.jacobian_hessian`; Robotics Toolbox's
+    ``(n, 6, n)`` layout, so ``reference="world"`` with ``task="full"`` is RTB's ``hessian0``)."""
+    return robot.jacobian_hessian(q, frame, reference)[..., task_rows(task), :]
+
+
+def hessian_in_frame_axes(robot: Robot, q: ArrayLike, frame: Optional[str] = None) -> np.ndarray:
+    """Robotics Toolbox's ``hessiane``: the world Hessian ``dJ_world/dq`` (RTB's ``hessian0``) with
+    its linear and angular rows expressed in the frame's own axes, ``diag(R^T, R^T) H0[i]``;
+    (n, 6, n) or (N, n, 6, n).
+
+    RTB computes it by applying ``hessian0``'s cross-product formulas to the end-effector Jacobian,
+    and cross products turn with the axes, so this equals that. It is *not* the derivative of the
+    ``"local"`` Jacobian (``robot.jacobian_hessian(q, reference="local")``), which also carries the
+    turning of the frame's axes: ``dJ_local/dq_i = diag(R^T, R^T) (H0[i] - [w_i x J_v; w_i x J_w])``.
+    ``sum_ij hessian_in_frame_axes[i, :, j] qd_i qd_j`` is the world acceleration drift in the
+    frame's axes, ``R^T (dJ_world/dt qd)``."""
+    H0 = robot.jacobian_hessian(q, frame, "world")
+    R = robot.pose(q, frame)[..., :3, :3]
+    out = np.empty_like(H0)
+    # (R^T x)_a = sum_b R[b, a] x_b for the linear rows 0..2 and the angular rows 3..5 of every H0[i][:, j]
+    out[..., :3, :] = np.einsum("...ba,...ibj->...iaj", R, H0[..., :3, :])
+    out[..., 3:, :] = np.einsum("...ba,...ibj->...iaj", R, H0[..., 3:, :])
+    return out
+
+
+def manipulability_jacobian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> np.ndarray:
+    """Gradient ``dw/dq`` of Yoshikawa's manipulability ``w = sqrt(det(J J^T))`` on the task rows
+    (the rows :func:`manipulability` uses): (n,), or (N, n) for a batch. Robotics Toolbox's
+    ``jacobm`` (which returns it as an (n, 1) column).
+
+    With ``A = J J^T`` and ``H_i = dJ/dq_i`` (the task rows of :func:`jacobian_hessian`),
+    ``d det A = det A tr(A^-1 dA)`` (Jacobi's formula) and ``dA = H_i J^T + J H_i^T`` give
+    ``dw/dq_i = w tr(A^-1 J H_i^T)`` (Yoshikawa 1985; Park & Kim 1998; Haviland & Corke 2022,
+    Part I). It is evaluated from the SVD ``J = U S V^T`` as ``sum_k (prod_{l != k} s_l) u_k^T H_i v_k``,
+    which is the same number without dividing by a small singular value.
+
+    Where exactly one singular value of the task Jacobian is zero (below ``tol * max(1, s_max)``),
+    ``w`` has a kink like ``|x|`` at 0 and no derivative: ValueError naming the configuration and
+    the lost direction. With two or more zero, the gradient is 0. More task rows than joints: ``w``
+    is 0 everywhere, and so is its gradient."""
+    rows = task_rows(task)
+    J = task_jacobian(robot, q, frame, rows, reference)
+    H = robot.jacobian_hessian(q, frame, reference)[..., rows, :]
+    n, m = robot.n, len(rows)
+    if m > n:  # J J^T is rank deficient by construction: w = 0 identically
+        return np.zeros(J.shape[:-2] + (n,))
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)  # s: (..., m), U: (..., m, m), Vt: (..., m, n)
+    threshold = tol * np.maximum(1.0, s[..., :1])
+    zero = s <= threshold
+    one_zero = np.sum(zero, axis=-1) == 1
+    if np.any(one_zero):
+        k = int(np.argmax(one_zero.reshape(-1)))
+        qs = np.asarray(q, dtype=float).reshape(-1, n)
+        where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
+        report = _report(J.reshape(-1, m, n)[k], rows, n, tol)
+        raise ValueError(
+            f"manipulability_jacobian: w = sqrt(det(J J^T)) is 0 at q = {np.array2string(qs[k], precision=6)}{where} "
+            f"and has no derivative there (one singular value of the task Jacobian is 0: {report.summary()})"
+        )
+    # others[..., k] = prod_{l != k} s_l, without dividing by s_k
+    others = np.stack([np.prod(np.delete(s, k, axis=-1), axis=-1) for k in range(m)], axis=-1)
+    # u_k^T H_i v_k for every i and k: (..., n, m)
+    projected = np.einsum("...ak,...iab,...kb->...ik", U, H, Vt)
+    return finite_result(projected @ others[..., :, None], "manipulability_jacobian: dw/dq", J.ndim - 2)[..., 0]
 
 
 @dataclass

@@ -254,23 +254,31 @@ class Robot:
 
     @property
     def viscous(self) -> np.ndarray:
-        """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)."""
+        """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)
+        (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
         return np.array([float(j.viscous) for j in self.joints])
 
     @property
     def coulomb(self) -> np.ndarray:
-        """Coulomb friction level per joint."""
+        """Coulomb friction level per joint for qd > 0 (the only level when friction is symmetric)."""
         return np.array([float(j.coulomb) for j in self.joints])
 
+    @property
+    def coulomb_negative(self) -> np.ndarray:
+        """Coulomb friction level per joint for qd < 0 (a magnitude; equals :attr:`coulomb` for
+        symmetric friction)."""
+        return np.array([float(j.coulomb_levels[1]) for j in self.joints])
+
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
-        """viscous * qd + coulomb * sign(qd), (n,) or (N, n)."""
+        """viscous * qd + Coulomb friction, (n,) or (N, n): ``coulomb`` for qd > 0,
+        ``-coulomb_negative`` for qd < 0, 0 at rest (``coulomb * sign(qd)`` when symmetric)."""
         qd = real_array(qd, "qd")
         if qd.shape[-1:] != (self.n,) or qd.ndim > 2:
             raise ValueError(f"qd must have shape ({self.n},) or a batch (N, {self.n}), got {qd.shape}")
         if not np.all(np.isfinite(qd)):
             raise ValueError("qd contains a non-finite value (NaN or inf)")
         with np.errstate(over="ignore"):
-            tau = self.viscous * qd + self.coulomb * np.sign(qd)
+            tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
         return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
     @property
@@ -294,7 +302,7 @@ class Robot:
         add(self.gravity)
         for link in self.links:
             j = link.joint
-            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb])
+            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb, j.coulomb_negative])
             add([link.inertia.mass, link.inertia.com, link.inertia.inertia])
             if is_symbolic(link.placement):
                 add(link.placement)
@@ -323,7 +331,7 @@ class Robot:
             j = link.joint
             joint = Joint(
                 j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
-                j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb),
+                j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb), f(j.coulomb_negative),
             )
             try:
                 inertia = link.inertia.subs(mapping)
@@ -335,7 +343,8 @@ class Robot:
         if self.dh is not None:
             dh = [
                 DHRow(f(r.theta), f(r.d), f(r.a), f(r.alpha), r.kind, r.name, r.inertia.subs(mapping), r.lower, r.upper,
-                      r.velocity_limit, r.effort_limit, f(r.gear_ratio), f(r.rotor_inertia), f(r.viscous), f(r.coulomb))
+                      r.velocity_limit, r.effort_limit, f(r.gear_ratio), f(r.rotor_inertia), f(r.viscous), f(r.coulomb),
+                      f(r.coulomb_negative))
                 for r in self.dh
             ]
         return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
@@ -399,7 +408,11 @@ class Robot:
         frames = self.tree.frames
         frame_body = np.array([f.body for f in frames], dtype=np.int64)
         frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
-        return _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement)
+        # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
+        coulomb_negative = self.coulomb_negative
+        asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
+        return _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement,
+                           coulomb_negative=asymmetric)
 
     @cached_property
     def _link_frame_ids(self) -> np.ndarray:
@@ -467,6 +480,20 @@ class Robot:
             fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
         return self._model.jacobian(self._state(q), fid, ref, point)
 
+    def jacobian_hessian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+        """Kinematic Hessian ``dJ/dq`` of :meth:`jacobian` (same frame, reference and point):
+        (n, 6, n), or (N, n, 6, n) for a batch, with ``H[i, :, j] = dJ[:, j]/dq_i`` (Robotics
+        Toolbox's layout: ``H[i]`` is the derivative of the whole Jacobian along joint i).
+
+        ``reference="world"`` is RTB's ``hessian0``; ``sum_ij H[i, :, j] qd_i qd_j`` equals
+        :meth:`jacobian_dot_qd` in every reference. RTB's ``hessiane`` is ``hessian0`` with its rows
+        turned into the frame's axes (not the derivative of the ``"local"`` Jacobian):
+        :func:`kinedyn.kinematics.hessian_in_frame_axes`. Computed in the native core from the
+        Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
+        """
+        fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
+        return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
+
     def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
@@ -484,7 +511,8 @@ class Robot:
 
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
-    # friction = viscous qd + coulomb sign(qd), M including the reflected rotor inertia r^2 J_m.
+    # friction = viscous qd + coulomb sign(qd) (direction-dependent levels: friction_torque), M including
+    # the reflected rotor inertia r^2 J_m.
     @cached_property
     def _link_origin_in_body(self) -> Optional[np.ndarray]:
         """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link

@@ -34,7 +34,11 @@ pub struct Model {
     pub armature: Vec<f64>,
     /// Viscous friction coefficient per joint: `tau_f = viscous qd + coulomb sign(qd)`.
     pub viscous: Vec<f64>,
+    /// Coulomb friction level per joint for `qd > 0` (for both directions when symmetric).
     pub coulomb: Vec<f64>,
+    /// Coulomb friction level (a magnitude) per joint for `qd < 0`, when it differs from `coulomb`
+    /// (Corke's PUMA 560 motors, `Tc = [Tc+, Tc-]`); `None`: symmetric. See [`Model::coulomb_torque`].
+    pub coulomb_negative: Option<Vec<f64>>,
     /// Gravity acceleration in base coordinates (e.g. `[0, 0, -9.81]`).
     pub gravity: Vec3,
     pub frames: Vec<Frame>,
@@ -151,11 +155,45 @@ impl Model {
             armature,
             viscous,
             coulomb,
+            coulomb_negative: None,
             gravity,
             frames,
             support,
             subtree_end,
             subtrees_contiguous,
         })
+    }
+
+    /// The model with direction-dependent Coulomb friction: `levels[i]` (>= 0) acts against
+    /// `qd_i < 0`, `coulomb[i]` against `qd_i > 0`.
+    pub fn with_coulomb_negative(mut self, levels: Vec<f64>) -> Result<Self> {
+        if levels.len() != self.n {
+            return Err(Error::InvalidModel(format!("coulomb_negative has {} entries for {} bodies", levels.len(), self.n)));
+        }
+        finite("coulomb_negative", &levels)?;
+        if let Some(k) = levels.iter().position(|c| *c < 0.0) {
+            return Err(Error::InvalidModel(format!("coulomb_negative of joint {k} is {}, a level must be >= 0", levels[k])));
+        }
+        self.coulomb_negative = Some(levels);
+        Ok(self)
+    }
+
+    /// Coulomb friction torque of joint i at rate `qd`: `coulomb_i` for `qd > 0`,
+    /// `-coulomb_negative_i` for `qd < 0`, 0 at rest (`coulomb_i sign(qd)` when symmetric).
+    #[inline]
+    pub fn coulomb_torque(&self, i: usize, qd: f64) -> f64 {
+        if qd > 0.0 {
+            self.coulomb[i]
+        } else if qd < 0.0 {
+            -self.coulomb_negative.as_ref().map_or(self.coulomb[i], |c| c[i])
+        } else {
+            0.0
+        }
+    }
+
+    /// Whether joint i has Coulomb friction in either direction.
+    #[inline]
+    pub fn has_coulomb(&self, i: usize) -> bool {
+        self.coulomb[i] != 0.0 || self.coulomb_negative.as_ref().is_some_and(|c| c[i] != 0.0)
     }
 }

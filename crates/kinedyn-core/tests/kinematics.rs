@@ -88,3 +88,42 @@ fn twist_is_j_qd_and_drift_is_its_derivative() {
         }
     }
 }
+
+#[test]
+fn hessian_matches_finite_differences_of_the_jacobian_and_gives_the_drift() {
+    for model in models() {
+        let mut data = Data::new(&model);
+        let mut rng = Rng::new(23);
+        let n = model.n;
+        let q = rng.vector(n, -3.0, 3.0);
+        let qd = rng.vector(n, -2.0, 2.0);
+        let h = 1e-6;
+        for point in [None, Some(Vec3::new(0.1, -0.2, 0.05))] {
+            for frame in 0..model.frames.len() {
+                for reference in REFS {
+                    let mut hess = vec![0.0; 6 * n * n];
+                    kinedyn_core::algorithms::frame_jacobian_hessian(&model, &mut data, &q, frame, reference, point.as_ref(), &mut hess);
+                    let (mut jp, mut jm) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+                    for i in 0..n {
+                        let (mut qp, mut qm) = (q.clone(), q.clone());
+                        qp[i] += h;
+                        qm[i] -= h;
+                        frame_jacobian(&model, &mut data, &qp, frame, reference, point.as_ref(), &mut jp);
+                        frame_jacobian(&model, &mut data, &qm, frame, reference, point.as_ref(), &mut jm);
+                        for k in 0..6 * n {
+                            let fd = (jp[k] - jm[k]) / (2.0 * h);
+                            let got = hess[i * 6 * n + k];
+                            assert!((got - fd).abs() < 1e-6 * fd.abs().max(1.0), "frame {frame} {reference:?} dJ[{}][{}]/dq{i} = {got}, fd {fd}", k / n, k % n);
+                        }
+                    }
+                    // sum_i H[i] qd_i qd = dJ/dt qd, the acceleration drift of the same reference
+                    let drift = jacobian_dot_qd(&model, &mut data, &q, &qd, frame, reference, point.as_ref()).to_array();
+                    for r in 0..6 {
+                        let hqq: f64 = (0..n).map(|i| (0..n).map(|j| hess[(i * 6 + r) * n + j] * qd[i] * qd[j]).sum::<f64>()).sum();
+                        assert!((hqq - drift[r]).abs() < 1e-9 * drift[r].abs().max(1.0), "frame {frame} {reference:?} drift row {r}: H qd qd = {hqq}, {}", drift[r]);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -458,6 +458,7 @@ impl PyModel {
 impl PyModel {
     #[new]
     #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None))]
     fn new(
         parent: Vec<i64>,
         kind: Vec<i64>,
@@ -471,6 +472,7 @@ impl PyModel {
         gravity: Vec<f64>,
         frame_body: Vec<i64>,
         frame_placement: PyReadonlyArrayDyn<f64>,
+        coulomb_negative: Option<Vec<f64>>,
     ) -> PyResult<Self> {
         guarded("Model.__new__", || {
             let n = parent.len();
@@ -514,8 +516,11 @@ impl PyModel {
                     Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
                 })
                 .collect::<PyResult<Vec<_>>>()?;
-            let model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
+            let mut model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
                 .map_err(core_err)?;
+            if let Some(levels) = coulomb_negative {
+                model = model.with_coulomb_negative(levels).map_err(core_err)?;
+            }
             let data = Mutex::new(Data::new(&model));
             Ok(Self { model, data })
         })
@@ -557,6 +562,20 @@ impl PyModel {
             let batch = Batch::gather(&[("q", &q, &[n])])?;
             batch.run(py, self, ("jacobian", "J"), &[6, n], |model, data, x, out| {
                 algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
+                Ok(())
+            })
+        })
+    }
+
+    /// Kinematic Hessian dJ/dq (n, 6, n) or (N, n, 6, n): `H[i, r, j] = dJ[r, j]/dq_i`.
+    #[pyo3(signature = (q, frame, reference, point=None))]
+    fn jacobian_hessian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        guarded("Model.jacobian_hessian", || {
+            let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
+            let n = self.n();
+            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            batch.run(py, self, ("jacobian_hessian", "dJ/dq"), &[n, 6, n], |model, data, x, out| {
+                algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
                 Ok(())
             })
         })

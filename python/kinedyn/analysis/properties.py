@@ -157,7 +157,7 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     d = np.min([np.diag(robot.mass_matrix(qc)) for qc in configurations], axis=0)
     wn = 5.0
     name = "passivity: int qd . tau dt == H(T) - H(0) + dissipated"
-    coulomb = bool(np.any(robot.coulomb > 0))
+    coulomb = bool(np.any(robot.coulomb > 0) or np.any(robot.coulomb_negative > 0))
     tol_p = 1e-3 if coulomb else 1e-6
     # the residual is RK4's truncation error (O(dt^4)) plus the quadrature's: where it is above the
     # tolerance at dt (a fast passage, e.g. elbow_3r spinning about its axis when upright), the same

@@ -42,7 +42,16 @@ class DHRow:
     gear_ratio: Any = 1.0
     rotor_inertia: Any = 0.0
     viscous: Any = 0.0
-    coulomb: Any = 0.0
+    coulomb: Any = 0.0  # one level, or (positive, negative) levels: see Joint
+    coulomb_negative: Any = None
+
+    def __post_init__(self):
+        # coulomb=(positive, negative) is stored as the two fields, as Joint stores it
+        if isinstance(self.coulomb, (tuple, list)):
+            if len(self.coulomb) != 2 or self.coulomb_negative is not None:
+                raise ValueError(f"DH row '{self.name}': coulomb must be one level or a pair (positive, negative), given once; got {self.coulomb!r}")
+            object.__setattr__(self, "coulomb_negative", self.coulomb[1])
+            object.__setattr__(self, "coulomb", self.coulomb[0])
 
     @classmethod
     def from_mapping(cls, row: dict, index: int) -> "DHRow":
@@ -105,6 +114,7 @@ def links_from_dh(rows, convention: str = "standard"):
             rotor_inertia=r.rotor_inertia,
             viscous=r.viscous,
             coulomb=r.coulomb,
+            coulomb_negative=r.coulomb_negative,
         )
         if convention == "standard":
             # Rz(theta) Tz(d) | Tx(a) Rx(alpha): the joint moves first, the rest is fixed to link i

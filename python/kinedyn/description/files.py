@@ -413,7 +413,21 @@ class _Reader:
             self.fail(ctx, str(e))
 
     def drive(self, raw: dict, ctx: str) -> dict:
-        return {k: self.value(raw[k], f"{ctx}.{k}") for k in ("gear_ratio", "rotor_inertia", "viscous", "coulomb") if k in raw}
+        out = {k: self.value(raw[k], f"{ctx}.{k}") for k in ("gear_ratio", "rotor_inertia", "viscous") if k in raw}
+        if "coulomb" in raw:
+            c = raw["coulomb"]
+            if not isinstance(c, (list, tuple)):
+                out["coulomb"] = self.value(c, f"{ctx}.coulomb")
+                return out
+            # [positive, negative]: direction-dependent Coulomb levels (magnitudes)
+            if len(c) != 2:
+                self.fail(f"{ctx}.coulomb", f"expected one level or a list [positive, negative] of two levels, got {len(c)} values")
+            levels = tuple(self.value(v, f"{ctx}.coulomb[{i}]") for i, v in enumerate(c))
+            for i, v in enumerate(levels):
+                if not isinstance(v, sp.Basic) and v < 0:
+                    self.fail(f"{ctx}.coulomb[{i}]", f"a Coulomb level is a magnitude >= 0, got {v} (Corke's Tc = [Tc+, Tc-] with Tc- < 0 is written [Tc+, -Tc-])")
+            out["coulomb"] = levels
+        return out
 
 
 def robot_from_mapping(data, where: str = "<robot mapping>", inertia: str = "warn"):
@@ -627,7 +641,11 @@ def _limits_mapping(joint) -> dict:
 
 def _drive_mapping(obj) -> dict:
     defaults = {"gear_ratio": 1.0, "rotor_inertia": 0.0, "viscous": 0.0, "coulomb": 0.0}
-    return {k: _dump(getattr(obj, k)) for k, d in defaults.items() if getattr(obj, k) != d}
+    out = {k: _dump(getattr(obj, k)) for k, d in defaults.items() if getattr(obj, k) != d}
+    negative = getattr(obj, "coulomb_negative", None)
+    if negative is not None and negative != obj.coulomb:  # direction-dependent: [positive, negative]
+        out["coulomb"] = [_dump(obj.coulomb), _dump(negative)]
+    return out
 
 
 def _inertia_mapping(inertia: Inertia) -> dict:

@@ -5,6 +5,12 @@ frame (at q = 0); the joint moves the child by a rotation about / translation al
 joint coordinate ``q + offset``. ``gear_ratio`` r and ``rotor_inertia`` J_m give the reflected rotor
 inertia r^2 J_m on the diagonal of M (Spong §9.1's single link generalised); ``viscous`` and
 ``coulomb`` friction act at the joint: tau_f = viscous * qd + coulomb * sign(qd).
+
+Coulomb friction may differ with the direction of motion (Corke's PUMA 560 motors have
+``Tc = [Tc+, Tc-]`` per joint): ``coulomb_negative`` is the level (a magnitude, >= 0) for qd < 0,
+``coulomb`` the level for qd > 0; then tau_f = viscous * qd + (coulomb if qd > 0, -coulomb_negative
+if qd < 0, 0 at rest). ``coulomb=(positive, negative)`` is accepted as a shorthand for both levels.
+Unset (None), ``coulomb_negative`` equals ``coulomb``: the symmetric case.
 """
 
 from __future__ import annotations
@@ -35,6 +41,8 @@ class Joint:
     rotor_inertia: Any = 0.0
     viscous: Any = 0.0
     coulomb: Any = 0.0
+    #: Coulomb level for qd < 0 (magnitude); None = the same as ``coulomb`` (symmetric friction)
+    coulomb_negative: Any = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -53,15 +61,32 @@ class Joint:
             else:
                 axis = tuple(a / norm for a in axis)
         object.__setattr__(self, "axis", axis)
+        # coulomb=(positive, negative): the two levels of direction-dependent Coulomb friction
+        if isinstance(self.coulomb, (tuple, list)):
+            if len(self.coulomb) != 2:
+                raise ValueError(f"{what}: coulomb must be one level or a pair (positive, negative) of levels, got {list(self.coulomb)!r}")
+            if self.coulomb_negative is not None:
+                raise ValueError(f"{what}: give the negative-direction Coulomb level once, as coulomb=(positive, negative) or coulomb_negative=...")
+            positive, negative = self.coulomb
+            object.__setattr__(self, "coulomb", positive)
+            object.__setattr__(self, "coulomb_negative", negative)
         # offset, drive train and friction: numbers (checked: real, finite, sane size) or symbols
         for name in ("offset", "gear_ratio", "rotor_inertia", "viscous", "coulomb"):
             object.__setattr__(self, name, number(getattr(self, name), f"{what}: {name}"))
         if not is_symbolic(self.gear_ratio) and self.gear_ratio == 0:
             raise ValueError(f"{what}: gear_ratio must be non-zero")
-        for name in ("rotor_inertia", "viscous", "coulomb"):
+        if self.coulomb_negative is not None:
+            object.__setattr__(self, "coulomb_negative", number(self.coulomb_negative, f"{what}: coulomb_negative"))
+            if self.coulomb_negative == self.coulomb:  # one description of symmetric friction
+                object.__setattr__(self, "coulomb_negative", None)
+        for name in ("rotor_inertia", "viscous", "coulomb", "coulomb_negative"):
             v = getattr(self, name)
-            if not is_symbolic(v) and v < 0:
-                raise ValueError(f"{what}: {name} must be >= 0, got {v}")
+            if v is not None and not is_symbolic(v) and v < 0:
+                hint = ""
+                if name == "coulomb_negative":
+                    hint = (" (a level, not a signed torque: Corke's Tc = [Tc+, Tc-] with Tc- < 0 is "
+                            "coulomb=(Tc+, -Tc-))")
+                raise ValueError(f"{what}: {name} must be >= 0, got {v}{hint}")
         # limits: numbers, +-inf allowed (no limit), never NaN
         for name in ("lower", "upper", "velocity_limit", "effort_limit"):
             object.__setattr__(self, name, real(getattr(self, name), f"{what}: {name}", infinite=True))
@@ -72,6 +97,33 @@ class Joint:
         for name in ("velocity_limit", "effort_limit"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{what}: {name} is negative")
+
+    @property
+    def coulomb_levels(self) -> tuple:
+        """(level for qd > 0, level for qd < 0), both >= 0; equal for symmetric friction."""
+        return (self.coulomb, self.coulomb if self.coulomb_negative is None else self.coulomb_negative)
+
+    @property
+    def coulomb_is_symmetric(self) -> bool:
+        return self.coulomb_negative is None or self.coulomb_negative == self.coulomb
+
+    def coulomb_torque(self, qd, convert=None):
+        """The Coulomb friction torque at joint rate ``qd``: a number for a number, or a SymPy
+        expression in the symbol ``qd``, written with ``sign`` only so that every printer and code
+        generator takes it: ``c sign(qd)`` when symmetric, else
+        ``(c+ + c-)/2 sign(qd) + (c+ - c-)/2 sign(qd)^2`` (= c+ for qd > 0, -c- for qd < 0, 0 at
+        rest). ``convert``: applied to each level first (the symbolic engine's exact numbers)."""
+        positive, negative = self.coulomb_levels
+        if not (is_symbolic(qd) or is_symbolic(positive) or is_symbolic(negative)):
+            return positive if qd > 0 else (-negative if qd < 0 else 0.0)
+        import sympy as sp
+
+        if convert is not None:
+            positive, negative = convert(positive), convert(negative)
+        s = sp.sign(qd)
+        if self.coulomb_is_symmetric:
+            return positive * s
+        return (positive + negative) / 2 * s + (positive - negative) / 2 * s**2
 
     @property
     def is_moving(self) -> bool:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -121,7 +121,7 @@ def puma560(
     inertias: Optional[Sequence] = None,
     gravity=(0.0, 0.0, -9.81),
     motors: bool = True,
-    friction: bool = False,
+    friction: Union[bool, str] = False,
 ) -> Robot:
     """The Unimation PUMA 560 in standard DH (Corke's ``p560``), gravity along -z0.
 
@@ -148,8 +148,11 @@ def puma560(
     so its Ixx and Izz never enter the dynamics.
 
     ``motors=True`` adds the reflected rotor inertia G^2 Jm to each joint (gear_ratio = G,
-    rotor_inertia = Jm). ``friction=True`` adds the motor friction referred to the joint:
-    viscous = B G^2 and Coulomb = |G| (Tc+ - Tc-) / 2 (the mean of the two published directions).
+    rotor_inertia = Jm). ``friction=True`` adds the motor friction referred to the joint as Corke's
+    model does (RTB ``Link.friction``: ``B G^2 qd + |G| Tc+`` for qd > 0 and ``|G| Tc-`` for qd < 0):
+    viscous = B G^2 and direction-dependent Coulomb levels coulomb = |G| Tc+ (qd > 0),
+    coulomb_negative = |G| |Tc-| (qd < 0), the sign of Tc chosen by the joint rate, as RTB does.
+    ``friction="symmetric"`` keeps one Coulomb level, the mean |G| (Tc+ - Tc-) / 2 of the two.
     ``masses``/``coms``/``inertias`` replace the six-entry tables above.
     """
     kin = [
@@ -161,10 +164,17 @@ def puma560(
         (0.0, 0.0, 0.0, 0.0, "revolute"),
     ]
     limits = [(lo * _DEG, hi * _DEG, math.inf, math.inf) for lo, hi in PUMA560_LIMITS_DEG]
+    if friction not in (True, False, "symmetric"):
+        raise ValueError(f"friction must be True (Corke's two Coulomb levels), 'symmetric' (their mean) or False, got {friction!r}")
     drive = []
     for jm, gear, b, (tc_pos, tc_neg) in PUMA560_MOTORS:
         viscous = b * gear**2 if friction else 0.0
-        coulomb = abs(gear) * (tc_pos - tc_neg) / 2 if friction else 0.0
+        if friction == "symmetric":
+            coulomb: Any = abs(gear) * (tc_pos - tc_neg) / 2
+        elif friction:
+            coulomb = (abs(gear) * tc_pos, abs(gear) * -tc_neg)  # (qd > 0, qd < 0) levels, both >= 0
+        else:
+            coulomb = 0.0
         drive.append((gear, jm if motors else 0.0, viscous, coulomb))
     rows = _rows(
         kin, limits,

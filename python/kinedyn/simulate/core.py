@@ -259,20 +259,27 @@ def _choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
     )
 
 
+def _coulomb_torque(coulomb, v):
+    """Coulomb friction torque at rates ``v`` for levels ``coulomb = (positive, negative)``, each
+    (n,) and >= 0: ``positive`` for v > 0, ``-negative`` for v < 0, 0 at rest."""
+    positive, negative = coulomb
+    return np.where(v > 0, positive, 0.0) - np.where(v < 0, negative, 0.0)
+
+
 def _implicit_step(q, qd, a, h, A_q, A_v, Minv, coulomb):
     """The linearly implicit Euler step of integrate.rs (``Method::Implicit``) in NumPy: returns the
-    new (q, qd). ``a``: the acceleration at (q, qd) (Coulomb friction included), ``coulomb``: (n,)
-    or None."""
+    new (q, qd). ``a``: the acceleration at (q, qd) (Coulomb friction included), ``coulomb``: the
+    levels (positive, negative), each (n,), or None."""
     n = q.size
     A = np.eye(n) - h * A_v - h * h * A_q
     lu = _lu(A)
-    a0 = a if coulomb is None else a + Minv @ (coulomb * np.sign(qd))
+    a0 = a if coulomb is None else a + Minv @ _coulomb_torque(coulomb, qd)
     v0 = qd + _solve(lu, h * (a0 + h * (A_q @ qd)))
     if coulomb is None:
         v = v0
     else:
-        v = v0 + _solve(lu, -h * (Minv @ (coulomb * np.sign(v0))))
-        v = np.where((coulomb != 0) & (v * v0 < 0), 0.0, v)
+        v = v0 + _solve(lu, -h * (Minv @ _coulomb_torque(coulomb, v0)))
+        v = np.where(((coulomb[0] != 0) | (coulomb[1] != 0)) & (v * v0 < 0), 0.0, v)
     return q + h * v, v
 
 
@@ -691,8 +698,8 @@ def _run_python(target, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_f
     accel = _accel_fn(target, robot, fext_fn)
     implicit = None
     if method == "implicit":
-        coulomb = np.array([float(j.coulomb) for j in target.joints]) if robot else None
-        implicit = (_derivatives_fn(target, robot, fext_fn), jac, coulomb if coulomb is not None and np.any(coulomb) else None)
+        coulomb = np.array([[float(c) for c in j.coulomb_levels] for j in target.joints]).T if robot else None
+        implicit = (_derivatives_fn(target, robot, fext_fn), jac, (coulomb[0], coulomb[1]) if coulomb is not None and np.any(coulomb) else None)
     results = []
     for i in range(batch or 1):
         qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)

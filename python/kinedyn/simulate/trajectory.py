@@ -136,7 +136,7 @@ class Trajectory:
         return out.reshape(self.q.shape[:-1] + (2,))
 
     def friction_torque(self) -> np.ndarray:
-        """Joint friction viscous qd + coulomb sign(qd) of a robot per sample (zeros otherwise)."""
+        """Joint friction of a robot per sample, :meth:`kinedyn.Robot.friction_torque` (zeros otherwise)."""
         s = self.system
         if not hasattr(s, "friction_torque"):
             return np.zeros_like(self.qd)

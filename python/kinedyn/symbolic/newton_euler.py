@@ -352,7 +352,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         t = sum((axis[j][k] * gen[k] for k in range(3)), zero)
         t = t + exact(b.joint.armature) * qdd[j]
         if friction:
-            t = t + exact(b.joint.viscous) * qd[j] + exact(b.joint.coulomb) * sp.sign(qd[j])
+            t = t + exact(b.joint.viscous) * qd[j] + b.joint.coulomb_torque(qd[j], exact)
         tau[j] = t
     prog.outputs["tau"] = tau
     return prog.prune()

@@ -36,7 +36,7 @@ class _Inertias:
 
 
 def _friction(robot, qd):
-    return sp.Matrix([_exact(b.joint.viscous) * v + _exact(b.joint.coulomb) * sp.sign(v) for b, v in zip(robot.tree.bodies, qd)])
+    return sp.Matrix([_exact(b.joint.viscous) * v + b.joint.coulomb_torque(v, _exact) for b, v in zip(robot.tree.bodies, qd)])
 
 
 def _outputs(model, d, simplify):

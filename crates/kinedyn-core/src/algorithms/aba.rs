@@ -3,8 +3,9 @@
 //! Source: RBDA Table 7.1 (Featherstone 2008, §7.3), gravity as the base acceleration `a_0 = -g`.
 //! Drives as in DESIGN.md: the reflected rotor inertia adds to the joint's articulated inertia,
 //! `D_i = s_i^T IA_i s_i + armature_i`, and friction is moved to the input side,
-//! `tau_i - viscous_i qd_i - coulomb_i sign(qd_i)`. A joint whose `D_i` vanishes (a massless
-//! subtree, a point mass on the axis) makes `M` singular: reported as an error naming the joint.
+//! `tau_i - viscous_i qd_i - coulomb_i sign(qd_i)` (direction-dependent Coulomb levels:
+//! `Model::coulomb_torque`). A joint whose `D_i` vanishes (a massless subtree, a point mass on the
+//! axis) makes `M` singular: reported as an error naming the joint.
 //!
 //! | symbol        | here                         | meaning                                       |
 //! |---------------|------------------------------|-----------------------------------------------|

@@ -326,13 +326,13 @@ fn implicit_step(
         }
     }
     lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| fail(Some(k), FailureKind::Singular(format!("the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"))))?;
-    // without Coulomb friction: a0 = qdd + M^-1 (coulomb sign(qd)) (the ABA's qdd includes it)
-    let coulomb = model.coulomb.iter().any(|c| *c != 0.0);
+    // without Coulomb friction: a0 = qdd + M^-1 coulomb_torque(qd) (the ABA's qdd includes it)
+    let coulomb = (0..n).any(|k| model.has_coulomb(k));
     // dv0 = (I - h A_v - h^2 A_q)^-1 h (a0 + h A_q qd)
     for r in 0..n {
         let mut a0 = qdd[r];
         if coulomb {
-            a0 += (0..n).map(|k| s.minv[r * n + k] * model.coulomb[k] * super::rnea::sign(qd[k])).sum::<f64>();
+            a0 += (0..n).map(|k| s.minv[r * n + k] * model.coulomb_torque(k, qd[k])).sum::<f64>();
         }
         let spring: f64 = (0..n).map(|k| s.a_q[r * n + k] * qd[k]).sum();
         s.rhs[r] = h * (a0 + h * spring);
@@ -342,15 +342,15 @@ fn implicit_step(
         s.v0[j] = qd[j] + s.rhs[j];
     }
     if coulomb {
-        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb sign(v0))
+        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb_torque(v0))
         for r in 0..n {
-            s.rhs[r] = -h * (0..n).map(|k| s.minv[r * n + k] * model.coulomb[k] * super::rnea::sign(s.v0[k])).sum::<f64>();
+            s.rhs[r] = -h * (0..n).map(|k| s.minv[r * n + k] * model.coulomb_torque(k, s.v0[k])).sum::<f64>();
         }
         lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
         for j in 0..n {
             let v1 = s.v0[j] + s.rhs[j];
             // friction stops a joint, it does not reverse it
-            qd[j] = if model.coulomb[j] != 0.0 && v1 * s.v0[j] < 0.0 { 0.0 } else { v1 };
+            qd[j] = if model.has_coulomb(j) && v1 * s.v0[j] < 0.0 { 0.0 } else { v1 };
         }
     } else {
         qd.copy_from_slice(&s.v0);

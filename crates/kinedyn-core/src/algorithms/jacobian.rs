@@ -7,6 +7,8 @@
 //!   origin and angular velocity, both in base axes: `[v_o + w x p; w]`;
 //! - `Local`: the same twist in the frame's own axes;
 //! - `Spatial` (Pinocchio's WORLD): the twist at the base origin in base axes.
+//!
+//! `frame_jacobian_hessian` gives the kinematic Hessian `dJ/dq` of each of these Jacobians.
 
 use super::kinematics::{forward_acceleration, forward_kinematics, forward_velocity, frame_pose};
 use crate::data::Data;
@@ -95,4 +97,65 @@ pub fn jacobian_dot_qd(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], fr
 pub fn frame_pose_at(model: &Model, data: &mut Data, q: &[f64], frame: usize) -> Transform {
     forward_kinematics(model, data, q);
     frame_pose(model, data, frame)
+}
+
+/// The kinematic Hessian `H[i] = dJ/dq_i` of the `reference` Jacobian of `frame` (or of a point
+/// fixed in it) at `q`, written row-major `n x 6 x n` to `out`: `out[(i * 6 + r) * n + j]` is
+/// `d J[r][j] / d q_i` (Robotics Toolbox's `(n, 6, n)` layout, `H[i, :, j]`).
+///
+/// Derivation (Haviland & Corke 2022, "Manipulator Differential Kinematics Part I", arXiv:2207.01796, its Hessian; there for
+/// the `World` Jacobian of a serial chain of revolute joints; here for any tree and both joint
+/// kinds). Let `S_j = [v_j; w_j]` be joint j's spatial column (`world_from_body[j] . s_j`, base
+/// axes, at the base origin), `p` the frame point in base axes, and write `i <= j` when joint i
+/// supports body j (i is j or an ancestor). Moving joint i turns everything it carries by the
+/// twist `S_i`, so (RBDA eq. 2.31 for the spatial cross product `x`):
+/// - `dS_j/dq_i = S_i x S_j` if `i <= j`, else 0;
+/// - `dp/dq_i = v_i + w_i x p` (the linear part of the `World` column `J_i = [Jv_i; w_i]`), for
+///   every joint i that supports the frame's body.
+///
+/// `World`, `J_j = [v_j + w_j x p; w_j]`: differentiating and simplifying with the Jacobi identity
+/// `(w_i x w_j) x p = w_i x (w_j x p) - w_j x (w_i x p)` gives the cross-product formulas
+/// - `i <= j`: `dJ_j/dq_i = [w_i x Jv_j; w_i x w_j]`,
+/// - `j < i`:  `dJ_j/dq_i = [w_j x Jv_i; 0]`,
+///
+/// (a prismatic joint has `w = 0`, so it neither turns a column nor is turned.) The linear rows
+/// are symmetric in (i, j), as second derivatives of the position must be.
+/// `Spatial`: `dS_j/dq_i = S_i x S_j` for `i <= j`, else 0.
+/// `Local`, `J^L = diag(R^T, R^T) J` with `dR/dq_i = [w_i]x R`: `dJ^L_j/dq_i =
+/// diag(R^T, R^T) (dJ_j/dq_i - [w_i x Jv_j; w_i x w_j])`, which is 0 for `i <= j` and
+/// `[R^T (w_j x Jv_i - w_i x Jv_j); R^T (w_j x w_i)]` for `j < i`.
+/// Columns of joints that do not support the frame's body are zero, as are their derivatives.
+pub fn frame_jacobian_hessian(model: &Model, data: &mut Data, q: &[f64], frame: usize, reference: Reference, point: Option<&Vec3>, out: &mut [f64]) {
+    let n = model.n;
+    out[..6 * n * n].fill(0.0);
+    forward_kinematics(model, data, q);
+    let Some(body) = model.frames[frame].body else { return };
+    let world_from_frame = data.world_from_body[body] * body_from_point(model, frame, point);
+    let (r, p) = (world_from_frame.rot, world_from_frame.trans);
+    let support = &model.support[body];
+    // spatial columns S_j and World columns J_j of the supporting joints, in support (chain) order
+    let spatial: Vec<Motion> = support.iter().map(|&j| data.world_from_body[j].act_motion(&data.s[j])).collect();
+    let world: Vec<Motion> = spatial.iter().map(|s| Motion::new(s.lin + s.ang.cross(&p), s.ang)).collect();
+    let rt = r.transpose();
+    let mut put = |i: usize, j: usize, h: Motion| {
+        for (k, value) in h.to_array().iter().enumerate() {
+            out[(i * 6 + k) * n + j] = *value;
+        }
+    };
+    for (a, &i) in support.iter().enumerate() {
+        for (b, &j) in support.iter().enumerate() {
+            // joint i supports joint j exactly when it comes first in the chain of supports
+            let i_supports_j = a <= b;
+            let (wi, wj) = (world[a].ang, world[b].ang);
+            let h = match reference {
+                Reference::World if i_supports_j => Motion::new(wi.cross(&world[b].lin), wi.cross(&wj)),
+                Reference::World => Motion::new(wj.cross(&world[a].lin), Vec3::zeros()),
+                Reference::Spatial if i_supports_j => spatial[a].cross_motion(&spatial[b]),
+                Reference::Spatial => continue,
+                Reference::Local if i_supports_j => continue,
+                Reference::Local => Motion::new(rt * (wj.cross(&world[a].lin) - wi.cross(&world[b].lin)), rt * wj.cross(&wi)),
+            };
+            put(i, j, h);
+        }
+    }
 }

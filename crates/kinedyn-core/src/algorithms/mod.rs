@@ -21,7 +21,7 @@ pub use crba::crba;
 pub use derivatives::{aba_derivatives, rnea_derivatives};
 pub use energy::{kinetic_energy, potential_energy};
 pub use gravity::gravity_torque;
-pub use jacobian::{frame_jacobian, frame_pose_at, frame_velocity, jacobian_dot_qd, Reference};
+pub use jacobian::{frame_jacobian, frame_jacobian_hessian, frame_pose_at, frame_velocity, jacobian_dot_qd, Reference};
 pub use kinematics::{forward_acceleration, forward_kinematics, forward_velocity, frame_pose, parent_from_body};
 pub use minv::mass_matrix_inverse;
 pub use momentum::{center_of_mass, spatial_momentum};

@@ -19,22 +19,11 @@ use crate::data::Data;
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
 
-/// `sign(x)` with `sign(0) = 0` (Coulomb friction is zero at rest).
-#[inline]
-pub(crate) fn sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
-}
-
-/// Joint friction `viscous qd + coulomb sign(qd)` of joint i.
+/// Joint friction `viscous qd + coulomb sign(qd)` of joint i (with direction-dependent Coulomb
+/// levels: [`Model::coulomb_torque`]).
 #[inline]
 pub(crate) fn friction(model: &Model, i: usize, qd: f64) -> f64 {
-    model.viscous[i] * qd + model.coulomb[i] * sign(qd)
+    model.viscous[i] * qd + model.coulomb_torque(i, qd)
 }
 
 /// What `rnea_with` includes besides the rigid-body terms.
