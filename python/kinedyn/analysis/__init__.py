@@ -3,10 +3,13 @@ with residuals (:func:`check_properties`), and identification of the base inerti
 excitation data (:func:`identify`). See docs/analysis.md."""
 
 from .identification import Identification, Measurements, excitation, identify, simulate_measurements, with_inertial_parameters
-from .properties import Check, PropertiesReport, check_properties
+from .properties import Check, InertiaBounds, PropertiesReport, check_properties, global_inertia_bounds, prove_properties
 
 __all__ = [
     "check_properties",
+    "prove_properties",
+    "global_inertia_bounds",
+    "InertiaBounds",
     "PropertiesReport",
     "Check",
     "excitation",
