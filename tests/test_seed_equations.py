@@ -749,3 +749,301 @@ def test_spong_9_121_to_9_133_regressor_misprints():
     eom, rename = kinedyn_planar_elbow()
     Yk, Thk = eom.regressor()
     assert all_zero((Yk * Thk).xreplace(rename) - tau)
+
+
+def test_spong_9_119_9_120_eigenvalue_bounds_at_a_configuration():
+    """(9.119) lambda_1(q) I <= D(q) <= lambda_n(q) I: D - lambda_1 I and lambda_n I - D are positive
+    semidefinite (eigenvalues >= 0) for kinedyn's planar elbow at random q. The uniform bounds (9.120)
+    by a global search: tests/test_properties_proved.py (closed form for the 2R)."""
+    eom, rename = kinedyn_planar_elbow()
+    vals = {m1: 2.0, m2: 1.5, l1: 1.3, lc1: 0.6, lc2: 0.35, I1: 0.21, I2: 0.13}
+    f = sp.lambdify([Q], eom.M.xreplace(rename).xreplace(vals), "numpy")
+    for qq in RNG.uniform(-math.pi, math.pi, size=(20, 2)):
+        D = np.array(f(qq), float)
+        lam = np.linalg.eigvalsh(D)
+        assert lam[0] > 0
+        assert np.linalg.eigvalsh(D - lam[0] * np.eye(2)).min() > -1e-12 and np.linalg.eigvalsh(lam[-1] * np.eye(2) - D).min() > -1e-12
+
+
+# ============================================================================================== LaValle §13.4
+tt = sp.Symbol("t", real=True)
+x_, xd_, xdd_ = sp.symbols("x xd xdd", real=True)
+
+
+def test_lavalle_13_114_to_13_118_first_variation_and_integration_by_parts():
+    """(13.116): Phi(x + g) - Phi(x) = int (dL/dx g + dL/dxd g') dt + O(g^2), checked with L = x^3 +
+    xd^2 (13.119), x = t^2, h = sin(pi t), g = eps h on [0, 1] (exact integrals); its last line
+    (integration by parts) equals the second; (13.117) prints the last integral with h for g: with
+    g = eps h it is off by the factor eps (a typo); (13.118) then follows: the boundary term vanishes."""
+    eps = sp.Symbol("epsilon", positive=True)
+    X = tt**2
+    h = sin(sp.pi * tt)
+    G = eps * h
+    Lf = lambda x, xd: x**3 + xd**2
+    Phi = lambda x: sp.integrate(Lf(x, sp.diff(x, tt)), (tt, 0, 1))
+    dLdx = 3 * X**2
+    dLdxd = 2 * sp.diff(X, tt)
+    first = sp.integrate(dLdx * G + dLdxd * sp.diff(G, tt), (tt, 0, 1))
+    change = sp.expand(Phi(X + G) - Phi(X))
+    assert sp.simplify(change.coeff(eps, 1) - first.coeff(eps, 1)) == 0
+    by_parts = sp.integrate(dLdx * G - sp.diff(dLdxd, tt) * G, (tt, 0, 1)) + (dLdxd * G).subs(tt, 1) - (dLdxd * G).subs(tt, 0)
+    assert sp.simplify(by_parts - first) == 0
+    boundary = (dLdxd * G).subs(tt, 1) - (dLdxd * G).subs(tt, 0)
+    right = sp.integrate(dLdxd * sp.diff(G, tt), (tt, 0, 1)) + sp.integrate(sp.diff(dLdxd, tt) * G, (tt, 0, 1))
+    printed = sp.integrate(dLdxd * sp.diff(G, tt), (tt, 0, 1)) + sp.integrate(sp.diff(dLdxd, tt) * h, (tt, 0, 1))
+    assert sp.simplify(boundary - right) == 0
+    assert sp.simplify((printed - boundary).subs(eps, sp.Rational(1, 2))) != 0
+
+
+def test_lavalle_examples_13_9_and_13_10_and_kinedyn():
+    """Ex 13.9 (13.115): E-L of sqrt(1 + xd^2) is -xdd / (1 + xd^2)^(3/2) = 0 (straight lines; nothing
+    printed to compare). Ex 13.10 (13.119)-(13.123): dL/dx = 3x^2, dL/dxd = 2xd, d/dt = 2xdd,
+    2xdd - 3x^2 = 0, xdd = 3x^2/2. kinedyn's LagrangianSystem(L=...) gives the same E-L expressions."""
+    (el9,) = euler_lagrange(sp.sqrt(1 + xd_**2), [x_], [xd_], [xdd_])
+    assert sp.simplify(el9 - xdd_ / (1 + xd_**2) ** sp.Rational(3, 2)) == 0
+    L10 = x_**3 + xd_**2
+    assert sp.diff(L10, x_) == 3 * x_**2 and sp.diff(L10, xd_) == 2 * xd_
+    (el10,) = euler_lagrange(L10, [x_], [xd_], [xdd_])
+    assert sp.expand(el10 - (2 * xdd_ - 3 * x_**2)) == 0
+    assert sp.solve(el10, xdd_) == [3 * x_**2 / 2]
+    for L, el in ((sp.sqrt(1 + xd_**2), el9), (L10, el10)):
+        system = LagrangianSystem([x_], L=L, qd=[xd_])
+        (k,) = system.euler_lagrange()
+        assert sp.simplify(k.xreplace({system.qdd[0]: xdd_}) - el) == 0
+
+
+V = sp.Function("V")
+
+
+def test_lavalle_13_128_newton_in_euler_lagrange_form_sign_misprint():
+    """(13.128) prints d/dt (m qd) - dV/dq = 0. With V the potential energy (force -dV/dq, as
+    13.130 and Ex 13.11 use) Newton's law m qdd = -dV/dq is d/dt (m qd) + dV/dq = 0: the E-L equation of
+    L = m qd^2/2 - V(q) (13.129) derived here."""
+    (el,) = euler_lagrange(m * xd_**2 / 2 - V(x_), [x_], [xd_], [xdd_])
+    misprint(m * xdd_ - sp.diff(V(x_), x_), el, m * xdd_ + sp.diff(V(x_), x_))
+    # (13.130): d/dt dK/dqd - dK/dq + dV/dq for K = qd^T M qd / 2 (the generic 2-DOF system above)
+    K = (sp.Matrix(QD).T * DG * sp.Matrix(QD))[0] / 2
+    for k in range(2):
+        assert sp.expand(ddt(sp.diff(K, QD[k])) - sp.diff(K, Q[k]) + sp.diff(Pf, Q[k]) - ELG[k]) == 0
+
+
+def test_lavalle_13_131_to_13_135_falling_particle_and_13_136_13_137():
+    """Ex 13.11: (13.131) K, (13.132) L (printed '= 0' at its end: a typo), (13.133) d/dt dL/dqd_i =
+    m qdd_i, (13.134) dV/dq = (0, 0, mg), (13.135) m qdd1 = m qdd2 = 0, m qdd3 + mg = 0; kinedyn's
+    LagrangianSystem agrees. (13.137): the double sum equals the quadratic form."""
+    qs, vs, acc = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True), sp.symbols("qdd1:4", real=True)
+    K = m * sum(v**2 for v in vs) / 2
+    Vp = m * g * qs[2]
+    el = euler_lagrange(K - Vp, qs, vs, acc)
+    assert [ddt(sp.diff(K - Vp, v), qs, vs, acc) for v in vs] == [m * a for a in acc]
+    assert [sp.diff(Vp, c) for c in qs] == [0, 0, m * g]
+    assert [sp.expand(e) for e in el] == [m * acc[0], m * acc[1], m * acc[2] + m * g]
+    eom = LagrangianSystem(list(qs), K=K, P=Vp, qd=list(vs)).equations_of_motion()
+    assert all_zero(eom.tau.xreplace(dict(zip(eom.qdd, acc))) - sp.Matrix(el))
+    Mg = sp.Matrix(3, 3, lambda i, j: sp.Function(f"m{i}{j}")(*qs) if i <= j else sp.Function(f"m{j}{i}")(*qs))
+    assert sp.expand((sp.Matrix(vs).T * Mg * sp.Matrix(vs))[0] / 2 - sum(Mg[i, j] * vs[i] * vs[j] for i in range(3) for j in range(3)) / 2) == 0
+
+
+def test_lavalle_example_13_12_planar_body_kinetic_energy_misprint():
+    """Ex 13.12: (13.138) K = m qd . qd / 2 + I qd3^2 / 2 with qd = (qd1, qd2, qd3) counts the
+    rotation twice (the third E-L equation becomes (m + I) qdd3 = u3, not the printed I qdd3 = u3 of
+    13.139): the dot product is over the translation (qd1, qd2) only; with it (13.139) holds."""
+    qs, vs, acc = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True), sp.symbols("qdd1:4", real=True)
+    Ib = sp.Symbol("I", positive=True)
+    printed = m * sum(v**2 for v in vs) / 2 + Ib * vs[2] ** 2 / 2
+    corrected = m * (vs[0] ** 2 + vs[1] ** 2) / 2 + Ib * vs[2] ** 2 / 2
+    # a planar body of particles moving with centre velocity (vx, vy) and rate w: its kinetic energy is
+    # the corrected K with m = total mass, I = the moment about the centre (the printed K is larger)
+    vx, vy, w = 0.3, -0.8, 1.7
+    pts = RNG.normal(size=(30, 2))
+    mp = RNG.uniform(0.1, 1.0, size=30)
+    c = mp @ pts / mp.sum()
+    K_particles = 0.5 * sum(mi * ((vx - w * (p_[1] - c[1])) ** 2 + (vy + w * (p_[0] - c[0])) ** 2) for mi, p_ in zip(mp, pts))
+    Izz = sum(mi * ((p_ - c) @ (p_ - c)) for mi, p_ in zip(mp, pts))
+    num = {m: mp.sum(), Ib: Izz, vs[0]: vx, vs[1]: vy, vs[2]: w}
+    assert float(corrected.xreplace(num)) == pytest.approx(K_particles, rel=1e-12)
+    assert abs(float(printed.xreplace(num)) - K_particles) > 0.1
+    assert sp.expand(printed - corrected) == m * vs[2] ** 2 / 2
+    el_pr = euler_lagrange(printed, qs, vs, acc)
+    el = euler_lagrange(corrected, qs, vs, acc)
+    assert [sp.expand(e) for e in el] == [m * acc[0], m * acc[1], Ib * acc[2]]
+    assert sp.expand(el_pr[2] - (m + Ib) * acc[2]) == 0
+
+
+def test_lavalle_13_140_to_13_147_general_form_and_christoffel_index_order():
+    """(13.140)-(13.141) E-L = sum m_ij qdd_j + sum h_ijk qd_j qd_k + g_i with h_ijk = dm_ij/dq_k -
+    dm_jk/dq_i / 2; (13.142)-(13.144) C qd = sum h qd qd; (13.145) the rewriting; (13.146)-(13.147)
+    c_ij = sum_k c_ijk qd_k, c_ijk = (dm_ij/dq_k + dm_ik/dq_j - dm_jk/dq_i)/2 (row index first:
+    LaValle's c_ijk is Spong's c_kji), for the generic 2-DOF system; kinedyn's eom.christoffel (Spong's
+    order) maps onto it for the planar elbow."""
+    M = DG
+    h = lambda i, j, k: sp.diff(M[i, j], Q[k]) - sp.diff(M[j, k], Q[i]) / 2
+    cL = lambda i, j, k: (sp.diff(M[i, j], Q[k]) + sp.diff(M[i, k], Q[j]) - sp.diff(M[j, k], Q[i])) / 2
+    C = sp.Matrix(2, 2, lambda i, j: sum(cL(i, j, k) * QD[k] for k in range(2)))
+    for i in range(2):
+        form = sum(M[i, j] * QDD[j] for j in range(2)) + sum(h(i, j, k) * QD[j] * QD[k] for j in range(2) for k in range(2)) + sp.diff(Pf, Q[i])
+        assert sp.expand(form - ELG[i]) == 0
+        hsum = sum(h(i, j, k) * QD[j] * QD[k] for j in range(2) for k in range(2))
+        rewritten = sum(sp.diff(M[i, j], Q[k]) * QD[j] * QD[k] for j in range(2) for k in range(2)) / 2 + sum(
+            (sp.diff(M[i, j], Q[k]) - sp.diff(M[j, k], Q[i])) * QD[j] * QD[k] for j in range(2) for k in range(2)) / 2
+        assert sp.expand(hsum - rewritten) == 0  # (13.145)
+        assert sp.expand((C * sp.Matrix(QD))[i] - hsum) == 0  # (13.143), (13.146)
+    cS = christoffel_spong(M, Q)
+    assert all(sp.expand(cL(i, j, k) - cS[k][j][i]) == 0 for i in range(2) for j in range(2) for k in range(2))
+    eom, rename = kinedyn_planar_elbow()
+    Mk = eom.M.xreplace(rename)
+    cLk = lambda i, j, k: (sp.diff(Mk[i, j], Q[k]) + sp.diff(Mk[i, k], Q[j]) - sp.diff(Mk[j, k], Q[i])) / 2
+    assert all(is_zero(eom.christoffel[k][j][i].xreplace(rename) - cLk(i, j, k)) for i in range(2) for j in range(2) for k in range(2))
+
+
+def test_lavalle_13_148_phase_form_and_the_numeric_core():
+    """(13.148) qdd = M^-1 (u - C qd - g): the engine's forward dynamics (ABA) equals it with its own
+    M, C, g, and solves M qdd + C qd + g = u."""
+    pytest.importorskip("kinedyn._core")
+    robot = kd.robots.puma560()
+    q, qd, u = RNG.uniform(-1, 1, 6), RNG.normal(size=6), RNG.normal(size=6)
+    M, C, gv = robot.mass_matrix(q), robot.coriolis_matrix(q, qd), robot.gravity_torque(q)
+    qdd = robot.forward_dynamics(q, qd, u)
+    np.testing.assert_allclose(qdd, np.linalg.solve(M, u - C @ qd - gv - robot.friction_torque(qd)), rtol=1e-9, atol=1e-9)
+
+
+d1s, ell1, ell2 = sp.symbols("d1 ell1 ell2", positive=True)
+
+
+def test_lavalle_example_13_13_two_link_manipulator():
+    """Ex 13.13, theta2 relative (m11's cos theta2 term says so), d1 = link 1's length, ell_i = joint i
+    to COM i. Derived here from the centres of mass: (13.149) K1 = m1 ell1 thd1^2/2 + ... MISPRINT
+    (ell1^2); (13.150) V1 OK; (13.151) K2 = p.p/2 + ... MISPRINT (m2 pdot.pdot/2); (13.152) p with
+    ell2 cos theta2: MISPRINT (cos(theta1 + theta2)); (13.153) V2 likewise MISPRINT; (13.155)-(13.156)
+    M OK; (13.157) c112 = c121 = c122 = -c211 = -m2 ell1 ell2 p2: MISPRINT (-m2 d1 ell2 sin theta2);
+    (13.158) g1 = (m1 ell1 + m2 d1) g p1 + m1 ell2 p2, g2 = m2 ell2 g p2: MISPRINT; (13.159) C with
+    +thd1 at (2,1): MISPRINT (-thd1); (13.160) r likewise; (13.161) row 1 OK with the corrected r, row 2
+    m22 thdd1 + m21 thdd2: MISPRINT (m21 thdd1 + m22 thdd2). kinedyn's planar_2r (lc1 = ell1, lc2 =
+    ell2, l1 = d1) gives the derived M, C, g."""
+    rc1 = sp.Matrix([ell1 * cos(th1), ell1 * sin(th1)])
+    pc2 = sp.Matrix([d1s * cos(th1) + ell2 * cos(th1 + th2), d1s * sin(th1) + ell2 * sin(th1 + th2)])
+    v1, v2 = rc1.jacobian(TH) * sp.Matrix(THD), pc2.jacobian(TH) * sp.Matrix(THD)
+    K1 = m1 * v1.dot(v1) / 2 + I1 * thd1**2 / 2
+    misprint(m1 * ell1 * thd1**2 / 2 + I1 * thd1**2 / 2, K1, m1 * ell1**2 * thd1**2 / 2 + I1 * thd1**2 / 2)
+    assert is_zero(m1 * g * rc1[1] - m1 * g * ell1 * sin(th1))
+    K2 = m2 * v2.dot(v2) / 2 + I2 * (thd1 + thd2) ** 2 / 2
+    misprint(v2.dot(v2) / 2 + I2 * (thd1 + thd2) ** 2 / 2, K2, m2 * v2.dot(v2) / 2 + I2 * (thd1 + thd2) ** 2 / 2)
+    p_pr = sp.Matrix([d1s * cos(th1) + ell2 * cos(th2), d1s * sin(th1) + ell2 * sin(th2)])
+    misprint(list(p_pr), list(pc2), list(pc2))
+    V2 = m2 * g * pc2[1]
+    misprint(m2 * g * (d1s * sin(th1) + ell2 * sin(th2)), V2, m2 * g * (d1s * sin(th1) + ell2 * sin(th1 + th2)))
+    L = K1 + K2 - m1 * g * rc1[1] - V2
+    M = sp.hessian(K1 + K2, THD)
+    M_pr = sp.Matrix([[I1 + m1 * ell1**2 + I2 + m2 * (d1s**2 + ell2**2 + 2 * d1s * ell2 * cos(th2)), I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2))],
+                      [I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2)), I2 + m2 * ell2**2]])
+    assert all_zero(M - M_pr)
+    cL = lambda i, j, k: (sp.diff(M[i, j], TH[k]) + sp.diff(M[i, k], TH[j]) - sp.diff(M[j, k], TH[i])) / 2
+    r = m2 * d1s * ell2 * sin(th2)
+    p2_printed = p_pr[1]
+    for (i, j, k), sign in {(0, 0, 1): -1, (0, 1, 0): -1, (0, 1, 1): -1, (1, 0, 0): 1}.items():
+        misprint(sign * m2 * ell1 * ell2 * p2_printed, cL(i, j, k), sign * r)
+    for i, j, k in ((0, 0, 0), (1, 0, 1), (1, 1, 0), (1, 1, 1)):
+        assert is_zero(cL(i, j, k))
+    gv = sp.Matrix([sp.diff(m1 * g * rc1[1] + V2, c) for c in TH])
+    g_pr = [(m1 * ell1 + m2 * d1s) * g * p_pr[0] + m1 * ell2 * p_pr[1], m2 * ell2 * g * p_pr[1]]
+    g_ok = [(m1 * ell1 + m2 * d1s) * g * cos(th1) + m2 * ell2 * g * cos(th1 + th2), m2 * ell2 * g * cos(th1 + th2)]
+    misprint(g_pr, list(gv), g_ok)
+    C = sp.Matrix(2, 2, lambda i, j: sum(cL(i, j, k) * THD[k] for k in range(2)))
+    misprint(list(-m2 * ell1 * ell2 * p2_printed * sp.Matrix([[thd2, thd1 + thd2], [thd1, 0]])), list(C), list(-r * sp.Matrix([[thd2, thd1 + thd2], [-thd1, 0]])))
+    tau = euler_lagrange(L, TH, THD, THDD)
+    assert is_zero(tau[0] - (M[0, 0] * thdd1 + M[0, 1] * thdd2 - 2 * r * thd1 * thd2 - r * thd2**2 + gv[0]))
+    misprint(M[1, 1] * thdd1 + M[1, 0] * thdd2 + r * thd1**2 + gv[1], tau[1], M[1, 0] * thdd1 + M[1, 1] * thdd2 + r * thd1**2 + gv[1])
+    eom, rename = kinedyn_planar_elbow()
+    to_lavalle = {q1: th1, q2: th2, qd1: thd1, qd2: thd2, lc1: ell1, lc2: ell2, l1: d1s}
+    assert all_zero(eom.M.xreplace(rename).xreplace(to_lavalle) - M)
+    assert all_zero(eom.C.xreplace(rename).xreplace(to_lavalle) - C)
+    assert all_zero(eom.g.xreplace(rename).xreplace(to_lavalle) - gv)
+
+
+def test_lavalle_13_162_to_13_171_multipliers_and_pfaffian_constraints():
+    """(13.162)-(13.164): extremes of h = x + y on x^2 + y^2 = 1 satisfy grad h + lambda grad g = 0
+    (solved here: (1, 1)/sqrt 2 with lambda = -1/sqrt 2); (13.165) a parametric constraint as an implicit
+    one; (13.166)-(13.169): L_c has no lambda-dot, so the multiplier equations reduce to dL_c/dlambda_i =
+    g_i = 0; (13.170)-(13.171): d/dt g(q) = sum dg/dq_j qd_j (the sphere's 13.176)."""
+    xx, yy, lam = sp.symbols("x y lambda", real=True)
+    sols = sp.solve([1 + lam * 2 * xx, 1 + lam * 2 * yy, xx**2 + yy**2 - 1], [xx, yy, lam], dict=True)
+    assert {(s[xx], s[yy], s[lam]) for s in sols} == {(sp.sqrt(2) / 2, sp.sqrt(2) / 2, -sp.sqrt(2) / 2), (-sp.sqrt(2) / 2, -sp.sqrt(2) / 2, sp.sqrt(2) / 2)}
+    qs, vs = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True)
+    gsph = sum(c**2 for c in qs) - 1
+    Lc = sum(v**2 for v in vs) + lam * gsph
+    lamd = sp.Symbol("lambdadot", real=True)
+    assert sp.diff(Lc, lamd) == 0 and sp.diff(Lc, lam) == gsph
+    gdot = ddt(gsph, qs, vs, [0, 0, 0])
+    assert sp.expand(gdot - (2 * qs[0] * vs[0] + 2 * qs[1] * vs[1] + 2 * qs[2] * vs[2])) == 0
+
+
+def test_lavalle_example_13_14_sphere_and_13_172_13_173():
+    """Ex 13.14, m = 2: (13.174) L, (13.175) g1, (13.176) its Pfaffian form; (13.172) gives
+    2 qdd_i + 2 lambda1 q_i = 0; the printed (13.177) qdd_i - 2 q_i lambda1 = 0 is not what (13.172)
+    gives (sign and factor: MISPRINT; it matches only with lambda1 renamed -lambda1/2, harmless for the
+    conclusion). (13.178): qdd parallel to q keeps q x qd constant, so c . q = 0 with c = q0 x qd0 (a
+    great circle): checked on an RK4 run with lambda eliminated (lambda = |qd|^2 on the unit sphere).
+    (13.173) differs from (13.172) by the multiplier's sign only. kinedyn's LagrangianSystem gives the
+    same multiplier."""
+    qs, vs, acc = list(sp.symbols("q1:4", real=True)), list(sp.symbols("qd1:4", real=True)), list(sp.symbols("qdd1:4", real=True))
+    lam = sp.Symbol("lambda1", real=True)
+    L = sum(v**2 for v in vs)  # m/2 |qd|^2 with m = 2
+    G = [2 * c for c in qs]
+    el = euler_lagrange(L, qs, vs, acc)
+    derived = [el[i] + lam * G[i] for i in range(3)]
+    assert [sp.expand(e) for e in derived] == [2 * acc[i] + 2 * lam * qs[i] for i in range(3)]
+    for i in range(3):
+        misprint(acc[i] - 2 * qs[i] * lam, derived[i] / 2, acc[i] + lam * qs[i])
+    # eliminate lambda with the constraint twice differentiated: q . qdd + |qd|^2 = 0
+    lam_solved = sp.solve(sum(qs[i] * (-lam * qs[i]) for i in range(3)) + sum(v**2 for v in vs), lam)[0]
+    assert sp.simplify(lam_solved.subs(qs[0] ** 2, 1 - qs[1] ** 2 - qs[2] ** 2) - sum(v**2 for v in vs)) == 0
+    system = LagrangianSystem(qs, K=L, qd=vs, holonomic=[sum(c**2 for c in qs) - 1], forces=[0, 0, 0])
+    (lam_k,) = system.multipliers()
+    assert sp.simplify((lam_k - sum(v**2 for v in vs) / sum(c**2 for c in qs)).subs(qs[0] ** 2, 1 - qs[1] ** 2 - qs[2] ** 2)) == 0
+
+    def f(s):
+        x, v = s[:3], s[3:]
+        return np.concatenate([v, -(v @ v) / (x @ x) * x])
+
+    s = np.concatenate([np.ones(3) / math.sqrt(3), [0.3, -0.1, -0.2]])
+    c = np.cross(s[:3], s[3:])
+    h_ = 1e-3
+    for _ in range(3000):
+        k1 = f(s); k2 = f(s + h_ / 2 * k1); k3 = f(s + h_ / 2 * k2); k4 = f(s + h_ * k3)
+        s = s + h_ / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    assert abs(c @ s[:3]) < 1e-12 and abs(np.linalg.norm(s[:3]) - 1) < 1e-9
+
+
+def test_lavalle_13_179_to_13_184_constrained_dynamics():
+    """(13.179) M qdd + C qd + g + G^T lambda = u with G k x n (printed n x k: MISPRINT, G^T lambda must be
+    n x 1 for lambda in R^k). (13.180) lambda = (G M^-1 G^T)^-1 G M^-1 (u - C qd): with (13.179) and
+    G qdd + Gdot qd = 0 the multiplier is (G M^-1 G^T)^-1 (G M^-1 (u - C qd - g) + Gdot qd): (13.180)
+    leaves out g and Gdot qd, (13.184) leaves out Gdot qd (MISPRINTs: "G time-invariant" is false for
+    any q-dependent constraint). For the sphere (13.180) gives lambda = 0 while the derivation (and
+    kinedyn's LagrangianSystem.multipliers) give |qd|^2. (13.181)-(13.183) add B and N: OK."""
+    qs, vs = list(sp.symbols("q1:4", real=True)), list(sp.symbols("qd1:4", real=True))
+    M = 2 * sp.eye(3)
+    G = sp.Matrix([[2 * c for c in qs]])  # k x n = 1 x 3
+    lam = sp.Matrix([sp.Symbol("lambda1", real=True)])
+    assert (G.T * lam).shape == (3, 1)
+    G_printed_shape = G.T  # n x k as printed: its transpose times lambda in R^k is not defined
+    with pytest.raises(sp.ShapeError):
+        _ = G_printed_shape.T * lam
+    Gdot = G.applyfunc(lambda e: ddt(e, qs, vs, [0, 0, 0]))
+    u = sp.zeros(3, 1)
+    derived = (G * M.inv() * G.T).inv() * (G * M.inv() * u + Gdot * sp.Matrix(vs))
+    printed_180 = (G * M.inv() * G.T).inv() * G * M.inv() * u
+    on_sphere = {qs[0] ** 2: 1 - qs[1] ** 2 - qs[2] ** 2}
+    assert sp.simplify(derived[0].subs(on_sphere) - sum(v**2 for v in vs)) == 0
+    assert printed_180[0] == 0
+    system = LagrangianSystem(qs, K=sum(v**2 for v in vs), qd=vs, holonomic=[sum(c**2 for c in qs) - 1], forces=[0, 0, 0])
+    assert sp.simplify((system.multipliers()[0] - derived[0]).subs(on_sphere)) == 0
+    # the general formula: qdd from (13.179) with this lambda keeps G qdd + Gdot qd = 0 (gravity g and B = N included)
+    gv = sp.Matrix([0, 0, 2 * g])
+    N = sp.Matrix([sp.Symbol(f"b{i}", real=True) * vs[i] for i in range(3)])
+    lam_full = (G * M.inv() * G.T).inv() * (G * M.inv() * (u - gv - N) + Gdot * sp.Matrix(vs))
+    qdd = M.inv() * (u - gv - N - G.T * lam_full)
+    assert sp.simplify((G * qdd + Gdot * sp.Matrix(vs))[0]) == 0
+    lam_184 = (G * M.inv() * G.T).inv() * G * M.inv() * (u - gv - N)
+    qdd_184 = M.inv() * (u - gv - N - G.T * lam_184)
+    assert sp.simplify((G * qdd_184 + Gdot * sp.Matrix(vs))[0]) != 0
