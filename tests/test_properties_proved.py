@@ -176,3 +176,13 @@ def test_an_equal_C_in_another_trigonometric_form_is_still_proved():
     report = _tampered(eom, disguised).check_properties()
     for name in ("dD/dt - 2C skew", "dD/dt == C + C^T", "D qdd + C qd + g"):
         assert report[name].status == "proved", str(report)
+
+
+def test_floating_point_residue_is_sampled_and_says_why():
+    """A model whose numbers carry rounding (here a 1e-17 stray term in C, as a rounded cos(pi/2) leaves in
+    a DH model) cannot be proved exactly: "sampled", and the detail says floating-point numbers are why."""
+    eom = _eom_2r()
+    report = _tampered(eom, eom.C + sp.Float(1e-17) * eom.qd[0] * sp.eye(2)).check_properties()
+    skew = report["dD/dt - 2C skew"]
+    assert skew.status == "sampled" and "floating-point" in skew.detail
+    assert "floating-point" not in _eom_2r().check_properties()["dD/dt - 2C skew"].detail

@@ -400,10 +400,14 @@ def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: 
     variables = set(q) | set(qd) | set(eom.qdd)
     checks = []
 
+    floating = any(m.has(sp.Float) for m in (D, C, g)) or (eom.P is not None and sp.sympify(eom.P).has(sp.Float))
+
     def decided(name, entries, source, what):
         status, residual, witness = _decide_zero(entries, q, variables, rng)
         how = {"proved": "reduces to 0 exactly (sin/cos of sums expanded, reduced modulo sin^2 + cos^2 = 1)",
-               "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)",
+               "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)"
+                          + ("; the model holds floating-point numbers (e.g. cos of a DH twist of pi/2 rounded), whose rounding "
+                             "leaves a residue exact cancellation cannot remove: exact (rational or symbolic) parameters can be proved" if floating else ""),
                "failed": f"not zero: |{what}| = {residual:.3g} at {witness}"}[status]
         checks.append(Check(name, status != "failed", residual, 0.0 if status == "proved" else 1e-9, f"{what}: {how}", source,
                             dict(witness=witness) if witness else {}, status=status))
