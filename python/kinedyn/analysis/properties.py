@@ -24,7 +24,7 @@ and random states find no counterexample, and "failed" with the state that shows
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
