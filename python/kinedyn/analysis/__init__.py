@@ -3,12 +3,15 @@ with residuals (:func:`check_properties`), and identification of the base inerti
 excitation data (:func:`identify`). See docs/analysis.md."""
 
 from .identification import Identification, Measurements, excitation, identify, simulate_measurements, with_inertial_parameters
-from .properties import Check, PropertiesReport, check_properties
+from .properties import Check, InertiaBounds, PropertiesReport, check_properties, global_inertia_bounds, prove_properties
 from .system_properties import check_system_properties
 
 __all__ = [
     "check_properties",
     "check_system_properties",
+    "prove_properties",
+    "global_inertia_bounds",
+    "InertiaBounds",
     "PropertiesReport",
     "Check",
     "excitation",

@@ -2,9 +2,11 @@
 each measured with its residual.
 
 - M(q) symmetric positive definite (Spong eq. 9.42: K = qd^T M qd / 2 > 0 for qd != 0).
-- Inertia bounds ``lambda_min I <= M(q) <= lambda_max I`` (Spong eqs. 9.119-9.120), measured over
-  sampled configurations with the worst ones reported (for a revolute arm the bounds exist because
-  M depends on q only through sines and cosines).
+- Inertia bounds ``lambda_min I <= M(q) <= lambda_max I`` (Spong eqs. 9.119-9.120) from a global
+  search over the configuration space (:func:`global_inertia_bounds`: multistart bounded truncated Newton (TNC) on the
+  extreme eigenvalues with their analytic gradient d lambda / dq_k = v^T (dM/dq_k) v, dM/dq_k from the
+  Christoffel symbols), reported with the configurations that attain them (for a revolute arm the
+  bounds exist because M depends on q only through sines and cosines).
 - Skew symmetry of ``dM/dt - 2C`` (Spong Prop. 9.1, eqs. 9.109-9.112) and ``dM/dt = C + C^T`` (which
   skew symmetry alone does not imply: a transposed C is also skew-consistent), dM/dt by central
   differences along qd.
@@ -12,24 +14,35 @@ each measured with its residual.
   ``int_0^T qd . tau dt = H(T) - H(0)`` (+ the energy friction dissipates).
 - Linearity in the parameters (Spong §9.5.3, eq. 9.121): ``Y(q, qd, qdd) pi == tau`` (rigid-body
   part; rotor inertia and friction are separate known terms).
+
+:func:`check_properties` measures these on the numeric engine (status "sampled", "searched" or
+"simulated"); :func:`prove_properties` (``eom.check_properties()``) proves the identities of a symbolic
+model by exact simplification (status "proved"), says "sampled" where simplification cannot decide
+and random states find no counterexample, and "failed" with the state that shows a counterexample.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["Check", "PropertiesReport", "check_properties"]
+__all__ = ["Check", "PropertiesReport", "InertiaBounds", "check_properties", "global_inertia_bounds", "prove_properties"]
+
+
+#: how a check was decided: exact simplification, numbers at random states, a global optimisation, a
+#: simulated trajectory; "failed" (a counterexample) and "skipped" (could not be evaluated, says why)
+STATUSES = ("proved", "sampled", "searched", "simulated", "failed", "skipped")
 
 
 @dataclass
 class Check:
-    """One property: ``passed`` when ``residual <= tolerance``; ``detail`` says what was measured."""
+    """One property: ``passed`` when ``residual <= tolerance``; ``detail`` says what was measured;
+    ``status`` how it was decided (one of :data:`STATUSES`; "sampled" or "failed" when not given)."""
 
     name: str
     passed: bool
@@ -38,9 +51,23 @@ class Check:
     detail: str = ""
     source: str = ""
     data: dict = field(default_factory=dict)
+    status: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = "sampled" if self.passed else "failed"
+        elif not self.passed:
+            self.status = "failed"
+        if self.status not in STATUSES:
+            raise ValueError(f"check status must be one of {STATUSES}, got {self.status!r}")
+
+    @property
+    def proved(self) -> bool:
+        return self.status == "proved"
 
     def to_dict(self) -> dict:
-        return dict(name=self.name, passed=self.passed, residual=self.residual, tolerance=self.tolerance, detail=self.detail, source=self.source, **self.data)
+        return dict(name=self.name, passed=self.passed, status=self.status, residual=self.residual, tolerance=self.tolerance, detail=self.detail,
+                    source=self.source, **{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.data.items()})
 
 
 @dataclass
@@ -70,9 +97,110 @@ class PropertiesReport:
     def __str__(self) -> str:
         lines = [f"properties of '{self.robot}' over {self.samples} sampled states:"]
         for c in self.checks:
-            mark = "ok  " if c.passed else "FAIL"
-            lines.append(f"  [{mark}] {c.name}: residual {c.residual:.3g} (tolerance {c.tolerance:.3g}); {c.detail}")
+            mark = "FAIL" if not c.passed else c.status
+            lines.append(f"  [{mark:9s}] {c.name}: residual {c.residual:.3g} (tolerance {c.tolerance:.3g}); {c.detail}")
         return "\n".join(lines)
+
+
+@dataclass
+class InertiaBounds:
+    """Uniform bounds ``lambda_min I <= M(q) <= lambda_max I`` over a box of configurations (Spong eq.
+    9.120), each with the configuration that attains it (``eigvalsh(M(q_lambda_min))[0] ==
+    lambda_min``), and the extremes of the random sample the search started from."""
+
+    lambda_min: float
+    q_lambda_min: np.ndarray
+    lambda_max: float
+    q_lambda_max: np.ndarray
+    sampled_min: float
+    sampled_max: float
+    samples: int
+    starts: int
+    lower: np.ndarray
+    upper: np.ndarray
+    periodic: np.ndarray
+
+    def describe(self) -> str:
+        box = ", ".join(("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic))
+        return (f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
+                f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
+                f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
+                f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box})")
+
+
+def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
+    q = np.array(q, dtype=float)
+    q[periodic] = (q[periodic] + np.pi) % (2 * np.pi) - np.pi
+    return q
+
+
+def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_matrix_gradient: Callable[[np.ndarray], np.ndarray],
+                          lower, upper, periodic=None, samples: int = 256, starts: int = 12, seed: int = 0) -> InertiaBounds:
+    """The least and greatest eigenvalue of M(q) over the box ``lower <= q <= upper`` (coordinates
+    marked ``periodic`` are searched without bounds, M being 2 pi-periodic in them, and reported in
+    [-pi, pi)), by a multistart local optimisation: ``samples`` uniform random configurations, then
+    truncated Newton (SciPy TNC: bounded, and free of the BLAS threading that made L-BFGS-B 30x slower on a
+    loaded machine) from the ``starts`` best of them (and as many more random ones), minimising lambda_min(q)
+    and -lambda_max(q) with the analytic gradient of a simple eigenvalue, d lambda / dq_k = v^T (dM/dq_k) v
+    (v its unit eigenvector). ``mass_matrix(q)``: (n, n) for one q, (N, n, n) for a batch (N, n);
+    ``mass_matrix_gradient(q)``: (n_q, n, n), dM/dq_k stacked. A search, not a proof: the reported
+    bounds are attained (at the returned configurations) and no worse than every sample."""
+    from scipy.optimize import minimize
+
+    lower = np.asarray(lower, dtype=float)
+    upper = np.asarray(upper, dtype=float)
+    nq = len(lower)
+    periodic = np.zeros(nq, dtype=bool) if periodic is None else np.asarray(periodic, dtype=bool)
+    if upper.shape != lower.shape or periodic.shape != lower.shape or np.any(~np.isfinite(lower)) or np.any(~np.isfinite(upper)) or np.any(upper < lower):
+        raise ValueError(f"the search box must be finite with lower <= upper, one entry per coordinate: lower {lower}, upper {upper}")
+    if samples < 1 or starts < 0:
+        raise ValueError(f"samples must be >= 1 and starts >= 0, got {samples} and {starts}")
+    rng = np.random.default_rng(seed)
+    Q = rng.uniform(lower, upper, size=(samples, nq))
+    eig = np.linalg.eigvalsh(np.asarray(mass_matrix(Q), dtype=float))
+    lo_s, hi_s = eig[:, 0], eig[:, -1]
+    bounds = [(None, None) if p else (a, b) for a, b, p in zip(lower, upper, periodic)]
+
+    def extreme(sign: float, column: int):
+        def f(q):
+            w, V = np.linalg.eigh(np.asarray(mass_matrix(q), dtype=float))
+            v = V[:, column]
+            dM = np.asarray(mass_matrix_gradient(q), dtype=float)
+            return sign * w[column], sign * np.einsum("i,kij,j->k", v, dM, v)
+        values = sign * (lo_s if column == 0 else hi_s)
+        order = np.argsort(values)
+        picks = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
+        best_q, best = Q[order[0]].copy(), values[order[0]]
+        for k in dict.fromkeys(int(i) for i in picks):
+            res = minimize(f, Q[k], jac=True, method="TNC", bounds=bounds, options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12))
+            x = np.array(res.x, dtype=float)
+            x[~periodic] = np.clip(x[~periodic], lower[~periodic], upper[~periodic])
+            x = _wrap(x, periodic)
+            val = sign * np.linalg.eigvalsh(np.asarray(mass_matrix(x), dtype=float))[column]
+            if val < best:
+                best, best_q = val, x
+        return sign * best, best_q
+
+    lmin, qmin = extreme(1.0, 0)
+    lmax, qmax = extreme(-1.0, -1)
+    return InertiaBounds(float(lmin), qmin, float(lmax), qmax, float(lo_s.min()), float(hi_s.max()), samples, starts, lower, upper, periodic)
+
+
+def _configuration_box(robot: Robot):
+    """The box random_configuration draws from: finite joint limits, else [-pi, pi] (revolute, then
+    periodic) or [-1, 1] (prismatic)."""
+    lo = np.array(robot.lower_limits, dtype=float)
+    hi = np.array(robot.upper_limits, dtype=float)
+    periodic = np.zeros(robot.n, dtype=bool)
+    for i, j in enumerate(robot.joints):
+        span = np.pi if j.kind == "revolute" else 1.0
+        if j.kind == "revolute" and not np.isfinite(lo[i]) and not np.isfinite(hi[i]):
+            periodic[i] = True
+        if not np.isfinite(lo[i]):
+            lo[i] = min(-span, hi[i] - 2 * span) if np.isfinite(hi[i]) else -span
+        if not np.isfinite(hi[i]):
+            hi[i] = max(span, lo[i] + 2 * span)
+    return lo, hi, periodic
 
 
 def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
@@ -89,24 +217,33 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     QDD = rng.uniform(-4.0, 4.0, size=(samples, n))
     checks = []
 
-    # M symmetric positive definite; inertia bounds (one native call for all samples)
+    # M symmetric positive definite (one native call for all samples)
     M = robot.mass_matrix(Q)
     scale = np.abs(M).max()
     sym = float(np.abs(M - np.swapaxes(M, 1, 2)).max() / scale)
     eig = np.linalg.eigvalsh(M)
-    lo, hi = eig[:, 0], eig[:, -1]
-    kmin, kmax = int(np.argmin(lo)), int(np.argmax(hi))
+    lo = eig[:, 0]
     checks.append(Check(
         "M symmetric positive definite", bool(sym <= 1e-12 and lo.min() > 0), sym, 1e-12,
         f"max |M - M^T| / max |M| = {sym:.2g}; smallest eigenvalue {lo.min():.6g} > 0", "Spong eq. 9.42",
-        dict(min_eigenvalue=float(lo.min())),
+        dict(min_eigenvalue=float(lo.min())), status="sampled",
     ))
+    # inertia bounds: a global search over the configuration box, dM/dq_i = c_i + c_i^T from the
+    # engine's Christoffel symbols (c[i, j, k] + c[i, k, j] = dM_kj/dq_i, Spong eq. 9.58)
+    box_lo, box_hi, periodic = _configuration_box(robot)
+
+    def dM(q):
+        c = np.asarray(robot.christoffel(q), dtype=float)
+        return c + np.swapaxes(c, 1, 2)
+
+    b = global_inertia_bounds(robot.mass_matrix, dM, box_lo, box_hi, periodic, samples=max(samples, 64), starts=8, seed=seed)
     checks.append(Check(
-        "inertia bounds lambda_min I <= M(q) <= lambda_max I", bool(lo.min() > 0), float(max(0.0, -lo.min())), 0.0,
-        f"lambda_min = {lo.min():.6g} at q = {np.array2string(Q[kmin], precision=3)}, lambda_max = {hi.max():.6g} at q = "
-        f"{np.array2string(Q[kmax], precision=3)}; worst condition number {float((hi / lo).max()):.4g}",
+        "inertia bounds lambda_min I <= M(q) <= lambda_max I", bool(b.lambda_min > 0), float(max(0.0, -b.lambda_min)), 0.0,
+        b.describe() + f"; condition number <= {b.lambda_max / b.lambda_min:.4g}" if b.lambda_min > 0 else b.describe(),
         "Spong eqs. 9.119-9.120",
-        dict(lambda_min=float(lo.min()), lambda_max=float(hi.max()), q_lambda_min=Q[kmin], q_lambda_max=Q[kmax], condition_number=float((hi / lo).max())),
+        dict(lambda_min=b.lambda_min, lambda_max=b.lambda_max, q_lambda_min=b.q_lambda_min, q_lambda_max=b.q_lambda_max,
+             sampled_min=b.sampled_min, sampled_max=b.sampled_max, condition_number=float(b.lambda_max / b.lambda_min) if b.lambda_min > 0 else float("inf")),
+        status="searched",
     ))
 
     # dM/dt - 2C skew, dM/dt == C + C^T (central differences along qd)
@@ -120,6 +257,7 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     checks.append(Check(
         "dM/dt - 2C skew-symmetric", bool(skew <= tol_fd), skew, tol_fd,
         f"max |N + N^T| / max(1, |dM/dt|) with N = dM/dt - 2C, dM/dt by central differences (h = {h:g})", "Spong Prop. 9.1, eq. 9.109",
+        status="sampled",
     ))
     checks.append(Check(
         "dM/dt == C + C^T", bool(cct <= tol_fd), cct, tol_fd, "max |dM/dt - C - C^T| / max(1, |dM/dt|)", "Spong eq. 9.110",
@@ -180,5 +318,151 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
         f"friction {bal['dissipated'][-1]:.6g} J" + ("; Coulomb friction's sign switches limit the quadrature" if coulomb else ""),
         "Spong eqs. 9.113-9.117",
         dict(work=float(bal["work"][-1]), dH=float(bal["dH"][-1]), dissipated=float(bal["dissipated"][-1])),
+        status="simulated",
     ))
     return PropertiesReport(robot.name, samples, checks)
+
+
+# ---------------------------------------------------------------------------------------------- proofs
+def _trig_normal_form(expr, coordinates):
+    """The numerator of ``expr`` as a polynomial in s_i = sin q_i, c_i = cos q_i (after expanding sines
+    and cosines of sums and multiples) and the other symbols, reduced modulo s_i^2 + c_i^2 - 1 (a
+    Groebner basis: the leading monomials s_i^2 are pairwise coprime), so every s_i has degree <= 1.
+    That remainder is unique, so it is 0 exactly when the polynomial identity holds: ``0`` proves
+    ``expr == 0``. Returns the remainder (SymPy expression)."""
+    import sympy as sp
+
+    e = sp.expand(expr)
+    if e == 0:
+        return e
+    e = sp.expand(sp.expand_trig(e))
+    if e == 0:
+        return e
+    rep = {}
+    pyth = []
+    for k, c in enumerate(coordinates):
+        s_k, c_k = sp.Dummy(f"s{k}"), sp.Dummy(f"c{k}")
+        rep[sp.sin(c)] = s_k
+        rep[sp.cos(c)] = c_k
+        pyth.append((s_k, c_k))
+    e = e.xreplace(rep)
+    num, _ = sp.fraction(sp.together(e))
+    num = sp.expand(num)
+    for s_k, c_k in pyth:
+        num = num.replace(lambda x, s_k=s_k: x.is_Pow and x.base == s_k and x.exp.is_Integer and x.exp >= 2,
+                          lambda x, s_k=s_k, c_k=c_k: s_k ** (int(x.exp) % 2) * (1 - c_k**2) ** (int(x.exp) // 2))
+    return sp.expand(num)
+
+
+def _decide_zero(entries, coordinates, variables, rng, tries: int = 12):
+    """("proved", 0, None) when every entry reduces to 0 (:func:`_trig_normal_form`); otherwise the
+    entries are evaluated at ``tries`` random points (coordinates and rates in [-pi, pi], other symbols
+    in [0.5, 2]): ("failed", residual, point) when one is not zero there, ("sampled", residual, None)
+    when none is (simplification could not decide, the numbers found no counterexample)."""
+    import sympy as sp
+
+    pending = [e for e in entries if _trig_normal_form(e, coordinates) != 0]
+    if not pending:
+        return "proved", 0.0, None
+    symbols = sorted(set().union(*(sp.sympify(e).free_symbols for e in pending)), key=str)
+    fn = sp.lambdify(symbols, pending, "numpy")
+    worst, witness = 0.0, None
+    for _ in range(tries):
+        point = {s: (rng.uniform(-np.pi, np.pi) if s in variables else rng.uniform(0.5, 2.0)) for s in symbols}
+        vals = np.abs(np.asarray(fn(*[point[s] for s in symbols]), dtype=complex))
+        if vals.max() > worst:
+            worst, witness = float(vals.max()), {str(k): float(v) for k, v in point.items()}
+    if worst > 1e-9:
+        return "failed", worst, witness
+    return "sampled", worst, None
+
+
+def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: int = 12, seed: int = 0) -> PropertiesReport:
+    """The properties of Spong §9.5 for a symbolic :class:`kinedyn.symbolic.EquationsOfMotion`
+    (``eom.check_properties()``), each decided exactly where it can be:
+
+    - D(q) symmetric, dD/dt - 2C skew-symmetric (Prop. 9.1), dD/dt = C + C^T (eq. 9.110), and
+      D qdd + C qd + g = d/dt dL/dqd - dL/dq with L = K - P (eqs. 9.52-9.61: C is the Christoffel
+      matrix of this D, g the gradient of this P; a transposed C passes the two identities before it,
+      not this one): status "proved" when the difference reduces to 0 exactly (sines and cosines of
+      sums expanded, then reduced modulo sin^2 + cos^2 = 1, a normal form), "failed" with the state
+      of a counterexample, "sampled" when simplification cannot decide and random states show none.
+    - Inertia bounds lambda_min I <= D(q) <= lambda_max I (eq. 9.120) by :func:`global_inertia_bounds`
+      with dD/dq_k differentiated symbolically (status "searched"), after substituting ``params``
+      ({symbol or name: value}); "skipped" (and saying which) while D has free parameters. A
+      coordinate that appears only inside sines and cosines is periodic; any other needs a range in
+      ``limits`` ({coordinate or name: (lower, upper)}), default [-1, 1].
+    """
+    import sympy as sp
+
+    from .._math import by_name
+
+    rng = np.random.default_rng(seed)
+    q = list(eom.q)
+    qd = list(eom.qd)
+    n = eom.n
+    D, C, g = eom.M, eom.C, eom.g
+    variables = set(q) | set(qd) | set(eom.qdd)
+    checks = []
+
+    floating = any(m.has(sp.Float) for m in (D, C, g)) or (eom.P is not None and sp.sympify(eom.P).has(sp.Float))
+
+    def decided(name, entries, source, what):
+        status, residual, witness = _decide_zero(entries, q, variables, rng)
+        how = {"proved": "reduces to 0 exactly (sin/cos of sums expanded, reduced modulo sin^2 + cos^2 = 1)",
+               "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)"
+                          + ("; the model holds floating-point numbers (e.g. cos of a DH twist of pi/2 rounded), whose rounding "
+                             "leaves a residue exact cancellation cannot remove: exact (rational or symbolic) parameters can be proved" if floating else ""),
+               "failed": f"not zero: |{what}| = {residual:.3g} at {witness}"}[status]
+        checks.append(Check(name, status != "failed", residual, 0.0 if status == "proved" else 1e-9, f"{what}: {how}", source,
+                            dict(witness=witness) if witness else {}, status=status))
+
+    decided("D symmetric", [D[i, j] - D[j, i] for i in range(n) for j in range(i + 1, n)], "Spong eq. 9.50", "D - D^T")
+    Ddot = sp.zeros(n, n)
+    for qi, vi in zip(q, qd):
+        Ddot += D.diff(qi) * vi
+    N = Ddot - 2 * C
+    decided("dD/dt - 2C skew-symmetric", [N[i, j] + N[j, i] for i in range(n) for j in range(i, n)], "Spong Prop. 9.1, eqs. 9.109-9.111", "N + N^T")
+    decided("dD/dt == C + C^T", [Ddot[i, j] - C[i, j] - C[j, i] for i in range(n) for j in range(i, n)], "Spong eq. 9.110", "dD/dt - C - C^T")
+    P = eom.P
+    if P is not None:
+        L = eom.K - P
+        lhs = []
+        for k in range(n):
+            p_k = sp.diff(L, qd[k])
+            ddt = sum(sp.diff(p_k, a) * b for a, b in zip(q + qd, qd + list(eom.qdd)))
+            lhs.append(ddt - sp.diff(L, q[k]))
+        rigid = D * eom.qdd + C * sp.Matrix(qd) + g
+        decided("D qdd + C qd + g == d/dt dL/dqd - dL/dq", [rigid[k] - lhs[k] for k in range(n)], "Spong eqs. 9.52-9.61",
+                "D qdd + C qd + g - (d/dt dL/dqd - dL/dq)")
+    else:
+        checks.append(Check("D qdd + C qd + g == d/dt dL/dqd - dL/dq", True, 0.0, 0.0, "no potential energy P in this model (not a natural system)",
+                            "Spong eqs. 9.52-9.61", status="skipped"))
+
+    # inertia bounds by a global search
+    name = "inertia bounds lambda_min I <= D(q) <= lambda_max I"
+    Dn = D.xreplace(by_name(params, eom.parameters)) if params else D
+    free = sorted(Dn.free_symbols - set(q), key=str)
+    if free:
+        checks.append(Check(name, True, 0.0, 0.0, f"D has free parameters {', '.join(map(str, free))}: give their values in params= to search the bounds",
+                            "Spong eqs. 9.119-9.120", status="skipped"))
+        return PropertiesReport(eom.name or "equations of motion", samples, checks)
+    limits = by_name(limits, q) if limits else {}
+    periodic = np.array([not Dn.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1)).has(c) for c in q])
+    lower = np.array([-np.pi if p else float(limits.get(c, (-1.0, 1.0))[0]) for c, p in zip(q, periodic)])
+    upper = np.array([np.pi if p else float(limits.get(c, (-1.0, 1.0))[1]) for c, p in zip(q, periodic)])
+    f_D = sp.lambdify([q], Dn, "numpy")
+    f_dD = sp.lambdify([q], [Dn.diff(c) for c in q], "numpy")
+
+    def mass_matrix(x):
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:
+            return np.array([np.asarray(f_D(row), dtype=float) for row in x])
+        return np.asarray(f_D(x), dtype=float)
+
+    b = global_inertia_bounds(mass_matrix, lambda x: np.asarray(f_dD(np.asarray(x, dtype=float)), dtype=float), lower, upper, periodic,
+                              samples=samples, starts=starts, seed=seed)
+    checks.append(Check(name, bool(b.lambda_min > 0), float(max(0.0, -b.lambda_min)), 0.0, b.describe(), "Spong eqs. 9.119-9.120",
+                        dict(lambda_min=b.lambda_min, lambda_max=b.lambda_max, q_lambda_min=b.q_lambda_min, q_lambda_max=b.q_lambda_max,
+                             sampled_min=b.sampled_min, sampled_max=b.sampled_max), status="searched"))
+    return PropertiesReport(eom.name or "equations of motion", samples, checks)

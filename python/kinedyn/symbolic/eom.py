@@ -235,6 +235,17 @@ class EquationsOfMotion:
 
         return base_parameters(self, known=known)
 
+    def check_properties(self, params=None, limits=None, samples: int = 256, starts: int = 12, seed: int = 0):
+        """The properties of Spong §9.5 decided on these symbolic equations: D symmetric, dD/dt - 2C
+        skew-symmetric, dD/dt = C + C^T and tau = d/dt dL/dqd - dL/dq *proved* by exact simplification
+        (status "proved", or "failed" with a counterexample, or "sampled" where simplification cannot
+        decide), and the inertia bounds of eq. 9.120 by a global search with the configurations that
+        attain them (``params`` gives values to free parameters). A
+        :class:`kinedyn.analysis.PropertiesReport`; see :func:`kinedyn.analysis.prove_properties`."""
+        from ..analysis.properties import prove_properties
+
+        return prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
+
     def subs(self, mapping) -> "EquationsOfMotion":
         """The same equations with parameters replaced (numbers or other expressions); keys are
         symbols or their names."""
