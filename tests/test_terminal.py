@@ -39,7 +39,7 @@ def parse_tables(text: str) -> dict:
     k = 0
     while k < len(lines):
         if lines[k].startswith("┏") and k > 0:
-            title = re.sub(r" \(columns \d+-\d+ of \d+\)$", "", lines[k - 1].strip())
+            title = re.sub(r" \(columns? \d+(-\d+)? of \d+\)$", "", lines[k - 1].strip())
             k += 1
             headers: list = []
             while lines[k].startswith("┃"):

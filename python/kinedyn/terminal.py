@@ -77,7 +77,8 @@ def fit_table(table, width: int, console) -> List:
     for group in groups:
         t = part(group)
         end = start + len(group) - 1
-        t.title = f"{title} (columns {start}-{end} of {len(rest)})" if title else f"columns {start}-{end} of {len(rest)}"
+        which = f"column {start} of {len(rest)}" if start == end else f"columns {start}-{end} of {len(rest)}"
+        t.title = f"{title} ({which})" if title else which
         out.append(t)
         start = end + 1
     return out
