@@ -119,3 +119,27 @@ def test_long_sums_are_broken_and_keep_their_value():
     rows = equation_rows("D(q)", sp.Matrix([[long_sum, 0], [0, a]]), 200)
     assert rows[0].startswith("D_{11}(q) &= ") and any(r.startswith("D_{22}(q) &= a") for r in rows)
     assert "the other entries" in rows[-1]
+
+
+def test_velocity_symbols_print_with_a_dot_and_stay_identifiers():
+    """One notation: eom.M/eom.C printed q̇₁ where they printed qd₁; the symbols' names follow SymPy's
+    accent convention (qdot1), so sp.pretty and sp.latex (and kinedyn's MathML) draw the dot while str and the
+    generated code keep a plain identifier."""
+    from kinedyn.symbolic.system import LagrangianSystem, coordinates
+
+    eom = kd.robots.planar_2r(symbolic=True).equations_of_motion(steps=False)
+    v, a = eom.qd[0], eom.qdd[0]
+    assert sp.pretty(v) == "q̇₁" and sp.pretty(a) == "q̈₁"
+    assert sp.latex(v) == r"\dot{q}_{1}" and sp.latex(a) == r"\ddot{q}_{1}"
+    assert str(v).isidentifier() and str(a).isidentifier()
+    assert "q̇₁" in sp.pretty(eom.C) and "qd" not in sp.pretty(eom.C)
+    from kinedyn.symbolic.render import rate_symbols, value_mathml
+
+    assert "<mover" in value_mathml(eom.C, rate_symbols(eom.q, eom.qd, eom.qdd))
+    for language in ("python", "numpy"):
+        compile(eom.to_code(language), f"<{language}>", "exec")  # valid Python
+    assert "qdot" not in eom.to_code("c").split("*/", 1)[1]  # the C body reads qd[k], never a symbol name
+    (x,), (xd,) = coordinates("x")
+    assert sp.pretty(xd) == "ẋ"
+    written = LagrangianSystem([x], K="m*x_d**2/2 + m*xdot**2/2")  # the former name still reads as the velocity
+    assert written.L.free_symbols & {xd} and sp.expand(written.L - sp.Symbol("m") * xd**2) == 0

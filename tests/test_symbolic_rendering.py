@@ -67,8 +67,8 @@ def test_plain_text_names_are_readable(planar):
     text = str(planar)
     lines = [line.strip() for line in text.splitlines()]
     for k in (1, 2):
-        assert any(line.startswith(f"dL/dqd{k} = ") for line in lines)
-        assert any(line.startswith(f"d/dt dL/dqd{k} = ") for line in lines)
+        assert any(line.startswith(f"dL/dqdot{k} = ") for line in lines)
+        assert any(line.startswith(f"d/dt dL/dqdot{k} = ") for line in lines)
         assert any(line.startswith(f"dL/dq{k} = ") for line in lines)
         assert any(line.startswith(f"J_vc{k} = ") for line in lines) and any(line.startswith(f"J_w{k} = ") for line in lines)
     assert "dotq" not in text and "ddt" not in text and "mathcal" not in text

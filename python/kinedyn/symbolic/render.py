@@ -19,7 +19,7 @@ from typing import Dict, List, Optional
 import sympy as sp
 from sympy.printing.mathml import MathMLPresentationPrinter
 
-__all__ = ["Name", "name", "of_q", "dL_dqd", "ddt_dL_dqd", "dL_dq", "lagrangian", "symbol_name", "vector_name",
+__all__ = ["rate_names", "legacy_rate_names", "Name", "name", "of_q", "dL_dqd", "ddt_dL_dqd", "dL_dq", "lagrangian", "symbol_name", "vector_name",
            "latex_to_mathml", "value_mathml", "equation_mathml", "text_of", "mathml_of"]
 
 MATHML_NS = "http://www.w3.org/1998/Math/MathML"
@@ -41,6 +41,30 @@ class Name(str):
     @property
     def latex(self) -> str:
         return str.__str__(self)
+
+
+# ------------------------------------------------------------------ velocity and acceleration symbols
+def rate_names(name: str) -> tuple:
+    """Names of the velocity and acceleration symbols of the coordinate ``name``, in SymPy's own
+    accent convention (a base ending in ``dot``/``ddot``): ``q1`` -> ``("qdot1", "qddot1")``,
+    ``theta_2`` -> ``("thetadot_2", "thetaddot_2")``, ``x`` -> ``("xdot", "xddot")``. SymPy's printers
+    draw them with the accent — ``sp.pretty`` q̇₁, ``sp.latex`` ``\\dot{q}_{1}`` (kinedyn's MathML via
+    :func:`rate_symbols`) — while ``str`` stays the plain identifier ``qdot1`` that code generation, ``sympify``
+    and JSON need."""
+    from sympy.printing.conventions import split_super_sub
+
+    base = split_super_sub(name)[0]
+    if not base or not name.startswith(base):
+        return f"{name}dot", f"{name}ddot"
+    rest = name[len(base):]
+    return f"{base}dot{rest}", f"{base}ddot{rest}"
+
+
+def legacy_rate_names(name: str) -> tuple:
+    """The names kinedyn gave the velocity and acceleration symbols before :func:`rate_names`
+    (``q1`` -> ``qd1``, ``qdd1``; ``x`` -> ``x_d``, ``x_dd``): still read in energies written as strings."""
+    m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
+    return (f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (f"{name}_d", f"{name}_dd")
 
 
 # ------------------------------------------------------------------ MathML pieces
