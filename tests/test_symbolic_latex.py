@@ -140,6 +140,6 @@ def test_velocity_symbols_print_with_a_dot_and_stay_identifiers():
         compile(eom.to_code(language), f"<{language}>", "exec")  # valid Python
     assert "qdot" not in eom.to_code("c").split("*/", 1)[1]  # the C body reads qd[k], never a symbol name
     (x,), (xd,) = coordinates("x")
-    assert sp.pretty(xd) == "ẋ"
+    assert sp.pretty(xd) in ("ẋ", "x\u0307")  # precomposed or x + combining dot, by SymPy version
     written = LagrangianSystem([x], K="m*x_d**2/2 + m*xdot**2/2")  # the former name still reads as the velocity
     assert written.L.free_symbols & {xd} and sp.expand(written.L - sp.Symbol("m") * xd**2) == 0

@@ -481,6 +481,8 @@ def textbook_form(expr, coordinates: Sequence = (), prismatic: Sequence = ()):
         return sp.factor_terms(x)
 
     candidates = [expr]
+    if sp.count_ops(expr) > 300:  # cancel/together on larger fractions takes minutes (the five-bar's H): keep it
+        return expr
     together = sp.together(expr)
     num, den = sp.fraction(together)
     try:
