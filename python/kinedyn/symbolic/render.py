@@ -222,9 +222,11 @@ def _xml_entities(m: str) -> str:
 
 
 def value_mathml(value, rates: Optional[Dict[sp.Symbol, str]] = None) -> str:
-    """Presentation MathML of a SymPy expression or matrix (``rates`` from :func:`rate_symbols`)."""
+    """Presentation MathML of a SymPy expression or matrix (``rates`` from :func:`rate_symbols`);
+    brackets and parentheses marked stretchy, so they grow around matrices and fractions."""
     printer = _Printer(rates or {})
-    return _xml_entities(printer.doprint(sp.sympify(value)))
+    m = _xml_entities(printer.doprint(sp.sympify(value)))
+    return re.sub(r"<mo>([()\[\]])</mo>", r'<mo stretchy="true">\1</mo>', m)
 
 
 def equation_mathml(lhs, value, rates=None, display: str = "block") -> str:
