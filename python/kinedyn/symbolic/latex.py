@@ -25,8 +25,9 @@ import sympy as sp
 
 __all__ = ["latex_text", "width", "expression_lines", "equation_rows", "fragment", "document", "LINE_PT"]
 
-#: the width, in points, given to the right-hand side of one line (text width 483 pt less the
-#: left-hand side column and the relation)
+#: the text width in points (A4 less 2 cm margins) and the width given to a right-hand side when the
+#: left-hand sides are short (the text width less the left-hand column, the relation and a margin)
+TEXT_PT = 483.0
 LINE_PT = 380.0
 
 _SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#", "%": r"\%",
@@ -148,6 +149,33 @@ def width(expr) -> float:
     return _CHAR * len(sp.latex(expr)) * 0.5
 
 
+def latex_width(tex: str) -> float:
+    """Estimated width in points of a small piece of LaTeX (a left-hand side such as
+    ``\\frac{\\partial \\mathcal{L}}{\\partial \\dot{q}_{1}}``): a fraction as its wider part,
+    subscripts smaller, each command one character."""
+    t = re.sub(r"\\(left|right|mathcal|mathit|mathrm|operatorname|dot|ddot|bigl|bigr|Bigl|Bigr)\b", "", str(tex))
+    frac = re.compile(r"\\frac\{([^{}]*)\}\{([^{}]*)\}")
+    while True:
+        t2 = re.sub(r"\{([^{}]*)\}", lambda m: "{" + m.group(1) + "}", t)
+        m = frac.search(t2)
+        if not m:
+            break
+        a, b = m.group(1), m.group(2)
+        t = t2[:m.start()] + (a if latex_width(a) >= latex_width(b) else b) + t2[m.end():]
+    subs = sum(len(re.sub(r"\\[A-Za-z]+", "x", x)) for x in re.findall(r"[_^]\{([^{}]*)\}", t))
+    t = re.sub(r"[_^]\{[^{}]*\}", "", t)
+    t = re.sub(r"\\[A-Za-z]+", "x", t)
+    t = re.sub(r"[{}\s]", "", t)
+    return _CHAR * len(t) + _SUB * subs
+
+
+def rhs_limit(lhs_names: Sequence[str]) -> float:
+    """The width left for right-hand sides in an ``align*`` whose widest left-hand side is among
+    ``lhs_names`` (the columns line up, so the widest one counts for every row)."""
+    widest = max((latex_width(str.__str__(n) if isinstance(n, str) else str(n)) for n in lhs_names), default=0.0)
+    return min(LINE_PT, TEXT_PT - widest - 40.0)
+
+
 # ------------------------------------------------------------------ breaking
 Line = Tuple[str, float]
 
@@ -204,6 +232,41 @@ def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None)
                 first = (head + r"\Bigl(" + inner[0][0], width(rest) + inner[0][1] + 10)
                 last = (inner[-1][0] + r"\Bigr)", inner[-1][1] + 5)
                 return [first, *inner[1:-1], last]
+    if expr.is_Mul and len(expr.args) > 1:  # a long product of short factors: split between factors
+        num, den = sp.fraction(expr)
+        if den == 1:
+            coeff, factors = expr.as_coeff_mul()
+            neg = coeff < 0
+            coeff = -coeff if neg else coeff
+            groups: List[List[Line]] = ([] if coeff == 1 else [[(_tex(coeff, names), width(coeff))]])
+            for f in factors:
+                sub = expression_lines(f, limit - 10, names)
+                if len(sub) == 1 and f.is_Add:
+                    sub = [(r"\left(" + sub[0][0] + r"\right)", sub[0][1] + 2 * _CHAR)]
+                groups.append(sub)
+            lines: List[Line] = []
+            cur, curw = "", 0.0
+            for group in groups:
+                first_tex, first_w = group[0]
+                if curw and curw + first_w > limit:
+                    lines.append((cur, curw))
+                    cur, curw = r"\cdot " + first_tex, first_w + 5
+                else:
+                    cur, curw = (cur + " " + first_tex) if cur else first_tex, curw + first_w + 1.5
+                if len(group) > 1:
+                    lines.append((cur, curw))
+                    lines.extend(group[1:-1])
+                    cur, curw = group[-1]
+            lines.append((cur, curw))
+            if neg:
+                lines[0] = ("- " + lines[0][0], lines[0][1] + _OP)
+            if len(lines) > 1:
+                return lines
+    if isinstance(expr, (sp.sin, sp.cos)) and expr.args[0].is_Add:  # a long argument: \sin\Bigl( ... \Bigr)
+        inner = expression_lines(expr.args[0], limit - 30, names)
+        if len(inner) > 1:
+            head = "\\" + type(expr).__name__
+            return [(head + r"\Bigl(" + inner[0][0], inner[0][1] + 25), *inner[1:-1], (inner[-1][0] + r"\Bigr)", inner[-1][1] + 5)]
     if expr.is_Pow and expr.base.is_Add and expr.exp.is_Integer and expr.exp > 0:
         inner = expression_lines(expr.base, limit - 20, names)
         if len(inner) > 1:
@@ -256,8 +319,10 @@ def equation_rows(lhs, value, limit: float = LINE_PT, names: Optional[Dict] = No
 RESULT_TITLE = r"D(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau"
 
 
-def fragment(steps: Sequence, final: Sequence[tuple], names: Optional[Dict] = None, limit: float = LINE_PT) -> str:
+def fragment(steps: Sequence, final: Sequence[tuple], names: Optional[Dict] = None, limit: Optional[float] = None) -> str:
     """One ``align*`` block: each step's title as a ``\\text`` row, its equations, then the result."""
+    if limit is None:
+        limit = rhs_limit([lhs for step in steps for lhs, _ in step.equations] + [lhs for lhs, _ in final])
     body: List[str] = []
     for step in steps:
         body.append(r"&\text{" + latex_text(step.title) + r"} \\")
@@ -288,7 +353,7 @@ def _align(rows: List[str]) -> str:
 
 
 def document(title: str, steps: Sequence, final: Sequence[tuple], names: Optional[Dict] = None, intro: str = "",
-             limit: float = LINE_PT) -> str:
+             limit: Optional[float] = None) -> str:
     """A complete LaTeX document (``pdflatex`` compiles it): a section per step with its prose and its
     equations, and the result."""
     parts = [PREAMBLE, r"\title{" + _escape(title) + "}", r"\date{}", r"\begin{document}", r"\maketitle"]
@@ -299,13 +364,15 @@ def document(title: str, steps: Sequence, final: Sequence[tuple], names: Optiona
         if getattr(step, "text", ""):
             parts.append(latex_text(step.text) + "\n")
         rows: List[str] = []
+        step_limit = limit if limit is not None else rhs_limit([lhs for lhs, _ in step.equations])
         for lhs, value in step.equations:
-            rows += equation_rows(lhs, value, limit, names)
+            rows += equation_rows(lhs, value, step_limit, names)
         parts.append(_align(rows))
     parts.append(r"\section*{Result: $" + RESULT_TITLE + "$}")
     rows = []
+    final_limit = limit if limit is not None else rhs_limit([lhs for lhs, _ in final])
     for lhs, value in final:
-        rows += equation_rows(lhs, value, limit, names)
+        rows += equation_rows(lhs, value, final_limit, names)
     parts.append(_align(rows))
     parts.append(r"\end{document}")
     return "\n".join(p for p in parts if p) + "\n"
