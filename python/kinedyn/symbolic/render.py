@@ -1,7 +1,7 @@
 """Names of the quantities in a derivation, in three notations at once, and the MathML of equations.
 
 A :class:`Name` is the LaTeX of a left-hand side (it *is* a ``str``, so code that reads the LaTeX keeps
-working) that also carries its plain-text form (``.text``: ``dL/dqd1``, ``d/dt dL/dqd1``, ``J_vc1``) and
+working) that also carries its plain-text form (``.text``: ``dL/dqdot1``, ``d/dt dL/dqdot1``, ``J_vc1``) and
 its presentation MathML (``.mathml``: ``<mfrac><mrow><mo>∂</mo>...``, ``<mover>`` for the dots of
 q̇ and q̈). Right-hand sides are SymPy expressions, printed by SymPy's presentation MathML printer
 with the velocity and acceleration symbols drawn with their dots.
