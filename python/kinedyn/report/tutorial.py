@@ -258,7 +258,7 @@ def _q1b() -> Answer:
     a.text("The determinant of the 2 x 2 Jacobian:")
     a.eq("det J", det)
     a.text("so J is invertible except where sin(theta2) = 0 (arm stretched out or folded back). "
-           "The inverse is the adjugate divided by the determinant, thetadot = J^-1 (xdot, ydot):")
+           "The inverse is the adjugate divided by the determinant, θ̇ = J⁻¹ (ẋ, ẏ):")
     adj = inverse.adjugate
     Jinv = adj / det
     a.eq("J^-1", sp.MatMul(1 / det, adj, evaluate=False))
@@ -530,7 +530,7 @@ def _q3() -> Answer:
         "dL/dth2": sp.diff(L, th2),
         "tau2": T(eom.tau[1]),
     }
-    a.text("Step 7 is the answer: the equations of motion tau_i = d/dt dL/dthetadot_i - dL/dtheta_i.")
+    a.text("Step 7 is the answer: the equations of motion τᵢ = d/dt ∂L/∂θ̇ᵢ − ∂L/∂θᵢ.")
     a.text("Independent check of every step: the arm written from its geometry alone (rod about its end, rod about its centre, "
            "the centre D of link 2), with every velocity and derivative taken by central finite differences; and the energy "
            "balance qd . tau = dH/dt (H = K + P) along the motion.")
@@ -793,6 +793,43 @@ def _latex(value) -> str:
     return sp.latex(_display(value))
 
 
+def name_latex(name: str) -> str:
+    """The LaTeX of an equation's name as the tutorial writes it in ASCII: ``J^-1`` -> ``J^{-1}``,
+    ``dL/dthetadot1`` -> ``\\frac{\\partial L}{\\partial \\dot{\\theta}_{1}}``, ``J_w_1`` -> ``J_{\\omega_{1}}``,
+    ``det J_v`` -> ``\\det J_{v}``; the same names the Markdown and the report's MathML show."""
+    import re
+
+    def coord(m: "re.Match") -> str:
+        dots = {"": "", "d": "dot", "dd": "ddot", "dot": "dot", "ddot": "ddot"}[m.group(2) or ""]
+        base = r"\theta"
+        return (f"\\{dots}{{{base}}}" if dots else base) + (f"_{{{m.group(3)}}}" if m.group(3) else "")
+
+    t = name.strip()
+    t = re.sub(r"^d/dt\s+", r"\\frac{d}{dt}", t)
+    t = re.sub(r"\bdL/d(theta|th)(ddot|dot|dd|d)?(\d?)\b", lambda m: r"\frac{\partial L}{\partial " + coord(m) + "}", t)
+    t = re.sub(r"(?<!\\)\b(theta|th)(ddot|dot|dd|d)?(\d?)\b", coord, t)
+    t = re.sub(r"\b([a-z])_([A-Z])\^(\d)\b", r"\1_{\2}^{\3}", t)
+    t = re.sub(r"\bJ_w_(\d)\b", r"J_{\\omega_{\1}}", t)
+    t = re.sub(r"\bJ_v_c(\d)\b", r"J_{v_{c\1}}", t)
+    t = re.sub(r"\b([rJ])_([a-z]?\d|[a-z])\b", r"\1_{\2}", t)
+    t = re.sub(r"\btau_?(\d)\b", r"\\tau_{\1}", t)
+    t = re.sub(r"\b([ov])(\d)\b", r"\1_{\2}", t)
+    t = re.sub(r"\^-1\b", "^{-1}", t)
+    t = re.sub(r"\bdet\s+", r"\\det ", t)
+    t = re.sub(r"\b(cos|sin)\(", r"\\\1(", t)
+    t = re.sub(r"\(", r"\\left(", t)
+    t = re.sub(r"\)", r"\\right)", t)
+    return t
+
+
+def _rates_mathml() -> Dict[sp.Symbol, str]:
+    """MathML of the displayed tutorial symbols theta_k, thetadot_k, thetaddot_k: θ with dots above."""
+    from ..symbolic.render import rate_symbols
+
+    q = [sp.Symbol(f"theta{k}", real=True) for k in (1, 2)]
+    return rate_symbols(q, [sp.Symbol(f"thetadot{k}", real=True) for k in (1, 2)], [sp.Symbol(f"thetaddot{k}", real=True) for k in (1, 2)])
+
+
 def render_markdown(answers: Sequence[Answer]) -> str:
     out = ["# The METR4202 Tutorial 4, worked with kinedyn", ""]
     for a in answers:
@@ -805,7 +842,7 @@ def render_markdown(answers: Sequence[Answer]) -> str:
                 if isinstance(value, str):
                     out += [f"- **{name}** = {value}", ""]
                 else:
-                    out += ["$$", f"{_md_name(name)} = {_latex(value)}", "$$", ""]
+                    out += ["$$", f"{name_latex(name)} = {_latex(value)}", "$$", ""]
             else:
                 _, title, headers, rows = it
                 out += [f"**{title}**", "", "| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
@@ -827,13 +864,15 @@ def render_html(answers: Sequence[Answer]) -> str:
     printed answer with the deciding check and, for a misprint, the correct value."""
     from html import escape
 
-    from ..symbolic.render import MATHML_NS, value_mathml
+    from ..symbolic.render import MATHML_NS, latex_to_mathml, value_mathml
+
+    rates = _rates_mathml()
 
     def equation(name: str, value) -> str:
         if isinstance(value, str):
             return f"<p><b>{escape(name)}</b> = {escape(value)}</p>"
-        lhs = f"<mtext>{escape(name)}</mtext>"
-        return f'<div class="eq"><math xmlns="{MATHML_NS}" display="block"><mrow>{lhs}<mo>=</mo>{value_mathml(_display(value))}</mrow></math></div>'
+        lhs = latex_to_mathml(name_latex(name))
+        return f'<div class="eq"><math xmlns="{MATHML_NS}" display="block"><mrow>{lhs}<mo>=</mo>{value_mathml(_display(value), rates)}</mrow></math></div>'
 
     def table(headers, rows) -> str:
         head = "".join(f"<th>{escape(str(h))}</th>" for h in headers)
@@ -842,7 +881,7 @@ def render_html(answers: Sequence[Answer]) -> str:
 
     def value(text: str, expr) -> str:
         if expr is not None:
-            return f'<math xmlns="{MATHML_NS}">{value_mathml(_display(expr))}</math>'
+            return f'<math xmlns="{MATHML_NS}">{value_mathml(_display(expr), rates)}</math>'
         return f"<code>{escape(text)}</code>"
 
     out = ["<section id='tutorial'><h2>The tutorial, worked</h2>",
@@ -864,7 +903,8 @@ def render_html(answers: Sequence[Answer]) -> str:
             for c in a.comparisons:
                 printed, mine = c.exprs[:2] if c.exprs else (None, None)
                 verdict = "<span class='ok'>agrees</span>" if c.agrees else "<span class='bad'>differs: misprint</span>"
-                rows.append(f"<tr><td>{escape(c.quantity)}</td><td>{value(c.printed, printed)}</td><td>{value(c.kinedyn, mine)}</td><td>{verdict}</td></tr>")
+                quantity = f'<math xmlns="{MATHML_NS}">{latex_to_mathml(name_latex(c.quantity))}</math>'
+                rows.append(f"<tr><td>{quantity}</td><td>{value(c.printed, printed)}</td><td>{value(c.kinedyn, mine)}</td><td>{verdict}</td></tr>")
             out.append("<table class='comparisons'><thead><tr><th>quantity</th><th>printed</th><th>kinedyn</th><th>verdict</th></tr></thead>"
                        f"<tbody>{''.join(rows)}</tbody></table>")
             for c in a.misprints:
@@ -872,10 +912,6 @@ def render_html(answers: Sequence[Answer]) -> str:
                            f"{value(c.correction or c.kinedyn, c.exprs[1] if c.exprs else None)}. Deciding check: {escape(c.check)}.</p>")
     out.append("</section>")
     return "\n".join(out)
-
-
-def _md_name(name: str) -> str:
-    return r"\text{" + name.replace("_", r"\_").replace("^", r"\^{}") + "}"
 
 
 def render_text(answers: Sequence[Answer], console=None) -> None:

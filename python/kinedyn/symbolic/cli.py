@@ -33,7 +33,7 @@ def cmd_derive(args) -> int:
         )
         fmt = args.format
         if fmt == "latex":
-            text = eom.to_latex()
+            text = eom.to_latex_document()
         elif fmt == "markdown":
             text = eom.to_markdown()
         elif fmt == "mathml":

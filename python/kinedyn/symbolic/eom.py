@@ -25,10 +25,14 @@ class Step:
     equations: List[tuple] = field(default_factory=list)
 
     def to_latex(self, names=None) -> str:
-        lines = [r"\text{" + self.title + "}"]
+        """An amsmath ``align*`` block: the title (prose escaped for TeX) and the equations, long ones
+        broken over lines (see :mod:`kinedyn.symbolic.latex`)."""
+        from .latex import _align, equation_rows, latex_text
+
+        rows = [r"&\text{" + latex_text(self.title) + r"} \\"]
         for lhs, value in self.equations:
-            lines.append(f"{lhs} = {sp.latex(value, symbol_names=names or {})}")
-        return " \\\\\n".join(lines)
+            rows += equation_rows(lhs, value, names=names or {})
+        return _align(rows)
 
     # notebooks (kinedyn.display); a step of an EquationsOfMotion prints q̇, q̈ with its names
     def _repr_html_(self) -> str:
@@ -305,31 +309,47 @@ class EquationsOfMotion:
         return [(of_q("D"), self.M), (of_q("C", rates=True), self.C), (of_q("g"), self.g), (name(r"\tau", "tau", "tau"), self.tau)]
 
     def to_latex(self, steps: bool = True) -> str:
-        """A LaTeX ``align*`` block: the steps of the derivation (if any) and the final matrices."""
-        names = self.latex_names
-        body = []
-        for step in self.steps if steps else []:
-            body.append(r"&\text{" + step.title + r"} \\")
-            for lhs, value in step.equations:
-                body.append(f"{lhs} &= {sp.latex(value, symbol_names=names)} \\\\")
-        body.append(r"&\text{Equations of motion: } D(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau \\")
-        for lhs, value in self._final_equations():
-            body.append(f"{lhs} &= {sp.latex(value, symbol_names=names)} \\\\")
-        return "\\begin{align*}\n" + "\n".join(body) + "\n\\end{align*}"
+        """A LaTeX fragment: one amsmath ``align*`` block with the steps of the derivation (if any, each
+        title a ``\\text`` row) and the final matrices, to paste into a document that loads ``amsmath``
+        (also valid KaTeX/MathJax input). Long sums are broken over lines and wide matrices written
+        entry by entry so that every line fits a 17 cm text width. :meth:`to_latex_document` gives a
+        complete document (``kinedyn derive --format latex``)."""
+        from .latex import fragment
+
+        return fragment(self.steps if steps else [], self._final_equations(), self.latex_names)
+
+    def to_latex_document(self, steps: bool = True) -> str:
+        """A complete LaTeX document (article, amsmath only) that ``pdflatex`` compiles: a section per
+        step with its prose and equations, then the result; see :mod:`kinedyn.symbolic.latex`."""
+        from .latex import document
+
+        title = f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method.replace('_', '-')})"
+        return document(title, self.steps if steps else [], self._final_equations(), self.latex_names)
 
     def to_markdown(self) -> str:
-        """Markdown with LaTeX math (``$$ ... $$``), one section per step."""
+        """Markdown with LaTeX math (``$$ ... $$``, long equations as ``aligned`` blocks broken over
+        lines), one section per step."""
+        from .latex import equation_rows
+
         names = self.latex_names
+
+        def block(lhs, value) -> List[str]:
+            rows = equation_rows(lhs, value, names=names)
+            if len(rows) == 1:
+                return ["$$", rows[0].replace(" &= ", " = ", 1)[: -len(r" \\")], "$$", ""]
+            rows[-1] = rows[-1][: -len(r" \\")]
+            return ["$$", r"\begin{aligned}", *rows, r"\end{aligned}", "$$", ""]
+
         out = [f"# Equations of motion{': ' + self.name if self.name else ''} ({self.method})", ""]
         for k, step in enumerate(self.steps, start=1):
             out += [f"## Step {k}: {step.title}", ""]
             if step.text:
                 out += [step.text, ""]
             for lhs, value in step.equations:
-                out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
+                out += block(lhs, value)
         out += ["## Result: $D(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
         for lhs, value in self._final_equations():
-            out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
+            out += block(lhs, value)
         return "\n".join(out)
 
     def equation_mathml(self, lhs, value, display: str = "block") -> str:

@@ -65,14 +65,14 @@ def _matrix(value) -> List[list]:
 
 
 def state_symbols(robot):
-    """(q, qd, qdd) symbol lists named after the joints: q1 -> qd1, qdd1; shoulder -> shoulder_d, shoulder_dd."""
-    import re
+    """(q, qd, qdd) symbol lists named after the joints: q1 -> qdot1, qddot1 (printed q̇₁, \\dot{q}_{1});
+    shoulder -> shoulderdot, shoulderddot (see :func:`kinedyn.symbolic.render.rate_names`)."""
+    from .render import rate_names
 
     q, qd, qdd = [], [], []
     taken = {str(s) for s in robot.symbols}
     for name in robot.joint_names:
-        m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
-        names = (name, f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (name, f"{name}_d", f"{name}_dd")
+        names = (name, *rate_names(name))
         for n in names:
             if n in taken:
                 raise ValueError(f"joint variable name '{n}' is also a parameter symbol of robot '{robot.name}': rename the joint or the symbol")

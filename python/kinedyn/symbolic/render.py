@@ -1,7 +1,7 @@
 """Names of the quantities in a derivation, in three notations at once, and the MathML of equations.
 
 A :class:`Name` is the LaTeX of a left-hand side (it *is* a ``str``, so code that reads the LaTeX keeps
-working) that also carries its plain-text form (``.text``: ``dL/dqd1``, ``d/dt dL/dqd1``, ``J_vc1``) and
+working) that also carries its plain-text form (``.text``: ``dL/dqdot1``, ``d/dt dL/dqdot1``, ``J_vc1``) and
 its presentation MathML (``.mathml``: ``<mfrac><mrow><mo>∂</mo>...``, ``<mover>`` for the dots of
 q̇ and q̈). Right-hand sides are SymPy expressions, printed by SymPy's presentation MathML printer
 with the velocity and acceleration symbols drawn with their dots.
@@ -19,7 +19,7 @@ from typing import Dict, List, Optional
 import sympy as sp
 from sympy.printing.mathml import MathMLPresentationPrinter
 
-__all__ = ["Name", "name", "of_q", "dL_dqd", "ddt_dL_dqd", "dL_dq", "lagrangian", "symbol_name", "vector_name",
+__all__ = ["rate_names", "legacy_rate_names", "Name", "name", "of_q", "dL_dqd", "ddt_dL_dqd", "dL_dq", "lagrangian", "symbol_name", "vector_name",
            "latex_to_mathml", "value_mathml", "equation_mathml", "text_of", "mathml_of"]
 
 MATHML_NS = "http://www.w3.org/1998/Math/MathML"
@@ -41,6 +41,30 @@ class Name(str):
     @property
     def latex(self) -> str:
         return str.__str__(self)
+
+
+# ------------------------------------------------------------------ velocity and acceleration symbols
+def rate_names(name: str) -> tuple:
+    """Names of the velocity and acceleration symbols of the coordinate ``name``, in SymPy's own
+    accent convention (a base ending in ``dot``/``ddot``): ``q1`` -> ``("qdot1", "qddot1")``,
+    ``theta_2`` -> ``("thetadot_2", "thetaddot_2")``, ``x`` -> ``("xdot", "xddot")``. SymPy's printers
+    draw them with the accent — ``sp.pretty`` q̇₁, ``sp.latex`` ``\\dot{q}_{1}`` (kinedyn's MathML via
+    :func:`rate_symbols`) — while ``str`` stays the plain identifier ``qdot1`` that code generation, ``sympify``
+    and JSON need."""
+    from sympy.printing.conventions import split_super_sub
+
+    base = split_super_sub(name)[0]
+    if not base or not name.startswith(base):
+        return f"{name}dot", f"{name}ddot"
+    rest = name[len(base):]
+    return f"{base}dot{rest}", f"{base}ddot{rest}"
+
+
+def legacy_rate_names(name: str) -> tuple:
+    """The names kinedyn gave the velocity and acceleration symbols before :func:`rate_names`
+    (``q1`` -> ``qd1``, ``qdd1``; ``x`` -> ``x_d``, ``x_dd``): still read in energies written as strings."""
+    m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
+    return (f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (f"{name}_d", f"{name}_dd")
 
 
 # ------------------------------------------------------------------ MathML pieces
@@ -198,9 +222,11 @@ def _xml_entities(m: str) -> str:
 
 
 def value_mathml(value, rates: Optional[Dict[sp.Symbol, str]] = None) -> str:
-    """Presentation MathML of a SymPy expression or matrix (``rates`` from :func:`rate_symbols`)."""
+    """Presentation MathML of a SymPy expression or matrix (``rates`` from :func:`rate_symbols`);
+    brackets and parentheses marked stretchy, so they grow around matrices and fractions."""
     printer = _Printer(rates or {})
-    return _xml_entities(printer.doprint(sp.sympify(value)))
+    m = _xml_entities(printer.doprint(sp.sympify(value)))
+    return re.sub(r"<mo>([()\[\]])</mo>", r'<mo stretchy="true">\1</mo>', m)
 
 
 def equation_mathml(lhs, value, rates=None, display: str = "block") -> str:

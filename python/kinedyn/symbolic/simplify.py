@@ -454,3 +454,62 @@ def simplify_trig(expr, coordinates: Sequence, prismatic: Sequence = (), factor:
     except ValueError:
         return sp.trigsimp(sp.cancel(expr))
     return ring.to_sympy(p, factor)
+
+
+def textbook_form(expr, coordinates: Sequence = (), prismatic: Sequence = ()):
+    """A result of a Lagrangian system (L, multipliers, H and Hamilton's equations, an Euler-Lagrange
+    expression) in the size a textbook prints it; a matrix entry by entry.
+
+    The expression is brought over one denominator (``sympy.together``); numerator and denominator
+    are each put in the trigonometric normal form of :func:`simplify_trig` (so ``sin^2 + cos^2``
+    collapses and products of sines and cosines become sines and cosines of sums), common factors
+    are cancelled, and constants pulled out (``sympy.factor_terms``). The smallest of the candidates
+    by ``sympy.count_ops`` is returned — never a larger expression than the input. Examples: the
+    sphere particle's multiplier ``(2 qd1^2 + ...)/(4 q1^2/m + ...)`` -> ``m (qd1^2 + ...)/(2 (q1^2 + ...))``;
+    the knife edge's ``.../(sin^2/m + cos^2/m)`` loses its denominator."""
+    if isinstance(expr, sp.MatrixBase):
+        return expr.applyfunc(lambda e: textbook_form(e, coordinates, prismatic))
+    expr = sp.sympify(expr)
+    if expr.is_Atom:
+        return expr
+    coordinates, prismatic = list(coordinates), list(prismatic)
+
+    def ring(x):
+        x = sp.expand(x)
+        if coordinates and x.free_symbols & set(coordinates):
+            return simplify_trig(x, coordinates, prismatic=prismatic)
+        return sp.factor_terms(x)
+
+    candidates = [expr]
+    if sp.count_ops(expr) > 300:  # cancel/together on larger fractions takes minutes (the five-bar's H): keep it
+        return expr
+    together = sp.together(expr)
+    num, den = sp.fraction(together)
+    try:
+        num, den = ring(num), ring(den)
+    except (ValueError, TypeError, NotImplementedError):  # not a trigonometric polynomial (sqrt, ...)
+        pass
+    candidates.append(sp.factor_terms(num) / sp.factor_terms(den))
+    try:
+        cancelled = sp.cancel(num / den)
+        n2, d2 = sp.fraction(cancelled)
+        candidates.append(sp.factor_terms(ring(n2)) / sp.factor_terms(ring(d2)))
+    except (sp.PolynomialError, ValueError, TypeError, NotImplementedError):
+        pass
+    if expr.is_Add:  # terms over different denominators (H = p^T M^-1 p / 2 + P): one fraction per denominator
+        groups: Dict[Any, list] = {}
+        try:
+            for term in sp.Add.make_args(expr):
+                n, d = sp.fraction(sp.cancel(sp.together(term)))
+                groups.setdefault(sp.factor_terms(ring(d)), []).append(n)
+            parts = []
+            for d, ns in groups.items():
+                n = ring(sp.Add(*ns))
+                n2, d2 = sp.fraction(sp.cancel(n / d))
+                parts.append(sp.factor_terms(ring(n2)) / sp.factor_terms(ring(d2)))
+            candidates.append(sp.Add(*parts))
+        except (sp.PolynomialError, ValueError, TypeError, NotImplementedError):
+            pass
+    if sp.count_ops(expr) < 60:  # small enough for SymPy's general heuristics (seconds on larger ones)
+        candidates.append(sp.factor_terms(sp.simplify(expr)))
+    return min(candidates, key=lambda e: (sp.count_ops(e), len(str(e))))

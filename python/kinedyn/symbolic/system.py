@@ -28,19 +28,21 @@ from sympy.core.function import AppliedUndef
 from ..description.expressions import parse_expression
 from .eom import EquationsOfMotion, Step
 from .render import lagrangian, name, of_q
-from .simplify import simplify_trig
+from .simplify import simplify_trig, textbook_form
 
 __all__ = ["LagrangianSystem", "coordinates"]
 
 
 def _rate_names(name: str):
-    m = re.fullmatch(r"([A-Za-z]+)(\d+)", name)
-    return (f"{m.group(1)}d{m.group(2)}", f"{m.group(1)}dd{m.group(2)}") if m else (f"{name}_d", f"{name}_dd")
+    from .render import rate_names  # q1 -> qdot1, qddot1 (printed q̇₁); x -> xdot, xddot
+
+    return rate_names(name)
 
 
 def coordinates(names):
     """(q, qd): real symbols for generalised coordinates and their velocities, e.g.
-    ``coordinates("p1 p2")`` -> ([p1, p2], [pd1, pd2]); ``coordinates("x")`` -> ([x], [x_d])."""
+    ``coordinates("p1 p2")`` -> ([p1, p2], [pdot1, pdot2]); ``coordinates("x")`` -> ([x], [xdot]) (SymPy
+    prints them ṗ₁, ẋ)."""
     if isinstance(names, str):
         names = names.replace(",", " ").split()
     q = [sp.Symbol(n, real=True) for n in names]
@@ -137,6 +139,11 @@ class LagrangianSystem:
             raise ValueError("give either K and P or L, not both")
         # in expressions given as strings, coordinate and velocity names are these symbols
         self._names = names = {v.name: v for v in [*coords, *qd, *self.qdd, self.t] if isinstance(v, sp.Symbol)}
+        from .render import legacy_rate_names  # "x_d", "qd1" in strings written before the rename
+
+        for c, v, a in zip(coords, qd, self.qdd):
+            for old_name, sym in zip(legacy_rate_names(c.name), (v, a)):
+                names.setdefault(old_name, sym)
         # SymPy expressions; K and P None when the Lagrangian was given
         self.K: Any = None
         self.P: Any = None
@@ -227,7 +234,7 @@ class LagrangianSystem:
                     K += (w.T * sp.Matrix(I) * w)[0, 0] / 2
                 else:
                     K += sp.sympify(I) * sp.sympify(w) ** 2 / 2
-        return cls(qs, K=sp.expand(K), P=sp.expand(P), qd=vs, **kwargs)
+        return cls(qs, K=textbook_form(K, qs), P=textbook_form(P, qs), qd=vs, **kwargs)
 
     # ------------------------------------------------------------------ derivation
     def _dt(self, e):
@@ -294,7 +301,7 @@ class LagrangianSystem:
         steps = [
             Step("Lagrangian", "L = K - P" if self.K is not None else "given directly", [(lagrangian(), self.L)]),
             Step("Euler-Lagrange equations d/dt dL/dqd_k - dL/dq_k = u_k - B_k - (A^T lambda)_k", "(LaValle eqs. 13.118, 13.181, 13.173)",
-                 [(name(f"E_{{{k + 1}}}", f"E_{k + 1}", "E", f"{k + 1}"), simp(e)) for k, e in enumerate(EL)]),
+                 [(name(f"E_{{{k + 1}}}", f"E_{k + 1}", "E", f"{k + 1}"), self._textbook(simp(e))) for k, e in enumerate(EL)]),
         ]
         if self.A.shape[0]:
             steps.append(Step("Constraints A(q) qd = 0", "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows", [(of_q("A"), self.A)]))
@@ -312,8 +319,16 @@ class LagrangianSystem:
             eom._P = None
         return eom
 
+    def _textbook(self, e):
+        return textbook_form(e, self._trig_coords(), self._poly_coords())
+
     def multipliers(self, u=None, M=None, bias=None):
-        """lambda = (A M^-1 A^T)^-1 (A M^-1 (u - h - B) + (dA/dt) qd), h = C qd + g (see module doc)."""
+        """lambda = (A M^-1 A^T)^-1 (A M^-1 (u - h - B) + (dA/dt) qd), h = C qd + g (see module doc);
+        simplified to textbook size (:func:`kinedyn.symbolic.simplify.textbook_form`) when called
+        without ``M`` and ``bias`` (phase_space passes them and skips that)."""
+        if M is None and bias is None:
+            return self._textbook(self.multipliers(u, sp.hessian(self.L, self.qd),
+                                                   sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])))
         if not self.A.shape[0]:
             return sp.zeros(0, 1)
         u = self.u if u is None else sp.Matrix(u)
@@ -363,10 +378,10 @@ class LagrangianSystem:
         M = sp.hessian(self.L, self.qd)
         qd_of_p = M.LUsolve(p)  # qd = M^-1 p
         P = -self.L.subs({v: 0 for v in self.qd})
-        H = (p.T * qd_of_p)[0, 0] / 2 + P  # H = p^T M^-1 p / 2 + P
-        qdot = sp.Matrix([sp.diff(H, pi) for pi in p])
-        B = self.B.subs(dict(zip(self.qd, qd_of_p)))
-        pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B
+        H = self._textbook((p.T * qd_of_p)[0, 0] / 2 + P)  # H = p^T M^-1 p / 2 + P
+        qdot = self._textbook(sp.Matrix([sp.diff(H, pi) for pi in p]))
+        B = self.B.subs(dict(zip(self.qd, qdot)))
+        pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B  # from the simplified H
         return p, H, qdot, pdot
 
     def _has_time(self) -> bool:
