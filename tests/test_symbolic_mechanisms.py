@@ -206,7 +206,7 @@ def test_lagrangian_system_change_of_coordinates_back_to_joint_angles():
     joint = remote.change_coordinates([[1, 0], [1, 1]], coordinates="q1 q2")
     eom = joint.equations_of_motion()
     arm = kd.robots.planar_2r(symbolic=True).equations_of_motion(steps=False)
-    assert [c.name for c in joint.q] == ["q1", "q2"] and [c.name for c in joint.qd] == ["qd1", "qd2"]
+    assert [c.name for c in joint.q] == ["q1", "q2"] and [c.name for c in joint.qd] == ["qdot1", "qdot2"]
     rename = dict(zip(arm.q, eom.q)) | dict(zip(arm.qd, eom.qd))
     assert _same(eom.M, arm.M.xreplace(rename))
     assert _same(eom.C, arm.C.xreplace(rename))
