@@ -17,6 +17,7 @@ import sympy as sp
 from ._arrays import finite_result, real_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
+from .description.geometry import Visual
 from .description.joint import Joint
 from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
@@ -62,8 +63,14 @@ class Robot:
         dh_convention: Optional[str] = None,
         source: str = "",
         inertia: str = "warn",
+        visuals: Sequence[Visual] = (),
+        collisions: Sequence[Visual] = (),
     ):
         self.name = name
+        # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
+        # kinedyn.visual draws them (a robot without any gets solid links along its kinematics)
+        self.visuals: tuple = tuple(visuals)
+        self.collisions: tuple = tuple(collisions)
         # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
         self.links, self.nonphysical = judge_inertias(links, inertia)
         self.inertia_policy = inertia
@@ -134,6 +141,8 @@ class Robot:
             dh_convention=self.dh_convention,
             source=self.source,
             inertia=self.inertia_policy,
+            visuals=self.visuals,
+            collisions=self.collisions,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
