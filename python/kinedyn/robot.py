@@ -368,6 +368,15 @@ class Robot:
         except KeyError:
             raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
 
+    def show(self, q: Optional[ArrayLike] = None, *, block: Optional[bool] = None, **kwargs):
+        """Open a live 3-D view of the robot at ``q`` in the browser (a viser server on localhost; its
+        URL is printed): meshes, frames, a slider per joint. Returns the :class:`kinedyn.visual.viewer.Viewer`;
+        ``block``: wait until Ctrl-C (default: from a script yes, in Jupyter no). ``kwargs``: host,
+        port, geometry ("visual" or "collision"). See docs/visualisation.md."""
+        from .visual.viewer import show
+
+        return show(self, q, block=block, **kwargs)
+
     def __repr__(self) -> str:
         return f"Robot(name={self.name!r}, n={self.n}, joints={self.joint_names}, tool={self.tool!r})"
 

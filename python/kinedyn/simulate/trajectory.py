@@ -249,6 +249,17 @@ class Trajectory:
             P = np.concatenate([P, np.zeros(P.shape[:-1] + (1,))], axis=-1)
         return P
 
+    def show(self, *, block: Optional[bool] = None, **kwargs):
+        """Play the motion in the live 3-D viewer (:meth:`kinedyn.Robot.show`, with a time slider and
+        play/pause). Returns the viewer; ``block`` as for ``Robot.show``."""
+        from ..visual.viewer import show
+
+        if self.batch is not None:
+            raise TypeError("show() plays one trajectory: use traj[i].show()")
+        if not hasattr(self.system, "frame_poses"):
+            raise TypeError("show() needs a trajectory of a kinedyn.Robot; use animate() for other systems")
+        return show(self.system, np.asarray(self.q, dtype=float)[0], trajectory=self, block=block, **kwargs)
+
     def animate(self, path, fps: int = 25, duration: Optional[float] = None, trail: bool = True):
         """A stick figure of the motion: GIF (``.gif``, Pillow), HTML (``.html``, self-contained
         JavaScript player) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
