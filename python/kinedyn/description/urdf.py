@@ -390,7 +390,8 @@ def _geometry(root, links: list, src: _Source) -> tuple:
     """(visuals, collisions) of every link, in file order."""
     materials = _materials(root, src)
     base_dir = None if src.label.startswith("<") else os.path.dirname(os.path.abspath(src.label))
-    visuals, collisions = [], []
+    visuals: list = []
+    collisions: list = []
     for link_name, element in links:
         for kind, out in (("visual", visuals), ("collision", collisions)):
             for k, item in enumerate(element.iterfind(kind)):

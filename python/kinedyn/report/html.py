@@ -47,7 +47,7 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
     once, in its frame's coordinates: kinedyn.visual.web)."""
     import warnings
 
-    from ..visual.scene import DEFAULT_BUDGET, MissingMeshWarning, robot_scene
+    from ..visual.scene import DEFAULT_BUDGET, MissingMeshWarning, robot_scene, scene_bounds
     from ..visual.web import encode_scene
 
     with warnings.catch_warnings():
@@ -66,7 +66,13 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
     frames = [{"name": f.name, "body": int(f.body), "placement": np.asarray(f.placement, dtype=float).ravel().tolist()} for f in tree.frames]
     # size of the scene: the farthest frame origin over q and a few random configurations
     qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
-    reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 1e-3)
+    origins = np.vstack([np.zeros((1, 3)), robot.frame_poses(qs)[..., :3, 3].reshape(-1, 3)])
+    reach = max(float(np.max(np.linalg.norm(origins, axis=-1))), 1e-3)
+    # the cube the view shows: around every frame origin of those configurations, with a margin for the meshes
+    lo, hi = origins.min(axis=0), origins.max(axis=0)
+    half = float(np.max(hi - lo)) / 2 + 0.12 * reach
+    # the camera looks at the robot as it stands at q: the box of its shapes (and frame origins)
+    focus_lo, focus_hi = scene_bounds(robot, scene, q)
     gravity = np.asarray(robot.gravity, dtype=float)
     up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
     axes = np.array([np.asarray(robot.pose(q, name)[:3, 2]) for name in robot.body_names])
@@ -87,7 +93,9 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
         "q": [float(x) for x in q],
         "tool": robot.tool,
         "reach": reach,
-        "center": [0.0, 0.0, 0.0] if planar else (0.5 * reach * up).tolist(),
+        "center": ((lo + hi) / 2).tolist(),
+        "half": half,
+        "focus": {"center": ((focus_lo + focus_hi) / 2).tolist(), "size": float(np.linalg.norm(focus_hi - focus_lo))},
         "up": up.tolist(),
         "view_from": np.asarray(view_from, dtype=float).tolist(),
         "planar": bool(planar),  # drawn as the textbook's figure: orthographic, along the joint axes

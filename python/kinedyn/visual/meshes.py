@@ -14,7 +14,7 @@ import os
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import List, Optional, Tuple
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 
@@ -48,7 +48,8 @@ class Part:
 def box(size) -> Part:
     """A box of full side lengths ``size`` centred on its frame: 12 triangles, 24 vertices (flat faces)."""
     hx, hy, hz = (0.5 * float(s) for s in size)
-    vertices, faces = [], []
+    vertices: list = []
+    faces: list = []
     for axis in range(3):
         for sign in (-1.0, 1.0):
             u, v = (axis + 1) % 3, (axis + 2) % 3
@@ -133,7 +134,10 @@ def _read(path: str, mtime_ns: int, size: int) -> Tuple[Part, ...]:
         by_colour.setdefault(_colour(m), []).append(m)
     parts = []
     for rgba, group in by_colour.items():
-        merged = group[0] if len(group) == 1 else trimesh.util.concatenate(group)
+        merged: Any = group[0] if len(group) == 1 else trimesh.util.concatenate(group)
+        # one vertex per position (files often repeat them per face): smaller, and decimation then
+        # collapses edges of a connected surface instead of tearing it
+        merged = trimesh.Trimesh(np.asarray(merged.vertices), np.asarray(merged.faces), process=True)
         v = np.asarray(merged.vertices, dtype=np.float64)
         if not np.all(np.isfinite(v)):
             raise ValueError(f"mesh '{path}' has vertices that are not finite numbers")

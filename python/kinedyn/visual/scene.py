@@ -110,6 +110,16 @@ def robot_scene(robot, geometry: str = "visual", budget: int = DEFAULT_BUDGET, s
     return scene
 
 
+def scene_bounds(robot, scene: Scene, q) -> Tuple[np.ndarray, np.ndarray]:
+    """(lo, hi): the box around the robot drawn at ``q`` (its shapes, frame origins and the base)."""
+    poses = robot.frame_poses(np.asarray(q, dtype=float))
+    by_name = dict(zip(robot.frame_names, poses))
+    points = [np.zeros((1, 3)), poses[:, :3, 3]]
+    points += [sp.part.vertices @ by_name[sp.frame][:3, :3].T + by_name[sp.frame][:3, 3] for sp in scene.parts]
+    allp = np.vstack(points)
+    return allp.min(axis=0), allp.max(axis=0)
+
+
 def _is_plain(rgba) -> bool:
     """A mesh colour that only says "no colour" (white or default grey), so the URDF material wins."""
     return rgba is None or all(c >= 0.99 for c in rgba[:3])

@@ -20,7 +20,7 @@ from typing import Any, List, Optional
 
 import numpy as np
 
-from .scene import DEFAULT_BUDGET, robot_scene
+from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
 
 __all__ = ["Viewer", "show"]
 
@@ -30,7 +30,7 @@ def _in_notebook() -> bool:
     if shell is None:
         return False
     try:
-        ip = shell.get_ipython()  # type: ignore[attr-defined]
+        ip = shell.get_ipython()
     except Exception:
         return False
     return ip is not None and "IPKernelApp" in getattr(ip, "config", {})
@@ -101,16 +101,17 @@ class Viewer:
         self._lock = threading.Lock()
         self._playing = False
         scene = self.server.scene
-        scene.set_up_direction(tuple(float(v) for v in self._up()))
+        scene.set_up_direction(np.asarray(self._up(), dtype=float))
         scene.add_frame("/base_axes", axes_length=0.25 * reach, axes_radius=0.006 * reach)
         up = self._up()
         if abs(up[2]) > 0.99:  # a floor grid through the base, perpendicular to "up"
             scene.add_grid("/grid", width=2.4 * reach, height=2.4 * reach, cell_size=reach / 5, section_size=reach, position=(0.0, 0.0, 0.0))
-        look = np.array([0.0, 0.0, 0.0]) + 0.35 * reach * up
+        lo, hi = scene_bounds(robot, self.scene, self.q)  # look at the robot as it stands at q
+        look = (lo + hi) / 2
         view_from = np.asarray(_view_direction(robot, self.q, up), dtype=float)
         camera = self.server.initial_camera
         camera.look_at = tuple(look)
-        camera.position = tuple(look + 2.3 * reach * view_from / np.linalg.norm(view_from))
+        camera.position = tuple(look + 1.1 * float(np.linalg.norm(hi - lo)) * view_from / np.linalg.norm(view_from))
         camera.up = tuple(up)
         self._mesh_handles: List[Any] = []
         for k, name in enumerate(self.scene.frames):
@@ -120,7 +121,7 @@ class Viewer:
             rgba = sp.part.rgba or (0.7, 0.7, 0.7, 1.0)
             self._mesh_handles.append(scene.add_mesh_simple(
                 f"/robot/f{frame}/mesh{m}", np.asarray(sp.part.vertices, dtype=np.float32), np.asarray(sp.part.faces, dtype=np.uint32),
-                color=tuple(int(round(255 * c)) for c in rgba[:3]), opacity=None if rgba[3] >= 1 else float(rgba[3]), side="double"))
+                color=np.round(255 * np.asarray(rgba[:3], dtype=float)).astype(np.uint8), opacity=None if rgba[3] >= 1 else float(rgba[3]), side="double"))
         self._tool = scene.add_frame("/tool", axes_length=0.12 * reach, axes_radius=0.005 * reach)
         self._stick = scene.add_line_segments("/stick", self._stick_points(self.q), (55, 71, 79), thickness=3.0, thickness_units="screen")
         self._gui(robot)
@@ -174,7 +175,7 @@ class Viewer:
     # ------------------------------------------------------------------ controls
     def _gui(self, robot) -> None:
         gui = self.server.gui
-        self._sliders: list = []
+        self._sliders: List[Any] = []
         self._quiet = False
         with gui.add_folder("Joints"):
             for i, j in enumerate(robot.joints):
@@ -190,13 +191,14 @@ class Viewer:
             reset = gui.add_button("reset")
             start = self.q.copy()
             reset.on_click(lambda _: self.set_q(start))
-        self._time = None
+        self._time: Any = None
         if self.trajectory is not None:
             t = np.asarray(self.trajectory.t, dtype=float)
             with gui.add_folder("Playback"):
                 self._time = gui.add_slider("t [s]", min=float(t[0]), max=float(t[-1]), step=float((t[-1] - t[0]) / max(len(t) - 1, 1)) or 1.0,
                                             initial_value=float(t[0]))
-                self._time.on_update(lambda _: None if self._quiet else self.show_time(self._time.value))
+                time_slider = self._time
+                time_slider.on_update(lambda _: None if self._quiet else self.show_time(time_slider.value))
                 play = gui.add_button("play / pause")
                 play.on_click(lambda _: self.play() if not self._playing else self.pause())
 

@@ -82,15 +82,19 @@
   // ---------------------------------------------------------------- the plot
   const view = document.getElementById("kinedyn-view");
   let q = model.q.slice();
-  const R = model.reach * 1.05, c = model.center;
-  const axis = (k, name) => ({ range: [c[k] - R, c[k] + R], title: { text: name }, backgroundcolor: "#f4f5f1", showbackground: true,
-                               gridcolor: "#dcded8", zerolinecolor: "#b9bdb5", tickfont: { size: 10 } });
-  const eye = model.view_from.map((v) => 1.05 * v);  // plotly eye units: the scene cube is about 1 across
+  const R = model.half, c = model.center;
+  const axis = (k, name) => ({ range: [c[k] - R, c[k] + R], title: { text: name }, backgroundcolor: "#d2d9dd", showbackground: true,
+                               gridcolor: "#bcc5cb", zerolinecolor: "#9aa5ac", tickfont: { size: 10 } });
+  // the camera looks at the robot at q (the box of its shapes, model.focus) from model.view_from; plotly's
+  // camera coordinates: the scene cube spans [-0.5, 0.5] in each axis
+  const focus = model.focus || { center: c, size: 2 * R };
+  const fc = [0, 1, 2].map((k) => (focus.center[k] - c[k]) / (2 * R));
+  const distance = Math.max(0.3, 1.35 * focus.size / (2 * R));
+  const eye = [0, 1, 2].map((k) => fc[k] + distance * model.view_from[k] / Math.hypot(...model.view_from));
   const layout = {
-    margin: { l: 0, r: 0, t: 0, b: 0 }, showlegend: false, uirevision: "kinedyn", paper_bgcolor: "#fbfbf8",
+    margin: { l: 0, r: 0, t: 0, b: 0 }, showlegend: false, uirevision: "kinedyn", paper_bgcolor: "#eef1f2",
     scene: { xaxis: axis(0, "x [m]"), yaxis: axis(1, "y [m]"), zaxis: axis(2, "z [m]"), aspectmode: "cube",
-             camera: { eye: { x: eye[0], y: eye[1], z: eye[2] }, up: { x: model.up[0], y: model.up[1], z: model.up[2] }, center: { x: 0, y: 0, z: 0 },
-                       projection: { type: model.planar ? "orthographic" : "perspective" } } },
+             camera: { eye: { x: eye[0], y: eye[1], z: eye[2] }, up: { x: model.up[0], y: model.up[1], z: model.up[2] }, center: { x: fc[0], y: fc[1], z: fc[2] } } },
   };
   const config = { displaylogo: false, responsive: true, modeBarButtonsToRemove: ["toImage"] };
   const drawnVisuals = new Set();
@@ -114,7 +118,7 @@
       }
       out.push({ type: "mesh3d", x: x, y: y, z: z, i: t.i, j: t.j, k: t.k, color: colour(t.rgba), opacity: t.rgba[3],
                  flatshading: false, hoverinfo: "skip",
-                 lighting: { ambient: 0.45, diffuse: 0.75, specular: 0.25, roughness: 0.5, fresnel: 0.15 },
+                 lighting: { ambient: 0.45, diffuse: 0.75, specular: 0.25, roughness: 0.5, fresnel: 0.15, facenormalsepsilon: 0, vertexnormalsepsilon: 0 },
                  lightposition: { x: 2 * R * model.view_from[0] + R, y: 2 * R * model.view_from[1] + R, z: 3 * R } });
     }
     // the stick figure: parent joint -> joint, joint -> each frame its body carries
