@@ -335,3 +335,37 @@ def test_view_command(capsys):
 
     assert main(["view", "puma560", "--q", "0", "30", "0", "0", "0", "0", "--deg", "--no-wait", "--port", str(free_port())]) == 0
     assert "http://localhost:" in capsys.readouterr().out
+
+
+def test_html_animations_are_offline(tmp_path, browser):
+    """Trajectory.animate(.html): a robot's is the mesh view (each mesh once, joint values per frame),
+    any other system's is matplotlib's player without its CDN stylesheet; neither fetches anything."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from kinedyn.simulate.systems import MechanicalSystem
+
+    robot = kd.Robot.from_urdf(erd(*UR5))
+    traj = kd.simulate.simulate(robot, (0.0, 0.4), np.zeros(2 * robot.n), dt=1e-3)
+    path = traj.animate(tmp_path / "ur5.html", fps=25)
+    page = path.read_text()
+    assert 'id="kinedyn-model"' in page and page.count('"vertices"') == len(model_block(page)["meshes"])
+    assert model_block(page)["shapes_drawn"] == len(robot.visuals)
+    pendulum = MechanicalSystem(1, lambda q: np.eye(1), lambda q, qd: np.array([9.81 * np.sin(q[0])]),
+                                points=lambda q: np.array([[0.0, 0.0], [np.sin(q[0]), -np.cos(q[0])]]), name="pendulum")
+    swing = kd.simulate.simulate(pendulum, (0.0, 0.2), np.array([0.5, 0.0]), dt=1e-2)
+    other = swing.animate(tmp_path / "pendulum.html", fps=10).read_text()
+    assert "font-awesome" not in other and "<link" not in other and "\u25b6" in other
+    context = browser.new_context()
+    for p in (path, tmp_path / "pendulum.html"):
+        tab = context.new_page()
+        requests, errors = watch(tab, "file:")
+        tab.goto(p.resolve().as_uri())
+        tab.wait_for_load_state("load")
+        if p == path:
+            tab.wait_for_function("window.kinedyn && window.kinedyn.ready()", timeout=60000)
+            tab.evaluate("window.kinedyn.ready()")
+            assert tab.evaluate("window.kinedyn.drawnVisuals()") == list(range(len(robot.visuals)))
+        assert requests == [p.resolve().as_uri()], requests
+        assert errors == [], errors
+    context.close()
