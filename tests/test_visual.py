@@ -369,3 +369,32 @@ def test_html_animations_are_offline(tmp_path, browser):
         assert requests == [p.resolve().as_uri()], requests
         assert errors == [], errors
     context.close()
+
+
+def test_robot_files_name_meshes_and_shapes(tmp_path):
+    """YAML visuals: (link, mesh|box|cylinder|sphere, scale, origin, color) on a DH robot's links; a
+    mesh path relative to the file; saved and loaded again; bad entries name the entry."""
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(tmp_path / "cube.stl")
+    (tmp_path / "arm.yaml").write_text("""name: arm
+joints:
+  - {a: 0.5}
+  - {a: 0.4}
+visuals:
+  - {link: link1, box: [0.5, 0.08, 0.08], origin: {xyz: [-0.25, 0, 0]}, color: [0.2, 0.4, 0.8, 1]}
+  - {link: link2, mesh: cube.stl, scale: [4, 0.8, 0.8], origin: {xyz: [-0.2, 0, 0]}}
+  - {link: tool, cylinder: {radius: 0.02, length: 0.1}}
+""")
+    robot = kd.load(tmp_path / "arm.yaml")
+    scene = robot_scene(robot)
+    assert scene.shapes == scene.drawn == 3 and not scene.generated
+    mesh = np.vstack([p.part.vertices for p in scene.parts if p.visual == 1])
+    np.testing.assert_allclose(mesh.min(axis=0), [-0.4, -0.04, -0.04], atol=1e-6)
+    assert [p.part.rgba for p in scene.parts if p.visual == 0] == [(0.2, 0.4, 0.8, 1.0)]
+    robot.save(tmp_path / "again.yaml")
+    again = kd.load(tmp_path / "again.yaml")
+    assert len(again.visuals) == 3 and robot_scene(again).drawn == 3
+    text = (tmp_path / "arm.yaml").read_text()
+    for bad, message in [("box: [0.5, 0.08, 0.08]", "visuals\\[0\\].*exactly one of"), ("link: link2", "names links \\['nope'\\]")]:
+        (tmp_path / "bad.yaml").write_text(text.replace(bad, bad + ", sphere: 1" if "box" in bad else "link: nope"))
+        with pytest.raises(ValueError, match=message):
+            kd.load(tmp_path / "bad.yaml")
