@@ -77,6 +77,8 @@
     for (let f = 0; f < F; f++) { t.i[f] = t.faces[3 * f]; t.j[f] = t.faces[3 * f + 1]; t.k[f] = t.faces[3 * f + 2]; }
     delete t.faces;
   }
+  // plotly reads <b>, <br>, <a> ... in text as markup: a name is shown as itself through entities
+  const plain = (s) => String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
   const colour = (c) => "rgb(" + Math.round(255 * c[0]) + "," + Math.round(255 * c[1]) + "," + Math.round(255 * c[2]) + ")";
 
   // ---------------------------------------------------------------- the plot
@@ -132,7 +134,7 @@
       const p = origin(K.body[i]);
       jx.push(p[0]); jy.push(p[1]); jz.push(p[2]);
       jc.push(model.bodies[i].kind === "revolute" ? "#ff9800" : "#8e24aa");
-      jt.push(model.joint_names[i]);
+      jt.push(plain(model.joint_names[i]));
     }
     out.push({ type: "scatter3d", mode: model.label_joints ? "markers+text" : "markers", x: jx, y: jy, z: jz, text: jt, textposition: "bottom right",
                textfont: { size: 11, color: "#333" }, marker: { size: 4, color: jc, line: { color: "#4e342e", width: 1 } }, hovertemplate: "%{text}<extra></extra>" });
