@@ -162,6 +162,10 @@ def test_robots_without_meshes_get_solid_links():
     parts = [p.part for p in robot_scene(puma).parts if p.frame == "link2" and p.part.rgba[0] < 0.9]
     spans = [np.ptp(p.vertices, axis=0) for p in parts]
     assert any(abs(s[0] - 0.4318) < 1e-3 and s[1] < 0.1 for s in spans), spans
+    # link 3 (d3 = 0.15005, a3 = 0.0203): one cylinder along d (z of frame 2: y of link 3's frame),
+    # then one along a (x of link 3's frame), not a slanted bar between the joints
+    spans = [np.ptp(p.part.vertices, axis=0) for p in robot_scene(puma).parts if p.frame == "link3" and p.part.rgba[0] < 0.9]
+    assert any(abs(s[1] - 0.15005) < 1e-3 for s in spans) and any(abs(s[0] - 0.0203) < 1e-3 for s in spans), spans
 
 
 # ------------------------------------------------------------------ §2 the report
