@@ -142,6 +142,16 @@ def _segment(start, end, radius: float) -> Optional[Part]:
     return cylinder(radius, length, sections=16).transformed(T)
 
 
+def _carriage(axis: np.ndarray, size: float) -> Part:
+    """A cube of side ``size`` with one edge along ``axis`` (the block of a prismatic joint)."""
+    z = axis / np.linalg.norm(axis)
+    x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
+    x /= np.linalg.norm(x)
+    T = np.eye(4)
+    T[:3, :3] = np.c_[x, np.cross(z, x), z]
+    return box((size, size, 1.4 * size)).transformed(T)
+
+
 def _split(p: np.ndarray, axis: np.ndarray, first: bool) -> List[np.ndarray]:
     """Corner points of the path to ``p``: along ``axis`` first (DH standard: d then a) or last
     (modified: a then d); the straight line when the split would not be a right angle."""
@@ -156,9 +166,8 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
     """Cylinders for a robot without visuals: one along each joint axis at the joint, and links from
     each body's joint to the joints and frames it carries (DH robots: along d, then a)."""
     tree = robot.tree
-    q0 = np.zeros(robot.n)
-    poses = robot.frame_poses(q0)
-    reach = max(float(np.max(np.linalg.norm(poses[:, :3, 3], axis=-1))), 0.05)
+    qs = np.vstack([np.zeros(robot.n), robot.random_configuration(np.random.default_rng(1), size=32)])
+    reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 0.05)
     r = 0.03 * reach
     out: List[Tuple[str, Part]] = []
     standard = getattr(robot, "dh_convention", None) == "standard"
@@ -208,10 +217,28 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
         frame, body_from_frame = body_pose_frame(i)
         axis = np.asarray(b.joint.axis, dtype=float)
         axis /= np.linalg.norm(axis)
-        part = _segment(-1.6 * r * axis, 1.6 * r * axis, 1.7 * r)
+        part = _segment(-1.6 * r * axis, 1.6 * r * axis, 1.7 * r) if b.joint.kind == "revolute" else _carriage(axis, 2.2 * r)
         if part is not None:
             rgba = REVOLUTE_RGBA if b.joint.kind == "revolute" else PRISMATIC_RGBA
             out.append((frame, Part(part.vertices, part.faces, rgba).transformed(np.linalg.inv(body_from_frame))))
+    # prismatic joints: a rail fixed to the parent along the joint's travel (its limits, or the
+    # robot's reach), on which the joint's block slides
+    for i, b in enumerate(tree.bodies):
+        if b.joint.kind != "prismatic":
+            continue
+        lo, hi = float(robot.lower_limits[i]), float(robot.upper_limits[i])
+        lo, hi = (lo if np.isfinite(lo) else -0.5 * reach), (hi if np.isfinite(hi) else 0.5 * reach)
+        offset = float(b.joint.offset)
+        placement = np.asarray(b.placement, dtype=float)
+        axis = placement[:3, :3] @ (np.asarray(b.joint.axis, dtype=float) / np.linalg.norm(b.joint.axis))
+        rail = _segment(placement[:3, 3] + (lo + offset) * axis, placement[:3, 3] + (hi + offset) * axis, 0.6 * r)
+        if rail is not None:
+            if b.parent < 0:
+                frame, to_frame = tree.base, np.eye(4)
+            else:
+                frame, body_from_frame = body_pose_frame(b.parent)
+                to_frame = np.linalg.inv(body_from_frame)
+            out.append((frame, Part(rail.vertices, rail.faces, (0.36, 0.40, 0.43, 1.0)).transformed(to_frame)))
     # a pedestal under the base
     g = np.asarray(robot.gravity, dtype=float)
     up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
