@@ -154,9 +154,14 @@ def test_robots_without_meshes_get_solid_links():
         q = default_configuration(robot)
         poses = dict(zip(robot.frame_names, robot.frame_poses(q)))
         world = np.vstack([p.part.vertices @ poses[p.frame][:3, :3].T + poses[p.frame][:3, 3] for p in scene.parts])
-        reach = max(float(np.max(np.linalg.norm(robot.frame_poses(np.zeros(robot.n))[:, :3, 3], axis=-1))), 0.05)
+        qs = robot.random_configuration(np.random.default_rng(1), size=32)
+        reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 0.05)
         for point in [*robot.forward_kinematics(q)[:, :3, 3], robot.pose(q)[:3, 3]]:
             assert np.min(np.linalg.norm(world - point, axis=1)) < 0.12 * reach, (name, point)
+    # prismatic joints: a rail on the parent as long as the travel (without limits: the robot's reach)
+    cart = kd.robots.cartesian_2p()
+    rails = [np.ptp(p.part.vertices, axis=0).max() for p in robot_scene(cart).parts if p.frame == "base"]
+    assert max(rails) > 1.0, rails
     # standard DH: the puma's link 2 (a2 = 0.4318 along x, d = 0) is one cylinder along its x axis
     puma = kd.robots.puma560()
     parts = [p.part for p in robot_scene(puma).parts if p.frame == "link2" and p.part.rgba[0] < 0.9]
