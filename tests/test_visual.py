@@ -280,6 +280,19 @@ def test_panda_report_draws_the_meshes_in_chromium(browser, panda_report):
 
 
 # ------------------------------------------------------------------ §3 the live viewer
+def settled_screenshot(page, timeout: float = 40.0) -> bytes:
+    """A screenshot once the picture stops changing (viser streams the meshes and fades them in)."""
+    last = page.screenshot()
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        time.sleep(1.0)
+        shot = page.screenshot()
+        if nonblank_diff(shot, last) == 0.0:
+            return shot
+        last = shot
+    return last
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -297,12 +310,10 @@ def test_live_viewer_of_the_panda(browser):
         requests, errors = watch(page, viewer.url)
         page.goto(viewer.url)
         page.wait_for_selector("canvas", timeout=60000)
-        time.sleep(5)
-        shown = page.screenshot()
+        shown = settled_screenshot(page)
         for h in viewer._mesh_handles:
             h.visible = False
-        time.sleep(2)
-        hidden = page.screenshot()
+        hidden = settled_screenshot(page)
         if os.environ.get("KINEDYN_VISUAL_SCREENSHOTS"):  # for a person to look at
             for name, png in (("panda-viewer.png", shown), ("panda-viewer-no-meshes.png", hidden)):
                 open(os.path.join(os.environ["KINEDYN_VISUAL_SCREENSHOTS"], name), "wb").write(png)
@@ -310,9 +321,8 @@ def test_live_viewer_of_the_panda(browser):
         for h in viewer._mesh_handles:
             h.visible = True
         viewer._sliders[1].value = 0.9  # as a user moving the slider: the callback moves the robot
-        time.sleep(2)
+        moved = settled_screenshot(page)
         assert viewer.q[1] == pytest.approx(0.9)
-        moved = page.screenshot()
         assert nonblank_diff(shown, moved) > 0.01
         hosts = {u.split("/")[2] for u in requests if "://" in u and not u.startswith(("data:", "blob:"))}
         assert hosts == {viewer.url.split("/")[2]}, hosts
