@@ -111,7 +111,7 @@ class Viewer:
         view_from = np.asarray(_view_direction(robot, self.q, up), dtype=float)
         camera = self.server.initial_camera
         camera.look_at = tuple(look)
-        camera.position = tuple(look + 1.1 * float(np.linalg.norm(hi - lo)) * view_from / np.linalg.norm(view_from))
+        camera.position = tuple(look + 0.95 * float(np.linalg.norm(hi - lo)) * view_from / np.linalg.norm(view_from))
         camera.up = tuple(up)
         self._mesh_handles: List[Any] = []
         for k, name in enumerate(self.scene.frames):
