@@ -716,6 +716,7 @@ def _command_modules() -> list:
         ("kinedyn.simulate.cli", "add_simulate_commands"),
         ("kinedyn.analysis.cli", "add_analysis_commands"),
         ("kinedyn.report.cli", "add_report_commands"),
+        ("kinedyn.visual.cli", "add_view_command"),
     ]
 
 

@@ -17,6 +17,7 @@ import sympy as sp
 from ._arrays import finite_result, real_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
+from .description.geometry import Visual
 from .description.joint import Joint
 from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
@@ -62,8 +63,14 @@ class Robot:
         dh_convention: Optional[str] = None,
         source: str = "",
         inertia: str = "warn",
+        visuals: Sequence[Visual] = (),
+        collisions: Sequence[Visual] = (),
     ):
         self.name = name
+        # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
+        # kinedyn.visual draws them (a robot without any gets solid links along its kinematics)
+        self.visuals: tuple = tuple(visuals)
+        self.collisions: tuple = tuple(collisions)
         # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
         self.links, self.nonphysical = judge_inertias(links, inertia)
         self.inertia_policy = inertia
@@ -136,6 +143,8 @@ class Robot:
             dh_convention=self.dh_convention,
             source=self.source,
             inertia=self.inertia_policy,
+            visuals=self.visuals,
+            collisions=self.collisions,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
@@ -369,6 +378,15 @@ class Robot:
             return self._frame_ids[frame]
         except KeyError:
             raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
+
+    def show(self, q: Optional[ArrayLike] = None, *, block: Optional[bool] = None, **kwargs):
+        """Open a live 3-D view of the robot at ``q`` in the browser (a viser server on localhost; its
+        URL is printed): meshes, frames, a slider per joint. Returns the :class:`kinedyn.visual.viewer.Viewer`;
+        ``block``: wait until Ctrl-C (default: from a script yes, in Jupyter no). ``kwargs``: host,
+        port, geometry ("visual" or "collision"). See docs/visualisation.md."""
+        from .visual.viewer import show
+
+        return show(self, q, block=block, **kwargs)
 
     def __repr__(self) -> str:
         return f"Robot(name={self.name!r}, n={self.n}, joints={self.joint_names}, tool={self.tool!r})"

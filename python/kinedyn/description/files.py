@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 
 __all__ = ["load", "save", "robot_from_mapping", "robot_to_mapping"]
 
-_TOP_COMMON = {"name", "gravity", "units", "frames", "source"}
+_TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals"}
 _TOP_DH = _TOP_COMMON | {"convention", "base_pose", "tool", "tool_frame", "joints"}
 _TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
 _ROW_KEYS = {"theta", "d", "a", "alpha", "type", "name", "limits", "mass", "com", "inertia",
@@ -54,6 +54,8 @@ _INERTIAL_KEYS = {"mass", "com", "inertia"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _POSE_KEYS = {"xyz", "rpy"}
 _FRAME_KEYS = {"name", "link", "origin"}
+_VISUAL_KEYS = {"link", "origin", "color", "mesh", "scale", "box", "cylinder", "sphere"}
+_SHAPE_KEYS = ("mesh", "box", "cylinder", "sphere")
 _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 # Bounds on a robot file, so that a small hostile file cannot ask for unbounded time or memory
@@ -450,8 +452,15 @@ def robot_from_mapping(data, where: str = "<robot mapping>", inertia: str = "war
         "inertia": inertia,
     }
     frames = _frames(r, data.get("frames", []))
+    visuals = _visuals(r, data.get("visuals", []), where)
     try:
-        return _dh_robot(r, data, common, frames) if dh else _tree_robot(r, data, common, frames)
+        robot = _dh_robot(r, data, common, frames) if dh else _tree_robot(r, data, common, frames)
+        if visuals:
+            unknown = sorted({v.frame for v in visuals} - set(robot.frame_names))
+            if unknown:
+                r.fail("visuals", f"names links {unknown} that the robot does not have (frames: {robot.frame_names})")
+            robot = robot.replace(visuals=visuals)
+        return robot
     except ValueError as e:
         if str(e).startswith(where):
             raise
@@ -472,6 +481,53 @@ def _frames(r: _Reader, raw) -> list:
             out.append(Frame(name, link, origin))
         except ValueError as e:  # the description's own checks (finite, bounded placement)
             r.fail(ctx, str(e))
+    return out
+
+
+def _visuals(r: _Reader, raw, where: str) -> list:
+    """``visuals:`` [{link, mesh|box|cylinder|sphere, scale, origin, color}] (docs/visualisation.md)."""
+    from .geometry import Box, Cylinder, Mesh, Sphere, Visual
+
+    base_dir = os.path.dirname(os.path.abspath(where)) if not where.startswith("<") else None
+    out = []
+    for i, v in enumerate(r.items(raw, "visuals", "{link, mesh | box | cylinder | sphere, ...}", lambda i: f"visuals[{i}]")):
+        ctx = f"visuals[{i}]"
+        v = r.check_keys(v, _VISUAL_KEYS, ctx)
+        if "link" not in v:
+            r.fail(ctx, "a visual needs the 'link' it is fixed to")
+        shapes = [k for k in _SHAPE_KEYS if k in v]
+        if len(shapes) != 1:
+            r.fail(ctx, f"a visual needs exactly one of {', '.join(_SHAPE_KEYS)}, got {shapes or 'none'}")
+        kind = shapes[0]
+        shape: object
+        if kind == "mesh":
+            sx, sy, sz = (r.number(x, f"{ctx}.scale") for x in r.vector(v.get("scale", [1, 1, 1]), f"{ctx}.scale"))
+            if 0 in (sx, sy, sz):
+                r.fail(f"{ctx}.scale", "may not hold 0")
+            shape = Mesh(r.text(v["mesh"], f"{ctx}.mesh"), (sx, sy, sz), base_dir)
+        elif kind == "box":
+            size = tuple(r.number(x, f"{ctx}.box") for x in r.vector(v["box"], f"{ctx}.box"))
+            if any(x <= 0 for x in size):
+                r.fail(f"{ctx}.box", "needs 3 positive side lengths")
+            shape = Box(size)  # type: ignore[arg-type]
+        elif kind == "cylinder":
+            c = r.check_keys(v["cylinder"], {"radius", "length"}, f"{ctx}.cylinder")
+            radius, length = r.number(c.get("radius", 0), f"{ctx}.cylinder.radius"), r.number(c.get("length", 0), f"{ctx}.cylinder.length")
+            if radius <= 0 or length <= 0:
+                r.fail(f"{ctx}.cylinder", "needs a positive radius and length")
+            shape = Cylinder(radius, length)
+        else:
+            radius = r.number(v["sphere"], f"{ctx}.sphere")
+            if radius <= 0:
+                r.fail(f"{ctx}.sphere", "needs a positive radius")
+            shape = Sphere(radius)
+        rgba = None
+        if "color" in v:
+            rgba = tuple(r.number(x, f"{ctx}.color") for x in r.vector(v["color"], f"{ctx}.color", n=4))
+            if any(not 0 <= x <= 1 for x in rgba):
+                r.fail(f"{ctx}.color", "needs 4 numbers between 0 and 1 (r, g, b, alpha)")
+        origin = r.pose(v["origin"], f"{ctx}.origin") if "origin" in v else np.eye(4)
+        out.append(Visual(r.text(v["link"], f"{ctx}.link"), shape, np.asarray(origin, dtype=float), rgba, None, f"{where} {ctx}"))  # type: ignore[arg-type]
     return out
 
 
@@ -570,7 +626,31 @@ def robot_to_mapping(robot: Robot) -> dict:
         data.update(_dh_mapping(robot, base_pose))
     else:
         data.update(_tree_mapping(robot))
+    if robot.visuals:
+        data["visuals"] = [_visual_mapping(v) for v in robot.visuals]
     return data
+
+
+def _visual_mapping(v) -> dict:
+    from .geometry import Box, Cylinder, Mesh
+
+    out: dict = {"link": v.frame}
+    s = v.shape
+    if isinstance(s, Mesh):
+        out["mesh"] = s.filename if s.base_dir is None or "://" in s.filename or os.path.isabs(s.filename) else os.path.join(s.base_dir, s.filename)
+        out["scale"] = [float(x) for x in s.scale]
+    elif isinstance(s, Box):
+        out["box"] = [float(x) for x in s.size]
+    elif isinstance(s, Cylinder):
+        out["cylinder"] = {"radius": float(s.radius), "length": float(s.length)}
+    else:
+        out["sphere"] = float(s.radius)
+    T = np.asarray(v.origin, dtype=float)
+    if not np.allclose(T, np.eye(4)):
+        out["origin"] = {"xyz": [float(x) for x in T[:3, 3]], "rpy": [float(x) for x in _rpy(T[:3, :3])]}
+    if v.rgba is not None:
+        out["color"] = [float(x) for x in v.rgba]
+    return out
 
 
 def _dump(v):

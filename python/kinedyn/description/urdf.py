@@ -13,7 +13,13 @@ Reads the kinematic and inertial parts of a URDF (ROS wiki, "urdf/XML/joint" and
   centre-of-mass frame's axes; rotated here into the link frame). A link without ``<inertial>``
   is massless.
 
-Ignored: ``<visual>``, ``<collision>``, meshes, ``<transmission>``, ``<gazebo>``, ``<calibration>``,
+- ``<link><visual>`` and ``<link><collision>`` (-> ``robot.visuals`` and ``robot.collisions``, see
+  :mod:`kinedyn.description.geometry`): ``<origin>``, ``<geometry>`` with one of ``<box size>``,
+  ``<cylinder radius length>``, ``<sphere radius>``, ``<mesh filename scale>``, and for visuals
+  ``<material name>`` with ``<color rgba>`` (inline, or defined by name at the robot level). Mesh files
+  are not read here: they are found and read when the robot is drawn.
+
+Ignored: ``<texture>``, ``<transmission>``, ``<gazebo>``, ``<calibration>``,
 ``<safety_controller>``; ``<mimic>`` is ignored too, so a mimic joint becomes an independent
 coordinate (as Pinocchio's ``buildModelFromUrdf`` does by default). Floating and planar joints are
 rejected.
@@ -34,8 +40,11 @@ import xml.etree.ElementTree as ET
 from typing import Optional
 from xml.parsers import expat
 
+import numpy as np
+
 from .._math import matmul, rpy_to_matrix, translation
 from .checks import LARGEST
+from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Link
@@ -83,13 +92,14 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
         tool = default_tool(links, base)
     name = root.get("name") or "urdf_robot"
     source = src.label if not src.label.startswith("<") else "URDF string"
+    visuals, collisions = _geometry(root, list(link_elements.items()), src)
     # the Robot judges the inertias (policy) and checks the tree: its errors and warnings name a
     # link or joint, to which the file and line are added here, once
     lines = {**{n: src.line(e) for n, e in link_elements.items()}, **{j["name"]: src.line(j["element"]) for j in joints}}
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia)
+            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia, visuals=visuals, collisions=collisions)
     except ValueError as e:
         raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None
     for w in caught:
@@ -324,6 +334,85 @@ def _inertial(link, src: _Source) -> Inertia:
         return Inertia.from_urdf(mass, *entries).transformed(com_frame)
     except ValueError as e:
         raise src.error(inertial, f"{what}: {e}") from None
+
+
+# ------------------------------------------------------------------------------------ geometry
+MAX_MESH_NAME = 4096  # characters of a mesh file name
+
+
+def _rgba(element, what: str, src: _Source) -> tuple:
+    rgba = _floats(element.get("rgba"), 4, (), f"{what} <color> rgba", element, src)
+    if not rgba or any(not 0.0 <= c <= 1.0 for c in rgba):
+        raise src.error(element, f"{what} <color> rgba must be 4 numbers between 0 and 1, got '{_short(element.get('rgba') or '')}'")
+    return rgba
+
+
+def _materials(root, src: _Source) -> dict:
+    """Colours of the materials defined at the robot level, by name."""
+    out: dict = {}
+    for m in root.iterfind("material"):
+        name = m.get("name")
+        color = m.find("color")
+        if name and color is not None:
+            out[name] = _rgba(color, f"material '{name}'", src)
+    return out
+
+
+def _shape(geometry, what: str, src: _Source, base_dir):
+    for child in geometry:
+        tag = child.tag
+        if tag == "box":
+            size = _floats(child.get("size") or "", 3, (), f"{what} <box> size", child, src)
+            if any(v <= 0 for v in size):
+                raise src.error(child, f"{what} <box> needs size with 3 positive numbers")
+            return Box(size)
+        if tag == "cylinder":
+            radius = _float(child, "radius", None, f"{what} <cylinder>", src)
+            length = _float(child, "length", None, f"{what} <cylinder>", src)
+            if radius <= 0 or length <= 0:
+                raise src.error(child, f"{what} <cylinder> needs a positive radius and length")
+            return Cylinder(radius, length)
+        if tag == "sphere":
+            radius = _float(child, "radius", None, f"{what} <sphere>", src)
+            if radius <= 0:
+                raise src.error(child, f"{what} <sphere> needs a positive radius")
+            return Sphere(radius)
+        if tag == "mesh":
+            filename = child.get("filename")
+            if not filename or len(filename) > MAX_MESH_NAME:
+                raise src.error(child, f"{what} <mesh> needs a filename (of at most {MAX_MESH_NAME} characters)")
+            scale = _floats(child.get("scale"), 3, (1.0, 1.0, 1.0), f"{what} <mesh> scale", child, src)
+            if any(v == 0 for v in scale):
+                raise src.error(child, f"{what} <mesh> scale may not hold 0")
+            return Mesh(filename, scale, base_dir)
+    raise src.error(geometry, f"{what} <geometry> holds none of <box>, <cylinder>, <sphere>, <mesh>")
+
+
+def _geometry(root, links: list, src: _Source) -> tuple:
+    """(visuals, collisions) of every link, in file order."""
+    materials = _materials(root, src)
+    base_dir = None if src.label.startswith("<") else os.path.dirname(os.path.abspath(src.label))
+    visuals: list = []
+    collisions: list = []
+    for link_name, element in links:
+        for kind, out in (("visual", visuals), ("collision", collisions)):
+            for k, item in enumerate(element.iterfind(kind)):
+                what = f"link '{link_name}' <{kind}>" + (f" {k + 1}" if k else "")
+                geometry = item.find("geometry")
+                if geometry is None:
+                    raise src.error(item, f"{what} has no <geometry>")
+                shape = _shape(geometry, what, src, base_dir)
+                rgba, material = None, None
+                m = item.find("material") if kind == "visual" else None
+                if m is not None:
+                    material = m.get("name")
+                    color = m.find("color")
+                    if color is not None:
+                        rgba = _rgba(color, f"{what} <material>", src)
+                    elif material in materials:
+                        rgba = materials[material]
+                out.append(Visual(link_name, shape, np.asarray(_origin(item, what, src), dtype=float), rgba, material, src.at(src.line(item))))
+    return visuals, collisions
 
 
 # --------------------------------------------------------------------------------- tree structure

@@ -1,7 +1,8 @@
 """``kinedyn report``: one self-contained HTML file about a robot that opens offline.
 
-Sections: the joint and DH tables; an interactive 3-D view (inline canvas renderer, assets/viewer.js,
-running the same forward kinematics as kinedyn.Robot); the tool pose, Jacobian and singular values;
+Sections: the joint and DH tables; an interactive 3-D view (the robot's meshes, or solid links, lit,
+drawn by plotly.js inlined from the plotly package; assets/viewer.js runs the same forward kinematics
+as kinedyn.Robot, so the joint sliders and the simulation's playback move the meshes); the tool pose, Jacobian and singular values;
 the equations of motion typeset as MathML from the symbolic engine; the properties check (M symmetric
 positive definite, dM/dt - 2C skew and dM/dt = C + C^T by finite differences, the regressor reproduces
 tau, RNEA = M qdd + C qd + g); and plots (inline SVG) of a short free motion under gravity with its
@@ -41,8 +42,17 @@ def _has_dynamics(robot) -> bool:
         return False
 
 
-def _model_for_view(robot, q) -> dict:
-    """What the inline viewer needs to run the forward kinematics itself."""
+def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = None) -> dict:
+    """What the inline viewer needs to run the forward kinematics itself and draw the meshes (each
+    once, in its frame's coordinates: kinedyn.visual.web)."""
+    import warnings
+
+    from ..visual.scene import DEFAULT_BUDGET, MissingMeshWarning, robot_scene, scene_bounds
+    from ..visual.web import encode_scene
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MissingMeshWarning)  # said in the report instead (model["missing"])
+        scene = robot_scene(robot, geometry, DEFAULT_BUDGET if budget is None else budget)
     tree = robot.tree
     bodies = []
     for b in tree.bodies:
@@ -56,7 +66,13 @@ def _model_for_view(robot, q) -> dict:
     frames = [{"name": f.name, "body": int(f.body), "placement": np.asarray(f.placement, dtype=float).ravel().tolist()} for f in tree.frames]
     # size of the scene: the farthest frame origin over q and a few random configurations
     qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
-    reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 1e-3)
+    origins = np.vstack([np.zeros((1, 3)), robot.frame_poses(qs)[..., :3, 3].reshape(-1, 3)])
+    reach = max(float(np.max(np.linalg.norm(origins, axis=-1))), 1e-3)
+    # the cube the view shows: around every frame origin of those configurations, with a margin for the meshes
+    lo, hi = origins.min(axis=0), origins.max(axis=0)
+    half = float(np.max(hi - lo)) / 2 + 0.12 * reach
+    # the camera looks at the robot as it stands at q: the box of its shapes (and frame origins)
+    focus_lo, focus_hi = scene_bounds(robot, scene, q)
     gravity = np.asarray(robot.gravity, dtype=float)
     up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
     axes = np.array([np.asarray(robot.pose(q, name)[:3, 2]) for name in robot.body_names])
@@ -77,9 +93,19 @@ def _model_for_view(robot, q) -> dict:
         "q": [float(x) for x in q],
         "tool": robot.tool,
         "reach": reach,
-        "center": [0.0, 0.0, 0.0] if planar else (0.5 * reach * up).tolist(),
+        "center": ((lo + hi) / 2).tolist(),
+        "half": half,
+        "focus": {"center": ((focus_lo + focus_hi) / 2).tolist(), "size": float(np.linalg.norm(focus_hi - focus_lo))},
         "up": up.tolist(),
         "view_from": np.asarray(view_from, dtype=float).tolist(),
+        "planar": bool(planar),  # drawn as the textbook's figure: orthographic, along the joint axes
+        "meshes": encode_scene(scene),
+        "geometry": geometry,
+        "shapes": scene.shapes,  # visuals described
+        "shapes_drawn": scene.drawn,  # of those, read and drawn (the rest are in "missing")
+        "missing": scene.missing,
+        "generated": scene.generated,  # solid links made from the kinematics (no visuals described)
+        "label_joints": scene.generated and robot.n <= 8,
     }
 
 
@@ -407,15 +433,16 @@ def _json_script(obj, element_id: str) -> str:
 
 
 def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, data: Optional[dict] = None,
-                 tutorial: bool = False, progress: Optional[bool] = False, time_budget: Optional[float] = SIMULATION_BUDGET) -> str:
+                 tutorial: bool = False, progress: Optional[bool] = False, time_budget: Optional[float] = SIMULATION_BUDGET, geometry: str = "visual") -> str:
     """The report as one HTML string (see the module docstring); ``tutorial``: add the seed
     tutorial's questions worked step by step (its arm is the default robot, planar_2r).
+    ``geometry``: the 3-D view draws the "visual" shapes of the description, or the "collision" ones.
     ``progress``: a progress bar of the steps on stderr (None: on a terminal)."""
     from ..progress import Steps
 
     total = (0 if data is not None else 4) + 2 + (len(_tutorial_questions()) if tutorial else 0)
     with Steps("report", total, progress) as steps:
-        return _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, steps)
+        return _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, steps, geometry)
 
 
 def _tutorial_questions():
@@ -424,8 +451,9 @@ def _tutorial_questions():
     return QUESTIONS
 
 
-def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, bar) -> str:
+def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progress, time_budget, bar, geometry="visual") -> str:
     from ..cli import _jsonable
+    from ..visual.web import plotly_script
 
     import kinedyn
 
@@ -454,12 +482,21 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
     description = "".join(sec)
 
     # --- 3-D view and kinematics
-    model = _model_for_view(robot, q)
+    model = _model_for_view(robot, q, geometry=geometry)
+    if model["generated"]:
+        looks = "No visual geometry is described, so the links are drawn as solids along the kinematics (joints orange when revolute, violet when prismatic)."
+    else:
+        looks = f"{model['shapes_drawn']} of the {model['shapes']} {geometry} shapes of the description are drawn."
+    missing = "".join(f"<li>{html.escape(m)}</li>" for m in model["missing"])
     view = ["<section id='view'><h2>The arm at q</h2><div class='grid'><div>",
-            '<canvas id="kinedyn-view" width="720" height="520" aria-label="3-D view of the arm"></canvas>',
-            "<p class='note'>Drag to rotate, scroll to zoom. Links grey, revolute joints orange, prismatic violet; base axes x red, y green, z blue; the small triad is the tool frame.</p>",
+            '<div id="kinedyn-view" role="img" aria-label="3-D view of the arm"></div>',
+            "<div id='kinedyn-playback' hidden><button id='kinedyn-play' type='button'>▶ play</button> "
+            "<input id='kinedyn-time' type='range' aria-label='simulation time'> <span id='kinedyn-clock'></span>"
+            " <span class='note'>the free motion simulated below</span></div>",
+            f"<p class='note'>Drag to rotate, scroll to zoom. {html.escape(looks)} The stick figure joins the joints; base axes x red, y green, z blue; the small triad is the tool frame.</p>",
+            f"<ul class='bad' id='kinedyn-missing'>{missing}</ul>" if missing else "",
             "</div><div><h3>Joints</h3><div id='kinedyn-sliders'></div><p><button id='kinedyn-reset' type='button'>reset</button> <span id='kinedyn-tool'></span></p>",
-            f"<p class='note'>q = ({html.escape(q_text)})</p>",
+            f"<p class='note' id='kinedyn-q'>q = ({html.escape(q_text)})</p>",
             "<h3>Tool pose</h3>", _matrix_table(d["tool_pose"], ["", "", "", ""], ["", "", "", ""], "pose"),
             "</div></div>"]
     names = ["vx", "vy", "vz", "ωx", "ωy", "ωz"]
@@ -542,6 +579,7 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
 <footer>Generated by <code>kinedyn report</code>. Self-contained: no network access, every script and style is in this file.</footer>
 {_json_script(model, "kinedyn-model")}
 {_json_script(public, "kinedyn-data")}
+{plotly_script()}
 <script>{_asset("viewer.js")}</script>
 </body></html>
 """

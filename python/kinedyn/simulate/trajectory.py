@@ -254,9 +254,20 @@ class Trajectory:
             P = np.concatenate([P, np.zeros(P.shape[:-1] + (1,))], axis=-1)
         return P
 
+    def show(self, *, block: Optional[bool] = None, **kwargs):
+        """Play the motion in the live 3-D viewer (:meth:`kinedyn.Robot.show`, with a time slider and
+        play/pause). Returns the viewer; ``block`` as for ``Robot.show``."""
+        from ..visual.viewer import show
+
+        if self.batch is not None:
+            raise TypeError("show() plays one trajectory: use traj[i].show()")
+        if not hasattr(self.system, "frame_poses"):
+            raise TypeError("show() needs a trajectory of a kinedyn.Robot; use animate() for other systems")
+        return show(self.system, np.asarray(self.q, dtype=float)[0], trajectory=self, block=block, **kwargs)
+
     def animate(self, path, fps: int = 25, duration: Optional[float] = None, trail: bool = True):
         """A stick figure of the motion: GIF (``.gif``, Pillow), HTML (``.html``, self-contained
-        JavaScript player) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
+        JavaScript player; a robot's is its meshes in a 3-D view, as in the report) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
         z = const (planar arms), else 3-D. Frames are taken every 1/fps seconds of simulated time.
         Returns the path."""
         import matplotlib.pyplot as plt
@@ -268,10 +279,16 @@ class Trajectory:
         suffix = path.suffix.lower()
         if suffix not in (".gif", ".html", ".mp4"):
             raise ValueError(f"animate writes .gif, .html or .mp4 files, got '{path.name}'")
-        P = self._points()
         span = self.t[-1] - self.t[0]
         frames = max(2, int(math.ceil((duration or span) * fps)) + 1)
         idx = np.unique(np.round(np.linspace(0, len(self) - 1, frames)).astype(int))
+        if suffix == ".html" and hasattr(self.system, "frame_poses"):
+            # a robot: its meshes in the report's 3-D view, sent once, then joint values per frame
+            from ..visual.web import animation_page
+
+            path.write_text(animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]), encoding="utf-8")
+            return path
+        P = self._points()
         planar = np.ptp(P[..., 2]) < 1e-9
         lo, hi = P.reshape(-1, 3).min(axis=0), P.reshape(-1, 3).max(axis=0)
         centre, radius = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3) * 1.1
@@ -318,7 +335,7 @@ class Trajectory:
             if suffix == ".gif":
                 anim.save(path, writer=animation.PillowWriter(fps=fps))
             elif suffix == ".html":
-                path.write_text(anim.to_jshtml(fps=fps))
+                path.write_text(_offline_jshtml(anim.to_jshtml(fps=fps)))
             else:
                 if not animation.FFMpegWriter.isAvailable():
                     raise RuntimeError("writing .mp4 needs ffmpeg on the PATH; write a .gif or .html instead")
@@ -326,3 +343,20 @@ class Trajectory:
         finally:
             plt.close(fig)
         return path
+
+
+# matplotlib's JavaScript player draws its buttons with Font Awesome from a CDN: the page would make a
+# network request, and show empty buttons offline. The same buttons as plain characters instead.
+_PLAYER_GLYPHS = {"fa fa-minus": "\u2212", "fa fa-fast-backward": "\u23ee", "fa fa-step-backward": "\u23f4\u23f4",
+                  "fa fa-play fa-flip-horizontal": "\u25c0", "fa fa-pause": "\u23f8", "fa fa-play": "\u25b6",
+                  "fa fa-step-forward": "\u23f5\u23f5", "fa fa-fast-forward": "\u23ed", "fa fa-plus": "+"}
+
+
+def _offline_jshtml(page: str) -> str:
+    """matplotlib's to_jshtml() page without its Font Awesome stylesheet link (see _PLAYER_GLYPHS)."""
+    import re
+
+    page = re.sub(r"<link[^>]*font-awesome[^>]*>", "", page)
+    for css, glyph in _PLAYER_GLYPHS.items():
+        page = page.replace(f'<i class="{css}"></i>', f"<span>{glyph}</span>")
+    return page

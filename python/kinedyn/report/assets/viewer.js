@@ -1,10 +1,15 @@
-// kinedyn report: a small 3-D view of a robot (canvas 2-D, orthographic), no external library.
-// The model (bodies, joint axes, placements, frames) comes from the JSON block #kinedyn-model; the
-// forward kinematics below is the one of kinedyn.Robot: T_i = T_parent(i) * placement_i * motion_i(q_i + offset_i).
-// Drag to rotate, wheel to zoom, sliders to move the joints. window.kinedyn exposes fk() for tests.
+// kinedyn report: the 3-D view of a robot, drawn with plotly.js (WebGL, inlined from the plotly Python
+// package) as lit triangle meshes, with the stick figure and the base and tool frames.
+// The model (bodies, joint axes, placements, frames, meshes) comes from the JSON block #kinedyn-model;
+// the forward kinematics below is the one of kinedyn.Robot: T_i = T_parent(i) * placement_i * motion_i(q_i + offset_i).
+// Each mesh is sent once, in its frame's coordinates (vertices quantised to 16 bits over its bounding
+// box, base64); a new q moves it by its frame's pose. Sliders move the joints, the play button replays
+// the simulation (#kinedyn-data's simulation.q). window.kinedyn exposes fk(), setQ() and counts for tests.
 (function () {
   "use strict";
   const model = JSON.parse(document.getElementById("kinedyn-model").textContent);
+  const dataBlock = document.getElementById("kinedyn-data");
+  const data = dataBlock ? JSON.parse(dataBlock.textContent) : {};
   const n = model.bodies.length;
 
   // 4x4 row-major matrices as flat arrays of 16 numbers
@@ -43,135 +48,208 @@
   }
   const origin = (T) => [T[3], T[7], T[11]];
 
-  // ---------------------------------------------------------------- camera
-  const canvas = document.getElementById("kinedyn-view");
-  const ctx = canvas.getContext("2d");
-  const norm = (v) => { const l = Math.hypot(v[0], v[1], v[2]) || 1; return [v[0] / l, v[1] / l, v[2] / l]; };
-  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-  const up = norm(model.up);                 // opposite to gravity
-  const back0 = norm(model.view_from);       // from the scene towards the viewer
-  const right0 = norm(cross(up, back0));
-  const view = { yaw: 0, pitch: 0, zoom: 1 };
+  // ---------------------------------------------------------------- meshes
+  function bytes(b64) {
+    const s = atob(b64), out = new Uint8Array(s.length);
+    for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+    return out;
+  }
+  // one plotly trace per colour; each mesh keeps its local vertices and its place in its trace
+  const traces = [], byColour = {};
+  const meshes = (model.meshes || []).map(function (m) {
+    const u = new Uint16Array(bytes(m.vertices).buffer);
+    const local = new Float32Array(u.length);
+    for (let k = 0; k < u.length; k++) local[k] = m.lo[k % 3] + m.step[k % 3] * u[k];
+    const f8 = bytes(m.faces);
+    const faces = m.wide ? new Uint32Array(f8.buffer) : new Uint16Array(f8.buffer);
+    const key = m.rgba.join(",");
+    if (!(key in byColour)) { byColour[key] = traces.length; traces.push({ rgba: m.rgba, meshes: [], vertices: 0, faces: [] }); }
+    const t = traces[byColour[key]];
+    const mesh = { frame: m.frame, visual: m.visual, local: local, trace: byColour[key], offset: t.vertices };
+    t.meshes.push(mesh);
+    for (let k = 0; k < faces.length; k++) t.faces.push(faces[k] + t.vertices);
+    t.vertices += local.length / 3;
+    return mesh;
+  });
+  for (const t of traces) {
+    const F = t.faces.length / 3;
+    t.i = new Int32Array(F); t.j = new Int32Array(F); t.k = new Int32Array(F);
+    for (let f = 0; f < F; f++) { t.i[f] = t.faces[3 * f]; t.j[f] = t.faces[3 * f + 1]; t.k[f] = t.faces[3 * f + 2]; }
+    delete t.faces;
+  }
+  // plotly reads <b>, <br>, <a> ... in text as markup: a name is shown as itself through entities
+  const plain = (s) => String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
+  const colour = (c) => "rgb(" + Math.round(255 * c[0]) + "," + Math.round(255 * c[1]) + "," + Math.round(255 * c[2]) + ")";
+
+  // ---------------------------------------------------------------- the plot
+  const view = document.getElementById("kinedyn-view");
   let q = model.q.slice();
+  const R = model.half, c = model.center;
+  const axis = (k, name) => ({ range: [c[k] - R, c[k] + R], title: { text: name }, backgroundcolor: "#d2d9dd", showbackground: true,
+                               gridcolor: "#bcc5cb", zerolinecolor: "#9aa5ac", tickfont: { size: 10 } });
+  // the camera looks at the robot at q (the box of its shapes, model.focus) from model.view_from; plotly's
+  // camera coordinates: the scene cube spans [-0.5, 0.5] in each axis
+  const focus = model.focus || { center: c, size: 2 * R };
+  const fc = [0, 1, 2].map((k) => (focus.center[k] - c[k]) / (2 * R));
+  const distance = Math.max(0.3, 1.35 * focus.size / (2 * R));
+  const eye = [0, 1, 2].map((k) => fc[k] + distance * model.view_from[k] / Math.hypot(...model.view_from));
+  const layout = {
+    margin: { l: 0, r: 0, t: 0, b: 0 }, showlegend: false, uirevision: "kinedyn", paper_bgcolor: "#eef1f2",
+    scene: { xaxis: axis(0, "x [m]"), yaxis: axis(1, "y [m]"), zaxis: axis(2, "z [m]"), aspectmode: "cube",
+             camera: { eye: { x: eye[0], y: eye[1], z: eye[2] }, up: { x: model.up[0], y: model.up[1], z: model.up[2] }, center: { x: fc[0], y: fc[1], z: fc[2] } } },
+  };
+  const config = { displaylogo: false, responsive: true, modeBarButtonsToRemove: ["toImage"] };
+  const drawnVisuals = new Set();
 
-  function basis() {
-    const cy = Math.cos(view.yaw), sy = Math.sin(view.yaw);
-    const right = [0, 1, 2].map((k) => cy * right0[k] + sy * back0[k]);
-    const back = [0, 1, 2].map((k) => -sy * right0[k] + cy * back0[k]);
-    const cp = Math.cos(view.pitch), sp = Math.sin(view.pitch);
-    const scrUp = [0, 1, 2].map((k) => cp * up[k] - sp * back[k]);
-    const depth = [0, 1, 2].map((k) => cp * back[k] + sp * up[k]);
-    return { right: right, up: scrUp, depth: depth };
-  }
-  function projector() {
-    const B = basis();
-    const w = canvas.width, h = canvas.height;
-    const scale = view.zoom * 0.42 * Math.min(w, h) / model.reach;
-    const c = model.center;
-    return function (p) {
-      const d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-      return [w / 2 + scale * dot(d, B.right), h / 2 - scale * dot(d, B.up), dot(d, B.depth)];
-    };
-  }
-
-  // ---------------------------------------------------------------- drawing
-  function line(P, a, b, color, width) {
-    const A = P(a), B = P(b);
-    ctx.strokeStyle = color; ctx.lineWidth = width; ctx.lineCap = "round";
-    ctx.beginPath(); ctx.moveTo(A[0], A[1]); ctx.lineTo(B[0], B[1]); ctx.stroke();
-  }
-  function triad(P, T, len, width, labels) {
-    const o = origin(T);
+  function figure(q) {
+    const K = fk(q);
+    const out = [];
+    for (const t of traces) {
+      const x = new Float32Array(t.vertices), y = new Float32Array(t.vertices), z = new Float32Array(t.vertices);
+      for (const m of t.meshes) {
+        const T = K.frames[m.frame];
+        if (!T) continue;
+        const L = m.local, V = L.length / 3;
+        for (let v = 0; v < V; v++) {
+          const a = L[3 * v], b = L[3 * v + 1], d = L[3 * v + 2];
+          x[m.offset + v] = T[0] * a + T[1] * b + T[2] * d + T[3];
+          y[m.offset + v] = T[4] * a + T[5] * b + T[6] * d + T[7];
+          z[m.offset + v] = T[8] * a + T[9] * b + T[10] * d + T[11];
+        }
+        drawnVisuals.add(m.visual);
+      }
+      out.push({ type: "mesh3d", x: x, y: y, z: z, i: t.i, j: t.j, k: t.k, color: colour(t.rgba), opacity: t.rgba[3],
+                 flatshading: false, hoverinfo: "skip",
+                 lighting: { ambient: 0.45, diffuse: 0.75, specular: 0.25, roughness: 0.5, fresnel: 0.15, facenormalsepsilon: 0, vertexnormalsepsilon: 0 },
+                 lightposition: { x: 2 * R * model.view_from[0] + R, y: 2 * R * model.view_from[1] + R, z: 3 * R } });
+    }
+    // the stick figure: parent joint -> joint, joint -> each frame its body carries
+    const sx = [], sy = [], sz = [];
+    const seg = (a, b) => { sx.push(a[0], b[0], null); sy.push(a[1], b[1], null); sz.push(a[2], b[2], null); };
+    for (let i = 0; i < n; i++) seg(model.bodies[i].parent < 0 ? [0, 0, 0] : origin(K.body[model.bodies[i].parent]), origin(K.body[i]));
+    for (const f of model.frames) if (f.body >= 0) seg(origin(K.body[f.body]), origin(K.frames[f.name]));
+    out.push({ type: "scatter3d", mode: "lines", x: sx, y: sy, z: sz, line: { color: "#37474f", width: meshes.length ? 3 : 7 }, hoverinfo: "skip" });
+    const jx = [], jy = [], jz = [], jc = [], jt = [];
+    for (let i = 0; i < n; i++) {
+      const p = origin(K.body[i]);
+      jx.push(p[0]); jy.push(p[1]); jz.push(p[2]);
+      jc.push(model.bodies[i].kind === "revolute" ? "#ff9800" : "#8e24aa");
+      jt.push(plain(model.joint_names[i]));
+    }
+    out.push({ type: "scatter3d", mode: model.label_joints ? "markers+text" : "markers", x: jx, y: jy, z: jz, text: jt, textposition: "bottom right",
+               textfont: { size: 11, color: "#333" }, marker: { size: 4, color: jc, line: { color: "#4e342e", width: 1 } }, hovertemplate: "%{text}<extra></extra>" });
+    // base and tool frames: x red, y green, z blue
+    const tool = K.frames[model.tool];
     const cols = ["#d62728", "#2ca02c", "#1f77b4"];
     for (let k = 0; k < 3; k++) {
-      const e = [o[0] + len * T[k], o[1] + len * T[4 + k], o[2] + len * T[8 + k]];
-      line(P, o, e, cols[k], width);
-      if (labels) { const E = P(e); ctx.fillStyle = cols[k]; ctx.font = "12px sans-serif"; ctx.fillText("xyz"[k], E[0] + 3, E[1] - 3); }
+      const ax = [], ay = [], az = [];
+      for (const [T, len] of [[I4, 0.25 * model.reach], [tool, 0.15 * model.reach]]) {
+        const o = origin(T);
+        ax.push(o[0], o[0] + len * T[k], null); ay.push(o[1], o[1] + len * T[4 + k], null); az.push(o[2], o[2] + len * T[8 + k], null);
+      }
+      out.push({ type: "scatter3d", mode: "lines", x: ax, y: ay, z: az, line: { color: cols[k], width: 5 }, hoverinfo: "skip" });
     }
-  }
-  function draw() {
-    const w = canvas.width, h = canvas.height;
-    ctx.clearRect(0, 0, w, h);
-    ctx.fillStyle = "#fbfbf8"; ctx.fillRect(0, 0, w, h);
-    const P = projector();
-    // ground grid, perpendicular to "up", through the base
-    const g1 = norm(cross(up, Math.abs(up[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0])), g2 = cross(up, g1);
-    const R = model.reach * 1.1, steps = 8;
-    for (let i = -steps; i <= steps; i++) {
-      const t = (i / steps) * R;
-      const col = i === 0 ? "#c8c8c0" : "#e6e6df";
-      line(P, [g1[0] * t - g2[0] * R, g1[1] * t - g2[1] * R, g1[2] * t - g2[2] * R], [g1[0] * t + g2[0] * R, g1[1] * t + g2[1] * R, g1[2] * t + g2[2] * R], col, 1);
-      line(P, [g2[0] * t - g1[0] * R, g2[1] * t - g1[1] * R, g2[2] * t - g1[2] * R], [g2[0] * t + g1[0] * R, g2[1] * t + g1[1] * R, g2[2] * t + g1[2] * R], col, 1);
-    }
-    triad(P, I4, 0.25 * model.reach, 2, true);
-    const K = fk(q);
-    // links: parent body origin -> body origin, body origin -> each frame it carries
-    const segs = [];
-    for (let i = 0; i < n; i++) {
-      const b = model.bodies[i];
-      segs.push([b.parent < 0 ? [0, 0, 0] : origin(K.body[b.parent]), origin(K.body[i])]);
-    }
-    for (const f of model.frames) if (f.body >= 0) segs.push([origin(K.body[f.body]), origin(K.frames[f.name])]);
-    const drawn = segs.filter((s) => Math.hypot(s[0][0] - s[1][0], s[0][1] - s[1][1], s[0][2] - s[1][2]) > 1e-9)
-      .map((s) => ({ s: s, z: (P(s[0])[2] + P(s[1])[2]) / 2 })).sort((a, b) => a.z - b.z);
-    for (const d of drawn) { line(P, d.s[0], d.s[1], "#37474f", 9); line(P, d.s[0], d.s[1], "#78909c", 5); }
-    // joints: a disc at each joint origin, coloured by kind
-    for (let i = 0; i < n; i++) {
-      const p = P(origin(K.body[i]));
-      ctx.fillStyle = model.bodies[i].kind === "revolute" ? "#ff9800" : "#8e24aa";
-      ctx.strokeStyle = "#4e342e"; ctx.lineWidth = 1.5;
-      ctx.beginPath(); ctx.arc(p[0], p[1], 7, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
-      ctx.fillStyle = "#333"; ctx.font = "12px sans-serif"; ctx.fillText(model.joint_names[i], p[0] + 9, p[1] + 14);
-    }
-    const tool = K.frames[model.tool];
-    triad(P, tool, 0.15 * model.reach, 2.5, false);
-    const t = origin(tool), T = P(t);
-    ctx.fillStyle = "#000"; ctx.beginPath(); ctx.arc(T[0], T[1], 4, 0, 2 * Math.PI); ctx.fill();
-    const out = document.getElementById("kinedyn-tool");
-    if (out) out.textContent = "tool at (" + t.map((v) => v.toFixed(4)).join(", ") + ") m";
+    const t = origin(tool);
+    out.push({ type: "scatter3d", mode: "markers", x: [t[0]], y: [t[1]], z: [t[2]], marker: { size: 4, color: "#000" }, hovertemplate: "tool<extra></extra>" });
+    return { traces: out, tool: tool };
   }
 
-  // ---------------------------------------------------------------- interaction
-  let drag = null;
-  canvas.addEventListener("pointerdown", (e) => { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); });
-  canvas.addEventListener("pointerup", () => { drag = null; });
-  canvas.addEventListener("pointermove", (e) => {
-    if (!drag) return;
-    view.yaw -= (e.clientX - drag[0]) * 0.01;
-    view.pitch = Math.max(-1.5, Math.min(1.5, view.pitch + (e.clientY - drag[1]) * 0.01));
-    drag = [e.clientX, e.clientY];
-    draw();
-  });
-  canvas.addEventListener("wheel", (e) => { e.preventDefault(); view.zoom *= Math.exp(-e.deltaY * 0.001); draw(); }, { passive: false });
+  // ---------------------------------------------------------------- readouts: tool position, pose table, q
+  const fmt = (v) => { if (Math.abs(v) < 1e-13) v = 0; const s = Number(v.toPrecision(6)).toString(); return s; };
+  const revolute = model.bodies.map((b) => b.kind === "revolute");
+  function readouts(tool) {
+    const t = origin(tool);
+    const out = document.getElementById("kinedyn-tool");
+    if (out) out.textContent = "tool at (" + t.map((v) => v.toFixed(4)).join(", ") + ") m";
+    const cells = document.querySelectorAll("table.pose tbody td.num");
+    if (cells.length === 16) cells.forEach((cell, k) => { cell.textContent = fmt(tool[k]); });
+    const qText = document.getElementById("kinedyn-q");
+    if (qText) qText.textContent = "q = (" + q.map((v, i) => revolute[i] ? fmt(v) + " rad (" + Number((v * 180 / Math.PI).toPrecision(5)) + "°)" : fmt(v) + " m").join(", ") + ")";
+  }
+
+  let pending = false, ready = null;
+  function draw() {
+    const f = figure(q);
+    readouts(f.tool);
+    if (view && window.Plotly) ready = window.Plotly.react(view, f.traces, layout, config);
+    return ready;
+  }
+  function schedule() {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => { pending = false; draw(); });
+  }
+
+  // ---------------------------------------------------------------- sliders, reset, playback
   const sliders = document.getElementById("kinedyn-sliders");
   function label(i) {
-    const b = model.bodies[i];
-    return b.kind === "revolute" ? (q[i] * 180 / Math.PI).toFixed(1) + "\u00b0" : q[i].toFixed(3) + " m";
+    return revolute[i] ? (q[i] * 180 / Math.PI).toFixed(1) + "\u00b0" : q[i].toFixed(3) + " m";
+  }
+  function syncSliders() {
+    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[i]; el.nextElementSibling.textContent = label(i); });
   }
   if (sliders) {
     for (let i = 0; i < n; i++) {
       const row = document.createElement("label");
-      const b = model.bodies[i];
-      const span = b.kind === "revolute" ? Math.PI : model.reach;
+      const span = revolute[i] ? Math.PI : model.reach;
       const lo = Number.isFinite(model.lower[i]) ? model.lower[i] : -span;
       const hi = Number.isFinite(model.upper[i]) ? model.upper[i] : span;
       row.innerHTML = "<span class='jn'></span><input type='range'><output></output>";
       row.querySelector(".jn").textContent = model.joint_names[i];
+      row.title = model.joint_names[i];
       const input = row.querySelector("input");
       input.min = lo; input.max = hi; input.step = (hi - lo) / 1000; input.value = q[i];
+      input.setAttribute("aria-label", model.joint_names[i]);
       const out = row.querySelector("output");
       out.textContent = label(i);
-      input.addEventListener("input", () => { q[i] = parseFloat(input.value); out.textContent = label(i); draw(); });
+      input.addEventListener("input", () => { stop(); q[i] = parseFloat(input.value); out.textContent = label(i); draw(); });
       sliders.appendChild(row);
     }
   }
   const reset = document.getElementById("kinedyn-reset");
-  if (reset) reset.addEventListener("click", () => {
-    q = model.q.slice(); view.yaw = 0; view.pitch = 0; view.zoom = 1;
-    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[i]; el.nextElementSibling.textContent = label(i); });
-    draw();
-  });
-  window.kinedyn = { model: model, fk: fk, draw: draw, view: view, setQ: (v) => { q = v.slice(); draw(); } };
+  if (reset) reset.addEventListener("click", () => { stop(); q = model.q.slice(); syncSliders(); if (view && window.Plotly) window.Plotly.relayout(view, { "scene.camera": layout.scene.camera }); draw(); });
+
+  const sim = data.simulation && data.simulation.q && data.simulation.q.length > 1 ? data.simulation : null;
+  const play = document.getElementById("kinedyn-play"), time = document.getElementById("kinedyn-time"), clock = document.getElementById("kinedyn-clock");
+  let playing = null;
+  function showSample(k) {
+    q = sim.q[k].slice();
+    if (time) time.value = k;
+    if (clock) clock.textContent = "t = " + sim.t[k].toFixed(2) + " s";
+    syncSliders();
+    schedule();
+  }
+  function stop() {
+    if (playing !== null) { cancelAnimationFrame(playing); playing = null; if (play) play.textContent = "\u25b6 play"; }
+  }
+  if (sim && play) {
+    const controls = document.getElementById("kinedyn-playback");
+    if (controls) controls.hidden = false;
+    if (time) { time.min = 0; time.max = sim.q.length - 1; time.step = 1; time.value = 0; time.addEventListener("input", () => { stop(); showSample(parseInt(time.value, 10)); }); }
+    play.addEventListener("click", () => {
+      if (playing !== null) { stop(); return; }
+      play.textContent = "\u275a\u275a pause";
+      const t0 = performance.now(), k0 = time && parseInt(time.value, 10) < sim.q.length - 1 ? parseInt(time.value, 10) : 0;
+      const start = sim.t[k0];
+      function tick(now) {
+        const target = start + (now - t0) / 1000;
+        let k = k0;
+        while (k < sim.t.length - 1 && sim.t[k + 1] <= target) k++;
+        showSample(k);
+        playing = k < sim.t.length - 1 ? requestAnimationFrame(tick) : null;
+        if (playing === null && play) play.textContent = "\u25b6 play";
+      }
+      playing = requestAnimationFrame(tick);
+    });
+  }
+
+  window.kinedyn = {
+    model: model, fk: fk, draw: draw,
+    setQ: (v) => { stop(); q = v.slice(); syncSliders(); return draw(); },
+    q: () => q.slice(),
+    meshes: meshes.length,
+    drawnVisuals: () => Array.from(drawnVisuals).sort((a, b) => a - b),
+    ready: () => ready,
+  };
   draw();
 })();

@@ -1,0 +1,31 @@
+"""``kinedyn view ROBOT [--q ...]``: the live 3-D viewer (kinedyn.visual.viewer), until Ctrl-C."""
+
+from __future__ import annotations
+
+
+def cmd_view(args) -> int:
+    from ..cli import _robot, parse_q
+    from .viewer import Viewer
+
+    robot = _robot(args)
+    q = None if args.q is None else parse_q(args.q, robot, args.deg)
+    viewer = Viewer(robot, q, host=args.host, port=args.port, geometry="collision" if args.collision else "visual")
+    if args.no_wait:  # for tests and scripts that only want the server checked
+        viewer.close()
+        return 0
+    print("Ctrl-C stops the viewer.", flush=True)
+    viewer.wait()
+    return 0
+
+
+def add_view_command(subparsers) -> None:
+    from ..cli import _state_args
+
+    p = subparsers.add_parser("view", help="open a live 3-D view of a robot in the browser (meshes, joint sliders); Ctrl-C stops it")
+    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
+    _state_args(p)
+    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only; over ssh use ssh -L PORT:localhost:PORT)")
+    p.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if it is taken)")
+    p.add_argument("--collision", action="store_true", help="draw the collision shapes instead of the visual ones")
+    p.add_argument("--no-wait", action="store_true", help="start the server, print its URL and stop (a check)")
+    p.set_defaults(func=cmd_view)

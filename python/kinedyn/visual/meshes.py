@@ -1,0 +1,197 @@
+"""Triangle meshes for drawing: mesh files read with trimesh (STL, OBJ, DAE/Collada through pycollada),
+bounded, grouped by colour, decimated to a triangle budget (quadric decimation, Garland & Heckbert 1997,
+through trimesh and fast-simplification) and cached per file; and the primitive shapes (box, cylinder,
+sphere) built here with NumPy.
+
+A :class:`Part` is one colour's triangles: ``vertices`` (V, 3) float32 in the shape's own frame,
+``faces`` (F, 3) int32, ``rgba`` (None: no colour of its own).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, List, Optional, Tuple
+
+import numpy as np
+
+__all__ = ["Part", "MAX_MESH_BYTES", "MAX_MESH_TRIANGLES", "read_mesh", "decimate", "box", "cylinder", "sphere"]
+
+MAX_MESH_BYTES = 128 * 2**20  # a mesh file larger than this is refused (a robot's largest is a few MiB)
+MAX_MESH_TRIANGLES = 4_000_000  # ... and so is one with more triangles than this
+
+
+@dataclass(frozen=True)
+class Part:
+    vertices: np.ndarray  # (V, 3) float32, in the shape's frame [m]
+    faces: np.ndarray  # (F, 3) int32, indices into vertices
+    rgba: Optional[Tuple[float, float, float, float]] = None
+
+    @property
+    def triangles(self) -> int:
+        return len(self.faces)
+
+    def transformed(self, T: np.ndarray, scale=(1.0, 1.0, 1.0)) -> "Part":
+        """The part scaled per axis, then moved by the 4x4 ``T``."""
+        v = self.vertices.astype(np.float64) * np.asarray(scale, dtype=float)
+        v = v @ np.asarray(T, dtype=float)[:3, :3].T + np.asarray(T, dtype=float)[:3, 3]
+        faces = self.faces
+        if np.prod(np.sign(scale)) < 0:  # a mirroring scale turns the triangles inside out
+            faces = faces[:, ::-1]
+        return Part(v.astype(np.float32), np.ascontiguousarray(faces), self.rgba)
+
+
+# ------------------------------------------------------------------------------ primitives
+def box(size) -> Part:
+    """A box of full side lengths ``size`` centred on its frame: 12 triangles, 24 vertices (flat faces)."""
+    hx, hy, hz = (0.5 * float(s) for s in size)
+    vertices: list = []
+    faces: list = []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+            corners = []
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[v] = sign, a, b
+                corners.append(p)
+            k = len(vertices)
+            vertices += corners
+            faces += [[k, k + 1, k + 2], [k, k + 2, k + 3]] if sign > 0 else [[k, k + 2, k + 1], [k, k + 3, k + 2]]
+    return Part((np.array(vertices) * [hx, hy, hz]).astype(np.float32), np.array(faces, dtype=np.int32))
+
+
+def cylinder(radius: float, length: float, sections: int = 24) -> Part:
+    """A closed cylinder along z, centred on its frame."""
+    a = np.linspace(0.0, 2 * math.pi, sections, endpoint=False)
+    ring = np.stack([radius * np.cos(a), radius * np.sin(a)], axis=1)
+    h = 0.5 * length
+    # side: two rings (s vertices each); caps: their own rings and centres, so the normals stay sharp
+    bottom, top = np.c_[ring, np.full(sections, -h)], np.c_[ring, np.full(sections, h)]
+    vertices = np.vstack([bottom, top, bottom, top, [[0, 0, -h], [0, 0, h]]])
+    i = np.arange(sections)
+    j = (i + 1) % sections
+    s = sections
+    side = np.r_[np.c_[i, j, s + j], np.c_[i, s + j, s + i]]
+    cb, ct = 4 * s, 4 * s + 1
+    caps = np.r_[np.c_[np.full(s, cb), 2 * s + j, 2 * s + i], np.c_[np.full(s, ct), 3 * s + i, 3 * s + j]]
+    return Part(vertices.astype(np.float32), np.r_[side, caps].astype(np.int32))
+
+
+def sphere(radius: float, rings: int = 12, sections: int = 24) -> Part:
+    """A UV sphere centred on its frame."""
+    theta = np.linspace(0.0, math.pi, rings + 1)
+    phi = np.linspace(0.0, 2 * math.pi, sections, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    vertices = radius * np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
+    faces = []
+    for r in range(rings):
+        for c in range(sections):
+            a, b = r * sections + c, r * sections + (c + 1) % sections
+            faces += [[a, a + sections, b + sections], [a, b + sections, b]]
+    return Part(vertices.astype(np.float32), np.array(faces, dtype=np.int32))
+
+
+# ------------------------------------------------------------------------------ mesh files
+def _colour(geometry) -> Optional[Tuple[float, float, float, float]]:
+    """The main colour trimesh found for a mesh (material colour or face/vertex colours), or None."""
+    visual = getattr(geometry, "visual", None)
+    if visual is None:
+        return None
+    try:
+        material = getattr(visual, "material", None)
+        if material is not None:
+            c = getattr(material, "main_color", None)
+        elif getattr(visual, "kind", None) is not None:  # ColorVisuals with colours the file gave
+            c = visual.main_color
+        else:
+            return None
+        if c is None:
+            return None
+        c = np.asarray(c, dtype=float).ravel()[:4] / 255.0
+        return tuple(float(x) for x in np.clip(c, 0.0, 1.0))  # type: ignore[return-value]
+    except Exception:  # a visual trimesh could not interpret: no colour of its own
+        return None
+
+
+@lru_cache(maxsize=256)
+def _read(path: str, mtime_ns: int, size: int) -> Tuple[Part, ...]:
+    import trimesh
+
+    loaded = trimesh.load(path, force="scene", process=False)
+    meshes = loaded.dump(concatenate=False) if hasattr(loaded, "dump") else [loaded]
+    by_colour: dict = {}
+    total = 0
+    for m in meshes:
+        if not hasattr(m, "faces") or len(m.faces) == 0:
+            continue
+        total += len(m.faces)
+        if total > MAX_MESH_TRIANGLES:
+            raise ValueError(f"mesh '{path}' has more than {MAX_MESH_TRIANGLES:,} triangles (kinedyn draws robots, not scans)")
+        by_colour.setdefault(_colour(m), []).append(m)
+    parts = []
+    for rgba, group in by_colour.items():
+        merged: Any = group[0] if len(group) == 1 else trimesh.util.concatenate(group)
+        # one vertex per position (files often repeat them per face): smaller, and decimation then
+        # collapses edges of a connected surface instead of tearing it
+        merged = trimesh.Trimesh(np.asarray(merged.vertices), np.asarray(merged.faces), process=True)
+        v = np.asarray(merged.vertices, dtype=np.float64)
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"mesh '{path}' has vertices that are not finite numbers")
+        parts.append(Part(v.astype(np.float32), np.asarray(merged.faces, dtype=np.int32), rgba))
+    if not parts:
+        raise ValueError(f"mesh '{path}' holds no triangles")
+    return tuple(parts)
+
+
+def read_mesh(path) -> List[Part]:
+    """The triangles of a mesh file, one :class:`Part` per colour (cached per file: path, size and
+    modification time). ValueError naming the file for one too large, unreadable or empty."""
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        raise ValueError(f"mesh '{path}': cannot read it ({e.strerror or e})") from None
+    if st.st_size > MAX_MESH_BYTES:
+        raise ValueError(f"mesh '{path}' is {st.st_size / 2**20:.0f} MiB, more than the {MAX_MESH_BYTES // 2**20} MiB kinedyn reads")
+    try:
+        import trimesh  # noqa: F401
+    except ImportError:
+        raise ValueError(f"mesh '{path}': reading mesh files needs trimesh (pip install 'kinedyn[viz]')") from None
+    try:
+        return list(_read(str(path.resolve()), st.st_mtime_ns, st.st_size))
+    except ValueError:
+        raise
+    except Exception as e:  # whatever trimesh or pycollada raise on a broken file
+        raise ValueError(f"mesh '{path}' could not be read: {type(e).__name__}: {e}") from None
+
+
+def decimate(part: Part, faces: int) -> Part:
+    """``part`` with at most about ``faces`` triangles (quadric decimation); unchanged if it has fewer
+    or if fast-simplification is not installed."""
+    if part.triangles <= faces:
+        return part
+    return _decimated(part, max(int(faces), 8))
+
+
+_DECIMATED: dict = {}
+
+
+def _decimated(part: Part, faces: int) -> Part:
+    key = (id(part.vertices), part.triangles, faces)
+    hit = _DECIMATED.get(key)
+    if hit is not None and hit[0] is part.vertices:
+        return hit[1]
+    try:
+        import fast_simplification
+    except ImportError:
+        return part
+    v, f = fast_simplification.simplify(part.vertices.astype(np.float32), part.faces.astype(np.int32), target_count=faces)
+    out = Part(np.asarray(v, dtype=np.float32), np.asarray(f, dtype=np.int32), part.rgba)
+    if len(_DECIMATED) > 1024:
+        _DECIMATED.clear()
+    _DECIMATED[key] = (part.vertices, out)
+    return out
