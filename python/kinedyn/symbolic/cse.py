@@ -21,6 +21,7 @@ differentiate: ``WP3x_a2`` = d WP3x / d qdd_2, ``W3x_v2`` = d W3x / d qd_2.
 
 from __future__ import annotations
 
+import re
 from typing import Dict, List, Sequence, Tuple
 
 import sympy as sp
@@ -60,6 +61,14 @@ class Block:
         out = list(self.assignments)
         out += [(s, e) for s, e in zip(self.entry_symbols(), self.entries) if e != 0]
         return out
+
+    def parameters(self) -> set:
+        """Free symbols of the block other than its own intermediate variables (state included)."""
+        defined = {s for s, _ in self.assignments}
+        free: set = set()
+        for e in [e for _, e in self.assignments] + list(self.entries):
+            free |= sp.sympify(e).free_symbols
+        return free - defined
 
     def op_count(self) -> Dict[str, int]:
         from .eom import _ops
@@ -293,3 +302,52 @@ def block_to_python(block: Block, args: Sequence[str] = ("q", "qd", "qdd")) -> s
 
     pr = PythonCodePrinter()
     return "\n".join([f"{s} = {pr.doprint(e)}" for s, e in block.assignments] + [f"out = [{', '.join(pr.doprint(e) for e in block.entries)}]"])
+
+
+# ---------------------------------------------------------------------------- display
+#: the customised model is shown in CSE form above this many operations (tau of the PUMA 560 with its
+#: numeric inertias has 354 and stays expanded; with general inertias 577)
+CSE_THRESHOLD = 400
+
+
+def _lhs(sym):
+    """The name of an intermediate variable, written the way SymPy's printers write the symbol in the
+    right-hand sides (C2 -> C_{2}, WP3x_a2 -> WP3x_{a2}) without calling them once per variable."""
+    from .render import Name
+
+    text = sym.name
+    digits = re.fullmatch(r"([A-Za-z]+)(\d+)", text)
+    base, sub = (digits.group(1), digits.group(2)) if digits else (text.split("_", 1) + [""])[:2]
+    if not sub:
+        return Name(text, text, f"<mi>{text}</mi>")
+    return Name(f"{base}_{{{sub}}}", text, f"<msub><mi>{base}</mi><mi>{sub}</mi></msub>")
+
+
+def _entry_name(block: Block, sym):
+    from .render import name
+
+    idx = sym.name[len(block.name):]
+    base = r"\tau" if block.name == "tau" else block.name
+    return name(f"{base}_{{{idx}}}", sym.name, block.name, idx)
+
+
+def closed_form_steps(cf: ClosedForm, which: Sequence[str] = ("M", "C", "g")) -> list:
+    """One :class:`~kinedyn.symbolic.eom.Step` per block: its intermediate variables, then its entries."""
+    from .eom import Step
+
+    steps = []
+    for key in which:
+        b = cf[key]
+        entries = set(b.entry_symbols())
+        eqs = [(_entry_name(b, s) if s in entries else _lhs(s), e) for s, e in b.equations()]
+        steps.append(Step(b.title, b.text, eqs))
+    return steps
+
+
+def final_equations(cf: ClosedForm, friction) -> list:
+    """The result as matrices of entry names (M11, ..., C11, ..., g1, ...) defined by the steps."""
+    from .render import name, of_q
+
+    tau = sp.Matrix([sp.Symbol(f"tau_{k + 1}", real=True) for k in range(len(cf.q))]) + sp.Matrix(friction)
+    return [(of_q("D"), cf["M"].symbol_matrix()), (of_q("C", rates=True), cf["C"].symbol_matrix()), (of_q("g"), cf["g"].symbol_matrix()),
+            (name(r"\tau", "tau", "tau"), tau)]
