@@ -331,6 +331,13 @@ def _entry_name(block: Block, sym):
     return name(f"{base}_{{{idx}}}", sym.name, block.name, idx)
 
 
+def block_equations(block: Block) -> Tuple[list, list]:
+    """(entries, intermediates) of a block as [(name, value)] for display: the non-zero entries
+    (M11 = ...) and the intermediate variables they use, in order."""
+    entries = [(_entry_name(block, s), e) for s, e in zip(block.entry_symbols(), block.entries) if e != 0]
+    return entries, [(_lhs(s), e) for s, e in block.assignments]
+
+
 def closed_form_steps(cf: ClosedForm, which: Sequence[str] = ("M", "C", "g")) -> list:
     """One :class:`~kinedyn.symbolic.eom.Step` per block: its intermediate variables, then its entries."""
     from .eom import Step
@@ -345,9 +352,10 @@ def closed_form_steps(cf: ClosedForm, which: Sequence[str] = ("M", "C", "g")) ->
 
 
 def final_equations(cf: ClosedForm, friction) -> list:
-    """The result as matrices of entry names (M11, ..., C11, ..., g1, ...) defined by the steps."""
+    """The result as matrices of entry names (M11, ..., C11, ..., g1, ...) defined by the steps, and
+    tau = M qdd + C qd + g + friction in those names."""
     from .render import name, of_q
 
-    tau = sp.Matrix([sp.Symbol(f"tau_{k + 1}", real=True) for k in range(len(cf.q))]) + sp.Matrix(friction)
-    return [(of_q("D"), cf["M"].symbol_matrix()), (of_q("C", rates=True), cf["C"].symbol_matrix()), (of_q("g"), cf["g"].symbol_matrix()),
-            (name(r"\tau", "tau", "tau"), tau)]
+    M, C, g = cf["M"].symbol_matrix(), cf["C"].symbol_matrix(), cf["g"].symbol_matrix()
+    tau = M * sp.Matrix(cf.qdd) + C * sp.Matrix(cf.qd) + g + sp.Matrix(friction)
+    return [(of_q("D"), M), (of_q("C", rates=True), C), (of_q("g"), g), (name(r"\tau", "tau", "tau"), tau)]
