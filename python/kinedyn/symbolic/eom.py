@@ -319,7 +319,10 @@ class EquationsOfMotion:
         dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
         from .render import equation_mathml, rate_symbols
 
-        return equation_mathml(lhs, value, rate_symbols(self.q, self.qd, self.qdd), display=display)
+        rates = self.__dict__.get("_rate_symbols")
+        if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
+            rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
+        return equation_mathml(lhs, value, rates, display=display)
 
     def to_mathml(self, steps: bool = True) -> str:
         """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per

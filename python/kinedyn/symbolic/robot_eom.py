@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Dict
+from typing import Any, Callable, Dict
 
 import sympy as sp
 
@@ -119,8 +119,8 @@ def _use_cse(form: str, prog) -> bool:
     return form == "cse" or (form == "auto" and prog.op_count()["total"] > CSE_THRESHOLD)
 
 
-def _attach_closed_form(eom, prog, q, qd, qdd):
-    """Show M, C, g in CSE form (kinedyn.symbolic.cse) instead of expanded; eom.M etc. are unchanged."""
+def _closed_form_getter(prog, q, qd, qdd) -> Callable[[], Any]:
+    """A cached getter of M, C, g in CSE form (kinedyn.symbolic.cse), built on first call."""
     cache: Dict[str, Any] = {}
 
     def closed():
@@ -128,9 +128,13 @@ def _attach_closed_form(eom, prog, q, qd, qdd):
             cache["cf"] = closed_form_of_program(prog, q, qd, qdd)
         return cache["cf"]
 
+    return closed
+
+
+def _attach_closed_form(eom, closed) -> None:
+    """Show M, C, g in CSE form instead of expanded; eom.M etc. are unchanged."""
     eom.closed_form = closed
     eom.final_equations = lambda: final_equations(closed(), eom.friction)
-    return closed
 
 
 class _LazyDerivation(dict):
@@ -192,6 +196,7 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
             if form == "cse":
                 raise
     cse = prog is not None and _use_cse(form, prog)
+    closed = _closed_form_getter(prog, q, qd, qdd) if cse else None
     steps: Any = None
     if with_steps and cse:
         def steps():
@@ -201,7 +206,8 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
                 "same unique inertia matrix, Christoffel Coriolis matrix and gravity vector, formed from the customised "
                 "Newton-Euler model and printed with named intermediate variables; eom.M, eom.C, eom.g give them expanded.",
             )
-            return [note] + closed_form_steps(eom.closed_form())
+            assert closed is not None
+            return [note] + closed_form_steps(closed())
     elif with_steps:
         steps = lambda: _steps(robot, model, d, conv, mat, vec, q, qd)
     eom = EquationsOfMotion(
@@ -220,8 +226,8 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
         latex_names=latex_names(q, qd, qdd),
         model=(model, d),
     )
-    if cse:
-        _attach_closed_form(eom, prog, q, qd, qdd)
+    if closed is not None:
+        _attach_closed_form(eom, closed)
     return eom
 
 
@@ -275,7 +281,7 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
     symbols), P and K from the kinematics."""
     q, qd, qdd = state_symbols(robot)
     prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
-    cse = _use_cse(form, prog)
+    closed = _closed_form_getter(prog, q, qd, qdd) if _use_cse(form, prog) else None
     friction = _friction(robot, qd)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
     cache: Dict[str, Any] = {}
@@ -310,13 +316,13 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
         friction=friction,
         christoffel=lambda: _christoffel_sympy(derived()["christoffel"], derived()["conv"]),
         tau=lambda: derived()["vec"](derived()["tau"]) + friction,
-        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd) + (closed_form_steps(eom.closed_form()) if cse else [])) if with_steps else None,
+        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd) + (closed_form_steps(closed()) if closed is not None else [])) if with_steps else None,
         name=robot.name,
         method="newton_euler",
         latex_names=latex_names(q, qd, qdd),
         program=prog,
     )
     eom._derived = derived
-    if cse:
-        _attach_closed_form(eom, prog, q, qd, qdd)
+    if closed is not None:
+        _attach_closed_form(eom, closed)
     return eom
