@@ -6,7 +6,7 @@ sympy.physics.mechanics LagrangesMethod and KanesMethod on the same mechanisms b
 description, in the same run; operation counts before and after common-subexpression elimination.
 
     PYTHONPATH=python python benches/bench_symbolic.py [--puma-lagranges] [--repeat N]
-    PYTHONPATH=python python benches/bench_symbolic.py --cse-only     # issue 12 §5 cases alone
+    PYTHONPATH=python python benches/bench_symbolic.py --cse-only [--expanded]   # issue 12 §5 cases alone
 
 Issue 12 §5 cases (section "CSE form"): `kinedyn derive puma560 --general --method newton_euler` in
 every --format and `derive ur5 --general`, CLI wall time in a child process; M, C, g in CSE form
@@ -172,7 +172,7 @@ def cli_seconds(args, timeout=600):
     return sec
 
 
-def cse_section():
+def cse_section(expanded=False):
     print("\n== CSE form (issue 12 §5); the machine may be shared: compare the ratios, not the seconds ==", flush=True)
     base = cli_seconds(["--version"])
     print(f"{'kinedyn --version (start-up only)':58s} {base:8.2f} s", flush=True)
@@ -183,6 +183,17 @@ def cse_section():
     print(f"{'derive puma560 --general --method newton_euler --json':58s} {sec:8.2f} s", flush=True)
     sec = cli_seconds(["derive", "ur5", "--general", "-o", "/dev/null"])
     print(f"{'derive ur5 --general (lagrange)':58s} {sec:8.2f} s", flush=True)
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        sec = cli_seconds(["report", "puma560", "--eom-joints", "6", "-o", f"{tmp}/puma.html"])
+    print(f"{'report puma560 --eom-joints 6':58s} {sec:8.2f} s", flush=True)
+    if expanded:  # the former path: every entry expanded and printed (minutes)
+        try:
+            sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--form", "expanded", "-o", "/dev/null"], timeout=900)
+            print(f"{'  same, --form expanded (the former output)':58s} {sec:8.2f} s", flush=True)
+        except subprocess.TimeoutExpired:
+            print(f"{'  same, --form expanded (the former output)':58s} > 900 s (stopped)", flush=True)
     for name, robot in (("puma560", kd.robots.puma560()), ("panda", panda_robot())):
         ours_sec, ops = closed_form_time(robot)
         try:
@@ -201,12 +212,13 @@ def main(argv=None):
     ap.add_argument("--puma-lagranges", action="store_true", help="also run LagrangesMethod on the PUMA 560 (minutes; once, capped)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--cse-only", action="store_true", help="only the issue 12 §5 cases (CSE form, CLI wall times, Panda)")
+    ap.add_argument("--expanded", action="store_true", help="also time derive PUMA --general --form expanded (the former output; minutes)")
     args = ap.parse_args(argv)
     if args.child and args.child.startswith("kanes-"):
         kanes_child(args.child[len("kanes-"):])
         return
     if args.cse_only:
-        cse_section()
+        cse_section(args.expanded)
         return
     if args.child == "puma-lagranges":
         sec, eqs = lagranges(kd.robots.puma560())
@@ -276,7 +288,7 @@ def main(argv=None):
         print(f"ratio numeric/generated: single {n_single / c_single:.2f}, batch {n_batch / c_batch:.2f}")
     except Exception as exc:  # the native module may not be built
         print(f"numeric engine unavailable: {exc}")
-    cse_section()
+    cse_section(args.expanded)
 
 
 if __name__ == "__main__":
