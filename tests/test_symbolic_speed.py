@@ -41,7 +41,7 @@ def _states(robot, count=3, seed=0):
     return [(rng.uniform(-math.pi, math.pi, robot.n), rng.normal(size=robot.n)) for _ in range(count)]
 
 
-@pytest.mark.parametrize("name", ["puma560", "ur5"])
+@pytest.mark.parametrize("name", ["puma560", "ur5", "stanford"])  # stanford: a prismatic joint
 def test_cse_blocks_equal_the_numeric_core_with_general_inertias(name):
     robot = kd.robots.get(name)
     q, qd, qdd = state_symbols(robot)
