@@ -26,7 +26,7 @@ from typing import Dict, List, Sequence, Tuple
 
 import sympy as sp
 
-__all__ = ["Block", "ClosedForm", "closed_form", "evaluate_block", "block_to_python"]
+__all__ = ["Block", "ClosedForm", "closed_form", "closed_form_of_program", "evaluate_block"]
 
 Assignment = Tuple[sp.Symbol, sp.Expr]
 
@@ -228,6 +228,8 @@ def closed_form(robot, q, qd, qdd, parameters=None, cse: bool = True) -> ClosedF
 
 
 def closed_form_of_program(prog, q, qd, qdd, cse: bool = True) -> ClosedForm:
+    """:func:`closed_form` of an already built customised model (a
+    :class:`~kinedyn.symbolic.newton_euler.Program` with output ``tau``, friction left out)."""
     n = len(q)
     base = list(prog.assignments)
     tau = [sp.sympify(e) for e in prog.outputs["tau"]]
@@ -250,9 +252,8 @@ def closed_form_of_program(prog, q, qd, qdd, cse: bool = True) -> ClosedForm:
                           "X_aj denotes d X / d qdd_j; x1, x2, ... are common subexpressions.")
 
     # g: tau(q, 0, 0)
-    g_assign, env_g = _specialise(base, {**{v: zero for v in qd}, **{a: zero for a in qdd}})
-    g_entries = [t.xreplace(env_g) for t in tau]
-    blocks["g"] = _finish("g", (n,), g_assign, g_entries, cse, names,
+    g_entries = [t.xreplace(env) for t in tau]
+    blocks["g"] = _finish("g", (n,), primal, g_entries, cse, names,
                           "Gravity vector g(q) = tau(q, 0, 0) (CSE form)",
                           "The Newton-Euler program with qd = qdd = 0.")
 
@@ -294,14 +295,6 @@ def evaluate_block(block: Block, values: dict) -> "list":
     for s, e in block.assignments:
         env[s] = sp.sympify(e).xreplace(env)
     return [sp.sympify(e).xreplace(env) for e in block.entries]
-
-
-def block_to_python(block: Block, args: Sequence[str] = ("q", "qd", "qdd")) -> str:
-    """The block as one Python statement list (math module), for tests and generated code."""
-    from sympy.printing.pycode import PythonCodePrinter
-
-    pr = PythonCodePrinter()
-    return "\n".join([f"{s} = {pr.doprint(e)}" for s, e in block.assignments] + [f"out = [{', '.join(pr.doprint(e) for e in block.entries)}]"])
 
 
 # ---------------------------------------------------------------------------- display
