@@ -6,6 +6,12 @@ sympy.physics.mechanics LagrangesMethod and KanesMethod on the same mechanisms b
 description, in the same run; operation counts before and after common-subexpression elimination.
 
     PYTHONPATH=python python benches/bench_symbolic.py [--puma-lagranges] [--repeat N]
+    PYTHONPATH=python python benches/bench_symbolic.py --cse-only [--expanded]   # issue 12 §5 cases alone
+
+Issue 12 §5 cases (section "CSE form"): `kinedyn derive puma560 --general --method newton_euler` in
+every --format and `derive ur5 --general`, CLI wall time in a child process; M, C, g in CSE form
+(kinedyn.symbolic.cse) of the PUMA 560 and the Panda (7 joints, example-robot-data's URDF) beside
+KanesMethod forming the same arm's equations (its mass matrix and forcing), ratios printed.
 
 LagrangesMethod on the PUMA 560 takes minutes: it runs only with --puma-lagranges, once, in a
 subprocess capped at 400 s.
@@ -131,11 +137,105 @@ def row(name, what, seconds, exprs):
     print(f"{name:10s} {what:34s} {seconds:9.3f} s   ops {b:8d}   after cse {a:7d}", flush=True)
 
 
+def panda_robot():
+    from kinedyn.testing import example_robot_data_dir
+    import os
+
+    path = os.path.join(example_robot_data_dir(), "panda_description/urdf/panda.urdf")
+    return kd.Robot.from_urdf(path).lock_joints({"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0})
+
+
+def closed_form_time(robot, parameters=None):
+    """Seconds to M, C, g in CSE form (from the robot, Newton-Euler program included), and op counts."""
+    from kinedyn.symbolic.cse import closed_form
+    from kinedyn.symbolic.lagrange import state_symbols
+
+    q, qd, qdd = state_symbols(robot)
+    t = time.perf_counter()
+    cf = closed_form(robot, q, qd, qdd, parameters=parameters)
+    sec = time.perf_counter() - t
+    return sec, sum(cf[k].op_count()["total"] for k in ("M", "C", "g"))
+
+
+def kanes_child(which):
+    robot = panda_robot() if which == "panda" else kd.robots.puma560()
+    sec, eqs = kanes(robot)
+    print(f"{sec:.3f}")
+
+
+class _Seconds(float):
+    """Wall seconds of a child command, with its CPU seconds (user + system) as ``.cpu``: on a shared
+    machine the CPU time is what the command itself cost, the wall time adds the wait for a core."""
+
+    cpu = 0.0
+
+
+def fmt(sec) -> str:
+    return f"{float(sec):8.2f} s wall {getattr(sec, 'cpu', float('nan')):6.2f} s CPU"
+
+
+def cli_seconds(args, timeout=600):
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, "-m", "kinedyn.cli", *args], capture_output=True, text=True, timeout=timeout)
+    sec = _Seconds(time.perf_counter() - t)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    sec.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if out.returncode != 0:
+        raise RuntimeError(out.stderr[-400:])
+    return sec
+
+
+def cse_section(expanded=False):
+    print("\n== CSE form (issue 12 §5); the machine may be shared: compare the ratios, not the seconds ==", flush=True)
+    base = cli_seconds(["--version"])
+    print(f"{'kinedyn --version (start-up only)':58s} {fmt(base)}", flush=True)
+    for output in ("text", "latex", "markdown", "mathml", "python", "numpy", "c"):
+        sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--format", output, "-o", "/dev/null"])
+        print(f"{'derive puma560 --general --method newton_euler --format ' + output:58s} {fmt(sec)}", flush=True)
+    sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--json"])
+    print(f"{'derive puma560 --general --method newton_euler --json':58s} {fmt(sec)}", flush=True)
+    sec = cli_seconds(["derive", "ur5", "--general", "-o", "/dev/null"])
+    print(f"{'derive ur5 --general (lagrange)':58s} {fmt(sec)}", flush=True)
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        sec = cli_seconds(["report", "puma560", "--eom-joints", "6", "-o", f"{tmp}/puma.html"])
+    print(f"{'report puma560 --eom-joints 6':58s} {fmt(sec)}", flush=True)
+    if expanded:  # the former path: every entry expanded and printed (minutes)
+        try:
+            sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--form", "expanded", "-o", "/dev/null"], timeout=900)
+            print(f"{'  same, --form expanded (the former output)':58s} {fmt(sec)}", flush=True)
+        except subprocess.TimeoutExpired:
+            print(f"{'  same, --form expanded (the former output)':58s} > 900 s (stopped)", flush=True)
+    for name, robot in (("puma560", kd.robots.puma560()), ("panda", panda_robot())):
+        ours_sec, ops = closed_form_time(robot)
+        try:
+            out = subprocess.run([sys.executable, __file__, "--child", f"kanes-{name}"], capture_output=True, text=True, timeout=400)
+            kane = float(out.stdout.split()[-1])
+            peer = f"KanesMethod {kane:8.2f} s   ratio Kane/kinedyn {kane / ours_sec:6.1f}"
+        except subprocess.TimeoutExpired:
+            peer = "KanesMethod > 400 s (stopped)"
+        print(f"{name:8s} M, C, g in CSE form {ours_sec:8.2f} s ({ops} ops)   {peer}", flush=True)
+    sec, ops = closed_form_time(kd.robots.puma560(), general_parameters(kd.robots.puma560()))
+    print(f"{'puma560 general inertias: M, C, g in CSE form':58s} {sec:8.2f} s ({ops} ops)", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--puma-lagranges", action="store_true", help="also run LagrangesMethod on the PUMA 560 (minutes; once, capped)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
+    ap.add_argument("--cse-only", action="store_true", help="only the issue 12 §5 cases (CSE form, CLI wall times, Panda)")
+    ap.add_argument("--expanded", action="store_true", help="also time derive PUMA --general --form expanded (the former output; minutes)")
     args = ap.parse_args(argv)
+    if args.child and args.child.startswith("kanes-"):
+        kanes_child(args.child[len("kanes-"):])
+        return
+    if args.cse_only:
+        cse_section(args.expanded)
+        return
     if args.child == "puma-lagranges":
         sec, eqs = lagranges(kd.robots.puma560())
         print(f"{sec:.3f} {_ops(eqs)['total']}")
@@ -204,6 +304,7 @@ def main(argv=None):
         print(f"ratio numeric/generated: single {n_single / c_single:.2f}, batch {n_batch / c_batch:.2f}")
     except Exception as exc:  # the native module may not be built
         print(f"numeric engine unavailable: {exc}")
+    cse_section(args.expanded)
 
 
 if __name__ == "__main__":

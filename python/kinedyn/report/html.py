@@ -195,7 +195,8 @@ def _symbolic_eom(robot, name: Optional[str], max_joints: int):
     if not hasattr(subject, "equations_of_motion"):
         return None, "This kinedyn has no symbolic engine."
     try:
-        eom = subject.equations_of_motion()
+        # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
+        eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")
     except ImportError:
         return None, "This kinedyn has no symbolic engine."
     return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
@@ -515,11 +516,28 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
         eq.append(f"<p class='note'>{html.escape(d['eom_note'])}; C from Christoffel symbols (Spong eq. 9.62).</p>")
         from ..symbolic.render import name, of_q
 
-        for lhs, value in [(of_q("D"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]:
-            eq.append(_equation(eom, lhs, value))
-        for k in range(eom.n):  # one line per joint: the torques are long
-            eq.append(_equation(eom, name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), eom.tau[k]))
         steps = getattr(eom, "steps", None) or []
+        if getattr(eom, "final_equations", None) is not None:  # CSE form: entry names, their values, then the variables
+            from ..symbolic.cse import block_equations
+
+            for lhs, value in eom.final_equations():
+                eq.append(_equation(eom, lhs, value))
+            eq.append("<p class='note'>Entries in terms of intermediate variables (Khalil &amp; Dombre's customised model, "
+                      "then common subexpressions x1, x2, ...); the variables are listed under each block.</p>")
+            cf = eom.closed_form()
+            for key in ("M", "C", "g"):
+                entries, intermediates = block_equations(cf[key])
+                eq.append(f"<h3>{html.escape(cf[key].title)}</h3>")
+                eq += [_equation(eom, lhs, value) for lhs, value in entries]
+                eq.append(f"<details><summary>its {len(intermediates)} intermediate variables</summary>")
+                eq += [_equation(eom, lhs, value) for lhs, value in intermediates]
+                eq.append("</details>")
+            steps = [s for s in steps if s.title not in {b.title for b in cf.blocks.values()}]
+        else:
+            for lhs, value in [(of_q("D"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]:
+                eq.append(_equation(eom, lhs, value))
+            for k in range(eom.n):  # one line per joint: the torques are long
+                eq.append(_equation(eom, name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), eom.tau[k]))
         if steps:
             eq.append("<details><summary>every step of the derivation</summary>")
             for k, step in enumerate(steps, 1):

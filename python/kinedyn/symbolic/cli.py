@@ -29,7 +29,7 @@ def cmd_derive(args) -> int:
     robot = _robot(args)
     with busy(f"deriving the equations of motion of '{robot.name}' ({args.method})", progress=False if args.json else None):
         eom = robot.equations_of_motion(
-            method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None
+            method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None, form=args.form
         )
         fmt = args.format
         if fmt == "latex":
@@ -42,22 +42,9 @@ def cmd_derive(args) -> int:
             text = str(eom)
         else:
             text = eom.to_code(fmt)
-        op_count = eom.op_count()
+        payload = _payload(args, robot, eom, text) if args.json else {}
     if args.output:
         Path(args.output).write_text(text)
-    payload = {
-        "robot": robot.name,
-        "method": args.method,
-        "format": fmt,
-        "q": [str(s) for s in eom.q],
-        "M": [[str(e) for e in row] for row in eom.M.tolist()],
-        "C": [[str(e) for e in row] for row in eom.C.tolist()],
-        "g": [str(e) for e in eom.g],
-        "tau": [str(e) for e in eom.tau],
-        "op_count": op_count,
-        "output": args.output,
-        "text": None if args.output else text,
-    }
 
     def render():
         if args.output:
@@ -67,6 +54,36 @@ def cmd_derive(args) -> int:
 
     emit(args, payload, render)
     return 0
+
+
+def _payload(args, robot, eom, text) -> dict:
+    """The --json document: M, C, g, tau as strings; in CSE form (a large model) each block's
+    intermediate variables as [name, expression] pairs beside its entries, in terms of them."""
+    payload = {"robot": robot.name, "method": args.method, "format": args.format, "q": [str(s) for s in eom.q]}
+    if eom.closed_form is not None:
+        cf = eom.closed_form()
+        n = eom.n
+        entries = {k: [str(e) for e in cf[k].entries] for k in ("M", "C", "g")}
+        payload.update(
+            form="cse",
+            M=[entries["M"][r * n:(r + 1) * n] for r in range(n)],
+            C=[entries["C"][r * n:(r + 1) * n] for r in range(n)],
+            g=entries["g"],
+            tau=[str(t + f) for t, f in zip(cf["tau"].entries, eom.friction)],
+            intermediates={k: [[str(s), str(e)] for s, e in cf[k].assignments] for k in ("M", "C", "g", "tau")},
+            op_count={k: cf[k].op_count() for k in ("M", "C", "g", "tau")},
+        )
+    else:
+        payload.update(
+            form="expanded",
+            M=[[str(e) for e in row] for row in eom.M.tolist()],
+            C=[[str(e) for e in row] for row in eom.C.tolist()],
+            g=[str(e) for e in eom.g],
+            tau=[str(e) for e in eom.tau],
+            op_count=eom.op_count(),
+        )
+    payload.update(output=args.output, text=None if args.output else text)
+    return payload
 
 
 def add_derive_command(subparsers) -> None:
@@ -79,6 +96,8 @@ def add_derive_command(subparsers) -> None:
     p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
     p.add_argument("--format", default="text", choices=FORMATS)
     p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
+    p.add_argument("--form", default="auto", choices=["auto", "cse", "expanded"],
+                   help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)")
     p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
     p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
     p.set_defaults(func=cmd_derive)

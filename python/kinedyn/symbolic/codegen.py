@@ -40,7 +40,13 @@ def _blocks(eom, what: Sequence[str], params=None):
         if name not in _ARGS:
             raise ValueError(f"cannot generate {name!r}: choose from {list(_ARGS)}")
         pre: List[tuple] = []
-        if name == "tau" and eom.program is not None:
+        closed = name in ("M", "C", "g") and getattr(eom, "closed_form", None) is not None
+        if closed:  # a large model: the CSE form of kinedyn.symbolic.cse, never expanded
+            block = eom.closed_form()[name]
+            pre = list(block.assignments)
+            exprs = list(block.entries)
+            shape = tuple(block.shape)
+        elif name == "tau" and eom.program is not None:
             pre = list(eom.program.assignments)
             exprs = [t + f for t, f in zip(eom.program.outputs["tau"], eom.friction)]
             shape = (eom.n,)
@@ -59,7 +65,10 @@ def _blocks(eom, what: Sequence[str], params=None):
         left = {s for s in free - known if "[" not in s.name}
         if left:
             raise ValueError(f"{name}: symbols {sorted(map(str, left))} have no value")
-        repl, red = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
+        if closed:  # already in CSE form (its own x1, x2, ... among pre)
+            repl, red = [], exprs
+        else:
+            repl, red = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
         out.append((name, shape, pre + list(repl), list(red)))
     return out, pars
 

@@ -121,6 +121,10 @@ class EquationsOfMotion:
         self.extra = dict(extra or {})
         #: robot equations: the Newton-Euler derivation, computed on first use (see robot_eom)
         self._derived: Optional[Callable[[], Dict[str, Any]]] = None
+        #: large robot models: M, C, g in CSE form (kinedyn.symbolic.cse.ClosedForm), and the rendered
+        #: result as matrices of the entry names it defines (see robot_eom's ``form``)
+        self.closed_form: Optional[Callable[[], Any]] = None
+        self.final_equations: Optional[Callable[[], list]] = None
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod
@@ -268,8 +272,13 @@ class EquationsOfMotion:
         """Free symbols of the equations other than the state, sorted by name."""
         state = set(self.q) | set(self.qd) | set(self.qdd)
         free = set()
-        for m in (self.M, self.C, self.g, self.friction):
-            free |= m.free_symbols
+        if self.closed_form is not None:  # the same symbols, without expanding M, C, g
+            for key in ("M", "C", "g"):
+                free |= self.closed_form()[key].parameters()
+            free |= self.friction.free_symbols
+        else:
+            for m in (self.M, self.C, self.g, self.friction):
+                free |= m.free_symbols
         free |= sp.sympify(self.P).free_symbols if self.P is not None else set()
         return sorted(free - state, key=str)
 
@@ -306,6 +315,8 @@ class EquationsOfMotion:
     def _final_equations(self):
         from .render import name, of_q
 
+        if self.final_equations is not None:  # CSE form: entry names, defined in the last steps
+            return self.final_equations()
         return [(of_q("D"), self.M), (of_q("C", rates=True), self.C), (of_q("g"), self.g), (name(r"\tau", "tau", "tau"), self.tau)]
 
     def to_latex(self, steps: bool = True) -> str:
@@ -357,7 +368,10 @@ class EquationsOfMotion:
         dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
         from .render import equation_mathml, rate_symbols
 
-        return equation_mathml(lhs, value, rate_symbols(self.q, self.qd, self.qdd), display=display)
+        rates = self.__dict__.get("_rate_symbols")
+        if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
+            rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
+        return equation_mathml(lhs, value, rates, display=display)
 
     def to_mathml(self, steps: bool = True) -> str:
         """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per
@@ -408,7 +422,7 @@ class EquationsOfMotion:
         return eom_markdown(self)
 
 
-def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None) -> EquationsOfMotion:
+def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None, form: str = "auto") -> EquationsOfMotion:
     """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
 
     ``method="lagrange"``: Euler-Lagrange from K and P with every step kept (Spong §9.2-9.3).
@@ -418,6 +432,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
     ``parameters="general"`` replaces every body's inertia by the ten symbols M_j, MX_j, MY_j, MZ_j,
     XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j (about the body origin, Khalil & Dombre's names), so that
     ``eom.regressor()`` groups them into base parameters; a list of per-body 10-vectors is used as given.
+    ``form``: how the renderings (``str``, ``to_latex`` ...) show M, C, g: ``"expanded"``, ``"cse"``
+    (named intermediate variables, Khalil & Dombre's way; :mod:`kinedyn.symbolic.cse`) or ``"auto"``
+    (CSE for a large model, e.g. a 6-joint arm with general inertias). ``eom.M`` etc. are the same.
     """
     if isinstance(parameters, str):
         if parameters != "general":
@@ -430,9 +447,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
     if method == "lagrange":
         from .robot_eom import lagrange_eom
 
-        return lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters)
+        return lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
     if method in ("newton_euler", "newton-euler", "rnea"):
         from .robot_eom import newton_euler_eom
 
-        return newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps)
+        return newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
     raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any, Dict
+from typing import Any, Callable, Dict
 
 import sympy as sp
 
+from .cse import closed_form_of_program, closed_form_steps, final_equations
 from .eom import EquationsOfMotion, Step
 from .lagrange import RingModel, _exact, christoffel, coriolis_matrix, derive_lagrange, latex_names, state_symbols
 from .newton_euler import newton_euler_program, newton_euler_steps
@@ -108,13 +109,107 @@ def _christoffel_sympy(c, conv):
     return [[[conv(c[i][j][k]) for k in range(n)] for j in range(n)] for i in range(n)]
 
 
-def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, parameters=None) -> EquationsOfMotion:
+def _use_cse(form: str, prog) -> bool:
+    """Whether the results are shown in CSE form: ``form`` "cse", "expanded" or "auto" (CSE above
+    :data:`kinedyn.symbolic.cse.CSE_THRESHOLD` operations of the customised model)."""
+    from .cse import CSE_THRESHOLD
+
+    if form not in ("auto", "cse", "expanded"):
+        raise ValueError(f"form must be 'auto', 'cse' or 'expanded', got {form!r}")
+    return form == "cse" or (form == "auto" and prog.op_count()["total"] > CSE_THRESHOLD)
+
+
+def _closed_form_getter(prog, q, qd, qdd) -> Callable[[], Any]:
+    """A cached getter of M, C, g in CSE form (kinedyn.symbolic.cse), built on first call."""
+    cache: Dict[str, Any] = {}
+
+    def closed():
+        if "cf" not in cache:
+            cache["cf"] = closed_form_of_program(prog, q, qd, qdd)
+        return cache["cf"]
+
+    return closed
+
+
+def _attach_closed_form(eom, closed) -> None:
+    """Show M, C, g in CSE form instead of expanded; eom.M etc. are unchanged."""
+    eom.closed_form = closed
+    eom.final_equations = lambda: final_equations(closed(), eom.friction)
+
+
+class _LazyDerivation(dict):
+    """The Lagrange derivation dict, computed on first access (a CSE-form display never needs it)."""
+
+    def __init__(self, model):
+        super().__init__()
+        self._model = model
+
+    def _ensure(self):
+        if not dict.__len__(self):
+            self.update(derive_lagrange(self._model))
+
+    def __getitem__(self, key):
+        self._ensure()
+        return dict.__getitem__(self, key)
+
+    def get(self, key, default=None):
+        self._ensure()
+        return dict.get(self, key, default)
+
+    def __contains__(self, key):
+        self._ensure()
+        return dict.__contains__(self, key)
+
+    def keys(self):
+        self._ensure()
+        return dict.keys(self)
+
+    def items(self):
+        self._ensure()
+        return dict.items(self)
+
+    def __iter__(self):
+        self._ensure()
+        return dict.__iter__(self)
+
+    def __len__(self):
+        self._ensure()
+        return dict.__len__(self)
+
+
+def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, parameters=None, form: str = "auto") -> EquationsOfMotion:
+    """Euler-Lagrange equations (Spong §9.2-9.3). With ``form`` "cse" (or "auto" for a large model) the
+    rendered results are M, C, g in CSE form from the customised Newton-Euler model -- the same unique M,
+    g and Christoffel C -- and the Lagrange steps, too large to read, are replaced by a note; ``eom.M``,
+    ``eom.C``... are the expanded matrices either way, formed on first use."""
     q, qd, qdd = state_symbols(robot)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
     model = RingModel(robot, q, qd, qdd, inertias=inertias)
-    d = derive_lagrange(model)
+    d = _LazyDerivation(model)
     conv, mat, vec = _outputs(model, d, simplify)
     friction = _friction(robot, qd)
+    prog = None
+    if form != "expanded":
+        try:
+            prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
+        except Exception:  # noqa: BLE001 - a model the recursion cannot take is shown expanded, as before
+            if form == "cse":
+                raise
+    cse = prog is not None and _use_cse(form, prog)
+    closed = _closed_form_getter(prog, q, qd, qdd) if cse else None
+    steps: Any = None
+    if with_steps and cse:
+        def steps():
+            note = Step(
+                "Lagrange's steps omitted (too large to read)",
+                f"K, P, L and their derivatives of this {robot.n}-joint model run to thousands of terms. M, C and g below are the "
+                "same unique inertia matrix, Christoffel Coriolis matrix and gravity vector, formed from the customised "
+                "Newton-Euler model and printed with named intermediate variables; eom.M, eom.C, eom.g give them expanded.",
+            )
+            assert closed is not None
+            return [note] + closed_form_steps(closed())
+    elif with_steps:
+        steps = lambda: _steps(robot, model, d, conv, mat, vec, q, qd)
     eom = EquationsOfMotion(
         q, qd, qdd,
         M=lambda: mat(d["M"]),
@@ -125,12 +220,14 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
         friction=friction,
         christoffel=lambda: _christoffel_sympy(d["christoffel"], conv),
         tau=lambda: vec(d["tau"]) + friction,
-        steps=(lambda: _steps(robot, model, d, conv, mat, vec, q, qd)) if with_steps else None,
+        steps=steps,
         name=robot.name,
         method="lagrange",
         latex_names=latex_names(q, qd, qdd),
         model=(model, d),
     )
+    if closed is not None:
+        _attach_closed_form(eom, closed)
     return eom
 
 
@@ -178,12 +275,13 @@ def _ring_converter(model):
     return convert
 
 
-def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: bool = True) -> EquationsOfMotion:
+def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: bool = True, form: str = "auto") -> EquationsOfMotion:
     """Equations from the customised Newton-Euler model; tau, M, g, C come from the program alone
     (M = d tau / d qdd and g = tau(q, 0, 0) of the exactly evaluated program, C from M's Christoffel
     symbols), P and K from the kinematics."""
     q, qd, qdd = state_symbols(robot)
     prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
+    closed = _closed_form_getter(prog, q, qd, qdd) if _use_cse(form, prog) else None
     friction = _friction(robot, qd)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
     cache: Dict[str, Any] = {}
@@ -203,20 +301,28 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
             cache.update(conv=conv, mat=mat, vec=vec)
         return cache
 
+    def potential():  # from the kinematics alone (cheap), not the whole derivation
+        if "P" in cache:
+            return derived()["conv"](cache["P"])
+        model = RingModel(robot, q, qd, qdd, inertias=inertias)
+        return _outputs(model, None, simplify)[0](model.potential_energy())
+
     eom = EquationsOfMotion(
         q, qd, qdd,
         M=lambda: derived()["mat"](derived()["M"]),
         C=lambda: derived()["mat"](derived()["C"]),
         g=lambda: derived()["vec"](derived()["g"]),
-        P=lambda: derived()["conv"](derived()["P"]),
+        P=potential,
         friction=friction,
         christoffel=lambda: _christoffel_sympy(derived()["christoffel"], derived()["conv"]),
         tau=lambda: derived()["vec"](derived()["tau"]) + friction,
-        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd)) if with_steps else None,
+        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd) + (closed_form_steps(closed()) if closed is not None else [])) if with_steps else None,
         name=robot.name,
         method="newton_euler",
         latex_names=latex_names(q, qd, qdd),
         program=prog,
     )
     eom._derived = derived
+    if closed is not None:
+        _attach_closed_form(eom, closed)
     return eom
