@@ -200,3 +200,45 @@ def test_talos_report_with_default_options_finishes_in_under_60_s(tmp_path):
     start = time.perf_counter()
     assert main(["report", erd(*TALOS), "-o", str(tmp_path / "talos.html")]) == 0
     assert time.perf_counter() - start < 60  # issue 13 §5's bound; ~3-10 s here under load
+
+
+def _page_json(page: str, element_id: str) -> dict:
+    import json
+
+    m = re.search(rf'<script type="application/json" id="{element_id}">(.*?)</script>', page, re.S)
+    return json.loads(m.group(1).replace("<\\/", "</"))
+
+
+def test_report_collision_option_draws_the_collision_shapes(tmp_path):
+    """`kinedyn report --collision`: the 3-D view draws the <collision> shapes (one sphere) instead of
+    the <visual> ones (two boxes)."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text("""<robot name="arm">
+  <link name="base"/>
+  <link name="l1">
+    <inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.1 0.1 0.5"/></geometry></visual>
+    <visual><origin xyz="0 0 0.5"/><geometry><box size="0.2 0.2 0.2"/></geometry></visual>
+    <collision><geometry><sphere radius="0.3"/></geometry></collision>
+  </link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>""")
+    drawn = {}
+    for flag in ([], ["--collision"]):
+        out = tmp_path / f"r{len(flag)}.html"
+        assert main(["report", str(urdf), "-o", str(out), "--t", "0.1", *flag]) == 0
+        model = _page_json(out.read_text(), "kinedyn-model")
+        drawn[bool(flag)] = (model["geometry"], model["shapes"], model["shapes_drawn"])
+    assert drawn == {False: ("visual", 2, 2), True: ("collision", 1, 1)}
+
+
+def test_report_of_a_changed_tutorial_arm_leaves_out_the_tutorial(tmp_path):
+    """The tutorial's numbers are the standard arm's: `report planar_2r --set l1=2` is another arm, so its
+    report has no tutorial section (the plain default report has one: tests/test_report.py)."""
+    out = tmp_path / "r.html"
+    assert main(["report", "planar_2r", "--set", "l1=2", "-o", str(out), "--t", "0.1"]) == 0
+    page = out.read_text()
+    assert "<section id='tutorial'>" not in page
+    assert main(["report", "planar_2r", "-o", str(out), "--t", "0.1"]) == 0
+    assert "<section id='tutorial'>" in out.read_text()

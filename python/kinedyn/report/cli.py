@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cli import OutputPath, console, emit, esc, load_robot, nonnegative_int, parse_q, positive_float
+from ..cli import OutputPath, console, emit, esc, load_robot, nonnegative_int, parse_q, positive_float, set_values
 
 __all__ = ["add_report_commands"]
 
@@ -42,8 +42,9 @@ def cmd_report(args) -> int:
     from ..progress import Steps
     from .html import SIMULATION_BUDGET, build_report
 
-    # the tutorial's arm (the default robot) gets the tutorial worked step by step
-    tutorial = spec == robots.DEFAULT and not args.no_tutorial
+    # the tutorial's arm (the default robot, as the tutorial sets it: no --set changes) gets the tutorial
+    # worked step by step; the tutorial's numbers are those of the standard arm, not of a changed one
+    tutorial = spec == robots.DEFAULT and not set_values() and not args.no_tutorial
     progress = False if args.json else None  # a bar on stderr on a terminal; never with --json
     budget = SIMULATION_BUDGET if args.time_budget is None else args.time_budget
     with Steps("report", 6 + (len(_questions()) if tutorial else 0), progress) as steps:
@@ -51,7 +52,8 @@ def cmd_report(args) -> int:
         public = {k: v for k, v in data.items() if not k.startswith("_")}
         from .html import _build_report
 
-        page = _build_report(robot, q, qd, spec, args.t, args.eom_joints, data, tutorial, progress, budget, steps)
+        page = _build_report(robot, q, qd, spec, args.t, args.eom_joints, data, tutorial, progress, budget, steps,
+                             geometry="collision" if args.collision else "visual")
     out.write_text(page, encoding="utf-8")
     payload = {"path": str(out.resolve()), **public}
     payload.pop("simulation", None)
@@ -101,6 +103,7 @@ def add_report_commands(subparsers) -> None:
     p.add_argument("--eom-joints", type=nonnegative_int, default=3, help="typeset the symbolic equations of motion for arms with up to this many joints (default 3)")
     p.add_argument("--time-budget", dest="time_budget", type=positive_float, default=None, metavar="S",
                    help="wall-clock seconds the free-motion simulation may take; a run cut short says so in the report (default 30)")
+    p.add_argument("--collision", action="store_true", help="the 3-D view draws the description's collision shapes instead of its visual ones")
     p.add_argument("--no-tutorial", action="store_true", help="leave out the worked tutorial (included for the default robot, the tutorial's arm)")
     p.add_argument("--json", action="store_true", help="print the report's numbers as one JSON document")
     p.set_defaults(func=cmd_report)
