@@ -31,6 +31,9 @@ CELLS = {
     "identification": ("r2 = kd.robots.planar_2r()\n"
                        "ident = analysis.identify(r2, analysis.simulate_measurements(r2, analysis.excitation(r2, harmonics=3, period=2.0, seed=1), rate=50.0))\n"
                        "ident"),
+    # robot.show() in a kernel returns at once (a script blocks until Ctrl-C) with its server running
+    "viewer": ("import urllib.request\nviewer = kd.robots.planar_2r().show(port=8765)\n"
+               "status = urllib.request.urlopen(viewer.url, timeout=60).status\nviewer.close()\n(status, viewer.url)"),
 }
 
 
@@ -140,3 +143,8 @@ def test_property_and_identification_results_are_tables(outputs):
     rows = cells_of(outputs["identification"]["text/html"], "kinedyn-identification")
     assert [r[0] for r in rows] == list(ident.names)
     np.testing.assert_allclose([float(r[1]) for r in rows], ident.estimates, rtol=5e-6, atol=1e-12)
+
+
+def test_the_live_viewer_returns_at_once_in_a_kernel_and_serves_its_page(outputs):
+    status, url = eval(outputs["viewer"]["text/plain"])  # the tuple the cell returned: (200, 'http://localhost:PORT')
+    assert status == 200 and re.fullmatch(r"http://localhost:\d+", url)
