@@ -375,11 +375,17 @@ class LagrangianSystem:
         if not self.is_natural():
             raise ValueError("hamiltonian(): the Legendre transform is formed here for natural systems (L = qd^T M qd / 2 - P)")
         p = sp.Matrix([sp.Symbol(f"p_{c.name}", real=True) for c in self.q])  # momentum conjugate to each q
-        M = sp.hessian(self.L, self.qd)
-        qd_of_p = M.LUsolve(p)  # qd = M^-1 p
-        P = -self.L.subs({v: 0 for v in self.qd})
-        H = self._textbook((p.T * qd_of_p)[0, 0] / 2 + P)  # H = p^T M^-1 p / 2 + P
-        qdot = self._textbook(sp.Matrix([sp.diff(H, pi) for pi in p]))
+        # M^-1 = adj(M) / det(M), each entry and the determinant simplified on their own: the quotient
+        # p^T adj(M) p / (2 det M) is the textbook's form, and simplifying it whole (one fraction of
+        # a few hundred operations, the five-bar's) takes minutes
+        M = sp.hessian(self.L, self.qd).applyfunc(self._textbook)
+        det = self._textbook(M.det())
+        if det == 0:
+            raise ValueError("hamiltonian(): the inertia matrix d2L/dqd2 is singular (det = 0), so p = M qd cannot be inverted")
+        adj = M.adjugate().applyfunc(self._textbook)
+        P = self._textbook(-self.L.subs({v: 0 for v in self.qd}))
+        H = self._textbook(sp.expand((p.T * adj * p)[0, 0])) / (2 * det) + P  # H = p^T M^-1 p / 2 + P
+        qdot = sp.Matrix([self._textbook(sp.expand((adj[i, :] * p)[0, 0])) / det for i in range(self.n)])  # dH/dp = M^-1 p
         B = self.B.subs(dict(zip(self.qd, qdot)))
         pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B  # from the simplified H
         return p, H, qdot, pdot
