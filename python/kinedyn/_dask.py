@@ -1,0 +1,215 @@
+"""Dask arrays through Robot's batched methods (docs/scale.md).
+
+Every batched numeric method of :class:`kinedyn.Robot` is wrapped by :func:`batched`. When none of
+its arguments is a ``dask.array.Array`` the wrapper costs one dictionary lookup and calls the method
+as before; dask is never imported here (a robot works without it installed). When one is, the call
+becomes a lazy ``dask.array`` built with ``blockwise``: one task per chunk of states, each calling
+the very same method on a NumPy block, so the numbers are those of the in-process batch.
+
+What travels to a worker is the robot's *description* (pickled once per call, a Robot drops its
+native model when pickled), wrapped in a :class:`_RobotByContent` that is unpickled on the worker
+through a per-process cache keyed by the description's SHA-256: each worker process unpickles the
+description and builds the native model once, whatever the number of chunks or calls.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import inspect
+import os
+import pickle
+import sys
+import threading
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, TypeVar
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+__all__ = ["batched", "is_dask_array", "process_cache_info"]
+
+
+def _dask_array_type() -> Optional[type]:
+    """``dask.array.Array`` if dask.array was imported by someone, else None (never imports it)."""
+    module = sys.modules.get("dask.array")
+    return getattr(module, "Array", None) if module is not None else None
+
+
+def is_dask_array(x: Any) -> bool:
+    """Whether ``x`` is a ``dask.array.Array``, without importing dask."""
+    array_type = _dask_array_type()
+    return array_type is not None and isinstance(x, array_type)
+
+
+# ------------------------------------------------------------------ the per-process robot cache
+_CACHE: dict[str, "Robot"] = {}
+_CACHE_LOCK = threading.Lock()
+_UNPICKLED: dict[str, int] = {}  # digest -> how many times this process unpickled the description
+
+
+def _robot_from_cache(digest: str, payload: bytes) -> "_RobotByContent":
+    """Unpickling side of :class:`_RobotByContent`: the robot of this process for ``digest``."""
+    with _CACHE_LOCK:
+        robot = _CACHE.get(digest)
+        if robot is None:
+            robot = _CACHE[digest] = pickle.loads(payload)
+            _UNPICKLED[digest] = _UNPICKLED.get(digest, 0) + 1
+    return _RobotByContent(robot, digest, payload)
+
+
+def process_cache_info() -> dict:
+    """This process's cache of robots received by dask tasks: ``pid``, and per description digest
+    how many times it was unpickled (``unpickled``, 1 when the cache works) and whether its native
+    model is built (``built``). Ask every worker with ``client.run(process_cache_info)``."""
+    with _CACHE_LOCK:
+        return {
+            "pid": os.getpid(),
+            "unpickled": dict(_UNPICKLED),
+            "built": {d: "_model" in r.__dict__ for d, r in _CACHE.items()},
+        }
+
+
+class _RobotByContent:
+    """A robot that pickles as its description plus the description's hash; unpickled, it is the
+    one robot of the receiving process with that hash (built once there)."""
+
+    __slots__ = ("robot", "digest", "payload")
+
+    def __init__(self, robot: "Robot", digest: str, payload: bytes):
+        self.robot, self.digest, self.payload = robot, digest, payload
+
+    @classmethod
+    def of(cls, robot: "Robot") -> "_RobotByContent":
+        payload = pickle.dumps(robot, protocol=pickle.HIGHEST_PROTOCOL)
+        return cls(robot, hashlib.sha256(payload).hexdigest(), payload)
+
+    def __reduce__(self):
+        return _robot_from_cache, (self.digest, self.payload)
+
+    def __dask_tokenize__(self):
+        return self.digest
+
+
+# ------------------------------------------------------------------ the dispatch
+def batched(*state_args: str) -> Callable[[F], F]:
+    """Decorate a Robot method whose arguments ``state_args`` are (N, ...) batches of states: with a
+    dask array among them it returns a lazy dask array (a tuple of them for tuple results)."""
+
+    def decorate(method: F) -> F:
+        signature = inspect.signature(method)
+
+        @functools.wraps(method)
+        def wrapper(self, *args, **kwargs):
+            array_type = _dask_array_type()
+            if array_type is not None and (
+                any(isinstance(a, array_type) for a in args) or any(isinstance(v, array_type) for v in kwargs.values())
+            ):
+                return _lazy_call(method, signature, state_args, self, args, kwargs)
+            return method(self, *args, **kwargs)
+
+        wrapper.__kinedyn_batched__ = state_args  # type: ignore[attr-defined]
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+def _check_chunks(name: str, x) -> None:
+    if x.ndim < 2:
+        raise ValueError(
+            f"{name} is a dask array of shape {x.shape}: dask inputs must be batches of states, "
+            f"(N, ...) with the states along axis 0 (for one state pass a NumPy array)"
+        )
+    for axis in range(1, x.ndim):
+        if len(x.chunks[axis]) > 1:
+            fix = ", ".join(f"{a}: -1" for a in range(1, x.ndim))
+            raise ValueError(
+                f"{name} is chunked along axis {axis} (chunks {x.chunks[axis]}), the per-state axis of "
+                f"shape {x.shape[1:]}: chunk only along the states (axis 0), e.g. {name}.rechunk({{{fix}}})"
+            )
+
+
+def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], robot: "Robot", args, kwargs):
+    import dask.array as da
+
+    bound = signature.bind(robot, *args, **kwargs)
+    bound.apply_defaults()
+    arguments = dict(bound.arguments)
+    del arguments["self"]
+    if arguments.get("out") is not None:
+        raise ValueError("out= cannot be used with dask inputs: the result is a new lazy dask array")
+    arguments.pop("out", None)
+
+    lazy = {name: arguments[name] for name in arguments if is_dask_array(arguments[name])}
+    wrong = sorted(set(lazy) - set(state_args))
+    if wrong:
+        raise TypeError(f"{method.__name__}: {', '.join(wrong)} cannot be a dask array (only {', '.join(state_args)} can)")
+    for name, x in lazy.items():
+        _check_chunks(name, x)
+    names = list(lazy)
+    first = lazy[names[0]]
+    for name in names[1:]:
+        if lazy[name].shape[0] != first.shape[0]:
+            raise ValueError(
+                f"{method.__name__}: {names[0]} has {first.shape[0]} states but {name} has {lazy[name].shape[0]}"
+            )
+    # the states' chunks are those of the first dask input; the others follow, and the per-state
+    # axes are one chunk each
+    arrays = [lazy[names[0]].astype(np.float64)] + [
+        lazy[name].astype(np.float64).rechunk({0: first.chunks[0], **{a: -1 for a in range(1, lazy[name].ndim)}}) for name in names[1:]
+    ]
+    # NumPy batch arguments (N, ...) become dask arrays with the same chunks; others travel as they are
+    fixed = {k: v for k, v in arguments.items() if k not in lazy}
+    for name in state_args:
+        v = fixed.get(name)
+        if v is not None and np.ndim(v) >= 2 and np.shape(v)[0] == first.shape[0] and not (name == "f_ext" and np.ndim(v) == 2):
+            arrays.append(da.from_array(np.asarray(v, dtype=np.float64), chunks=(first.chunks[0],) + np.shape(v)[1:]))
+            names.append(name)
+            del fixed[name]
+
+    # the shape and dtype of one state's result, from a probe at one state (numbers never used)
+    probe_args = dict(fixed)
+    for name, x in zip(names, arrays):
+        probe_args[name] = np.zeros((1,) + x.shape[1:])
+    if "q" in names:
+        probe_args["q"] = robot.neutral()[None] if arrays[names.index("q")].shape[1:] == (robot.n,) else probe_args["q"]
+    probe = method(robot, **probe_args)
+    results = probe if isinstance(probe, tuple) else (probe,)
+    shapes = [np.shape(r)[1:] for r in results]
+
+    carrier = _RobotByContent.of(robot)
+    block = functools.partial(_block, carrier, method.__name__, tuple(names), fixed, len(results))
+    states = "s"
+    letters = iter("abcdefghijklmnopqrtuvwxyz")
+    pairs: list[Any] = []
+    for x in arrays:
+        pairs += [x, states + "".join(next(letters) for _ in range(1, x.ndim))]
+    if len(results) == 1:
+        out_axes = "".join(next(letters) for _ in shapes[0])
+        new_axes = dict(zip(out_axes, shapes[0]))
+    else:  # tuple results: packed into one (N, total) block, sliced back out lazily below
+        sizes = [int(np.prod(s)) for s in shapes]
+        out_axes = next(letters)
+        new_axes = {out_axes: sum(sizes)}
+    out = da.blockwise(block, states + out_axes, *pairs, new_axes=new_axes, concatenate=True, dtype=np.float64,
+                       align_arrays=False, name=f"kinedyn-{method.__name__}-{carrier.digest[:8]}-" + da.core.tokenize(*arrays, fixed))
+    if len(results) == 1:
+        return out
+    parts, start = [], 0
+    for size, shape in zip(sizes, shapes):
+        parts.append(out[:, start:start + size].reshape((out.shape[0],) + tuple(shape)))
+        start += size
+    return tuple(parts)
+
+
+def _block(carrier: _RobotByContent, method_name: str, names: tuple, fixed: dict, n_results: int, *blocks):
+    """One chunk of states through the NumPy method, on whatever process runs the task."""
+    robot = carrier.robot
+    method = getattr(type(robot), method_name).__wrapped__
+    result = method(robot, **fixed, **dict(zip(names, blocks)))
+    if n_results == 1:
+        return np.asarray(result, dtype=np.float64)
+    return np.concatenate([np.asarray(r, dtype=np.float64).reshape(len(blocks[0]), -1) for r in result], axis=1)
