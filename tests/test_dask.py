@@ -185,3 +185,31 @@ def test_results_compose_and_stay_lazy(robot, states):
     speed = da.linalg.norm(v[:, :3], axis=1)
     assert isinstance(speed, da.Array)
     np.testing.assert_array_equal(speed.compute(scheduler="sync"), np.linalg.norm(robot.frame_velocity(q, qd)[:, :3], axis=1))
+
+
+def test_batch_inverse_kinematics(client, robot, states):
+    """A dask batch of targets (and of starts) gives lazy IKBatchResult fields equal to the NumPy
+    batch's, on the cluster; positions as well as poses."""
+    q, _, _ = states
+    poses, starts = robot.pose(q), q + 0.01
+    expected = robot.inverse_kinematics(poses, q0=starts)
+    got = robot.inverse_kinematics(lazy(poses), q0=lazy(starts, 90))
+    assert isinstance(got.q, da.Array) and got.q.chunks == ((120, 120, 120, 120, 20), (robot.n,))
+    assert got.solver == expected.solver
+    fields = ("q", "success", "position_error", "orientation_error", "iterations")
+    for name, value in zip(fields, dask.compute(*(getattr(got, f) for f in fields), scheduler=client.get)):
+        assert value.dtype == getattr(expected, name).dtype, name
+        np.testing.assert_array_equal(value, getattr(expected, name), err_msg=name)
+    assert expected.success.all()
+    # position targets (the numeric solver: its random restarts are drawn per chunk, so its answers
+    # are other solutions than the NumPy batch's, each reaching its target), one start for all
+    points = poses[:, :3, 3]
+    numeric = robot.inverse_kinematics(lazy(points), q0=q[0], method="numeric")
+    assert numeric.solver == "numeric:lm"
+    solutions, success = dask.compute(numeric.q, numeric.success, scheduler="sync")
+    assert success.all()
+    np.testing.assert_allclose(robot.pose(solutions)[:, :3, 3], points, rtol=0, atol=1e-9)
+    # NumPy targets with a dask batch of starts
+    np.testing.assert_array_equal(robot.inverse_kinematics(poses, q0=lazy(starts)).q.compute(scheduler="sync"), expected.q)
+    with pytest.raises(ValueError, match=r"target is chunked along axis 1"):
+        robot.inverse_kinematics(da.from_array(poses, chunks=(100, 2, 4)))

@@ -213,3 +213,53 @@ def _block(carrier: _RobotByContent, method_name: str, names: tuple, fixed: dict
     if n_results == 1:
         return np.asarray(result, dtype=np.float64)
     return np.concatenate([np.asarray(r, dtype=np.float64).reshape(len(blocks[0]), -1) for r in result], axis=1)
+
+
+# ------------------------------------------------------------------ batch inverse kinematics
+def lazy_inverse_kinematics(robot: "Robot", target, q0, mask, method: str, respect_limits: bool, options: dict):
+    """``robot.inverse_kinematics`` of a dask batch of targets, (N, 4, 4) poses or (N, 3) positions:
+    an ``IKBatchResult`` whose ``q`` (N, n), ``success``, ``position_error``, ``orientation_error``
+    and ``iterations`` (N,) are lazy dask arrays chunked as the targets. ``q0`` may be one (n,) start
+    or an (N, n) batch (NumPy or dask). The closed forms give the NumPy batch's answers; the numeric
+    solver draws its random restarts per chunk (from ``seed`` and the index in the chunk), so where
+    restarts are needed it may find other, equally valid, solutions than one NumPy call."""
+    import dask.array as da
+
+    from .ik.solve import IKBatchResult
+
+    _check_chunks("target", target)
+    if target.shape[1:] not in ((4, 4), (3,)):
+        raise ValueError(f"target must be a batch of 4x4 poses (N, 4, 4) or positions (N, 3), got a dask array of shape {target.shape}")
+    target = target.astype(np.float64)
+    arrays, names = [target], ["target"]
+    n = robot.n
+    if q0 is not None and (is_dask_array(q0) or np.ndim(q0) == 2):
+        q0 = q0 if is_dask_array(q0) else da.from_array(np.asarray(q0, dtype=np.float64), chunks=(target.chunks[0], -1))
+        _check_chunks("q0", q0)
+        if q0.shape != (target.shape[0], n):
+            raise ValueError(f"q0 must be one start (n,) = ({n},) or one per target ({target.shape[0]}, {n}), got {q0.shape}")
+        arrays.append(q0.astype(np.float64).rechunk({0: target.chunks[0], 1: -1}))
+        names.append("q0")
+        q0 = None
+    # the solver's name, from a probe at the neutral pose (the numbers are not used)
+    neutral = robot.pose(robot.neutral()[None], options.get("frame"))
+    probe = robot.inverse_kinematics(neutral if target.ndim == 3 else neutral[:, :3, 3], q0, mask, method, respect_limits, **options)
+    fixed = {"q0": q0, "mask": mask, "method": method, "respect_limits": respect_limits, **options}
+    carrier = _RobotByContent.of(robot)
+    block = functools.partial(_ik_block, carrier, tuple(names), fixed)
+    pairs: list[Any] = [target, "s" + "ab"[: target.ndim - 1]]
+    if len(arrays) > 1:
+        pairs += [arrays[1], "sc"]
+    packed = da.blockwise(block, "sz", *pairs, new_axes={"z": n + 4}, concatenate=True, dtype=np.float64, align_arrays=False,
+                          name="kinedyn-inverse_kinematics-" + carrier.digest[:8] + "-" + da.core.tokenize(*arrays, fixed))
+    return IKBatchResult(q=packed[:, :n], success=packed[:, n] > 0.5, position_error=packed[:, n + 1],
+                         orientation_error=packed[:, n + 2], iterations=packed[:, n + 3].astype(np.int64), solver=probe.solver)
+
+
+def _ik_block(carrier: _RobotByContent, names: tuple, fixed: dict, *blocks):
+    arguments = dict(fixed, **dict(zip(names, blocks)))
+    solve = type(carrier.robot).inverse_kinematics
+    result = solve(carrier.robot, arguments.pop("target"), arguments.pop("q0"), arguments.pop("mask"), arguments.pop("method"),
+                   arguments.pop("respect_limits"), **arguments)
+    columns = [result.success, result.position_error, result.orientation_error, result.iterations]
+    return np.concatenate([np.asarray(result.q, dtype=np.float64)] + [np.asarray(c, dtype=np.float64)[:, None] for c in columns], axis=1)

@@ -8,6 +8,7 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 from __future__ import annotations
 
 import math
+import sys
 from functools import cached_property
 from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
 
@@ -15,7 +16,7 @@ import numpy as np
 import sympy as sp
 
 from ._arrays import finite_result, real_array
-from ._dask import batched
+from ._dask import batched, is_dask_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.geometry import Visual
@@ -39,6 +40,17 @@ def _load_ik():
 
     _IK_SOLVE = inverse_kinematics
     return _IK_SOLVE
+
+_DASK_ARRAYS = ("dask.array",)  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
+
+
+def _dask_targets(target, q0):
+    """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
+    import dask.array as da
+
+    target = np.asarray(target, dtype=np.float64)
+    return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
+
 
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
 _F64 = np.dtype(np.float64)
@@ -533,6 +545,10 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
+            from ._dask import lazy_inverse_kinematics
+
+            return lazy_inverse_kinematics(self, target if is_dask_array(target) else _dask_targets(target, q0), q0, mask, method, respect_limits, kwargs)
         solve = _IK_SOLVE or _load_ik()
         return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
