@@ -213,3 +213,50 @@ def test_batch_inverse_kinematics(client, robot, states):
     np.testing.assert_array_equal(robot.inverse_kinematics(poses, q0=lazy(starts)).q.compute(scheduler="sync"), expected.q)
     with pytest.raises(ValueError, match=r"target is chunked along axis 1"):
         robot.inverse_kinematics(da.from_array(poses, chunks=(100, 2, 4)))
+
+
+def _manipulability(robot, q):
+    """Yoshikawa's manipulability sqrt(det(J J^T)) of a block of configurations."""
+    J = robot.jacobian(q)
+    return np.sqrt(np.abs(np.linalg.det(J @ np.swapaxes(J, -1, -2))))
+
+
+def test_sweep_to_zarr_on_the_cluster(client, robot, tmp_path):
+    """A random sweep written chunk by chunk on the worker processes: every array equals the
+    in-process batch at the stored configurations, progress reported per chunk up to the total,
+    and the sample is the same on the cluster as on threads."""
+    seen = []
+    quantities = {"M": "mass_matrix", "g": "gravity_torque", "P": "potential_energy", "manipulability": _manipulability}
+    store = kinedyn.sweep(robot, tmp_path / "cluster.zarr", quantities, samples=N, chunk=CHUNK, seed=7, progress=lambda d, t: seen.append((d, t)))
+    q = store["q"][:]
+    assert q.shape == (N, robot.n) and len(np.unique(q, axis=0)) == N
+    lo, hi = robot.lower_limits, robot.upper_limits
+    assert np.all((q >= np.where(np.isfinite(lo), lo, -np.pi)) & (q <= np.where(np.isfinite(hi), hi, np.pi)))
+    np.testing.assert_array_equal(store["M"][:], robot.mass_matrix(q))
+    np.testing.assert_array_equal(store["g"][:], robot.gravity_torque(q))
+    np.testing.assert_array_equal(store["P"][:], robot.potential_energy(q))
+    np.testing.assert_array_equal(store["manipulability"][:], _manipulability(robot, q))
+    assert [t for _, t in seen] == [N] * 5 and sorted(d for d, _ in seen) == [d for d, _ in seen] and seen[-1][0] == N
+    assert store.attrs["robot"] == robot.name and store.attrs["joint_names"] == list(robot.joint_names)
+    with dask.config.set(scheduler="threads"):
+        again = kinedyn.sweep(robot, tmp_path / "threads.zarr", ["gravity_torque"], samples=N, chunk=CHUNK, seed=7, progress=False)
+    np.testing.assert_array_equal(again["q"][:], q)
+    with pytest.raises(Exception, match="exist"):  # never overwrites a store unless asked
+        kinedyn.sweep(robot, tmp_path / "threads.zarr", ["gravity_torque"], samples=N, chunk=CHUNK, progress=False)
+
+
+def test_sweep_grid(robot, tmp_path):
+    """A grid sweep holds every combination of per-joint points once, the last joint fastest."""
+    points = [3, 2, 1, 1, 2, 4]
+    with dask.config.set(scheduler="sync"):
+        store = kinedyn.sweep(robot, tmp_path / "grid.zarr", ["pose"], grid=points, chunk=7, progress=False)
+    q = store["q"][:]
+    assert q.shape == (48, robot.n)
+    assert [len(np.unique(q[:, j])) for j in range(robot.n)] == points
+    assert len(np.unique(q, axis=0)) == 48
+    assert np.all(np.diff(q[:4, 5]) > 0)
+    np.testing.assert_array_equal(store["pose"][:], robot.pose(q))
+    with pytest.raises(ValueError, match="either samples=N .* or grid"):
+        kinedyn.sweep(robot, tmp_path / "x.zarr", samples=3, grid=2)
+    with pytest.raises(ValueError, match="not a Robot method of q alone"):
+        kinedyn.sweep(robot, tmp_path / "y.zarr", ["inverse_dynamics"], samples=3)
