@@ -71,7 +71,7 @@ def main() -> None:
 
     robot = kinedyn.robots.puma560()
     env = {"PYTHONPATH": os.pathsep.join([str(Path(kinedyn.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    with LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=None, env=env,
+    with LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=":0", env=env,
                       memory_limit="6GiB", silence_logs=40) as cluster, Client(cluster) as client:
         on_cluster(client, robot, 4 * args.chunk, args.chunk, "mass_matrix")  # workers warm: imports, model built
         rss_start = client.run(peak_rss_mib)

@@ -30,7 +30,7 @@ CHUNK = 120  # five chunks of states, the last one short
 def client():
     """One LocalCluster of two worker processes (one thread each) for the module."""
     env = {"PYTHONPATH": os.pathsep.join([str(Path(kinedyn.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=None,
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=":0",
                                   env=env, silence_logs=40) as cluster, distributed.Client(cluster) as c:
         yield c
 
