@@ -95,22 +95,45 @@ class _RobotByContent:
 
 
 # ------------------------------------------------------------------ the dispatch
+_MODULES = sys.modules
+_DASK_ARRAY = "dask.array"
+
+
+def _any_dask(values: tuple) -> bool:
+    array_type = _MODULES[_DASK_ARRAY].Array
+    for value in values:  # a plain loop: a generator costs more than the check
+        if isinstance(value, array_type):
+            return True
+    return False
+
+
 def batched(*state_args: str) -> Callable[[F], F]:
     """Decorate a Robot method whose arguments ``state_args`` are (N, ...) batches of states: with a
-    dask array among them it returns a lazy dask array (a tuple of them for tuple results)."""
+    dask array among them it returns a lazy dask array (a tuple of them for tuple results).
+
+    The wrapper is generated with the method's own parameters (no ``*args``/``**kwargs`` repacking):
+    these methods run in control loops, and without dask imported the added cost is one dictionary
+    lookup and one plain call."""
 
     def decorate(method: F) -> F:
         signature = inspect.signature(method)
-
-        @functools.wraps(method)
-        def wrapper(self, *args, **kwargs):
-            array_type = _dask_array_type()
-            if array_type is not None and (
-                any(isinstance(a, array_type) for a in args) or any(isinstance(v, array_type) for v in kwargs.values())
-            ):
-                return _lazy_call(method, signature, state_args, self, args, kwargs)
-            return method(self, *args, **kwargs)
-
+        parameters = list(signature.parameters.values())
+        if any(p.kind is not p.POSITIONAL_OR_KEYWORD for p in parameters) or not set(state_args) <= set(signature.parameters):
+            raise TypeError(f"batched: {method.__name__} must take plain parameters including {state_args}")
+        defaults = {f"_default_{p.name}": p.default for p in parameters if p.default is not p.empty}
+        header = ", ".join(p.name if p.default is p.empty else f"{p.name}=_default_{p.name}" for p in parameters)
+        names = ", ".join(p.name for p in parameters[1:])
+        states = ", ".join(state_args) + ("," if len(state_args) == 1 else "")
+        source = (
+            f"def {method.__name__}({header}):\n"
+            f"    if _DASK_ARRAY in _MODULES and _any_dask(({states})):\n"
+            f"        return _lazy_call(_method, _signature, _state_args, {parameters[0].name}, ({names}{',' if len(parameters) == 2 else ''}), {{}})\n"
+            f"    return _method({parameters[0].name}, {names})\n"
+        )
+        namespace = {"_DASK_ARRAY": _DASK_ARRAY, "_MODULES": _MODULES, "_any_dask": _any_dask, "_lazy_call": _lazy_call,
+                     "_method": method, "_signature": signature, "_state_args": state_args, **defaults}
+        exec(compile(source, f"<kinedyn._dask.batched {method.__name__}>", "exec"), namespace)
+        wrapper = functools.wraps(method)(namespace[method.__name__])
         wrapper.__kinedyn_batched__ = state_args  # type: ignore[attr-defined]
         return wrapper  # type: ignore[return-value]
 
