@@ -260,3 +260,18 @@ def test_sweep_grid(robot, tmp_path):
         kinedyn.sweep(robot, tmp_path / "x.zarr", samples=3, grid=2)
     with pytest.raises(ValueError, match="not a Robot method of q alone"):
         kinedyn.sweep(robot, tmp_path / "y.zarr", ["inverse_dynamics"], samples=3)
+
+
+def test_kinedyn_never_imports_dask_itself():
+    """Without dask imported (or installed) a robot works and kinedyn does not import it: the
+    dispatch only looks at sys.modules."""
+    import subprocess
+
+    code = ("import sys; sys.modules['dask'] = None\n"  # as if not installed: importing it would fail
+            "import kinedyn, numpy as np\n"
+            "r = kinedyn.robots.puma560()\n"
+            "assert r.mass_matrix(np.zeros((3, 6))).shape == (3, 6, 6)\n"
+            "assert r.inverse_kinematics(r.pose(np.zeros((2, 6)))).q.shape == (2, 6)\n"
+            "assert not any(m.startswith('dask.') for m in sys.modules)\n")
+    env = dict(os.environ, PYTHONPATH=str(Path(kinedyn.__file__).parents[1]))
+    subprocess.run([sys.executable, "-c", code], env=env, check=True, timeout=120)
