@@ -8,6 +8,7 @@ from ._core import NonFiniteResultError
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
+from .scale import sweep  # configuration-space sweeps into Zarr on a dask scheduler (docs/scale.md)
 from . import robots
 if TYPE_CHECKING:
     # what type checkers and IDEs see: kd.simulate is the function and still holds the package's
@@ -45,5 +46,5 @@ def load(path: PathLike, **kwargs) -> Robot:
 
 __all__ = [
     "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "PhysicalConsistencyWarning", "NonFiniteResultError", "__version__", *_SUBMODULES,
+    "Trajectory", "sweep", "PhysicalConsistencyWarning", "NonFiniteResultError", "__version__", *_SUBMODULES,
 ]

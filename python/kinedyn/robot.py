@@ -8,6 +8,7 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 from __future__ import annotations
 
 import math
+import sys
 from functools import cached_property
 from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
 
@@ -15,6 +16,7 @@ import numpy as np
 import sympy as sp
 
 from ._arrays import finite_result, real_array
+from ._dask import batched, is_dask_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
 from .description.dh import DHRow, links_from_dh
 from .description.geometry import Visual
@@ -38,6 +40,17 @@ def _load_ik():
 
     _IK_SOLVE = inverse_kinematics
     return _IK_SOLVE
+
+_DASK_ARRAYS = ("dask.array",)  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
+
+
+def _dask_targets(target, q0):
+    """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
+    import dask.array as da
+
+    target = np.asarray(target, dtype=np.float64)
+    return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
+
 
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
 _F64 = np.dtype(np.float64)
@@ -278,6 +291,7 @@ class Robot:
         symmetric friction)."""
         return np.array([float(j.coulomb_levels[1]) for j in self.joints])
 
+    @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
         """viscous * qd + Coulomb friction, (n,) or (N, n): ``coulomb`` for qd > 0,
         ``-coulomb_negative`` for qd < 0, 0 at rest (``coulomb * sign(qd)`` when symmetric)."""
@@ -459,16 +473,19 @@ class Robot:
         return p
 
     # kinematics ---------------------------------------------------------------------------
+    @batched("q")
     def forward_kinematics(self, q: ArrayLike) -> np.ndarray:
         """Poses of the moving links' frames in the base: (n, 4, 4), or (N, n, 4, 4) for a batch."""
         return self._model.frame_poses(self._state(q), self._link_frame_ids)
 
+    @batched("q")
     def frame_poses(self, q: ArrayLike, frames: Optional[Sequence[str]] = None) -> np.ndarray:
         """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
         names = self.frame_names if frames is None else list(frames)
         ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
         return self._model.frame_poses(self._state(q), ids)
 
+    @batched("q")
     def pose(self, q: ArrayLike, frame: Optional[str] = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
         out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
@@ -485,6 +502,7 @@ class Robot:
             ids = self._frame_id_arrays[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
         return ids
 
+    @batched("q")
     def jacobian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Geometric Jacobian (6, n), rows [linear; angular] (see docs/conventions.md).
 
@@ -498,6 +516,7 @@ class Robot:
             fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
         return self._model.jacobian(self._state(q), fid, ref, point)
 
+    @batched("q")
     def jacobian_hessian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Kinematic Hessian ``dJ/dq`` of :meth:`jacobian` (same frame, reference and point):
         (n, 6, n), or (N, n, 6, n) for a batch, with ``H[i, :, j] = dJ[:, j]/dq_i`` (Robotics
@@ -512,10 +531,12 @@ class Robot:
         fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
         return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
 
+    @batched("q", "qd")
     def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
 
+    @batched("q", "qd")
     def jacobian_dot_qd(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
         return self._model.jdot_qd(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
@@ -524,6 +545,10 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
+            from ._dask import lazy_inverse_kinematics
+
+            return lazy_inverse_kinematics(self, target if is_dask_array(target) else _dask_targets(target, q0), q0, mask, method, respect_limits, kwargs)
         solve = _IK_SOLVE or _load_ik()
         return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
@@ -602,6 +627,7 @@ class Robot:
     def _scalar(x):
         return float(x) if np.ndim(x) == 0 else x
 
+    @batched("q", "qd", "qdd", "f_ext")
     def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
@@ -614,12 +640,14 @@ class Robot:
         q = self._state(q)
         return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext), out)
 
+    @batched("q")
     def mass_matrix(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric.
         ``out``: a float64 array of the result's shape to write into instead of allocating one (as
         NumPy's ``out=``; also on the other per-step methods, for control loops)."""
         return self._model.mass_matrix(q, out)
 
+    @batched("q")
     def mass_matrix_inverse(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
@@ -627,6 +655,7 @@ class Robot:
         except RuntimeError as e:
             raise self._singular(e) from None
 
+    @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
         """qdd solving M qdd = tau - C qd - g - friction + sum_i J_i^T f_ext_i (articulated-body
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
@@ -639,6 +668,7 @@ class Robot:
         except RuntimeError as e:
             raise self._singular(e) from None
 
+    @batched("q", "qd", "qdd", "f_ext")
     def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dtau/dq, dtau/dqd, dtau/dqdd = M)`` of :meth:`inverse_dynamics`, each (n, n) (or
         (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical and exact, O(n^2), from one pass
@@ -653,6 +683,7 @@ class Robot:
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq + shift), dqd, M
 
+    @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
@@ -684,40 +715,49 @@ class Robot:
         dm = np.cross(dd, f[..., :, None, :3])  # (w_j x d_b) x f_b
         return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
 
+    @batched("q", "qd")
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         return self._model.coriolis_matrix(q, qd, out)
 
+    @batched("q")
     def christoffel(self, q: ArrayLike) -> np.ndarray:
         """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
         ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
         return self._model.christoffel(q)
 
+    @batched("q")
     def gravity_torque(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """g(q) = dP/dq."""
         return self._model.gravity_torque(q, out)
 
+    @batched("q", "qd")
     def bias_torque(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
         return self._model.bias_torque(q, qd, out)
 
+    @batched("q", "qd")
     def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> FloatOrArray:
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
         return self._scalar(self._model.kinetic_energy(q, qd))
 
+    @batched("q")
     def potential_energy(self, q: ArrayLike) -> FloatOrArray:
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
         return self._scalar(self._model.potential_energy(q))
 
+    @batched("q")
     def center_of_mass(self, q: ArrayLike) -> np.ndarray:
         """Centre of mass of the moving links in base coordinates, (3,) or (N, 3)."""
         return self._model.center_of_mass(q)
 
+    @batched("q", "qd")
     def momentum(self, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
         """Spatial momentum of the robot, (6,) or (N, 6): [linear momentum; angular momentum about
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
+    @batched("q", "qd", "qdd")
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         return self._model.regressor(q, qd, qdd)
