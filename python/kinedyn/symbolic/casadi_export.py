@@ -18,10 +18,12 @@ Function            inputs                          output
 ``jacobian``        ``q`` [, ``p``]                ``J`` (6 x n), rows [linear; angular], world
 ==================  =============================  ========================================
 
-``p`` is present only when parameters are left symbolic; its order is ``CasadiEOM.parameters``:
-``eom.parameters`` less those given in ``params``, the order of :func:`kinedyn.symbolic.codegen.generate`
-and ``eom.compile``. ``pose``/``jacobian`` need the robot (known to equations from
-``robot.equations_of_motion()``); their symbols must be among the parameters of the dynamics.
+``p`` is present only when parameters are left symbolic, and is the same vector for every Function;
+its order is ``CasadiEOM.parameters``: ``eom.parameters`` less those given in ``params`` (the order of
+:func:`kinedyn.symbolic.codegen.generate` and ``eom.compile``), then, sorted by name, any symbols that
+only the pose and Jacobian use (a tool offset that the dynamics never see, such as the last link's
+length of the two-link arm). ``pose``/``jacobian`` need the robot (known to equations from
+``robot.equations_of_motion()``).
 """
 
 from __future__ import annotations
@@ -83,6 +85,19 @@ def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> Casa
     n = eom.n
     params = _params_by_name(eom, params)
     blocks, pars = _blocks(eom, ("M", "C", "g", "tau"), params)
+    robot = robot if robot is not None else getattr(eom, "robot", None)
+    state = {s: sp.Symbol(f"q[{i}]") for i, s in enumerate(eom.q)}
+    kinematic = []
+    if robot is not None:  # the tool pose and Jacobian; symbols only they use extend p at its end
+        from . import kinematics
+
+        by_name = {str(k): v for k, v in params.items()}
+        for label, matrix in (("pose", kinematics.pose(robot, frame, simplify=False)),
+                              ("jacobian", kinematics.jacobian(robot, frame, simplify=False))):
+            fixed = {s: by_name[str(s)] for s in matrix.free_symbols if str(s) in by_name}
+            kinematic.append((label, matrix.subs(fixed) if fixed else matrix))
+        known = set(state) | set(pars)
+        pars = list(pars) + sorted({s for _, m in kinematic for s in m.free_symbols} - known, key=str)
     q, qd, qdd, tau_in = (ca.SX.sym(name, n) for name in ("q", "qd", "qdd", "tau"))
     p = ca.SX.sym("p", len(pars))
     env: Dict[sp.Symbol, Any] = {}
@@ -116,23 +131,12 @@ def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> Casa
     bias = ca.substitute(outputs["tau"], qdd, ca.SX.zeros(n))
     funcs["forward_dynamics"] = function("forward_dynamics", ("q", "qd", "tau"), "qdd", ca.solve(outputs["M"], tau_in - bias))
 
-    robot = robot if robot is not None else getattr(eom, "robot", None)
-    if robot is not None:
-        from . import kinematics
-
-        state = {s: sp.Symbol(f"q[{i}]") for i, s in enumerate(eom.q)}
-        pmap = {s: sp.Symbol(f"p[{i}]") for i, s in enumerate(pars)}
-        by_name = {str(k): v for k, v in params.items()}
-        for label, matrix in (("pose", kinematics.pose(robot, frame, simplify=False)),
-                              ("jacobian", kinematics.jacobian(robot, frame, simplify=False))):
-            fixed = {s: by_name[str(s)] for s in matrix.free_symbols if str(s) in by_name}
-            m = matrix.subs(fixed).xreplace({**state, **pmap}) if fixed else matrix.xreplace({**state, **pmap})
-            left = sorted(str(s) for s in m.free_symbols if "[" not in s.name)
-            if left:
-                raise ValueError(f"{label}: symbols {left} are not parameters of the dynamics; give their values in params")
-            reps, reduced = sp.cse(list(m), symbols=sp.numbered_symbols("k"), order="none")
-            walker = Walker(env, fns)
-            walker.assign(reps)
-            funcs[label] = function(label, ("q",), "T" if label == "pose" else "J",
-                                    _sx_matrix(ca, [walker(e) for e in reduced], tuple(m.shape)))
+    pmap = {s: sp.Symbol(f"p[{i}]") for i, s in enumerate(pars)}
+    for label, matrix in kinematic:
+        m = matrix.xreplace({**state, **pmap})
+        reps, reduced = sp.cse(list(m), symbols=sp.numbered_symbols("k"), order="none")
+        walker = Walker(env, fns)
+        walker.assign(reps)
+        funcs[label] = function(label, ("q",), "T" if label == "pose" else "J",
+                                _sx_matrix(ca, [walker(e) for e in reduced], tuple(m.shape)))
     return CasadiEOM(n, list(pars), funcs)
