@@ -7,8 +7,9 @@ each taking one state (n,) or a batch (N, n) (a batch is mapped with ``jax.vmap`
 ``jax.jit``-ed, and compose with ``jax.jit``, ``jax.vmap``, ``jax.grad``, ``jax.jacfwd``/``jacrev``.
 
 The SymPy programs of :mod:`kinedyn.symbolic.codegen` (common subexpressions eliminated; for large
-models the CSE form of :mod:`kinedyn.symbolic.cse`) are traced, node by node, into ``jax.numpy``
-operations by :class:`kinedyn.symbolic.translate.Walker`.
+models the CSE form of :mod:`kinedyn.symbolic.cse`) are printed once as straight-line ``jax.numpy``
+code (SymPy's ``JaxPrinter``; ``fn.source``), so tracing under ``jit``/``grad`` replays plain Python
+assignments, not a walk over SymPy trees.
 
 Precision: the functions compute in float64. JAX defaults to float32, so requesting this backend
 turns on ``jax.config.update("jax_enable_x64", True)`` (a process-wide JAX setting). Importing kinedyn
@@ -35,17 +36,11 @@ def _jax():
     return jax
 
 
-def _functions(jnp) -> Dict[str, Any]:
-    return {"sin": jnp.sin, "cos": jnp.cos, "tan": jnp.tan, "exp": jnp.exp, "log": jnp.log, "sqrt": jnp.sqrt,
-            "fabs": jnp.abs, "sign": jnp.sign, "asin": jnp.arcsin, "acos": jnp.arccos, "atan": jnp.arctan,
-            "atan2": jnp.arctan2, "sinh": jnp.sinh, "cosh": jnp.cosh, "tanh": jnp.tanh, "fmax": jnp.maximum,
-            "fmin": jnp.minimum}
-
-
 def compile_jax(eom, what=("M", "C", "g", "tau"), params=None, p=None):
     """JAX functions of ``eom`` (see the module docstring); ``params`` and ``p`` as in ``eom.compile``."""
-    from .codegen import _ARGS, CompiledEOM, _blocks, _params_by_name, generate
-    from .translate import Walker
+    from sympy.printing.numpy import JaxPrinter
+
+    from .codegen import _ARGS, CompiledEOM, _blocks, _params_by_name
 
     jax = _jax()
     import jax.numpy as jnp
@@ -58,38 +53,42 @@ def compile_jax(eom, what=("M", "C", "g", "tau"), params=None, p=None):
         raise ValueError(f"p has {len(p)} values, the equations have {len(pars)} parameters {[str(s) for s in pars]}")
     pvals = jnp.asarray(np.asarray([] if p is None else p, dtype=float), dtype=jnp.float64)
     n = eom.n
-    fns = _functions(jnp)
-    funcs = {}
+    printer = JaxPrinter({"fully_qualified_modules": True})
+    lines = ["def _f(x):", "    return jnp.asarray(x, dtype=jnp.float64)", ""]
     for name, shape, assignments, exprs in blocks:
-        args = _ARGS[name]
+        lines.append(f"def single_{name}({', '.join(_ARGS[name])}, p):")
+        lines += [f"    {s} = {printer.doprint(e)}" for s, e in assignments]
+        lines.append("    return jnp.stack([" + ", ".join(f"_f({printer.doprint(e)})" for e in exprs) + f"]).reshape({tuple(shape)!r})")
+        lines.append("")
+    source = "\n".join(lines).replace("jax.numpy.", "jnp.").replace("numpy.", "jnp.")
+    namespace: Dict[str, Any] = {"jnp": jnp, "jax": jax}
+    exec(compile(source, "<kinedyn jax>", "exec"), namespace)
+    funcs = {}
+    for name, shape, _, _ in blocks:
+        funcs[name] = _callable(jax, jnp, name, namespace[f"single_{name}"], n, pvals)
+    return CompiledEOM("jax", funcs, n, source, [] if p is None else list(p))
 
-        def single(*xs, _name=name, _shape=shape, _assign=assignments, _exprs=exprs, _args=args):
-            env: Dict[sp.Symbol, Any] = {}
-            for a, x in zip(_args, xs):
-                for i in range(n):
-                    env[sp.Symbol(f"{a}[{i}]")] = x[i]
-            for i in range(len(pars)):
-                env[sp.Symbol(f"p[{i}]")] = pvals[i]
-            walker = Walker(env, fns, constant=lambda c: jnp.asarray(c, dtype=jnp.float64))
-            walker.assign(_assign)
-            values = [jnp.asarray(walker(e), dtype=jnp.float64) for e in _exprs]
-            return jnp.stack(values).reshape(_shape)
 
-        def call(*xs, _single=single, _name=name, _args=args):
-            if len(xs) != len(_args):
-                raise TypeError(f"{_name} takes {len(_args)} arrays ({', '.join(_args)}), got {len(xs)}")
-            xs = tuple(jnp.asarray(x, dtype=jnp.float64) for x in xs)
-            first = xs[0]
-            if first.ndim not in (1, 2) or first.shape[-1] != n:
-                raise ValueError(f"{_name}: expected arrays of shape ({n},) or (N, {n}), got {first.shape}")
-            for a, v in zip(_args, xs):
-                if v.shape != first.shape:
-                    raise ValueError(f"{_name}: {a} has shape {v.shape}, expected {first.shape}")
-            return _single(*xs) if first.ndim == 1 else jax.vmap(_single)(*xs)
+def _callable(jax, jnp, name: str, single, n: int, pvals):
+    """The jitted function ``name`` of one state (n,) or a batch (N, n) (mapped with ``jax.vmap``)."""
+    from .codegen import _ARGS
 
-        jitted = jax.jit(call)
-        jitted.__doc__ = f"{name}({', '.join(args)}) of {eom.name or 'the system'} in JAX (one state (n,) or a batch (N, n))."
-        funcs[name] = jitted
-    src = generate(eom, "numpy", what, name="kd", params=params)  # the same program, readable
-    out = CompiledEOM("jax", funcs, n, src, [] if p is None else list(p))
-    return out
+    args = _ARGS[name]
+
+    def call(*xs):
+        if len(xs) != len(args):
+            raise TypeError(f"{name} takes {len(args)} arrays ({', '.join(args)}), got {len(xs)}")
+        xs = tuple(jnp.asarray(x, dtype=jnp.float64) for x in xs)
+        first = xs[0]
+        if first.ndim not in (1, 2) or first.shape[-1] != n:
+            raise ValueError(f"{name}: expected arrays of shape ({n},) or (N, {n}), got {first.shape}")
+        for a, v in zip(args, xs):
+            if v.shape != first.shape:
+                raise ValueError(f"{name}: {a} has shape {v.shape}, expected {first.shape}")
+        if first.ndim == 1:
+            return single(*xs, pvals)
+        return jax.vmap(lambda *x: single(*x, pvals))(*xs)
+
+    call.__name__ = name
+    call.__doc__ = f"{name}({', '.join(args)}) in JAX: one state (n,) or a batch (N, n); float64."
+    return jax.jit(call)
