@@ -158,3 +158,17 @@ def test_trajectory_optimisation_is_reproduced_by_simulate():
     deviation = np.abs(np.hstack([exact.q, exact.qd]) - X).max()
     assert deviation < 1.5 * estimate
     assert np.abs(np.concatenate([exact.q[-1], exact.qd[-1]]) - x1).max() < 1.5 * estimate  # it swings up
+
+
+def test_lagrangian_system_without_a_robot():
+    from kinedyn.symbolic import examples
+
+    eom = examples.remotely_driven_arm().equations_of_motion()
+    f = eom.to_casadi()
+    assert "pose" not in f.functions and f.tau.name_in() == ["q", "qd", "qdd", "p"]
+    p = RNG.uniform(0.5, 2.0, size=len(f.parameters))
+    numeric = eom.compile(backend="numpy", p=p)
+    q, qd, qdd, tau = RNG.uniform(-2, 2, size=(4, 2))
+    _close(f.tau(q, qd, qdd, p), numeric.tau(q, qd, qdd))
+    expected = np.linalg.solve(numeric.M(q), tau - numeric.tau(q, qd, np.zeros(2)))
+    _close(f.forward_dynamics(q, qd, tau, p), expected)
