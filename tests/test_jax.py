@@ -110,3 +110,22 @@ def test_float64_is_enabled_only_when_the_backend_is_requested():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "float64"
+
+
+def test_parameters_at_call_time_are_differentiable():
+    eom = kd.robots.planar_2r(symbolic=True).equations_of_motion(steps=False)
+    names = [str(s) for s in eom.parameters]
+    base = dict(l1=1.3, lc1=0.6, lc2=0.35, m1=2.0, m2=1.5, I1=0.21, I2=0.13, g=9.81)
+    f = eom.compile(backend="jax", p=[base[k] for k in names])
+    other = dict(base, m2=2.5, I1=0.3)
+    q, qd, qdd = RNG.uniform(-2, 2, size=(3, 2))
+    p_other = jnp.asarray([other[k] for k in names])
+    _close(f.tau(q, qd, qdd, p=p_other), kd.robots.planar_2r(l2=0.9, **other).inverse_dynamics(q, qd, qdd))
+    # tau is linear in m2 for fixed lengths: d tau / d m2 is the difference quotient, exactly
+    k = names.index("m2")
+    grad = jax.jacfwd(lambda p: f.tau(q, qd, qdd, p=p))(p_other)[:, k]
+    step = np.zeros(len(names))
+    step[k] = 1.0
+    _close(grad, np.asarray(f.tau(q, qd, qdd, p=p_other + step)) - np.asarray(f.tau(q, qd, qdd, p=p_other)), tol=1e-9)
+    with pytest.raises(ValueError, match="p has shape"):
+        f.tau(q, qd, qdd, p=jnp.zeros(3))

@@ -3,7 +3,9 @@ dynamics.
 
 The functions have the interface of the other compiled backends (:class:`kinedyn.symbolic.codegen.CompiledEOM`):
 ``fn.M(q)``, ``fn.C(q, qd)``, ``fn.g(q)``, ``fn.tau(q, qd, qdd)`` (and ``fn.friction(qd)`` when asked),
-each taking one state (n,) or a batch (N, n) (a batch is mapped with ``jax.vmap``). They are
+each taking one state (n,) or a batch (N, n) (a batch is mapped with ``jax.vmap``). Parameters left
+symbolic are given at compile time (``p=``) and may be replaced at call time by the keyword ``p=``, a
+JAX input like any other (``jax.grad`` with respect to the parameters, for identification or learning). They are
 ``jax.jit``-ed, and compose with ``jax.jit``, ``jax.vmap``, ``jax.grad``, ``jax.jacfwd``/``jacrev``.
 
 The SymPy programs of :mod:`kinedyn.symbolic.codegen` (common subexpressions eliminated; for large
@@ -22,7 +24,6 @@ from __future__ import annotations
 from typing import Any, Dict
 
 import numpy as np
-import sympy as sp
 
 __all__ = ["compile_jax"]
 
@@ -75,7 +76,7 @@ def _callable(jax, jnp, name: str, single, n: int, pvals):
 
     args = _ARGS[name]
 
-    def call(*xs):
+    def call(*xs, p=None):
         if len(xs) != len(args):
             raise TypeError(f"{name} takes {len(args)} arrays ({', '.join(args)}), got {len(xs)}")
         xs = tuple(jnp.asarray(x, dtype=jnp.float64) for x in xs)
@@ -85,10 +86,14 @@ def _callable(jax, jnp, name: str, single, n: int, pvals):
         for a, v in zip(args, xs):
             if v.shape != first.shape:
                 raise ValueError(f"{name}: {a} has shape {v.shape}, expected {first.shape}")
+        pv = pvals if p is None else jnp.asarray(p, dtype=jnp.float64)
+        if pv.shape != pvals.shape:
+            raise ValueError(f"{name}: p has shape {pv.shape}, expected {pvals.shape} (the parameters in eom.parameters order)")
         if first.ndim == 1:
-            return single(*xs, pvals)
-        return jax.vmap(lambda *x: single(*x, pvals))(*xs)
+            return single(*xs, pv)
+        return jax.vmap(lambda *x: single(*x, pv))(*xs)
 
     call.__name__ = name
-    call.__doc__ = f"{name}({', '.join(args)}) in JAX: one state (n,) or a batch (N, n); float64."
+    call.__doc__ = (f"{name}({', '.join(args)}, p=None) in JAX: one state (n,) or a batch (N, n); float64; "
+                    "p: parameter values replacing those given at compile time (differentiable).")
     return jax.jit(call)
