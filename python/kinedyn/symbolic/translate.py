@@ -1,7 +1,7 @@
 """Translation of SymPy expressions (the generated straight-line programs of
-:mod:`kinedyn.symbolic.codegen`) into another library's expression objects: CasADi ``SX`` or traced
-JAX arrays. One walker serves both: it maps each SymPy node to the library's operation through a small
-table (``sin``, ``cos``, ``sqrt``, ``fabs``, ``sign`` ...) and memoises by node, so a subexpression that
+:mod:`kinedyn.symbolic.codegen`) into another library's expression objects, such as CasADi ``SX``
+(:mod:`kinedyn.symbolic.casadi_export`; any library whose values support ``+ * / **`` will do). It
+maps each SymPy node to the library's operation through a small table (``sin``, ``cos``, ``sqrt``, ``fabs``, ``sign`` ...) and memoises by node, so a subexpression that
 occurs many times becomes one node of the target graph (shared, not copied)."""
 
 from __future__ import annotations
