@@ -235,13 +235,27 @@ def _c_callable(lib, prefix, name, shape, n, p):
     return call
 
 
-def compile_eom(eom, what=("M", "C", "g", "tau"), backend: str = "auto", params=None, p=None) -> CompiledEOM:
-    """Compile; ``params``: {symbol or name: value} substituted before generation (so the remaining
-    parameters, if any, are passed as ``p`` at call time — give them here as ``p``)."""
+def _params_by_name(eom, params) -> dict:
+    """``params`` ({symbol or name: value}) keyed by the equations' own symbols, matched by name so that
+    symbols with other assumptions are found."""
     params = {(sp.Symbol(k) if isinstance(k, str) else k): v for k, v in dict(params or {}).items()}
-    if params:  # match by name so that symbols with other assumptions are found
+    if params:
         names = {str(k): v for k, v in params.items()}
         params = {s: names[str(s)] for s in eom.parameters if str(s) in names}
+    return params
+
+
+def compile_eom(eom, what=("M", "C", "g", "tau"), backend: str = "auto", params=None, p=None) -> CompiledEOM:
+    """Compile; ``params``: {symbol or name: value} substituted before generation (so the remaining
+    parameters, if any, are passed as ``p`` at call time — give them here as ``p``). ``backend``:
+    ``"auto"``, ``"c"``, ``"numpy"`` or ``"jax"`` (see :mod:`kinedyn.symbolic.jax_backend`)."""
+    if backend not in ("auto", "c", "numpy", "jax"):
+        raise ValueError(f"backend must be 'auto', 'c', 'numpy' or 'jax', got {backend!r}")
+    if backend == "jax":
+        from .jax_backend import compile_jax
+
+        return compile_jax(eom, what, params=params, p=p)
+    params = _params_by_name(eom, params)
     blocks, pars = _blocks(eom, what, params)
     if pars and p is None:
         raise ValueError(f"the equations still contain the parameters {[str(s) for s in pars]}: give their values, compile(params={{...}})")

@@ -125,6 +125,9 @@ class EquationsOfMotion:
         #: result as matrices of the entry names it defines (see robot_eom's ``form``)
         self.closed_form: Optional[Callable[[], Any]] = None
         self.final_equations: Optional[Callable[[], list]] = None
+        #: the kinedyn.Robot these equations were derived from (None for a LagrangianSystem); to_casadi
+        #: takes the tool pose and Jacobian from it
+        self.robot: Any = None
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod
@@ -293,11 +296,22 @@ class EquationsOfMotion:
     def compile(self, what: Sequence[str] = ("M", "C", "g", "tau"), backend: str = "auto", params=None, p=None):
         """Fast callables for the requested matrices: C compiled with the system compiler when
         available (``backend="c"``), NumPy otherwise; each accepts one state or a batch (N, n).
+        ``backend="jax"``: jit-able, vmap-able, differentiable JAX functions in float64 (this turns on
+        ``jax_enable_x64``; see :mod:`kinedyn.symbolic.jax_backend`).
         ``params``: {symbol or name: value} substituted before generation; ``p``: values of the
         parameters left symbolic, in ``eom.parameters`` order, passed to every call."""
         from .codegen import compile_eom
 
         return compile_eom(self, what, backend=backend, params=params, p=p)
+
+    def to_casadi(self, params=None, robot=None, frame: Optional[str] = None):
+        """CasADi Functions (SX, common subexpressions shared) ``M``, ``C``, ``g``, ``tau``,
+        ``forward_dynamics`` and, for a robot, the tool ``pose`` and ``jacobian``; inputs named
+        ``q``, ``qd``, ``qdd``/``tau`` and ``p`` (parameters left symbolic, in the order of the
+        result's ``parameters``). See :mod:`kinedyn.symbolic.casadi_export`."""
+        from .casadi_export import to_casadi
+
+        return to_casadi(self, params=params, robot=robot, frame=frame)
 
     def op_count(self, what: str = "tau", cse: bool = False) -> Dict[str, int]:
         """Operation counts of ``tau`` (or ``M``, ``g``...) as formed; for the Newton-Euler method the
@@ -447,9 +461,12 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
     if method == "lagrange":
         from .robot_eom import lagrange_eom
 
-        return lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
-    if method in ("newton_euler", "newton-euler", "rnea"):
+        eom = lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
+    elif method in ("newton_euler", "newton-euler", "rnea"):
         from .robot_eom import newton_euler_eom
 
-        return newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
-    raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
+        eom = newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
+    else:
+        raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
+    eom.robot = robot
+    return eom
