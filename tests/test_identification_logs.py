@@ -90,6 +90,9 @@ def test_cutoff_rule_follows_the_signal():
     assert an.logs.motion_bandwidth(slow, RATE) == pytest.approx(0.5, abs=0.1)
     assert an.logs.choose_cutoff(fast, RATE) == pytest.approx(40.0, rel=0.05)
     assert an.logs.choose_cutoff(slow, RATE) == pytest.approx(2.5, rel=0.2)
+    # a record that is not a whole number of periods: its end jump must not leak into the bandwidth
+    uneven = np.sin(2 * np.pi * 0.33 * t + 0.4)[:, None]
+    assert an.logs.motion_bandwidth(uneven, RATE) < 0.6
 
 
 def test_csv_npz_dataframe_and_currents_agree(tmp_path, logs):
@@ -181,8 +184,8 @@ def test_friction_none_leaves_friction_in_the_residual(true_robot, logs):
 
 @pytest.fixture(scope="module")
 def poorly_excited(true_robot):
-    """The wrist's last joint moves by 3 mrad: its body's inertia about the axis is buried in noise."""
-    amp = np.array([0.8, 0.8, 0.8, 0.8, 0.8, 0.003])
+    """The wrist's last joint moves by 1 mrad (20 encoder counts): its body's inertia about the axis is buried in noise."""
+    amp = np.array([0.8, 0.8, 0.8, 0.8, 0.8, 0.001])
     cols, truth = simulated_log(true_robot, seed=0, amplitude=amp)
     return cols, truth
 
@@ -201,7 +204,7 @@ def test_consistent_estimate_has_positive_definite_mass_matrix(true_robot, poorl
     model = fit.robot  # a Robot: simulable, its M agrees with the regressor's
     np.testing.assert_allclose(model.mass_matrix(states), fit.mass_matrix(states), atol=1e-6)
     np.testing.assert_allclose(model.viscous, fit.friction_estimates[0::2], rtol=1e-12)
-    # it still predicts the torques of the well-excited joints (joint 6's, 3 mrad at 17 bits, are
+    # it still predicts the torques of the well-excited joints (joint 6's, 1 mrad at 17 bits, are
     # mostly quantisation-blurred Coulomb friction)
     assert np.all(fit.validate(cols).r2[:5] > 0.99)
 
@@ -223,6 +226,8 @@ def test_identify_errors(true_robot, logs):
         an.identify(kd.robots.get("ur5"), cols, friction="viscous+stribeck")
     with pytest.raises(an.LogError, match=r"robot has 3 joints"):
         an.identify(kd.robots.get("elbow_3r"), cols)
+    with pytest.raises(ValueError, match=r"the log has 6 joints but robot 'elbow_3r' has 3"):
+        an.identify(kd.robots.get("elbow_3r"), an.load_log(cols))
 
 
 def test_plot(logs):

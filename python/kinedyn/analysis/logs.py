@@ -22,7 +22,7 @@ model", and Swevers et al. 1997 §IV):
    aliases nothing).
 
 The cut-off rule (overridable by ``cutoff=``): the *bandwidth* of the motion is the frequency below
-which 99.9 % of the power of the (mean-removed) positions lies, the largest over the joints; the
+which 99.9 % of the power of the positions lies (mean and linear trend removed, Hann-windowed), the largest over the joints; the
 cut-off is 5 times that bandwidth, at least 1 Hz and at most 0.4 times the Nyquist frequency. The
 factor 5 keeps the attenuation of the motion itself below 1e-3 for a 4th-order filter
 (|H(f)|^2 = 1 / (1 + (f/fc)^(2 N)) twice, filtfilt) while cutting the quantisation and torque noise
@@ -77,9 +77,11 @@ def motion_bandwidth(q: np.ndarray, rate: float, fraction: float = 0.999) -> flo
     lies, the largest over the joints (0 for a log without motion)."""
     x = np.asarray(q, dtype=float)
     x = x - x.mean(axis=0)
-    # a linear trend would smear power over every frequency: take it out before the FFT
+    # the jump between the log's last and first sample would leak power over every frequency (the
+    # FFT sees the record as periodic): a linear trend is taken out, then a Hann window tapers the ends
     s = np.arange(x.shape[0]) - (x.shape[0] - 1) / 2
     x = x - np.outer(s, (s @ x) / max(float(s @ s), 1.0))
+    x = x * np.hanning(x.shape[0])[:, None]
     power = np.abs(np.fft.rfft(x, axis=0)) ** 2
     freqs = np.fft.rfftfreq(x.shape[0], 1.0 / rate)
     band = 0.0
