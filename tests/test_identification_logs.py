@@ -254,3 +254,29 @@ def test_cli_identify_from_a_log(tmp_path, logs, capsys):
     write_csv(tmp_path / "bad.csv", bad)
     assert main(["identify", "ur5", "--data", str(tmp_path / "bad.csv")]) == 1
     assert "missing column 'tau2'" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- §3 excitation
+
+
+def test_optimised_excitation_lowers_the_condition_number(tmp_path):
+    from kinedyn.analysis.excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+
+    robot = kd.robots.get("ur5")
+    limits = dict(qd=1.5, qdd=5.0)
+    start = optimize_excitation(robot, period=10.0, harmonics=4, limits=limits, samples=40, seed=0, maxiter=0)
+    best = optimize_excitation(robot, period=10.0, harmonics=4, limits=limits, samples=40, seed=0, maxiter=40)
+    before, after = excitation_condition(robot, start, samples=40), excitation_condition(robot, best, samples=40)
+    print(f"cond(W_base): random start in the limits {before:.4g}, optimised {after:.4g}, ratio {before / after:.3g}")
+    assert after < before / 10
+    t = np.linspace(0.0, best.period, 4001)
+    q, qd, qdd = best(t)
+    np.testing.assert_allclose(qd[0], 0.0, atol=1e-12)  # at rest at the start and, periodic, at the end
+    np.testing.assert_allclose(qdd[0], 0.0, atol=1e-12)
+    lo, hi = robot.lower_limits, robot.upper_limits
+    assert np.all(q >= np.where(np.isfinite(lo), lo, -np.pi)) and np.all(q <= np.where(np.isfinite(hi), hi, np.pi))
+    assert np.all(np.abs(qd) <= 1.5 * 1.05) and np.all(np.abs(qdd) <= 5.0 * 1.05)  # limits held at 40 samples, 5 % between
+    write_trajectory_csv(best, tmp_path / "traj.csv", rate=100.0)
+    table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
+    assert table.shape == (1001, 1 + 18)
+    np.testing.assert_allclose(table[:, 1:7], best(table[:, 0])[0], atol=1e-8)

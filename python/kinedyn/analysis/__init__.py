@@ -2,6 +2,7 @@
 with residuals (:func:`check_properties`), and identification of the base inertial parameters from
 excitation data (:func:`identify`). See docs/analysis.md."""
 
+from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
 from .friction import FrictionModel
 from .identification import Identification, Measurements, Validation, excitation, identify, pseudo_inertia, simulate_measurements, with_inertial_parameters
 from .logs import Log, LogError, load_log
@@ -28,4 +29,7 @@ __all__ = [
     "Validation",
     "FrictionModel",
     "pseudo_inertia",
+    "optimize_excitation",
+    "excitation_condition",
+    "write_trajectory_csv",
 ]
