@@ -280,3 +280,15 @@ def test_optimised_excitation_lowers_the_condition_number(tmp_path):
     table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
     assert table.shape == (1001, 1 + 18)
     np.testing.assert_allclose(table[:, 1:7], best(table[:, 0])[0], atol=1e-8)
+
+
+def test_cli_writes_an_excitation(tmp_path, capsys):
+    from kinedyn.cli import main
+
+    out = tmp_path / "traj.csv"
+    assert main(["identify", "planar_2r", "--excite", str(out), "--period", "4", "--harmonics", "3", "--rate", "50", "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["condition_number"] < payload["random_condition_number"]
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table.shape == (201, 1 + 6)
+    np.testing.assert_allclose(table[0, 3:], 0.0, atol=1e-12)  # qd, qdd at rest at the start

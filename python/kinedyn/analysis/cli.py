@@ -45,6 +45,8 @@ def cmd_identify(args) -> int:
     from .identification import excitation, identify, simulate_measurements
 
     robot = load_robot(args.robot or robots.DEFAULT)
+    if args.excite:
+        return _write_excitation(robot, args)
     if args.data:
         return _identify_from_log(robot, args)
     ref = excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
@@ -71,6 +73,28 @@ def cmd_identify(args) -> int:
         c.print(t)
         if result.dropped:
             c.print(f"not excited (zero regressor columns on the data): {esc(', '.join(result.dropped))}")
+
+    emit(args, payload, render)
+    return 0
+
+
+def _write_excitation(robot, args) -> int:
+    """``kinedyn identify ROBOT --excite traj.csv``: an optimised excitation for a controller."""
+    from ..cli import console, emit, esc
+    from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+    from .identification import excitation
+
+    ref = optimize_excitation(robot, period=args.period, harmonics=args.harmonics, seed=args.seed)
+    write_trajectory_csv(ref, args.excite, rate=args.rate)
+    cond = excitation_condition(robot, ref)
+    random_cond = excitation_condition(robot, excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed))
+    payload = dict(robot=robot.name, trajectory=str(args.excite), period=args.period, harmonics=args.harmonics, rate=args.rate,
+                   condition_number=cond, random_condition_number=random_cond)
+
+    def render():
+        console().print(f"[bold]{esc(robot.name)}[/bold]: excitation of {args.harmonics} harmonics, period {args.period:g} s, "
+                        f"at rest at both ends, written to {esc(str(args.excite))} at {args.rate:g} Hz; "
+                        f"cond(Y_base) {cond:.4g} (a random Fourier excitation of the same band: {random_cond:.4g})")
 
     emit(args, payload, render)
     return 0
@@ -152,5 +176,7 @@ def add_analysis_commands(subparsers) -> None:
     p.add_argument("--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model")
     p.add_argument("--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)")
     p.add_argument("--decimate", type=positive_int, default=None, help="keep every k-th sample after filtering (default: rate / (5 cut-off))")
+    p.add_argument("--excite", metavar="CSV", action=OutputPath,
+                   help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop")
     p.add_argument("--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)")
     p.set_defaults(func=cmd_identify)
