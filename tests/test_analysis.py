@@ -82,7 +82,7 @@ def test_identification_is_exact_from_noise_free_data(puma, excitation_data):
 def test_estimates_plug_back_into_a_model(puma, excitation_data):
     _, data = excitation_data
     result = an.identify(puma, data)
-    identified = result.robot()
+    identified = result.robot
     rng = np.random.default_rng(7)
     q, qd, qdd = puma.random_configuration(rng, size=30), rng.normal(size=(30, 6)), rng.normal(size=(30, 6))
     tau = puma.inverse_dynamics(q, qd, qdd)
@@ -98,7 +98,7 @@ def test_estimates_plug_back_into_a_model(puma, excitation_data):
 def test_identification_from_a_different_prior_still_gives_the_true_base_parameters(puma, excitation_data):
     """Only the base parameters are identifiable and the estimates do not depend on the nominal model:
     a prior with 20 % heavier links gives the same estimates and predicts the true torques. Its
-    minimum-norm correction needs inertias no rigid body has, so robot() says so."""
+    minimum-norm correction needs inertias no rigid body has, so .robot says so."""
     _, data = excitation_data
     prior = kd.robots.puma560(masses=[1.2 * m for m in kd.robots.industrial.PUMA560_MASSES])
     result = an.identify(prior, data)
@@ -108,7 +108,7 @@ def test_identification_from_a_different_prior_still_gives_the_true_base_paramet
     np.testing.assert_allclose(result.predict(q, qd, qdd), puma.inverse_dynamics(q, qd, qdd), atol=1e-8)
     assert np.abs(prior.inverse_dynamics(q, qd, qdd) - puma.inverse_dynamics(q, qd, qdd)).max() > 1e-2
     with pytest.raises(ValueError, match=r"body 'link\d': .*(positive semi-definite|negative)"):
-        result.robot()
+        result.robot
 
 
 @pytest.mark.parametrize("weighted", [False, True])
@@ -164,7 +164,7 @@ def test_identification_without_used_rows_means_all_base_parameters():
     rng = np.random.default_rng(3)
     q, qd, qdd = rng.normal(size=(5, 2)), rng.normal(size=(5, 2)), rng.normal(size=(5, 2))
     np.testing.assert_allclose(everything.predict(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
-    np.testing.assert_allclose(everything.robot().inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
+    np.testing.assert_allclose(everything.robot.inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
 
 
 # ------------------------------------------------------------------ elbow_3r upright; check deterministic

@@ -2,7 +2,10 @@
 with residuals (:func:`check_properties`), and identification of the base inertial parameters from
 excitation data (:func:`identify`). See docs/analysis.md."""
 
-from .identification import Identification, Measurements, excitation, identify, simulate_measurements, with_inertial_parameters
+from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+from .friction import FrictionModel
+from .identification import Identification, Measurements, Validation, excitation, identify, pseudo_inertia, simulate_measurements, with_inertial_parameters
+from .logs import Log, LogError, load_log
 from .properties import Check, InertiaBounds, PropertiesReport, check_properties, global_inertia_bounds, prove_properties
 from .system_properties import check_system_properties
 
@@ -20,4 +23,13 @@ __all__ = [
     "Identification",
     "Measurements",
     "with_inertial_parameters",
+    "load_log",
+    "Log",
+    "LogError",
+    "Validation",
+    "FrictionModel",
+    "pseudo_inertia",
+    "optimize_excitation",
+    "excitation_condition",
+    "write_trajectory_csv",
 ]

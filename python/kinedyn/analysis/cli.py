@@ -1,5 +1,5 @@
 """``kinedyn check ROBOT`` (properties report) and ``kinedyn identify ROBOT`` (base-parameter
-identification from a simulated excitation)."""
+identification from a robot's log, ``--data``, or from a simulated excitation)."""
 
 from __future__ import annotations
 
@@ -45,6 +45,10 @@ def cmd_identify(args) -> int:
     from .identification import excitation, identify, simulate_measurements
 
     robot = load_robot(args.robot or robots.DEFAULT)
+    if args.excite:
+        return _write_excitation(robot, args)
+    if args.data:
+        return _identify_from_log(robot, args)
     ref = excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
     data = simulate_measurements(robot, ref, T=args.periods * args.period, rate=args.rate, noise=args.noise, seed=args.seed)
     result = identify(robot, data, weighted=args.weighted)
@@ -74,8 +78,77 @@ def cmd_identify(args) -> int:
     return 0
 
 
+def _write_excitation(robot, args) -> int:
+    """``kinedyn identify ROBOT --excite traj.csv``: an optimised excitation for a controller."""
+    from ..cli import console, emit, esc
+    from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+    from .identification import excitation
+
+    ref = optimize_excitation(robot, period=args.period, harmonics=args.harmonics, seed=args.seed)
+    write_trajectory_csv(ref, args.excite, rate=args.rate)
+    cond = excitation_condition(robot, ref)
+    random_cond = excitation_condition(robot, excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed))
+    payload = dict(robot=robot.name, trajectory=str(args.excite), period=args.period, harmonics=args.harmonics, rate=args.rate,
+                   condition_number=cond, random_condition_number=random_cond)
+
+    def render():
+        console().print(f"[bold]{esc(robot.name)}[/bold]: excitation of {args.harmonics} harmonics, period {args.period:g} s, "
+                        f"at rest at both ends, written to {esc(str(args.excite))} at {args.rate:g} Hz; "
+                        f"cond(Y_base) {cond:.4g} (a random Fourier excitation of the same band: {random_cond:.4g})")
+
+    emit(args, payload, render)
+    return 0
+
+
+def _identify_from_log(robot, args) -> int:
+    """``kinedyn identify ROBOT --data log.csv``: a real robot's log (see docs/analysis.md)."""
+    from ..cli import console, emit, esc
+    from .identification import identify
+    from .logs import load_log
+
+    options = dict(cutoff=args.cutoff, decimate=args.decimate)
+    log = load_log(args.data, n=robot.n, **options)
+    result = identify(robot, log, weighted=args.weighted, friction=args.friction, consistent=args.consistent, smoothing=args.smoothing)
+    payload = dict(robot=robot.name, data=str(args.data), cutoff_hz=log.cutoff, rate_hz=log.rate, **result.to_dict())
+    check = None
+    if args.validate:
+        check = result.validate(args.validate, **options)
+        payload["validation"] = check.to_dict()
+    if args.plot:
+        fig = result.plot(args.validate or log)
+        fig.savefig(args.plot)
+        payload["plot"] = str(args.plot)
+
+    def render():
+        from rich.table import Table
+
+        c = console()
+        c.print(f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters and {len(result.friction_names)} friction coefficients "
+                f"from {len(log)} samples of {esc(str(args.data))} (cut-off {log.cutoff or 0:.3g} Hz, {log.rate:.4g} Hz after decimation); "
+                f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+                + (", physically consistent (SDP)" if result.consistent else ""))
+        t = Table(title_justify="left")
+        for col in ("parameter", "estimate", "std", "std %"):
+            t.add_column(col, justify="right")
+        for nm, e, sd, rel in zip(result.names, result.estimates, result.std, result.relative_std):
+            t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{rel:.3g}")
+        for nm, e, sd in zip(result.friction_names, result.friction_estimates, result.friction_std):
+            t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{100 * sd / max(abs(e), 1e-300):.3g}")
+        c.print(t)
+        if check is not None:
+            v = Table(title=f"validation on {esc(str(args.validate))}", title_justify="left")
+            for col in ("joint", "torque RMS", "R²"):
+                v.add_column(col, justify="right")
+            for j, (rms, r2) in enumerate(zip(check.rms, check.r2)):
+                v.add_row(str(j + 1), f"{rms:.4g}", f"{r2:.5f}")
+            c.print(v)
+
+    emit(args, payload, render)
+    return 0
+
+
 def add_analysis_commands(subparsers) -> None:
-    from ..cli import _robot_arg, nonnegative_float, nonnegative_int, positive_float, positive_int
+    from ..cli import OutputPath, _robot_arg, nonnegative_float, nonnegative_int, positive_float, positive_int
 
     p = subparsers.add_parser("check", help="properties of the equations of motion, each with its residual (Spong §9.5)")
     _robot_arg(p)
@@ -86,7 +159,7 @@ def add_analysis_commands(subparsers) -> None:
                    help="also prove the identities on the symbolic model (exact simplification) and search its inertia bounds")
     p.set_defaults(func=cmd_check)
 
-    p = subparsers.add_parser("identify", help="identify the base inertial parameters from a simulated Fourier excitation")
+    p = subparsers.add_parser("identify", help="identify base inertial parameters and friction from a log (--data) or a simulated Fourier excitation")
     _robot_arg(p)
     p.add_argument("--noise", type=nonnegative_float, default=0.0, help="torque noise standard deviation, N m (default 0)")
     p.add_argument("--harmonics", type=positive_int, default=5)
@@ -96,4 +169,14 @@ def add_analysis_commands(subparsers) -> None:
     p.add_argument("--rate", type=positive_float, default=100.0, help="sample rate, Hz (default 100)")
     p.add_argument("--weighted", action="store_true", help="weighted least squares (per-joint noise levels)")
     p.add_argument("--seed", type=nonnegative_int, default=0)
+    p.add_argument("--data", metavar="LOG", help="identify from a log (CSV or NPZ: t, q1..qn, tau1..taun) instead of a simulated excitation")
+    p.add_argument("--friction", default="viscous+coulomb", help="friction terms estimated with --data: viscous, coulomb, offset joined by '+', or none / known (default viscous+coulomb)")
+    p.add_argument("--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s")
+    p.add_argument("--consistent", action="store_true", help="physically consistent parameters (pseudo-inertias positive definite; an SDP through cvxpy)")
+    p.add_argument("--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model")
+    p.add_argument("--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)")
+    p.add_argument("--decimate", type=positive_int, default=None, help="keep every k-th sample after filtering (default: rate / (5 cut-off))")
+    p.add_argument("--excite", metavar="CSV", action=OutputPath,
+                   help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop")
+    p.add_argument("--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)")
     p.set_defaults(func=cmd_identify)

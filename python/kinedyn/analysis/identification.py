@@ -30,13 +30,14 @@ from typing import TYPE_CHECKING, Optional
 import numpy as np
 
 from ..simulate.control import Fourier
+from .friction import FrictionModel, parse_friction
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..dynamics import BaseParameters
     from ..robot import Robot
 
-__all__ = ["Measurements", "Identification", "excitation", "simulate_measurements", "identify", "with_inertial_parameters"]
+__all__ = ["Measurements", "Identification", "Validation", "pseudo_inertia", "excitation", "simulate_measurements", "identify", "with_inertial_parameters"]
 
 
 @dataclass
@@ -70,6 +71,26 @@ class Identification:
     dropped: tuple = ()
     #: which rows of ``base`` the estimates are for (None: all of them)
     used: Optional[np.ndarray] = field(default=None, repr=False)
+    #: the friction model (``known``: the nominal robot's friction, subtracted, not estimated)
+    friction: FrictionModel = field(default_factory=lambda: FrictionModel((), known=True))
+    friction_names: tuple = ()
+    friction_estimates: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    friction_std: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: per-joint torque noise standard deviation estimated from the least-squares residuals
+    noise: Optional[np.ndarray] = None
+    #: physically consistent estimate (``consistent=True``): all 10 n standard parameters
+    standard: Optional[np.ndarray] = field(default=None, repr=False)
+    samples: int = 0
+
+    @property
+    def consistent(self) -> bool:
+        return self.standard is not None
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """100 std / |estimate| (%) per base parameter (Gautier's criterion: above ~10 % an estimate
+        is poorly identified by the data)."""
+        return 100.0 * self.std / np.maximum(np.abs(self.estimates), 1e-300)
 
     def _rows(self) -> np.ndarray:
         """Indices of the rows of ``base`` the estimates are for."""
@@ -86,24 +107,85 @@ class Identification:
             return None
         return np.abs(self.estimates - self.true_values) / np.maximum(np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max()))
 
-    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
-        """Torques of the identified model (base regressor times estimates plus the known drives)."""
-        Y = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self._rows()]]
-        return Y @ self.estimates + self.nominal.armature * np.asarray(qdd) + self.nominal.friction_torque(qd)
+    def predict_torque(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
+        """Torques of the identified model, (n,) or (S, n): rigid body (base regressor times the
+        estimates, or the full regressor times the consistent standard parameters) plus the drive
+        terms (the nominal rotor inertia, and the identified or the nominal friction)."""
+        q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
+        if self.standard is not None:
+            rigid = self.nominal.regressor(q, qd, qdd) @ self.standard
+        else:
+            rigid = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self._rows()]] @ self.estimates
+        if self.friction.known:
+            fric = self.nominal.friction_torque(qd)
+        else:
+            fric = self.friction.torque(qd, self.friction_estimates)
+        return rigid + self.nominal.armature * qdd + fric
 
+    predict = predict_torque
+
+    def mass_matrix(self, q: ArrayLike) -> np.ndarray:
+        """M(q) of the identified model, (n, n) or (S, n, n), from its regressor alone (no Robot is
+        built, so it exists for any estimate): column k is tau(q, 0, e_k) - tau(q, 0, 0), rotor
+        inertia included. Its eigenvalues show whether an estimate can be simulated."""
+        q = np.asarray(q, dtype=float)
+        batch = q.reshape(-1, self.nominal.n)
+        S, n = batch.shape
+        zero = np.zeros((S, n))
+        rows = [self.predict_torque(batch, zero, np.tile(e, (S, 1))) for e in np.eye(n)]
+        rest = self.predict_torque(batch, zero, zero)
+        # friction at qd = 0 (an offset, sign(0) = 0) is the same in both and cancels
+        M = np.stack([r - rest for r in rows], axis=-1)
+        return M.reshape(q.shape[:-1] + (n, n))
+
+    @property
     def robot(self):
-        """A :class:`kinedyn.Robot` with these base parameters (see the module docstring). Raises
-        ValueError if the corrected parameters are not physically valid (e.g. a negative mass)."""
-        G = self.base.grouping[self._rows()]
-        pi0 = self.nominal.inertial_parameters()
-        pi = pi0 + np.linalg.pinv(G) @ (self.estimates - G @ pi0)
-        return with_inertial_parameters(self.nominal, pi)
+        """A :class:`kinedyn.Robot` with the identified parameters: the consistent standard
+        parameters, or (unconstrained) the nominal robot's corrected by the minimum-norm change
+        (see the module docstring); identified viscous and Coulomb friction go into its joints.
+        ValueError if the parameters are not physically valid (e.g. a negative mass): only the
+        consistent estimate is always valid."""
+        if self.standard is not None:
+            pi = self.standard
+        else:
+            G = self.base.grouping[self._rows()]
+            pi0 = self.nominal.inertial_parameters()
+            pi = pi0 + np.linalg.pinv(G) @ (self.estimates - G @ pi0)
+        robot = with_inertial_parameters(self.nominal, pi)
+        if self.friction.known or not ({"viscous", "coulomb"} & set(self.friction.terms)):
+            return robot
+        return _with_friction(robot, self.friction, self.friction_estimates)
+
+    def validate(self, log, **load_options) -> "Validation":
+        """Torque prediction on another log (a :class:`Log`, or anything :func:`load_log` reads,
+        processed with ``load_options``): RMS error and R^2 per joint."""
+        from .logs import load_log
+
+        data = log if isinstance(log, Measurements) else load_log(log, n=self.nominal.n, **load_options)
+        predicted = self.predict_torque(data.q, data.qd, data.qdd)
+        sign = getattr(data, "filtered_sign", None)
+        if sign is not None and not self.friction.known:  # the log's torques went through its filter
+            predicted = predicted - self.friction.torque(data.qd, self.friction_estimates)
+            predicted = predicted + (self.friction.regressor(np.asarray(data.qd), sign) @ self.friction_estimates)
+        return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
+
+    def plot(self, log, **load_options):
+        """Measured vs predicted torques and the residuals on ``log`` (matplotlib Figure)."""
+        return self.validate(log, **load_options).plot()
 
     def to_dict(self) -> dict:
         d = dict(
             names=list(self.names), estimates=self.estimates, std=self.std, condition_number=self.condition_number,
             residual_rms=self.residual_rms, weighted=self.weighted, dropped=list(self.dropped),
         )
+        if not self.friction.known:
+            d.update(relative_std_percent=self.relative_std, friction_names=list(self.friction_names),
+                     friction_estimates=self.friction_estimates, friction_std=self.friction_std, consistent=self.consistent,
+                     samples=self.samples)
+            if self.noise is not None:
+                d.update(noise=self.noise)
+            if self.standard is not None:
+                d.update(standard_parameters=self.standard)
         if self.true_values is not None:
             errors = self.estimates - self.true_values
             d.update(true_values=self.true_values, errors=errors, max_abs_error=float(np.abs(errors).max()),
@@ -122,7 +204,58 @@ class Identification:
             if self.true_values is not None:
                 s += f"   true {self.true_values[k]: .8g}   error {self.estimates[k] - self.true_values[k]: .2g}"
             lines.append(s)
+        for k, nm in enumerate(self.friction_names):
+            lines.append(f"  {nm:<22} {self.friction_estimates[k]: .8g} +- {self.friction_std[k]:.2g}")
         return "\n".join(lines)
+
+
+@dataclass
+class Validation:
+    """Measured and predicted torques on a log, with the RMS error and R^2 per joint."""
+
+    t: np.ndarray
+    measured: np.ndarray
+    predicted: np.ndarray
+    source: str = "<data>"
+
+    @property
+    def residuals(self) -> np.ndarray:
+        return self.measured - self.predicted
+
+    @property
+    def rms(self) -> np.ndarray:
+        return np.sqrt(np.mean(self.residuals**2, axis=0))
+
+    @property
+    def r2(self) -> np.ndarray:
+        """1 - SS_res / SS_tot per joint (1: perfect; 0: no better than the mean torque)."""
+        centred = self.measured - self.measured.mean(axis=0)
+        total = np.sum(centred**2, axis=0)
+        return 1.0 - np.sum(self.residuals**2, axis=0) / np.maximum(total, 1e-300)
+
+    def to_dict(self) -> dict:
+        return dict(source=self.source, samples=int(len(self.t)), rms=self.rms, r2=self.r2)
+
+    def plot(self):
+        """A matplotlib Figure: per joint, measured and predicted torque over time, and the residual."""
+        from matplotlib.figure import Figure
+
+        n = self.measured.shape[1]
+        fig = Figure(figsize=(9, 1.8 * n + 0.5))
+        axes = fig.subplots(n, 2, squeeze=False, sharex=True)
+        for j in range(n):
+            ax, rx = axes[j]
+            ax.plot(self.t, self.measured[:, j], lw=0.8, label="measured")
+            ax.plot(self.t, self.predicted[:, j], lw=0.8, ls="--", label="predicted")
+            ax.set_ylabel(f"tau{j + 1}")
+            ax.set_title(f"joint {j + 1}: RMS {self.rms[j]:.3g}, R² {self.r2[j]:.4f}", fontsize=8)
+            rx.plot(self.t, self.residuals[:, j], lw=0.6, color="C3")
+            rx.set_ylabel("residual")
+        axes[0, 0].legend(fontsize=7)
+        axes[-1, 0].set_xlabel("t (s)")
+        axes[-1, 1].set_xlabel("t (s)")
+        fig.tight_layout()
+        return fig
 
 
 def excitation(robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0: Optional[ArrayLike] = None, seed: int = 0) -> Fourier:
@@ -156,32 +289,74 @@ def simulate_measurements(robot: Robot, reference, T: Optional[float] = None, ra
     return Measurements(t, q, qd, qdd, tau, tau_true, sigma)
 
 
-def identify(robot: Robot, data: Measurements, weighted: bool = False, base=None) -> Identification:
-    """Least-squares estimates of ``robot``'s base parameters from ``data`` (``robot`` gives the
-    kinematics, the known drive terms and, for comparison, the true values)."""
+def identify(
+    robot: Robot,
+    data,
+    weighted: bool = False,
+    base=None,
+    *,
+    friction=None,
+    consistent: bool = False,
+    smoothing: Optional[float] = None,
+    regularization: float = 1e-4,
+    margin: float = 1e-8,
+    solver: Optional[str] = None,
+    **load_options,
+) -> Identification:
+    """Least-squares estimates of ``robot``'s base parameters (and friction) from ``data``.
+
+    ``data``: simulated :class:`Measurements`, a :class:`~kinedyn.analysis.logs.Log`, or anything
+    :func:`~kinedyn.analysis.load_log` reads (CSV / NPZ path, DataFrame; ``load_options`` go to it).
+    ``robot`` gives the kinematics, the rotor inertia (taken as known) and the prior parameters.
+    ``friction``: the terms estimated per joint (``"viscous+coulomb"``, ``"+offset"``, ``"none"``) or
+    ``"known"`` (the robot's own friction subtracted); default ``"known"`` for Measurements,
+    ``"viscous+coulomb"`` for a log. ``smoothing``: Coulomb sign smoothed as tanh(qd / smoothing).
+    ``weighted``: weighted least squares, each joint's rows divided by its noise level estimated from
+    the ordinary fit's residuals. ``consistent``: the physically consistent estimate (see the module
+    docstring: an SDP with every body's pseudo-inertia ``>= margin I``, ``regularization`` the weight
+    of the pull toward ``robot``'s parameters relative to the data term)."""
+    from .logs import Log, load_log
+
     base = robot.base_parameters() if base is None else base
     n = robot.n
-    S = data.q.shape[0]
-    Y = robot.regressor(data.q, data.qd, data.qdd)[..., base.indices]  # (S, n, b)
-    y = data.tau - robot.armature * data.qdd - robot.friction_torque(data.qd)  # (S, n)
-    b = base.count
-    if S * n <= b:
-        raise ValueError(f"{S} samples x {n} joints = {S * n} equations cannot determine {b} base parameters")
-    W = Y.reshape(S * n, b)
+    true_values: Optional[np.ndarray] = None
+    if isinstance(data, Measurements):
+        model = parse_friction("known" if friction is None else friction, smoothing)
+        true_values = np.asarray(base.values, dtype=float)
+    else:
+        data = data if isinstance(data, Log) else load_log(data, n=n, **load_options)
+        if data.n != n:
+            raise ValueError(f"the log has {data.n} joints but robot '{robot.name}' has {n}")
+        model = parse_friction("viscous+coulomb" if friction is None else friction, smoothing)
+    q, qd, qdd, tau = (np.ascontiguousarray(a, dtype=float) for a in (data.q, data.qd, data.qdd, data.tau))
+    S = q.shape[0]
+    Yfull = robot.regressor(q, qd, qdd)  # (S, n, 10 n)
+    F = model.regressor(qd, getattr(data, "filtered_sign", None))  # (S, n, f)
+    y = tau - robot.armature * qdd
+    if model.known:
+        y = y - robot.friction_torque(qd)
+    nb, nf = base.count, F.shape[2]
+    if S * n <= nb + nf:
+        raise ValueError(f"{S} samples x {n} joints = {S * n} equations cannot determine {nb} base parameters and {nf} friction coefficients")
+    W = np.concatenate([Yfull[..., base.indices], F], axis=2).reshape(S * n, nb + nf)
     yv = y.reshape(S * n)
-    # a base column that is round-off noise on the data carries no information: leave it out
+    # a column that is round-off noise on the data carries no information: leave it out
     norms = np.linalg.norm(W, axis=0)
-    used = norms > 1e-9 * norms.max()
+    keep = norms > 1e-9 * norms.max()
+    if not keep[nb:].all():
+        idle = [nm for nm, k in zip(model.names(n), keep[nb:]) if not k]
+        raise ValueError(f"friction terms {idle} have no excitation in the data (a joint that never moves?): use friction='none' or move the joint")
+    used = keep[:nb]
     dropped = tuple(nm for nm, u in zip(base.names, used) if not u)
-    W = W[:, used]
-    b = int(used.sum())
+    W = W[:, keep]
+    p = W.shape[1]
+    dof = S * n - p
     est, *_ = np.linalg.lstsq(W, yv, rcond=None)
     r = (yv - W @ est).reshape(S, n)
-    dof = S * n - b
+    # per-joint noise (Gautier & Poignet 2001): residual variance of each joint's S equations
+    sig = np.sqrt((r**2).sum(axis=0) / max(S - p / n, 1.0))
+    sig = np.where(sig > 0, sig, max(float(sig.max()), 1e-300))
     if weighted:
-        # per-joint noise variance from the OLS residuals, then rows scaled by 1 / sigma_j
-        sig = np.sqrt((r**2).sum(axis=0) / max(S - b / n, 1.0))
-        sig = np.where(sig > 0, sig, max(float(sig.max()), 1e-300))
         w = np.tile(1.0 / sig, S)
         Ww = W * w[:, None]
         est, *_ = np.linalg.lstsq(Ww, yv * w, rcond=None)
@@ -191,14 +366,111 @@ def identify(robot: Robot, data: Measurements, weighted: bool = False, base=None
         cov = s2 * np.linalg.pinv(Ww.T @ Ww)
         cond = float(np.linalg.cond(Ww))
     else:
+        w = np.ones(S * n)
         s2 = float((r**2).sum()) / dof
         cov = s2 * np.linalg.pinv(W.T @ W)
         cond = float(np.linalg.cond(W))
+    std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    standard = None
+    if consistent:
+        A = np.concatenate([Yfull.reshape(S * n, 10 * n), F.reshape(S * n, nf)], axis=1) * w[:, None]
+        standard, fric = _consistent_fit(robot, A, yv * w, nf, regularization, margin, solver)
+        est = np.concatenate([base.grouping[used] @ standard, fric])
+        x = np.concatenate([standard, fric])
+        r = (yv - np.concatenate([Yfull.reshape(S * n, 10 * n), F.reshape(S * n, nf)], axis=1) @ x).reshape(S, n)
+    kb = int(used.sum())
     return Identification(
-        names=tuple(nm for nm, u in zip(base.names, used) if u), estimates=est, std=np.sqrt(np.maximum(np.diag(cov), 0.0)), covariance=cov,
-        true_values=np.asarray(base.values, dtype=float)[used], condition_number=cond, residual_rms=np.sqrt((r**2).mean(axis=0)),
+        names=tuple(nm for nm, u in zip(base.names, used) if u), estimates=est[:kb], std=std[:kb], covariance=cov[:kb, :kb],
+        true_values=None if true_values is None else true_values[used], condition_number=cond, residual_rms=np.sqrt((r**2).mean(axis=0)),
         weighted=weighted, base=base, nominal=robot, dropped=dropped, used=used,
+        friction=model, friction_names=model.names(n), friction_estimates=est[kb:], friction_std=std[kb:], noise=sig,
+        standard=standard, samples=S,
     )
+
+
+def pseudo_inertia(parameters: ArrayLike) -> np.ndarray:
+    """The 4x4 pseudo-inertia J = [[Sigma, h], [h^T, m]] of a body's 10 standard parameters
+    [m, hx, hy, hz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about its frame origin, with the second moment
+    Sigma = 1/2 tr(I) 1 - I (Wensing, Kim & Slotine, "Linear matrix inequalities for physically
+    consistent inertial parameter identification", IEEE RA-L 3(1), 2018; J = int [r; 1][r; 1]^T dm,
+    so J >= 0 exactly when some mass distribution has these parameters)."""
+    m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = np.asarray(parameters, dtype=float)
+    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    J = np.zeros((4, 4))
+    J[:3, :3] = 0.5 * np.trace(inertia) * np.eye(3) - inertia
+    J[:3, 3] = J[3, :3] = (hx, hy, hz)
+    J[3, 3] = m
+    return J
+
+
+def _pseudo_inertia_basis() -> np.ndarray:
+    """(10, 4, 4): J(pi) = sum_k pi_k B_k (pseudo_inertia is linear)."""
+    return np.array([pseudo_inertia(e) for e in np.eye(10)])
+
+
+def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, regularization: float, margin: float, solver: Optional[str]):
+    """min |A [pi; f] - b|^2 + lam |pi - pi0|^2 subject to J_k(pi) >= margin I for every body:
+    a semidefinite program (cvxpy; Clarabel, else SCS). The data term enters through the R factor of
+    A = QR, so the program's size does not grow with the number of samples."""
+    try:
+        import cvxpy as cp
+    except ImportError:  # pragma: no cover - depends on the installation
+        raise ImportError("consistent identification needs cvxpy with Clarabel or SCS: pip install 'kinedyn[identify]'") from None
+    n = robot.n
+    pi0 = robot.inertial_parameters()
+    scale = np.linalg.norm(A, axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    # column scaling keeps the program well conditioned (masses ~ 1, inertias ~ 1e-3 ...)
+    R = np.asarray(np.linalg.qr(A / scale, mode="r"))
+    Q_b = np.linalg.lstsq(R.T, (A / scale).T @ b, rcond=None)[0]  # Q^T b without forming Q
+    x = cp.Variable(A.shape[1])
+    pi = cp.multiply(x[: 10 * n], 1.0 / scale[: 10 * n])
+    B = _pseudo_inertia_basis()
+    constraints = []
+    for k in range(n):
+        J = sum(pi[10 * k + c] * B[c] for c in range(10))
+        constraints.append(J - margin * np.eye(4) >> 0)
+    # the prior term in the scaled coordinates: a parameter's deviation weighs by its column norm,
+    # i.e. by how much torque it moves over the log (each scaled column has unit norm)
+    objective = cp.Minimize(cp.sum_squares(R @ x - Q_b) + regularization * cp.sum_squares(x[: 10 * n] - pi0 * scale[: 10 * n]))
+    problem = cp.Problem(objective, constraints)
+    solvers = [solver] if solver else [s for s in ("CLARABEL", "SCS") if s in cp.installed_solvers()]
+    if not solvers:
+        raise ImportError("consistent identification needs the Clarabel or SCS solver for cvxpy")
+    last: Optional[Exception] = None
+    for name in solvers:
+        try:
+            problem.solve(solver=name)
+        except cp.error.SolverError as e:
+            last = e
+            continue
+        if problem.status in ("optimal", "optimal_inaccurate") and x.value is not None:
+            xs = np.asarray(x.value) / scale
+            return xs[: 10 * n], xs[10 * n :]
+        last = RuntimeError(f"solver {name}: {problem.status}")
+    raise RuntimeError(f"the consistent (SDP) identification failed: {last}")
+
+
+def _with_friction(robot: Robot, model: FrictionModel, coefficients: np.ndarray) -> Robot:
+    """``robot`` with the identified viscous and (symmetric) Coulomb coefficients in its joints."""
+    from dataclasses import replace as dc_replace
+
+    from ..description.link import Link
+
+    k = len(model.terms)
+    index = {j.name: i for i, j in enumerate(robot.joints)}
+    links = []
+    for link in robot.links:
+        i = index.get(link.joint.name) if link.joint.is_moving else None
+        if i is not None:
+            c = dict(zip(model.terms, coefficients[i * k : (i + 1) * k]))
+            joint = dc_replace(link.joint, viscous=float(c.get("viscous", link.joint.viscous)),
+                               coulomb=float(abs(c.get("coulomb", link.joint.coulomb))), coulomb_negative=None)
+            link = Link(link.name, link.parent, joint, link.placement, link.post, link.inertia)
+        links.append(link)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return robot.replace(links=links)
 
 
 def with_inertial_parameters(robot: Robot, pi: ArrayLike) -> Robot:

@@ -1,0 +1,270 @@
+"""Robot logs for identification: reading, checking, filtering and differentiating (docs/analysis.md).
+
+A log holds, per sample, the time ``t`` (s, strictly increasing), the joint positions ``q1..qn``
+(rad or m) and either the joint torques ``tau1..taun`` (N m or N) or the motor currents ``i1..in``
+(A) with a torque constant ``k_t`` (N m / A) and a gear ratio ``r`` per joint, so that
+``tau_j = r_j k_t,j i_j``. Velocities ``qd1..qdn`` and accelerations ``qdd1..qddn`` are optional.
+
+When velocities or accelerations are absent they are computed from the positions (the usual
+processing of identification data, Gautier 1997 "Dynamic identification of robots with power
+model", and Swevers et al. 1997 §IV):
+
+1. the positions are low-pass filtered with a zero-phase Butterworth filter (``scipy.signal.butter``
+   applied forwards and backwards by ``filtfilt``, so without delay), then differentiated twice by
+   central differences (``numpy.gradient``);
+2. the torques go through the same filter, so that the torques and the motion they are compared
+   with see the same (zero) phase and the same attenuation; so does sign(qd), the Coulomb friction
+   column (the filter smears the torque's Coulomb jump at a reversal over ~1 / cutoff: comparing it
+   with an unfiltered sign would leave that smear as a residual many times the noise; filtering the
+   regressor column and the torque alike is Gautier's "parallel filtering");
+3. the filter edges, where ``filtfilt``'s start-up transient lives, are trimmed, and the samples are
+   decimated (the signals are already band-limited below the cut-off, so keeping every k-th sample
+   aliases nothing).
+
+The cut-off rule (overridable by ``cutoff=``): the *bandwidth* of the motion is the frequency below
+which 99.9 % of the power of the positions lies (mean and linear trend removed, Hann-windowed), the largest over the joints; the
+cut-off is 5 times that bandwidth, at least 1 Hz and at most 0.4 times the Nyquist frequency. The
+factor 5 keeps the attenuation of the motion itself below 1e-3 for a 4th-order filter
+(|H(f)|^2 = 1 / (1 + (f/fc)^(2 N)) twice, filtfilt) while cutting the quantisation and torque noise
+spread over the whole band.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+__all__ = ["Log", "LogError", "load_log", "motion_bandwidth", "choose_cutoff"]
+
+
+class LogError(ValueError):
+    """A log that cannot be used: the message names the file and the column, row or setting."""
+
+
+@dataclass
+class Log:
+    """Samples (S,) / (S, n) ready for identification, and how they were processed."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    tau: np.ndarray
+    #: sample rate after decimation, Hz
+    rate: float
+    #: low-pass cut-off in Hz (None: the log came with velocities and accelerations, not filtered)
+    cutoff: Optional[float] = None
+    decimation: int = 1
+    source: str = "<data>"
+    #: sign(qd) passed through the same low-pass filter as the torques (None when not filtered): the
+    #: Coulomb column of the friction regressor, so that it sees the filter the torque's Coulomb part saw
+    filtered_sign: Optional[np.ndarray] = None
+
+    @property
+    def n(self) -> int:
+        return int(self.q.shape[1])
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+
+def motion_bandwidth(q: np.ndarray, rate: float, fraction: float = 0.999) -> float:
+    """Frequency (Hz) below which ``fraction`` of the power of each joint's mean-removed position
+    lies, the largest over the joints (0 for a log without motion)."""
+    x = np.asarray(q, dtype=float)
+    x = x - x.mean(axis=0)
+    # the jump between the log's last and first sample would leak power over every frequency (the
+    # FFT sees the record as periodic): a linear trend is taken out, then a Hann window tapers the ends
+    s = np.arange(x.shape[0]) - (x.shape[0] - 1) / 2
+    x = x - np.outer(s, (s @ x) / max(float(s @ s), 1.0))
+    x = x * np.hanning(x.shape[0])[:, None]
+    power = np.abs(np.fft.rfft(x, axis=0)) ** 2
+    freqs = np.fft.rfftfreq(x.shape[0], 1.0 / rate)
+    band = 0.0
+    for j in range(x.shape[1]):
+        total = power[:, j].sum()
+        if total <= 0:
+            continue
+        k = int(np.searchsorted(np.cumsum(power[:, j]) / total, fraction))
+        band = max(band, float(freqs[min(k, len(freqs) - 1)]))
+    return band
+
+
+def choose_cutoff(q: np.ndarray, rate: float) -> float:
+    """The cut-off rule of this module: 5 x :func:`motion_bandwidth`, within [1 Hz, 0.4 Nyquist]."""
+    nyquist = rate / 2
+    return float(min(max(5.0 * motion_bandwidth(q, rate), 1.0), 0.4 * nyquist))
+
+
+def _columns_from_table(names: Sequence[str], data: np.ndarray) -> dict:
+    return {str(nm).strip(): data[:, k] for k, nm in enumerate(names)}
+
+
+def _read(source: Any) -> tuple[dict, str]:
+    """A mapping column name -> 1-D array, and a name for messages."""
+    try:
+        import pandas as pd  # type: ignore[import-untyped]
+    except ImportError:  # pragma: no cover - pandas is optional
+        pd = None
+    if pd is not None and isinstance(source, pd.DataFrame):
+        cols = {}
+        for c in source.columns:
+            try:
+                cols[str(c).strip()] = source[c].to_numpy(dtype=float)
+            except (TypeError, ValueError):
+                raise LogError(f"data frame: column '{c}' is not numeric") from None
+        return cols, "data frame"
+    if isinstance(source, dict):
+        return {str(k): np.asarray(v, dtype=float) for k, v in source.items()}, "mapping"
+    path = os.fspath(source)
+    if not os.path.exists(path):
+        raise LogError(f"{path}: no such file")
+    if path.lower().endswith(".npz"):
+        with np.load(path) as z:
+            cols = {}
+            for k in z.files:
+                a = np.asarray(z[k], dtype=float)
+                if a.ndim == 2 and k in ("q", "qd", "qdd", "tau", "i"):  # whole (S, n) arrays
+                    for j in range(a.shape[1]):
+                        cols[f"{k}{j + 1}"] = a[:, j]
+                else:
+                    cols[k] = a.reshape(-1) if a.ndim <= 1 else a
+        return cols, path
+    with open(path, encoding="utf-8") as f:
+        header = f.readline()
+    names = [h.strip() for h in header.strip().split(",")]
+    if not names or not any(names):
+        raise LogError(f"{path}: line 1 should be a header of column names (t, q1..qn, tau1..taun)")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as e:
+        m = re.search(r"at row (\d+)", str(e))
+        where = f" line {int(m.group(1)) + 2}:" if m else ""
+        raise LogError(f"{path}:{where} not a number ({e})") from None
+    if data.shape[1] != len(names):
+        raise LogError(f"{path}: the header names {len(names)} columns but the rows have {data.shape[1]}")
+    return _columns_from_table(names, data), path
+
+
+def _numbered(cols: dict, prefix: str) -> list:
+    """Columns prefix1, prefix2, ... (consecutive from 1)."""
+    out: list = []
+    while f"{prefix}{len(out) + 1}" in cols:
+        out.append(f"{prefix}{len(out) + 1}")
+    return out
+
+
+def _lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray:
+    from scipy.signal import butter, sosfiltfilt
+
+    sos = butter(order, cutoff, btype="low", fs=rate, output="sos")
+    return sosfiltfilt(sos, x, axis=0)
+
+
+def load_log(
+    source: Any,
+    *,
+    n: Optional[int] = None,
+    torque_constants: Optional[Any] = None,
+    gear_ratios: Optional[Any] = None,
+    cutoff: Optional[float] = None,
+    order: int = 4,
+    decimate: Optional[int] = None,
+    trim: Optional[float] = None,
+) -> Log:
+    """Read and prepare a log (CSV with a header line, NPZ, a pandas DataFrame or a dict of columns).
+
+    ``n``: the number of joints expected (e.g. ``robot.n``); ``torque_constants`` / ``gear_ratios``:
+    per joint, to turn the currents ``i1..in`` into torques; ``cutoff``: the low-pass cut-off in Hz
+    (default: the rule in the module docstring); ``order``: Butterworth order; ``decimate``: keep
+    every k-th sample (default: the largest k with ``rate / k >= 5 cutoff``); ``trim``: seconds cut at each end (default ``3 / cutoff``).
+    Raises :class:`LogError` (a ValueError) naming the file and the missing, non-finite or
+    inconsistent column."""
+    if isinstance(source, Log):
+        return source
+    cols, name = _read(source)
+    if "t" not in cols:
+        raise LogError(f"{name}: missing column 't' (time, s); columns: {sorted(cols)}")
+    qn = _numbered(cols, "q")
+    if not qn:
+        raise LogError(f"{name}: missing columns 'q1'..'qn' (joint positions); columns: {sorted(cols)}")
+    if n is not None and len(qn) != n:
+        raise LogError(f"{name}: {len(qn)} position columns q1..q{len(qn)} but the robot has {n} joints")
+    n = len(qn)
+    S = len(cols["t"])
+    for k, v in cols.items():
+        if np.asarray(v).shape != (S,):
+            raise LogError(f"{name}: column '{k}' has {np.asarray(v).shape} values, 't' has {S}")
+    t = cols["t"]
+
+    def block(prefix: str, what: str, required: bool = True) -> Optional[np.ndarray]:
+        present = [f"{prefix}{j}" for j in range(1, n + 1) if f"{prefix}{j}" in cols]
+        if not present:
+            if required:
+                raise LogError(f"{name}: missing columns '{prefix}1'..'{prefix}{n}' ({what})")
+            return None
+        if len(present) < n:
+            missing = next(f"{prefix}{j}" for j in range(1, n + 1) if f"{prefix}{j}" not in cols)
+            raise LogError(f"{name}: missing column '{missing}' ({what})")
+        return np.column_stack([cols[c] for c in present])
+
+    q = block("q", "joint positions")
+    assert q is not None
+    tau = block("tau", "joint torques", required=False)
+    if tau is None:
+        cur = block("i", "motor currents", required=False)
+        if cur is None:
+            raise LogError(f"{name}: missing columns 'tau1'..'tau{n}' (joint torques, N m) or 'i1'..'i{n}' (motor currents, A)")
+        if torque_constants is None or gear_ratios is None:
+            raise LogError(f"{name}: the log has motor currents i1..i{n}: give torque_constants and gear_ratios to turn them into torques")
+        kt = np.broadcast_to(np.asarray(torque_constants, dtype=float), (n,))
+        r = np.broadcast_to(np.asarray(gear_ratios, dtype=float), (n,))
+        if not (np.all(np.isfinite(kt)) and np.all(np.isfinite(r))):
+            raise LogError(f"{name}: torque_constants and gear_ratios must be finite")
+        tau = cur * kt * r
+    qd = block("qd", "joint velocities", required=False)
+    qdd = block("qdd", "joint accelerations", required=False)
+    for label, arr in (("t", t[:, None]), ("q", q), ("tau" if "tau1" in cols else "i", tau), ("qd", qd), ("qdd", qdd)):
+        if arr is None:
+            continue
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            row, j = (int(x) for x in np.argwhere(bad)[0])
+            col = label if label == "t" else f"{label}{j + 1}"
+            raise LogError(f"{name}: column '{col}' has a non-finite value (NaN or inf) at sample {row} (t index), data row {row + 1}")
+    if S < 10:
+        raise LogError(f"{name}: {S} samples are too few to identify anything")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        k = int(np.argmax(dt <= 0))
+        raise LogError(f"{name}: time is not increasing at sample {k + 1} (t = {t[k]:g} then {t[k + 1]:g})")
+    rate = float(1.0 / np.median(dt))
+    if np.max(np.abs(dt * rate - 1.0)) > 0.05:
+        raise LogError(f"{name}: the sampling is not uniform (steps from {dt.min():g} to {dt.max():g} s); resample the log first")
+    if qd is not None and qdd is not None and cutoff is None:
+        k = 1 if decimate is None else int(decimate)
+        return Log(t[::k], q[::k], qd[::k], qdd[::k], tau[::k], rate / k, None, k, name)
+    if cutoff is None:
+        cutoff = choose_cutoff(q, rate)
+    if not 0 < cutoff < rate / 2:
+        raise LogError(f"{name}: cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
+    qf = _lowpass(q, cutoff, rate, order)
+    h = 1.0 / rate
+    qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
+    qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
+    tau_f = _lowpass(tau, cutoff, rate, order)
+    if trim is None:
+        trim = 3.0 / cutoff
+    edge = int(np.ceil(trim * rate))
+    if 2 * edge >= S - 10:
+        raise LogError(f"{name}: the log ({S / rate:g} s) is too short to trim {trim:g} s of filter edge at each end")
+    k = max(1, int(np.floor(rate / (5.0 * cutoff)))) if decimate is None else int(decimate)
+    if k < 1:
+        raise LogError(f"{name}: decimate must be a whole number >= 1, got {decimate}")
+    sl = slice(edge, S - edge, k)
+    sign_f = _lowpass(np.sign(qd_f), cutoff, rate, order)
+    return Log(t[sl], qf[sl], qd_f[sl], qdd_f[sl], tau_f[sl], rate / k, float(cutoff), k, name, sign_f[sl])
