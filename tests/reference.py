@@ -104,3 +104,13 @@ def erd(*parts) -> str:
     if root is None:
         pytest.skip("example-robot-data is not installed")
     return os.path.join(root, *parts)
+
+
+def symbolic_backend_robots() -> dict:
+    """The robots the symbolic backends (CasADi, JAX) are checked on against the core: name -> maker.
+    ``puma560_drives`` has viscous and direction-dependent Coulomb friction (sign(qd)) and rotor inertia."""
+    import kinedyn as kd
+
+    return {"planar_2r": kd.robots.planar_2r, "puma560": kd.robots.puma560,
+            "ur5": lambda: kd.Robot.from_urdf(erd(*UR5)),
+            "puma560_drives": lambda: kd.robots.puma560(friction=True, motors=True)}

@@ -9,7 +9,7 @@ import pytest
 
 import kinedyn as kd
 
-from reference import UR5, erd
+from reference import symbolic_backend_robots
 
 ca = pytest.importorskip("casadi")
 
@@ -17,13 +17,7 @@ RNG = np.random.default_rng(15)
 TOL = 1e-10
 
 
-def _ur5():
-    return kd.Robot.from_urdf(erd(*UR5))
-
-
-ROBOTS = {"planar_2r": kd.robots.planar_2r, "puma560": kd.robots.puma560, "ur5": _ur5,
-          # viscous and direction-dependent Coulomb friction (sign(qd)) and rotor inertia
-          "puma560_drives": lambda: kd.robots.puma560(friction=True, motors=True)}
+ROBOTS = symbolic_backend_robots()
 
 
 @pytest.fixture(scope="module", params=list(ROBOTS))
