@@ -229,8 +229,34 @@ class Robot:
     # ------------------------------------------------------------------ description queries
     @property
     def n(self) -> int:
-        """Number of joint coordinates."""
-        return self.tree.n
+        """Number of degrees of freedom: the length of ``qd``, ``qdd`` and ``tau`` (= :attr:`nv`). For a
+        robot of 1-DOF joints it is also the length of ``q``; with floating, spherical or planar joints
+        ``q`` has :attr:`nq` entries (docs/conventions.md)."""
+        return self.nv
+
+    @property
+    def nq(self) -> int:
+        """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
+        return sum(b.joint.nq for b in self.tree.bodies)
+
+    @property
+    def nv(self) -> int:
+        """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
+        return sum(b.joint.nv for b in self.tree.bodies)
+
+    @property
+    def has_multi_dof_joints(self) -> bool:
+        """Whether a joint is floating, spherical or planar (then nq may differ from nv)."""
+        return any(b.joint.is_multi_dof for b in self.tree.bodies)
+
+    def require_one_dof_joints(self, feature: str) -> None:
+        """Raise a ValueError naming the joint when ``feature`` does not handle multi-DOF joints yet."""
+        for b in self.tree.bodies:
+            if b.joint.is_multi_dof:
+                raise ValueError(
+                    f"{feature} handles revolute and prismatic joints only; robot '{self.name}' has the "
+                    f"{b.joint.kind} joint '{b.joint.name}' (nq={self.nq}, nv={self.nv})"
+                )
 
     @property
     def joints(self) -> tuple:
@@ -427,6 +453,7 @@ class Robot:
                 f"robot '{self.name}' has symbolic parameters {sorted(map(str, self.symbols))}: "
                 "use robot.subs({...}) to give them values before numeric computation"
             )
+        self.require_one_dof_joints("the numeric engine")
         bodies = self.tree.bodies
         n = len(bodies)
         parent = np.array([b.parent for b in bodies], dtype=np.int64)

@@ -22,15 +22,23 @@ from typing import Any
 from .._math import is_symbolic
 from .checks import number, real, vector
 
-__all__ = ["Joint", "JOINT_KINDS"]
+__all__ = ["Joint", "JOINT_KINDS", "JOINT_SIZES", "MULTI_DOF_KINDS"]
 
-JOINT_KINDS = ("revolute", "prismatic", "fixed")
+JOINT_KINDS = ("revolute", "prismatic", "fixed", "floating", "spherical", "planar")
+
+#: Configuration and velocity sizes (nq, nv) of each kind (Pinocchio's conventions, docs/conventions.md):
+#: floating (free-flyer): q = (x, y, z, qx, qy, qz, qw), v = [linear; angular] in the child's frame;
+#: spherical: q = (qx, qy, qz, qw), v = angular velocity in the child's frame;
+#: planar: q = (x, y, cos theta, sin theta) in the plane normal to ``axis``, v = (vx, vy, omega) in the
+#: child's frame.
+JOINT_SIZES = {"revolute": (1, 1), "prismatic": (1, 1), "fixed": (0, 0), "floating": (7, 6), "spherical": (4, 3), "planar": (4, 3)}
+MULTI_DOF_KINDS = ("floating", "spherical", "planar")
 
 
 @dataclass(frozen=True)
 class Joint:
     name: str
-    kind: str = "revolute"  # "revolute" | "prismatic" | "fixed"
+    kind: str = "revolute"  # "revolute" | "prismatic" | "fixed" | "floating" | "spherical" | "planar"
     axis: tuple = (0.0, 0.0, 1.0)
     offset: Any = 0.0
     lower: float = -math.inf
@@ -87,6 +95,14 @@ class Joint:
                     hint = (" (a level, not a signed torque: Corke's Tc = [Tc+, Tc-] with Tc- < 0 is "
                             "coulomb=(Tc+, -Tc-))")
                 raise ValueError(f"{what}: {name} must be >= 0, got {v}{hint}")
+        if self.is_multi_dof:
+            # a multi-DOF joint has one scalar of each per degree of freedom in no file format kinedyn
+            # reads; refusing them beats silently applying one number to 3 or 6 coordinates
+            for name, default in (("offset", 0), ("rotor_inertia", 0), ("viscous", 0), ("coulomb", 0)):
+                if getattr(self, name) != default:
+                    raise ValueError(f"{what}: a {self.kind} joint takes no {name} (got {getattr(self, name)})")
+            if self.coulomb_negative is not None:
+                raise ValueError(f"{what}: a {self.kind} joint takes no coulomb_negative")
         # limits: numbers, +-inf allowed (no limit), never NaN
         for name in ("lower", "upper", "velocity_limit", "effort_limit"):
             object.__setattr__(self, name, real(getattr(self, name), f"{what}: {name}", infinite=True))
@@ -128,6 +144,20 @@ class Joint:
     @property
     def is_moving(self) -> bool:
         return self.kind != "fixed"
+
+    @property
+    def nq(self) -> int:
+        """Number of configuration coordinates (7 floating, 4 spherical and planar, 1, 0 fixed)."""
+        return JOINT_SIZES[self.kind][0]
+
+    @property
+    def nv(self) -> int:
+        """Number of velocity coordinates, the joint's degrees of freedom (6, 3, 3, 1, 0 fixed)."""
+        return JOINT_SIZES[self.kind][1]
+
+    @property
+    def is_multi_dof(self) -> bool:
+        return self.kind in MULTI_DOF_KINDS
 
     @property
     def armature(self):
