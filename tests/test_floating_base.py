@@ -88,6 +88,10 @@ def compare(pair: PinPair, rng, states: int = 2, frames: int = 3, derivatives: b
         if not robot.armature.any():
             _close("kinetic energy (Pinocchio)", robot.kinetic_energy(q, v), pin.computeKineticEnergy(model, data, qp, vp), scale)
         _close("centre of mass", robot.center_of_mass(q), pin.centerOfMass(model, data, qp))
+        A = pin.ccrba(model, data, qp, vp)
+        _close("centroidal momentum matrix", robot.centroidal_momentum_matrix(q)[:, P], A, scale)
+        _close("centroidal momentum", robot.centroidal_momentum_matrix(q) @ v, data.hg.vector, scale)
+        _close("centre-of-mass Jacobian", robot.center_of_mass_jacobian(q)[:, P], pin.jacobianCenterOfMass(model, data, qp))
         if derivatives:
             dq, dv, _ = pin.computeRNEADerivatives(model, data, qp, vp, ap)
             Dq, Dv, Dqdd = robot.inverse_dynamics_derivatives(q, v, a)
@@ -183,3 +187,49 @@ def test_drones_load_with_a_floating_base_only():
     mass = drone.mass_matrix(q)[0, 0]
     # hovering: the free-flyer's gravity force is m g straight down, in the body frame (level)
     np.testing.assert_allclose(drone.gravity_torque(q)[:3], [0, 0, mass * 9.81], rtol=1e-12)
+
+
+# ------------------------------------------------------------------ minimal coordinates (symbolic engine)
+def test_euler_parametrisation_has_the_same_dynamics_as_the_native_joints():
+    """The symbolic engine's coordinates (position + ZYX Euler angles) against the quaternion model:
+    with v = T(q_e) qd_e, M_e = T^T M T, g_e = T^T g, tau_e = T^T tau(q, v, T qdd_e + dT/dt qd_e)."""
+    from kinedyn.description.parametrise import euler_parametrised, euler_to_native, euler_velocity_map
+
+    robot = random_robot(0, n=7, branching=True, floating=True, spherical=0.3, planar=0.2, prismatic=0.3, friction=False)
+    assert {"floating", "spherical", "planar"} <= {j.kind for j in robot.joints}
+    euler = euler_parametrised(robot)
+    assert euler.nq == euler.nv == robot.nv and not euler.has_multi_dof_joints
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        qe, qde, qdde = rng.uniform(-1.2, 1.2, robot.nv), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+        q, v = euler_to_native(robot, qe, qde)
+        T = euler_velocity_map(robot, qe)
+        h = 1e-6
+        Tdot = (euler_velocity_map(robot, qe + h * qde) - euler_velocity_map(robot, qe - h * qde)) / (2 * h)
+        for name in robot.frame_names:
+            _close(f"pose of {name}", euler.pose(qe, name), robot.pose(q, name))
+        _close("M", euler.mass_matrix(qe), T.T @ robot.mass_matrix(q) @ T, 10.0)
+        _close("g", euler.gravity_torque(qe), T.T @ robot.gravity_torque(q), 10.0)
+        _close("K", euler.kinetic_energy(qe, qde), robot.kinetic_energy(q, v), 10.0)
+        tau = T.T @ robot.inverse_dynamics(q, v, T @ qdde + Tdot @ qde)
+        assert np.abs(euler.inverse_dynamics(qe, qde, qdde) - tau).max() < 1e-6 * max(1.0, np.abs(tau).max())
+
+
+def test_symbolic_equations_of_a_floating_robot_match_the_core():
+    """eom of a floating two-link robot (derived in Euler coordinates) evaluated at random states equals
+    the core's M and g mapped through T (two engines, two parametrisations)."""
+    from kinedyn.description.parametrise import euler_to_native, euler_velocity_map
+
+    robot = random_robot(2, n=2, floating=True, friction=False, fixed=0)
+    eom = robot.equations_of_motion(simplify=False)
+    assert [str(s) for s in eom.q] == ["j1_x", "j1_y", "j1_z", "j1_yaw", "j1_pitch", "j1_roll", "j2"]
+    rng = np.random.default_rng(5)
+    for _ in range(2):
+        qe = rng.uniform(-1.2, 1.2, robot.nv)
+        q, _v = euler_to_native(robot, qe)
+        T = euler_velocity_map(robot, qe)
+        values = dict(zip(eom.q, qe))
+        M = np.array(eom.M.subs(values).evalf(), dtype=float)
+        g = np.array(eom.g.subs(values).evalf(), dtype=float).ravel()
+        _close("symbolic M", M, T.T @ robot.mass_matrix(q) @ T, 10.0)
+        _close("symbolic g", g, T.T @ robot.gravity_torque(q), 10.0)

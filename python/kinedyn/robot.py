@@ -876,6 +876,23 @@ class Robot:
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
+    @batched("q")
+    def centroidal_momentum_matrix(self, q: ArrayLike) -> np.ndarray:
+        """A_G(q), (6, n) or (N, 6, n): the momentum about the centre of mass, h_G = A_G qd =
+        [m c_dot; L_G] in base axes (Orin, Goswami & Lee 2013; Pinocchio's ``ccrba`` ``Ag``)."""
+        return self._model.centroidal_momentum_matrix(q)
+
+    @batched("q")
+    def center_of_mass_jacobian(self, q: ArrayLike) -> np.ndarray:
+        """J_c(q), (3, n) or (N, 3, n): the centre of mass's velocity c_dot = J_c qd in base axes
+        (the linear rows of the centroidal momentum matrix over the total mass)."""
+        A = self._model.centroidal_momentum_matrix(q)
+        return A[..., :3, :] / self._total_mass
+
+    @cached_property
+    def _total_mass(self) -> float:
+        return float(sum(float(b.inertia.mass) for b in self.tree.bodies))
+
     @batched("q", "qd", "qdd")
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
