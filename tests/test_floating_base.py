@@ -233,3 +233,16 @@ def test_symbolic_equations_of_a_floating_robot_match_the_core():
         g = np.array(eom.g.subs(values).evalf(), dtype=float).ravel()
         _close("symbolic M", M, T.T @ robot.mass_matrix(q) @ T, 10.0)
         _close("symbolic g", g, T.T @ robot.gravity_torque(q), 10.0)
+
+
+def test_locking_the_floating_joint_gives_the_fixed_base_robot_at_that_pose():
+    robot = random_robot(3, n=5, branching=True, floating=True, spherical=0.5, friction=False)
+    pair = PinPair(robot, pinocchio_model(robot))
+    q, v, _ = pair.random_state(np.random.default_rng(8))
+    fixed = robot.lock_joints([robot.joint_names[0]], at=q)
+    assert fixed.joints[0].kind != "floating" and (fixed.nq, fixed.nv) == (robot.nq - 7, robot.nv - 6)
+    _close("tool pose", fixed.pose(q[7:], fixed.tool), robot.pose(q, robot.tool))
+    _close("M of the joints", fixed.mass_matrix(q[7:]), robot.mass_matrix(q)[6:, 6:], 10.0)
+    spherical = robot.joint_names[[j.kind for j in robot.joints].index("spherical")]
+    with pytest.raises(ValueError, match=f"joint '{spherical}'.* not unit"):
+        robot.lock_joints({spherical: [0.0, 0.0, 0.0, 2.0]})

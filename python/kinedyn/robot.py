@@ -70,6 +70,33 @@ def _planar_basis(normal) -> tuple:
     return e1, np.cross(n, e1)
 
 
+def _locked_block(joint, block) -> np.ndarray:
+    """The 4x4 joint motion of a multi-DOF ``joint`` at its q ``block`` (unit quaternion / (cos, sin)
+    checked): what :meth:`Robot.lock_joints` folds into the placement."""
+    b = real_array(block, f"value of joint '{joint.name}'").ravel()
+    if b.shape != (joint.nq,) or not np.all(np.isfinite(b)):
+        raise ValueError(f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}")
+    T = np.eye(4)
+    unit = b[-4:] if joint.kind != "planar" else b[2:]
+    if abs(np.linalg.norm(unit) - 1.0) > 1e-6:
+        raise ValueError(f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit")
+    if joint.kind == "planar":
+        e1, e2 = _planar_basis(to_float_array(joint.axis, (3,), "axis"))
+        n = np.cross(e1, e2)
+        c, s = b[2], b[3]
+        K = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+        T[:3, :3] = c * np.eye(3) + s * K + (1 - c) * np.outer(n, n)
+        T[:3, 3] = b[0] * e1 + b[1] * e2
+        return T
+    x, y, z, w = b[-4:]
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    if joint.kind == "floating":
+        T[:3, 3] = b[:3]
+    return T
+
+
 def _joint_columns(joint) -> list:
     """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
     1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
@@ -199,20 +226,24 @@ class Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
 
         ``joints``: a mapping ``{joint: value}``, or a sequence (list, tuple, set, array) of joints
-        locked at their value in ``at`` (a configuration (n,); default: zero, the joint's offset
-        position). A joint is named by its name (``robot.joint_names``) or its index in ``q``.
+        locked at their value in ``at`` (a configuration (nq,); default: :meth:`neutral`). A joint is
+        named by its name (``robot.joint_names``) or its index in that list (= its index in ``q`` when
+        every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
+        position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
         from ._math import rot_axis, translation
 
         names = self.joint_names
+        n_joints = len(names)
+        starts = np.cumsum([0] + [j.nq for j in self.joints])
         if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
             raise TypeError(f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}")
         if isinstance(joints, Mapping):
             items = list(joints.items())
         else:
-            q_at = np.zeros(self.n) if at is None else real_array(at, "at")
-            if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
-                raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
+            q_at = self.neutral() if at is None else real_array(at, "at")
+            if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
+                raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
         unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
         if unknown:
@@ -222,13 +253,17 @@ class Robot:
             if isinstance(key, str):
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not -self.n <= key < self.n:
-                    raise ValueError(f"lock_joints: joint index {key} is out of range for {self.n} joints")
-                i = int(key) % self.n
+                if not -n_joints <= key < n_joints:
+                    raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
+                i = int(key) % n_joints
             else:
                 raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
+            if self.joints[i].is_multi_dof:
+                block = q_at[starts[i]:starts[i + 1]] if value is None else value
+                values[names[i]] = _locked_block(self.joints[i], block)
+                continue
             if value is None:
-                value = q_at[i]
+                value = q_at[starts[i]]
             try:
                 v = float(value)
             except (TypeError, ValueError):
@@ -239,7 +274,10 @@ class Robot:
         links = []
         for link in self.links:
             j = link.joint
-            if j.name in values and j.is_moving:
+            if j.name in values and j.is_multi_dof:
+                fixed = Joint(j.name, "fixed")
+                link = Link(link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia)
+            elif j.name in values and j.is_moving:
                 x = values[j.name] + j.offset
                 motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
                 fixed = Joint(j.name, "fixed", j.axis)
