@@ -92,12 +92,33 @@ def compare(pair: PinPair, rng, states: int = 2, frames: int = 3, derivatives: b
         _close("centroidal momentum matrix", robot.centroidal_momentum_matrix(q)[:, P], A, scale)
         _close("centroidal momentum", robot.centroidal_momentum_matrix(q) @ v, data.hg.vector, scale)
         _close("centre-of-mass Jacobian", robot.center_of_mass_jacobian(q)[:, P], pin.jacobianCenterOfMass(model, data, qp))
+        # the acceleration drift J_dot v of each compared frame (a = 0): Pinocchio's classical acceleration
+        pin.forwardKinematics(model, data, qp, vp, 0 * vp)
+        for name, index, is_frame in picked[:2]:
+            if is_frame:
+                drift = pin.getFrameClassicalAcceleration(model, data, index, pin.LOCAL_WORLD_ALIGNED)
+            else:
+                placement = pin.SE3(data.oMi[index].rotation, np.zeros(3))
+                drift = placement.act(data.a[index]).vector
+                drift[:3] += np.cross(placement.act(data.v[index]).angular, placement.act(data.v[index]).linear)
+            _close(f"J_dot v of {name}", robot.jacobian_dot_qd(q, v, name), drift, scale)
+        _close("potential energy", robot.potential_energy(q), pin.computePotentialEnergy(model, data, qp), scale)
+        Y = pin.computeJointTorqueRegressor(model, data, qp, vp, ap)
+        pi = np.concatenate([model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)])
+        _close("Y pi == tau (Pinocchio's regressor)", Y @ pi, tau - model.armature * ap, float(np.abs(tau).max()))
+        _close("Y pi == tau (kinedyn's regressor)", (robot.regressor(q, v, a) @ robot.inertial_parameters())[P],
+               tau - model.armature * ap, float(np.abs(tau).max()))
         if derivatives:
             dq, dv, _ = pin.computeRNEADerivatives(model, data, qp, vp, ap)
             Dq, Dv, Dqdd = robot.inverse_dynamics_derivatives(q, v, a)
             _close("dtau/dq", Dq[B], dq, scale)
             _close("dtau/dv", Dv[B], dv + np.diag(robot.viscous[P]), scale)
             _close("dtau/dqdd", Dqdd[B], M, scale)
+            # at the torque that gives qdd = a in both (kinedyn's includes the joints' friction)
+            fq, fv, ftau = pin.computeABADerivatives(model, data, qp, vp, tau)
+            Fq, Fv, Ftau = robot.forward_dynamics_derivatives(q, v, robot.inverse_dynamics(q, v, a))
+            _close("dqdd/dq", Fq[B], fq, float(np.abs(fq).max()))
+            _close("dqdd/dtau", Ftau[B], ftau, float(np.abs(ftau).max()))
 
 
 @pytest.mark.skipif(not URDFS, reason="example-robot-data is not installed")
