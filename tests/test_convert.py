@@ -1,0 +1,253 @@
+"""Robots out and between formats: robot.to_urdf / to_mjcf, DH extraction, `kinedyn convert`.
+
+Every conversion is checked by what the result computes, against the source: frame poses (every
+frame of the source, by name), M and inverse dynamics at random states; MJCF against MuJoCo itself
+(mj_fullM, qfrc_bias = C qd + g, body poses); URDF also against Pinocchio reading the written file."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import kinedyn as kd
+from kinedyn._math import matmul, rot_axis, rpy_to_matrix, translation
+from kinedyn.description.dh import DHRow
+from kinedyn.description.export import default_visuals, quaternion_from_matrix, rpy_from_matrix
+from kinedyn.description.geometry import Cylinder
+from kinedyn.description.joint import Joint
+from kinedyn.description.link import Link
+from kinedyn.testing import random_robot
+from reference import PANDA, UR5, erd
+
+DH_BUILTINS = ["planar_2r", "elbow_3r", "cartesian_2p", "puma560", "stanford", "ur5"]
+
+
+def _unit(rng):
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def with_posts(robot, seed):
+    """``robot`` with a random post transform on every moving link (a frame off the joint axis, as a
+    standard DH link has), so the writers' handling of ``post`` is exercised on trees too."""
+    rng = np.random.default_rng(seed)
+    links = [
+        Link(l.name, l.parent, l.joint, l.placement, matmul(translation(*rng.uniform(-0.3, 0.3, 3)), rot_axis(_unit(rng), rng.uniform(-3, 3))), l.inertia)
+        if l.joint.is_moving else l
+        for l in robot.links
+    ]
+    return robot.replace(links=links, name=f"{robot.name}_posts")
+
+
+def same_robot(source, result, states=3, seed=0, armature_dropped=False, frames=None):
+    """Largest differences (FK over the source's frames, M, inverse dynamics) at random states."""
+    rng = np.random.default_rng(seed)
+    names = frames or source.frame_names
+    worst = {"fk": 0.0, "M": 0.0, "tau": 0.0}
+    for _ in range(states):
+        q, qd, qdd = (rng.uniform(-1.5, 1.5, source.n) for _ in range(3))
+        worst["fk"] = max(worst["fk"], float(np.abs(source.frame_poses(q, names) - result.frame_poses(q, names)).max()))
+        extra = np.diag(source.armature) if armature_dropped else 0.0
+        worst["M"] = max(worst["M"], float(np.abs(source.mass_matrix(q) - result.mass_matrix(q) - extra).max()))
+        tau_extra = source.armature * qdd if armature_dropped else 0.0
+        worst["tau"] = max(worst["tau"], float(np.abs(source.inverse_dynamics(q, qd, qdd) - result.inverse_dynamics(q, qd, qdd) - tau_extra).max()))
+    return worst
+
+
+def from_urdf_text(source, text):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)  # the source's own (Corke's PUMA data)
+        return kd.Robot.from_urdf(text, gravity=source.gravity, tool=source.tool)
+
+
+# ---------------------------------------------------------------------------------------- rotations
+@pytest.mark.parametrize("pitch", [math.pi / 2, -math.pi / 2, math.pi / 2 - 1e-9, -math.pi / 2 + 3e-13, 0.3, math.pi / 2 - 1e-5])
+def test_rpy_is_exact_at_and_near_gimbal_lock(pitch):
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        R = np.asarray(rpy_to_matrix(rng.uniform(-3, 3), pitch, rng.uniform(-3, 3)))[:3, :3]
+        back = np.asarray(rpy_to_matrix(*rpy_from_matrix(R)))[:3, :3]
+        assert np.abs(back - R).max() < 4e-16 * 8
+
+
+def test_rpy_of_an_exact_gimbal_lock_matrix():
+    # pitch exactly +-90 degrees, written with exact zeros: only yaw -+ roll is defined; any split must rebuild R
+    for sign in (1.0, -1.0):
+        for angle in (0.3, -2.5, math.pi):
+            c, s = math.cos(angle), math.sin(angle)
+            R = np.array([[0.0, -s, sign * c], [0.0, c, sign * s], [-sign, 0.0, 0.0]])
+            back = np.asarray(rpy_to_matrix(*rpy_from_matrix(R)))[:3, :3]
+            assert np.abs(back - R).max() < 1e-15
+
+
+def test_quaternion_is_mujocos_w_x_y_z():
+    rng = np.random.default_rng(2)
+    for angle in [0.0, 1e-9, 1.0, math.pi - 1e-9, math.pi]:
+        axis = _unit(rng)
+        w, x, y, z = quaternion_from_matrix(np.asarray(rot_axis(axis, angle))[:3, :3])
+        assert w >= 0
+        # q = (cos a/2, sin a/2 axis), up to the sign fixed by w >= 0
+        expected = np.array([math.cos(angle / 2), *(math.sin(angle / 2) * axis)])
+        assert np.abs(np.array([w, x, y, z]) - expected).max() < 1e-12 or np.abs(np.array([w, x, y, z]) + expected).max() < 1e-12
+
+
+# ---------------------------------------------------------------------------------------- URDF
+@pytest.mark.parametrize("name", DH_BUILTINS)
+def test_dh_builtins_to_urdf_keep_kinematics_and_dynamics(name):
+    source = kd.robots.get(name)
+    text = source.to_urdf()
+    back = from_urdf_text(source, text)
+    err = same_robot(source, back, armature_dropped=True)
+    assert err["fk"] < 1e-12 and err["M"] < 1e-12 and err["tau"] < 1e-10, err
+    # URDF has no rotor inertia: the writer keeps it in Drake's <transmission> extension
+    if np.any(source.armature):
+        assert "drake:rotor_inertia" in text and 'xmlns:drake="http://drake.mit.edu"' in text
+    # geometry where the DH robot has none: cylinders on the links
+    assert back.visuals and all(v.frame in back.frame_names for v in back.visuals)
+
+
+@pytest.mark.parametrize("robot", [random_robot(3), with_posts(random_robot(4, branching=True, fixed=2), 4)], ids=lambda r: r.name)
+def test_random_trees_with_offsets_and_posts_to_urdf(robot):
+    assert any(float(j.offset) for j in robot.joints)  # the folding of offsets is exercised
+    back = from_urdf_text(robot, robot.to_urdf())
+    err = same_robot(robot, back, armature_dropped=True)
+    assert err["fk"] < 1e-12 and err["M"] < 1e-12 and err["tau"] < 1e-10, err
+    assert [j.name for j in back.joints] == robot.joint_names
+    np.testing.assert_array_equal(back.viscous, robot.viscous)
+    np.testing.assert_array_equal(back.coulomb, robot.coulomb)
+
+
+def test_urdf_written_is_what_pinocchio_reads():
+    pin = pytest.importorskip("pinocchio")
+    robot = with_posts(random_robot(5, branching=True), 5)
+    model = pin.buildModelFromXML(robot.to_urdf())
+    data = model.createData()
+    rng = np.random.default_rng(5)
+    # Pinocchio orders joints depth-first as kinedyn does; map by name to be safe
+    order = [model.names[i] for i in range(1, model.njoints)]
+    index = [robot.joint_names.index(n) for n in order]
+    for _ in range(3):
+        q = rng.uniform(-1, 1, robot.n)
+        # a continuous joint's configuration in Pinocchio is (cos q, sin q)
+        q_pin = np.concatenate([[q[k]] if model.joints[i + 1].nq == 1 else [math.cos(q[k]), math.sin(q[k])] for i, k in enumerate(index)])
+        M = pin.crba(model, data, q_pin)
+        M = np.triu(M) + np.triu(M, 1).T
+        ours = robot.mass_matrix(q)[np.ix_(index, index)] - np.diag(robot.armature[index])
+        assert np.abs(M - ours).max() < 1e-12
+
+
+def test_urdf_writes_limits_continuous_dynamics_and_file(tmp_path):
+    robot = kd.robots.get("ur5")
+    joints = robot.joints
+    path = tmp_path / "arm.urdf"
+    text = robot.to_urdf(path)
+    assert path.read_text() == text
+    back = kd.load(path, tool=robot.tool)
+    np.testing.assert_array_equal(back.lower_limits, robot.lower_limits)
+    np.testing.assert_array_equal(back.upper_limits, robot.upper_limits)
+    np.testing.assert_array_equal(back.effort_limits, robot.effort_limits)
+    unlimited = kd.Robot.from_dh([(0, 0.1, 0.2, 0)])
+    assert 'type="continuous"' in unlimited.to_urdf()
+    assert all(j.kind in ("revolute", "prismatic") for j in joints)
+
+
+def test_urdf_refuses_spherical_and_symbolic_robots():
+    ball = Link("ball", None, Joint("shoulder", "spherical"), np.eye(4), np.eye(4), kd.Inertia(1.0, inertia=np.eye(3)))
+    arm = Link("arm", "ball", Joint("elbow"), np.eye(4), np.eye(4), kd.Inertia(1.0, inertia=np.eye(3)))
+    robot = kd.Robot([ball, arm])
+    with pytest.raises(ValueError, match="joint 'shoulder'.*spherical.*URDF has no spherical"):
+        robot.to_urdf()
+    l1 = sp.Symbol("l1")
+    symbolic = kd.Robot.from_dh([(0, 0, l1, 0), (0, 0, 1.0, 0)])
+    with pytest.raises(ValueError, match=r"symbolic parameters \['l1'\].*robot.subs"):
+        symbolic.to_urdf()
+    with pytest.raises(ValueError, match=r"symbolic parameters \['l1'\]"):
+        symbolic.to_mjcf()
+
+
+def test_urdf_warns_when_coulomb_friction_is_direction_dependent():
+    robot = kd.Robot.from_dh([DHRow(a=1.0, coulomb=(0.3, 0.1), inertia=kd.Inertia(1.0, (0.5, 0, 0)))])
+    with pytest.warns(UserWarning, match="joint 'q1' has 0.3 for qd > 0 and 0.1 for qd < 0; writing 0.3"):
+        text = robot.to_urdf()
+    assert 'friction="0.3"' in text
+
+
+def test_massless_rotor_inertia_survives_a_fixed_child():
+    # Corke's PUMA link 1 has no mass but a rotational inertia; merging a massless fixed frame into it
+    # (the URDF writer's link frame, a tool flange) must keep that inertia
+    rotor = kd.Inertia(0.0, inertia=np.diag([0.0, 0.0, 0.35]))
+    merged = rotor + kd.Inertia(0.0)
+    np.testing.assert_array_equal(np.array(merged.inertia), np.diag([0.0, 0.0, 0.35]))
+
+
+def test_default_visuals_follow_the_dh_offsets():
+    robot = kd.robots.get("puma560")
+    shapes = default_visuals(robot)
+    links = [v for v in shapes if v.rgba[2] < 0.78]  # grey link cylinders (joints are blue)
+    total = sum(v.shape.length for v in links)
+    # standard DH: each link runs d along the joint axis, then a across; the tool frame is at the last link
+    expected = sum(abs(float(r.d)) + abs(float(r.a)) for r in robot.dh)
+    assert total == pytest.approx(expected, rel=1e-12)
+    assert all(isinstance(v.shape, Cylinder) for v in shapes)
+    assert len([v for v in shapes if v not in links]) == robot.n  # one joint cylinder per joint
+
+
+# ---------------------------------------------------------------------------------------- MJCF
+def repaired(name):
+    """A built-in whose published inertias no rigid body has (Stanford's link 5), projected onto physical ones."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+        return kd.robots.get(name).replace(inertia="repair")
+
+
+def mujoco_state(model_text, q, qd):
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_string(model_text)
+    d = mujoco.MjData(m)
+    d.qpos[:], d.qvel[:] = q, qd
+    mujoco.mj_forward(m, d)
+    M = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, M)
+    return mujoco, m, d, M
+
+
+@pytest.mark.parametrize(
+    "robot",
+    [kd.robots.get("elbow_3r"), repaired("stanford"), kd.robots.get("planar_2r"), random_robot(6, branching=True),
+     with_posts(random_robot(7, branching=True, fixed=2), 7)],
+    ids=lambda r: r.name,
+)
+def test_mjcf_agrees_with_mujoco(robot, tmp_path):
+    path = tmp_path / "robot.xml"
+    text = robot.to_mjcf(path)
+    assert path.read_text() == text
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        q, qd = rng.uniform(-1.5, 1.5, robot.n), rng.uniform(-1.5, 1.5, robot.n)
+        mujoco, m, d, M = mujoco_state(path.read_text(), q, qd)
+        assert [m.joint(i).name for i in range(m.njnt)] == robot.joint_names
+        # a thin rod's zero principal moment is written as MIN_MOMENT (1e-12 kg m^2): planar_2r's M moves by 2e-12
+        assert np.abs(M - robot.mass_matrix(q)).max() < 1e-9
+        assert np.abs(d.qfrc_bias - (robot.coriolis_matrix(q, qd) @ qd + robot.gravity_torque(q))).max() < 1e-9
+        names = [l.name for l in robot.links] + [f.name for f in robot.frames]
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
+        poses = robot.frame_poses(q, names)
+        assert np.abs(d.xpos[ids] - poses[:, :3, 3]).max() < 1e-9
+        assert np.abs(d.xmat[ids].reshape(-1, 3, 3) - poses[:, :3, :3]).max() < 1e-9
+    # drive data: armature r^2 J_m, damping, frictionloss
+    np.testing.assert_allclose(m.dof_armature, robot.armature, rtol=1e-15)
+    np.testing.assert_allclose(m.dof_damping, robot.viscous, rtol=1e-15)
+    np.testing.assert_allclose(m.dof_frictionloss, robot.coulomb, rtol=1e-15)
+    np.testing.assert_allclose(m.opt.gravity, robot.gravity)
+
+
+def test_mjcf_refuses_what_mujoco_cannot_hold():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+        puma = kd.robots.get("puma560")
+    with pytest.raises(ValueError, match="link 'link1' has rotational inertia without mass"):
+        puma.to_mjcf()
