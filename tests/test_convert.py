@@ -15,7 +15,7 @@ import sympy as sp
 
 import kinedyn as kd
 from kinedyn._math import matmul, rot_axis, rpy_to_matrix, translation
-from kinedyn.description.dh import DHRow
+from kinedyn.description.dh import DHRow, dh_from_robot
 from kinedyn.description.export import default_visuals, quaternion_from_matrix, rpy_from_matrix
 from kinedyn.description.geometry import Cylinder
 from kinedyn.description.joint import Joint
@@ -251,3 +251,80 @@ def test_mjcf_refuses_what_mujoco_cannot_hold():
         puma = kd.robots.get("puma560")
     with pytest.raises(ValueError, match="link 'link1' has rotational inertia without mass"):
         puma.to_mjcf()
+
+
+# ---------------------------------------------------------------------------------------- URDF -> DH
+def _erd_robot(parts):
+    return kd.Robot.from_urdf(erd(*parts))
+
+
+def dh_sources():
+    yield from (kd.robots.get(n) for n in ["planar_2r", "elbow_3r", "cartesian_2p", "puma560", "stanford", "ur5"])
+    yield from (random_robot(seed, n=6, prismatic=0.3) for seed in range(3))
+
+
+def check_dh_extraction(source, convention, states=3):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
+        found = dh_from_robot(source, convention)
+    dh = found.robot
+    assert dh.dh_convention == convention and len(found.rows) == source.n
+    rng = np.random.default_rng(11)
+    for _ in range(states):
+        q, qd, qdd = (rng.uniform(-2.5, 2.5, source.n) for _ in range(3))
+        # every frame of the source, through the DH frame it hangs from
+        names = [n for n in source.frame_names if n != source.base]
+        ours = source.frame_poses(q, names)
+        owners = dh.frame_poses(q, [found.source_frames[n][0] for n in names])
+        theirs = owners @ np.array([found.source_frames[n][1] for n in names])
+        assert np.abs(ours - theirs).max() < 1e-12
+        assert np.abs(source.pose(q) - dh.pose(q, "tool")).max() < 1e-12
+        assert np.abs(source.mass_matrix(q) - dh.mass_matrix(q)).max() < 1e-11
+        assert np.abs(source.inverse_dynamics(q, qd, qdd) - dh.inverse_dynamics(q, qd, qdd)).max() < 1e-10
+    return found
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_dh_from_builtins_and_random_chains(convention):
+    for source in dh_sources():
+        check_dh_extraction(source, convention)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_dh_from_ur5_and_panda_urdfs(convention):
+    ur5 = _erd_robot(UR5)
+    check_dh_extraction(ur5, convention)
+    panda = _erd_robot(PANDA)
+    with pytest.raises(ValueError, match="joint 'panda_finger_joint2' branches off link 'panda_link7'.*joint 'panda_finger_joint1'"):
+        dh_from_robot(panda, convention)
+    found = check_dh_extraction(panda.lock_joints(["panda_finger_joint1", "panda_finger_joint2"]), convention)
+    if convention == "modified":
+        # the Panda is published in Craig's DH (Franka's documentation): a = 0.0825 at joints 4 and 5,
+        # d = 0.333, 0.316, 0.384 on joints 1, 3, 5; alpha = +-90 degrees throughout but alpha_0
+        rows = found.rows
+        assert [round(abs(r.a), 6) for r in rows] == [0.0, 0.0, 0.0, 0.0825, 0.0825, 0.0, 0.088]
+        assert [round(abs(r.alpha), 9) for r in rows] == [0.0] + [round(math.pi / 2, 9)] * 6
+
+
+def test_dh_from_chains_with_parallel_and_intersecting_axes():
+    # parallel axes (planar_3r, elbow_3r's joints 2 and 3), intersecting (puma's wrist), collinear
+    # (a prismatic joint along the revolute axis before it)
+    collinear = kd.Robot.from_dh([(0.3, 0.2, 0.0, 0.0), (0.0, 0.4, 0.0, 0.0, "prismatic"), (0.2, 0.0, 0.5, 0.7)], name="collinear")
+    for source in (kd.robots.get("planar_3r"), collinear):
+        for convention in ("standard", "modified"):
+            found = check_dh_extraction(source, convention)
+            if source.name == "planar_3r":  # parallel axes: the common normal through the previous origin, d = 0
+                assert [r.d for r in found.rows] == [0.0, 0.0, 0.0]
+                lengths = [float(r.a) for r in source.dh]  # Craig's rows hold a_{i-1}: the last length is in the tool transform
+                expected = lengths if convention == "standard" else [0.0] + lengths[:-1]
+                assert [abs(r.a) for r in found.rows] == pytest.approx(expected, abs=1e-15)
+
+
+def test_dh_from_robot_names_what_stops_it():
+    with pytest.raises(ValueError, match="joint 'j5' branches off link 'link2'.*joint 'j4'"):
+        dh_from_robot(random_robot(0, branching=True))
+    ball = Link("ball", None, Joint("shoulder", "spherical"), np.eye(4), np.eye(4), kd.Inertia(1.0, inertia=np.eye(3)))
+    with pytest.raises(ValueError, match="joint 'shoulder' is spherical"):
+        dh_from_robot(kd.Robot([ball]))
+    with pytest.raises(ValueError, match="convention must be 'standard' or 'modified'"):
+        dh_from_robot(kd.robots.get("planar_2r"), "craig")
