@@ -310,6 +310,12 @@ def test_dh_from_chains_with_parallel_and_intersecting_axes():
     # parallel axes (planar_3r, elbow_3r's joints 2 and 3), intersecting (puma's wrist), collinear
     # (a prismatic joint along the revolute axis before it)
     collinear = kd.Robot.from_dh([(0.3, 0.2, 0.0, 0.0), (0.0, 0.4, 0.0, 0.0, "prismatic"), (0.2, 0.0, 0.5, 0.7)], name="collinear")
+    stacked = kd.Robot([  # parallel z axes whose joint origins climb: the d = 0 choice puts the heights into d_1 only
+        Link(f"l{i}", f"l{i - 1}" if i else None, Joint(f"j{i}"), translation(0.3, 0.1 * i, 0.2), np.eye(4), kd.Inertia(1.0, (0.1, 0, 0), np.eye(3) * 0.01))
+        for i in range(3)
+    ], name="stacked")
+    found = check_dh_extraction(stacked, "standard")
+    assert found.rows[1].d == 0.0  # (row 3 climbs to the tool frame, by the tool origin choice)
     for source in (kd.robots.get("planar_3r"), collinear):
         for convention in ("standard", "modified"):
             found = check_dh_extraction(source, convention)
