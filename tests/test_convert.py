@@ -334,3 +334,85 @@ def test_dh_from_robot_names_what_stops_it():
         dh_from_robot(kd.Robot([ball]))
     with pytest.raises(ValueError, match="convention must be 'standard' or 'modified'"):
         dh_from_robot(kd.robots.get("planar_2r"), "craig")
+
+
+# ---------------------------------------------------------------------------------------- kinedyn convert
+def convert_cli(capsys, *argv):
+    from kinedyn.cli import main
+
+    code = main(["convert", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _read_back_errors(out: str):
+    """The three maxima the CLI printed (FK, M, tau)."""
+    import re
+
+    return [float(x) for x in re.findall(r"max \|\w+ error\| ([0-9.e+-]+)", out)]
+
+
+@pytest.mark.parametrize("name", ["elbow_3r", "puma560", "stanford"])
+def test_cli_converts_dh_builtins_to_urdf_mjcf_yaml(capsys, tmp_path, name):
+    for out, extra in (("r.urdf", []), ("r.xml", ["--inertia", "repair"]), ("r.yaml", []), ("r.toml", ["--to", "dh", "--convention", "modified"])):
+        if name == "puma560" and out == "r.xml":  # a massless link with rotor inertia: MuJoCo cannot hold it
+            code, _, err = convert_cli(capsys, name, tmp_path / out, *extra)
+            assert code == 1 and "link 'link1' has rotational inertia without mass" in err
+            continue
+        code, text, err = convert_cli(capsys, name, tmp_path / out, *extra)
+        assert code == 0, err
+        assert f"wrote {tmp_path / out}" in text and "checked by reading it back" in text
+        errors = _read_back_errors(text)
+        assert len(errors) == 3 and max(errors) < 1e-9, text
+    # the robot file, loaded, is the robot (independently of the CLI's own check)
+    source = kd.robots.get(name)
+    err = same_robot(source, kd.load(tmp_path / "r.yaml"))
+    assert max(err.values()) < 1e-12
+
+
+def test_cli_round_trips_example_robot_data_through_yaml_and_urdf(capsys, tmp_path):
+    # UR5 and the Panda (fixed joints, a branch: the two fingers) -> YAML -> URDF, each step checked
+    for parts in (UR5, PANDA):
+        path = erd(*parts)
+        code, text, err = convert_cli(capsys, path, tmp_path / "r.yaml")
+        assert code == 0 and max(_read_back_errors(text)) < 1e-9, err + text
+        code, text, err = convert_cli(capsys, tmp_path / "r.yaml", tmp_path / "r.urdf")
+        assert code == 0 and max(_read_back_errors(text)) < 1e-9, err + text
+        source, result = kd.load(path), kd.load(tmp_path / "r.urdf")
+        assert result.joint_names == source.joint_names
+        err = same_robot(source, result, frames=[n for n in source.frame_names if n != source.base])
+        assert max(err.values()) < 1e-12, err
+        assert len(result.visuals) == len(source.visuals)  # the meshes travel (absolute paths)
+
+
+def test_cli_convert_to_dh_needs_a_serial_chain(capsys, tmp_path):
+    panda = erd(*PANDA)
+    code, _, err = convert_cli(capsys, panda, tmp_path / "p.yaml", "--to", "dh")
+    assert code == 1 and "joint 'panda_finger_joint2' branches off link 'panda_link7'" in err
+    code, text, err = convert_cli(capsys, panda, tmp_path / "p.yaml", "--to", "dh", "--lock", "panda_finger_joint1", "--lock", "panda_finger_joint2")
+    assert code == 0 and "(DH standard, 7 joints)" in text and max(_read_back_errors(text)) < 1e-9, err
+    dh = kd.load(tmp_path / "p.yaml")
+    assert dh.dh is not None and len(dh.dh) == 7
+
+
+def test_cli_convert_says_what_is_wrong(capsys, tmp_path):
+    code, _, err = convert_cli(capsys, "planar_2r", tmp_path / "r.txt")
+    assert code == 1 and "cannot tell the format of" in err and "--to" in err
+    code, _, err = convert_cli(capsys, "planar_2r", tmp_path / "r.urdf", "--to", "dh")
+    assert code == 1 and "must end in .yaml, .yml or .toml" in err
+    (tmp_path / "a.urdf").write_text(kd.robots.get("planar_2r").to_urdf())
+    code, _, err = convert_cli(capsys, tmp_path / "a.urdf", tmp_path / "a.urdf")
+    assert code == 1 and "OUT:" in err and "is the robot file this command reads" in err
+
+
+def test_convert_check_catches_a_wrong_writer(capsys, tmp_path, monkeypatch):
+    # the check is real: a writer that drops the joint offsets is caught and the CLI fails
+    from kinedyn.description import export
+
+    source = tmp_path / "random.yaml"
+    random_robot(3).save(source)  # joint offsets in (-0.5, 0.5)
+    code, text, err = convert_cli(capsys, source, tmp_path / "good.urdf")
+    assert code == 0, err
+    monkeypatch.setattr(export, "_motion", lambda joint, x: np.eye(4))
+    code, text, err = convert_cli(capsys, source, tmp_path / "p.urdf")
+    assert code == 1 and f"differs from {source}" in err
