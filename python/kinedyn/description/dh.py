@@ -228,7 +228,7 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
             )
     n = len(bodies)
     # world poses of the body frames at q = 0 (each joint at its offset): W_B_i = W_B_parent P_i M(offset_i)
-    world_body = []
+    world_body: list = []
     for b in bodies:
         axis = [float(a) for a in b.joint.axis]
         off = float(b.joint.offset)
@@ -265,7 +265,7 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
         x = _perpendicular(world_tool[:3, 3] - prev[:3, 3], u[n - 1], prev[:3, 0])
         frames.append(_frame(world_tool[:3, 3], x, u[n - 1]))
     else:
-        frame_of = [None] * (n + 1)
+        frame_of: list = [None] * (n + 1)
         for i in range(n):  # frame i+1 on axis i+1: x along the common normal to axis i+2
             if i == 0:
                 start = p[0]

@@ -175,8 +175,8 @@ def default_visuals(robot: "Robot", radius: Optional[float] = None) -> List[Visu
     children: Dict[str, list] = {}
     for link in robot.links:
         children.setdefault(link.parent or robot.base, []).append((_np(link.placement), link.joint))
-    for frame in robot.frames:
-        children.setdefault(frame.link or robot.base, []).append((_np(frame.placement), None))
+    for extra in robot.frames:
+        children.setdefault(extra.link or robot.base, []).append((_np(extra.placement), None))
 
     def polyline(frame: str, start: np.ndarray, end: np.ndarray, axis: Optional[np.ndarray], axis_first: bool) -> None:
         d = end - start
@@ -281,7 +281,7 @@ def _urdf_shape(parent: ET.Element, shape) -> None:
         attributes = {"filename": _mesh_file(shape)}
         if tuple(shape.scale) != (1.0, 1.0, 1.0):
             attributes["scale"] = _fs(shape.scale)
-        ET.SubElement(g, "mesh", **attributes)
+        ET.SubElement(g, "mesh", attributes)
 
 
 def _urdf_inertial(parent: ET.Element, inertia) -> None:
@@ -374,7 +374,7 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
                 if math.isfinite(v):
                     limit[key] = _f(v)
             if limit:
-                ET.SubElement(el, "limit", **limit)
+                ET.SubElement(el, "limit", limit)
             viscous, coulomb = float(j.viscous), _coulomb(j, "URDF")
             if viscous or coulomb:
                 ET.SubElement(el, "dynamics", damping=_f(viscous), friction=_f(coulomb))
@@ -497,7 +497,7 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         if coulomb:
             drive["frictionloss"] = _f(coulomb)
         if j.kind in ("revolute", "prismatic"):
-            el = ET.SubElement(body, "joint", name=j.name, type="hinge" if j.kind == "revolute" else "slide", axis=_fs(axis), **drive)
+            el = ET.SubElement(body, "joint", {"name": j.name, "type": "hinge" if j.kind == "revolute" else "slide", "axis": _fs(axis), **drive})
             if np.any(anchor) and j.kind == "revolute":
                 el.set("pos", _fs(anchor))
             if math.isfinite(j.lower) and math.isfinite(j.upper):
@@ -512,7 +512,7 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
                 )
             ET.SubElement(body, "freejoint", name=j.name)
         elif j.kind == "spherical":
-            el = ET.SubElement(body, "joint", name=j.name, type="ball", **drive)
+            el = ET.SubElement(body, "joint", {"name": j.name, "type": "ball", **drive})
             if np.any(anchor):
                 el.set("pos", _fs(anchor))
         else:  # planar
@@ -520,7 +520,7 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
                 raise ValueError(f"to_mjcf: planar joint '{j.name}': MJCF has no planar joint; kinedyn writes one about z "
                                  "(two slides and a hinge) only for an axis (0, 0, 1) and no post transform")
             for suffix, kind, ax in (("x", "slide", "1 0 0"), ("y", "slide", "0 1 0"), ("theta", "hinge", "0 0 1")):
-                ET.SubElement(body, "joint", name=f"{j.name}_{suffix}", type=kind, axis=ax, **drive)
+                ET.SubElement(body, "joint", {"name": f"{j.name}_{suffix}", "type": kind, "axis": ax, **drive})
     for frame in robot.frames:
         body = ET.SubElement(bodies[frame.link or robot.base], "body", name=frame.name)
         bodies[frame.name] = body
