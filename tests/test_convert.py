@@ -416,3 +416,39 @@ def test_convert_check_catches_a_wrong_writer(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(export, "_motion", lambda joint, x: np.eye(4))
     code, text, err = convert_cli(capsys, source, tmp_path / "p.urdf")
     assert code == 1 and f"differs from {source}" in err
+
+
+# ---------------------------------------------------------------------------------------- multi-DOF joints
+def legged():
+    box = kd.Inertia.box(2.0, (0.4, 0.2, 0.1))
+    rod = kd.Inertia.cylinder(0.5, 0.03, 0.3, com=(0, 0, -0.15))
+    return kd.Robot([
+        Link("trunk", None, Joint("root_joint", "floating"), np.eye(4), np.eye(4), box),
+        Link("hip", "trunk", Joint("hip_ball", "spherical"), translation(0.2, 0.1, 0), np.eye(4), rod),
+        Link("knee", "hip", Joint("knee", axis=(0, 1, 0), lower=-2, upper=0.1), translation(0, 0, -0.3), np.eye(4), rod),
+        Link("slider", "trunk", Joint("rail", "planar"), translation(-0.2, 0, 0), np.eye(4), rod),
+    ], name="legged")
+
+
+def test_floating_spherical_and_planar_joints_in_urdf_and_mjcf():
+    import xml.etree.ElementTree as ET
+
+    robot = legged()
+    with pytest.raises(ValueError, match="joint 'hip_ball'.*spherical"):
+        robot.to_urdf()
+    no_ball = robot.replace(links=[l for l in robot.links if l.name not in ("hip", "knee")], tool="slider")
+    # the free-flying trunk becomes the URDF root (read back with floating_base=True) ...
+    root = ET.fromstring(no_ball.to_urdf())
+    assert [l.get("name") for l in root.findall("link")][0] == "trunk"
+    assert [(j.get("name"), j.get("type")) for j in root.findall("joint")] == [("rail", "planar")]
+    # ... or stays a URDF floating joint below the base
+    root = ET.fromstring(no_ball.to_urdf(floating_base_as_root=False))
+    assert [(j.get("name"), j.get("type")) for j in root.findall("joint")] == [("root_joint", "floating"), ("rail", "planar")]
+    # MJCF holds them all: free (nq 7, nv 6), ball (4, 3), hinge, planar as slide x, slide y, hinge
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_string(robot.to_mjcf())
+    kinds = [int(m.jnt_type[i]) for i in range(m.njnt)]
+    J = mujoco.mjtJoint
+    assert kinds == [J.mjJNT_FREE, J.mjJNT_BALL, J.mjJNT_HINGE, J.mjJNT_SLIDE, J.mjJNT_SLIDE, J.mjJNT_HINGE]
+    assert (m.nq, m.nv) == (7 + 4 + 1 + 3, 6 + 3 + 1 + 3)
+    np.testing.assert_allclose(m.body("trunk").mass, 2.0)

@@ -297,7 +297,22 @@ def _urdf_inertial(parent: ET.Element, inertia) -> None:
     ET.SubElement(el, "inertia", ixx=_f(I[0, 0]), ixy=_f(I[0, 1]), ixz=_f(I[0, 2]), iyy=_f(I[1, 1]), iyz=_f(I[1, 2]), izz=_f(I[2, 2]))
 
 
-def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool = True) -> str:
+def floating_trunk(robot: "Robot"):
+    """The link a free-flyer carries when it is the robot's only link on the base, with identity
+    placement and post and nothing else on the base (the shape ``from_urdf(path, floating_base=True)``
+    gives a URDF's root), else None."""
+    on_base = [l for l in robot.links if l.parent is None]
+    if len(on_base) != 1 or on_base[0].joint.kind != "floating":
+        return None
+    link = on_base[0]
+    if not (_is_identity(_np(link.placement)) and _is_identity(_np(link.post))):
+        return None
+    if any(f.link is None for f in robot.frames) or any(v.frame == robot.base for v in (*robot.visuals, *robot.collisions)):
+        return None
+    return link
+
+
+def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
     """The robot as URDF text (written to ``path`` when given).
 
     Every link becomes a ``<link>`` (a link with a ``post`` transform becomes two, see the module
@@ -309,6 +324,11 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
     gear ratio and rotor inertia go into Drake's ``<transmission>`` extension (``drake:gear_ratio``,
     ``drake:rotor_inertia``) since URDF has no rotor inertia. Gravity is not part of URDF.
     ``geometry``: give a robot without visuals the cylinders of :func:`default_visuals`.
+    ``floating_base_as_root``: a robot whose base carries only a free-flyer to one link (what
+    ``Robot.from_urdf(path, floating_base=True)`` makes of a legged robot's URDF, see
+    :func:`floating_trunk`) is written with that link as the URDF root and no floating joint, the
+    usual form of such files, to be read back with ``floating_base=True``; otherwise (or with False)
+    the base is the root and the free-flyer a URDF ``floating`` joint.
     A symbolic robot is refused: substitute numbers first (``robot.subs``)."""
     _require_numeric(robot, "to_urdf: URDF")
     for link in robot.links:
@@ -324,8 +344,17 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
     taken = {robot.base} | {l.name for l in robot.links} | {f.name for f in robot.frames}
     link_elements: Dict[str, ET.Element] = {}
     # where each named frame's geometry goes: (URDF link, pose of the named frame in that link)
-    geometry_home: Dict[str, Tuple[str, np.ndarray]] = {robot.base: (robot.base, np.eye(4))}
-    link_elements[robot.base] = ET.SubElement(root, "link", name=robot.base)
+    geometry_home: Dict[str, Tuple[str, np.ndarray]] = {}
+    trunk = floating_trunk(robot) if floating_base_as_root else None
+    links = list(robot.links)
+    if trunk is None:
+        geometry_home[robot.base] = (robot.base, np.eye(4))
+        link_elements[robot.base] = ET.SubElement(root, "link", name=robot.base)
+    else:  # the trunk is the URDF root; its free-flyer is what from_urdf(..., floating_base=True) adds back
+        links.remove(trunk)
+        link_elements[trunk.name] = ET.SubElement(root, "link", name=trunk.name)
+        _urdf_inertial(link_elements[trunk.name], trunk.inertia)
+        geometry_home[trunk.name] = (trunk.name, np.eye(4))
     joints: List[ET.Element] = []
     transmissions: List[ET.Element] = []
     joint_names = {l.joint.name for l in robot.links}
@@ -343,7 +372,7 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         joints.append(el)
         return el
 
-    for link in robot.links:
+    for link in links:
         j = link.joint
         parent = link.parent or robot.base
         post = _np(link.post)
