@@ -801,7 +801,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--lock", action="append", default=[], metavar="JOINT",
                    help="fix a joint at 0 before converting (repeatable; e.g. a gripper's fingers, for --to dh)")
     p.add_argument("--states", type=int, default=5, help="random states of the check (default 5)")
-    p.add_argument("--no-check", action="store_true", help="write only: skip reading the result back")
+    p.add_argument("--no-check", action="store_true", help="skip the check (reading the result back)")
     p.set_defaults(func=cmd_convert)
 
     for module, function in _command_modules():

@@ -56,6 +56,7 @@ class Conversion:
     path: str
     format: str
     joints: int
+    robot: str = ""  # the source's name
     checked: bool = False
     states: int = 0
     max_frame_error: float = 0.0  # largest entry of a 4x4 pose difference, over the compared frames
@@ -69,7 +70,7 @@ class Conversion:
         return max(self.max_frame_error, self.max_mass_matrix_error, self.max_torque_error)
 
     def summary(self) -> str:
-        lines = [f"wrote {self.path} ({self.format}, {self.joints} joints)"]
+        lines = [f"wrote {self.path} ({self.format}, {self.joints} joints){f' from robot {self.robot!r}' if self.robot else ''}"]
         if self.checked:
             lines.append(
                 f"checked by reading it back: {len(self.frames_compared)} frames, M and inverse dynamics at {self.states} random states: "
@@ -117,7 +118,7 @@ def convert(robot: "Robot", path: "PathLike", to: Optional[str] = None, *, conve
             notes.append(f"in the DH file, {', '.join(clashing)} are the DH table's own frames (the source's frames of those names are not kept)")
     else:
         robot.save(path)
-    result = Conversion(path, "DH " + convention if fmt == "dh" else fmt, source.n, notes=notes)
+    result = Conversion(path, "DH " + convention if fmt == "dh" else fmt, source.n, source.name, notes=notes)
     if not check:
         return result
     if source.is_symbolic:
