@@ -497,6 +497,22 @@ class Robot:
 
         save(self, path)
 
+    def to_urdf(self, path: Optional[PathLike] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
+        """The robot as URDF text, written to ``path`` when given (joint offsets folded into the joint
+        origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
+        robots"). ``geometry``: cylinders along the links of a robot without visuals;
+        ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
+        from .description.export import to_urdf
+
+        return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
+
+    def to_mjcf(self, path: Optional[PathLike] = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
+        """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
+        :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
+        from .description.export import to_mjcf
+
+        return to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
+
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
