@@ -267,3 +267,25 @@ def test_locking_the_floating_joint_gives_the_fixed_base_robot_at_that_pose():
     spherical = robot.joint_names[[j.kind for j in robot.joints].index("spherical")]
     with pytest.raises(ValueError, match=f"joint '{spherical}'.* not unit"):
         robot.lock_joints({spherical: [0.0, 0.0, 0.0, 2.0]})
+
+
+def test_floating_robots_convert_to_urdf_and_back():
+    """robot.to_urdf of a floating robot (the trunk becomes the URDF root) read back with
+    floating_base=True, and a planar joint written as URDF's planar type: the same dynamics."""
+    root = example_robot_data_dir()
+    if root is None:
+        pytest.skip("example-robot-data is not installed")
+    solo = kd.Robot.from_urdf(os.path.join(root, "solo_description", "robots", "solo12.urdf"), floating_base=True)
+    planar = random_robot(4, n=4, planar=1.0, friction=False)
+    assert "planar" in {j.kind for j in planar.joints}
+    for robot, floating in ((solo, True), (planar, False)):
+        back = kd.Robot.from_urdf(robot.to_urdf(), floating_base=floating)
+        assert back.joint_names == robot.joint_names and (back.nq, back.nv) == (robot.nq, robot.nv)
+        pair = PinPair(robot, pinocchio_model(robot))
+        rng = np.random.default_rng(2)
+        for _ in range(2):
+            q, v, a = pair.random_state(rng)
+            _close("M", back.mass_matrix(q), robot.mass_matrix(q), 10.0)
+            _close("tau", back.inverse_dynamics(q, v, a), robot.inverse_dynamics(q, v, a), 10.0)
+            for name in robot.body_names:
+                _close(f"pose of {name}", back.pose(q, name), robot.pose(q, name))

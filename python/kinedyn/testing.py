@@ -68,7 +68,8 @@ def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: 
     for i in range(n + fixed):
         moving = i < n
         parent = None if i == 0 else (names[int(rng.integers(0, i))] if branching else names[-1])
-        draw = rng.uniform()
+        # (drawn only when asked for, so that the robots of a seed stay those of earlier versions)
+        draw = rng.uniform() if spherical or planar else 1.0
         multi = "floating" if floating and i == 0 else ("spherical" if draw < spherical else "planar" if draw < spherical + planar else None)
         if moving and multi is not None and i > 0 or (moving and multi == "floating"):
             joint = Joint(f"j{i + 1}", multi, (0.0, 0.0, 1.0))
