@@ -339,3 +339,30 @@ def test_length_and_non_finite_numbers_are_refused():
         ROBOT.normalize(zero)
     with pytest.raises(ValueError, match=r"size must be a whole number"):
         ROBOT.random_configuration(0, size=-1)
+
+
+# ---------------------------------------------------------------- the Rust core's shared vectors
+def test_python_reproduces_the_vectors_shared_with_the_rust_core():
+    """crates/kinedyn-core/src/lie.rs tests its SO(3)/SE(3)/SE(2) functions on vectors written by this
+    module; reading them back here keeps the two implementations pinned to the same numbers."""
+    import re
+    from pathlib import Path
+
+    source = (Path(__file__).parents[1] / "crates" / "kinedyn-core" / "src" / "lie.rs").read_text(encoding="utf-8")
+    shared = source[source.index("// BEGIN SHARED VECTORS"):source.index("// END SHARED VECTORS")]
+    kinds = {"Scalar": "revolute", "Spherical": "spherical", "FreeFlyer": "floating", "Planar": "planar"}
+
+    def numbers(text):
+        return np.array([float(x) for x in text.split(",") if x.strip()])
+
+    integrate_part, difference_part = shared.split("const DIFFERENCE_VECTORS")
+    rows = re.findall(r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*([-+.\deE]+),\s*&\[([^\]]*)\],?\s*\)", integrate_part)
+    assert len(rows) == 16
+    for kind, q, v, dt, expected in rows:
+        space = cfg.ConfigurationSpace([Joint("j", kind=kinds[kind])])
+        np.testing.assert_allclose(space.integrate(numbers(q), numbers(v), float(dt)), numbers(expected), atol=1e-15, rtol=0)
+    rows = re.findall(r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],?\s*\)", difference_part)
+    assert len(rows) == 16
+    for kind, q0, q1, expected in rows:
+        space = cfg.ConfigurationSpace([Joint("j", kind=kinds[kind])])
+        np.testing.assert_allclose(space.difference(numbers(q0), numbers(q1)), numbers(expected), atol=1e-15, rtol=0)
