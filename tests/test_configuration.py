@@ -366,3 +366,35 @@ def test_python_reproduces_the_vectors_shared_with_the_rust_core():
     for kind, q0, q1, expected in rows:
         space = cfg.ConfigurationSpace([Joint("j", kind=kinds[kind])])
         np.testing.assert_allclose(space.difference(numbers(q0), numbers(q1)), numbers(expected), atol=1e-15, rtol=0)
+
+
+def test_mujoco_conversion_of_docs_conventions():
+    """docs/conventions.md: MuJoCo's free joint is (x, y, z, qw, qx, qy, qz) with world-frame linear and
+    body-frame angular velocity, its ball joint (qw, qx, qy, qz) with body-frame angular velocity.
+    mj_integratePos over a short step and kinedyn's integrate of the converted state must agree to first
+    order (taking MuJoCo's linear velocity as body-frame instead would be off by O(1))."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is an optional test oracle")
+    model = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body name='b'><freejoint/><geom size='.1' mass='1'/>"
+        "<body name='c'><joint type='ball'/><geom size='.1' mass='1' pos='0 0 .3'/></body></body></worldbody></mujoco>")
+    robot = kd.Robot([Link("b", None, Joint("free", kind="floating")), Link("c", "b", Joint("ball", kind="spherical"))])
+    assert (model.nq, model.nv) == (robot.nq, robot.nv)
+
+    def to_kinedyn(qpos, qvel):
+        q = np.r_[qpos[0:3], qpos[4:7], qpos[3], qpos[8:11], qpos[7]]
+        rotation = cfg.quaternion_to_matrix(q[3:7])
+        return q, np.r_[rotation.T @ qvel[0:3], qvel[3:9]]
+
+    rng = np.random.default_rng(13)
+    dt = 1e-7
+    for _ in range(20):
+        qpos = rng.normal(size=model.nq)
+        qpos[3:7] /= np.linalg.norm(qpos[3:7])
+        qpos[7:11] /= np.linalg.norm(qpos[7:11])
+        qvel = rng.normal(size=model.nv)
+        after = qpos.copy()
+        mujoco.mj_integratePos(model, after, qvel, dt)
+        q, v = to_kinedyn(qpos, qvel)
+        q_after, _ = to_kinedyn(after, qvel)
+        rate = (robot.integrate(q, v, dt) - q) / dt
+        np.testing.assert_allclose(rate, (q_after - q) / dt, atol=1e-5, rtol=0)

@@ -4,15 +4,12 @@ plain angles, and the operations that replace ``q + v dt`` and ``q1 - q0`` on th
 Conventions (Pinocchio's, so that numbers move between the two unchanged; docs/conventions.md):
 ``q`` is the joints' blocks in body order (``robot.tree.bodies``), ``v`` likewise;
 
-==========  =====================================  ==================================  =====================
-kind        q block                                v block                             q ⊕ v
-==========  =====================================  ==================================  =====================
-revolute,   the angle / displacement (1)           its rate (1)                        q + v
-prismatic
-spherical   unit quaternion (qx, qy, qz, qw) (4)   angular velocity, child frame (3)   R(q) Exp(ω)
-floating    (x, y, z, qx, qy, qz, qw) (7)          [linear; angular], child frame (6)  M(q) Exp(v)  (SE(3))
-planar      (x, y, cos θ, sin θ) (4)               (vx, vy, ω), child frame (3)        M(q) Exp(v)  (SE(2))
-==========  =====================================  ==================================  =====================
+| kind | q block | v block | q ⊕ v |
+|------|---------|---------|-------|
+| revolute, prismatic | the angle / displacement (1) | its rate (1) | q + v |
+| spherical | unit quaternion (qx, qy, qz, qw) (4) | angular velocity, child frame (3) | R(q) Exp(ω) |
+| floating | (x, y, z, qx, qy, qz, qw) (7) | [linear; angular], child frame (6) | M(q) Exp(v) in SE(3) |
+| planar | (x, y, cos θ, sin θ) (4) | (vx, vy, ω), child frame (3) | M(q) Exp(v) in SE(2) |
 
 ``integrate(q, v, dt) = q ⊕ (v dt)`` multiplies the joint's pose by the group exponential on the
 right (the velocity is expressed in the moving frame), ``difference(q0, q1) = Log(M(q0)⁻¹ M(q1))``
