@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ConfigurationSpace", "UNIT_TOLERANCE", "space", "neutral", "integrate", "difference", "interpolate",
-    "random_configuration", "normalize", "check_configuration",
+    "random_configuration", "normalize", "check_configuration", "integrate_jacobians", "difference_jacobians",
     "quaternion_multiply", "quaternion_rotate", "quaternion_to_matrix", "exp3", "log3",
 ]
 
@@ -50,8 +50,8 @@ __all__ = [
 #: :func:`check_configuration` refuses it (normalise with :func:`normalize` / ``robot.normalize(q)``).
 UNIT_TOLERANCE = 1e-6
 
-# below this rotation angle the series of (θ - sin θ)/θ³ and (1 - (θ/2)cot(θ/2))/θ² replace the closed
-# forms, which cancel there; at 1e-2 the first omitted term of each series is below 1e-17
+# below this rotation angle the series of (1 - (θ/2)cot(θ/2))/θ² replaces the closed form, whose
+# error ε/θ² there multiplies θ²; at 1e-2 the first omitted term of the series is below 1e-17
 _SERIES_BELOW = 1e-2
 
 _Q_NAMES = {
@@ -131,12 +131,16 @@ def log3(quat: ArrayLike) -> np.ndarray:
 
 
 # ------------------------------------------------------------------- left Jacobians V of SE(3), SE(2)
+# the series of (θ - sin θ)/θ³ in θ², highest power first (for np.polyval)
+_B_SERIES = [(-1) ** k / math.factorial(2 * k + 3) for k in range(7, -1, -1)]
+
+
 def _theta_minus_sin_over_cube(theta: np.ndarray) -> np.ndarray:
-    """(θ - sin θ)/θ³, by its series 1/6 - θ²/120 + θ⁴/5040 for small θ."""
-    small = theta < _SERIES_BELOW
-    t = np.where(small, 1.0, theta)
-    t2 = theta * theta
-    return np.where(small, 1 / 6 - t2 / 120 + t2 * t2 / 5040, (t - np.sin(t)) / (t * t * t))
+    """(θ - sin θ)/θ³: the closed form loses digits as ε/θ², so below θ = 0.5 its series
+    Σ (-1)ᵏ θ²ᵏ/(2k+3)! (8 terms; the first omitted is below 1e-21)."""
+    near = theta < 0.5
+    t = np.where(near, 1.0, theta)
+    return np.where(near, np.polyval(_B_SERIES, theta * theta), (t - np.sin(t)) / (t * t * t))
 
 
 def _se3_left_jacobian_times(omega: np.ndarray, theta: np.ndarray, rho: np.ndarray) -> np.ndarray:
@@ -158,6 +162,137 @@ def _se3_left_jacobian_inverse_times(omega: np.ndarray, theta: np.ndarray, p: np
     c = np.where(small, 1 / 12 + t2 / 720 + t2 * t2 / 30240, (1.0 - half * np.cos(half) / np.sin(half)) / (t * t))
     wxp = _cross(omega, p)
     return p - 0.5 * wxp + c[..., None] * _cross(omega, wxp)
+
+
+
+# ------------------------------------------------------------- Jacobians of integrate, difference
+# Perturbations act on the right, as velocities do: q ⊕ δ. With the group's adjoint Ad and its right
+# Jacobian Jr(τ) (Exp(τ + δ) ≈ Exp(τ) Exp(Jr(τ) δ)), and Jl(τ) = Jr(-τ) = Σ ad_τᵏ/(k+1)!:
+#   ∂(q ⊕ v)/∂q = Ad(Exp(v))⁻¹ = Ad(Exp(-v)),   ∂(q ⊕ v)/∂v = Jr(v) = Jl(-v);
+#   ∂Log(q0⁻¹ q1)/∂q1 = Jr⁻¹(d) = Jl⁻¹(-d),     ∂Log(q0⁻¹ q1)/∂q0 = -Jl⁻¹(d)     (d = the difference)
+# (Solà, Deray & Atchuthan 2018, eqs. 72-81). Jl of SE(3) and SE(2) is a function of the block
+# upper-triangular matrix ad_τ, so its off-diagonal block is the Fréchet derivative of that function
+# (Higham, *Functions of Matrices*, 2008, Thm 3.6 / eq. 3.16): for SE(3), ad = [[ω×, ρ×], [0, ω×]] and
+# Q(ρ, ω) = D Jl_SO(3)(ω)[ρ], the derivative of SO(3)'s Jl = I + a W + b W² along ρ (W = ω×).
+def _skew(w: np.ndarray) -> np.ndarray:
+    z = np.zeros(w.shape[:-1])
+    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
+                     np.stack([w[..., 2], z, -w[..., 0]], -1),
+                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
+
+
+# coefficients of the series of a'(θ)/θ and b'(θ)/θ in θ², highest power first (for np.polyval)
+_DA_SERIES = [(-1) ** k * 2 * k / math.factorial(2 * k + 2) for k in range(8, 0, -1)]
+_DB_SERIES = [(-1) ** k * 2 * k / math.factorial(2 * k + 3) for k in range(8, 0, -1)]
+
+
+def _so3_coefficients(theta: np.ndarray) -> tuple:
+    """a = (1 - cos θ)/θ², b = (θ - sin θ)/θ³, c = (1 - (θ/2) cot(θ/2))/θ², and a'(θ)/θ, b'(θ)/θ,
+    each by its Taylor series below 1e-2 where the closed form cancels."""
+    small = theta < _SERIES_BELOW
+    t = np.where(small, 1.0, theta)
+    t2 = theta * theta
+    a = 0.5 * np.sinc(theta / (2 * np.pi)) ** 2
+    b = _theta_minus_sin_over_cube(theta)
+    half = t / 2
+    c = np.where(small, 1 / 12 + t2 / 720 + t2 * t2 / 30240, (1.0 - half * np.cos(half) / np.sin(half)) / (t * t))
+    # a' = sin θ/θ² - 2(1 - cos θ)/θ³, b' = (1 - cos θ)/θ³ - 3(θ - sin θ)/θ⁴: their closed forms lose
+    # digits as ε/θ, so below θ = 0.5 the series (k >= 1, 8 terms, the first omitted < 1e-18)
+    # a'/θ = Σ (-1)ᵏ 2k θ²⁽ᵏ⁻¹⁾/(2k+2)!,  b'/θ = Σ (-1)ᵏ 2k θ²⁽ᵏ⁻¹⁾/(2k+3)!
+    near = theta < 0.5
+    u = np.where(near, 1.0, theta)
+    one_minus_cos = 2 * np.sin(u / 2) ** 2
+    da = np.where(near, np.polyval(_DA_SERIES, t2), (u * np.sin(u) - 2 * one_minus_cos) / u**4)
+    db = np.where(near, np.polyval(_DB_SERIES, t2), (u * one_minus_cos - 3 * (u - np.sin(u))) / u**5)
+    return a, b, c, da, db
+
+
+def _so3_left_jacobian(omega: np.ndarray) -> tuple:
+    """Jl(ω) = I + a W + b W², Jl(ω)⁻¹ = I - ½ W + c W², and the coefficients."""
+    theta = _norm(omega)
+    a, b, c, da, db = _so3_coefficients(theta)
+    w = _skew(omega)
+    w2 = w @ w
+    eye = np.eye(3)
+    jl = eye + a[..., None, None] * w + b[..., None, None] * w2
+    jl_inv = eye - 0.5 * w + c[..., None, None] * w2
+    return jl, jl_inv, (a, b, da, db, w, w2)
+
+
+def _se3_left_jacobian(tau: np.ndarray) -> tuple:
+    """Jl(τ) and Jl(τ)⁻¹ (6x6) of SE(3), τ = [ρ; ω]: [[Jl(ω), Q], [0, Jl(ω)]] with
+    Q = (ω·ρ)(a'/θ) W + a P + (ω·ρ)(b'/θ) W² + b (P W + W P), P = ρ×."""
+    rho, omega = tau[..., :3], tau[..., 3:]
+    jl, jl_inv, (a, b, da, db, w, w2) = _so3_left_jacobian(omega)
+    p = _skew(rho)
+    dot = np.sum(omega * rho, axis=-1)
+    e = lambda x: x[..., None, None]  # noqa: E731 - a scalar per state against 3x3 blocks
+    q = e(dot * da) * w + e(a) * p + e(dot * db) * w2 + e(b) * (p @ w + w @ p)
+    out = np.zeros(tau.shape[:-1] + (6, 6))
+    out[..., :3, :3] = out[..., 3:, 3:] = jl
+    out[..., :3, 3:] = q
+    inv = np.zeros_like(out)
+    inv[..., :3, :3] = inv[..., 3:, 3:] = jl_inv
+    inv[..., :3, 3:] = -jl_inv @ q @ jl_inv
+    return out, inv
+
+
+def _se3_adjoint_of_exp(tau: np.ndarray) -> np.ndarray:
+    """Ad(Exp(τ)) = [[R, p× R], [0, R]] for Exp(τ) = (R, p), in the [linear; angular] order."""
+    rho, omega = tau[..., :3], tau[..., 3:]
+    r = quaternion_to_matrix(exp3(omega))
+    p = _se3_left_jacobian_times(omega, _norm(omega), rho)
+    out = np.zeros(tau.shape[:-1] + (6, 6))
+    out[..., :3, :3] = out[..., 3:, 3:] = r
+    out[..., :3, 3:] = _skew(p) @ r
+    return out
+
+
+def _se2_left_jacobian(tau: np.ndarray) -> tuple:
+    """Jl(τ) and its inverse (3x3) of SE(2), τ = (ρ, θ): ad = [[θ J, -J ρ], [0, 0]] (J the 90° rotation),
+    so Jl = [[V(θ), h(θ J)(-J ρ)], [0, 1]] with h(x) = (eˣ - 1 - x)/x²: the top right is
+    (θ - sin θ)/θ² ρ - (1 - cos θ)/θ² J ρ."""
+    theta = tau[..., 2]
+    a = np.sinc(theta / np.pi)                                  # sin θ/θ
+    half = 0.5 * np.sinc(theta / (2 * np.pi)) ** 2              # (1 - cos θ)/θ²
+    b = half * theta                                            # (1 - cos θ)/θ
+    d = theta * _theta_minus_sin_over_cube(np.abs(theta))       # (θ - sin θ)/θ²
+    rx, ry = tau[..., 0], tau[..., 1]
+    corner = np.stack([d * rx + half * ry, d * ry - half * rx], axis=-1)   # J ρ = (-ρy, ρx)
+    out = np.zeros(tau.shape[:-1] + (3, 3))
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = a, -b, b, a
+    out[..., :2, 2] = corner
+    out[..., 2, 2] = 1.0
+    alpha = np.cos(theta / 2) / np.sinc(theta / (2 * np.pi))   # V⁻¹ = [[α, θ/2], [-θ/2, α]]
+    inv = np.zeros_like(out)
+    inv[..., 0, 0], inv[..., 0, 1], inv[..., 1, 0], inv[..., 1, 1] = alpha, theta / 2, -theta / 2, alpha
+    inv[..., :2, 2] = -np.einsum("...ij,...j->...i", inv[..., :2, :2], corner)
+    inv[..., 2, 2] = 1.0
+    return out, inv
+
+
+def _se2_adjoint_of_exp(tau: np.ndarray) -> np.ndarray:
+    """Ad(Exp(τ)) = [[R, (t_y, -t_x)ᵀ], [0, 1]] for Exp(τ) = (R, t) in SE(2)."""
+    m = np.stack([np.zeros_like(tau[..., 0])] * 2 + [np.ones_like(tau[..., 0]), np.zeros_like(tau[..., 0])], axis=-1)
+    m = _integrate_planar(m, tau)
+    out = np.zeros(tau.shape[:-1] + (3, 3))
+    c, s = m[..., 2], m[..., 3]
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    out[..., 0, 2], out[..., 1, 2] = m[..., 1], -m[..., 0]
+    out[..., 2, 2] = 1.0
+    return out
+
+
+def _block_jacobians(kind: str, v: np.ndarray) -> tuple:
+    """(Ad(Exp(v)), Jl(v), Jl(v)⁻¹) of one joint kind's group at its tangent vector v."""
+    if kind == "floating":
+        jl, inv = _se3_left_jacobian(v)
+        return _se3_adjoint_of_exp(v), jl, inv
+    if kind == "spherical":
+        jl, inv, _ = _so3_left_jacobian(v)
+        return quaternion_to_matrix(exp3(v)), jl, inv
+    jl, inv = _se2_left_jacobian(v)
+    return _se2_adjoint_of_exp(v), jl, inv
 
 
 # ---------------------------------------------------------------------------------- per joint kind
@@ -380,6 +515,46 @@ class ConfigurationSpace:
         # at t = 1 exactly, q1 (not -q1's quaternion sign, nor its last rounding)
         return np.where(tv == 1.0, np.broadcast_to(q1, out.shape), out)
 
+    def integrate_jacobians(self, q, v, dt=1.0) -> tuple:
+        """(∂(q ⊕ v dt)/∂q, ∂(q ⊕ v dt)/∂v), each (nv, nv) or (..., nv, nv), in the tangent spaces
+        (perturbations on the right, as Pinocchio's ``dIntegrate`` ARG0 and ARG1): block diagonal,
+        Ad(Exp(v dt))⁻¹ and Jr(v dt) dt per multi-DOF joint, 1 and dt for 1-DOF joints."""
+        q = self.check(q)
+        v = self._velocity(v)
+        dt = np.asarray(dt, dtype=float)
+        if dt.ndim or not np.isfinite(dt):
+            raise ValueError(f"dt must be one finite number, got {dt}")
+        vdt = np.asarray(v * dt)
+        shape = np.broadcast_shapes(q.shape[:-1], vdt.shape[:-1])
+        vdt = np.broadcast_to(vdt, shape + (self.nv,))
+        d_q = np.zeros(shape + (self.nv, self.nv))
+        d_v = np.zeros(shape + (self.nv, self.nv))
+        d_q[..., self._scalar_v, self._scalar_v] = 1.0
+        d_v[..., self._scalar_v, self._scalar_v] = float(dt)
+        for kind, (_, vi) in self._kinds.items():
+            for cols in vi:
+                ad, jl, _ = _block_jacobians(kind, -vdt[..., cols])
+                d_q[..., cols[:, None], cols[None, :]] = ad
+                d_v[..., cols[:, None], cols[None, :]] = jl * float(dt)
+        return d_q, d_v
+
+    def difference_jacobians(self, q0, q1) -> tuple:
+        """(∂ difference/∂q0, ∂ difference/∂q1), each (nv, nv) or (..., nv, nv), in the tangent spaces
+        (as Pinocchio's ``dDifference`` ARG0 and ARG1): -Jl⁻¹(d) and Jr⁻¹(d) per multi-DOF joint,
+        d = difference(q0, q1); -1 and 1 for 1-DOF joints."""
+        d = self.difference(q0, q1)
+        d_q0 = np.zeros(d.shape[:-1] + (self.nv, self.nv))
+        d_q1 = np.zeros_like(d_q0)
+        d_q0[..., self._scalar_v, self._scalar_v] = -1.0
+        d_q1[..., self._scalar_v, self._scalar_v] = 1.0
+        for kind, (_, vi) in self._kinds.items():
+            for cols in vi:
+                _, _, inv_plus = _block_jacobians(kind, d[..., cols])
+                _, _, inv_minus = _block_jacobians(kind, -d[..., cols])
+                d_q0[..., cols[:, None], cols[None, :]] = -inv_plus
+                d_q1[..., cols[:, None], cols[None, :]] = inv_minus
+        return d_q0, d_q1
+
     def normalize(self, q) -> np.ndarray:
         """``q`` with each quaternion and planar (cos, sin) pair divided by its norm (a copy)."""
         a = self._array(q, self.nq, "q", "nq")
@@ -489,3 +664,13 @@ def check_configuration(robot: "Robot", q: ArrayLike) -> np.ndarray:
     and block: the length is not nq, a number is NaN or infinite, or a quaternion or planar
     (cos θ, sin θ) pair has a norm further than :data:`UNIT_TOLERANCE` (1e-6) from 1."""
     return space(robot).check(q)
+
+
+def integrate_jacobians(robot: "Robot", q: ArrayLike, v: ArrayLike, dt: float = 1.0) -> tuple:
+    """(∂(q ⊕ v dt)/∂q, ∂(q ⊕ v dt)/∂v): see :meth:`ConfigurationSpace.integrate_jacobians`."""
+    return space(robot).integrate_jacobians(q, v, dt)
+
+
+def difference_jacobians(robot: "Robot", q0: ArrayLike, q1: ArrayLike) -> tuple:
+    """(∂ difference/∂q0, ∂ difference/∂q1): see :meth:`ConfigurationSpace.difference_jacobians`."""
+    return space(robot).difference_jacobians(q0, q1)
