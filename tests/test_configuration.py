@@ -516,3 +516,30 @@ def test_velocity_jacobian_is_the_series_of_the_adjoint(theta):
         (vx, vy, w) = v[9:12]
         ad = np.array([[0, -w, vy], [w, 0, -vx], [0, 0, 0]])                        # SE(2): [[ω J, -J ρ], [0, 0]]
         np.testing.assert_allclose(d_v[9:12, 9:12], series(ad), atol=1e-15 * max(1, np.abs(v).max() ** 2), rtol=0)
+
+
+# ------------------------------------------------------------------------ with the numeric core
+def test_integrate_moves_every_body_with_the_cores_velocity():
+    """The numeric core's body velocities (frame_velocity, reference="local") are the rates of change
+    of the bodies' poses along integrate(q, v t): q ⊕ v and the core's Jacobians read v in the same
+    frames, for every joint kind, on a chain with offsets between the joints."""
+    rng = np.random.default_rng(19)
+    links, parent = [], None
+    for i, (name, kind) in enumerate(KINDS):
+        placement = np.eye(4)
+        placement[:3, 3] = rng.normal(size=3) * 0.3
+        axis = (1.0, 0, 0) if kind == "prismatic" else (0, 0, 1.0)
+        links.append(Link(f"l{i}", parent, Joint(name, kind=kind, axis=axis), placement=placement, inertia=kd.Inertia.box(1.0, (0.1, 0.2, 0.3))))
+        parent = f"l{i}"
+    robot = kd.Robot(links, name="mixed")
+    h = 1e-6
+    for _ in range(5):
+        q, v = robot.random_configuration(rng), rng.normal(size=robot.nv)
+        ahead, behind = robot.integrate(q, v, h), robot.integrate(q, v, -h)
+        for body in robot.body_names:
+            T, T_ahead, T_behind = robot.pose(q, body), robot.pose(ahead, body), robot.pose(behind, body)
+            R = T[:3, :3]
+            linear = R.T @ (T_ahead[:3, 3] - T_behind[:3, 3]) / (2 * h)
+            spin = R.T @ (T_ahead[:3, :3] - T_behind[:3, :3]) / (2 * h)   # [ω]× in the body's axes
+            angular = np.array([spin[2, 1], spin[0, 2], spin[1, 0]])
+            np.testing.assert_allclose(np.r_[linear, angular], robot.frame_velocity(q, v, body, reference="local"), atol=1e-7)
