@@ -339,6 +339,10 @@ def test_length_and_non_finite_numbers_are_refused():
         ROBOT.normalize(zero)
     with pytest.raises(ValueError, match=r"size must be a whole number"):
         ROBOT.random_configuration(0, size=-1)
+    with pytest.raises(TypeError, match=r"v must be real numbers, got an array of dtype complex128"):
+        ROBOT.integrate(ROBOT.neutral(), np.zeros(14) + 1j)
+    with pytest.raises(TypeError, match=r"q0 must be real numbers"):
+        ROBOT.difference(["a"] * 17, ROBOT.neutral())
 
 
 # ---------------------------------------------------------------- the Rust core's shared vectors

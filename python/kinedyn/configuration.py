@@ -403,9 +403,12 @@ class ConfigurationSpace:
     # ------------------------------------------------------------------------------ arguments
     def _array(self, x, size: int, name: str, what: str) -> np.ndarray:
         try:
-            a = np.asarray(x, dtype=float)
+            a = np.asarray(x)
+            if a.dtype.kind not in "fiubO":  # complex numbers would lose their imaginary part, text is no number
+                raise TypeError(f"an array of dtype {a.dtype}")
+            a = a.astype(float, copy=False)
         except (TypeError, ValueError) as e:
-            raise TypeError(f"{name} must be real numbers: {e}") from None
+            raise TypeError(f"{name} must be real numbers, got {e}") from None
         if a.ndim == 0 or a.shape[-1] != size:
             raise ValueError(f"{name} must have {size} entries ({what}) along its last axis, got shape {a.shape}")
         return a
