@@ -973,24 +973,41 @@ class Robot:
 
         return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
+    # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------
     def neutral(self) -> np.ndarray:
-        """The zero configuration (n,)."""
-        return np.zeros(self.n)
+        """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
+        from .configuration import neutral
+
+        return neutral(self)
 
     def random_configuration(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
-        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
-        if size is not None and not (isinstance(size, (int, np.integer)) and size >= 0):
-            raise ValueError(f"size must be a whole number of configurations >= 0 (or None for one), got {size!r}")
-        rng = np.random.default_rng(rng)
-        lo = self.lower_limits.copy()
-        hi = self.upper_limits.copy()
-        for i, j in enumerate(self.joints):
-            # an infinite side is replaced by one span beyond the finite side (or -span..span):
-            # a one-sided limit such as lower=5 (upper inf) must not give lo > hi
-            span = math.pi if j.kind == "revolute" else 1.0
-            if not math.isfinite(lo[i]):
-                lo[i] = min(-span, hi[i] - 2 * span) if math.isfinite(hi[i]) else -span
-            if not math.isfinite(hi[i]):
-                hi[i] = max(span, lo[i] + 2 * span)
-        shape = (self.n,) if size is None else (size, self.n)
-        return rng.uniform(lo, hi, size=shape)
+        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
+        uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
+        from .configuration import random_configuration
+
+        return random_configuration(self, rng, size)
+
+    def integrate(self, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
+        """q ⊕ v dt (nq,) or (N, nq): q + v dt for 1-DOF joints, M(q) Exp(v dt) for floating, spherical and
+        planar joints (v in the child's frame): see :mod:`kinedyn.configuration`."""
+        from .configuration import integrate
+
+        return integrate(self, q, v, dt)
+
+    def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
+        """v (nv,) or (N, nv) with integrate(q0, v) == q1: Log(M(q0)^-1 M(q1)), rotations the short way."""
+        from .configuration import difference
+
+        return difference(self, q0, q1)
+
+    def interpolate(self, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
+        """integrate(q0, t * difference(q0, q1)): the geodesic from q0 (t = 0) to q1 (t = 1)."""
+        from .configuration import interpolate
+
+        return interpolate(self, q0, q1, t)
+
+    def normalize(self, q: ArrayLike) -> np.ndarray:
+        """``q`` with each quaternion and planar (cos, sin) pair divided by its norm."""
+        from .configuration import normalize
+
+        return normalize(self, q)
