@@ -289,3 +289,30 @@ def test_floating_robots_convert_to_urdf_and_back():
             _close("tau", back.inverse_dynamics(q, v, a), robot.inverse_dynamics(q, v, a), 10.0)
             for name in robot.body_names:
                 _close(f"pose of {name}", back.pose(q, name), robot.pose(q, name))
+
+
+def test_identities_and_base_parameters_hold_on_a_floating_tree():
+    """kinedyn.testing.check_identities (finite differences along q ⊕ t qd) and the base parameters
+    (Y[:, base] pi_base == Y pi) on a tree with every multi-DOF kind."""
+    from kinedyn.testing import check_identities
+
+    robot = random_robot(0, n=7, branching=True, floating=True, spherical=0.3, planar=0.2)
+    worst = check_identities(robot, states=3)
+    assert len(worst) >= 10
+    for name, residual in worst.items():
+        assert residual < (1e-7 if "finite differences" in name else 1e-10), (name, residual)
+    base = robot.base_parameters(samples=40)
+    rng = np.random.default_rng(6)
+    q, v, a = robot.random_configuration(rng), rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    Y = robot.regressor(q, v, a)
+    assert Y.shape == (robot.nv, 10 * len(robot.body_names))
+    _close("Y_base pi_base", Y[:, base.indices] @ base.values, Y @ robot.inertial_parameters(), 10.0)
+
+
+def test_what_does_not_take_multi_dof_joints_yet_says_so():
+    robot = random_robot(1, n=3, floating=True, friction=False)
+    q = robot.neutral()
+    for call, feature in ((lambda: kd.simulate(robot, np.zeros(robot.nq + robot.nv), 0.1), "simulation"),
+                          (lambda: robot.inverse_kinematics(np.eye(4), q0=q), "inverse kinematics")):
+        with pytest.raises(ValueError, match=f"{feature} handles revolute and prismatic joints only.*floating joint 'j1'"):
+            call()
