@@ -77,6 +77,8 @@ CALLS = {
     "potential_energy": lambda r, q, qd, a: r.potential_energy(q),
     "center_of_mass": lambda r, q, qd, a: r.center_of_mass(q),
     "momentum": lambda r, q, qd, a: r.momentum(q, qd),
+    "centroidal_momentum_matrix": lambda r, q, qd, a: r.centroidal_momentum_matrix(q),
+    "center_of_mass_jacobian": lambda r, q, qd, a: r.center_of_mass_jacobian(q),
     "regressor": lambda r, q, qd, a: r.regressor(q, qd, a),
     "friction_torque": lambda r, q, qd, a: r.friction_torque(qd),
 }

@@ -248,7 +248,7 @@ class Robot:
         unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
         if unknown:
             raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names})")
-        values = {}
+        values: dict = {}
         for key, value in items:
             if isinstance(key, str):
                 i = names.index(key)
@@ -567,7 +567,12 @@ class Robot:
         # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
         # transform, read from q) and members at the identity on it, the last carrying the link
         # (crates/kinedyn-core/src/model.rs); a 1-DOF joint is one body
-        parent, kind, axis, offset, placement, blocks = [], [], [], [], [], []
+        parent: list = []
+        kind: list = []
+        axis: list = []
+        offset: list = []
+        placement: list = []
+        blocks: list = []
         link_inertia = self.inertial_parameters().reshape(len(bodies), 10)
         inertia = np.zeros((self.nv, 10))
         for b, body in enumerate(bodies):

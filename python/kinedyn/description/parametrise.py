@@ -84,20 +84,21 @@ def euler_to_native(robot, q_euler, qd_euler=None):
     """``(q, v)`` of ``robot`` (quaternions, body-frame velocities) at the state ``(q_euler, qd_euler)``
     of :func:`euler_parametrised`'s robot (``v`` None when ``qd_euler`` is None)."""
     q_euler = np.asarray(q_euler, dtype=float)
-    q, k = [], 0
+    values: list = []
+    k = 0
     for joint in robot.joints:
         block = q_euler[k:k + joint.nv]
         k += joint.nv
         if joint.kind == "planar":
             x, y, th = block
-            q.extend([x, y, np.cos(th), np.sin(th)])
+            values.extend([x, y, np.cos(th), np.sin(th)])
         elif joint.kind == "floating":
-            q.extend([*block[:3], *_quaternion_zyx(*block[3:])])
+            values.extend([*block[:3], *_quaternion_zyx(*block[3:])])
         elif joint.kind == "spherical":
-            q.extend(_quaternion_zyx(*block))
+            values.extend(_quaternion_zyx(*block))
         else:
-            q.extend(block)
-    q = np.array(q)
+            values.extend(block)
+    q = np.array(values)
     if qd_euler is None:
         return q, None
     return q, euler_velocity_map(robot, q_euler) @ np.asarray(qd_euler, dtype=float)
