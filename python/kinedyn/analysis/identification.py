@@ -230,9 +230,28 @@ class Identification:
             predicted = predicted + (self.friction.regressor(np.asarray(data.qd), sign) @ self.friction_estimates)
         return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
 
-    def plot(self, log, **load_options):
-        """Measured vs predicted torques and the residuals on ``log`` (matplotlib Figure)."""
+    def plot(self, log=None, **load_options):
+        """Measured vs predicted torques and the residuals on ``log`` (default: the fitted data), a
+        matplotlib Figure."""
+        if log is None:
+            if self.data is None:
+                raise ValueError("this result does not hold the data it was fitted to: give a log to plot")
+            log = self.data
         return self.validate(log, **load_options).plot()
+
+    def to_html(self, validate=None, **load_options) -> str:
+        """A self-contained HTML report (:mod:`kinedyn.report.identification`): the parameters with
+        their standard deviations, friction, rotor inertia, measured vs predicted torques and the
+        residuals per joint on the fitted log and on ``validate`` (another log) when given."""
+        from ..report.identification import identification_report
+
+        return identification_report(self, validate, **load_options)
+
+    def write_html(self, path, validate=None, **load_options):
+        """Write :meth:`to_html` to ``path``; returns the path."""
+        from ..report.identification import write_identification_report
+
+        return write_identification_report(self, path, validate, **load_options)
 
     def to_dict(self) -> dict:
         d = dict(
