@@ -21,9 +21,13 @@ VISCOUS, COULOMB = 0.5, 1.0
 @pytest.fixture(scope="module")
 def true_robot():
     """The 'real' UR5: every link 15 % heavier than the prior's, centres of mass moved 1 cm."""
-    prior = kd.robots.get("ur5")
+    return perturbed(kd.robots.get("ur5"))
+
+
+def perturbed(prior, seed=42):
+    """``prior`` with every link 15 % heavier, its centre of mass moved by up to 1 cm per axis."""
     pi = prior.inertial_parameters().reshape(prior.n, 10).copy()
-    rng = np.random.default_rng(42)
+    rng = np.random.default_rng(seed)
     for k in range(prior.n):
         m, h = pi[k, 0], pi[k, 1:4]
         c = h / m + rng.uniform(-0.01, 0.01, 3)
