@@ -494,7 +494,7 @@ def pseudo_inertia(parameters: ArrayLike) -> np.ndarray:
     """The 4x4 pseudo-inertia J = [[Sigma, h], [h^T, m]] of a body's 10 standard parameters
     [m, hx, hy, hz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about its frame origin, with the second moment
     Sigma = 1/2 tr(I) 1 - I (Wensing, Kim & Slotine, "Linear matrix inequalities for physically
-    consistent inertial parameter identification", IEEE RA-L 3(1), 2018; J = int [r; 1][r; 1]^T dm,
+    consistent inertial parameter identification", IEEE RA-L 3(1), 2018; ``J = int [r; 1] [r; 1]^T dm``,
     so J >= 0 exactly when some mass distribution has these parameters)."""
     m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = np.asarray(parameters, dtype=float)
     inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
