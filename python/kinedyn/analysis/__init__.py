@@ -4,7 +4,8 @@ excitation data (:func:`identify`). See docs/analysis.md."""
 
 from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
 from .friction import FrictionModel
-from .identification import Identification, Measurements, Validation, excitation, identify, pseudo_inertia, simulate_measurements, with_inertial_parameters
+from .identification import (Identification, Measurements, RotorEstimate, Validation, base_parameters_with_rotors, excitation, geared_joints, identify,
+                             pseudo_inertia, simulate_measurements, with_inertial_parameters)
 from .logs import Log, LogError, load_log
 from .properties import Check, InertiaBounds, PropertiesReport, check_properties, global_inertia_bounds, prove_properties
 from .system_properties import check_system_properties
@@ -27,6 +28,9 @@ __all__ = [
     "Log",
     "LogError",
     "Validation",
+    "RotorEstimate",
+    "base_parameters_with_rotors",
+    "geared_joints",
     "FrictionModel",
     "pseudo_inertia",
     "optimize_excitation",

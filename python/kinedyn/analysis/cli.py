@@ -53,6 +53,8 @@ def cmd_identify(args) -> int:
     data = simulate_measurements(robot, ref, T=args.periods * args.period, rate=args.rate, noise=args.noise, seed=args.seed)
     result = identify(robot, data, weighted=args.weighted)
     payload = dict(robot=robot.name, samples=len(data.t), noise=args.noise, **result.to_dict())
+    if args.output:
+        payload["report"] = str(result.write_html(args.output))
 
     def render():
         from rich.table import Table
@@ -118,6 +120,8 @@ def _identify_from_log(robot, args) -> int:
         fig = result.plot(args.validate or log)
         fig.savefig(args.plot)
         payload["plot"] = str(args.plot)
+    if args.output:
+        payload["report"] = str(result.write_html(args.output, args.validate, **options))
 
     def render():
         from rich.table import Table
@@ -135,6 +139,12 @@ def _identify_from_log(robot, args) -> int:
         for nm, e, sd in zip(result.friction_names, result.friction_estimates, result.friction_std):
             t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{100 * sd / max(abs(e), 1e-300):.3g}")
         c.print(t)
+        grouped = [r for r in result.rotors if r.armature is None]
+        if grouped:
+            c.print("armatures r² J_m grouped with link parameters (not identifiable on their own): "
+                    + "; ".join(f"{esc(r.joint)} into {esc(', '.join(r.grouped_into))}" for r in grouped))
+        if args.output:
+            c.print(f"report written to {esc(str(args.output))}")
         if check is not None:
             v = Table(title=f"validation on {esc(str(args.validate))}", title_justify="left")
             for col in ("joint", "torque RMS", "R²"):
@@ -179,4 +189,6 @@ def add_analysis_commands(subparsers) -> None:
     p.add_argument("--excite", metavar="CSV", action=OutputPath,
                    help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop")
     p.add_argument("--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)")
+    p.add_argument("-o", "--output", metavar="HTML", action=OutputPath, default=None,
+                   help="write a self-contained HTML identification report (parameters, friction, rotor inertia, torque and residual plots)")
     p.set_defaults(func=cmd_identify)

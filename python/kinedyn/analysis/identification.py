@@ -15,7 +15,14 @@ parameters of serial robots", IEEE T-RA 6(3), 1990; numerically Gautier 1991, as
   "Extended Kalman filtering and weighted least squares dynamic identification of robot", Control
   Eng. Practice 9(12), 2001). Covariance ``sigma^2 (W^T W)^-1`` (``(W^T S^-1 W)^-1`` weighted) gives a
   standard deviation per estimate; ``cond(W)`` measures how well the excitation separates them.
-- The drive terms (rotor inertia ``r^2 J_m qdd``, friction) are taken as known and subtracted.
+- Drive terms. Friction: known and subtracted, or estimated per joint (:mod:`.friction`). Rotor
+  inertia: the armature ``a_j = r_j^2 J_m,j`` adds ``a_j qdd_j`` to joint j's torque (it sits on
+  M's diagonal), linear in ``a_j`` like the link parameters. For a log, every joint whose model has
+  a gear ratio or a rotor inertia gets a regressor column ``qdd_j`` (in joint j's row) beside the
+  link columns, and the base parameters are found for the whole set
+  (:func:`base_parameters_with_rotors`): a rotor column can be a combination of link columns (the
+  first joint about a fixed vertical axis: ``a_1`` and link 1's ``Izz`` only ever act as
+  ``Izz + a_1``), and is then grouped into those base parameters, not estimated on its own.
 - Estimates plug back into a model: :meth:`Identification.robot` returns a Robot whose base
   parameters are the estimates (the nominal robot's parameters corrected by the minimum-norm change
   ``pi = pi_0 + G^+ (pi_hat - G pi_0)``), and :meth:`Identification.predict` the torques.
@@ -25,7 +32,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -37,7 +44,8 @@ if TYPE_CHECKING:
     from ..dynamics import BaseParameters
     from ..robot import Robot
 
-__all__ = ["Measurements", "Identification", "Validation", "pseudo_inertia", "excitation", "simulate_measurements", "identify", "with_inertial_parameters"]
+__all__ = ["Measurements", "Identification", "Validation", "RotorEstimate", "pseudo_inertia", "excitation", "simulate_measurements", "identify",
+           "with_inertial_parameters", "base_parameters_with_rotors", "geared_joints"]
 
 
 @dataclass
@@ -81,6 +89,15 @@ class Identification:
     #: physically consistent estimate (``consistent=True``): all 10 n standard parameters
     standard: Optional[np.ndarray] = field(default=None, repr=False)
     samples: int = 0
+    #: joints whose armature r^2 J_m is estimated (their columns follow the 10 n link columns of the
+    #: augmented parameter vector that ``base`` is over); the other joints' rotor inertia is known
+    rotor_joints: tuple = ()
+    #: consistent estimate: the armature of each of ``rotor_joints`` (>= 0)
+    standard_armature: Optional[np.ndarray] = field(default=None, repr=False)
+    #: consistent estimate: the unconstrained (ordinary or weighted least-squares) fit of the same data
+    unconstrained: Optional["Identification"] = field(default=None, repr=False)
+    #: the samples fitted (a Log or Measurements), for plots and reports
+    data: Any = field(default=None, repr=False)
 
     @property
     def consistent(self) -> bool:
@@ -112,15 +129,50 @@ class Identification:
         estimates, or the full regressor times the consistent standard parameters) plus the drive
         terms (the nominal rotor inertia, and the identified or the nominal friction)."""
         q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
+        armature = self.nominal.armature.copy()
+        armature[list(self.rotor_joints)] = 0.0  # estimated: in the regressor (or standard_armature)
         if self.standard is not None:
             rigid = self.nominal.regressor(q, qd, qdd) @ self.standard
+            if self.standard_armature is not None:
+                armature[list(self.rotor_joints)] = self.standard_armature
         else:
-            rigid = self.nominal.regressor(q, qd, qdd)[..., self.base.indices[self._rows()]] @ self.estimates
+            rigid = self._regressor(q, qd, qdd)[..., self.base.indices[self._rows()]] @ self.estimates
         if self.friction.known:
             fric = self.nominal.friction_torque(qd)
         else:
             fric = self.friction.torque(qd, self.friction_estimates)
-        return rigid + self.nominal.armature * qdd + fric
+        return rigid + armature * qdd + fric
+
+    def _regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """The link regressor, with the rotor columns of ``rotor_joints`` after it."""
+        Y = self.nominal.regressor(q, qd, qdd)
+        if not self.rotor_joints:
+            return Y
+        n = self.nominal.n
+        R = rotor_regressor(qdd, self.rotor_joints, n).reshape(Y.shape[:-1] + (len(self.rotor_joints),))
+        return np.concatenate([Y, R], axis=-1)
+
+    @property
+    def rotors(self) -> list:
+        """A :class:`RotorEstimate` per joint of ``rotor_joints``: the identified armature, or the
+        base parameters it is grouped into when the data cannot separate it from link parameters."""
+        n = self.nominal.n
+        names = list(self.names)
+        rows = self._rows()
+        G = self.base.grouping[rows]
+        out = []
+        for k, j in enumerate(self.rotor_joints):
+            joint = self.nominal.joints[j]
+            own = f"{joint.name}.armature"
+            nominal = float(self.nominal.armature[j])
+            if own in names:
+                i = names.index(own)
+                value = float(self.standard_armature[k]) if self.standard_armature is not None else float(self.estimates[i])
+                out.append(RotorEstimate(joint.name, float(joint.gear_ratio), nominal, value, float(self.std[i])))
+            else:
+                grouped = tuple(names[i] for i in np.flatnonzero(np.abs(G[:, 10 * n + k]) > 0))
+                out.append(RotorEstimate(joint.name, float(joint.gear_ratio), nominal, None, None, grouped))
+        return out
 
     predict = predict_torque
 
@@ -145,13 +197,22 @@ class Identification:
         (see the module docstring); identified viscous and Coulomb friction go into its joints.
         ValueError if the parameters are not physically valid (e.g. a negative mass): only the
         consistent estimate is always valid."""
+        n, rotor = self.nominal.n, list(self.rotor_joints)
         if self.standard is not None:
             pi = self.standard
+            armature = self.standard_armature if self.standard_armature is not None else self.nominal.armature[rotor]
         else:
             G = self.base.grouping[self._rows()]
-            pi0 = self.nominal.inertial_parameters()
-            pi = pi0 + np.linalg.pinv(G) @ (self.estimates - G @ pi0)
+            x0 = np.concatenate([self.nominal.inertial_parameters(), self.nominal.armature[rotor]])
+            # a grouped armature keeps its nominal value: the links' parameters take up the group
+            free = np.ones(x0.size, dtype=bool)
+            free[10 * n:] = [r.armature is not None for r in self.rotors]
+            x = x0.copy()
+            x[free] += np.linalg.pinv(G[:, free]) @ (self.estimates - G @ x0)
+            pi, armature = x[: 10 * n], x[10 * n:]
         robot = with_inertial_parameters(self.nominal, pi)
+        if rotor:
+            robot = _with_armatures(robot, dict(zip(rotor, armature)))
         if self.friction.known or not ({"viscous", "coulomb"} & set(self.friction.terms)):
             return robot
         return _with_friction(robot, self.friction, self.friction_estimates)
@@ -169,9 +230,28 @@ class Identification:
             predicted = predicted + (self.friction.regressor(np.asarray(data.qd), sign) @ self.friction_estimates)
         return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
 
-    def plot(self, log, **load_options):
-        """Measured vs predicted torques and the residuals on ``log`` (matplotlib Figure)."""
+    def plot(self, log=None, **load_options):
+        """Measured vs predicted torques and the residuals on ``log`` (default: the fitted data), a
+        matplotlib Figure."""
+        if log is None:
+            if self.data is None:
+                raise ValueError("this result does not hold the data it was fitted to: give a log to plot")
+            log = self.data
         return self.validate(log, **load_options).plot()
+
+    def to_html(self, validate=None, **load_options) -> str:
+        """A self-contained HTML report (:mod:`kinedyn.report.identification`): the parameters with
+        their standard deviations, friction, rotor inertia, measured vs predicted torques and the
+        residuals per joint on the fitted log and on ``validate`` (another log) when given."""
+        from ..report.identification import identification_report
+
+        return identification_report(self, validate, **load_options)
+
+    def write_html(self, path, validate=None, **load_options):
+        """Write :meth:`to_html` to ``path``; returns the path."""
+        from ..report.identification import write_identification_report
+
+        return write_identification_report(self, path, validate, **load_options)
 
     def to_dict(self) -> dict:
         d = dict(
@@ -186,6 +266,8 @@ class Identification:
                 d.update(noise=self.noise)
             if self.standard is not None:
                 d.update(standard_parameters=self.standard)
+            if self.rotor_joints:
+                d.update(rotors=[r.to_dict() for r in self.rotors])
         if self.true_values is not None:
             errors = self.estimates - self.true_values
             d.update(true_values=self.true_values, errors=errors, max_abs_error=float(np.abs(errors).max()),
@@ -297,6 +379,7 @@ def identify(
     *,
     friction=None,
     consistent: bool = False,
+    rotor: Optional[bool] = None,
     smoothing: Optional[float] = None,
     regularization: float = 1e-4,
     margin: float = 1e-8,
@@ -314,25 +397,40 @@ def identify(
     ``weighted``: weighted least squares, each joint's rows divided by its noise level estimated from
     the ordinary fit's residuals. ``consistent``: the physically consistent estimate (see the module
     docstring: an SDP with every body's pseudo-inertia ``>= margin I``, ``regularization`` the weight
-    of the pull toward ``robot``'s parameters relative to the data term)."""
+    of the pull toward ``robot``'s parameters relative to the data term, the armatures kept ``>= 0``).
+    ``rotor``: estimate the armature ``r^2 J_m`` of every joint whose model has a gear ratio or a
+    rotor inertia (:func:`geared_joints`; see the module docstring), or take it as known (False);
+    default: estimated for a log, known for Measurements."""
     from .logs import Log, load_log
 
-    base = robot.base_parameters() if base is None else base
     n = robot.n
-    true_values: Optional[np.ndarray] = None
-    if isinstance(data, Measurements):
-        model = parse_friction("known" if friction is None else friction, smoothing)
-        true_values = np.asarray(base.values, dtype=float)
-    else:
+    simulated = isinstance(data, Measurements)
+    if not simulated:
         data = data if isinstance(data, Log) else load_log(data, n=n, **load_options)
         if data.n != n:
             raise ValueError(f"the log has {data.n} joints but robot '{robot.name}' has {n}")
+    rotor_joints = geared_joints(robot) if (not simulated if rotor is None else rotor) else ()
+    if base is None:
+        base = base_parameters_with_rotors(robot, rotor_joints)
+    elif rotor_joints and base.grouping.shape[1] != 10 * n + len(rotor_joints):
+        raise ValueError(f"base: {base.grouping.shape[1]} parameters, but the link parameters and the armatures of the geared joints "
+                         f"{[robot.joints[j].name for j in rotor_joints]} are {10 * n + len(rotor_joints)} (see base_parameters_with_rotors, or rotor=False)")
+    true_values: Optional[np.ndarray] = None
+    if simulated:
+        model = parse_friction("known" if friction is None else friction, smoothing)
+        true_values = np.asarray(base.values, dtype=float)
+    else:
         model = parse_friction("viscous+coulomb" if friction is None else friction, smoothing)
     q, qd, qdd, tau = (np.ascontiguousarray(a, dtype=float) for a in (data.q, data.qd, data.qdd, data.tau))
     S = q.shape[0]
+    nr = len(rotor_joints)
     Yfull = robot.regressor(q, qd, qdd)  # (S, n, 10 n)
+    if nr:  # the armatures' columns after the links' (S, n, 10 n + nr)
+        Yfull = np.concatenate([Yfull, rotor_regressor(qdd, rotor_joints, n)], axis=2)
     F = model.regressor(qd, getattr(data, "filtered_sign", None))  # (S, n, f)
-    y = tau - robot.armature * qdd
+    known_armature = robot.armature.copy()
+    known_armature[list(rotor_joints)] = 0.0
+    y = tau - known_armature * qdd
     if model.known:
         y = y - robot.friction_torque(qd)
     nb, nf = base.count, F.shape[2]
@@ -371,28 +469,32 @@ def identify(
         cov = s2 * np.linalg.pinv(W.T @ W)
         cond = float(np.linalg.cond(W))
     std = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    standard = None
-    if consistent:
-        A = np.concatenate([Yfull.reshape(S * n, 10 * n), F.reshape(S * n, nf)], axis=1) * w[:, None]
-        standard, fric = _consistent_fit(robot, A, yv * w, nf, regularization, margin, solver)
-        est = np.concatenate([base.grouping[used] @ standard, fric])
-        x = np.concatenate([standard, fric])
-        r = (yv - np.concatenate([Yfull.reshape(S * n, 10 * n), F.reshape(S * n, nf)], axis=1) @ x).reshape(S, n)
     kb = int(used.sum())
-    return Identification(
-        names=tuple(nm for nm, u in zip(base.names, used) if u), estimates=est[:kb], std=std[:kb], covariance=cov[:kb, :kb],
-        true_values=None if true_values is None else true_values[used], condition_number=cond, residual_rms=np.sqrt((r**2).mean(axis=0)),
-        weighted=weighted, base=base, nominal=robot, dropped=dropped, used=used,
-        friction=model, friction_names=model.names(n), friction_estimates=est[kb:], friction_std=std[kb:], noise=sig,
-        standard=standard, samples=S,
-    )
+
+    def result(est, r, **extra) -> Identification:
+        return Identification(
+            names=tuple(nm for nm, u in zip(base.names, used) if u), estimates=est[:kb], std=std[:kb], covariance=cov[:kb, :kb],
+            true_values=None if true_values is None else true_values[used], condition_number=cond, residual_rms=np.sqrt((r**2).mean(axis=0)),
+            weighted=weighted, base=base, nominal=robot, dropped=dropped, used=used,
+            friction=model, friction_names=model.names(n), friction_estimates=est[kb:], friction_std=std[kb:], noise=sig,
+            samples=S, rotor_joints=rotor_joints, data=data, **extra,
+        )
+
+    free = result(est, r)
+    if not consistent:
+        return free
+    full = np.concatenate([Yfull.reshape(S * n, 10 * n + nr), F.reshape(S * n, nf)], axis=1)
+    standard, armature, fric = _consistent_fit(robot, full * w[:, None], yv * w, nf, rotor_joints, regularization, margin, solver)
+    x = np.concatenate([standard, armature])
+    r = (yv - full @ np.concatenate([x, fric])).reshape(S, n)
+    return result(np.concatenate([base.grouping[used] @ x, fric]), r, standard=standard, standard_armature=armature if nr else None, unconstrained=free)
 
 
 def pseudo_inertia(parameters: ArrayLike) -> np.ndarray:
     """The 4x4 pseudo-inertia J = [[Sigma, h], [h^T, m]] of a body's 10 standard parameters
     [m, hx, hy, hz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about its frame origin, with the second moment
     Sigma = 1/2 tr(I) 1 - I (Wensing, Kim & Slotine, "Linear matrix inequalities for physically
-    consistent inertial parameter identification", IEEE RA-L 3(1), 2018; J = int [r; 1][r; 1]^T dm,
+    consistent inertial parameter identification", IEEE RA-L 3(1), 2018; ``J = int [r; 1] [r; 1]^T dm``,
     so J >= 0 exactly when some mass distribution has these parameters)."""
     m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = np.asarray(parameters, dtype=float)
     inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
@@ -408,16 +510,19 @@ def _pseudo_inertia_basis() -> np.ndarray:
     return np.array([pseudo_inertia(e) for e in np.eye(10)])
 
 
-def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, regularization: float, margin: float, solver: Optional[str]):
-    """min |A [pi; f] - b|^2 + lam |pi - pi0|^2 subject to J_k(pi) >= margin I for every body:
-    a semidefinite program (cvxpy; Clarabel, else SCS). The data term enters through the R factor of
-    A = QR, so the program's size does not grow with the number of samples."""
+def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, rotor_joints: tuple, regularization: float, margin: float, solver: Optional[str]):
+    """min |A [pi; a; f] - b|^2 + lam |[pi; a] - [pi0; a0]|^2 subject to J_k(pi) >= margin I for
+    every body and the armatures a >= 0: a semidefinite program (cvxpy; Clarabel, else SCS). The data
+    term enters through the R factor of A = QR, so the program's size does not grow with the number
+    of samples. Returns pi (10 n), a (len(rotor_joints)), f (nf)."""
     try:
         import cvxpy as cp
     except ImportError:  # pragma: no cover - depends on the installation
         raise ImportError("consistent identification needs cvxpy with Clarabel or SCS: pip install 'kinedyn[identify]'") from None
     n = robot.n
-    pi0 = robot.inertial_parameters()
+    nr = len(rotor_joints)
+    m = 10 * n + nr  # inertial unknowns: link parameters, then armatures
+    pi0 = np.concatenate([robot.inertial_parameters(), robot.armature[list(rotor_joints)]])
     scale = np.linalg.norm(A, axis=0)
     scale = np.where(scale > 0, scale, 1.0)
     # column scaling keeps the program well conditioned (masses ~ 1, inertias ~ 1e-3 ...)
@@ -430,9 +535,11 @@ def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, regular
     for k in range(n):
         J = sum(pi[10 * k + c] * B[c] for c in range(10))
         constraints.append(J - margin * np.eye(4) >> 0)
+    if nr:
+        constraints.append(x[10 * n : m] >= 0)
     # the prior term in the scaled coordinates: a parameter's deviation weighs by its column norm,
     # i.e. by how much torque it moves over the log (each scaled column has unit norm)
-    objective = cp.Minimize(cp.sum_squares(R @ x - Q_b) + regularization * cp.sum_squares(x[: 10 * n] - pi0 * scale[: 10 * n]))
+    objective = cp.Minimize(cp.sum_squares(R @ x - Q_b) + regularization * cp.sum_squares(x[:m] - pi0 * scale[:m]))
     problem = cp.Problem(objective, constraints)
     solvers = [solver] if solver else [s for s in ("CLARABEL", "SCS") if s in cp.installed_solvers()]
     if not solvers:
@@ -446,7 +553,7 @@ def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, regular
             continue
         if problem.status in ("optimal", "optimal_inaccurate") and x.value is not None:
             xs = np.asarray(x.value) / scale
-            return xs[: 10 * n], xs[10 * n :]
+            return xs[: 10 * n], np.maximum(xs[10 * n : m], 0.0), xs[m:]
         last = RuntimeError(f"solver {name}: {problem.status}")
     raise RuntimeError(f"the consistent (SDP) identification failed: {last}")
 
@@ -524,6 +631,118 @@ def with_inertial_parameters(robot: Robot, pi: ArrayLike) -> Robot:
                 link = Link(link.name, link.parent, link.joint, link.placement, link.post, body_inertia.transformed(inv))
         elif link.name in moving_descendant:
             link = Link(link.name, link.parent, link.joint, link.placement, link.post, Inertia())
+        links.append(link)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return robot.replace(links=links)
+
+
+# ------------------------------------------------------------------ rotor inertia
+def geared_joints(robot: Robot) -> tuple:
+    """Indices of the joints whose model has a drive train: a gear ratio other than 1 or a rotor
+    inertia (their armature ``r^2 J_m`` is estimated from a log)."""
+    out = []
+    for k, j in enumerate(robot.joints):
+        try:
+            if float(j.gear_ratio) != 1.0 or float(j.rotor_inertia) != 0.0:
+                out.append(k)
+        except TypeError:  # a symbolic drive train: not something to fit numbers to
+            raise ValueError(f"joint '{j.name}': identification needs a numeric gear ratio and rotor inertia") from None
+    return tuple(out)
+
+
+def rotor_regressor(qdd: ArrayLike, joints: tuple, n: int) -> np.ndarray:
+    """(S, n, len(joints)) for qdd (S, n): column k is ``qdd_j`` in joint ``j = joints[k]``'s row
+    (the armature's torque ``a_j qdd_j``), zero in the other rows."""
+    qdd = np.asarray(qdd, dtype=float).reshape(-1, n)
+    out = np.zeros((qdd.shape[0], n, len(joints)))
+    for k, j in enumerate(joints):
+        out[:, j, k] = qdd[:, j]
+    return out
+
+
+def base_parameters_with_rotors(robot: Robot, joints: tuple, samples: int = 200, rng=0, tol: float = 1e-9, dependence: float = 1e-7) -> BaseParameters:
+    """Base parameters of the link parameters and the armatures of ``joints`` together.
+
+    The parameter vector is ``[pi (10 n); a (len(joints))]`` and the regressor ``[Y, R]`` with R of
+    :func:`rotor_regressor`. The link part is :meth:`Robot.base_parameters` (Gautier 1991); then each
+    rotor column in turn, stacked at ``samples`` random states, is tested against the span of the
+    columns kept so far (least squares, residual ``<= dependence`` times its norm): an independent one
+    becomes a base parameter ``<joint>.armature``; a dependent one, ``R_k = W_kept beta``, is grouped
+    (``grouping[:, 10 n + k] = beta``), i.e. it only acts through those base parameters. Returns a
+    :class:`~kinedyn.dynamics.BaseParameters` over the augmented vector (``indices`` into ``[Y, R]``)."""
+    from ..dynamics import BaseParameters
+
+    link = robot.base_parameters(samples=samples, rng=rng, tol=tol)
+    n, nr = robot.n, len(joints)
+    if nr == 0:
+        return link
+    gen = np.random.default_rng(rng if isinstance(rng, (int, np.integer)) else None)
+    q = robot.random_configuration(gen, size=samples)
+    qd = gen.uniform(-2.0, 2.0, size=(samples, n))
+    qdd = gen.uniform(-4.0, 4.0, size=(samples, n))
+    kept = robot.regressor(q, qd, qdd)[..., link.indices].reshape(samples * n, link.count)
+    R = rotor_regressor(qdd, joints, n).reshape(samples * n, nr)
+    rows = [np.concatenate([g, np.zeros(nr)]) for g in link.grouping]
+    indices = list(link.indices)
+    names = list(link.names)
+    for k, j in enumerate(joints):
+        col = R[:, k]
+        beta, *_ = np.linalg.lstsq(kept, col, rcond=None)
+        if np.linalg.norm(col - kept @ beta) <= dependence * np.linalg.norm(col):
+            beta[np.abs(beta) < 1e-10 * max(1.0, float(np.abs(beta).max()))] = 0.0
+            for i, b in enumerate(beta):
+                rows[i][10 * n + k] += b
+        else:
+            row = np.zeros(10 * n + nr)
+            row[10 * n + k] = 1.0
+            rows.append(row)
+            indices.append(10 * n + k)
+            names.append(f"{robot.joints[j].name}.armature")
+            kept = np.column_stack([kept, col])
+    grouping = np.array(rows)
+    values = grouping @ np.concatenate([robot.inertial_parameters(), robot.armature[list(joints)]])
+    return BaseParameters(indices=np.array(indices), grouping=grouping, values=values, names=tuple(names))
+
+
+@dataclass
+class RotorEstimate:
+    """The armature ``a = r^2 J_m`` of one geared joint as identified: ``armature`` and ``std``
+    (and ``rotor_inertia = armature / r^2``) when the data identify it on its own; otherwise
+    ``grouped_into`` names the base parameters it only acts through, and ``armature`` is None."""
+
+    joint: str
+    gear_ratio: float
+    nominal: float
+    armature: Optional[float]
+    std: Optional[float]
+    grouped_into: tuple = ()
+
+    @property
+    def rotor_inertia(self) -> Optional[float]:
+        return None if self.armature is None else self.armature / self.gear_ratio**2
+
+    def to_dict(self) -> dict:
+        return dict(joint=self.joint, gear_ratio=self.gear_ratio, nominal_armature=self.nominal, armature=self.armature, std=self.std,
+                    rotor_inertia=self.rotor_inertia, grouped_into=list(self.grouped_into))
+
+
+def _with_armatures(robot: Robot, armatures: dict) -> Robot:
+    """``robot`` with joint index -> armature ``r^2 J_m`` set through the rotor inertia ``a / r^2``.
+    ValueError naming the joint for a negative armature (not physical)."""
+    from dataclasses import replace as dc_replace
+
+    from ..description.link import Link
+
+    by_name = {robot.joints[k].name: float(a) for k, a in armatures.items()}
+    links = []
+    for link in robot.links:
+        a = by_name.get(link.joint.name) if link.joint.is_moving else None
+        if a is not None:
+            r = float(link.joint.gear_ratio)
+            if a < 0:
+                raise ValueError(f"joint '{link.joint.name}': the identified armature r^2 J_m = {a:.4g} is negative (not physical; try consistent=True)")
+            link = Link(link.name, link.parent, dc_replace(link.joint, rotor_inertia=a / r**2), link.placement, link.post, link.inertia)
         links.append(link)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -266,5 +266,8 @@ def load_log(
     if k < 1:
         raise LogError(f"{name}: decimate must be a whole number >= 1, got {decimate}")
     sl = slice(edge, S - edge, k)
-    sign_f = _lowpass(np.sign(qd_f), cutoff, rate, order)
+    # a joint that never moves has a filtered velocity of round-off (~1e-13), whose sign would be a
+    # Coulomb column of +-1 noise: velocities below 1e-9 of the log's largest count as rest
+    rest = np.abs(qd_f) <= 1e-9 * max(float(np.abs(qd_f).max()), 1e-300)
+    sign_f = _lowpass(np.where(rest, 0.0, np.sign(qd_f)), cutoff, rate, order)
     return Log(t[sl], qf[sl], qd_f[sl], qdd_f[sl], tau_f[sl], rate / k, float(cutoff), k, name, sign_f[sl])
