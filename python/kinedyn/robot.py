@@ -143,6 +143,15 @@ class Robot:
 
         return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
+    @classmethod
+    def from_mjcf(cls, path_or_string: Union[PathLike, bytes], *, gravity: Optional[ArrayLike] = None, tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+        """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
+        and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
+        ``tool`` and ``inertia`` as :meth:`from_urdf`."""
+        from .description.mjcf import robot_from_mjcf
+
+        return robot_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
+
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
         kwargs = dict(
