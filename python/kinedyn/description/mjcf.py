@@ -609,10 +609,10 @@ class _Reader:
                 raise self.src.error(element, f"{what}: has a range but limited='auto' with autolimits off (MuJoCo refuses it too)")
             if limited == "true" or (limited == "auto" and "range" in a):
                 lower, upper = _numbers(element, "range", self.src, 2, text=a.get("range", "0 0"))
-                if angular:
-                    lower, upper = self.angle(lower), self.angle(upper)
                 if lower > upper:
                     raise self.src.error(element, f"{what}: attribute 'range' has lower {lower:g} above upper {upper:g}")
+                if angular:
+                    lower, upper = self.angle(lower), self.angle(upper)
                 options["lower"], options["upper"] = lower, upper
         else:
             if scalars["ref"] != 0:
@@ -635,7 +635,20 @@ class _Reader:
         self.site_names.append(name)
         frame_name = name if name not in self.names else f"site:{name}"
         self.claim(frame_name, element, f"site '{name}'")
-        self.frames.append(Frame(frame_name, None if link == "world" else link, link_from_here @ self.frame(element, a)))
+        pose = self.frame(element, a)
+        if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
+            pose = self.segment(element, a["fromto"])[0]
+        self.frames.append(Frame(frame_name, None if link == "world" else link, link_from_here @ pose))
+
+    def segment(self, element, text: str) -> tuple:
+        """(pose at the middle of ``fromto``, its z axis along it, from the second end towards the
+        first as MuJoCo's compiler orients it; the segment's length)."""
+        ends = np.array(_numbers(element, "fromto", self.src, 6, text=text))
+        d = ends[:3] - ends[3:]
+        length = float(np.linalg.norm(d))
+        if length < 1e-12:
+            raise self.src.error(element, "attribute 'fromto' has two equal ends")
+        return _pose((ends[:3] + ends[3:]) / 2, _z_to(d / length)), length
 
     def geom(self, element, link: str, link_from_here: np.ndarray, childclass: str) -> dict:
         """The geom's shape, pose (in the link) and mass properties; its visual/collision is recorded."""
@@ -650,13 +663,11 @@ class _Reader:
         if "fromto" in a:
             if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
                 raise self.src.error(element, f"{what}: 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {kind}")
-            ends = np.array(_numbers(element, "fromto", self.src, 6, text=a["fromto"]))
-            d = ends[3:] - ends[:3]
-            length = float(np.linalg.norm(d))
-            if length < 1e-12:
-                raise self.src.error(element, f"{what}: attribute 'fromto' has two equal ends")
-            pose = _pose((ends[:3] + ends[3:]) / 2, _z_to(d / length))
-            size[1 if kind in ("capsule", "cylinder") else 2] = length / 2
+            pose, length = self.segment(element, a["fromto"])
+            if kind in ("capsule", "cylinder"):
+                size[1] = length / 2
+            else:  # MuJoCo: a box's or ellipsoid's cross-section is square/round, of size[0]
+                size[1], size[2] = size[0], length / 2
         needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}.get(kind, 0)
         if any(s <= 0 for s in size[:needed]):
             raise self.src.error(element, f"{what}: a {kind} needs {needed} positive size number{'s' if needed > 1 else ''}, got size='{a.get('size', '')}'")
@@ -696,8 +707,10 @@ class _Reader:
             if name not in self.meshes:
                 raise self.src.error(element, f"{what}: mesh='{name}' names no <asset><mesh>")
             file, scale, _ = self.meshes[name]
-            if file is None or self.meshdir is None:
+            if file is None:  # a mesh of inline vertices: not drawn
                 return None
+            if self.meshdir is None:
+                return Mesh(file, tuple(scale), None), np.eye(4)
             return Mesh(os.path.join(self.meshdir, file), tuple(scale), self.meshdir), np.eye(4)
         return None
 

@@ -1,0 +1,458 @@
+"""MJCF (MuJoCo XML) reader: MuJoCo itself as the oracle (mass matrix, bias forces, inverse dynamics,
+body and site poses, body inertias) on models written here and on the `mujoco` package's own test
+model; the structure of ball and free joints; includes, defaults and the security rules."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import kinedyn as kd
+from kinedyn.description.mjcf import MAX_DEPTH, MAX_INCLUDE_DEPTH, robot_from_mjcf
+
+mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is an optional test oracle")
+
+TOL = 1e-9
+
+DOUBLE_PENDULUM = """<mujoco model="double_pendulum">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="upper" pos="0.1 0.2 0.3" euler="0.1 0.2 0.3">
+      <joint name="shoulder" axis="0 1 0" pos="0 0 0.1" damping="0.4" armature="0.02"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05"/>
+      <body name="lower" pos="0 0 -0.5" quat="0.9 0.1 0.2 0.3">
+        <joint name="elbow" axis="1 0 1" pos="0.05 0 0.02" damping="0.1" armature="0.01"/>
+        <geom type="box" size="0.05 0.06 0.2" pos="0 0 -0.2"/>
+        <site name="tip" pos="0.01 0.02 -0.4" euler="0.3 0.2 0.1"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+CART_POLE = """<mujoco model="cart_pole">
+  <option gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="cart" pos="0 0 0.5">
+      <joint name="slider" type="slide" axis="1 0 0" range="-2 2" ref="0.3" damping="0.5"/>
+      <geom type="box" size="0.2 0.1 0.05" mass="2"/>
+      <body name="pole" pos="0 0 0.05">
+        <joint name="hinge" type="hinge" axis="0 1 0" pos="0 0 -0.02" range="-120 120" ref="10"/>
+        <geom type="cylinder" fromto="0 0 0 0.001 0 0.8" size="0.02" mass="0.3"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+# A 3-D arm: default classes (nested, class=, childclass=), every way of writing an orientation,
+# several joints in one body at different positions, inertials with quat and fullinertia, frames.
+ARM = """<mujoco model="arm3d">
+  <compiler angle="degree" eulerseq="{eulerseq}"/>
+  <option gravity="0.3 -0.2 -9.7"/>
+  <default>
+    <joint damping="0.3" armature="0.05"/>
+    <geom density="700"/>
+    <default class="wrist">
+      <joint axis="1 0 0" damping="0.1" range="-90 90"/>
+      <geom type="box" size="0.03 0.02 0.05"/>
+      <default class="fingertip">
+        <geom type="ellipsoid" size="0.01 0.02 0.015"/>
+      </default>
+    </default>
+    <default class="heavy">
+      <geom density="2500" type="capsule" size="0.04"/>
+    </default>
+  </default>
+  <worldbody>
+    <geom type="plane" size="2 2 0.1"/>
+    <body name="base_link" pos="0 0 0.2" axisangle="0 0 1 30">
+      <geom type="cylinder" size="0.08 0.05"/>
+      <site name="base_site" pos="0.1 0 0" zaxis="1 1 0"/>
+      <body name="shoulder" pos="0 0.05 0.1" euler="10 20 30">
+        <joint name="yaw" axis="0 0 1" pos="0.01 0 0"/>
+        <joint name="pitch" axis="0 1 0" pos="0 0.02 0.03" ref="15"/>
+        <geom class="heavy" fromto="0 0 0 0.3 0 0.1"/>
+        <body name="elbow" pos="0.3 0 0.1" xyaxes="0 1 0 -1 0.2 0" childclass="wrist">
+          <joint name="elbow" axis="0 1 1" pos="0.01 0.02 0.03"/>
+          <inertial pos="0.1 0.01 0" quat="0.8 0.1 0.2 0.3" mass="1.2" diaginertia="0.01 0.02 0.025"/>
+          <geom/>
+          <body name="forearm" pos="0.25 0 0" zaxis="0 1 1">
+            <joint name="roll"/>
+            <joint name="extend" type="slide" axis="0 0 1" pos="0 0.1 0" class="main"/>
+            <inertial pos="0.05 0 0" mass="0.7" fullinertia="0.004 0.005 0.006 0.0005 -0.0003 0.0002"/>
+            <frame pos="0.1 0 0" euler="0 90 0">
+              <site name="tool_site" pos="0 0 0.05" quat="0.7 0 0.7 0.1"/>
+              <geom pos="0 0 0.02"/>
+            </frame>
+            <body name="hand" pos="0.12 0 0" quat="0.5 0.5 0.5 0.5">
+              <joint name="hand" axis="0 0 1" pos="0.01 0 0"/>
+              <geom size="0.05"/>
+              <geom class="fingertip" pos="0.03 0 0.05" euler="10 0 40"/>
+              <frame childclass="fingertip" pos="0 0.01 0.02"><geom/></frame>
+              <frame pos="0 0.02 0.04" axisangle="1 1 0 40">
+                <geom type="sphere" size="0.015" pos="0.01 0 0"/>
+              </frame>
+            </body>
+          </body>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+# Inertia from geoms only: every primitive, fromto on each shape that takes it, mass= and density=,
+# a geom outside inertiagrouprange, a plane (no mass)
+GEOMS = """<mujoco model="geoms">
+  <compiler inertiagrouprange="0 2"/>
+  <worldbody>
+    <body name="lumpy" pos="0.1 0 0.2">
+      <joint name="j" axis="0.3 1 0.2" pos="0.02 0.01 0"/>
+      <geom type="sphere" size="0.05" pos="0.1 0 0"/>
+      <geom type="box" size="0.05 0.04 0.03" pos="0 0.1 0" quat="0.9 0.3 0.1 0.2" density="300"/>
+      <geom type="box" size="0.02 0.03" fromto="0 0 0 0.1 0.2 0.3"/>
+      <geom type="capsule" size="0.03 0.1" pos="0 0 0.1" euler="20 30 40"/>
+      <geom type="capsule" size="0.02" fromto="0.1 0.1 0.1 -0.1 0.2 0.0" mass="0.8"/>
+      <geom type="cylinder" size="0.04 0.05" xyaxes="0 0 1 0 1 0"/>
+      <geom type="cylinder" size="0.01" fromto="0 0 0 0 0 -0.3"/>
+      <geom type="ellipsoid" size="0.03 0.05 0.07" pos="-0.1 0 0" axisangle="1 2 3 50"/>
+      <geom type="ellipsoid" size="0.03 0.04" fromto="0 0 0 0.2 0 -0.1"/>
+      <geom type="sphere" size="0.3" group="3"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+# ------------------------------------------------------------------------------------- helpers
+def both(xml: str, disable_constraints: bool = True):
+    """(kinedyn robot, MuJoCo model, MuJoCo data) of one MJCF string."""
+    robot = robot_from_mjcf(xml)
+    model = mujoco.MjModel.from_xml_string(xml)
+    if disable_constraints:
+        model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    return robot, model, mujoco.MjData(model)
+
+
+def mujoco_state(model, data, q, qd):
+    data.qpos[:] = q
+    data.qvel[:] = qd
+    mujoco.mj_forward(model, data)
+
+
+def compare_dynamics(robot, model, data, seed: int, states: int = 5):
+    """M, the bias forces and inverse dynamics (with damping) of kinedyn and MuJoCo at random states."""
+    rng = np.random.default_rng(seed)
+    n = robot.n
+    assert (model.nq, model.nv) == (n, n)
+    for _ in range(states):
+        q, qd, qdd = rng.uniform(-1.5, 1.5, n), rng.normal(size=n), rng.normal(size=n)
+        mujoco_state(model, data, q, qd)
+        M = np.zeros((n, n))
+        mujoco.mj_fullM(model, data, M)
+        np.testing.assert_allclose(robot.mass_matrix(q), M, atol=TOL, rtol=0)
+        # qfrc_bias = C qd + g (no friction, no damping)
+        np.testing.assert_allclose(robot.bias_torque(q, qd), data.qfrc_bias, atol=TOL, rtol=0)
+        data.qacc[:] = qdd
+        mujoco.mj_inverse(model, data)
+        # qfrc_inverse = M qacc + qfrc_bias - qfrc_passive, with qfrc_passive = -damping qvel here
+        np.testing.assert_allclose(robot.inverse_dynamics(q, qd, qdd), data.qfrc_inverse, atol=TOL, rtol=0)
+        compare_poses(robot, model, data, q)
+
+
+def compare_poses(robot, model, data, q):
+    """Every MuJoCo body's (xpos, xmat) and every site's against the frame of the same name."""
+    mujoco.mj_kinematics(model, data)
+    for b in range(1, model.nbody):
+        name = model.body(b).name or f"body{b}"
+        T = robot.pose(q, frame=name)
+        np.testing.assert_allclose(T[:3, 3], data.xpos[b], atol=TOL, rtol=0, err_msg=name)
+        np.testing.assert_allclose(T[:3, :3], data.xmat[b].reshape(3, 3), atol=TOL, rtol=0, err_msg=name)
+    frames = set(robot.frame_names)
+    for s in range(model.nsite):
+        name = model.site(s).name
+        name = name if f"site:{name}" not in frames else f"site:{name}"
+        T = robot.pose(q, frame=name)
+        np.testing.assert_allclose(T[:3, 3], data.site_xpos[s], atol=TOL, rtol=0, err_msg=name)
+        np.testing.assert_allclose(T[:3, :3], data.site_xmat[s].reshape(3, 3), atol=TOL, rtol=0, err_msg=name)
+
+
+def body_inertia_in_body_frame(model, b: int) -> tuple:
+    """(mass, centre of mass, 3x3 inertia about it in body axes) of MuJoCo's compiled body ``b``."""
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, model.body_iquat[b])
+    R = R.reshape(3, 3)
+    return model.body_mass[b], model.body_ipos[b], R @ np.diag(model.body_inertia[b]) @ R.T
+
+
+def link_inertia(robot, name: str):
+    return next(link.inertia for link in robot.links if link.name == name)
+
+
+def compare_inertias(robot, model):
+    for b in range(1, model.nbody):
+        name = model.body(b).name or f"body{b}"
+        mass, com, tensor = body_inertia_in_body_frame(model, b)
+        inertia = link_inertia(robot, name)
+        assert inertia.mass == pytest.approx(mass, abs=TOL, rel=0), name
+        if mass > 0:
+            np.testing.assert_allclose(inertia.com, com, atol=TOL, rtol=0, err_msg=name)
+            np.testing.assert_allclose(np.array(inertia.inertia), tensor, atol=TOL, rtol=0, err_msg=name)
+
+
+# ------------------------------------------------------------------------- MuJoCo as the oracle
+def test_double_pendulum_with_off_origin_hinges_agrees_with_mujoco():
+    robot, model, data = both(DOUBLE_PENDULUM)
+    assert robot.joint_names == ["shoulder", "elbow"]
+    assert [j.rotor_inertia for j in robot.joints] == [0.02, 0.01]
+    assert [j.viscous for j in robot.joints] == [0.4, 0.1]
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=1)
+
+
+def test_cart_pole_slide_and_hinge_with_ref_and_limits_agrees_with_mujoco():
+    robot, model, data = both(CART_POLE)
+    slider, hinge = robot.joints
+    assert (slider.kind, hinge.kind) == ("prismatic", "revolute")
+    # MuJoCo's qpos is kinedyn's q: the reference position ref becomes the offset -ref
+    assert slider.offset == pytest.approx(-0.3) and hinge.offset == pytest.approx(-math.radians(10))
+    assert (slider.lower, slider.upper) == (-2.0, 2.0)
+    assert (hinge.lower, hinge.upper) == pytest.approx((-math.radians(120), math.radians(120)))
+    np.testing.assert_allclose(model.jnt_range, [[-2, 2], [-math.radians(120), math.radians(120)]])
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=2)
+
+
+@pytest.mark.parametrize("eulerseq", ["xyz", "zyx", "XYZ", "zYx"])
+def test_arm_with_defaults_frames_and_joint_chains_agrees_with_mujoco(eulerseq):
+    xml = ARM.format(eulerseq=eulerseq)
+    robot, model, data = both(xml)
+    assert robot.joint_names == ["yaw", "pitch", "elbow", "roll", "extend", "hand"]
+    # two joints in one body: a massless link at the first joint, the body's inertia on the second
+    assert link_inertia(robot, "shoulder/yaw").mass == 0 and link_inertia(robot, "forearm/roll").mass == 0
+    roll, extend, hand = robot.joints[3:]
+    # childclass "wrist": axis, damping and range; class="main" overrides it; the top default's armature
+    assert roll.axis == (1.0, 0.0, 0.0) and roll.viscous == 0.1 and roll.upper == pytest.approx(math.pi / 2)
+    assert extend.kind == "prismatic" and extend.viscous == 0.3 and extend.upper == math.inf
+    assert hand.rotor_inertia == 0.05 and hand.viscous == 0.1
+    assert {"base_site", "tool_site"} <= set(robot.frame_names)
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=3)
+
+
+def test_inertia_from_geoms_agrees_with_mujoco():
+    robot, model, data = both(GEOMS)
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=4)
+
+
+def test_inertiafromgeom_true_replaces_the_inertial_and_false_ignores_the_geoms():
+    body = ('<body name="b"><joint name="j" axis="1 0 0"/><inertial pos="0.1 0 0" mass="3" diaginertia="1 2 3"/>'
+            '<geom type="box" size="0.1 0.2 0.3" pos="0 0.1 0"/></body>')
+    for setting in ("true", "false", "auto"):
+        xml = f'<mujoco><compiler inertiafromgeom="{setting}"/><worldbody>{body}</worldbody></mujoco>'
+        robot, model, _ = both(xml)
+        compare_inertias(robot, model)
+        assert link_inertia(robot, "b").mass == pytest.approx(3.0 if setting != "true" else 1000 * 0.2 * 0.4 * 0.6)
+
+
+def test_the_mujoco_test_model_with_its_free_and_ball_joints_turned_into_hinges_agrees():
+    """The `mujoco` wheel's own testdata/model.xml (defaults with springs, fromto capsules, boxes and
+    cylinders, ellipsoids, sites, tendons, actuators, sensors), its free and ball joints made hinges
+    (the numeric engine takes 1-DOF joints until the multi-DOF core lands) and its mesh body (whose
+    inertia kinedyn does not compute) given a box instead."""
+    text = _mujoco_test_model()
+    text = text.replace("<freejoint/>", '<joint type="hinge" axis="0.2 0.3 1"/>').replace('type="ball"', 'type="hinge"')
+    text = without_mesh_geom(text)
+    text = text.replace('<weld body1="world" body2="cylinder"/>', "")
+    text = re.sub(r"<keyframe>.*?</keyframe>", "", text, flags=re.S)  # its qpos is for free and ball joints
+    with pytest.warns(UserWarning, match=r"does not model.*<actuator>.*<sensor>.*<tendon>.*spring \(stiffness\) of joint 'hipy_0'"):
+        robot = robot_from_mjcf(text)
+    model = mujoco.MjModel.from_xml_string(text)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING)
+    model.opt.density = model.opt.viscosity = 0.0  # no fluid forces (kinedyn has no fluid model)
+    model.body_gravcomp[:] = 0  # kinedyn does not model gravity compensation (named in the warning)
+    assert robot.joint_names == [model.joint(i).name or f"joint{i}" for i in range(model.njnt)]
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, mujoco.MjData(model), seed=5, states=3)
+
+
+def without_mesh_geom(text: str) -> str:
+    mesh = '<geom type="mesh" mesh="icosahedron" size=".1" rgba="0 0 1 1"/>'
+    assert mesh in text
+    return text.replace(mesh, '<geom type="box" size=".1 .05 .08" rgba="0 0 1 1"/>')
+
+
+def _mujoco_test_model() -> str:
+    path = os.path.join(os.path.dirname(mujoco.__file__), "testdata", "model.xml")
+    with open(path) as f:
+        return f.read()
+
+
+def test_the_mujoco_test_model_names_its_mesh_body_whose_inertia_is_not_computed():
+    path = os.path.join(os.path.dirname(mujoco.__file__), "testdata", "model.xml")
+    with pytest.raises(ValueError, match=r"model\.xml:\d+: <geom> geom of body 'body9': kinedyn does not compute a mesh's inertia"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            robot_from_mjcf(path)
+
+
+# ----------------------------------------------------------------- ball and free joints: structure
+def test_ball_and_free_joints_parse_with_mujoco_sizes_placements_and_inertias():
+    text = without_mesh_geom(_mujoco_test_model())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = robot_from_mjcf(text)
+    model = mujoco.MjModel.from_xml_string(text)
+    kinds = {0: "floating", 1: "spherical", 2: "prismatic", 3: "revolute"}
+    assert [j.kind for j in robot.joints] == [kinds[int(t)] for t in model.jnt_type]
+    assert (robot.nq, robot.nv) == (model.nq, model.nv)
+    assert robot.has_multi_dof_joints
+    compare_inertias(robot, model)
+    links = {link.name: link for link in robot.links}
+    # a free body sits at qpos in the world: its placement is the identity (its pos/quat are qpos0)
+    assert np.array_equal(links["head"].placement, np.eye(4)) and links["head"].parent is None or links["head"].parent == "world"
+    # the ball joint's link: its body's pose in the parent, at the joint position (here 0)
+    wheel = next(l for l in robot.links if l.joint.name == "wheel_0")
+    b = model.jnt_bodyid[model.joint("wheel_0").id]
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, model.body_quat[b])
+    np.testing.assert_allclose(wheel.placement[:3, 3], model.body_pos[b], atol=TOL)
+    np.testing.assert_allclose(wheel.placement[:3, :3], R.reshape(3, 3), atol=TOL)
+
+
+def test_a_ball_joint_off_its_body_origin_is_placed_at_the_joint():
+    xml = ('<mujoco><worldbody><body name="b" pos="1 2 3" euler="0 0 90"><joint name="ball" type="ball" pos="0.1 0.2 0.3"/>'
+           '<geom size="0.1"/></body></worldbody></mujoco>')
+    link = robot_from_mjcf(xml).links[0]
+    assert link.joint.kind == "spherical"
+    np.testing.assert_allclose(link.placement[:3, 3], [1 - 0.2, 2 + 0.1, 3 + 0.3], atol=1e-12)
+    np.testing.assert_allclose(link.post[:3, 3], [-0.1, -0.2, -0.3])
+
+
+def test_a_free_joint_must_be_the_only_joint_of_a_top_level_body():
+    xml = '<mujoco><worldbody><body><geom size="1"/><body><freejoint/><geom size="1"/></body></body></worldbody></mujoco>'
+    with pytest.raises(ValueError, match=r"<MJCF string>:1: <freejoint> joint 'joint0': a free joint must be the only joint"):
+        robot_from_mjcf(xml)
+
+
+# ------------------------------------------------------------------------------ files and includes
+def test_kd_load_reads_an_mjcf_file_with_includes(tmp_path):
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "pole.xml").write_text(
+        '<mujoco><body name="pole" pos="0 0 0.05"><joint name="hinge" axis="0 1 0"/>'
+        '<geom type="cylinder" fromto="0 0 0 0 0 0.8" size="0.02" mass="0.3"/></body></mujoco>')
+    (tmp_path / "defaults.xml").write_text('<mujoco><default><joint damping="0.25"/></default></mujoco>')
+    (tmp_path / "model.xml").write_text(
+        '<mujoco model="included"><include file="defaults.xml"/><worldbody><body name="cart">'
+        '<joint name="slider" type="slide" axis="1 0 0"/><geom type="box" size="0.2 0.1 0.05"/>'
+        '<include file="parts/pole.xml"/></body></worldbody></mujoco>')
+    robot = kd.load(tmp_path / "model.xml")
+    assert robot.name == "included" and robot.joint_names == ["slider", "hinge"]
+    assert [j.viscous for j in robot.joints] == [0.25, 0.25]
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "model.xml"))
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    compare_dynamics(robot, model, mujoco.MjData(model), seed=6, states=2)
+    assert kd.Robot.from_mjcf(str(tmp_path / "model.xml")).joint_names == robot.joint_names
+
+
+def test_an_include_may_not_leave_the_model_folder(tmp_path):
+    (tmp_path / "secret.xml").write_text("<mujoco/>")
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "model.xml").write_text('<mujoco><include file="../secret.xml"/><worldbody/></mujoco>')
+    with pytest.raises(ValueError, match=r"model\.xml:1: <include> file='\.\./secret\.xml' is outside the model's folder"):
+        kd.load(tmp_path / "m" / "model.xml")
+
+
+def test_includes_are_depth_bounded(tmp_path):
+    (tmp_path / "loop.xml").write_text('<mujoco><include file="loop.xml"/></mujoco>')
+    with pytest.raises(ValueError, match=rf"<include> file='loop\.xml': includes nested deeper than {MAX_INCLUDE_DEPTH} levels"):
+        robot_from_mjcf(str(tmp_path / "loop.xml"))
+
+
+def test_a_string_cannot_include():
+    with pytest.raises(ValueError, match=r"<MJCF string>:1: <include> file='x\.xml': a model given as an XML string cannot include"):
+        robot_from_mjcf('<mujoco><include file="x.xml"/></mujoco>')
+
+
+# ----------------------------------------------------------------------------------- security
+def test_entities_and_doctype_declarations_are_refused():
+    bomb = ('<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]>'
+            '<mujoco model="&b;"><worldbody/></mujoco>')
+    with pytest.raises(ValueError, match="DOCTYPE with declarations"):
+        robot_from_mjcf(bomb)
+
+
+def test_nesting_is_bounded():
+    xml = "<mujoco><worldbody>" + "<body>" * (MAX_DEPTH + 1) + "</body>" * (MAX_DEPTH + 1) + "</worldbody></mujoco>"
+    with pytest.raises(ValueError, match=f"nested deeper than {MAX_DEPTH}"):
+        robot_from_mjcf(xml)
+
+
+@pytest.mark.parametrize(
+    "inner, message",
+    [
+        ('<joint name="j" range="1 a"/>', r"<joint> attribute 'range' must be numbers, got '1 a'"),
+        ('<joint name="j" range="2 1" limited="true"/>', r"<joint> joint 'j': attribute 'range' has lower 2 above upper 1"),
+        ('<joint name="j" type="universal"/>', r"<joint> joint 'j': attribute 'type' is 'universal'"),
+        ('<joint name="j" axis="0 0 0"/>', r"<joint> joint 'j': axis .* zero"),
+        ('<joint name="j" axis="0 0 nan"/>', r"<joint> attribute 'axis' must hold finite numbers"),
+        ('<joint name="j" class="nope"/>', r"<joint> class='nope' names no <default> class"),
+        ('<joint name="j"/><geom type="box" size="1 1"/>', r"<geom> geom: a box needs 3 positive size numbers"),
+        ('<joint name="j"/><geom type="torus"/>', r"<geom> geom: attribute 'type' is 'torus'"),
+        ('<joint name="j"/><geom size="1" quat="1 0 0 0" euler="0 0 0"/>', r"<geom> gives its orientation twice \(quat, euler\)"),
+        ('<joint name="j"/><inertial mass="1"/>', r"<inertial> of body 'b' has neither 'diaginertia' nor 'fullinertia'"),
+        ('<joint name="j"/><inertial mass="-1" diaginertia="1 1 1"/>', r"<inertial> of body 'b': attribute 'mass' is negative"),
+        ('<joint name="j"/><geom type="mesh" mesh="m"/>', r"<geom> geom: mesh='m' names no <asset><mesh>"),
+    ],
+)
+def test_every_error_names_the_line_the_element_and_the_attribute(inner, message):
+    xml = f'<mujoco>\n<worldbody>\n<body name="b">{inner}</body></worldbody></mujoco>'
+    with pytest.raises(ValueError, match=r"^<MJCF string>:3: " + message):
+        robot_from_mjcf(xml)
+
+
+def test_errors_from_a_file_name_the_file(tmp_path):
+    path = tmp_path / "bad.xml"
+    path.write_text('<mujoco>\n<worldbody>\n<body>\n<joint name="j" ref="x"/></body></worldbody></mujoco>')
+    with pytest.raises(ValueError, match=r"bad\.xml:4: <joint> attribute 'ref' must be numbers"):
+        kd.load(path)
+    with pytest.raises(ValueError, match=r"cannot read MJCF file"):
+        kd.load(tmp_path / "missing.xml")
+
+
+def test_a_model_without_joints_or_worldbody_is_refused():
+    with pytest.raises(ValueError, match="has no joint"):
+        robot_from_mjcf('<mujoco><worldbody><body><geom size="1"/></body></worldbody></mujoco>')
+    with pytest.raises(ValueError, match=r"<mujoco> has no <worldbody>"):
+        robot_from_mjcf("<mujoco></mujoco>")
+    with pytest.raises(ValueError, match=r"the root element is <robot>, expected <mujoco>"):
+        robot_from_mjcf("<robot/>")
+
+
+@pytest.mark.parametrize("tag", ["replicate", "composite", "attach", "flexcomp"])
+def test_elements_that_generate_bodies_are_refused(tag):
+    with pytest.raises(ValueError, match=rf"<{tag}> is not read by kinedyn"):
+        robot_from_mjcf(f'<mujoco><worldbody><body><joint/><geom size="1"/><{tag}/></body></worldbody></mujoco>')
+
+
+# --------------------------------------------------------------------------------- geometry
+def test_geoms_become_visuals_and_collisions():
+    xml = ('<mujoco><asset><material name="red" rgba="1 0 0 1"/><mesh name="part" file="part.stl" scale="2 2 2"/></asset>'
+           '<worldbody><geom name="floor" type="plane" size="1 1 1"/><body name="b"><joint/><inertial mass="1" diaginertia="1 1 1"/>'
+           '<geom type="box" size="0.1 0.2 0.3" material="red" pos="1 0 0"/>'
+           '<geom type="capsule" size="0.1 0.5" contype="0" conaffinity="0" rgba="0 1 0 1"/>'
+           '<geom type="mesh" mesh="part" group="3"/></body></worldbody></mujoco>')
+    robot = robot_from_mjcf(xml)
+    shapes = [(v.frame, v.describe(), v.rgba) for v in robot.visuals]
+    assert shapes == [("b", "box", (1.0, 0.0, 0.0, 1.0)), ("b", "cylinder", (0.0, 1.0, 0.0, 1.0))]
+    assert robot.visuals[0].shape.size == (0.2, 0.4, 0.6) and robot.visuals[0].origin[0, 3] == 1.0
+    assert robot.visuals[1].shape.length == pytest.approx(1.2)
+    assert [v.describe() for v in robot.collisions] == ["box", "mesh 'part.stl'"]
+    assert robot.collisions[1].shape.scale == (2.0, 2.0, 2.0)
