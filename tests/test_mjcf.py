@@ -154,8 +154,7 @@ def compare_dynamics(robot, model, data, seed: int, states: int = 5):
     for _ in range(states):
         q, qd, qdd = rng.uniform(-1.5, 1.5, n), rng.normal(size=n), rng.normal(size=n)
         mujoco_state(model, data, q, qd)
-        M = np.zeros((n, n))
-        mujoco.mj_fullM(model, data, M)
+        M = full_mass_matrix(model, data)
         np.testing.assert_allclose(robot.mass_matrix(q), M, atol=TOL, rtol=0)
         # qfrc_bias = C qd + g (no friction, no damping)
         np.testing.assert_allclose(robot.bias_torque(q, qd), data.qfrc_bias, atol=TOL, rtol=0)
@@ -181,6 +180,15 @@ def compare_poses(robot, model, data, q):
         T = robot.pose(q, frame=name)
         np.testing.assert_allclose(T[:3, 3], data.site_xpos[s], atol=TOL, rtol=0, err_msg=name)
         np.testing.assert_allclose(T[:3, :3], data.site_xmat[s].reshape(3, 3), atol=TOL, rtol=0, err_msg=name)
+
+
+def full_mass_matrix(model, data) -> np.ndarray:
+    M = np.zeros((model.nv, model.nv))
+    try:
+        mujoco.mj_fullM(model, data, M)  # MuJoCo >= 3.4 (m, d, dst)
+    except TypeError:
+        mujoco.mj_fullM(model, M, data.qM)  # earlier (m, dst, qM)
+    return M
 
 
 def body_inertia_in_body_frame(model, b: int) -> tuple:

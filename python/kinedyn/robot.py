@@ -8,6 +8,7 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 from __future__ import annotations
 
 import math
+import os
 import sys
 from functools import cached_property
 from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
@@ -134,13 +135,25 @@ class Robot:
         return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
-    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
+                  xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False, package_dirs: Sequence[PathLike] = ()) -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
-        or ``"strict"`` (ValueError); see docs/model-files.md."""
-        from .description.urdf import robot_from_urdf
+        or ``"strict"`` (ValueError); see docs/model-files.md.
 
+        A path ending in ``.xacro`` is expanded by the ``xacro`` package first, with ``xacro_args``
+        (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
+        Python expressions from the file, so it needs ``trust_xacro=True``
+        (:mod:`kinedyn.description.xacro`)."""
+        from .description.urdf import robot_from_urdf
+        from .description.xacro import expand_xacro, is_xacro
+
+        if is_xacro(path_or_string):
+            text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
+            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, source_path=os.fspath(path_or_string))
+        if xacro_args:
+            raise ValueError("xacro_args are for a .xacro file")
         return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
     @classmethod
