@@ -24,7 +24,7 @@ import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Dict, Optional, Sequence
+from typing import Any, Callable, Dict, Optional, Sequence
 
 import numpy as np
 
@@ -101,7 +101,7 @@ def _robot_file(spec: str):
     if path.is_dir():
         raise ValueError(f"robot file '{spec}' is a folder")
     run = _INVOCATION.get()
-    options = {}
+    options: Dict[str, Any] = {}
     if ext == ".xacro" and run is not None:
         options = {"xacro_args": run.xacro_args, "trust_xacro": run.trust_xacro}
     try:

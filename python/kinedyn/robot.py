@@ -151,7 +151,7 @@ class Robot:
 
         if is_xacro(path_or_string):
             text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
-            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, source_path=os.fspath(path_or_string))
+            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, source_path=os.fsdecode(path_or_string))
         if xacro_args:
             raise ValueError("xacro_args are for a .xacro file")
         return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)

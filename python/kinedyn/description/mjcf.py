@@ -323,7 +323,7 @@ class _Reader:
         self.root = root
         self.ignored: set = set()
         self.compiler()
-        self.defaults = {}  # class name -> {element tag: {attribute: value}}
+        self.defaults: dict = {}  # class name -> {element tag: {attribute: value}}
         self.gravity = self.option()
         for section in root.iterfind("default"):
             self.read_defaults(section, "main", {t: {} for t in _DEFAULTED})

@@ -52,7 +52,7 @@ def expand_xacro(path, xacro_args: Optional[Mapping[str, object]] = None, *, tru
     if not os.path.isfile(path):
         raise ValueError(f"{path}: cannot read xacro file (no such file)")
     try:
-        import xacro
+        import xacro  # type: ignore[import-untyped]
         from xacro import substitution_args
     except ImportError:
         raise ValueError(f"{path}: reading xacro files needs the 'xacro' package (pip install xacro, or kinedyn[ros])") from None
