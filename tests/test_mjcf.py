@@ -464,3 +464,84 @@ def test_geoms_become_visuals_and_collisions():
     assert robot.visuals[1].shape.length == pytest.approx(1.2)
     assert [v.describe() for v in robot.collisions] == ["box", "mesh 'part.stl'"]
     assert robot.collisions[1].shape.scale == (2.0, 2.0, 2.0)
+
+
+def test_the_warning_names_what_is_ignored_and_points_at_the_caller():
+    xml = ('<mujoco><worldbody><body gravcomp="1"><joint name="j" stiffness="3"/><geom size="1"/></body></worldbody>'
+           '<actuator><motor joint="j"/></actuator></mujoco>')
+    with pytest.warns(UserWarning, match=r"<actuator> \(1 elements\); gravcomp of body 'body1'; the spring \(stiffness\) of joint 'j'") as caught:
+        robot_from_mjcf(xml)
+    assert len(caught) == 1 and caught[0].filename == __file__
+
+
+def test_the_cli_reads_an_mjcf_file(tmp_path):
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    path = tmp_path / "cart_pole.xml"
+    path.write_text(CART_POLE)
+    env = {**os.environ, "PYTHONPATH": str(Path(kd.__file__).parents[1])}
+    done = subprocess.run([sys.executable, "-m", "kinedyn", "info", str(path), "--json"], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "slider" in done.stdout and "hinge" in done.stdout and json.loads(done.stdout)
+
+
+# ------------------------------------------------------------------------------ random models
+def random_model(seed: int) -> str:
+    """A random tree of bodies: each hangs from an earlier one, with 0-3 hinge/slide joints at random
+    positions and axes, its pose written in a random one of MuJoCo's five orientation forms, and an
+    <inertial> (diagonal with a quat, or full) or geoms only."""
+    rng = np.random.default_rng(seed)
+    angle = rng.choice(["degree", "radian"])
+    scale = 180 / np.pi if angle == "degree" else 1.0
+    vec = lambda n: " ".join(f"{v:.6f}" for v in rng.uniform(-1, 1, n))
+
+    def orientation():
+        form = rng.integers(6)
+        if form == 0:
+            return ""
+        if form == 1:
+            return f' quat="{vec(4)}"'
+        if form == 2:
+            return f' axisangle="{vec(3)} {rng.uniform(-3, 3) * scale:.6f}"'
+        if form == 3:
+            return f' euler="{" ".join(f"{a * scale:.6f}" for a in rng.uniform(-3, 3, 3))}"'
+        if form == 4:
+            return f' xyaxes="{vec(6)}"'
+        return f' zaxis="{vec(3)}"'
+
+    def body(k: int, depth: int) -> str:
+        parts = [f'<body name="b{k}" pos="{vec(3)}"{orientation()}>']
+        for j in range(rng.integers(0 if depth else 1, 4)):
+            kind = rng.choice(["hinge", "slide"])
+            parts.append(f'<joint name="j{k}_{j}" type="{kind}" axis="{vec(3)}" pos="{vec(3)}" armature="{rng.uniform(0, 0.1):.4f}" damping="{rng.uniform(0, 1):.4f}"/>')
+        if rng.random() < 0.5:
+            m = rng.uniform(0.5, 3)
+            d = np.sort(rng.uniform(0.05, 0.2, 3))
+            parts.append(f'<inertial pos="{vec(3)}"{orientation()} mass="{m:.4f}" diaginertia="{d[0] + d[1]:.5f} {d[1] + d[2]:.5f} {d[0] + d[2]:.5f}"/>')
+        else:
+            for _ in range(rng.integers(1, 3)):
+                shape = rng.choice(["box", "sphere", "capsule", "cylinder", "ellipsoid"])
+                parts.append(f'<geom type="{shape}" size="{" ".join(f"{s:.4f}" for s in rng.uniform(0.02, 0.2, 3))}" pos="{vec(3)}"{orientation()}/>')
+        return "\n".join(parts)
+
+    text, open_bodies, k = [], 0, 0
+    for k in range(int(rng.integers(2, 7))):
+        # close 0..open-1 bodies, so the next hangs from a random ancestor
+        close = int(rng.integers(0, open_bodies)) if open_bodies > 1 else 0
+        text += ["</body>"] * close
+        open_bodies -= close
+        text.append(body(k, open_bodies))
+        open_bodies += 1
+    text += ["</body>"] * open_bodies
+    return f'<mujoco><compiler angle="{angle}"/><option gravity="{vec(3)}"/><worldbody>' + "\n".join(text) + "</worldbody></mujoco>"
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_random_models_agree_with_mujoco(seed):
+    xml = random_model(seed)
+    robot, model, data = both(xml)
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=seed, states=3)

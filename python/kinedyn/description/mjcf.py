@@ -123,9 +123,16 @@ def robot_from_mjcf(path_or_string, *, tool: Optional[str] = None, inertia: str 
 
 
 def _caller_level() -> int:
-    from .urdf import _caller_level as level
+    """The stacklevel, for a warning raised in the function that calls this, of the first frame
+    outside kinedyn (so the warning points at the user's call)."""
+    import sys
 
-    return level() + 1
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame = sys._getframe(2)
+    level = 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 # ============================================================================== XML, bounded
