@@ -545,3 +545,151 @@ def test_random_models_agree_with_mujoco(seed):
     robot, model, data = both(xml)
     compare_inertias(robot, model)
     compare_dynamics(robot, model, data, seed=seed, states=3)
+
+
+# ------------------------------------------- ball and free joints: numbers, through Pinocchio
+FREE, BALL = int(mujoco.mjtJoint.mjJNT_FREE), int(mujoco.mjtJoint.mjJNT_BALL)
+
+
+def mujoco_to_pinocchio_state(model, qpos, qvel, qacc):
+    """(q, v, vdot) in kinedyn's (Pinocchio's) conventions and T with qvel = T v, from MuJoCo's.
+
+    Quaternions: MuJoCo (w, x, y, z) -> (x, y, z, w). Free joint: MuJoCo's qvel is [linear velocity of
+    the body origin in world axes; angular velocity in body axes], Pinocchio's [linear; angular] both
+    in body axes: v_lin = R^T qvel_lin, and d/dt (R^T v_world) = R^T a_world - w x v_lin. Ball joint:
+    angular velocity in the child's axes in both."""
+    q, v, vd, T = [], np.array(qvel, float), np.array(qacc, float), np.eye(model.nv)
+    for j in range(model.njnt):
+        a, b, kind = model.jnt_qposadr[j], model.jnt_dofadr[j], int(model.jnt_type[j])
+        if kind == FREE:
+            R = np.zeros(9)
+            mujoco.mju_quat2Mat(R, qpos[a + 3:a + 7])
+            R = R.reshape(3, 3)
+            q += [*qpos[a:a + 3], *qpos[a + 4:a + 7], qpos[a + 3]]
+            v[b:b + 3] = R.T @ qvel[b:b + 3]
+            vd[b:b + 3] = R.T @ qacc[b:b + 3] - np.cross(qvel[b + 3:b + 6], v[b:b + 3])
+            T[b:b + 3, b:b + 3] = R
+        elif kind == BALL:
+            q += [*qpos[a + 1:a + 4], qpos[a]]
+        else:
+            q.append(qpos[a])
+    return np.array(q), v, vd, T
+
+
+def random_qpos(model, rng):
+    qpos = model.qpos0.copy()
+    for j in range(model.njnt):
+        a, kind = model.jnt_qposadr[j], int(model.jnt_type[j])
+        if kind == FREE:
+            qpos[a:a + 3] = rng.normal(size=3)
+            a += 3
+        if kind in (FREE, BALL):
+            quat = rng.normal(size=4)
+            qpos[a:a + 4] = quat / np.linalg.norm(quat)
+        else:
+            qpos[a] = rng.uniform(-1.5, 1.5)
+    return qpos
+
+
+def pinocchio_model_of(robot):
+    """A Pinocchio model made from kinedyn's compiled tree (joint kinds, placements, inertias, rotor
+    inertias) and nothing else: it checks the MJCF reader's description of ball and free joints while
+    kinedyn's numeric engine takes 1-DOF joints only."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) stands in for the multi-DOF core")
+    model = pin.Model()
+    model.gravity.linear = np.array(robot.gravity, dtype=float)
+    armature = []
+    for i, body in enumerate(robot.tree.bodies):
+        j = body.joint
+        if j.kind == "revolute":
+            joint = pin.JointModelRevoluteUnaligned(np.array(j.axis, dtype=float))
+        elif j.kind == "prismatic":
+            joint = pin.JointModelPrismaticUnaligned(np.array(j.axis, dtype=float))
+        elif j.kind == "spherical":
+            joint = pin.JointModelSpherical()
+        else:
+            assert j.kind == "floating"
+            joint = pin.JointModelFreeFlyer()
+        placement = np.array(body.placement, dtype=float)
+        index = model.addJoint(body.parent + 1, joint, pin.SE3(placement[:3, :3], placement[:3, 3]), j.name)
+        inertia = body.inertia
+        model.appendBodyToJoint(index, pin.Inertia(float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)), pin.SE3.Identity())
+        armature += [float(j.armature)] * j.nv
+        assert j.offset == 0  # (the models below have no ref)
+    model.armature = np.array(armature)
+    return model
+
+
+def compare_multi_dof(robot, model, seed: int, states: int = 3):
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) stands in for the multi-DOF core")
+    pm = pinocchio_model_of(robot)
+    pd = pm.createData()
+    assert (pm.nq, pm.nv) == (model.nq, model.nv) == (robot.nq, robot.nv)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(seed)
+    for _ in range(states):
+        qpos, qvel, qacc = random_qpos(model, rng), rng.normal(size=model.nv), rng.normal(size=model.nv)
+        mujoco_state(model, data, qpos, qvel)
+        M = full_mass_matrix(model, data)
+        data.qacc[:] = qacc
+        mujoco.mj_inverse(model, data)
+        q, v, vd, T = mujoco_to_pinocchio_state(model, qpos, qvel, qacc)
+        Mp = pin.crba(pm, pd, q)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        # the mass matrix and generalised forces in kinedyn's velocity coordinates: T^T M T, T^T tau
+        np.testing.assert_allclose(Mp, T.T @ M @ T, atol=TOL, rtol=0)
+        np.testing.assert_allclose(pin.rnea(pm, pd, q, v, vd), T.T @ data.qfrc_inverse, atol=TOL, rtol=0)
+        pin.forwardKinematics(pm, pd, q)
+        mujoco.mj_kinematics(model, data)
+        for b in range(1, model.nbody):
+            frame = robot.tree.frames[robot.tree.frame_index(model.body(b).name or f"body{b}")]
+            pose = (pd.oMi[frame.body + 1].homogeneous if frame.body >= 0 else np.eye(4)) @ np.array(frame.placement, dtype=float)
+            np.testing.assert_allclose(pose[:3, 3], data.xpos[b], atol=TOL, rtol=0)
+            np.testing.assert_allclose(pose[:3, :3], data.xmat[b].reshape(3, 3), atol=TOL, rtol=0)
+
+
+BALLS = """<mujoco model="balls">
+  <option gravity="0.1 -0.2 -9.81"/>
+  <worldbody>
+    <body name="torso" pos="0 0 1" euler="10 20 30">
+      <freejoint name="root"/>
+      <inertial pos="0.1 0.02 0.03" mass="3" diaginertia="0.1 0.2 0.15" quat="0.9 0.1 0.2 0.1"/>
+      <body name="arm" pos="0.3 0 0" axisangle="1 1 0 30">
+        <joint name="shoulder" type="ball" pos="0.05 0.02 -0.03" armature="0"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+        <body name="forearm" pos="0.3 0 0">
+          <joint name="elbow" axis="0 1 0" pos="0.01 0 0" armature="0.02"/>
+          <joint name="twist" axis="1 0 0"/>
+          <geom type="box" size="0.1 0.02 0.03" pos="0.1 0 0"/>
+          <body name="hand" pos="0.2 0 0"><joint name="wrist" type="ball"/><geom type="sphere" size="0.04" pos="0.04 0 0"/></body>
+        </body>
+      </body>
+    </body>
+    <body name="ball" pos="1 0 0"><freejoint/><geom type="ellipsoid" size="0.1 0.2 0.3"/></body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_free_and_ball_joints_off_their_origins_agree_with_mujoco_through_pinocchio():
+    robot = robot_from_mjcf(BALLS)
+    assert [j.kind for j in robot.joints] == ["floating", "spherical", "revolute", "revolute", "spherical", "floating"]
+    model = mujoco.MjModel.from_xml_string(BALLS)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    compare_multi_dof(robot, model, seed=7)
+
+
+def test_the_mujoco_test_model_with_free_and_ball_joints_agrees_through_pinocchio():
+    text = without_mesh_geom(_mujoco_test_model())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = robot_from_mjcf(text)
+    model = mujoco.MjModel.from_xml_string(text)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING)
+    model.opt.density = model.opt.viscosity = 0.0
+    model.body_gravcomp[:] = 0
+    model.dof_damping[:] = 0  # Pinocchio's rnea has no damping (kinedyn's does: see the 1-DOF tests)
+    for j in range(model.njnt):  # kinedyn ignores (and names in its warning) a ball joint's armature
+        if int(model.jnt_type[j]) == BALL:
+            model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
+    compare_multi_dof(robot, model, seed=8)
