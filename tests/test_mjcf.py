@@ -415,8 +415,9 @@ def test_nesting_is_bounded():
         ('<joint name="j"/><geom type="box" size="1 1"/>', r"<geom> geom: a box needs 3 positive size numbers"),
         ('<joint name="j"/><geom type="torus"/>', r"<geom> geom: attribute 'type' is 'torus'"),
         ('<joint name="j"/><geom size="1" quat="1 0 0 0" euler="0 0 0"/>', r"<geom> gives its orientation twice \(quat, euler\)"),
-        ('<joint name="j"/><inertial mass="1"/>', r"<inertial> of body 'b' has neither 'diaginertia' nor 'fullinertia'"),
-        ('<joint name="j"/><inertial mass="-1" diaginertia="1 1 1"/>', r"<inertial> of body 'b': attribute 'mass' is negative"),
+        ('<joint name="j"/><inertial pos="0 0 0" mass="1"/>', r"<inertial> of body 'b' has neither 'diaginertia' nor 'fullinertia'"),
+        ('<joint name="j"/><inertial mass="1" diaginertia="1 1 1"/>', r"<inertial> of body 'b' has no 'pos' attribute \(MuJoCo requires it\)"),
+        ('<joint name="j"/><inertial pos="0 0 0" mass="-1" diaginertia="1 1 1"/>', r"<inertial> of body 'b': attribute 'mass' is negative"),
         ('<joint name="j"/><geom type="mesh" mesh="m"/>', r"<geom> geom: mesh='m' names no <asset><mesh>"),
     ],
 )
@@ -453,7 +454,7 @@ def test_elements_that_generate_bodies_are_refused(tag):
 # --------------------------------------------------------------------------------- geometry
 def test_geoms_become_visuals_and_collisions():
     xml = ('<mujoco><asset><material name="red" rgba="1 0 0 1"/><mesh name="part" file="part.stl" scale="2 2 2"/></asset>'
-           '<worldbody><geom name="floor" type="plane" size="1 1 1"/><body name="b"><joint/><inertial mass="1" diaginertia="1 1 1"/>'
+           '<worldbody><geom name="floor" type="plane" size="1 1 1"/><body name="b"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
            '<geom type="box" size="0.1 0.2 0.3" material="red" pos="1 0 0"/>'
            '<geom type="capsule" size="0.1 0.5" contype="0" conaffinity="0" rgba="0 1 0 1"/>'
            '<geom type="mesh" mesh="part" group="3"/></body></worldbody></mujoco>')
@@ -693,3 +694,69 @@ def test_the_mujoco_test_model_with_free_and_ball_joints_agrees_through_pinocchi
         if int(model.jnt_type[j]) == BALL:
             model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
     compare_multi_dof(robot, model, seed=8)
+
+
+@pytest.mark.parametrize(
+    "options, extra",
+    [
+        ('boundmass="2" boundinertia="0.05"', '<body name="light" pos="0 0 1"><joint name="y"/><geom size="0.01" pos="0.1 0 0" mass="0.1"/></body>'),
+        ('settotalmass="7"', ""),
+        ('balanceinertia="true"', '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/></body>'),
+        ('boundmass="0.5" boundinertia="0.01" settotalmass="3" balanceinertia="true"',
+         '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/>'
+         '<body name="empty"><joint name="y"/></body></body>'),
+    ],
+)
+def test_compiler_inertia_adjustments_agree_with_mujoco(options, extra):
+    xml = random_model(3).replace("<compiler ", f"<compiler {options} ").replace("</worldbody>", extra + "</worldbody>")
+    robot, model, data = both(xml)
+    compare_inertias(robot, model)
+    compare_dynamics(robot, model, data, seed=9, states=2)
+
+
+# ----------------------------------------------------- the MJCF files pybullet ships (gym's models)
+def pybullet_mjcf_files():
+    """pybullet_data's MJCF files that today's MuJoCo compiles (a few are in MuJoCo 1.x syntax)."""
+    try:
+        import pybullet_data
+    except ImportError:
+        return []
+    folder = os.path.join(pybullet_data.getDataPath(), "mjcf")
+    out = []
+    for name in sorted(os.listdir(folder)):
+        try:
+            if name.endswith(".xml"):
+                mujoco.MjModel.from_xml_path(os.path.join(folder, name))
+                out.append(os.path.join(folder, name))
+        except ValueError:
+            pass
+    return out
+
+
+def test_pybullet_data_holds_the_mjcf_models():
+    pytest.importorskip("pybullet_data", reason="pybullet (the peers extra) ships gym's MJCF models")
+    names = {os.path.basename(p) for p in pybullet_mjcf_files()}
+    assert len(names) >= 18 and {"ant.xml", "humanoid.xml", "striker.xml", "thrower.xml", "reacher.xml"} <= names
+
+
+@pytest.mark.parametrize("path", pybullet_mjcf_files(), ids=os.path.basename)
+def test_every_mjcf_file_of_pybullet_data_that_mujoco_compiles_agrees_with_mujoco(path):
+    """pybullet_data (the peers extra) ships gym's MJCF models (ant, humanoid, reacher, pusher,
+    striker, ...): kinedyn reads every one MuJoCo compiles, with the same M, inverse dynamics and
+    body poses (through Pinocchio where a model has free or ball joints)."""
+    model = mujoco.MjModel.from_xml_path(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = robot_from_mjcf(path)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING)
+    model.opt.density = model.opt.viscosity = 0.0
+    model.body_gravcomp[:] = 0
+    compare_inertias(robot, model)
+    if robot.has_multi_dof_joints:
+        model.dof_damping[:] = 0
+        for j in range(model.njnt):
+            if int(model.jnt_type[j]) in (FREE, BALL):
+                model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + (6 if int(model.jnt_type[j]) == FREE else 3)] = 0
+        compare_multi_dof(robot, model, seed=10, states=2)
+    else:
+        compare_dynamics(robot, model, mujoco.MjData(model), seed=10, states=2)

@@ -344,6 +344,8 @@ class _Reader:
     def compiler(self) -> None:
         self.degrees, self.eulerseq, self.autolimits = True, "xyz", True
         self.inertiafromgeom, self.groups = "auto", (0, 5)
+        # MuJoCo's compiler adjustments of body inertias (off by default)
+        self.boundmass, self.boundinertia, self.settotalmass, self.balanceinertia = 0.0, 0.0, -1.0, False
         self.meshdir = self.src.base_dir
         for c in self.root.iter("compiler"):
             for attribute, value in c.attrib.items():
@@ -369,8 +371,10 @@ class _Reader:
                         self.meshdir = os.path.join(self.src.base_dir, value)
                 elif attribute == "coordinate" and value != "local":
                     raise self.src.error(c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)")
-                elif attribute in ("boundmass", "boundinertia", "settotalmass") and float(value or 0) > 0 or (attribute == "balanceinertia" and value == "true"):
-                    raise self.src.error(c, f"attribute '{attribute}' changes the model's inertias, which kinedyn does not reproduce; remove it or give the inertias")
+                elif attribute in ("boundmass", "boundinertia", "settotalmass"):
+                    setattr(self, attribute, _numbers(c, attribute, self.src, 1)[0])
+                elif attribute == "balanceinertia":
+                    self.balanceinertia = self.boolean(c, attribute, value)
 
     @staticmethod
     def boolean_value(value: str) -> Optional[bool]:
@@ -513,7 +517,32 @@ class _Reader:
             raise self.src.error(self.root, "has no <worldbody>")
         for world in worlds:
             self.children(world, "world", np.eye(4), "main", world=True)
+        if self.settotalmass > 0:
+            self.scale_to_total_mass()
         return links, frames, visuals, collisions
+
+    def adjusted(self, inertia: Inertia) -> Inertia:
+        """A body's inertia after MuJoCo's compiler options ``boundmass`` (a least mass),
+        ``boundinertia`` (least principal moments) and ``balanceinertia`` (principal moments that
+        break the triangle inequality replaced by their mean)."""
+        if self.boundmass <= 0 and self.boundinertia <= 0 and not self.balanceinertia:
+            return inertia
+        mass = max(float(inertia.mass), self.boundmass)
+        moments, axes = np.linalg.eigh(np.array(inertia.inertia, dtype=float))
+        if self.balanceinertia and moments[0] + moments[1] < moments[2]:
+            moments = np.full(3, moments.mean())
+        moments = np.maximum(moments, self.boundinertia)
+        return Inertia(mass, inertia.com, (axes * moments) @ axes.T)
+
+    def scale_to_total_mass(self) -> None:
+        """MuJoCo's ``settotalmass``: every body's mass and inertia scaled so that they add up to it."""
+        total = sum(float(link.inertia.mass) for link in self.links)
+        if total <= 0:
+            raise ValueError(f"{self.src.label}: <compiler settotalmass> needs bodies with mass to scale")
+        k = self.settotalmass / total
+        self.links[:] = [Link(link.name, link.parent, link.joint, link.placement, link.post,
+                              Inertia(k * link.inertia.mass, link.inertia.com, k * np.array(link.inertia.inertia, dtype=float)))
+                         for link in self.links]
 
     def children(self, element, link: str, link_from_here: np.ndarray, childclass: str, world: bool = False) -> list:
         """The bodies, geoms, sites and frames inside ``element`` (a body or frame), whose poses are
@@ -575,7 +604,7 @@ class _Reader:
         index = len(self.links) - 1  # the link that carries the body
         # the body's geoms, sites and child bodies, in the body's own frame
         geoms = self.children(element, name, np.eye(4), childclass)
-        body_inertia = self.inertia(element, name, geoms)
+        body_inertia = self.adjusted(self.inertia(element, name, geoms))
         last = self.links[index]
         self.links[index] = Link(last.name, last.parent, last.joint, last.placement, last.post, body_inertia)
 
@@ -739,8 +768,9 @@ class _Reader:
     def inertial(self, element, body: str) -> Inertia:
         what = f"body '{body}' <inertial>"
         a = element.attrib
-        if "mass" not in a:
-            raise self.src.error(element, f"of body '{body}' has no 'mass' attribute")
+        for required in ("pos", "mass"):
+            if required not in a:
+                raise self.src.error(element, f"of body '{body}' has no '{required}' attribute (MuJoCo requires it)")
         mass = _numbers(element, "mass", self.src, 1)[0]
         if mass < 0:
             raise self.src.error(element, f"of body '{body}': attribute 'mass' is negative ({mass:g})")
