@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 import os
+import types
 import warnings
 import xml.etree.ElementTree as ET
 from typing import Optional
@@ -128,7 +129,7 @@ def _caller_level() -> int:
     import sys
 
     package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame = sys._getframe(2)
+    frame: Optional[types.FrameType] = sys._getframe(2)
     level = 2
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
         frame, level = frame.f_back, level + 1
