@@ -3,8 +3,8 @@
 Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Reference"):
 
 - ``<mujoco model>``; ``<compiler angle="degree|radian" eulerseq autolimits meshdir assetdir
-  inertiafromgeom inertiagrouprange>`` (MuJoCo's defaults: degrees, ``xyz``, autolimits on,
-  inertia from geoms when a body has no ``<inertial>``); ``<option gravity>`` and
+  inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia settotalmass>`` (MuJoCo's
+  defaults: degrees, ``xyz``, autolimits on, inertia from geoms when a body has no ``<inertial>``); ``<option gravity>`` and
   ``<option><flag gravity="disable">``.
 - ``<default>`` classes (the top one is ``main``; nested classes inherit; an element's ``class``, else
   the ``childclass`` of the nearest enclosing body or frame, else ``main``) for ``joint``, ``geom``,
@@ -36,7 +36,7 @@ Not modelled, and named in one warning when present: actuators, tendons, equalit
 contact pairs and exclusions, sensors, keyframes, joint springs (``stiffness``), ``gravcomp``,
 friction and armature of ball and free joints. Lights, cameras, textures and the ``<visual>``
 settings are presentation and are skipped silently. ``<replicate>``, ``<attach>``, ``<composite>``,
-``<flexcomp>`` and ``<compiler coordinate="global">`` are refused (they make bodies kinedyn cannot
+``<flexcomp>``, mocap bodies, ``shellinertia`` and ``<compiler coordinate="global">`` are refused (they make bodies kinedyn cannot
 read here).
 
 The base of the robot is MuJoCo's world body, named ``world``; bodies without a joint are welded to
