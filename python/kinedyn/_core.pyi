@@ -34,9 +34,12 @@ class Model:
         frame_body: I64,  # (nf,) body of each named frame, -1 = base
         frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
         coulomb_negative: Optional[F64] = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
+        blocks: Optional[I64] = None,  # (n,) 0 a 1-DOF joint; 1/2/3 head of a free-flyer/spherical/planar joint; -1 its further bodies
     ) -> None: ...
     @property
-    def n(self) -> int: ...
+    def n(self) -> int: ...  # bodies = degrees of freedom (nv)
+    @property
+    def nq(self) -> int: ...  # length of a configuration q
     @property
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----

@@ -54,6 +54,37 @@ def _dask_targets(target, q0):
 
 
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
+
+# the native model's code for the first body of each multi-DOF joint (crates/kinedyn-py/src/lib.rs)
+_BLOCK_CODES = {"floating": 1, "spherical": 2, "planar": 3}
+
+
+def _planar_basis(normal) -> tuple:
+    """In-plane unit axes (e1, e2) with e1 x e2 = normal: x and y for the normal z (Pinocchio's
+    JointModelPlanar), else e1 along the coordinate axis most orthogonal to the normal."""
+    n = np.asarray(normal, dtype=float)
+    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
+        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    e = np.eye(3)[int(np.argmin(np.abs(n)))]
+    e1 = e - n * (n @ e)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(n, e1)
+
+
+def _joint_columns(joint) -> list:
+    """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
+    1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
+    planar: linear e1, e2, angular normal (0 revolute, 1 prismatic)."""
+    e = np.eye(3)
+    if joint.kind == "floating":
+        return [(1, e[k]) for k in range(3)] + [(0, e[k]) for k in range(3)]
+    if joint.kind == "spherical":
+        return [(0, e[k]) for k in range(3)]
+    axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
+    if joint.kind == "planar":
+        e1, e2 = _planar_basis(axis)
+        return [(1, e1), (1, e2), (0, np.cross(e1, e2))]
+    return [(0 if joint.kind == "revolute" else 1, axis)]
 _F64 = np.dtype(np.float64)
 
 
@@ -136,11 +167,13 @@ class Robot:
 
     @classmethod
     def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
-                  xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False, package_dirs: Sequence[PathLike] = ()) -> "Robot":
+                  floating_base: bool = False, xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False,
+                  package_dirs: Sequence[PathLike] = ()) -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
-        or ``"strict"`` (ValueError); see docs/model-files.md.
+        or ``"strict"`` (ValueError); see docs/model-files.md. ``floating_base=True``: the root link
+        moves on a free-flyer joint ``root_joint`` (Pinocchio's ``JointModelFreeFlyer``; nq = nv + 1).
 
         A path ending in ``.xacro`` is expanded by the ``xacro`` package first, with ``xacro_args``
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
@@ -151,10 +184,11 @@ class Robot:
 
         if is_xacro(path_or_string):
             text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
-            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, source_path=os.fsdecode(path_or_string))
+            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base,
+                                   source_path=os.fsdecode(path_or_string))
         if xacro_args:
             raise ValueError("xacro_args are for a .xacro file")
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base)
 
     @classmethod
     def from_mjcf(cls, path_or_string: Union[PathLike, bytes], *, gravity: Optional[ArrayLike] = None, tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
@@ -301,43 +335,65 @@ class Robot:
     def parents(self) -> list:
         return self.tree.parents
 
+    def _per_coordinate(self, value, size: str, multi=math.inf) -> np.ndarray:
+        """``value(joint)`` for each q coordinate (``size="nq"``) or degree of freedom (``"nv"``);
+        a multi-DOF joint's coordinates get ``multi`` (no limits, no drive data)."""
+        out = []
+        for j in self.joints:
+            k = j.nq if size == "nq" else j.nv
+            out.extend([multi] * k if j.is_multi_dof else [value(j)])
+        return np.array(out, dtype=float)
+
     @property
     def lower_limits(self) -> np.ndarray:
-        return np.array([j.lower for j in self.joints])
+        """Lower position limit per q coordinate (nq,); -inf for multi-DOF joints' coordinates."""
+        return self._per_coordinate(lambda j: j.lower, "nq", -math.inf)
 
     @property
     def upper_limits(self) -> np.ndarray:
-        return np.array([j.upper for j in self.joints])
+        """Upper position limit per q coordinate (nq,); inf for multi-DOF joints' coordinates."""
+        return self._per_coordinate(lambda j: j.upper, "nq")
 
     @property
     def velocity_limits(self) -> np.ndarray:
-        return np.array([j.velocity_limit for j in self.joints])
+        return self._per_coordinate(lambda j: j.velocity_limit, "nv")
 
     @property
     def effort_limits(self) -> np.ndarray:
-        return np.array([j.effort_limit for j in self.joints])
+        return self._per_coordinate(lambda j: j.effort_limit, "nv")
 
     @property
     def armature(self) -> np.ndarray:
-        """Reflected rotor inertia r^2 J_m per joint (added to the diagonal of M)."""
-        return np.array([float(j.armature) for j in self.joints])
+        """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
+        return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
 
     @property
     def viscous(self) -> np.ndarray:
-        """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)
+        """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
         (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
-        return np.array([float(j.viscous) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
 
     @property
     def coulomb(self) -> np.ndarray:
-        """Coulomb friction level per joint for qd > 0 (the only level when friction is symmetric)."""
-        return np.array([float(j.coulomb) for j in self.joints])
+        """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
+        return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
 
     @property
     def coulomb_negative(self) -> np.ndarray:
-        """Coulomb friction level per joint for qd < 0 (a magnitude; equals :attr:`coulomb` for
+        """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
         symmetric friction)."""
-        return np.array([float(j.coulomb_levels[1]) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
+
+    @cached_property
+    def _dof_body(self) -> np.ndarray:
+        """(nv,) the moving link (index into body_names) each degree of freedom belongs to."""
+        return np.repeat(np.arange(len(self.tree.bodies)), [b.joint.nv for b in self.tree.bodies])
+
+    @cached_property
+    def _body_last_dof(self) -> np.ndarray:
+        """(n_links,) the last degree of freedom of each moving link's joint: the native body that
+        carries the link (a multi-DOF joint is one native body per degree of freedom)."""
+        return np.cumsum([b.joint.nv for b in self.tree.bodies]) - 1
 
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
@@ -475,25 +531,46 @@ class Robot:
                 f"robot '{self.name}' has symbolic parameters {sorted(map(str, self.symbols))}: "
                 "use robot.subs({...}) to give them values before numeric computation"
             )
-        self.require_one_dof_joints("the numeric engine")
         bodies = self.tree.bodies
-        n = len(bodies)
-        parent = np.array([b.parent for b in bodies], dtype=np.int64)
-        kind = np.array([0 if b.joint.kind == "revolute" else 1 for b in bodies], dtype=np.int64)
-        axis = np.array([to_float_array(b.joint.axis, (3,), f"axis of joint '{b.joint.name}'") for b in bodies])
-        offset = np.array([float(b.joint.offset) for b in bodies])
-        placement = np.array([to_float_array(b.placement, (4, 4), f"placement of '{b.name}'") for b in bodies])
-        inertia = self.inertial_parameters().reshape(n, 10)
+        last = self._body_last_dof
+        # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
+        # transform, read from q) and members at the identity on it, the last carrying the link
+        # (crates/kinedyn-core/src/model.rs); a 1-DOF joint is one body
+        parent, kind, axis, offset, placement, blocks = [], [], [], [], [], []
+        link_inertia = self.inertial_parameters().reshape(len(bodies), 10)
+        inertia = np.zeros((self.nv, 10))
+        for b, body in enumerate(bodies):
+            joint = body.joint
+            first = len(parent)
+            parent.append(-1 if body.parent < 0 else int(last[body.parent]))
+            placement.append(to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"))
+            offset.append(float(joint.offset))
+            columns = _joint_columns(joint)
+            for m, (k, a) in enumerate(columns):
+                if m > 0:
+                    parent.append(first + m - 1)
+                    placement.append(np.eye(4))
+                    offset.append(0.0)
+                kind.append(k)
+                axis.append(a)
+            blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
+            inertia[last[b]] = link_inertia[b]
         armature, viscous, coulomb = self.armature, self.viscous, self.coulomb
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
-        frame_body = np.array([f.body for f in frames], dtype=np.int64)
+        frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
         frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
         # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
         coulomb_negative = self.coulomb_negative
         asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        return _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement,
-                           coulomb_negative=asymmetric)
+        return _core.Model(np.array(parent, dtype=np.int64), np.array(kind, dtype=np.int64), np.array(axis, dtype=float).reshape(-1, 3),
+                           np.array(offset), np.array(placement).reshape(-1, 4, 4), inertia, armature, viscous, coulomb, gravity,
+                           frame_body, frame_placement, coulomb_negative=asymmetric,
+                           blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None)
+
+    @cached_property
+    def _multi_dof(self) -> bool:
+        return self.has_multi_dof_joints
 
     @cached_property
     def _link_frame_ids(self) -> np.ndarray:
@@ -609,7 +686,7 @@ class Robot:
     def _link_origin_in_body(self) -> Optional[np.ndarray]:
         """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
         frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
-        u = np.zeros((self.n, 3))
+        u = np.zeros((len(self.tree.bodies), 3))
         for i, name in enumerate(self.body_names):
             T = to_float_array(self.tree.frames[self.frame_index(name)].placement, (4, 4), f"frame '{name}'")
             u[i] = T[:3, :3].T @ T[:3, 3]
@@ -621,9 +698,22 @@ class Robot:
         if f_ext is None:
             return None
         f = real_array(f_ext, "f_ext")
-        if f.shape == (self.n, 6) and np.ndim(q) == 2:
+        links = len(self.tree.bodies)
+        if f.shape == (links, 6) and np.ndim(q) == 2:
             # one set of wrenches for every state of a batch
-            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), self.n, 6)))
+            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
+        if self._multi_dof:
+            if f.shape[-2:] != (links, 6):
+                raise ValueError(f"f_ext must have shape ({links}, 6): one wrench per moving link {self.body_names}, got {f.shape}")
+            u = self._link_origin_in_body
+            if u is not None and f.ndim == np.ndim(q) + 1:
+                R = self.forward_kinematics(q)[..., :3, :3]
+                f = f.copy()
+                f[..., 3:] += np.cross(np.einsum("...ij,...j->...i", R, u), f[..., :3])
+            # the native model has a body per degree of freedom: the link's wrench acts on its last
+            full = np.zeros(f.shape[:-2] + (self.nv, 6))
+            full[..., self._body_last_dof, :] = f
+            return full
         u = self._link_origin_in_body
         if u is None or f.shape[-2:] != (self.n, 6) or f.ndim != np.ndim(q) + 1:
             return f  # (wrong shapes are reported by the core)
@@ -643,8 +733,11 @@ class Robot:
         seen = set()
 
         def named(match):
-            i = int(match.group(1))
-            if i >= self.n or i in seen:
+            dof = int(match.group(1))
+            if dof >= self.n:
+                return match.group(0)
+            i = int(self._dof_body[dof])  # the native body (a degree of freedom) -> its link
+            if i in seen:
                 return match.group(0)
             seen.add(i)
             return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
@@ -662,7 +755,7 @@ class Robot:
         """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
         positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
         subtree, parents = {joint}, self.parents
-        for i in range(joint + 1, self.n):  # parent[i] < i
+        for i in range(joint + 1, len(self.tree.bodies)):  # parent[i] < i
             if parents[i] in subtree:
                 subtree.add(i)
         bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
@@ -808,8 +901,13 @@ class Robot:
 
     @batched("q", "qd", "qdd")
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
-        """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
-        return self._model.regressor(q, qd, qdd)
+        """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
+        y = self._model.regressor(q, qd, qdd)
+        if self._multi_dof:
+            # the native model's extra bodies of a multi-DOF joint are massless: keep the links' columns
+            columns = (10 * self._body_last_dof[:, None] + np.arange(10)).ravel()
+            y = np.ascontiguousarray(y[..., columns])
+        return y
 
     def base_parameters(self, samples: int = 200, rng: SeedLike = 0, tol: float = 1e-9) -> BaseParameters:
         """A minimal identifiable parameter set (:class:`kinedyn.dynamics.BaseParameters`): column

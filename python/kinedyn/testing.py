@@ -56,16 +56,23 @@ def random_inertia(rng) -> Inertia:
     return Inertia(m, tuple(rng.uniform(-0.3, 0.3, 3)), R @ principal @ R.T)
 
 
-def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: float = 0.25, fixed: int = 1, friction: bool = True) -> Robot:
+def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: float = 0.25, fixed: int = 1, friction: bool = True,
+                 floating: bool = False, spherical: float = 0.0, planar: float = 0.0) -> Robot:
     """A random robot of ``n`` moving joints (plus ``fixed`` fixed links with inertia, merged at
-    compile time). ``branching=True`` gives a tree (each link's parent is any earlier link)."""
+    compile time). ``branching=True`` gives a tree (each link's parent is any earlier link).
+    ``floating=True``: the first joint is a free-flyer; ``spherical`` / ``planar``: the chance that
+    a later joint is spherical / planar (normal z, Pinocchio's JointModelPlanar)."""
     rng = np.random.default_rng(seed)
     links = []
     names: list[str] = []
     for i in range(n + fixed):
         moving = i < n
         parent = None if i == 0 else (names[int(rng.integers(0, i))] if branching else names[-1])
-        if moving:
+        draw = rng.uniform()
+        multi = "floating" if floating and i == 0 else ("spherical" if draw < spherical else "planar" if draw < spherical + planar else None)
+        if moving and multi is not None and i > 0 or (moving and multi == "floating"):
+            joint = Joint(f"j{i + 1}", multi, (0.0, 0.0, 1.0))
+        elif moving:
             kind = "prismatic" if rng.uniform() < prismatic else "revolute"
             joint = Joint(
                 f"j{i + 1}",
