@@ -273,8 +273,8 @@ def test_inertiafromgeom_true_replaces_the_inertial_and_false_ignores_the_geoms(
 def test_the_mujoco_test_model_with_its_free_and_ball_joints_turned_into_hinges_agrees():
     """The `mujoco` wheel's own testdata/model.xml (defaults with springs, fromto capsules, boxes and
     cylinders, ellipsoids, sites, tendons, actuators, sensors), its free and ball joints made hinges
-    (the numeric engine takes 1-DOF joints until the multi-DOF core lands) and its mesh body (whose
-    inertia kinedyn does not compute) given a box instead."""
+    (so that every joint keeps its damping and armature; the whole model is compared below) and its
+    mesh geom (whose inertia kinedyn does not compute) a box instead."""
     text = _mujoco_test_model()
     text = text.replace("<freejoint/>", '<joint type="hinge" axis="0.2 0.3 1"/>').replace('type="ball"', 'type="hinge"')
     text = without_mesh_geom(text)
@@ -594,9 +594,9 @@ def random_qpos(model, rng):
 
 def pinocchio_model_of(robot):
     """A Pinocchio model made from kinedyn's compiled tree (joint kinds, placements, inertias, rotor
-    inertias) and nothing else: it checks the MJCF reader's description of ball and free joints while
-    kinedyn's numeric engine takes 1-DOF joints only."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) stands in for the multi-DOF core")
+    inertias) and nothing else: it checks the MJCF reader's description of ball and free joints
+    independently of kinedyn's numeric engine."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) is an optional test oracle")
     model = pin.Model()
     model.gravity.linear = np.array(robot.gravity, dtype=float)
     armature = []
@@ -622,7 +622,7 @@ def pinocchio_model_of(robot):
 
 
 def compare_multi_dof(robot, model, seed: int, states: int = 3):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) stands in for the multi-DOF core")
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) is an optional test oracle")
     pm = pinocchio_model_of(robot)
     pd = pm.createData()
     assert (pm.nq, pm.nv) == (model.nq, model.nv) == (robot.nq, robot.nv)
@@ -753,10 +753,80 @@ def test_every_mjcf_file_of_pybullet_data_that_mujoco_compiles_agrees_with_mujoc
     model.body_gravcomp[:] = 0
     compare_inertias(robot, model)
     if robot.has_multi_dof_joints:
-        model.dof_damping[:] = 0
-        for j in range(model.njnt):
+        for j in range(model.njnt):  # kinedyn ignores (and names in its warning) these of ball and free joints
             if int(model.jnt_type[j]) in (FREE, BALL):
-                model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + (6 if int(model.jnt_type[j]) == FREE else 3)] = 0
+                dofs = slice(model.jnt_dofadr[j], model.jnt_dofadr[j] + (6 if int(model.jnt_type[j]) == FREE else 3))
+                model.dof_armature[dofs] = model.dof_damping[dofs] = 0
+        compare_multi_dof_kinedyn(robot, model, seed=10, states=2)
+        model.dof_damping[:] = 0  # Pinocchio's rnea has no damping
         compare_multi_dof(robot, model, seed=10, states=2)
     else:
         compare_dynamics(robot, model, mujoco.MjData(model), seed=10, states=2)
+
+
+# ---------------------------------------------- ball and free joints: kinedyn's own numbers
+def mujoco_acceleration(model, qpos, qvel, vd):
+    """MuJoCo's qacc for kinedyn's vdot (the inverse of mujoco_to_pinocchio_state's map): a free
+    joint's world linear acceleration is R (vdot_lin + w x v_lin)."""
+    qacc = np.array(vd, float)
+    for j in range(model.njnt):
+        a, b = model.jnt_qposadr[j], model.jnt_dofadr[j]
+        if int(model.jnt_type[j]) == FREE:
+            R = np.zeros(9)
+            mujoco.mju_quat2Mat(R, qpos[a + 3:a + 7])
+            R = R.reshape(3, 3)
+            v_lin = R.T @ qvel[b:b + 3]
+            qacc[b:b + 3] = R @ (vd[b:b + 3] + np.cross(qvel[b + 3:b + 6], v_lin))
+    return qacc
+
+
+def compare_multi_dof_kinedyn(robot, model, seed: int, states: int = 3):
+    """kinedyn's M, bias forces, inverse and forward dynamics and body poses against MuJoCo's, in
+    kinedyn's coordinates (M_kd = T^T M T, tau_kd = T^T tau_mj with qvel = T v)."""
+    assert (robot.nq, robot.nv) == (model.nq, model.nv)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(seed)
+    for _ in range(states):
+        qpos, qvel = random_qpos(model, rng), rng.normal(size=model.nv)
+        mujoco_state(model, data, qpos, qvel)
+        M = full_mass_matrix(model, data)
+        q, v, _, T = mujoco_to_pinocchio_state(model, qpos, qvel, np.zeros(model.nv))
+        np.testing.assert_allclose(robot.mass_matrix(q), T.T @ M @ T, atol=TOL, rtol=0)
+        for vd in (np.zeros(model.nv), rng.normal(size=model.nv)):
+            data.qacc[:] = mujoco_acceleration(model, qpos, qvel, vd)
+            mujoco.mj_inverse(model, data)
+            tau = T.T @ data.qfrc_inverse
+            np.testing.assert_allclose(robot.inverse_dynamics(q, v, vd), tau, atol=TOL, rtol=0)
+            if not vd.any():  # kinedyn's bias torque: C v + g (+ friction, zero here)
+                np.testing.assert_allclose(robot.bias_torque(q, v) + robot.friction_torque(v), tau, atol=TOL, rtol=0)
+            np.testing.assert_allclose(robot.forward_dynamics(q, v, tau), vd, atol=1e-7, rtol=0)
+        mujoco.mj_kinematics(model, data)
+        for b in range(1, model.nbody):
+            T_b = robot.pose(q, frame=model.body(b).name or f"body{b}")
+            np.testing.assert_allclose(T_b[:3, 3], data.xpos[b], atol=TOL, rtol=0)
+            np.testing.assert_allclose(T_b[:3, :3], data.xmat[b].reshape(3, 3), atol=TOL, rtol=0)
+
+
+def test_free_and_ball_joints_agree_with_mujoco_in_kinedyns_engine():
+    robot = robot_from_mjcf(BALLS)
+    model = mujoco.MjModel.from_xml_string(BALLS)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    compare_multi_dof_kinedyn(robot, model, seed=11)
+
+
+def test_the_mujoco_test_model_agrees_with_mujoco_in_kinedyns_engine():
+    """testdata/model.xml whole (bar its mesh geom): free bodies, ball joints, hinges and a slide,
+    with their damping and armature (but a ball joint's, which kinedyn names in its warning)."""
+    text = without_mesh_geom(_mujoco_test_model())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = robot_from_mjcf(text)
+    model = mujoco.MjModel.from_xml_string(text)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING)
+    model.opt.density = model.opt.viscosity = 0.0
+    model.body_gravcomp[:] = 0
+    for j in range(model.njnt):
+        if int(model.jnt_type[j]) == BALL:
+            model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
+            model.dof_damping[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
+    compare_multi_dof_kinedyn(robot, model, seed=12)
