@@ -616,8 +616,8 @@ class _Reader:
 
     def joint(self, element, childclass: str, body: str, count: int, top_level: bool):
         self.joint_count += 1
-        a = {} if element.tag == "freejoint" else self.attributes(element, childclass)
-        a.update(element.attrib) if element.tag == "freejoint" else None
+        # <freejoint> takes no default class (MuJoCo's reference); <joint> does
+        a = dict(element.attrib) if element.tag == "freejoint" else self.attributes(element, childclass)
         name = a.get("name") or f"joint{self.joint_count - 1}"
         kind = "free" if element.tag == "freejoint" else a.get("type", "hinge")
         what = f"joint '{name}'"
