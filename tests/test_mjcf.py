@@ -707,7 +707,8 @@ def test_the_mujoco_test_model_with_free_and_ball_joints_agrees_through_pinocchi
          '<body name="empty"><joint name="y"/></body></body>'),
     ],
 )
-def test_compiler_inertia_adjustments_agree_with_mujoco(options, extra):
+def test_compiler_inertia_adjustments_agree_with_mujoco(options, extra, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning (settotalmass is deprecated) to ./MUJOCO_LOG.TXT
     xml = random_model(3).replace("<compiler ", f"<compiler {options} ").replace("</worldbody>", extra + "</worldbody>")
     robot, model, data = both(xml)
     compare_inertias(robot, model)
