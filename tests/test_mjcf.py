@@ -831,3 +831,11 @@ def test_the_mujoco_test_model_agrees_with_mujoco_in_kinedyns_engine():
             model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
             model.dof_damping[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
     compare_multi_dof_kinedyn(robot, model, seed=12)
+
+
+def test_a_ball_joints_range_and_damping_are_named_as_ignored():
+    xml = ('<mujoco><worldbody><body><joint name="b" type="ball" range="0 30" damping="1"/><geom size="0.1"/></body>'
+           '</worldbody></mujoco>')
+    with pytest.warns(UserWarning, match=r"damping of the ball joint 'b'; the range \(a cone\) of the ball joint 'b'"):
+        robot = robot_from_mjcf(xml)
+    assert robot.joints[0].kind == "spherical" and robot.joints[0].viscous == 0

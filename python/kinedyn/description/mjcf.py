@@ -34,7 +34,7 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
 
 Not modelled, and named in one warning when present: actuators, tendons, equality constraints,
 contact pairs and exclusions, sensors, keyframes, joint springs (``stiffness``), ``gravcomp``,
-friction and armature of ball and free joints. Lights, cameras, textures and the ``<visual>``
+friction and armature of ball and free joints, a ball joint's range (a cone). Lights, cameras, textures and the ``<visual>``
 settings are presentation and are skipped silently. ``<replicate>``, ``<attach>``, ``<composite>``,
 ``<flexcomp>``, mocap bodies, ``shellinertia`` and ``<compiler coordinate="global">`` are refused (they make bodies kinedyn cannot
 read here).
@@ -657,6 +657,8 @@ class _Reader:
             for attribute in ("armature", "damping", "frictionloss"):
                 if scalars[attribute] != 0:
                     self.ignored.add(f"{attribute} of the {kind} joint '{name}'")
+            if kind == "ball" and "range" in a and a.get("limited", "auto") != "false":
+                self.ignored.add(f"the range (a cone) of the ball joint '{name}'")
         try:
             joint = Joint(name, _JOINT_KINDS[kind], axis, **options)
         except ValueError as e:
