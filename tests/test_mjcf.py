@@ -95,6 +95,8 @@ ARM = """<mujoco model="arm3d">
               <geom size="0.05"/>
               <geom class="fingertip" pos="0.03 0 0.05" euler="10 0 40"/>
               <frame childclass="fingertip" pos="0 0.01 0.02"><geom/></frame>
+              <site name="down" type="capsule" size="0.01" fromto="0 0 0 0 0 0.1"/>
+              <site name="along" type="cylinder" size="0.01" fromto="0 0 0.1 0.05 0.02 0"/>
               <frame pos="0 0.02 0.04" axisangle="1 1 0 40">
                 <geom type="sphere" size="0.015" pos="0.01 0 0"/>
               </frame>

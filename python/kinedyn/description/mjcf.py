@@ -676,6 +676,8 @@ class _Reader:
         self.claim(frame_name, element, f"site '{name}'")
         pose = self.frame(element, a)
         if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
+            if a.get("type", "sphere") not in ("capsule", "cylinder", "box", "ellipsoid"):
+                raise self.src.error(element, f"site '{name}': 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {a.get('type', 'sphere')}")
             pose = self.segment(element, a["fromto"])[0]
         self.frames.append(Frame(frame_name, None if link == "world" else link, link_from_here @ pose))
 
