@@ -68,6 +68,7 @@ class Model:
     def regressor(self, q: F64, qd: F64, qdd: F64) -> F64: ...  # (n, 10 n) | (N, n, 10 n)
     def center_of_mass(self, q: F64) -> F64: ...  # (3,) | (N, 3)
     def momentum(self, q: F64, qd: F64) -> F64: ...  # (6,) | (N, 6), [p; L about the base origin]
+    def centroidal_momentum_matrix(self, q: F64) -> F64: ...  # (6, n) | (N, 6, n), h_G = A_G qd
 
 class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""

@@ -71,6 +71,33 @@ def _planar_basis(normal) -> tuple:
     return e1, np.cross(n, e1)
 
 
+def _locked_block(joint, block) -> np.ndarray:
+    """The 4x4 joint motion of a multi-DOF ``joint`` at its q ``block`` (unit quaternion / (cos, sin)
+    checked): what :meth:`Robot.lock_joints` folds into the placement."""
+    b = real_array(block, f"value of joint '{joint.name}'").ravel()
+    if b.shape != (joint.nq,) or not np.all(np.isfinite(b)):
+        raise ValueError(f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}")
+    T = np.eye(4)
+    unit = b[-4:] if joint.kind != "planar" else b[2:]
+    if abs(np.linalg.norm(unit) - 1.0) > 1e-6:
+        raise ValueError(f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit")
+    if joint.kind == "planar":
+        e1, e2 = _planar_basis(to_float_array(joint.axis, (3,), "axis"))
+        n = np.cross(e1, e2)
+        c, s = b[2], b[3]
+        K = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+        T[:3, :3] = c * np.eye(3) + s * K + (1 - c) * np.outer(n, n)
+        T[:3, 3] = b[0] * e1 + b[1] * e2
+        return T
+    x, y, z, w = b[-4:]
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    if joint.kind == "floating":
+        T[:3, 3] = b[:3]
+    return T
+
+
 def _joint_columns(joint) -> list:
     """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
     1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
@@ -222,20 +249,24 @@ class Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
 
         ``joints``: a mapping ``{joint: value}``, or a sequence (list, tuple, set, array) of joints
-        locked at their value in ``at`` (a configuration (n,); default: zero, the joint's offset
-        position). A joint is named by its name (``robot.joint_names``) or its index in ``q``.
+        locked at their value in ``at`` (a configuration (nq,); default: :meth:`neutral`). A joint is
+        named by its name (``robot.joint_names``) or its index in that list (= its index in ``q`` when
+        every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
+        position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
         from ._math import rot_axis, translation
 
         names = self.joint_names
+        n_joints = len(names)
+        starts = np.cumsum([0] + [j.nq for j in self.joints])
         if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
             raise TypeError(f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}")
         if isinstance(joints, Mapping):
             items = list(joints.items())
         else:
-            q_at = np.zeros(self.n) if at is None else real_array(at, "at")
-            if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
-                raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
+            q_at = self.neutral() if at is None else real_array(at, "at")
+            if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
+                raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
         unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
         if unknown:
@@ -245,13 +276,17 @@ class Robot:
             if isinstance(key, str):
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not -self.n <= key < self.n:
-                    raise ValueError(f"lock_joints: joint index {key} is out of range for {self.n} joints")
-                i = int(key) % self.n
+                if not -n_joints <= key < n_joints:
+                    raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
+                i = int(key) % n_joints
             else:
                 raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
+            if self.joints[i].is_multi_dof:
+                block = q_at[starts[i]:starts[i + 1]] if value is None else value
+                values[names[i]] = _locked_block(self.joints[i], block)
+                continue
             if value is None:
-                value = q_at[i]
+                value = q_at[starts[i]]
             try:
                 v = float(value)
             except (TypeError, ValueError):
@@ -262,7 +297,10 @@ class Robot:
         links = []
         for link in self.links:
             j = link.joint
-            if j.name in values and j.is_moving:
+            if j.name in values and j.is_multi_dof:
+                fixed = Joint(j.name, "fixed")
+                link = Link(link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia)
+            elif j.name in values and j.is_moving:
                 x = values[j.name] + j.offset
                 motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
                 fixed = Joint(j.name, "fixed", j.axis)
@@ -482,6 +520,22 @@ class Robot:
 
         save(self, path)
 
+    def to_urdf(self, path: Optional[PathLike] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
+        """The robot as URDF text, written to ``path`` when given (joint offsets folded into the joint
+        origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
+        robots"). ``geometry``: cylinders along the links of a robot without visuals;
+        ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
+        from .description.export import to_urdf
+
+        return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
+
+    def to_mjcf(self, path: Optional[PathLike] = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
+        """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
+        :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
+        from .description.export import to_mjcf
+
+        return to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
+
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
@@ -671,6 +725,7 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        self.require_one_dof_joints("inverse kinematics")
         if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             from ._dask import lazy_inverse_kinematics
 
@@ -899,6 +954,23 @@ class Robot:
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
+    @batched("q")
+    def centroidal_momentum_matrix(self, q: ArrayLike) -> np.ndarray:
+        """A_G(q), (6, n) or (N, 6, n): the momentum about the centre of mass, h_G = A_G qd =
+        [m c_dot; L_G] in base axes (Orin, Goswami & Lee 2013; Pinocchio's ``ccrba`` ``Ag``)."""
+        return self._model.centroidal_momentum_matrix(q)
+
+    @batched("q")
+    def center_of_mass_jacobian(self, q: ArrayLike) -> np.ndarray:
+        """J_c(q), (3, n) or (N, 3, n): the centre of mass's velocity c_dot = J_c qd in base axes
+        (the linear rows of the centroidal momentum matrix over the total mass)."""
+        A = self._model.centroidal_momentum_matrix(q)
+        return A[..., :3, :] / self._total_mass
+
+    @cached_property
+    def _total_mass(self) -> float:
+        return float(sum(float(b.inertia.mass) for b in self.tree.bodies))
+
     @batched("q", "qd", "qdd")
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
@@ -925,24 +997,41 @@ class Robot:
 
         return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
+    # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------
     def neutral(self) -> np.ndarray:
-        """The zero configuration (n,)."""
-        return np.zeros(self.n)
+        """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
+        from .configuration import neutral
+
+        return neutral(self)
 
     def random_configuration(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
-        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
-        if size is not None and not (isinstance(size, (int, np.integer)) and size >= 0):
-            raise ValueError(f"size must be a whole number of configurations >= 0 (or None for one), got {size!r}")
-        rng = np.random.default_rng(rng)
-        lo = self.lower_limits.copy()
-        hi = self.upper_limits.copy()
-        for i, j in enumerate(self.joints):
-            # an infinite side is replaced by one span beyond the finite side (or -span..span):
-            # a one-sided limit such as lower=5 (upper inf) must not give lo > hi
-            span = math.pi if j.kind == "revolute" else 1.0
-            if not math.isfinite(lo[i]):
-                lo[i] = min(-span, hi[i] - 2 * span) if math.isfinite(hi[i]) else -span
-            if not math.isfinite(hi[i]):
-                hi[i] = max(span, lo[i] + 2 * span)
-        shape = (self.n,) if size is None else (size, self.n)
-        return rng.uniform(lo, hi, size=shape)
+        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
+        uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
+        from .configuration import random_configuration
+
+        return random_configuration(self, rng, size)
+
+    def integrate(self, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
+        """q ⊕ v dt (nq,) or (N, nq): q + v dt for 1-DOF joints, M(q) Exp(v dt) for floating, spherical and
+        planar joints (v in the child's frame): see :mod:`kinedyn.configuration`."""
+        from .configuration import integrate
+
+        return integrate(self, q, v, dt)
+
+    def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
+        """v (nv,) or (N, nv) with integrate(q0, v) == q1: Log(M(q0)^-1 M(q1)), rotations the short way."""
+        from .configuration import difference
+
+        return difference(self, q0, q1)
+
+    def interpolate(self, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
+        """integrate(q0, t * difference(q0, q1)): the geodesic from q0 (t = 0) to q1 (t = 1)."""
+        from .configuration import interpolate
+
+        return interpolate(self, q0, q1, t)
+
+    def normalize(self, q: ArrayLike) -> np.ndarray:
+        """``q`` with each quaternion and planar (cos, sin) pair divided by its norm."""
+        from .configuration import normalize
+
+        return normalize(self, q)

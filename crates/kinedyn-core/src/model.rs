@@ -355,6 +355,63 @@ impl Model {
         }
     }
 
+    /// `out = q ⊕ (v dt)`: each joint's block moved by its velocity (Lie-group exponential of a
+    /// multi-DOF joint, [`crate::lie::integrate_block`]; `q + v dt` for a 1-DOF joint).
+    pub fn integrate_configuration(&self, q: &[f64], v: &[f64], dt: f64, out: &mut [f64]) {
+        if self.plain {
+            for j in 0..self.n {
+                out[j] = q[j] + v[j] * dt;
+            }
+            return;
+        }
+        for (i, c) in self.coordinates.iter().enumerate() {
+            match *c {
+                Coordinates::Scalar { at } => out[at] = q[at] + v[i] * dt,
+                Coordinates::Head { block, at } => {
+                    let lie_block = match block {
+                        Block::FreeFlyer => crate::lie::Block::FreeFlyer,
+                        Block::Spherical => crate::lie::Block::Spherical,
+                        Block::Planar => crate::lie::Block::Planar,
+                    };
+                    let end = at + block.nq();
+                    crate::lie::integrate_block(lie_block, &q[at..end], &v[i..i + block.nv()], dt, &mut out[at..end]);
+                }
+                Coordinates::Member => {}
+            }
+        }
+    }
+
+    /// `out = dexp⁻¹_{-Ω}(v) ≈ v + [Ω, v]/2 + [Ω, [Ω, v]]/12` per multi-DOF joint (`v` on a 1-DOF
+    /// joint): the rate of the chart `q(t) = q0 ⊕ Ω(t)` for the body velocity `v`, to the order
+    /// RKMK4 needs (Munthe-Kaas, "High order Runge-Kutta methods on manifolds", Appl. Numer. Math.
+    /// 29, 1999; the brackets of so(3), se(3) in [linear; angular] and se(2)).
+    pub fn chart_rate(&self, omega: &[f64], v: &[f64], out: &mut [f64]) {
+        out[..self.n].copy_from_slice(&v[..self.n]);
+        if self.plain {
+            return;
+        }
+        for (i, c) in self.coordinates.iter().enumerate() {
+            if let Coordinates::Head { block, .. } = *c {
+                let k = block.nv();
+                let (w, x) = (&omega[i..i + k], &v[i..i + k]);
+                let bracket = |a: &[f64], b: &[f64]| -> [f64; 6] { lie_bracket(block, a, b) };
+                let wx = bracket(w, x);
+                let wwx = bracket(w, &wx[..k]);
+                for j in 0..k {
+                    out[i + j] = x[j] + 0.5 * wx[j] + wwx[j] / 12.0;
+                }
+            }
+        }
+    }
+
+    /// The (q index, v index) of every 1-DOF joint's coordinate (the ones with position limits).
+    pub fn scalar_coordinates(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.coordinates.iter().enumerate().filter_map(|(i, c)| match c {
+            Coordinates::Scalar { at } => Some((*at, i)),
+            _ => None,
+        })
+    }
+
     /// The velocity product `c_J` of body i (RBDA eq. 5.8's `v_i x v_J` for `cJ = 0`): `v_i x s_i qd_i`
     /// for a 1-DOF joint; for a multi-DOF joint `v_i x (S qd)` of the whole joint on its last body,
     /// zero on the others (massless: their accelerations never act).
@@ -408,5 +465,24 @@ impl Model {
     #[inline]
     pub fn has_coulomb(&self, i: usize) -> bool {
         self.coulomb[i] != 0.0 || self.coulomb_negative.as_ref().is_some_and(|c| c[i] != 0.0)
+    }
+}
+
+/// The Lie bracket `[a, b]` of two velocities of a multi-DOF joint (the first `block.nv()` entries):
+/// so(3) `a x b`; se(3) `[a_lin; a_ang]`: `(a_ang x b_lin - b_ang x a_lin, a_ang x b_ang)`; se(2)
+/// `(vx, vy, w)`: `(w_a J v_b - w_b J v_a, 0)` with `J` the quarter turn.
+fn lie_bracket(block: Block, a: &[f64], b: &[f64]) -> [f64; 6] {
+    let cross = |x: &[f64], y: &[f64]| [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+    match block {
+        Block::Spherical => {
+            let c = cross(a, b);
+            [c[0], c[1], c[2], 0.0, 0.0, 0.0]
+        }
+        Block::FreeFlyer => {
+            let (p, q) = (cross(&a[3..6], &b[0..3]), cross(&b[3..6], &a[0..3]));
+            let w = cross(&a[3..6], &b[3..6]);
+            [p[0] - q[0], p[1] - q[1], p[2] - q[2], w[0], w[1], w[2]]
+        }
+        Block::Planar => [-a[2] * b[1] + b[2] * a[1], a[2] * b[0] - b[2] * a[0], 0.0, 0.0, 0.0, 0.0],
     }
 }

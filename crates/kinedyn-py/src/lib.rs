@@ -899,6 +899,19 @@ impl PyModel {
         })
     }
 
+    /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
+    fn centroidal_momentum_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        guarded("Model.centroidal_momentum_matrix", || {
+            let q = f64_array("q", &q)?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
+            batch.run(py, self, ("centroidal_momentum_matrix", "A_G"), &[6, n], |model, data, x, out| {
+                algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
+                Ok(())
+            })
+        })
+    }
+
     /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
     fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.momentum", || {

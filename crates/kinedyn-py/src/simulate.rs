@@ -77,14 +77,17 @@ fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict
 
 /// Fresh output arrays `(batch?, samples, n)` x 4 (q, qd, qdd, tau), their total size checked
 /// first: a MemoryError naming the bytes when they cannot be had (e.g. a tiny dt over a long span).
-fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; 4]> {
-    let shape: Vec<usize> = match batch {
-        Some(b) => vec![b, samples, n],
-        None => vec![samples, n],
+fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize, nq: usize) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; 4]> {
+    let shape_of = |w: usize| -> Vec<usize> {
+        match batch {
+            Some(b) => vec![b, samples, w],
+            None => vec![samples, w],
+        }
     };
+    let (shape, shape_q) = (shape_of(n), shape_of(nq));
     const WHAT: &str = "simulate (the recorded q, qd, qdd and tau)";
-    guard::check_size(WHAT, 4, &shape)?;
-    Ok([guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?])
+    guard::check_size(WHAT, 4, &shape_of(n.max(nq)))?;
+    Ok([guard::zeros(py, WHAT, &shape_q)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?])
 }
 
 fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcomes: &[Outcome]) -> PyResult<Bound<'py, PyTuple>> {
@@ -100,17 +103,22 @@ fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcom
     PyTuple::new(py, [q.into_any(), qd.into_any(), qdd.into_any(), tau.into_any(), steps.into_any(), failures.into_any()])
 }
 
-/// Check `q0`, `qd0` ((n,) or (N, n), same shape): (batch, q0, qd0 flattened).
-fn initial_states(n: usize, q0: &PyReadonlyArrayDyn<f64>, qd0: &PyReadonlyArrayDyn<f64>) -> PyResult<(Option<usize>, Vec<f64>, Vec<f64>)> {
+/// Check `q0` ((nq,) or (N, nq)) and `qd0` ((n,) or (N, n), the same batch), and the unit blocks of
+/// q0's multi-DOF joints: (batch, q0, qd0 flattened).
+fn initial_states(m: &PyModel, q0: &PyReadonlyArrayDyn<f64>, qd0: &PyReadonlyArrayDyn<f64>) -> PyResult<(Option<usize>, Vec<f64>, Vec<f64>)> {
+    let (n, nq) = (m.model.n, m.model.nq);
     let batch = match q0.shape() {
-        [m] if *m == n => None,
-        [b, m] if *m == n => Some(*b),
-        s => return Err(PyValueError::new_err(format!("q0 must have shape ({n},) or a batch (N, {n}), got {s:?}"))),
+        [w] if *w == nq => None,
+        [b, w] if *w == nq => Some(*b),
+        s => return Err(PyValueError::new_err(format!("q0 must have shape ({nq},) or a batch (N, {nq}), got {s:?}"))),
     };
-    if qd0.shape() != q0.shape() {
-        return Err(PyValueError::new_err(format!("qd0 has shape {:?}, q0 has shape {:?}: they must match", qd0.shape(), q0.shape())));
+    let expected: Vec<usize> = batch.into_iter().chain([n]).collect();
+    if qd0.shape() != expected.as_slice() {
+        return Err(PyValueError::new_err(format!("qd0 has shape {:?}, q0 has shape {:?}: qd0 must have shape {expected:?}", qd0.shape(), q0.shape())));
     }
-    Ok((batch, flat("q0", q0)?, flat("qd0", qd0)?))
+    let q0 = flat("q0", q0)?;
+    m.check_configurations(&q0)?;
+    Ok((batch, q0, flat("qd0", qd0)?))
 }
 
 /// Integrate from `q0, qd0` ((n,) or a batch (N, n)) over `steps` steps of `dt`, the torque given by
@@ -138,8 +146,8 @@ pub fn integrate_fixed<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_fixed", || {
     let m = model.get();
-    let n = m.model.n;
-    let bounds = limits(n, lower.as_ref(), upper.as_ref())?;
+    let (n, nq) = (m.model.n, m.model.nq);
+    let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
     let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
     let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed, limits };
     if !(dt > 0.0 && dt.is_finite()) {
@@ -148,7 +156,7 @@ pub fn integrate_fixed<'py>(
     if record_every == 0 {
         return Err(PyValueError::new_err("record_every must be at least 1"));
     }
-    let (batch, q0, qd0) = initial_states(n, &q0, &qd0)?;
+    let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
     let count = batch.unwrap_or(1);
     // torque samples: (rows per trajectory, shared?)
     let (tau, rows, shared) = match tau.as_ref() {
@@ -174,14 +182,14 @@ pub fn integrate_fixed<'py>(
         }
     };
     let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n)?;
+    let arrays = outputs(py, batch, samples, n, nq)?;
     // SAFETY: the arrays were created above; nothing else refers to them yet.
     let mut views = Vec::with_capacity(4);
     for a in arrays.iter() {
         views.push(unsafe { a.as_slice_mut()? });
     }
     let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
-    let per = samples * n;
+    let (per, per_q) = (samples * n, samples * nq);
     let model_ref = &m.model;
     let run_one = |i: usize, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], t: &mut [f64]| -> Result<Outcome, kinedyn_core::Error> {
         let values = if rows == 0 {
@@ -193,7 +201,7 @@ pub fn integrate_fixed<'py>(
         };
         let mut source = Sampled { values, n, t0, dt, linear };
         let mut data = Data::new(model_ref);
-        integrate::integrate(model_ref, &mut data, &settings, &q0[i * n..(i + 1) * n], &qd0[i * n..(i + 1) * n], &mut source, Record { q, qd, qdd, tau: t })
+        integrate::integrate(model_ref, &mut data, &settings, &q0[i * nq..(i + 1) * nq], &qd0[i * n..(i + 1) * n], &mut source, Record { q, qd, qdd, tau: t })
     };
     let outcomes: Vec<Outcome> = py
         .detach(|| {
@@ -201,7 +209,7 @@ pub fn integrate_fixed<'py>(
                 return Ok(run_one(0, oq, oqd, oqdd, otau).map(|o| vec![o]));
             }
             guard::install(|| {
-                oq.par_chunks_mut(per)
+                oq.par_chunks_mut(per_q)
                     .zip(oqd.par_chunks_mut(per))
                     .zip(oqdd.par_chunks_mut(per))
                     .zip(otau.par_chunks_mut(per))
@@ -272,8 +280,8 @@ pub fn integrate_callback<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_callback", || {
     let m = model.get();
-    let n = m.model.n;
-    let bounds = limits(n, lower.as_ref(), upper.as_ref())?;
+    let (n, nq) = (m.model.n, m.model.nq);
+    let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
     let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
     let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed, limits };
     if !(dt > 0.0 && dt.is_finite()) {
@@ -282,16 +290,16 @@ pub fn integrate_callback<'py>(
     if record_every == 0 {
         return Err(PyValueError::new_err("record_every must be at least 1"));
     }
-    let (batch, q0, qd0) = initial_states(n, &q0, &qd0)?;
+    let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
     let count = batch.unwrap_or(1);
     let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n)?;
+    let arrays = outputs(py, batch, samples, n, nq)?;
     let mut views = Vec::with_capacity(4);
     for a in arrays.iter() {
         views.push(unsafe { a.as_slice_mut()? });
     }
     let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
-    let per = samples * n;
+    let (per, per_q) = (samples * n, samples * nq);
     let error: RefCell<Option<PyErr>> = RefCell::new(None);
     let torque = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
         let mut call = || -> PyResult<()> {
@@ -344,8 +352,8 @@ pub fn integrate_callback<'py>(
     let mut data = Data::new(&m.model);
     for i in 0..count {
         let r = i * per..(i + 1) * per;
-        let out = Record { q: &mut oq[r.clone()], qd: &mut oqd[r.clone()], qdd: &mut oqdd[r.clone()], tau: &mut otau[r] };
-        let outcome = integrate::integrate(&m.model, &mut data, &settings, &q0[i * n..(i + 1) * n], &qd0[i * n..(i + 1) * n], &mut source, out)
+        let out = Record { q: &mut oq[i * per_q..(i + 1) * per_q], qd: &mut oqd[r.clone()], qdd: &mut oqdd[r.clone()], tau: &mut otau[r] };
+        let outcome = integrate::integrate(&m.model, &mut data, &settings, &q0[i * nq..(i + 1) * nq], &qd0[i * n..(i + 1) * n], &mut source, out)
             .map_err(core_err)?;
         if let Some(e) = error.borrow_mut().take() {
             return Err(e);

@@ -117,18 +117,21 @@ def _names(system) -> list:
     return list(system.joint_names) if hasattr(system, "joint_names") else list(system.names)
 
 
-def _split_state(x0, n: int, name: str):
+def _split_state(x0, n: int, name: str, nq: Optional[int] = None):
+    """(q0, qd0) from x0 = concatenate([q0, qd0]): nq + n numbers (nq = n without multi-DOF joints)."""
     from .._arrays import real_array
 
+    nq = n if nq is None else nq
     x = real_array(x0, "x0")  # TypeError for complex, text or integers beyond float64
-    if x.ndim not in (1, 2) or x.shape[-1] != 2 * n:
+    if x.ndim not in (1, 2) or x.shape[-1] != nq + n:
+        size = f"2 n = {2 * n}" if nq == n else f"nq + nv = {nq} + {n}"
         raise ValueError(
-            f"x0 must be concatenate([q0, qd0]) with 2 n = {2 * n} entries for '{name}' ({n} coordinates), "
-            f"or a batch (N, {2 * n}); got shape {x.shape}"
+            f"x0 must be concatenate([q0, qd0]) with {size} entries for '{name}' ({n} coordinates), "
+            f"or a batch (N, {nq + n}); got shape {x.shape}"
         )
     if not np.all(np.isfinite(x)):
         raise ValueError("x0 contains a non-finite value (NaN or inf)")
-    return np.ascontiguousarray(x[..., :n]), np.ascontiguousarray(x[..., n:])
+    return np.ascontiguousarray(x[..., :nq]), np.ascontiguousarray(x[..., nq:])
 
 
 def _time_grid(t_span, dt, method):
@@ -233,7 +236,7 @@ def _choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
     when it has ``jacobian``) exceeds :data:`RK4_STABLE` at an initial state, else the implicit
     step. Returns (method, reason)."""
     states = [(q0, qd0)] if q0.ndim == 1 else list(zip(q0[:16], qd0[:16]))
-    n = q0.shape[-1]
+    n = qd0.shape[-1]
     worst, joint = 0.0, None
     for q, qd in states:
         try:
@@ -250,6 +253,7 @@ def _choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
         if abs(lam[i]) > worst:
             worst = float(abs(lam[i]))
             joint = int(np.argmax(np.abs(vec[:n, i]) + np.abs(vec[n:, i]) / max(worst, 1e-300)))
+            joint = int(robot._dof_body[joint]) if hasattr(robot, "_dof_body") else joint  # a degree of freedom -> its joint
     stiffness = dt * worst
     if stiffness <= RK4_STABLE:
         return "rk4", f"auto: rk4 (dt |lambda|max = {stiffness:.3g} <= {RK4_STABLE:g}, inside RK4's stability region)"
@@ -492,6 +496,9 @@ def simulate(
     if method in ADAPTIVE_METHODS and not (rtol > 0 and atol > 0 and math.isfinite(rtol) and math.isfinite(atol)):
         raise ValueError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
     robot = _is_robot(system)
+    # a floating, spherical or planar joint: q (nq) and qd (nv) differ, and only the core's
+    # fixed-step integrators step q on the manifold (q ⊕ h qd)
+    multi_dof = robot and cast("Robot", system).has_multi_dof_joints
     mech = None if robot else _as_mechanical(system, params, baumgarte, points)
     target = system if robot else mech
     n = system.n if mech is None else mech.n
@@ -500,7 +507,7 @@ def simulate(
     controller_n = getattr(controller, "n", None)
     if isinstance(controller_n, (int, np.integer)) and controller_n != n:
         raise ValueError(f"the controller is made for {controller_n} joints but '{name}' has {n}")
-    q0, qd0 = _split_state(x0, n, name)
+    q0, qd0 = _split_state(x0, n, name, cast("Robot", system).nq if multi_dof else n)
     batch = q0.shape[0] if q0.ndim == 2 else None
     t0, t1, dt, steps = _time_grid(t_span, dt, method)
     jac = getattr(controller, "jacobian", None) if controller is not None else None
@@ -538,6 +545,10 @@ def simulate(
     count = batch or 1
     work = steps * count * (4 if method == "rk4" else 1)
     native = robot and method in FIXED_METHODS and fext_fn is None
+    if multi_dof and not native:
+        why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext"
+        raise ValueError(f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
+                         f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext); {why} needs the Python loop, which steps q + h qd")
     pure_native = native and u_fn is None and controller is None
     delay = 0.0
     if progress is None:

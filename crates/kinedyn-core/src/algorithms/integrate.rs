@@ -201,6 +201,8 @@ pub struct Record<'a> {
 
 /// Scratch of one run (allocated once per trajectory).
 struct Stage {
+    /// RK4's weighted mean velocity (k1 + 2 k2 + 2 k3 + k4) / 6.
+    mean: Vec<f64>,
     q: Vec<f64>,
     qd: Vec<f64>,
     tau: Vec<f64>,
@@ -219,12 +221,14 @@ struct ImplicitScratch {
     pivot: Vec<usize>,
     rhs: Vec<f64>,
     v0: Vec<f64>,
+    /// The next configuration (nq numbers).
+    q_next: Vec<f64>,
 }
 
 impl ImplicitScratch {
-    fn new(n: usize) -> Self {
+    fn new(n: usize, nq: usize) -> Self {
         let m = || vec![0.0; n * n];
-        ImplicitScratch { a_q: m(), a_v: m(), minv: m(), k_q: m(), k_v: m(), lu: m(), pivot: vec![0; n], rhs: vec![0.0; n], v0: vec![0.0; n] }
+        ImplicitScratch { a_q: m(), a_v: m(), minv: m(), k_q: m(), k_v: m(), lu: m(), pivot: vec![0; n], rhs: vec![0.0; n], v0: vec![0.0; n], q_next: vec![0.0; nq] }
     }
 }
 
@@ -355,23 +359,28 @@ fn implicit_step(
     } else {
         qd.copy_from_slice(&s.v0);
     }
-    // q_{k+1} = q_k + h qd_{k+1}
-    for j in 0..n {
-        q[j] += h * qd[j];
-    }
+    // q_{k+1} = q_k ⊕ h qd_{k+1}
+    step_configuration(model, q, qd, h, &mut s.q_next);
     Ok(())
+}
+
+/// `q = q ⊕ h v` in place (`scratch`: nq numbers).
+fn step_configuration(model: &Model, q: &mut [f64], v: &[f64], h: f64, scratch: &mut [f64]) {
+    model.integrate_configuration(q, v, h, scratch);
+    q.copy_from_slice(&scratch[..q.len()]);
 }
 
 /// Inelastic stops: a joint beyond a limit goes back on it, and a joint on a limit loses its
 /// velocity into the limit.
-fn apply_limits(limits: &Limits<'_>, q: &mut [f64], qd: &mut [f64]) {
-    for j in 0..q.len() {
+fn apply_limits(model: &Model, limits: &Limits<'_>, q: &mut [f64], qd: &mut [f64]) {
+    // limits per q coordinate; only 1-DOF joints have them (a multi-DOF joint's are infinite)
+    for (j, v) in model.scalar_coordinates() {
         if q[j] <= limits.lower[j] {
             q[j] = limits.lower[j];
-            qd[j] = qd[j].max(0.0);
+            qd[v] = qd[v].max(0.0);
         } else if q[j] >= limits.upper[j] {
             q[j] = limits.upper[j];
-            qd[j] = qd[j].min(0.0);
+            qd[v] = qd[v].min(0.0);
         }
     }
 }
@@ -413,13 +422,17 @@ fn singular_joint(e: &Error) -> Option<usize> {
 
 /// Check a state after a step: finite, and no joint faster than `max_speed`.
 fn check_state(q: &[f64], qd: &[f64], max_speed: f64, step: usize, t: f64) -> std::result::Result<(), Failure> {
-    for (j, (a, v)) in q.iter().zip(qd).enumerate() {
-        if !a.is_finite() || !v.is_finite() {
+    // joint: the velocity coordinate (the q coordinate when only q is non-finite)
+    for (j, v) in qd.iter().enumerate() {
+        if !v.is_finite() {
             return Err(Failure { step, t, joint: Some(j), kind: FailureKind::NonFinite });
         }
         if v.abs() > max_speed {
             return Err(Failure { step, t, joint: Some(j), kind: FailureKind::Diverged(*v) });
         }
+    }
+    if let Some(j) = q.iter().position(|a| !a.is_finite()) {
+        return Err(Failure { step, t, joint: Some(j.min(qd.len().saturating_sub(1))), kind: FailureKind::NonFinite });
     }
     Ok(())
 }
@@ -435,10 +448,7 @@ pub fn integrate(
     source: &mut dyn TorqueFn,
     out: Record<'_>,
 ) -> Result<Outcome> {
-    let n = model.n;
-    if !model.plain {
-        return Err(Error::InvalidInput("simulation of multi-DOF joints (floating, spherical, planar) needs Lie-group integration, not implemented yet".into()));
-    }
+    let (n, nq) = (model.n, model.nq);
     let h = settings.dt;
     let every = settings.record_every;
     if !(h > 0.0) || !h.is_finite() {
@@ -447,33 +457,34 @@ pub fn integrate(
     if every == 0 {
         return Err(Error::InvalidInput("record_every must be at least 1".into()));
     }
-    if q0.len() != n || qd0.len() != n {
-        return Err(Error::InvalidInput(format!("q0 and qd0 must have {n} entries, got {} and {}", q0.len(), qd0.len())));
+    if q0.len() != nq || qd0.len() != n {
+        return Err(Error::InvalidInput(format!("q0 and qd0 must have {nq} and {n} entries, got {} and {}", q0.len(), qd0.len())));
     }
     if let Some(l) = &settings.limits {
-        if l.lower.len() != n || l.upper.len() != n {
-            return Err(Error::InvalidInput(format!("joint limits must have {n} lower and upper values, got {} and {}", l.lower.len(), l.upper.len())));
+        if l.lower.len() != nq || l.upper.len() != nq {
+            return Err(Error::InvalidInput(format!("joint limits must have {nq} lower and upper values, got {} and {}", l.lower.len(), l.upper.len())));
         }
-        if let Some(j) = (0..n).find(|&j| l.lower[j].is_nan() || l.upper[j].is_nan() || l.lower[j] > l.upper[j]) {
+        if let Some(j) = (0..nq).find(|&j| l.lower[j].is_nan() || l.upper[j].is_nan() || l.lower[j] > l.upper[j]) {
             return Err(Error::InvalidInput(format!("joint {j} has limits [{}, {}]: lower must not exceed upper", l.lower[j], l.upper[j])));
         }
     }
     let need = settings.samples() * n;
-    if out.q.len() < need || out.qd.len() < need || out.qdd.len() < need || out.tau.len() < need {
+    if out.q.len() < settings.samples() * nq || out.qd.len() < need || out.qdd.len() < need || out.tau.len() < need {
         return Err(Error::InvalidInput(format!("output arrays must hold {} samples of {n} values", settings.samples())));
     }
     let mut q = q0.to_vec();
     let mut qd = qd0.to_vec();
     let zeros = || vec![0.0; n];
-    let mut s = Stage { q: zeros(), qd: zeros(), tau: zeros(), kq: [zeros(), zeros(), zeros(), zeros()], kv: [zeros(), zeros(), zeros(), zeros()] };
-    let mut implicit = (settings.method == Method::Implicit).then(|| ImplicitScratch::new(n));
+    let mut s = Stage { mean: zeros(), q: vec![0.0; nq], qd: zeros(), tau: zeros(), kq: [zeros(), zeros(), zeros(), zeros()], kv: [zeros(), zeros(), zeros(), zeros()] };
+    let mut next_q = vec![0.0; nq];
+    let mut implicit = (settings.method == Method::Implicit).then(|| ImplicitScratch::new(n, nq));
     let mut samples = 0;
     let t_of = |k: usize| settings.t0 + k as f64 * h;
 
     // write sample `samples` from the state at step k, using k1 = (qd, qdd) and tau evaluated there
     let mut record = |samples: &mut usize, q: &[f64], qd: &[f64], qdd: &[f64], tau: &[f64]| {
         let r = *samples * n..(*samples + 1) * n;
-        out.q[r.clone()].copy_from_slice(q);
+        out.q[*samples * nq..(*samples + 1) * nq].copy_from_slice(q);
         out.qd[r.clone()].copy_from_slice(qd);
         out.qdd[r.clone()].copy_from_slice(qdd);
         out.tau[r].copy_from_slice(tau);
@@ -499,19 +510,19 @@ pub fn integrate(
         let evaluate = !settings.hold;
         let step = match settings.method {
             Method::Euler => {
-                // x_{k+1} = x_k + h f(t_k, x_k)
+                // x_{k+1} = x_k + h f(t_k, x_k)  (q_{k+1} = q_k ⊕ h qd_k on a multi-DOF joint)
+                step_configuration(model, &mut q, &qd, h, &mut next_q);
                 for j in 0..n {
-                    q[j] += h * qd[j];
                     qd[j] += h * kv0[0][j];
                 }
                 Ok(())
             }
             Method::SemiImplicitEuler => {
-                // qd_{k+1} = qd_k + h qdd_k ;  q_{k+1} = q_k + h qd_{k+1}
+                // qd_{k+1} = qd_k + h qdd_k ;  q_{k+1} = q_k ⊕ h qd_{k+1}
                 for j in 0..n {
                     qd[j] += h * kv0[0][j];
-                    q[j] += h * qd[j];
                 }
+                step_configuration(model, &mut q, &qd, h, &mut next_q);
                 Ok(())
             }
             Method::Implicit => {
@@ -524,23 +535,32 @@ pub fn integrate(
                 // k2 = f(t + h/2, x + h/2 k1) ;  k3 = f(t + h/2, x + h/2 k2) ;  k4 = f(t + h, x + h k3)
                 for (stage, (c, dt_stage)) in [(0.5 * h, 0.5 * h), (0.5 * h, 0.5 * h), (h, h)].into_iter().enumerate() {
                     let prev_v = if stage == 0 { &kv0[0] } else { &rest[stage - 1] };
+                    // stage configuration q ⊕ c k (the stages' velocities are tangent vectors at q)
+                    model.integrate_configuration(&q, &kq[stage], c, &mut s.q);
                     for j in 0..n {
-                        s.q[j] = q[j] + c * kq[stage][j];
                         s.qd[j] = qd[j] + c * prev_v[j];
                     }
-                    kq[stage + 1].copy_from_slice(&s.qd);
+                    // RKMK4: the chart's rate dexp⁻¹(v) at Ω = c k_stage (v on 1-DOF joints)
+                    for j in 0..n {
+                        s.mean[j] = c * kq[stage][j];
+                    }
+                    let (head, tail) = kq.split_at_mut(stage + 1);
+                    model.chart_rate(&s.mean, &s.qd, &mut tail[0]);
+                    let _ = head;
                     derivative(model, data, source, k, t + dt_stage, &s.q, &s.qd, &mut s.tau, evaluate, &mut rest[stage])?;
                 }
-                // x_{k+1} = x_k + h/6 (k1 + 2 k2 + 2 k3 + k4)
+                // x_{k+1} = x_k + h/6 (k1 + 2 k2 + 2 k3 + k4), q_{k+1} = q_k ⊕ h/6 (k1 + ...): the
+                // Runge-Kutta-Munthe-Kaas method (fourth order on the manifold too)
                 for j in 0..n {
-                    q[j] += h / 6.0 * (kq[0][j] + 2.0 * kq[1][j] + 2.0 * kq[2][j] + kq[3][j]);
+                    s.mean[j] = (kq[0][j] + 2.0 * kq[1][j] + 2.0 * kq[2][j] + kq[3][j]) / 6.0;
                     qd[j] += h / 6.0 * (kv0[0][j] + 2.0 * rest[0][j] + 2.0 * rest[1][j] + rest[2][j]);
                 }
+                step_configuration(model, &mut q, &s.mean, h, &mut next_q);
                 Ok(())
             })(),
         };
         if let (Ok(()), Some(limits)) = (&step, &settings.limits) {
-            apply_limits(limits, &mut q, &mut qd);
+            apply_limits(model, limits, &mut q, &mut qd);
         }
         let checked = step.and_then(|_| check_state(&q, &qd, settings.max_speed, k, t));
         if let Err(f) = checked {
