@@ -159,17 +159,17 @@ def test_missing_and_unsupported_robot_files(capsys, tmp_path):
     for command, extra in commands(tmp_path):
         code, _, err = run(capsys, command, tmp_path / "missing.yaml", *extra)
         assert_one_line_error(code, err, "missing.yaml", "does not exist")
-        # .xml: the CLI accepts exactly what kinedyn.load reads, and says which extensions those are
-        (tmp_path / "arm.xml").write_text((EXAMPLES / "planar_2r.urdf").read_text())
-        code, _, err = run(capsys, command, tmp_path / "arm.xml", *extra)
-        line = assert_one_line_error(code, err, "arm.xml", ".urdf, .yaml, .yml, .toml")
+        # .sdf: the CLI accepts exactly what kinedyn.load reads, and says which extensions those are
+        (tmp_path / "arm.sdf").write_text((EXAMPLES / "planar_2r.urdf").read_text())
+        code, _, err = run(capsys, command, tmp_path / "arm.sdf", *extra)
+        line = assert_one_line_error(code, err, "arm.sdf", ".urdf, .yaml, .yml, .toml, .xml, .xacro")
         with pytest.raises(ValueError, match="unknown robot file extension"):
-            kd.load(tmp_path / "arm.xml")
+            kd.load(tmp_path / "arm.sdf")
         code, _, err = run(capsys, command, tmp_path, *extra)  # a folder
         assert_one_line_error(code, err, str(tmp_path))
     assert line
     # the CLI's table is load()'s: every extension in it is one load() reads (an empty file fails
-    # for its content, not its name), and .xml is not
+    # for its content, not its name), and .sdf is not
     for ext in cli.ROBOT_FILE_EXTENSIONS:
         empty = tmp_path / f"empty{ext}"
         empty.write_text("")

@@ -24,7 +24,7 @@ import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Dict, Optional, Sequence
+from typing import Any, Callable, Dict, Optional, Sequence
 
 import numpy as np
 
@@ -40,7 +40,7 @@ EXIT_INTERRUPTED = 130  # Ctrl-C (128 + SIGINT, as shells report it)
 
 # ------------------------------------------------------------------ shared helpers
 # The robot file extensions kinedyn.load reads (kinedyn.description.files.load dispatches on these).
-ROBOT_FILE_EXTENSIONS = (".urdf", ".yaml", ".yml", ".toml")
+ROBOT_FILE_EXTENSIONS = (".urdf", ".yaml", ".yml", ".toml", ".xml", ".xacro")
 
 
 @dataclass
@@ -51,6 +51,8 @@ class _Invocation:
     command: str
     values: Dict[str, float] = field(default_factory=dict)
     numeric: bool = True
+    xacro_args: Dict[str, str] = field(default_factory=dict)  # --xacro-arg NAME:=VALUE
+    trust_xacro: bool = False  # --trust-xacro: expanding xacro runs the file's Python expressions
 
 
 _INVOCATION: contextvars.ContextVar[Optional[_Invocation]] = contextvars.ContextVar("kinedyn_cli_invocation", default=None)
@@ -98,8 +100,17 @@ def _robot_file(spec: str):
         raise ValueError(f"robot file '{spec}' does not exist")
     if path.is_dir():
         raise ValueError(f"robot file '{spec}' is a folder")
+    run = _INVOCATION.get()
+    options: Dict[str, Any] = {}
+    if ext == ".xacro" and run is not None:
+        options = {"xacro_args": run.xacro_args, "trust_xacro": run.trust_xacro}
     try:
-        return load(path)
+        try:
+            return load(path, **options)
+        except ValueError as e:
+            if ext == ".xacro" and "trust_xacro=True" in str(e):
+                raise ValueError(str(e).replace("pass trust_xacro=True (command line: --trust-xacro)", "add --trust-xacro")) from None
+            raise
     except ValueError as e:  # the loader's own message; make sure it says which file
         if spec in str(e) or str(path) in str(e):
             raise
@@ -169,6 +180,14 @@ def _parse_set(text: str):
         return name, _parse_set_value(value.strip())
     except ValueError as e:
         raise argparse.ArgumentTypeError(f"{name}: the value must be a number, got '{value.strip()}' ({e})") from None
+
+
+def _parse_xacro_arg(text: str):
+    """``--xacro-arg name:=value`` as (name, value), as xacro's own command line writes it."""
+    name, eq, value = text.partition(":=")
+    if not eq or not name.strip() or any(c.isspace() for c in name.strip()):
+        raise argparse.ArgumentTypeError(f"expected NAME:=VALUE (e.g. --xacro-arg prefix:=left_), got '{text}'")
+    return name.strip(), value
 
 
 def _set_values(pairs) -> Dict[str, float]:
@@ -743,6 +762,11 @@ def _common_options(p: argparse.ArgumentParser, global_: bool = False) -> None:
     if global_ or any(a.dest == "robot" for a in p._actions):
         p.add_argument("--set", dest="set_global" if global_ else "set", action="append", type=_parse_set, default=None if global_ else argparse.SUPPRESS,
                        metavar="NAME=VALUE", help="give a robot parameter a value (repeatable): a symbol of a robot file, or a keyword of a built-in (e.g. --set l1=0.5)")
+    if not global_ and any(a.dest == "robot" for a in p._actions):
+        p.add_argument("--xacro-arg", dest="xacro_args", action="append", type=_parse_xacro_arg, default=argparse.SUPPRESS, metavar="NAME:=VALUE",
+                       help="an argument of a .xacro robot file (repeatable)")
+        p.add_argument("--trust-xacro", action="store_true", default=argparse.SUPPRESS,
+                       help="expand a .xacro robot file: xacro runs Python expressions from the file, so only for files you trust")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -905,7 +929,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         command = args.command
         debug = bool(args.debug)
         phrases = getattr(args, "_flag_phrases", None)
-        run = _Invocation(command, _set_values((args.set_global or []) + (getattr(args, "set", None) or [])), command not in SYMBOLIC_COMMANDS)
+        run = _Invocation(command, _set_values((args.set_global or []) + (getattr(args, "set", None) or [])), command not in SYMBOLIC_COMMANDS,
+                          dict(getattr(args, "xacro_args", None) or []), bool(getattr(args, "trust_xacro", False)))
         token = _INVOCATION.set(run)
         try:
             with warnings.catch_warnings():

@@ -8,6 +8,7 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 from __future__ import annotations
 
 import math
+import os
 import sys
 from functools import cached_property
 from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
@@ -193,15 +194,37 @@ class Robot:
 
     @classmethod
     def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
-                  floating_base: bool = False) -> "Robot":
+                  floating_base: bool = False, xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False,
+                  package_dirs: Sequence[PathLike] = ()) -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
         or ``"strict"`` (ValueError); see docs/model-files.md. ``floating_base=True``: the root link
-        moves on a free-flyer joint ``root_joint`` (Pinocchio's ``JointModelFreeFlyer``; nq = nv + 1)."""
-        from .description.urdf import robot_from_urdf
+        moves on a free-flyer joint ``root_joint`` (Pinocchio's ``JointModelFreeFlyer``; nq = nv + 1).
 
+        A path ending in ``.xacro`` is expanded by the ``xacro`` package first, with ``xacro_args``
+        (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
+        Python expressions from the file, so it needs ``trust_xacro=True``
+        (:mod:`kinedyn.description.xacro`)."""
+        from .description.urdf import robot_from_urdf
+        from .description.xacro import expand_xacro, is_xacro
+
+        if is_xacro(path_or_string):
+            text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
+            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base,
+                                   source_path=os.fsdecode(path_or_string))
+        if xacro_args:
+            raise ValueError("xacro_args are for a .xacro file")
         return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base)
+
+    @classmethod
+    def from_mjcf(cls, path_or_string: Union[PathLike, bytes], *, gravity: Optional[ArrayLike] = None, tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+        """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
+        and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
+        ``tool`` and ``inertia`` as :meth:`from_urdf`."""
+        from .description.mjcf import robot_from_mjcf
+
+        return robot_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""

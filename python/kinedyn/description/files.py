@@ -69,18 +69,28 @@ _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 
 
 # ============================================================================ public functions
 def load(path: PathLike, inertia: str = "warn", **kwargs) -> Robot:
-    """A robot from ``.urdf`` (``kwargs``: gravity, tool), ``.yaml``/``.yml`` or ``.toml`` (``kwargs``
+    """A robot from ``.urdf`` (``kwargs``: gravity, tool), ``.xml``/``.mjcf`` (MuJoCo; the same
+    ``kwargs``), ``.xacro`` (expanded to URDF; ``kwargs`` also ``xacro_args``, ``trust_xacro``,
+    ``package_dirs``: see :meth:`kinedyn.Robot.from_urdf`), ``.yaml``/``.yml`` or ``.toml`` (``kwargs``
     replace constructor arguments, e.g. ``gravity=``). ``inertia`` is the policy for inertia tensors
     no rigid body has: "warn" (keep, with a PhysicalConsistencyWarning), "repair" (project onto the
     nearest consistent tensor) or "strict" (raise); see docs/model-files.md."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
+    if ext == ".xacro":  # robot.urdf.xacro; kwargs: xacro_args, trust_xacro, package_dirs, gravity, tool
+        from ..robot import Robot
+
+        return Robot.from_urdf(path, inertia=inertia, **kwargs)
     if ext == ".urdf":
         from .urdf import robot_from_urdf
 
         return robot_from_urdf(path, inertia=inertia, **kwargs)
+    if ext in (".xml", ".mjcf"):
+        from .mjcf import robot_from_mjcf
+
+        return robot_from_mjcf(path, inertia=inertia, **kwargs)
     if ext not in (".yaml", ".yml", ".toml"):
-        raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .yaml, .yml or .toml)")
+        raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .xacro, .xml (MJCF), .yaml, .yml or .toml)")
     text = _read_text(path)
     data = _parse_toml(text, path) if ext == ".toml" else _parse_yaml(text, path)
     robot = robot_from_mapping(data, where=path, inertia=inertia)

@@ -60,7 +60,8 @@ FLOATING_BASE_FRAME = "universe"
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
-def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", floating_base: bool = False):
+def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", floating_base: bool = False,
+                    source_path: Optional[str] = None):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
@@ -76,13 +77,14 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     or ``"strict"`` (see :func:`kinedyn.description.inertia.judge` and docs/model-files.md).
 
     Every problem with the file is a ValueError naming the file, the line, and the link, joint or
-    attribute. The XML may not declare entities (no DOCTYPE with an internal subset or an external
+    attribute. ``source_path``: the file an XML string was made from (a xacro file): it names the
+    source in messages and its folder is where relative mesh paths start. The XML may not declare entities (no DOCTYPE with an internal subset or an external
     DTD: entity expansion is unbounded work) nor nest elements deeper than ``MAX_DEPTH``; the work is
     linear in the size of the file.
     """
     from ..robot import Robot
 
-    src, root = _parse(path_or_string)
+    src, root = _parse(path_or_string, source_path)
     if root.tag != "robot":
         raise src.error(root, f"the root element is <{root.tag}>, expected <robot>")
     link_elements = _links(root, src)
@@ -160,7 +162,7 @@ class _Source:
         return ValueError(f"{self.at(self.line(element))}: {message}")
 
 
-def _parse(path_or_string):
+def _parse(path_or_string, source_path: Optional[str] = None):
     """(source, root element): the XML parsed by expat with line numbers, no entity declarations
     (billion laughs, external entities) and a bounded nesting depth."""
     text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
@@ -170,7 +172,7 @@ def _parse(path_or_string):
         raise TypeError(f"robot_from_urdf expects a path or an XML string, got {type(path_or_string).__name__}")
     data: str | bytes
     if "<" in text or "\n" in text:  # XML (perhaps malformed), never a file name
-        src, data = _Source("<URDF string>"), text
+        src, data = _Source(os.fspath(source_path) if source_path is not None else "<URDF string>"), text
     else:
         src = _Source(text)
         try:

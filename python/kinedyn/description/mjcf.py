@@ -1,0 +1,836 @@
+"""MJCF (MuJoCo's XML) -> :class:`kinedyn.Robot`.
+
+Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Reference"):
+
+- ``<mujoco model>``; ``<compiler angle="degree|radian" eulerseq autolimits meshdir assetdir
+  inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia settotalmass>`` (MuJoCo's
+  defaults: degrees, ``xyz``, autolimits on, inertia from geoms when a body has no ``<inertial>``); ``<option gravity>`` and
+  ``<option><flag gravity="disable">``.
+- ``<default>`` classes (the top one is ``main``; nested classes inherit; an element's ``class``, else
+  the ``childclass`` of the nearest enclosing body or frame, else ``main``) for ``joint``, ``geom``,
+  ``site`` and ``mesh``.
+- ``<worldbody>`` and nested ``<body name pos quat|axisangle|euler|xyaxes|zaxis childclass>``
+  (quaternions in MuJoCo's (w, x, y, z) order), and ``<frame>`` groups.
+- ``<joint type="hinge|slide|ball|free" axis pos range limited ref armature damping frictionloss>``
+  and ``<freejoint>``: hinge -> revolute, slide -> prismatic, ball -> spherical, free -> floating.
+  The joint's ``pos`` and ``axis`` are in the body frame; a body with several joints becomes a chain
+  of massless links (named ``BODY/JOINT``), one per joint, composed in file order as MuJoCo does, the
+  last carrying the body's name and inertia. A hinge at ``pos`` p moves its body by
+  ``Tr(p) Rot(axis, q - ref) Tr(-p)``, which is a kinedyn link with ``placement = body_pose Tr(p)`` and
+  ``post = Tr(-p)``; ``ref`` becomes the joint's offset ``-ref``, so kinedyn's ``q`` is MuJoCo's
+  ``qpos``. ``armature`` -> rotor inertia (gear ratio 1), ``damping`` -> viscous, ``frictionloss``
+  -> Coulomb friction. A free joint puts its body at ``qpos`` in the world: the body's own ``pos``
+  and ``quat`` are only MuJoCo's initial ``qpos0``, so kinedyn's placement of it is the identity.
+- ``<inertial pos quat mass diaginertia|fullinertia>``; a body without one gets its inertia from its
+  geoms (box, sphere, capsule, cylinder, ellipsoid: solid, of ``density`` (default 1000) or the
+  geom's ``mass``); a mesh geom's inertia is not computed (give the body an ``<inertial>``).
+- Geoms (``box sphere cylinder capsule ellipsoid mesh``, with ``size``, ``fromto``, ``pos``,
+  orientation, ``rgba``/``material``) -> ``robot.visuals`` (those of groups 0-2, which MuJoCo's
+  viewer shows) and ``robot.collisions`` (those with ``contype`` or ``conaffinity`` set);
+  MuJoCo's capsules and ellipsoids are drawn as the cylinders and spheres nearest them.
+- ``<site name pos orientation>`` -> named frames on its body (``site:NAME`` when a body has the name).
+- ``<include file>``: relative to the including file's folder, which it may not leave; nested at
+  most ``MAX_INCLUDE_DEPTH`` deep.
+
+Not modelled, and named in one warning when present: actuators, tendons, equality constraints,
+contact pairs and exclusions, sensors, keyframes, joint springs (``stiffness``), ``gravcomp``,
+friction and armature of ball and free joints, a ball joint's range (a cone). Lights, cameras, textures and the ``<visual>``
+settings are presentation and are skipped silently. ``<replicate>``, ``<attach>``, ``<composite>``,
+``<flexcomp>``, mocap bodies, ``shellinertia`` and ``<compiler coordinate="global">`` are refused (they make bodies kinedyn cannot
+read here).
+
+The base of the robot is MuJoCo's world body, named ``world``; bodies without a joint are welded to
+their parent (fixed joints). Unnamed bodies and joints get MuJoCo's numbering: ``body{id}``,
+``joint{id}``.
+
+Security, as the URDF loader: the XML may not declare entities; nesting, file size and includes are
+bounded; every problem is a ValueError naming the file, the line, the element and the attribute.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import types
+import warnings
+import xml.etree.ElementTree as ET
+from typing import Optional
+from xml.parsers import expat
+
+import numpy as np
+
+from .checks import LARGEST
+from .geometry import Box, Cylinder, Mesh, Sphere, Visual
+from .inertia import Inertia, PhysicalConsistencyWarning
+from .joint import Joint
+from .link import Frame, Link
+
+__all__ = ["robot_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
+
+MAX_DEPTH = 200  # deepest element nesting accepted (bodies nest; guards the parser's memory)
+MAX_INCLUDE_DEPTH = 8  # <include> inside included files, at most this deep
+MAX_FILE_BYTES = 16 * 2**20  # per file, and for all included files together
+MAX_INCLUDES = 256  # <include> elements in one model
+
+_JOINT_KINDS = {"hinge": "revolute", "slide": "prismatic", "ball": "spherical", "free": "floating"}
+_SHAPES = ("sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "plane", "hfield", "sdf")
+_DEFAULTED = ("joint", "geom", "site", "mesh")
+# top-level sections with dynamics kinedyn does not model (named in the warning)
+_UNMODELLED = ("actuator", "tendon", "equality", "contact", "sensor", "keyframe", "deformable")
+# sections or elements kinedyn skips silently (presentation, bookkeeping)
+_PRESENTATION = ("visual", "statistic", "size", "custom", "extension", "light", "camera", "asset")
+_REFUSED = ("replicate", "attach", "composite", "flexcomp")
+
+
+# ============================================================================== entry point
+def robot_from_mjcf(path_or_string, *, tool: Optional[str] = None, inertia: str = "warn", gravity=None):
+    """A :class:`kinedyn.Robot` from an MJCF file path or an XML string (see the module docstring).
+
+    A string holding ``<`` or a line break is parsed as XML, anything else is a path (an XML string
+    may not ``<include>`` files). ``gravity``: overrides ``<option gravity>``. ``tool`` and
+    ``inertia`` as :func:`kinedyn.description.urdf.robot_from_urdf`.
+    """
+    from ..robot import Robot
+
+    src, root = _parse_model(path_or_string)
+    if root.tag != "mujoco":
+        raise src.error(root, f"the root element is <{root.tag}>, expected <mujoco>")
+    reader = _Reader(src, root)
+    links, frames, visuals, collisions = reader.read()
+    name = root.get("model") or "mjcf_robot"
+    source = src.label if src.base_dir is not None else "MJCF string"
+    if gravity is None:
+        gravity = reader.gravity
+    if reader.ignored:
+        shown = sorted(reader.ignored)
+        warnings.warn(
+            f"{src.label}: kinedyn does not model, and ignores: {'; '.join(shown[:20])}"
+            + (f" and {len(shown) - 20} more" if len(shown) > 20 else ""),
+            UserWarning,
+            stacklevel=_caller_level(),
+        )
+    if not any(link.joint.is_moving for link in links):
+        raise ValueError(f"{src.label}: model '{name}' has no joint (kinedyn needs at least one moving joint)")
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", PhysicalConsistencyWarning)
+            robot = Robot(links, frames, gravity=gravity, base="world", tool=tool, name=name, source=source,
+                          inertia=inertia, visuals=visuals, collisions=collisions)
+    except ValueError as e:
+        raise ValueError(f"{src.label}: {e}") from None
+    for w in caught:
+        warnings.warn(f"{src.label}: {w.message}", w.category, stacklevel=_caller_level())
+    return robot
+
+
+def _caller_level() -> int:
+    """The stacklevel, for a warning raised in the function that calls this, of the first frame
+    outside kinedyn (so the warning points at the user's call)."""
+    import sys
+
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame: Optional[types.FrameType] = sys._getframe(2)
+    level = 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+# ============================================================================== XML, bounded
+class _Sources:
+    """Where each element came from: (file label, line), for messages; the model's folder."""
+
+    def __init__(self, label: str, base_dir: Optional[str]):
+        self.label = label
+        self.base_dir = base_dir
+        self.where: dict = {}  # id(element) -> (label, line)
+        self.total_bytes = 0
+        self.includes = 0
+
+    def at(self, element) -> str:
+        label, line = self.where.get(id(element), (self.label, None))
+        return label if line is None else f"{label}:{line}"
+
+    def error(self, element, message: str) -> ValueError:
+        return ValueError(f"{self.at(element)}: <{element.tag}> {message}")
+
+
+def _parse_model(path_or_string):
+    text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
+    if not isinstance(text, str):
+        raise TypeError(f"robot_from_mjcf expects a path or an XML string, got {type(path_or_string).__name__}")
+    if "<" in text or "\n" in text:
+        src = _Sources("<MJCF string>", None)
+        data = text.encode("utf-8")
+        if len(data) > MAX_FILE_BYTES:
+            raise ValueError(f"{src.label}: the XML is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model")
+        src.total_bytes += len(data)
+        root = _parse_xml(data, src.label, src)
+    else:
+        src = _Sources(text, os.path.dirname(os.path.abspath(text)))
+        root = _parse_xml(_read(text, src), text, src)
+    _expand_includes(root, src, src.base_dir, 0)
+    return src, root
+
+
+def _read(path: str, src: _Sources, element=None) -> bytes:
+    try:
+        with open(path, "rb") as f:
+            data = f.read(MAX_FILE_BYTES + 1)
+    except OSError as e:
+        where = f"{src.at(element)}: <include> " if element is not None else f"{path}: "
+        raise ValueError(f"{where}cannot read MJCF file '{path}' ({e.strerror or e})") from None
+    src.total_bytes += len(data)
+    if len(data) > MAX_FILE_BYTES or src.total_bytes > MAX_FILE_BYTES:
+        raise ValueError(f"{path}: the model (with its includes) is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model")
+    return data
+
+
+def _parse_xml(data: bytes, label: str, src: _Sources):
+    """The root element of ``data``, parsed by expat without entity declarations and with bounded depth."""
+    builder = ET.TreeBuilder()
+    parser = expat.ParserCreate()
+    depth = 0
+
+    def start(tag, attributes):
+        nonlocal depth
+        depth += 1
+        if depth > MAX_DEPTH:
+            raise ValueError(f"{label}:{parser.CurrentLineNumber}: elements nested deeper than {MAX_DEPTH} levels")
+        src.where[id(builder.start(tag, attributes))] = (label, parser.CurrentLineNumber)
+
+    def end(tag):
+        nonlocal depth
+        depth -= 1
+        builder.end(tag)
+
+    def doctype(name, system_id, public_id, has_internal_subset):
+        if has_internal_subset or system_id or public_id:
+            raise ValueError(
+                f"{label}:{parser.CurrentLineNumber}: a DOCTYPE with declarations or an external DTD is not accepted "
+                "in an MJCF model (entity expansion is unbounded work); remove it"
+            )
+
+    def entity(name, *args):
+        raise ValueError(f"{label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in an MJCF model")
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.StartDoctypeDeclHandler = doctype
+    parser.EntityDeclHandler = entity
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    try:
+        parser.Parse(data, True)
+    except expat.ExpatError as e:
+        raise ValueError(f"{label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}") from None
+    except LookupError as e:
+        raise ValueError(f"{label}: the XML declaration names an unknown encoding ({e})") from None
+    return builder.close()
+
+
+def _expand_includes(element, src: _Sources, folder: Optional[str], depth: int) -> None:
+    """Replace every ``<include file>`` below ``element`` by the children of the included ``<mujoco>``."""
+    k = 0
+    while k < len(element):
+        child = element[k]
+        if child.tag != "include":
+            _expand_includes(child, src, folder, depth)
+            k += 1
+            continue
+        name = child.get("file")
+        if not name:
+            raise src.error(child, "has no 'file' attribute")
+        if folder is None or src.base_dir is None:
+            raise src.error(child, f"file='{name}': a model given as an XML string cannot include files (load it from its file)")
+        if depth >= MAX_INCLUDE_DEPTH:
+            raise src.error(child, f"file='{name}': includes nested deeper than {MAX_INCLUDE_DEPTH} levels")
+        src.includes += 1
+        if src.includes > MAX_INCLUDES:
+            raise src.error(child, f"file='{name}': more than {MAX_INCLUDES} includes in one model")
+        path = os.path.realpath(os.path.join(folder, name))
+        top = os.path.realpath(src.base_dir)
+        if os.path.commonpath([path, top]) != top:
+            raise src.error(child, f"file='{name}' is outside the model's folder {top} (an included file must lie inside it)")
+        label = os.path.relpath(path) if not os.path.isabs(src.label) else path
+        included = _parse_xml(_read(path, src, child), label, src)
+        if included.tag != "mujoco":
+            raise src.error(child, f"file='{name}': the included file's root element is <{included.tag}>, expected <mujoco>")
+        _expand_includes(included, src, os.path.dirname(path), depth + 1)
+        element[k:k + 1] = list(included)
+        k += len(included)
+
+
+# ============================================================================== numbers, poses
+def _numbers(element, attribute: str, src: _Sources, n: Optional[int] = None, text: Optional[str] = None, at_most: Optional[int] = None) -> tuple:
+    text = element.get(attribute) if text is None else text
+    assert text is not None
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        raise src.error(element, f"attribute '{attribute}' must be numbers, got '{_short(text)}'") from None
+    if n is not None and len(values) != n:
+        raise src.error(element, f"attribute '{attribute}' must be {n} numbers, got {len(values)}: '{_short(text)}'")
+    if at_most is not None and not 1 <= len(values) <= at_most:
+        raise src.error(element, f"attribute '{attribute}' must be 1 to {at_most} numbers, got {len(values)}: '{_short(text)}'")
+    for v in values:
+        if not math.isfinite(v) or abs(v) > LARGEST:
+            raise src.error(element, f"attribute '{attribute}' must hold finite numbers of magnitude at most {LARGEST:g}, got '{_short(text)}'")
+    return values
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _quat_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (w, x, y, z)."""
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def _axis_angle(axis, angle: float) -> np.ndarray:
+    x, y, z = axis
+    c, s, v = math.cos(angle), math.sin(angle), 1 - math.cos(angle)
+    return np.array([
+        [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
+        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
+        [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
+    ])
+
+
+def _z_to(vector: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking the z axis to the unit ``vector``."""
+    z = np.array([0.0, 0.0, 1.0])
+    axis = np.cross(z, vector)
+    s, c = np.linalg.norm(axis), float(vector @ z)
+    if s < 1e-14:
+        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])  # MuJoCo: 180 degrees about x
+    return _axis_angle(axis / s, math.atan2(s, c))
+
+
+def _pose(p, R) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = p
+    return T
+
+
+def _translation(p) -> np.ndarray:
+    return _pose(p, np.eye(3))
+
+
+# ============================================================================== the reader
+class _Reader:
+    def __init__(self, src: _Sources, root):
+        self.src = src
+        self.root = root
+        self.ignored: set = set()
+        self.compiler()
+        self.defaults: dict = {}  # class name -> {element tag: {attribute: value}}
+        self.gravity = self.option()
+        for section in root.iterfind("default"):
+            self.read_defaults(section, "main", {t: {} for t in _DEFAULTED})
+        self.materials, self.meshes = self.assets()
+        self.names: set = {"world"}
+        self.site_names: list = []
+        self.body_count = 0
+        self.joint_count = 0
+
+    # --------------------------------------------------------------------- model-wide settings
+    def compiler(self) -> None:
+        self.degrees, self.eulerseq, self.autolimits = True, "xyz", True
+        self.inertiafromgeom, self.groups = "auto", (0, 5)
+        # MuJoCo's compiler adjustments of body inertias (off by default)
+        self.boundmass, self.boundinertia, self.settotalmass, self.balanceinertia = 0.0, 0.0, -1.0, False
+        self.meshdir = self.src.base_dir
+        for c in self.root.iter("compiler"):
+            for attribute, value in c.attrib.items():
+                if attribute == "angle":
+                    if value not in ("degree", "radian"):
+                        raise self.src.error(c, f"attribute 'angle' must be 'degree' or 'radian', got '{_short(value)}'")
+                    self.degrees = value == "degree"
+                elif attribute == "eulerseq":
+                    if len(value) != 3 or any(ch not in "xyzXYZ" for ch in value):
+                        raise self.src.error(c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{_short(value)}'")
+                    self.eulerseq = value
+                elif attribute == "autolimits":
+                    self.autolimits = self.boolean(c, attribute, value)
+                elif attribute == "inertiafromgeom":
+                    if value not in ("true", "false", "auto"):
+                        raise self.src.error(c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{_short(value)}'")
+                    self.inertiafromgeom = value
+                elif attribute == "inertiagrouprange":
+                    lo, hi = _numbers(c, attribute, self.src, 2)
+                    self.groups = (int(lo), int(hi))
+                elif attribute in ("meshdir", "assetdir"):
+                    if self.src.base_dir is not None and (attribute == "meshdir" or c.get("meshdir") is None):
+                        self.meshdir = os.path.join(self.src.base_dir, value)
+                elif attribute == "coordinate" and value != "local":
+                    raise self.src.error(c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)")
+                elif attribute in ("boundmass", "boundinertia", "settotalmass"):
+                    setattr(self, attribute, _numbers(c, attribute, self.src, 1)[0])
+                elif attribute == "balanceinertia":
+                    self.balanceinertia = self.boolean(c, attribute, value)
+
+    @staticmethod
+    def boolean_value(value: str) -> Optional[bool]:
+        return {"true": True, "false": False}.get(value)
+
+    def boolean(self, element, attribute: str, value: str) -> bool:
+        b = self.boolean_value(value)
+        if b is None:
+            raise self.src.error(element, f"attribute '{attribute}' must be true or false, got '{_short(value)}'")
+        return b
+
+    def option(self) -> tuple:
+        gravity = (0.0, 0.0, -9.81)
+        for o in self.root.iter("option"):
+            if o.get("gravity") is not None:
+                gravity = _numbers(o, "gravity", self.src, 3)
+            for flag in o.iterfind("flag"):
+                if flag.get("gravity") == "disable":
+                    gravity = (0.0, 0.0, 0.0)
+        return gravity
+
+    def read_defaults(self, element, name: str, inherited: dict) -> None:
+        cls = element.get("class") or name
+        if cls in self.defaults:
+            raise self.src.error(element, f"class '{cls}' is defined twice")
+        own = {t: dict(a) for t, a in inherited.items()}
+        for child in element:
+            if child.tag in _DEFAULTED:
+                own[child.tag].update(child.attrib)
+        self.defaults[cls] = own
+        for child in element:
+            if child.tag == "default":
+                if not child.get("class"):
+                    raise self.src.error(child, "a nested <default> needs a 'class' attribute")
+                self.read_defaults(child, child.get("class"), own)
+
+    def attributes(self, element, childclass: str) -> dict:
+        """The element's attributes over its default class's."""
+        cls = element.get("class") or childclass
+        if cls not in self.defaults:
+            if cls == "main":
+                return dict(element.attrib)
+            raise self.src.error(element, f"class='{cls}' names no <default> class")
+        out = dict(self.defaults[cls].get(element.tag, {}))
+        if element.tag == "geom" and "size" in out and "size" in element.attrib:
+            # MuJoCo reads the numbers given over the default's (a sphere's size="r" keeps the rest)
+            given = element.get("size").split()
+            rest = out["size"].split()[len(given):]
+            out["size"] = " ".join(given + rest)
+            element = {k: v for k, v in element.attrib.items() if k != "size"}
+            out.update(element)
+            return out
+        out.update(element.attrib)
+        return out
+
+    def assets(self) -> tuple:
+        materials, meshes = {}, {}
+        for asset in self.root.iterfind("asset"):
+            for m in asset.iterfind("material"):
+                if m.get("name") and m.get("rgba"):
+                    materials[m.get("name")] = self.rgba(m, m.get("rgba"))
+            for mesh in asset.iterfind("mesh"):
+                a = self.attributes(mesh, "main")
+                file = a.get("file")
+                name = a.get("name") or (os.path.splitext(os.path.basename(file))[0] if file else None)
+                if not name:
+                    raise self.src.error(mesh, "has neither 'name' nor 'file'")
+                scale = _numbers(mesh, "scale", self.src, 3, text=a.get("scale", "1 1 1"))
+                meshes[name] = (file, scale, mesh)
+        return materials, meshes
+
+    def rgba(self, element, text: str) -> tuple:
+        values = _numbers(element, "rgba", self.src, 4, text=text)
+        if any(not 0.0 <= v <= 1.0 for v in values):
+            raise self.src.error(element, f"attribute 'rgba' must be 4 numbers between 0 and 1, got '{_short(text)}'")
+        return values
+
+    # --------------------------------------------------------------------- orientation
+    def angle(self, value: float) -> float:
+        return math.radians(value) if self.degrees else value
+
+    def rotation(self, element, a: dict) -> np.ndarray:
+        """The orientation given by one of quat, axisangle, euler, xyaxes, zaxis (identity if none)."""
+        given = [k for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis") if k in a]
+        if len(given) > 1:
+            raise self.src.error(element, f"gives its orientation twice ({', '.join(given)}); keep one")
+        if not given:
+            return np.eye(3)
+        key = given[0]
+        if key == "quat":
+            q = np.array(_numbers(element, key, self.src, 4, text=a[key]))
+            norm = np.linalg.norm(q)
+            if norm < 1e-12:
+                raise self.src.error(element, f"attribute 'quat' is zero: '{a[key]}'")
+            return _quat_matrix(*(q / norm))
+        if key == "axisangle":
+            *axis, angle = _numbers(element, key, self.src, 4, text=a[key])
+            return _axis_angle(self.unit(element, key, axis), self.angle(angle))
+        if key == "euler":
+            angles = _numbers(element, key, self.src, 3, text=a[key])
+            R = np.eye(3)
+            for letter, angle in zip(self.eulerseq, angles):
+                step = _axis_angle(np.eye(3)["xyz".index(letter.lower())], self.angle(angle))
+                # lower case: axes that move with the body (R = R1 R2 R3); upper case: fixed axes (R3 R2 R1)
+                R = R @ step if letter.islower() else step @ R
+            return R
+        if key == "xyaxes":
+            v = _numbers(element, key, self.src, 6, text=a[key])
+            x = self.unit(element, key, v[:3])
+            y = np.array(v[3:]) - (np.array(v[3:]) @ x) * x
+            y = self.unit(element, key, y)
+            return np.column_stack([x, y, np.cross(x, y)])
+        return _z_to(self.unit(element, key, _numbers(element, key, self.src, 3, text=a[key])))
+
+    def unit(self, element, key: str, v) -> np.ndarray:
+        v = np.asarray(v, dtype=float)
+        norm = np.linalg.norm(v)
+        if norm < 1e-12:
+            raise self.src.error(element, f"attribute '{key}' has a zero-length vector")
+        return v / norm
+
+    def frame(self, element, a: dict) -> np.ndarray:
+        p = _numbers(element, "pos", self.src, 3, text=a["pos"]) if "pos" in a else (0.0, 0.0, 0.0)
+        return _pose(p, self.rotation(element, a))
+
+    # --------------------------------------------------------------------- bodies
+    def read(self):
+        links: list = []
+        frames: list = []
+        visuals: list = []
+        collisions: list = []
+        self.links, self.frames, self.visuals, self.collisions = links, frames, visuals, collisions
+        for child in self.root:
+            if child.tag in _UNMODELLED and len(child):
+                self.ignored.add(f"<{child.tag}> ({len(child)} elements)")
+            elif child.tag in _REFUSED:
+                raise self.src.error(child, "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)")
+        worlds = list(self.root.iterfind("worldbody"))
+        if not worlds:
+            raise self.src.error(self.root, "has no <worldbody>")
+        for world in worlds:
+            self.children(world, "world", np.eye(4), "main", world=True)
+        if self.settotalmass > 0:
+            self.scale_to_total_mass()
+        return links, frames, visuals, collisions
+
+    def adjusted(self, inertia: Inertia) -> Inertia:
+        """A body's inertia after MuJoCo's compiler options ``boundmass`` (a least mass),
+        ``boundinertia`` (least principal moments) and ``balanceinertia`` (principal moments that
+        break the triangle inequality replaced by their mean)."""
+        if self.boundmass <= 0 and self.boundinertia <= 0 and not self.balanceinertia:
+            return inertia
+        mass = max(float(inertia.mass), self.boundmass)
+        moments, axes = np.linalg.eigh(np.array(inertia.inertia, dtype=float))
+        if self.balanceinertia and moments[0] + moments[1] < moments[2]:
+            moments = np.full(3, moments.mean())
+        moments = np.maximum(moments, self.boundinertia)
+        return Inertia(mass, inertia.com, (axes * moments) @ axes.T)
+
+    def scale_to_total_mass(self) -> None:
+        """MuJoCo's ``settotalmass``: every body's mass and inertia scaled so that they add up to it."""
+        total = sum(float(link.inertia.mass) for link in self.links)
+        if total <= 0:
+            raise ValueError(f"{self.src.label}: <compiler settotalmass> needs bodies with mass to scale")
+        k = self.settotalmass / total
+        self.links[:] = [Link(link.name, link.parent, link.joint, link.placement, link.post,
+                              Inertia(k * link.inertia.mass, link.inertia.com, k * np.array(link.inertia.inertia, dtype=float)))
+                         for link in self.links]
+
+    def children(self, element, link: str, link_from_here: np.ndarray, childclass: str, world: bool = False) -> list:
+        """The bodies, geoms, sites and frames inside ``element`` (a body or frame), whose poses are
+        given in ``element``'s frame, ``link_from_here`` in the frame of the kinedyn link ``link``;
+        returns the geoms (of nested frames too), for the body's inertia."""
+        geoms = []
+        for child in element:
+            tag = child.tag
+            if tag == "body":
+                self.body(child, link, link_from_here, childclass, world)
+            elif tag == "frame":
+                a = child.attrib
+                geoms += self.children(child, link, link_from_here @ self.frame(child, a), a.get("childclass", childclass), world)
+            elif tag == "geom":
+                geoms.append(self.geom(child, link, link_from_here, childclass))
+            elif tag == "site":
+                self.site(child, link, link_from_here, childclass)
+            elif tag in _REFUSED:
+                raise self.src.error(child, "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)")
+            elif tag in ("joint", "freejoint") and (world or element.tag == "frame"):
+                raise self.src.error(child, "must be inside a <body> (not the world body or a <frame>)")
+        return geoms
+
+    def body(self, element, parent: str, parent_from_here: np.ndarray, childclass: str, parent_is_world: bool) -> None:
+        self.body_count += 1
+        name = element.get("name") or f"body{self.body_count}"
+        a = element.attrib
+        childclass = a.get("childclass", childclass)
+        if childclass not in self.defaults and childclass != "main":
+            raise self.src.error(element, f"childclass='{childclass}' names no <default> class")
+        what = f"body '{name}'"
+        self.claim(name, element, what)
+        if a.get("gravcomp") not in (None, "0"):
+            self.ignored.add(f"gravcomp of {what}")
+        if a.get("mocap") == "true":
+            raise self.src.error(element, f"{what} is a mocap body, which kinedyn does not read")
+        parent_from_body = parent_from_here @ self.frame(element, a)
+        joints = [j for j in element if j.tag in ("joint", "freejoint")]
+        # the chain of links: one per joint (the last one is the body), or one welded link
+        link_parent, placement = parent, parent_from_body
+        if not joints:
+            fixed = Joint(f"{name}_weld", "fixed")
+            self.links.append(Link(name, parent, fixed, parent_from_body))
+        for k, j in enumerate(joints):
+            joint, pos = self.joint(j, childclass, name, len(joints), parent_is_world and link_parent == "world")
+            link_name = name if k == len(joints) - 1 else f"{name}/{joint.name}"
+            if link_name != name:
+                self.claim(link_name, j, f"the link of joint '{joint.name}'")
+            if joint.kind == "floating":
+                # MuJoCo places a free body at qpos in the world; its pos/quat are only qpos0
+                joint_frame, post = np.eye(4), np.eye(4)
+            else:
+                joint_frame, post = placement @ _translation(pos), _translation(-np.asarray(pos))
+            try:
+                self.links.append(Link(link_name, link_parent, joint, joint_frame, post))
+            except ValueError as e:
+                raise self.src.error(j, str(e)) from None
+            link_parent, placement = link_name, np.eye(4)
+        index = len(self.links) - 1  # the link that carries the body
+        # the body's geoms, sites and child bodies, in the body's own frame
+        geoms = self.children(element, name, np.eye(4), childclass)
+        body_inertia = self.adjusted(self.inertia(element, name, geoms))
+        last = self.links[index]
+        self.links[index] = Link(last.name, last.parent, last.joint, last.placement, last.post, body_inertia)
+
+    def claim(self, name: str, element, what: str) -> None:
+        if name in self.names:
+            raise self.src.error(element, f"{what}: the name '{name}' is used twice")
+        self.names.add(name)
+
+    def joint(self, element, childclass: str, body: str, count: int, top_level: bool):
+        self.joint_count += 1
+        # <freejoint> takes no default class (MuJoCo's reference); <joint> does
+        a = dict(element.attrib) if element.tag == "freejoint" else self.attributes(element, childclass)
+        name = a.get("name") or f"joint{self.joint_count - 1}"
+        kind = "free" if element.tag == "freejoint" else a.get("type", "hinge")
+        what = f"joint '{name}'"
+        if kind not in _JOINT_KINDS:
+            raise self.src.error(element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_JOINT_KINDS)}")
+        if kind == "free" and not (top_level and count == 1):
+            raise self.src.error(element, f"{what}: a free joint must be the only joint of a body whose parent is the world body")
+        axis = _numbers(element, "axis", self.src, 3, text=a.get("axis", "0 0 1"))
+        pos = _numbers(element, "pos", self.src, 3, text=a.get("pos", "0 0 0"))
+        scalars = {}
+        for attribute in ("armature", "damping", "frictionloss", "ref", "stiffness"):
+            scalars[attribute] = _numbers(element, attribute, self.src, 1, text=a[attribute])[0] if attribute in a else 0.0
+        if scalars["stiffness"] != 0:
+            self.ignored.add(f"the spring (stiffness) of {what}")
+        angular = kind == "hinge"
+        options: dict = {}
+        if kind in ("hinge", "slide"):
+            options["offset"] = -(self.angle(scalars["ref"]) if angular else scalars["ref"])
+            options["rotor_inertia"] = scalars["armature"]
+            options["viscous"] = scalars["damping"]
+            options["coulomb"] = scalars["frictionloss"]
+            limited = a.get("limited", "auto")
+            if limited not in ("true", "false", "auto"):
+                raise self.src.error(element, f"{what}: attribute 'limited' must be true, false or auto, got '{_short(limited)}'")
+            if limited == "auto" and not self.autolimits and "range" in a:
+                raise self.src.error(element, f"{what}: has a range but limited='auto' with autolimits off (MuJoCo refuses it too)")
+            if limited == "true" or (limited == "auto" and "range" in a):
+                lower, upper = _numbers(element, "range", self.src, 2, text=a.get("range", "0 0"))
+                if lower > upper:
+                    raise self.src.error(element, f"{what}: attribute 'range' has lower {lower:g} above upper {upper:g}")
+                if angular:
+                    lower, upper = self.angle(lower), self.angle(upper)
+                options["lower"], options["upper"] = lower, upper
+        else:
+            if scalars["ref"] != 0:
+                raise self.src.error(element, f"{what}: a {kind} joint takes no 'ref'")
+            for attribute in ("armature", "damping", "frictionloss"):
+                if scalars[attribute] != 0:
+                    self.ignored.add(f"{attribute} of the {kind} joint '{name}'")
+            if kind == "ball" and "range" in a and a.get("limited", "auto") != "false":
+                self.ignored.add(f"the range (a cone) of the ball joint '{name}'")
+        try:
+            joint = Joint(name, _JOINT_KINDS[kind], axis, **options)
+        except ValueError as e:
+            raise self.src.error(element, str(e)) from None
+        return joint, pos
+
+    # --------------------------------------------------------------------- geoms, sites, inertia
+    def site(self, element, link: str, link_from_here: np.ndarray, childclass: str) -> None:
+        a = self.attributes(element, childclass)
+        name = a.get("name")
+        if not name:
+            return
+        self.site_names.append(name)
+        frame_name = name if name not in self.names else f"site:{name}"
+        self.claim(frame_name, element, f"site '{name}'")
+        pose = self.frame(element, a)
+        if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
+            if a.get("type", "sphere") not in ("capsule", "cylinder", "box", "ellipsoid"):
+                raise self.src.error(element, f"site '{name}': 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {a.get('type', 'sphere')}")
+            pose = self.segment(element, a["fromto"])[0]
+        self.frames.append(Frame(frame_name, None if link == "world" else link, link_from_here @ pose))
+
+    def segment(self, element, text: str) -> tuple:
+        """(pose at the middle of ``fromto``, its z axis along it, from the second end towards the
+        first as MuJoCo's compiler orients it; the segment's length)."""
+        ends = np.array(_numbers(element, "fromto", self.src, 6, text=text))
+        d = ends[:3] - ends[3:]
+        length = float(np.linalg.norm(d))
+        if length < 1e-12:
+            raise self.src.error(element, "attribute 'fromto' has two equal ends")
+        return _pose((ends[:3] + ends[3:]) / 2, _z_to(d / length)), length
+
+    def geom(self, element, link: str, link_from_here: np.ndarray, childclass: str) -> dict:
+        """The geom's shape, pose (in the link) and mass properties; its visual/collision is recorded."""
+        a = self.attributes(element, childclass)
+        kind = a.get("type", "sphere")
+        what = f"geom '{a['name']}'" if a.get("name") else "geom"
+        if kind not in _SHAPES:
+            raise self.src.error(element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_SHAPES)}")
+        size = list(_numbers(element, "size", self.src, text=a["size"], at_most=3)) if "size" in a else []
+        size += [0.0] * (3 - len(size))
+        pose = self.frame(element, a)
+        if "fromto" in a:
+            if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
+                raise self.src.error(element, f"{what}: 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {kind}")
+            pose, length = self.segment(element, a["fromto"])
+            if kind in ("capsule", "cylinder"):
+                size[1] = length / 2
+            else:  # MuJoCo: a box's or ellipsoid's cross-section is square/round, of size[0]
+                size[1], size[2] = size[0], length / 2
+        needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}.get(kind, 0)
+        if any(s <= 0 for s in size[:needed]):
+            raise self.src.error(element, f"{what}: a {kind} needs {needed} positive size number{'s' if needed > 1 else ''}, got size='{a.get('size', '')}'")
+        group = int(_numbers(element, "group", self.src, 1, text=a.get("group", "0"))[0])
+        shape = self.shape(element, kind, size, a, what)
+        where = self.src.at(element)
+        in_link = link_from_here @ pose
+        if shape is not None:
+            rgba = None
+            if "rgba" in a:
+                rgba = self.rgba(element, a["rgba"])
+            elif a.get("material") in self.materials:
+                rgba = self.materials[a["material"]]
+            elif kind != "mesh":
+                rgba = (0.5, 0.5, 0.5, 1.0)
+            shown, drawn_pose = shape
+            item = Visual(link, shown, in_link @ drawn_pose, rgba, a.get("material"), where)
+            if 0 <= group <= 2:
+                self.visuals.append(item)
+            if a.get("contype", "1") != "0" or a.get("conaffinity", "1") != "0":
+                self.collisions.append(item)
+        return {"element": element, "kind": kind, "size": size, "pose": in_link, "a": a, "what": what, "group": group}
+
+    def shape(self, element, kind: str, size: list, a: dict, what: str):
+        """(kinedyn shape, its pose in the geom frame), or None for shapes kinedyn does not draw."""
+        if kind == "box":
+            return Box(tuple(2 * s for s in size)), np.eye(4)
+        if kind == "sphere":
+            return Sphere(size[0]), np.eye(4)
+        if kind in ("cylinder", "capsule"):
+            # a capsule is drawn as the cylinder of its full length
+            return Cylinder(size[0], 2 * size[1] + (2 * size[0] if kind == "capsule" else 0.0)), np.eye(4)
+        if kind == "ellipsoid":
+            return Sphere(max(size)), np.eye(4)
+        if kind == "mesh":
+            name = a.get("mesh")
+            if name not in self.meshes:
+                raise self.src.error(element, f"{what}: mesh='{name}' names no <asset><mesh>")
+            file, scale, _ = self.meshes[name]
+            if file is None:  # a mesh of inline vertices: not drawn
+                return None
+            if self.meshdir is None:
+                return Mesh(file, tuple(scale), None), np.eye(4)
+            return Mesh(os.path.join(self.meshdir, file), tuple(scale), self.meshdir), np.eye(4)
+        return None
+
+    def inertia(self, element, name: str, geoms: list) -> Inertia:
+        """The body's inertia in its frame: ``<inertial>``, or its geoms' (MuJoCo's inertiafromgeom)."""
+        inertial = element.find("inertial")
+        if inertial is not None and self.inertiafromgeom != "true":
+            return self.inertial(inertial, name)
+        if inertial is None and self.inertiafromgeom == "false":
+            return Inertia()
+        total = Inertia()
+        lo, hi = self.groups
+        for g in geoms:
+            if not lo <= g["group"] <= hi or g["kind"] in ("plane", "hfield", "sdf"):
+                continue
+            total = total + self.geom_inertia(g, name)
+        return total
+
+    def inertial(self, element, body: str) -> Inertia:
+        what = f"body '{body}' <inertial>"
+        a = element.attrib
+        for required in ("pos", "mass"):
+            if required not in a:
+                raise self.src.error(element, f"of body '{body}' has no '{required}' attribute (MuJoCo requires it)")
+        mass = _numbers(element, "mass", self.src, 1)[0]
+        if mass < 0:
+            raise self.src.error(element, f"of body '{body}': attribute 'mass' is negative ({mass:g})")
+        if "diaginertia" in a and "fullinertia" in a:
+            raise self.src.error(element, f"of body '{body}' gives both 'diaginertia' and 'fullinertia'; keep one")
+        if "fullinertia" in a:
+            if any(k in a for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis")):
+                raise self.src.error(element, f"of body '{body}': 'fullinertia' takes no orientation (MuJoCo refuses it too)")
+            ixx, iyy, izz, ixy, ixz, iyz = _numbers(element, "fullinertia", self.src, 6)
+        elif "diaginertia" in a:
+            ixx, iyy, izz = _numbers(element, "diaginertia", self.src, 3)
+            ixy = ixz = iyz = 0.0
+        else:
+            raise self.src.error(element, f"of body '{body}' has neither 'diaginertia' nor 'fullinertia'")
+        try:
+            return Inertia.from_urdf(mass, ixx, ixy, ixz, iyy, iyz, izz).transformed(self.frame(element, a))
+        except ValueError as e:
+            raise self.src.error(element, f"of body '{body}': {e}") from None
+
+    def geom_inertia(self, g: dict, body: str) -> Inertia:
+        """A solid geom's mass properties (MuJoCo's: volume times density, or the geom's ``mass``)."""
+        kind, (s0, s1, s2), a, element = g["kind"], g["size"], g["a"], g["element"]
+        what = f"{g['what']} of body '{body}'"
+        if kind == "mesh":
+            raise self.src.error(element, f"{what}: kinedyn does not compute a mesh's inertia; give body '{body}' an <inertial> (MuJoCo's compiled model shows it: model.body_inertia)")
+        if kind == "sphere":
+            volume = 4 / 3 * math.pi * s0**3
+            unit = (2 / 5 * s0**2,) * 3  # moments per unit mass
+        elif kind == "box":
+            volume = 8 * s0 * s1 * s2
+            unit = ((s1**2 + s2**2) / 3, (s0**2 + s2**2) / 3, (s0**2 + s1**2) / 3)
+        elif kind == "ellipsoid":
+            volume = 4 / 3 * math.pi * s0 * s1 * s2
+            unit = ((s1**2 + s2**2) / 5, (s0**2 + s2**2) / 5, (s0**2 + s1**2) / 5)
+        elif kind == "cylinder":
+            volume = math.pi * s0**2 * 2 * s1
+            across = (3 * s0**2 + (2 * s1) ** 2) / 12
+            unit = (across, across, s0**2 / 2)
+        else:  # capsule: a cylinder of length 2 s1 and two hemispherical caps of radius s0
+            r, h = s0, 2 * s1
+            cylinder, sphere = math.pi * r**2 * h, 4 / 3 * math.pi * r**3
+            volume = cylinder + sphere
+            # each cap (half the sphere's volume): about its own centre of mass (3r/8 from its flat
+            # face) 83/320 m r^2 across, shifted to the capsule's centre by h/2 + 3r/8
+            cap = (83 / 320 * r**2 + (h / 2 + 3 * r / 8) ** 2) * sphere  # both caps, times their volume
+            across = (cylinder * (3 * r**2 + h**2) / 12 + cap) / volume
+            axial = (cylinder * r**2 / 2 + sphere * 2 / 5 * r**2) / volume
+            unit = (across, across, axial)
+        if "mass" in a:
+            mass = _numbers(element, "mass", self.src, 1, text=a["mass"])[0]
+        else:
+            mass = volume * _numbers(element, "density", self.src, 1, text=a.get("density", "1000"))[0]
+        if mass < 0:
+            raise self.src.error(element, f"{what}: its mass is negative ({mass:g})")
+        if a.get("shellinertia") == "true":
+            raise self.src.error(element, f"{what}: shellinertia is not read by kinedyn; give body '{body}' an <inertial>")
+        body_inertia = Inertia(mass, (0.0, 0.0, 0.0), np.diag([mass * u for u in unit]))
+        return body_inertia.transformed(g["pose"])
