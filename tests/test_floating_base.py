@@ -364,3 +364,28 @@ def test_simulation_of_multi_dof_joints_needs_the_native_integrators():
     bad[6] = 2.0
     with pytest.raises(ValueError, match="quaternion .* normalise"):
         kd.simulate(robot, 0.1, bad)
+
+
+def test_the_command_line_takes_a_floating_base(capsys):
+    """--floating-base on the commands that read a robot: fk, dynamics and simulate run on the
+    configuration (nq numbers, the neutral one by default); what does not handle it yet says so."""
+    from kinedyn.cli import main
+
+    root = example_robot_data_dir()
+    if root is None:
+        pytest.skip("example-robot-data is not installed")
+    path = os.path.join(root, "solo_description", "robots", "solo12.urdf")
+    robot = kd.Robot.from_urdf(path, floating_base=True)
+    q = robot.random_configuration(3)
+    assert main(["fk", path, "--floating-base", "--json", "--q", *map(str, q)]) == 0
+    import json
+
+    out = json.loads(capsys.readouterr().out)
+    _close("tool pose", np.array(out["frames"][robot.tool]["pose"]), robot.pose(q))
+    assert main(["simulate", path, "--floating-base", "--t", "0.02"]) == 0
+    capsys.readouterr()
+    assert main(["fk", path, "--floating-base", "--q", *map(str, q[:-1])]) != 0
+    assert "--q needs 19 values" in capsys.readouterr().err
+    assert main(["check", path, "--floating-base"]) != 0
+    assert "properties report (kinedyn check) handles revolute and prismatic joints only" in capsys.readouterr().err
+    assert main(["info", "planar_2r", "--floating-base"]) != 0

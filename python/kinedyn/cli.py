@@ -53,6 +53,7 @@ class _Invocation:
     numeric: bool = True
     xacro_args: Dict[str, str] = field(default_factory=dict)  # --xacro-arg NAME:=VALUE
     trust_xacro: bool = False  # --trust-xacro: expanding xacro runs the file's Python expressions
+    floating_base: bool = False  # --floating-base: a URDF's root link on a free-flyer
 
 
 _INVOCATION: contextvars.ContextVar[Optional[_Invocation]] = contextvars.ContextVar("kinedyn_cli_invocation", default=None)
@@ -74,6 +75,8 @@ def load_robot(spec: str, *, values: Optional[Dict[str, float]] = None, numeric:
     if numeric is None:
         numeric = run.numeric if run is not None else False
     if spec in robots.CATALOGUE:
+        if run is not None and run.floating_base:
+            raise ValueError(f"--floating-base applies to URDF (and xacro) files; '{spec}' is a built-in robot with a fixed base")
         robot = _builtin(spec, values)
     else:
         robot = _substitute(_robot_file(spec), values, spec)
@@ -104,6 +107,10 @@ def _robot_file(spec: str):
     options: Dict[str, Any] = {}
     if ext == ".xacro" and run is not None:
         options = {"xacro_args": run.xacro_args, "trust_xacro": run.trust_xacro}
+    if run is not None and run.floating_base:
+        if ext not in (".urdf", ".xacro"):
+            raise ValueError(f"--floating-base applies to URDF (and xacro) files, not '{spec}' (a robot file or MJCF says its own joints)")
+        options["floating_base"] = True
     try:
         try:
             return load(path, **options)
@@ -294,19 +301,31 @@ def in_cli_terms(text: str, phrases: Optional[Dict[str, str]]) -> str:
     return text
 
 
-def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, flag: str = "--q") -> np.ndarray:
-    """Joint values (or rates) from the command line (zeros when omitted); degrees convert revolute
-    joints only. ``flag`` names the option in the error message."""
+def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, flag: str = "--q", rates: Optional[bool] = None) -> np.ndarray:
+    """Joint values (``--q``, ``--q0``, ``--goal``: a configuration of ``robot.nq`` numbers, the
+    neutral one when omitted) or rates, accelerations, torques (the other flags, or ``rates=True``:
+    ``robot.nv`` numbers, zeros when omitted); degrees convert revolute joints only. ``flag`` names
+    the option in the error message."""
+    rates = flag not in ("--q", "--q0", "--goal") if rates is None else rates
+    size = robot.nv if rates else robot.nq
     if values is None:
-        return np.zeros(robot.n)
+        return np.zeros(size) if rates else robot.neutral()
     q = np.array(values, dtype=float)
-    if q.shape != (robot.n,):
-        raise ValueError(f"{flag} needs {robot.n} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}), got {q.size}")
+    # the 1-DOF joint each number belongs to (None inside a multi-DOF joint's block)
+    owners: list = []
+    for j in robot.joints:
+        k = j.nv if rates else j.nq
+        owners.extend([None] * k if j.is_multi_dof else [j])
+    if q.shape != (size,):
+        what = "rates" if rates else "coordinates"
+        extra = f" {what}: nq = {robot.nq} with its multi-DOF joints" if robot.has_multi_dof_joints and not rates else ""
+        raise ValueError(f"{flag} needs {size} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}{extra}), got {q.size}")
     bad = np.flatnonzero(~np.isfinite(q))
     if bad.size:
-        raise ValueError(f"{flag}: value {bad[0] + 1} ({robot.joint_names[bad[0]]}) is {q[bad[0]]}, not a finite number")
+        owner = owners[bad[0]]
+        raise ValueError(f"{flag}: value {bad[0] + 1} ({owner.name if owner is not None else 'a multi-DOF joint'}) is {q[bad[0]]}, not a finite number")
     if degrees:
-        q = np.array([math.radians(v) if j.kind == "revolute" else v for v, j in zip(q, robot.joints)])
+        q = np.array([math.radians(v) if j is not None and j.kind == "revolute" else v for v, j in zip(q, owners)])
     return q
 
 
@@ -767,6 +786,8 @@ def _common_options(p: argparse.ArgumentParser, global_: bool = False) -> None:
                        help="an argument of a .xacro robot file (repeatable)")
         p.add_argument("--trust-xacro", action="store_true", default=argparse.SUPPRESS,
                        help="expand a .xacro robot file: xacro runs Python expressions from the file, so only for files you trust")
+        p.add_argument("--floating-base", action="store_true", default=argparse.SUPPRESS,
+                       help="a URDF's root link moves freely on a free-flyer joint 'root_joint' (q: position, quaternion x y z w, joints)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -930,7 +951,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         debug = bool(args.debug)
         phrases = getattr(args, "_flag_phrases", None)
         run = _Invocation(command, _set_values((args.set_global or []) + (getattr(args, "set", None) or [])), command not in SYMBOLIC_COMMANDS,
-                          dict(getattr(args, "xacro_args", None) or []), bool(getattr(args, "trust_xacro", False)))
+                          dict(getattr(args, "xacro_args", None) or []), bool(getattr(args, "trust_xacro", False)),
+                          bool(getattr(args, "floating_base", False)))
         token = _INVOCATION.set(run)
         try:
             with warnings.catch_warnings():

@@ -210,6 +210,9 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     configurations drawn from the seed). The trajectory depends on ``seed`` only, not on ``samples``."""
     from ..simulate import PDGravity, SimulationError, simulate
 
+    # its PD set point, search box and finite differences are per joint coordinate
+    robot.require_one_dof_joints("the properties report (kinedyn check)")
+
     rng = np.random.default_rng(seed)
     n = robot.n
     Q = robot.random_configuration(rng, size=samples)

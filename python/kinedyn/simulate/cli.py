@@ -46,6 +46,9 @@ def cmd_simulate(args) -> int:
     robot = load_robot(args.robot or robots.DEFAULT)
     q0 = parse_q(args.q, robot, args.deg, flag="--q")
     qd0 = parse_q(args.qd, robot, args.deg, flag="--qd")
+    if robot.has_multi_dof_joints and args.controller != "none":
+        raise ValueError(f"--controller {args.controller} steers joint coordinates to --goal; robot '{robot.name}' has multi-DOF joints, "
+                         "whose error needs the configuration difference (simulate it with --controller none, or from Python)")
     goal = parse_q(args.goal, robot, args.deg, flag="--goal") if args.goal is not None else np.zeros(robot.n)
     kp, kd = _gains(args.kp, robot, "--kp"), _gains(args.kd, robot, "--kd")
     method = str(args.method).lower()
