@@ -23,6 +23,7 @@ from .description.geometry import Visual
 from .description.joint import Joint
 from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
+from .description.mimic import mimic_map as _mimic_map
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -78,6 +79,7 @@ class Robot:
         inertia: str = "warn",
         visuals: Sequence[Visual] = (),
         collisions: Sequence[Visual] = (),
+        mimic: str = "reduce",
     ):
         self.name = name
         # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
@@ -96,6 +98,10 @@ class Robot:
         self.tree: KinematicTree = build_tree(self.links, self.frames, base)
         if self.tree.n == 0:
             raise ValueError(f"robot '{name}' has no moving joint")
+        # mimic joints (Joint.mimic): "reduce" removes the followers' coordinates, "independent" keeps
+        # them (kinedyn.description.mimic); None when no joint follows another
+        self.mimic_mode = mimic
+        self._mimic = _mimic_map([b.joint for b in self.tree.bodies], [link.joint for link in self.links], mimic, name)
         names = [f.name for f in self.tree.frames]
         if tool is None:
             from .description.tool import default_tool
@@ -134,14 +140,16 @@ class Robot:
         return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
-    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", mimic: str = "reduce") -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
-        or ``"strict"`` (ValueError); see docs/model-files.md."""
+        or ``"strict"`` (ValueError); see docs/model-files.md. ``mimic``: ``"reduce"`` (default) removes
+        the coordinates of ``<mimic>`` joints (q_follower = multiplier * q_leader + offset), or
+        ``"independent"`` keeps each one a coordinate of its own (docs/model-files.md, "Mimic joints")."""
         from .description.urdf import robot_from_urdf
 
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, mimic=mimic)
 
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
@@ -158,6 +166,7 @@ class Robot:
             inertia=self.inertia_policy,
             visuals=self.visuals,
             collisions=self.collisions,
+            mimic=self.mimic_mode,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
@@ -237,12 +246,12 @@ class Robot:
     @property
     def nq(self) -> int:
         """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
-        return sum(b.joint.nq for b in self.tree.bodies)
+        return sum(j.nq for j in self.joints)
 
     @property
     def nv(self) -> int:
         """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
-        return sum(b.joint.nv for b in self.tree.bodies)
+        return sum(j.nv for j in self.joints)
 
     @property
     def has_multi_dof_joints(self) -> bool:
@@ -260,11 +269,30 @@ class Robot:
 
     @property
     def joints(self) -> tuple:
-        return tuple(b.joint for b in self.tree.bodies)
+        """The joints of the coordinates, in q's order: every moving joint, less the mimic followers
+        when they are reduced (:attr:`mimic_joints`)."""
+        bodies = self.tree.bodies
+        if self._mimic is None:
+            return tuple(b.joint for b in bodies)
+        return tuple(bodies[i].joint for i in self._mimic.independent)
 
     @property
     def joint_names(self) -> list:
-        return [b.joint.name for b in self.tree.bodies]
+        return [j.name for j in self.joints]
+
+    @property
+    def mimic_joints(self) -> dict:
+        """The reduced mimic followers: ``{follower: Mimic(leader, multiplier, offset)}`` with each
+        leader an independent joint (chains resolved); empty without them or with mimic="independent"."""
+        return {} if self._mimic is None else dict(self._mimic.relations)
+
+    def require_no_mimic_joints(self, feature: str) -> None:
+        """Raise a ValueError naming a follower when ``feature`` does not handle reduced mimic joints."""
+        if self._mimic is not None:
+            follower, relation = next(iter(self._mimic.relations.items()))
+            raise ValueError(
+                f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
+                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)")
 
     @property
     def body_names(self) -> list:
@@ -327,7 +355,12 @@ class Robot:
         if not np.all(np.isfinite(qd)):
             raise ValueError("qd contains a non-finite value (NaN or inf)")
         with np.errstate(over="ignore"):
-            tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
+            if self._mimic is not None:  # the followers' friction too, at qd_full = G qd, mapped back by G^T
+                from .description.mimic import follower_friction
+
+                tau = follower_friction(self, qd)
+            else:
+                tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
         return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
     @property
@@ -381,6 +414,7 @@ class Robot:
             joint = Joint(
                 j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
                 j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb), f(j.coulomb_negative),
+                mimic=j.mimic,
             )
             try:
                 inertia = link.inertia.subs(mapping)
@@ -462,16 +496,22 @@ class Robot:
         offset = np.array([float(b.joint.offset) for b in bodies])
         placement = np.array([to_float_array(b.placement, (4, 4), f"placement of '{b.name}'") for b in bodies])
         inertia = self.inertial_parameters().reshape(n, 10)
-        armature, viscous, coulomb = self.armature, self.viscous, self.coulomb
+        # per moving joint, followers of mimic joints included (the native model has them all)
+        armature, viscous, coulomb = (np.array([float(getattr(b.joint, k)) for b in bodies]) for k in ("armature", "viscous", "coulomb"))
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
         frame_body = np.array([f.body for f in frames], dtype=np.int64)
         frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
         # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-        coulomb_negative = self.coulomb_negative
+        coulomb_negative = np.array([float(b.joint.coulomb_levels[1]) for b in bodies])
         asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        return _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement,
-                           coulomb_negative=asymmetric)
+        native = _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement,
+                             coulomb_negative=asymmetric)
+        if self._mimic is None:
+            return native
+        from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
+
+        return ReducedModel(native, self._mimic, self.name)
 
     @cached_property
     def _link_frame_ids(self) -> np.ndarray:
@@ -587,7 +627,7 @@ class Robot:
     def _link_origin_in_body(self) -> Optional[np.ndarray]:
         """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
         frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
-        u = np.zeros((self.n, 3))
+        u = np.zeros((len(self.body_names), 3))  # one per moving link (mimic followers' too)
         for i, name in enumerate(self.body_names):
             T = to_float_array(self.tree.frames[self.frame_index(name)].placement, (4, 4), f"frame '{name}'")
             u[i] = T[:3, :3].T @ T[:3, 3]
@@ -599,11 +639,12 @@ class Robot:
         if f_ext is None:
             return None
         f = real_array(f_ext, "f_ext")
-        if f.shape == (self.n, 6) and np.ndim(q) == 2:
+        links = len(self.body_names)  # = n, unless mimic followers are reduced (their links still take wrenches)
+        if f.shape == (links, 6) and np.ndim(q) == 2:
             # one set of wrenches for every state of a batch
-            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), self.n, 6)))
+            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
         u = self._link_origin_in_body
-        if u is None or f.shape[-2:] != (self.n, 6) or f.ndim != np.ndim(q) + 1:
+        if u is None or f.shape[-2:] != (links, 6) or f.ndim != np.ndim(q) + 1:
             return f  # (wrong shapes are reported by the core)
         R = self.forward_kinematics(q)[..., :3, :3]
         d = np.einsum("...ij,...j->...i", R, u)

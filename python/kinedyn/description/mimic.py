@@ -1,0 +1,160 @@
+"""Mimic joints (URDF ``<mimic>``): a follower joint's coordinate is a fixed affine function of its
+leader's, ``q_f = multiplier * q_leader + offset`` (:class:`kinedyn.description.joint.Mimic`).
+
+A robot with mimic joints has two coordinate sets. The *full* one has a coordinate for every moving
+joint (what the native core computes with); the *reduced* one (``Robot(..., mimic="reduce")``, the
+default, as Pinocchio 3's ``buildModelFromUrdf(path, mimic=True)``) has only the independent joints'.
+They are related by constant maps::
+
+    v_full = G v            (G: nv_full x nv; a column per independent coordinate: 1 at its own
+                             row, ``multiplier`` at each of its followers' rows)
+    q_full = expand(q)      (the independent blocks copied, each follower's entry
+                             ``multiplier * q[leader] + offset``)
+
+built by index ranges from each joint's ``nq`` and ``nv`` so that multi-DOF blocks (floating,
+spherical, planar joints, which can neither lead nor follow) are copied whole. A follower of a
+follower is resolved to the first leader (the relations compose: ``m2 (m1 q + o1) + o2``); a cycle
+of followers is an error. How the dynamics reduce with G: :mod:`kinedyn._mimic`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional, Sequence
+
+import numpy as np
+
+from .joint import Mimic
+
+__all__ = ["MimicMap", "mimic_map", "MIMIC_MODES"]
+
+MIMIC_MODES = ("reduce", "independent")
+
+
+@dataclass(frozen=True, eq=False)
+class MimicMap:
+    """The constant maps between reduced and full coordinates of one robot (see the module)."""
+
+    #: follower joint name -> its relation to an independent leader (chains resolved)
+    relations: dict
+    #: indices (in body order) of the bodies whose joints are independent, and of the followers
+    independent: tuple
+    followers: tuple
+    nq_full: int
+    nv_full: int
+    nq: int
+    nv: int
+    #: full-q indices of the independent coordinates, in reduced order (len nq)
+    q_keep: np.ndarray
+    #: full-q index of each follower, reduced-q index of its leader, multiplier, offset
+    q_follow: np.ndarray
+    q_lead: np.ndarray
+    multiplier: np.ndarray
+    offset: np.ndarray
+    #: v_full = G v, (nv_full, nv)
+    G: np.ndarray = field(repr=False)
+
+    def expand_q(self, q: np.ndarray) -> np.ndarray:
+        """Full configuration(s) from reduced one(s): (..., nq) -> (..., nq_full)."""
+        full = np.empty(q.shape[:-1] + (self.nq_full,))
+        full[..., self.q_keep] = q
+        full[..., self.q_follow] = q[..., self.q_lead] * self.multiplier + self.offset
+        return full
+
+    def expand_v(self, v: np.ndarray) -> np.ndarray:
+        """Full velocities (or accelerations) from reduced ones: ``G v``, (..., nv) -> (..., nv_full)."""
+        return v @ self.G.T
+
+    def reduce_force(self, tau: np.ndarray) -> np.ndarray:
+        """Generalised forces on the reduced coordinates: ``G^T tau``, (..., nv_full) -> (..., nv)
+        (the principle of virtual work: tau_r . dq_r = tau . G dq_r for every dq_r)."""
+        return tau @ self.G
+
+    def follower_names(self) -> list:
+        return list(self.relations)
+
+
+def _sizes(joints) -> tuple:
+    iq, iv, q0, v0 = [], [], 0, 0
+    for j in joints:
+        iq.append(q0)
+        iv.append(v0)
+        q0 += j.nq
+        v0 += j.nv
+    return iq, iv, q0, v0
+
+
+def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robot: str = "robot") -> Optional[MimicMap]:
+    """The coordinate maps of a robot whose moving joints (in body order) are ``joints``;
+    ``all_joints`` includes the fixed ones (for the error naming a fixed leader). None when no
+    joint follows another or ``mode == "independent"`` (mimic relations are then ignored, without
+    checking them: the way to load a file whose ``<mimic>`` names a joint it does not have).
+
+    ValueError naming the follower when its leader is missing, fixed, multi-DOF, or when followers
+    form a cycle."""
+    if mode not in MIMIC_MODES:
+        raise ValueError(f"mimic must be one of {list(MIMIC_MODES)}, got {mode!r}")
+    if mode == "independent" or not any(j.mimic is not None for j in joints):
+        return None
+    index = {j.name: i for i, j in enumerate(joints)}
+    kinds = {j.name: j.kind for j in all_joints}
+    for j in joints:
+        m = j.mimic
+        if m is None:
+            continue
+        what = f"robot '{robot}': joint '{j.name}' mimics joint '{m.leader}'"
+        if m.leader not in index:
+            if m.leader in kinds:
+                raise ValueError(f"{what}, which is {kinds[m.leader]}: a leader must be a revolute or prismatic joint")
+            raise ValueError(f"{what}, which the robot does not have (joints: {list(index)}); "
+                             "load it with mimic='independent' to keep the follower as an independent joint")
+        leader = joints[index[m.leader]]
+        if leader.kind not in ("revolute", "prismatic"):
+            raise ValueError(f"{what}, which is {leader.kind}: a leader must be a revolute or prismatic joint")
+    relations: dict = {}
+    for j in joints:
+        if j.mimic is None:
+            continue
+        relation, seen = j.mimic, [j.name]
+        while joints[index[relation.leader]].mimic is not None:  # a follower of a follower
+            if relation.leader in seen:
+                raise ValueError(f"robot '{robot}': mimic joints form a cycle: {' -> '.join(seen + [relation.leader])}")
+            seen.append(relation.leader)
+            relation = joints[index[relation.leader]].mimic.then(relation)
+        relations[j.name] = relation
+    independent = tuple(i for i, j in enumerate(joints) if j.name not in relations)
+    followers = tuple(i for i, j in enumerate(joints) if j.name in relations)
+    iq, iv, nq_full, nv_full = _sizes(joints)
+    riq, riv, nq, nv = _sizes([joints[i] for i in independent])
+    reduced_q = dict(zip(independent, riq))
+    reduced_v = dict(zip(independent, riv))
+    q_keep = np.concatenate([np.arange(iq[i], iq[i] + joints[i].nq) for i in independent]).astype(np.int64)
+    G = np.zeros((nv_full, nv))
+    for i in independent:
+        G[iv[i]:iv[i] + joints[i].nv, reduced_v[i]:reduced_v[i] + joints[i].nv] = np.eye(joints[i].nv)
+    q_lead, mult, off = [], [], []
+    for f in followers:
+        relation = relations[joints[f].name]
+        leader = index[relation.leader]
+        q_lead.append(reduced_q[leader])
+        mult.append(relation.multiplier)
+        off.append(relation.offset)
+        G[iv[f], reduced_v[leader]] = relation.multiplier
+    return MimicMap(
+        relations=relations, independent=independent, followers=followers, nq_full=nq_full, nv_full=nv_full, nq=nq, nv=nv,
+        q_keep=q_keep, q_follow=np.array([iq[f] for f in followers], dtype=np.int64), q_lead=np.array(q_lead, dtype=np.int64),
+        multiplier=np.array(mult), offset=np.array(off), G=G,
+    )
+
+
+def follower_friction(robot, qd: np.ndarray) -> np.ndarray:
+    """``robot.friction_torque`` with reduced mimic joints: every moving joint's friction at
+    ``qd_full = G qd``, mapped back by ``G^T`` (the same torque the dynamics include)."""
+    m = robot._mimic
+    joints = [b.joint for b in robot.tree.bodies]
+    sizes = [j.nv for j in joints]  # a multi-DOF joint has no friction: its zeros repeated per coordinate
+    viscous = np.repeat([float(j.viscous) for j in joints], sizes)
+    positive = np.repeat([float(j.coulomb_levels[0]) for j in joints], sizes)
+    negative = np.repeat([float(j.coulomb_levels[1]) for j in joints], sizes)
+    v = m.expand_v(qd)
+    return m.reduce_force(viscous * v + np.where(v > 0, positive, 0.0) - np.where(v < 0, negative, 0.0))
