@@ -190,11 +190,15 @@ class Robot:
             if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
                 raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
-        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
+        followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
+        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
         if unknown:
-            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names})")
-        values = {}
+            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
+        values, follower_values = {}, {}
         for key, value in items:
+            if isinstance(key, str) and key in followers:
+                follower_values[key] = value
+                continue
             if isinstance(key, str):
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
@@ -212,6 +216,10 @@ class Robot:
             if not math.isfinite(v):
                 raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
             values[names[i]] = v
+        if followers:
+            from .description.mimic import lock_followers
+
+            values = lock_followers(followers, values, follower_values)
         links = []
         for link in self.links:
             j = link.joint
@@ -326,23 +334,39 @@ class Robot:
     @property
     def armature(self) -> np.ndarray:
         """Reflected rotor inertia r^2 J_m per joint (added to the diagonal of M)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "armature")
         return np.array([float(j.armature) for j in self.joints])
 
     @property
     def viscous(self) -> np.ndarray:
         """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)
         (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "viscous")
         return np.array([float(j.viscous) for j in self.joints])
 
     @property
     def coulomb(self) -> np.ndarray:
         """Coulomb friction level per joint for qd > 0 (the only level when friction is symmetric)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "coulomb")
         return np.array([float(j.coulomb) for j in self.joints])
 
     @property
     def coulomb_negative(self) -> np.ndarray:
         """Coulomb friction level per joint for qd < 0 (a magnitude; equals :attr:`coulomb` for
         symmetric friction)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "coulomb_negative")
         return np.array([float(j.coulomb_levels[1]) for j in self.joints])
 
     @batched("qd")
@@ -355,12 +379,7 @@ class Robot:
         if not np.all(np.isfinite(qd)):
             raise ValueError("qd contains a non-finite value (NaN or inf)")
         with np.errstate(over="ignore"):
-            if self._mimic is not None:  # the followers' friction too, at qd_full = G qd, mapped back by G^T
-                from .description.mimic import follower_friction
-
-                tau = follower_friction(self, qd)
-            else:
-                tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
+            tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
         return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
     @property

@@ -147,14 +147,59 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
     )
 
 
-def follower_friction(robot, qd: np.ndarray) -> np.ndarray:
-    """``robot.friction_torque`` with reduced mimic joints: every moving joint's friction at
-    ``qd_full = G qd``, mapped back by ``G^T`` (the same torque the dynamics include)."""
+
+def reduced_coefficient(robot, name: str) -> np.ndarray:
+    """A per-joint drive coefficient of a robot with reduced mimic joints, followers included, per
+    independent joint ``k``: the followers' friction and rotor inertia act on ``G qd`` and come back
+    through ``G^T``; each full coordinate lies in one column of G, so ``G^T diag(a) G`` is diagonal:
+
+    - ``armature`` and ``viscous``: ``a_k + sum_f m_f^2 a_f`` over the followers f of k (multiplier m_f);
+    - Coulomb levels: a follower with ``m_f > 0`` adds ``m_f c_f`` of the same direction's level, one
+      with ``m_f < 0`` moves the other way and adds ``|m_f|`` times its opposite level: ``coulomb``
+      (qd > 0) gets ``|m_f| (c_f+ if m_f > 0 else c_f-)``, ``coulomb_negative`` the reverse.
+
+    so that ``robot.friction_torque(qd) == G^T friction_full(G qd)`` and ``M_r`` has ``armature`` on
+    its diagonal, as without mimic joints."""
     m = robot._mimic
     joints = [b.joint for b in robot.tree.bodies]
-    sizes = [j.nv for j in joints]  # a multi-DOF joint has no friction: its zeros repeated per coordinate
-    viscous = np.repeat([float(j.viscous) for j in joints], sizes)
-    positive = np.repeat([float(j.coulomb_levels[0]) for j in joints], sizes)
-    negative = np.repeat([float(j.coulomb_levels[1]) for j in joints], sizes)
-    v = m.expand_v(qd)
-    return m.reduce_force(viscous * v + np.where(v > 0, positive, 0.0) - np.where(v < 0, negative, 0.0))
+    index = {j.name: k for k, j in enumerate(robot.joints)}
+
+    def own(j, key):
+        return float(j.coulomb_levels[1] if key == "coulomb_negative" else getattr(j, key))
+
+    out = np.array([own(j, name) for j in robot.joints])
+    for follower in (joints[i] for i in m.followers):
+        relation = m.relations[follower.name]
+        mult = relation.multiplier
+        if name in ("armature", "viscous"):
+            out[index[relation.leader]] += mult * mult * own(follower, name)
+        else:
+            same = (name == "coulomb") == (mult > 0)
+            out[index[relation.leader]] += abs(mult) * own(follower, "coulomb" if same else "coulomb_negative")
+    return out
+
+
+def lock_followers(relations: dict, values: dict, given: dict) -> dict:
+    """``Robot.lock_joints`` with reduced mimic joints: ``values`` (leader name -> locked value) with
+    every follower of a locked leader added, at ``given[follower]`` when the caller named it with a
+    value, else at ``multiplier * value + offset``. A follower named without its leader is an error
+    (it moves with its leader: lock the leader, or load the robot with mimic="independent")."""
+    values = dict(values)
+    for follower, value in given.items():
+        leader = relations[follower].leader
+        if leader not in values:
+            raise ValueError(f"lock_joints: joint '{follower}' follows joint '{leader}' (mimic); lock '{leader}' too "
+                             "(its followers are locked with it), or load the robot with mimic='independent'")
+    for follower, relation in relations.items():
+        if relation.leader in values:
+            value = given.get(follower)
+            if value is None:
+                value = relation.multiplier * values[relation.leader] + relation.offset
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"lock_joints: the value of joint '{follower}' must be a number, got {value!r}") from None
+            if not np.isfinite(v):
+                raise ValueError(f"lock_joints: the value of joint '{follower}' must be finite, got {v}")
+            values[follower] = v
+    return values

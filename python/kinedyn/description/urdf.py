@@ -309,8 +309,9 @@ def _mimic(element, what: str, src: _Source) -> Optional[Mimic]:
     leader = element.get("joint")
     if not leader:
         raise src.error(element, f"{what}: <mimic> has no joint attribute (the joint it follows)")
+    multiplier, offset = _float(element, "multiplier", 1.0, f"{what} <mimic>", src), _float(element, "offset", 0.0, f"{what} <mimic>", src)
     try:
-        return Mimic(leader, _float(element, "multiplier", 1.0, f"{what} <mimic>", src), _float(element, "offset", 0.0, f"{what} <mimic>", src))
+        return Mimic(leader, multiplier, offset)
     except ValueError as e:
         raise src.error(element, f"{what}: {e}") from None
 

@@ -537,7 +537,9 @@ def simulate(
         fext_fn = None
     count = batch or 1
     work = steps * count * (4 if method == "rk4" else 1)
-    native = robot and method in FIXED_METHODS and fext_fn is None
+    # a robot with reduced mimic joints runs the Python loop on its reduced methods (the native
+    # integrators take the full model)
+    native = robot and method in FIXED_METHODS and fext_fn is None and not getattr(system, "mimic_joints", None)
     pure_native = native and u_fn is None and controller is None
     delay = 0.0
     if progress is None:
