@@ -405,5 +405,29 @@ def test_report_on_a_mimic_robot(tmp_path):
 
     robot = kd.Robot.from_urdf(gripper_urdf())
     data = collect(robot, name="gripper", t_end=0.2)
-    text = repr(data)
-    assert "symbolic engine does not handle mimic joints" in text
+    assert "symbolic engine does not handle mimic joints yet (joint 'right_finger' follows 'left_finger')" in repr(data)
+
+
+def test_the_reports_viewer_moves_the_followers(browser, tmp_path):
+    """viewer.js runs the forward kinematics itself: each follower at multiplier * q[leader] + offset,
+    one slider per reduced coordinate."""
+    from kinedyn.cli import main
+
+    urdf = tmp_path / "gripper.urdf"
+    urdf.write_text(gripper_urdf(chain=True))
+    path = tmp_path / "gripper.html"
+    assert main(["report", str(urdf), "-o", str(path), "--t", "0.2"]) == 0
+    page = browser.new_page()
+    errors = []
+    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.goto(path.resolve().as_uri())
+    page.wait_for_function("window.kinedyn && window.kinedyn.ready()", timeout=60000)
+    robot = kd.Robot.from_urdf(str(urdf))
+    for q in ([0.1, 0.2, 0.01], [-1.0, 0.7, 0.03]):
+        for frame in ("right", "tip", "knuckle", "left"):
+            T = np.array(page.evaluate(f"(q) => window.kinedyn.fk(q).frames['{frame}']", q)).reshape(4, 4)
+            np.testing.assert_allclose(T, robot.pose(q, frame), atol=1e-12, err_msg=frame)
+    assert page.locator("#kinedyn-sliders input").count() == 3
+    assert errors == []
+    page.close()

@@ -32,7 +32,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._arrays import real_array
+from ._arrays import finite_result, real_array
 from .description.mimic import MimicMap
 
 __all__ = ["ReducedModel"]
@@ -69,7 +69,10 @@ class ReducedModel:
 
     def _q(self, q) -> tuple:
         q = self._arg(q, "q", self.map.nq)
-        return q, self.map.expand_q(q)
+        full = self.map.expand_q(q)
+        if not np.isfinite(full).all():
+            raise ValueError(f"q is too large: a mimic follower's coordinate multiplier * q_leader + offset overflows float64 (robot '{self.robot}')")
+        return q, full
 
     def _v(self, v, name: str, q: np.ndarray) -> np.ndarray:
         v = self._arg(v, name, self.map.nv, q.ndim)
@@ -88,13 +91,16 @@ class ReducedModel:
         out[...] = result
         return out
 
+    # G^T of finite but huge numbers can overflow: a NonFiniteResultError, never an inf returned
     def _left(self, tau: np.ndarray) -> np.ndarray:
         """G^T tau for (..., nv_full)."""
-        return tau @ self.G
+        with np.errstate(over="ignore", invalid="ignore"):
+            return finite_result(tau @ self.G, "G^T tau (mimic joints reduced)")
 
     def _both(self, A: np.ndarray) -> np.ndarray:
         """G^T A G for (..., nv_full, nv_full)."""
-        return self.G.T @ A @ self.G
+        with np.errstate(over="ignore", invalid="ignore"):
+            return finite_result(self.G.T @ A @ self.G, "G^T M G (mimic joints reduced)")
 
     # ------------------------------------------------------------------ kinematics
     def frame_poses(self, q, frames):
@@ -128,8 +134,13 @@ class ReducedModel:
         try:
             return np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
+            if np.abs(M).max() > 1e150:  # its factorisation squares the entries
+                from ._core import NonFiniteResultError
+
+                raise NonFiniteResultError(f"robot '{self.robot}': the reduced mass matrix G^T M G has entries of "
+                                           f"{np.abs(M).max():.3g}, too large for float64 to factor") from None
             raise RuntimeError(
-                f"robot '{self.robot}': the reduced mass matrix G^T M G is singular or not positive definite "
+                "the reduced mass matrix G^T M G is singular or not positive definite "
                 "(a massless leader with massless followers and no rotor inertia?)") from None
 
     def mass_matrix_inverse(self, q, out=None):

@@ -203,3 +203,19 @@ def lock_followers(relations: dict, values: dict, given: dict) -> dict:
                 raise ValueError(f"lock_joints: the value of joint '{follower}' must be finite, got {v}")
             values[follower] = v
     return values
+
+
+def body_coordinates(robot) -> list:
+    """Per moving body of a robot with reduced mimic joints: ``{"q": k, "scale": m, "shift": o}``, its
+    joint's coordinate being ``m * q[k] + o`` (1 and 0 for an independent joint, k its own index); for
+    viewers that run the forward kinematics themselves (the report's viewer.js). 1-DOF joints only."""
+    m = robot._mimic
+    names = robot.joint_names
+    out = []
+    for b in robot.tree.bodies:
+        relation = m.relations.get(b.joint.name)
+        if relation is None:
+            out.append({"q": names.index(b.joint.name), "scale": 1.0, "shift": 0.0})
+        else:
+            out.append({"q": names.index(relation.leader), "scale": relation.multiplier, "shift": relation.offset})
+    return out
