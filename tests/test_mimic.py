@@ -431,3 +431,19 @@ def test_the_reports_viewer_moves_the_followers(browser, tmp_path):
     assert page.locator("#kinedyn-sliders input").count() == 3
     assert errors == []
     page.close()
+
+
+def test_robot_files_read_and_write_mimic(tmp_path):
+    robot = kd.Robot.from_urdf(gripper_urdf(chain=True))
+    for ext in ("yaml", "toml"):
+        path = tmp_path / f"gripper.{ext}"
+        robot.save(path)
+        again = kd.load(path)
+        assert again.joint_names == robot.joint_names and again.mimic_joints == robot.mimic_joints
+        q = np.array([0.3, -0.2, 0.01])
+        np.testing.assert_allclose(again.mass_matrix(q), robot.mass_matrix(q), atol=1e-12)
+        assert kd.load(path, mimic="independent").n == 6
+    text = (tmp_path / "gripper.yaml").read_text().replace("multiplier: -1.0", "multiplier: 0")
+    (tmp_path / "bad.yaml").write_text(text)
+    with pytest.raises(ValueError, match=r"bad.yaml, line \d+: links row 4 \('right'\).joint.mimic: mimic of joint 'left_finger': multiplier must be non-zero"):
+        kd.load(tmp_path / "bad.yaml")
