@@ -393,8 +393,10 @@ def test_symbolic_engine_and_ik_refuse_naming_the_follower():
         robot.equations_of_motion()
     with pytest.raises(ValueError, match=r"the symbolic engine .*'right_finger'"):
         kd.symbolic.kinematics.pose(robot)
-    with pytest.raises(ValueError, match=r"inverse kinematics does not handle mimic joints yet.*'right_finger'.*mimic='independent'"):
-        robot.inverse_kinematics(np.eye(4))
+    with pytest.raises(ValueError, match=r"inverse kinematics of frame 'right' does not handle mimic joints yet: the follower joint 'right_finger'.*mimic='independent'"):
+        robot.inverse_kinematics(np.eye(4), frame="right")
+    with pytest.raises(ValueError, match=r"inverse kinematics does not handle mimic joints yet; robot 'gripper' has the follower joint 'right_finger'"):
+        kd.ik.inverse_kinematics(robot, np.eye(4), frame="left")  # the native solvers directly: refused
     # with the followers kept independent, both run
     full = kd.Robot.from_urdf(gripper_urdf(), mimic="independent")
     assert full.equations_of_motion(simplify=False).M.shape == (5, 5)
@@ -447,3 +449,23 @@ def test_robot_files_read_and_write_mimic(tmp_path):
     (tmp_path / "bad.yaml").write_text(text)
     with pytest.raises(ValueError, match=r"bad.yaml, line \d+: links row 4 \('right'\).joint.mimic: mimic of joint 'left_finger': multiplier must be non-zero"):
         kd.load(tmp_path / "bad.yaml")
+
+
+def test_ik_of_a_frame_no_follower_moves():
+    """Solved on the robot with independent joints, the followers' coordinates dropped."""
+    robot = kd.Robot.from_urdf(gripper_urdf())
+    q_goal = np.array([0.4, -0.3, 0.02])
+    target = robot.pose(q_goal, "left")
+    result = robot.inverse_kinematics(target, q0=[0.3, -0.2, 0.01], frame="left")
+    assert result.success and result.q.shape == (3,)
+    np.testing.assert_allclose(robot.pose(result.q, "left"), target, atol=1e-8)
+    batch = robot.inverse_kinematics(np.stack([target, robot.pose(np.zeros(3), "left")]), q0=np.zeros((2, 3)), frame="left")
+    assert batch.q.shape == (2, 3) and batch.success.all()
+    with pytest.raises(ValueError, match=r"q0 must have shape \(3,\) or a batch \(N, 3\), got \(5,\)"):
+        robot.inverse_kinematics(target, q0=np.zeros(5), frame="left")
+    panda = kd.Robot.from_urdf(erd_path(ERD_MIMIC[0]))
+    q = np.array([0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.4, 0.02])
+    result = panda.inverse_kinematics(panda.pose(q), q0=np.r_[q[:7] + 0.1, 0.01])
+    assert result.success and result.q.shape == (8,)
+    np.testing.assert_allclose(panda.pose(result.q), panda.pose(q), atol=1e-6)
+    assert result.q[7] == 0.01  # the finger does not move the tool

@@ -210,3 +210,39 @@ class ReducedModel:
     def momentum(self, q, qd):
         q, qf = self._q(q)
         return self.native.momentum(qf, self._v(qd, "qd", q))
+
+
+def inverse_kinematics(robot, target, q0, mask, method, respect_limits, **kwargs):
+    """``Robot.inverse_kinematics`` of a robot with reduced mimic joints, for a frame that no follower
+    moves (the Panda's ``panda_hand_tcp``, not a finger): solved on the same robot with every joint
+    independent (the native solvers take the full model), the followers' coordinates then dropped.
+    Exact: the frame's pose depends only on the joints between it and the base, none a follower, so a
+    full solution's independent coordinates put the frame at the target in the reduced robot too
+    (a leader on that path moves its followers elsewhere, which the frame does not see).
+    ValueError naming the follower for a frame a follower moves."""
+    import dataclasses
+
+    frame = kwargs.get("frame") or robot.tool
+    m = robot._mimic
+    tree = robot.tree
+    body = tree.frames[robot.frame_index(frame)].body
+    while body >= 0:
+        joint = tree.bodies[body].joint
+        if joint.name in m.relations:
+            raise ValueError(
+                f"inverse kinematics of frame '{frame}' does not handle mimic joints yet: the follower joint '{joint.name}' "
+                f"(mimics '{m.relations[joint.name].leader}') moves it; load the robot with mimic='independent', or lock the leader")
+        body = tree.bodies[body].parent
+    full = robot.__dict__.get("_independent_robot")
+    if full is None:
+        full = robot.__dict__["_independent_robot"] = robot.replace(mimic="independent")
+    if q0 is not None and not hasattr(q0, "dask"):
+        q0 = real_array(q0, "q0")
+        if q0.shape[-1:] != (m.nq,) or q0.ndim > 2:
+            raise ValueError(f"q0 must have shape ({m.nq},) or a batch (N, {m.nq}), got {q0.shape}")
+        q0 = m.expand_q(q0)
+    result = full.inverse_kinematics(target, q0, mask, method, respect_limits, **kwargs)
+    if hasattr(result, "solutions"):  # IKResult
+        nearest_q = None if result.nearest_q is None else np.asarray(result.nearest_q)[..., m.q_keep]
+        return dataclasses.replace(result, solutions=np.asarray(result.solutions)[..., m.q_keep], nearest_q=nearest_q)
+    return dataclasses.replace(result, q=np.asarray(result.q)[..., m.q_keep])  # IKBatchResult

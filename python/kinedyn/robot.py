@@ -235,7 +235,7 @@ class Robot:
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
     # pickled or copied, and built again on first use on the other side (DESIGN.md: "a Robot
     # pickles"). Everything else is the frozen description: numbers, NumPy arrays, SymPy objects.
-    _NATIVE_STATE = ("_model", "_ik_chains")
+    _NATIVE_STATE = ("_model", "_ik_chains", "_independent_robot")
 
     def __getstate__(self) -> dict:
         return {k: v for k, v in self.__dict__.items() if k not in self._NATIVE_STATE}
@@ -635,6 +635,10 @@ class Robot:
             from ._dask import lazy_inverse_kinematics
 
             return lazy_inverse_kinematics(self, target if is_dask_array(target) else _dask_targets(target, q0), q0, mask, method, respect_limits, kwargs)
+        if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
+            from ._mimic import inverse_kinematics
+
+            return inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
         solve = _IK_SOLVE or _load_ik()
         return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
