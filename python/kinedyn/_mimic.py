@@ -57,11 +57,11 @@ class ReducedModel:
         return self.native.n_frames
 
     def _arg(self, x, name: str, size: int, batch: Optional[int] = None) -> np.ndarray:
-        a = real_array(x, name)
+        a = x if type(x) is np.ndarray and x.dtype == np.float64 else real_array(x, name)
         if a.shape[-1:] != (size,) or a.ndim > 2 or a.ndim < 1:
             raise ValueError(f"{name} must have shape ({size},) or a batch (N, {size}), got {a.shape}")
-        bad = np.flatnonzero(~np.isfinite(a.reshape(-1)))
-        if bad.size:
+        if not np.isfinite(a).all():
+            bad = np.flatnonzero(~np.isfinite(a.reshape(-1)))
             raise ValueError(f"{name} contains a non-finite value (NaN or inf) at index {bad[0] % size}")
         if batch is not None and a.ndim != batch:
             raise ValueError(f"{name} has shape {a.shape} but q has {'a batch' if batch == 2 else 'one state'} (shape {'(N, n)' if batch == 2 else '(n,)'})")
@@ -69,7 +69,8 @@ class ReducedModel:
 
     def _q(self, q) -> tuple:
         q = self._arg(q, "q", self.map.nq)
-        full = self.map.expand_q(q)
+        with np.errstate(over="ignore", invalid="ignore"):
+            full = self.map.expand_q(q)
         if not np.isfinite(full).all():
             raise ValueError(f"q is too large: a mimic follower's coordinate multiplier * q_leader + offset overflows float64 (robot '{self.robot}')")
         return q, full
@@ -94,13 +95,13 @@ class ReducedModel:
     # G^T of finite but huge numbers can overflow: a NonFiniteResultError, never an inf returned
     def _left(self, tau: np.ndarray) -> np.ndarray:
         """G^T tau for (..., nv_full)."""
-        with np.errstate(over="ignore", invalid="ignore"):
-            return finite_result(tau @ self.G, "G^T tau (mimic joints reduced)")
+        out = tau @ self.G
+        return out if np.isfinite(out).all() else finite_result(out, "G^T tau (mimic joints reduced)")
 
     def _both(self, A: np.ndarray) -> np.ndarray:
         """G^T A G for (..., nv_full, nv_full)."""
-        with np.errstate(over="ignore", invalid="ignore"):
-            return finite_result(self.G.T @ A @ self.G, "G^T M G (mimic joints reduced)")
+        out = self.G.T @ A @ self.G
+        return out if np.isfinite(out).all() else finite_result(out, "G^T M G (mimic joints reduced)")
 
     # ------------------------------------------------------------------ kinematics
     def frame_poses(self, q, frames):

@@ -53,13 +53,14 @@ class MimicMap:
     offset: np.ndarray
     #: v_full = G v, (nv_full, nv)
     G: np.ndarray = field(repr=False)
+    #: q_full = q @ Gq_T + b: the same map on configurations, (nq, nq_full) and (nq_full,) (exact:
+    #: each full entry is one reduced entry times 1 or a multiplier, plus zeros and an offset)
+    Gq_T: np.ndarray = field(repr=False)
+    b: np.ndarray = field(repr=False)
 
     def expand_q(self, q: np.ndarray) -> np.ndarray:
         """Full configuration(s) from reduced one(s): (..., nq) -> (..., nq_full)."""
-        full = np.empty(q.shape[:-1] + (self.nq_full,))
-        full[..., self.q_keep] = q
-        full[..., self.q_follow] = q[..., self.q_lead] * self.multiplier + self.offset
-        return full
+        return q @ self.Gq_T + self.b
 
     def expand_v(self, v: np.ndarray) -> np.ndarray:
         """Full velocities (or accelerations) from reduced ones: ``G v``, (..., nv) -> (..., nv_full)."""
@@ -140,10 +141,15 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
         mult.append(relation.multiplier)
         off.append(relation.offset)
         G[iv[f], reduced_v[leader]] = relation.multiplier
+    q_follow = np.array([iq[f] for f in followers], dtype=np.int64)
+    Gq_T, b = np.zeros((nq, nq_full)), np.zeros(nq_full)
+    Gq_T[np.arange(nq), q_keep] = 1.0
+    Gq_T[q_lead, q_follow] = mult
+    b[q_follow] = off
     return MimicMap(
         relations=relations, independent=independent, followers=followers, nq_full=nq_full, nv_full=nv_full, nq=nq, nv=nv,
-        q_keep=q_keep, q_follow=np.array([iq[f] for f in followers], dtype=np.int64), q_lead=np.array(q_lead, dtype=np.int64),
-        multiplier=np.array(mult), offset=np.array(off), G=G,
+        q_keep=q_keep, q_follow=q_follow, q_lead=np.array(q_lead, dtype=np.int64),
+        multiplier=np.array(mult), offset=np.array(off), G=G, Gq_T=Gq_T, b=b,
     )
 
 
