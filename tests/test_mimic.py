@@ -469,3 +469,11 @@ def test_ik_of_a_frame_no_follower_moves():
     assert result.success and result.q.shape == (8,)
     np.testing.assert_allclose(panda.pose(result.q), panda.pose(q), atol=1e-6)
     assert result.q[7] == 0.01  # the finger does not move the tool
+
+
+def test_an_unmapped_native_method_is_refused_by_name():
+    model = kd.Robot.from_urdf(gripper_urdf())._model
+    with pytest.raises((NotImplementedError, AttributeError), match=r"'no_such_method'"):
+        model.no_such_method
+    for name in [m for m in dir(model.native) if not m.startswith("_") and callable(getattr(model.native, m))]:
+        assert name in type(model).__dict__, f"ReducedModel does not map the core's {name}"

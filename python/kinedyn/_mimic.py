@@ -53,8 +53,22 @@ class ReducedModel:
         return self.map.nv
 
     @property
+    def nq(self) -> int:
+        return self.map.nq
+
+    @property
     def n_frames(self) -> int:
         return self.native.n_frames
+
+    def __getattr__(self, name: str):
+        # a method of the native model this wrapper does not map (added to the core after it): an
+        # error naming it, never the full model's answer in the wrong coordinates
+        if name.startswith("__") or name in ("native", "map", "robot", "G"):
+            raise AttributeError(name)
+        if callable(getattr(self.native, name, None)):
+            raise NotImplementedError(f"robot '{self.robot}': '{name}' is not mapped to reduced mimic coordinates yet "
+                                      "(kinedyn/_mimic.py); load the robot with mimic='independent'")
+        raise AttributeError(f"'ReducedModel' object has no attribute '{name}'")
 
     def _arg(self, x, name: str, size: int, batch: Optional[int] = None) -> np.ndarray:
         a = x if type(x) is np.ndarray and x.dtype == np.float64 else real_array(x, name)
@@ -204,6 +218,10 @@ class ReducedModel:
         q, qf = self._q(q)
         Y = self.native.regressor(qf, self._v(qd, "qd", q), self._v(qdd, "qdd", q))
         return np.einsum("ai,...ap->...ip", self.G, Y)
+
+    def centroidal_momentum_matrix(self, q):
+        """A_G G: the momentum about the centre of mass is A_G qd_full = A_G G qd."""
+        return self.native.centroidal_momentum_matrix(self._q(q)[1]) @ self.G
 
     def center_of_mass(self, q):
         return self.native.center_of_mass(self._q(q)[1])
