@@ -155,8 +155,8 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
 
 
 def reduced_coefficient(robot, name: str) -> np.ndarray:
-    """A per-joint drive coefficient of a robot with reduced mimic joints, followers included, per
-    independent joint ``k``: the followers' friction and rotor inertia act on ``G qd`` and come back
+    """A drive coefficient of a robot with reduced mimic joints, followers included, per degree of
+    freedom of the independent joints (a leader ``k`` is 1-DOF): the followers' friction and rotor inertia act on ``G qd`` and come back
     through ``G^T``; each full coordinate lies in one column of G, so ``G^T diag(a) G`` is diagonal:
 
     - ``armature`` and ``viscous``: ``a_k + sum_f m_f^2 a_f`` over the followers f of k (multiplier m_f);
@@ -168,20 +168,24 @@ def reduced_coefficient(robot, name: str) -> np.ndarray:
     its diagonal, as without mimic joints."""
     m = robot._mimic
     joints = [b.joint for b in robot.tree.bodies]
-    index = {j.name: k for k, j in enumerate(robot.joints)}
 
     def own(j, key):
         return float(j.coulomb_levels[1] if key == "coulomb_negative" else getattr(j, key))
 
-    out = np.array([own(j, name) for j in robot.joints])
+    values: list = []  # per reduced degree of freedom (a multi-DOF joint has no drive data: zeros)
+    start = {}
+    for j in robot.joints:
+        start[j.name] = len(values)
+        values.extend([0.0] * j.nv if j.is_multi_dof else [own(j, name)])
+    out = np.array(values)
     for follower in (joints[i] for i in m.followers):
         relation = m.relations[follower.name]
         mult = relation.multiplier
         if name in ("armature", "viscous"):
-            out[index[relation.leader]] += mult * mult * own(follower, name)
+            out[start[relation.leader]] += mult * mult * own(follower, name)
         else:
             same = (name == "coulomb") == (mult > 0)
-            out[index[relation.leader]] += abs(mult) * own(follower, "coulomb" if same else "coulomb_negative")
+            out[start[relation.leader]] += abs(mult) * own(follower, "coulomb" if same else "coulomb_negative")
     return out
 
 
