@@ -126,6 +126,16 @@ def test_urdf_mimic_is_read_and_reduced():
     assert robot.replace(name="other").n == 3 and robot.subs({}).n == 3
 
 
+@pytest.mark.filterwarnings("ignore::kinedyn.description.inertia.PhysicalConsistencyWarning")
+def test_a_fixed_joints_mimic_is_ignored():
+    """Talos's talos_left_arm.urdf fixes gripper_left_inner_double_joint and keeps its <mimic>."""
+    fixed = gripper_urdf().replace('<joint name="right_finger" type="prismatic"', '<joint name="right_finger" type="fixed"')
+    robot = kd.Robot.from_urdf(fixed)
+    assert robot.joint_names == ["shoulder", "wrist", "left_finger"] and "right_finger" not in robot.mimic_joints
+    arm = kd.Robot.from_urdf(erd_path("talos_data/robots/talos_left_arm.urdf"))
+    assert "gripper_left_inner_double_joint" not in arm.joint_names + list(arm.mimic_joints)
+
+
 def test_mimic_errors_name_the_joint():
     base = gripper_urdf()
     missing = base.replace('mimic joint="left_finger"', 'mimic joint="no_such_joint"')

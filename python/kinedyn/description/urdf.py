@@ -294,7 +294,8 @@ def _joint(element, src: _Source) -> dict:
         axis = _floats(axis_element.get("xyz"), 3, axis, f"{what} axis", axis_element, src)
     limits = _limits(element.find("limit"), kind, what, src)
     friction = _dynamics(element.find("dynamics"), what, src)
-    mimic = _mimic(element.find("mimic"), what, src)
+    # a fixed joint has no coordinate to follow with: its <mimic> is ignored (Talos's talos_left_arm.urdf has one)
+    mimic = _mimic(element.find("mimic"), what, src) if kind != "fixed" else None
     try:
         joint = Joint(name, "revolute" if kind == "continuous" else kind, axis, **limits, **friction, mimic=mimic)
     except ValueError as e:
