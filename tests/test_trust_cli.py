@@ -64,6 +64,7 @@ def commands(tmp: Path):
         ("report", ["-o", tmp / "r.html", "--t", "0.01", "--eom-joints", "0"]),
         ("derive", []),
         ("view", ["--no-wait", "--port", "0"]),  # the live viewer: starts its server and stops at once
+        ("convert", [tmp / "converted.urdf"]),
     ]
 
 
@@ -205,8 +206,8 @@ def output_options():
     found = []
     for name, p in sub.choices.items():
         for a in p._actions:
-            if isinstance(a, cli.OutputPath):
-                found.append((name, a.option_strings[-1]))
+            if isinstance(a, cli.OutputPath):  # an option, or a positional OUT (convert) named by its metavar
+                found.append((name, a.option_strings[-1] if a.option_strings else a.metavar))
     return found
 
 
@@ -219,8 +220,8 @@ def test_every_file_option_is_checked():
     for name, p in sub.choices.items():
         for a in p._actions:
             text = f"{a.help or ''} {a.metavar or ''}".lower()
-            if a.option_strings and ("write" in text or a.dest in ("output", "plot", "animate", "csv", "npz")):
-                writers.add((name, a.option_strings[-1]))
+            if (a.option_strings or a.dest == "output") and ("write" in text or a.dest in ("output", "plot", "animate", "csv", "npz")):
+                writers.add((name, a.option_strings[-1] if a.option_strings else a.metavar))
     assert writers == set(output_options())
     assert ("report", "--output") in writers and ("derive", "--output") in writers and ("simulate", "--csv") in writers
 
@@ -256,7 +257,7 @@ def test_unwritable_outputs_fail_before_the_work(capsys, tmp_path, monkeypatch):
     assert len(options) >= 6
     for command, flag in options:
         for path, reason in _unwritable(tmp_path):
-            code, _, err = run(capsys, command, "planar_2r", flag, path)
+            code, _, err = run(capsys, command, "planar_2r", *([flag, path] if flag.startswith("-") else [path]))
             line = assert_one_line_error(code, err, flag, reason)
             assert code == cli.EXIT_ERROR, line
 

@@ -13,7 +13,7 @@ from . import robots
 if TYPE_CHECKING:
     # what type checkers and IDEs see: kd.simulate is the function and still holds the package's
     # names (kd.simulate.PD); the lazily loaded submodules are the modules themselves
-    from . import analysis, dynamics, ik, kinematics, symbolic, testing
+    from . import analysis, configuration, dynamics, ik, kinematics, symbolic, testing
     from ._typing import PathLike
     from .simulate._callable import simulate
 else:
@@ -23,7 +23,7 @@ from .symbolic import LagrangianSystem
 
 __version__ = "0.1.0"
 
-_SUBMODULES = ("analysis", "dynamics", "ik", "kinematics", "symbolic", "testing")
+_SUBMODULES = ("analysis", "configuration", "dynamics", "ik", "kinematics", "symbolic", "testing")
 
 
 def __getattr__(name):

@@ -34,9 +34,12 @@ class Model:
         frame_body: I64,  # (nf,) body of each named frame, -1 = base
         frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
         coulomb_negative: Optional[F64] = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
+        blocks: Optional[I64] = None,  # (n,) 0 a 1-DOF joint; 1/2/3 head of a free-flyer/spherical/planar joint; -1 its further bodies
     ) -> None: ...
     @property
-    def n(self) -> int: ...
+    def n(self) -> int: ...  # bodies = degrees of freedom (nv)
+    @property
+    def nq(self) -> int: ...  # length of a configuration q
     @property
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----
@@ -65,6 +68,7 @@ class Model:
     def regressor(self, q: F64, qd: F64, qdd: F64) -> F64: ...  # (n, 10 n) | (N, n, 10 n)
     def center_of_mass(self, q: F64) -> F64: ...  # (3,) | (N, 3)
     def momentum(self, q: F64, qd: F64) -> F64: ...  # (6,) | (N, 6), [p; L about the base origin]
+    def centroidal_momentum_matrix(self, q: F64) -> F64: ...  # (6, n) | (N, 6, n), h_G = A_G qd
 
 class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""

@@ -76,7 +76,8 @@ def base_parameters(robot: Robot, samples: int = 200, rng: SeedLike = 0, tol: fl
     q = robot.random_configuration(rng, size=samples)
     qd = rng.uniform(-2.0, 2.0, size=(samples, n))
     qdd = rng.uniform(-4.0, 4.0, size=(samples, n))
-    W = robot.regressor(q, qd, qdd).reshape(samples * n, 10 * n)
+    p = robot.inertial_parameters().size  # 10 per moving link (n of them unless a joint has several DOF)
+    W = robot.regressor(q, qd, qdd).reshape(samples * n, p)
     # scale columns so that the rank test does not depend on the units of each parameter
     scale = np.linalg.norm(W, axis=0)
     # a column that is rounding noise (e.g. PUMA link2's m cz, norm ~1e-15) is structurally zero:
@@ -94,7 +95,7 @@ def base_parameters(robot: Robot, samples: int = 200, rng: SeedLike = 0, tol: fl
     beta = beta_s * scale[dependent][None, :] / scale[independent][:, None]
     beta[np.abs(beta) < 1e-10 * max(1.0, np.abs(beta).max(initial=0.0))] = 0.0
     order = np.argsort(independent)
-    grouping = np.zeros((b, 10 * n))
+    grouping = np.zeros((b, p))
     grouping[np.arange(b), independent] = 1.0
     grouping[:, dependent] = beta
     grouping = grouping[order]

@@ -54,6 +54,64 @@ def _dask_targets(target, q0):
 
 
 _REFERENCES = {"world": 0, "local": 1, "spatial": 2}
+
+# the native model's code for the first body of each multi-DOF joint (crates/kinedyn-py/src/lib.rs)
+_BLOCK_CODES = {"floating": 1, "spherical": 2, "planar": 3}
+
+
+def _planar_basis(normal) -> tuple:
+    """In-plane unit axes (e1, e2) with e1 x e2 = normal: x and y for the normal z (Pinocchio's
+    JointModelPlanar), else e1 along the coordinate axis most orthogonal to the normal."""
+    n = np.asarray(normal, dtype=float)
+    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
+        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    e = np.eye(3)[int(np.argmin(np.abs(n)))]
+    e1 = e - n * (n @ e)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(n, e1)
+
+
+def _locked_block(joint, block) -> np.ndarray:
+    """The 4x4 joint motion of a multi-DOF ``joint`` at its q ``block`` (unit quaternion / (cos, sin)
+    checked): what :meth:`Robot.lock_joints` folds into the placement."""
+    b = real_array(block, f"value of joint '{joint.name}'").ravel()
+    if b.shape != (joint.nq,) or not np.all(np.isfinite(b)):
+        raise ValueError(f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}")
+    T = np.eye(4)
+    unit = b[-4:] if joint.kind != "planar" else b[2:]
+    if abs(np.linalg.norm(unit) - 1.0) > 1e-6:
+        raise ValueError(f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit")
+    if joint.kind == "planar":
+        e1, e2 = _planar_basis(to_float_array(joint.axis, (3,), "axis"))
+        n = np.cross(e1, e2)
+        c, s = b[2], b[3]
+        K = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+        T[:3, :3] = c * np.eye(3) + s * K + (1 - c) * np.outer(n, n)
+        T[:3, 3] = b[0] * e1 + b[1] * e2
+        return T
+    x, y, z, w = b[-4:]
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    if joint.kind == "floating":
+        T[:3, 3] = b[:3]
+    return T
+
+
+def _joint_columns(joint) -> list:
+    """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
+    1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
+    planar: linear e1, e2, angular normal (0 revolute, 1 prismatic)."""
+    e = np.eye(3)
+    if joint.kind == "floating":
+        return [(1, e[k]) for k in range(3)] + [(0, e[k]) for k in range(3)]
+    if joint.kind == "spherical":
+        return [(0, e[k]) for k in range(3)]
+    axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
+    if joint.kind == "planar":
+        e1, e2 = _planar_basis(axis)
+        return [(1, e1), (1, e2), (0, np.cross(e1, e2))]
+    return [(0 if joint.kind == "revolute" else 1, axis)]
 _F64 = np.dtype(np.float64)
 
 
@@ -140,16 +198,19 @@ class Robot:
         return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
 
     @classmethod
-    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", mimic: str = "reduce") -> "Robot":
+    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
+                  floating_base: bool = False, mimic: str = "reduce") -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
-        or ``"strict"`` (ValueError); see docs/model-files.md. ``mimic``: ``"reduce"`` (default) removes
-        the coordinates of ``<mimic>`` joints (q_follower = multiplier * q_leader + offset), or
-        ``"independent"`` keeps each one a coordinate of its own (docs/model-files.md, "Mimic joints")."""
+        or ``"strict"`` (ValueError); see docs/model-files.md. ``floating_base=True``: the root link
+        moves on a free-flyer joint ``root_joint`` (Pinocchio's ``JointModelFreeFlyer``; nq = nv + 1).
+        ``mimic``: ``"reduce"`` (default) removes the coordinates of ``<mimic>`` joints (q_follower =
+        multiplier * q_leader + offset), or ``"independent"`` keeps each one a coordinate of its own
+        (docs/model-files.md, "Mimic joints")."""
         from .description.urdf import robot_from_urdf
 
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, mimic=mimic)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic)
 
     def replace(self, **changes) -> "Robot":
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
@@ -175,26 +236,31 @@ class Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
 
         ``joints``: a mapping ``{joint: value}``, or a sequence (list, tuple, set, array) of joints
-        locked at their value in ``at`` (a configuration (n,); default: zero, the joint's offset
-        position). A joint is named by its name (``robot.joint_names``) or its index in ``q``.
+        locked at their value in ``at`` (a configuration (nq,); default: :meth:`neutral`). A joint is
+        named by its name (``robot.joint_names``) or its index in that list (= its index in ``q`` when
+        every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
+        position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
         from ._math import rot_axis, translation
 
         names = self.joint_names
+        n_joints = len(names)
+        starts = np.cumsum([0] + [j.nq for j in self.joints])
         if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
             raise TypeError(f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}")
         if isinstance(joints, Mapping):
             items = list(joints.items())
         else:
-            q_at = np.zeros(self.n) if at is None else real_array(at, "at")
-            if q_at.shape != (self.n,) or not np.all(np.isfinite(q_at)):
-                raise ValueError(f"lock_joints: at must be {self.n} finite joint values, got shape {q_at.shape}")
+            q_at = self.neutral() if at is None else real_array(at, "at")
+            if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
+                raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
         followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
         unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
         if unknown:
             raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
-        values, follower_values = {}, {}
+        values: dict = {}
+        follower_values: dict = {}
         for key, value in items:
             if isinstance(key, str) and key in followers:
                 follower_values[key] = value
@@ -202,13 +268,17 @@ class Robot:
             if isinstance(key, str):
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not -self.n <= key < self.n:
-                    raise ValueError(f"lock_joints: joint index {key} is out of range for {self.n} joints")
-                i = int(key) % self.n
+                if not -n_joints <= key < n_joints:
+                    raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
+                i = int(key) % n_joints
             else:
                 raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
+            if self.joints[i].is_multi_dof:
+                block = q_at[starts[i]:starts[i + 1]] if value is None else value
+                values[names[i]] = _locked_block(self.joints[i], block)
+                continue
             if value is None:
-                value = q_at[i]
+                value = q_at[starts[i]]
             try:
                 v = float(value)
             except (TypeError, ValueError):
@@ -223,7 +293,10 @@ class Robot:
         links = []
         for link in self.links:
             j = link.joint
-            if j.name in values and j.is_moving:
+            if j.name in values and j.is_multi_dof:
+                fixed = Joint(j.name, "fixed")
+                link = Link(link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia)
+            elif j.name in values and j.is_moving:
                 x = values[j.name] + j.offset
                 motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
                 fixed = Joint(j.name, "fixed", j.axis)
@@ -315,59 +388,81 @@ class Robot:
     def parents(self) -> list:
         return self.tree.parents
 
+    def _per_coordinate(self, value, size: str, multi=math.inf) -> np.ndarray:
+        """``value(joint)`` for each q coordinate (``size="nq"``) or degree of freedom (``"nv"``);
+        a multi-DOF joint's coordinates get ``multi`` (no limits, no drive data)."""
+        out = []
+        for j in self.joints:
+            k = j.nq if size == "nq" else j.nv
+            out.extend([multi] * k if j.is_multi_dof else [value(j)])
+        return np.array(out, dtype=float)
+
     @property
     def lower_limits(self) -> np.ndarray:
-        return np.array([j.lower for j in self.joints])
+        """Lower position limit per q coordinate (nq,); -inf for multi-DOF joints' coordinates."""
+        return self._per_coordinate(lambda j: j.lower, "nq", -math.inf)
 
     @property
     def upper_limits(self) -> np.ndarray:
-        return np.array([j.upper for j in self.joints])
+        """Upper position limit per q coordinate (nq,); inf for multi-DOF joints' coordinates."""
+        return self._per_coordinate(lambda j: j.upper, "nq")
 
     @property
     def velocity_limits(self) -> np.ndarray:
-        return np.array([j.velocity_limit for j in self.joints])
+        return self._per_coordinate(lambda j: j.velocity_limit, "nv")
 
     @property
     def effort_limits(self) -> np.ndarray:
-        return np.array([j.effort_limit for j in self.joints])
+        return self._per_coordinate(lambda j: j.effort_limit, "nv")
 
     @property
     def armature(self) -> np.ndarray:
-        """Reflected rotor inertia r^2 J_m per joint (added to the diagonal of M)."""
+        """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
             from .description.mimic import reduced_coefficient
 
             return reduced_coefficient(self, "armature")
-        return np.array([float(j.armature) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
 
     @property
     def viscous(self) -> np.ndarray:
-        """Viscous friction coefficient per joint: tau_f = viscous * qd + coulomb * sign(qd)
+        """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
         (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
             from .description.mimic import reduced_coefficient
 
             return reduced_coefficient(self, "viscous")
-        return np.array([float(j.viscous) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
 
     @property
     def coulomb(self) -> np.ndarray:
-        """Coulomb friction level per joint for qd > 0 (the only level when friction is symmetric)."""
+        """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
             from .description.mimic import reduced_coefficient
 
             return reduced_coefficient(self, "coulomb")
-        return np.array([float(j.coulomb) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
 
     @property
     def coulomb_negative(self) -> np.ndarray:
-        """Coulomb friction level per joint for qd < 0 (a magnitude; equals :attr:`coulomb` for
+        """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
         symmetric friction)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
             from .description.mimic import reduced_coefficient
 
             return reduced_coefficient(self, "coulomb_negative")
-        return np.array([float(j.coulomb_levels[1]) for j in self.joints])
+        return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
+
+    @cached_property
+    def _dof_body(self) -> np.ndarray:
+        """(nv,) the moving link (index into body_names) each degree of freedom belongs to."""
+        return np.repeat(np.arange(len(self.tree.bodies)), [b.joint.nv for b in self.tree.bodies])
+
+    @cached_property
+    def _body_last_dof(self) -> np.ndarray:
+        """(n_links,) the last degree of freedom of each moving link's joint: the native body that
+        carries the link (a multi-DOF joint is one native body per degree of freedom)."""
+        return np.cumsum([b.joint.nv for b in self.tree.bodies]) - 1
 
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
@@ -457,6 +552,22 @@ class Robot:
 
         save(self, path)
 
+    def to_urdf(self, path: Optional[PathLike] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
+        """The robot as URDF text, written to ``path`` when given (joint offsets folded into the joint
+        origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
+        robots"). ``geometry``: cylinders along the links of a robot without visuals;
+        ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
+        from .description.export import to_urdf
+
+        return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
+
+    def to_mjcf(self, path: Optional[PathLike] = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
+        """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
+        :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
+        from .description.export import to_mjcf
+
+        return to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
+
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
@@ -506,31 +617,60 @@ class Robot:
                 f"robot '{self.name}' has symbolic parameters {sorted(map(str, self.symbols))}: "
                 "use robot.subs({...}) to give them values before numeric computation"
             )
-        self.require_one_dof_joints("the numeric engine")
         bodies = self.tree.bodies
-        n = len(bodies)
-        parent = np.array([b.parent for b in bodies], dtype=np.int64)
-        kind = np.array([0 if b.joint.kind == "revolute" else 1 for b in bodies], dtype=np.int64)
-        axis = np.array([to_float_array(b.joint.axis, (3,), f"axis of joint '{b.joint.name}'") for b in bodies])
-        offset = np.array([float(b.joint.offset) for b in bodies])
-        placement = np.array([to_float_array(b.placement, (4, 4), f"placement of '{b.name}'") for b in bodies])
-        inertia = self.inertial_parameters().reshape(n, 10)
-        # per moving joint, followers of mimic joints included (the native model has them all)
-        armature, viscous, coulomb = (np.array([float(getattr(b.joint, k)) for b in bodies]) for k in ("armature", "viscous", "coulomb"))
+        last = self._body_last_dof
+        # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
+        # transform, read from q) and members at the identity on it, the last carrying the link
+        # (crates/kinedyn-core/src/model.rs); a 1-DOF joint is one body
+        parent: list = []
+        kind: list = []
+        axis: list = []
+        offset: list = []
+        placement: list = []
+        blocks: list = []
+        link_inertia = self.inertial_parameters().reshape(len(bodies), 10)
+        inertia = np.zeros((len(self._dof_body), 10))  # every native body (mimic followers' too)
+        for b, body in enumerate(bodies):
+            joint = body.joint
+            first = len(parent)
+            parent.append(-1 if body.parent < 0 else int(last[body.parent]))
+            placement.append(to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"))
+            offset.append(float(joint.offset))
+            columns = _joint_columns(joint)
+            for m, (k, a) in enumerate(columns):
+                if m > 0:
+                    parent.append(first + m - 1)
+                    placement.append(np.eye(4))
+                    offset.append(0.0)
+                kind.append(k)
+                axis.append(a)
+            blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
+            inertia[last[b]] = link_inertia[b]
+        # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
+        def per_dof(value):
+            return np.array([x for body in bodies for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])])
+
+        armature, viscous, coulomb = (per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb"))
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
-        frame_body = np.array([f.body for f in frames], dtype=np.int64)
+        frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
         frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
         # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-        coulomb_negative = np.array([float(b.joint.coulomb_levels[1]) for b in bodies])
+        coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
         asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        native = _core.Model(parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement,
-                             coulomb_negative=asymmetric)
+        native = _core.Model(np.array(parent, dtype=np.int64), np.array(kind, dtype=np.int64), np.array(axis, dtype=float).reshape(-1, 3),
+                             np.array(offset), np.array(placement).reshape(-1, 4, 4), inertia, armature, viscous, coulomb, gravity,
+                             frame_body, frame_placement, coulomb_negative=asymmetric,
+                             blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None)
         if self._mimic is None:
             return native
         from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
 
         return ReducedModel(native, self._mimic, self.name)
+
+    @cached_property
+    def _multi_dof(self) -> bool:
+        return self.has_multi_dof_joints
 
     @cached_property
     def _link_frame_ids(self) -> np.ndarray:
@@ -631,6 +771,7 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        self.require_one_dof_joints("inverse kinematics")
         if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             from ._dask import lazy_inverse_kinematics
 
@@ -650,7 +791,7 @@ class Robot:
     def _link_origin_in_body(self) -> Optional[np.ndarray]:
         """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
         frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
-        u = np.zeros((len(self.body_names), 3))  # one per moving link (mimic followers' too)
+        u = np.zeros((len(self.tree.bodies), 3))
         for i, name in enumerate(self.body_names):
             T = to_float_array(self.tree.frames[self.frame_index(name)].placement, (4, 4), f"frame '{name}'")
             u[i] = T[:3, :3].T @ T[:3, 3]
@@ -662,10 +803,22 @@ class Robot:
         if f_ext is None:
             return None
         f = real_array(f_ext, "f_ext")
-        links = len(self.body_names)  # = n, unless mimic followers are reduced (their links still take wrenches)
+        links = len(self.tree.bodies)
         if f.shape == (links, 6) and np.ndim(q) == 2:
             # one set of wrenches for every state of a batch
             f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
+        if self._multi_dof:
+            if f.shape[-2:] != (links, 6):
+                raise ValueError(f"f_ext must have shape ({links}, 6): one wrench per moving link {self.body_names}, got {f.shape}")
+            u = self._link_origin_in_body
+            if u is not None and f.ndim == np.ndim(q) + 1:
+                R = self.forward_kinematics(q)[..., :3, :3]
+                f = f.copy()
+                f[..., 3:] += np.cross(np.einsum("...ij,...j->...i", R, u), f[..., :3])
+            # the native model has a body per degree of freedom: the link's wrench acts on its last
+            full = np.zeros(f.shape[:-2] + (len(self._dof_body), 6))  # every native body
+            full[..., self._body_last_dof, :] = f
+            return full
         u = self._link_origin_in_body
         if u is None or f.shape[-2:] != (links, 6) or f.ndim != np.ndim(q) + 1:
             return f  # (wrong shapes are reported by the core)
@@ -685,8 +838,11 @@ class Robot:
         seen = set()
 
         def named(match):
-            i = int(match.group(1))
-            if i >= self.n or i in seen:
+            dof = int(match.group(1))
+            if dof >= self.n:
+                return match.group(0)
+            i = int(self._dof_body[dof])  # the native body (a degree of freedom) -> its link
+            if i in seen:
                 return match.group(0)
             seen.add(i)
             return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
@@ -704,7 +860,7 @@ class Robot:
         """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
         positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
         subtree, parents = {joint}, self.parents
-        for i in range(joint + 1, self.n):  # parent[i] < i
+        for i in range(joint + 1, len(self.tree.bodies)):  # parent[i] < i
             if parents[i] in subtree:
                 subtree.add(i)
         bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
@@ -848,10 +1004,32 @@ class Robot:
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
+    @batched("q")
+    def centroidal_momentum_matrix(self, q: ArrayLike) -> np.ndarray:
+        """A_G(q), (6, n) or (N, 6, n): the momentum about the centre of mass, h_G = A_G qd =
+        [m c_dot; L_G] in base axes (Orin, Goswami & Lee 2013; Pinocchio's ``ccrba`` ``Ag``)."""
+        return self._model.centroidal_momentum_matrix(q)
+
+    @batched("q")
+    def center_of_mass_jacobian(self, q: ArrayLike) -> np.ndarray:
+        """J_c(q), (3, n) or (N, 3, n): the centre of mass's velocity c_dot = J_c qd in base axes
+        (the linear rows of the centroidal momentum matrix over the total mass)."""
+        A = self._model.centroidal_momentum_matrix(q)
+        return A[..., :3, :] / self._total_mass
+
+    @cached_property
+    def _total_mass(self) -> float:
+        return float(sum(float(b.inertia.mass) for b in self.tree.bodies))
+
     @batched("q", "qd", "qdd")
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
-        """Y(q, qd, qdd), (n, 10 n), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
-        return self._model.regressor(q, qd, qdd)
+        """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
+        y = self._model.regressor(q, qd, qdd)
+        if self._multi_dof:
+            # the native model's extra bodies of a multi-DOF joint are massless: keep the links' columns
+            columns = (10 * self._body_last_dof[:, None] + np.arange(10)).ravel()
+            y = np.ascontiguousarray(y[..., columns])
+        return y
 
     def base_parameters(self, samples: int = 200, rng: SeedLike = 0, tol: float = 1e-9) -> BaseParameters:
         """A minimal identifiable parameter set (:class:`kinedyn.dynamics.BaseParameters`): column
@@ -869,24 +1047,41 @@ class Robot:
 
         return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
+    # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------
     def neutral(self) -> np.ndarray:
-        """The zero configuration (n,)."""
-        return np.zeros(self.n)
+        """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
+        from .configuration import neutral
+
+        return neutral(self)
 
     def random_configuration(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
-        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else."""
-        if size is not None and not (isinstance(size, (int, np.integer)) and size >= 0):
-            raise ValueError(f"size must be a whole number of configurations >= 0 (or None for one), got {size!r}")
-        rng = np.random.default_rng(rng)
-        lo = self.lower_limits.copy()
-        hi = self.upper_limits.copy()
-        for i, j in enumerate(self.joints):
-            # an infinite side is replaced by one span beyond the finite side (or -span..span):
-            # a one-sided limit such as lower=5 (upper inf) must not give lo > hi
-            span = math.pi if j.kind == "revolute" else 1.0
-            if not math.isfinite(lo[i]):
-                lo[i] = min(-span, hi[i] - 2 * span) if math.isfinite(hi[i]) else -span
-            if not math.isfinite(hi[i]):
-                hi[i] = max(span, lo[i] + 2 * span)
-        shape = (self.n,) if size is None else (size, self.n)
-        return rng.uniform(lo, hi, size=shape)
+        """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
+        uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
+        from .configuration import random_configuration
+
+        return random_configuration(self, rng, size)
+
+    def integrate(self, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
+        """q ⊕ v dt (nq,) or (N, nq): q + v dt for 1-DOF joints, M(q) Exp(v dt) for floating, spherical and
+        planar joints (v in the child's frame): see :mod:`kinedyn.configuration`."""
+        from .configuration import integrate
+
+        return integrate(self, q, v, dt)
+
+    def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
+        """v (nv,) or (N, nv) with integrate(q0, v) == q1: Log(M(q0)^-1 M(q1)), rotations the short way."""
+        from .configuration import difference
+
+        return difference(self, q0, q1)
+
+    def interpolate(self, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
+        """integrate(q0, t * difference(q0, q1)): the geodesic from q0 (t = 0) to q1 (t = 1)."""
+        from .configuration import interpolate
+
+        return interpolate(self, q0, q1, t)
+
+    def normalize(self, q: ArrayLike) -> np.ndarray:
+        """``q`` with each quaternion and planar (cos, sin) pair divided by its norm."""
+        from .configuration import normalize
+
+        return normalize(self, q)

@@ -56,16 +56,24 @@ def random_inertia(rng) -> Inertia:
     return Inertia(m, tuple(rng.uniform(-0.3, 0.3, 3)), R @ principal @ R.T)
 
 
-def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: float = 0.25, fixed: int = 1, friction: bool = True) -> Robot:
+def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: float = 0.25, fixed: int = 1, friction: bool = True,
+                 floating: bool = False, spherical: float = 0.0, planar: float = 0.0) -> Robot:
     """A random robot of ``n`` moving joints (plus ``fixed`` fixed links with inertia, merged at
-    compile time). ``branching=True`` gives a tree (each link's parent is any earlier link)."""
+    compile time). ``branching=True`` gives a tree (each link's parent is any earlier link).
+    ``floating=True``: the first joint is a free-flyer; ``spherical`` / ``planar``: the chance that
+    a later joint is spherical / planar (normal z, Pinocchio's JointModelPlanar)."""
     rng = np.random.default_rng(seed)
     links = []
     names: list[str] = []
     for i in range(n + fixed):
         moving = i < n
         parent = None if i == 0 else (names[int(rng.integers(0, i))] if branching else names[-1])
-        if moving:
+        # (drawn only when asked for, so that the robots of a seed stay those of earlier versions)
+        draw = rng.uniform() if spherical or planar else 1.0
+        multi = "floating" if floating and i == 0 else ("spherical" if draw < spherical else "planar" if draw < spherical + planar else None)
+        if moving and multi is not None and i > 0 or (moving and multi == "floating"):
+            joint = Joint(f"j{i + 1}", multi, (0.0, 0.0, 1.0))
+        elif moving:
             kind = "prismatic" if rng.uniform() < prismatic else "revolute"
             joint = Joint(
                 f"j{i + 1}",
@@ -123,12 +131,12 @@ def check_identities(robot: Robot, states: int = 5, seed: Optional[int] = 0, h: 
         record("K == qd M qd / 2", robot.kinetic_energy(q, qd), qd @ M @ qd / 2)
         Y = robot.regressor(q, qd, qdd)
         record("Y pi == tau (no friction, no rotor)", Y @ pi, tau - friction - armature * qdd)
-        # finite differences along q(t) = q + t qd
-        Mp, Mm = robot.mass_matrix(q + h * qd), robot.mass_matrix(q - h * qd)
+        # finite differences along q(t) = q ⊕ t qd (q + t qd for 1-DOF joints; robot.integrate)
+        Mp, Mm = robot.mass_matrix(robot.integrate(q, qd, h)), robot.mass_matrix(robot.integrate(q, qd, -h))
         Mdot = (Mp - Mm) / (2 * h)
         record("dM/dt == C + C^T (finite differences)", Mdot, C + C.T)
         S = Mdot - 2 * C
         record("dM/dt - 2C skew (finite differences)", S, -S.T)
-        dP = np.array([(robot.potential_energy(q + h * e) - robot.potential_energy(q - h * e)) / (2 * h) for e in np.eye(n)])
+        dP = np.array([(robot.potential_energy(robot.integrate(q, e, h)) - robot.potential_energy(robot.integrate(q, e, -h))) / (2 * h) for e in np.eye(n)])
         record("g == dP/dq (finite differences)", g, dP)
     return worst

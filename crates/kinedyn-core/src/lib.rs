@@ -8,6 +8,7 @@ pub mod algorithms;
 pub mod data;
 pub mod error;
 pub mod joint;
+pub mod lie;
 pub mod model;
 pub mod rng;
 pub mod spatial;

@@ -2,10 +2,70 @@
 //!
 //! Bodies are numbered so that `parent[i] < i`. Body i's frame is its joint frame after the joint
 //! moved: `parent_from_body(q) = parent_from_joint[i] * jcalc(q_i + offset_i)`.
+//!
+//! Multi-DOF joints (free-flyer, spherical, planar) are held as one body per degree of freedom:
+//! the *head* body carries the whole joint transform, read from its block of q (nq numbers:
+//! a unit quaternion, or (cos, sin)); each further *member* body sits at the identity on the one
+//! before it, is massless except the last, and adds one column `s` of the joint's motion subspace
+//! (a unit linear or angular axis of the child frame, constant in it, as RBDA Table 4.1's
+//! free-flyer `S = 1`). Every algorithm written for 1-DOF bodies then computes the multi-DOF
+//! joint's positions, velocities, forces and mass matrix exactly; the one place where the split
+//! would differ is the joint's velocity product `c_J = v_i x S qd` (RBDA eq. 5.8 with `cJ = 0` for
+//! these joints), which must use the whole joint velocity: [`Model::velocity_product`] puts it on
+//! the last member (the members before it are massless, so their accelerations never act).
 
 use crate::error::{Error, Result};
 use crate::joint::Joint;
-use crate::spatial::{AxisRotation, Inertia, Transform, Vec3};
+use crate::spatial::{AxisRotation, Inertia, Mat3, Motion, Transform, Vec3};
+
+/// The rotation matrix of a unit quaternion `(x, y, z, w)`.
+#[inline]
+pub fn quaternion_matrix(q: &[f64]) -> Mat3 {
+    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    Mat3::new(
+        1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w),
+        2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w),
+        2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y),
+    )
+}
+
+/// The multi-DOF joint kinds (their columns and q blocks, Pinocchio's conventions).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Block {
+    /// q = (x, y, z, qx, qy, qz, qw), columns: linear x, y, z then angular x, y, z of the child frame.
+    FreeFlyer,
+    /// q = (qx, qy, qz, qw), columns: angular x, y, z of the child frame.
+    Spherical,
+    /// q = (x, y, cos th, sin th), columns: linear e1, e2 and angular n (the members' axes, with
+    /// (e1, e2, n) right-handed): translation x e1 + y e2, rotation th about n.
+    Planar,
+}
+
+impl Block {
+    pub fn nq(self) -> usize {
+        match self {
+            Block::FreeFlyer => 7,
+            Block::Spherical | Block::Planar => 4,
+        }
+    }
+    pub fn nv(self) -> usize {
+        match self {
+            Block::FreeFlyer => 6,
+            Block::Spherical | Block::Planar => 3,
+        }
+    }
+}
+
+/// Where body i's joint transform comes from in the configuration q.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coordinates {
+    /// A 1-DOF joint with coordinate `q[at]`.
+    Scalar { at: usize },
+    /// The first body of a multi-DOF joint, whose transform is read from `q[at..at + block.nq()]`.
+    Head { block: Block, at: usize },
+    /// A further degree of freedom of the multi-DOF joint of the body before (identity transform).
+    Member,
+}
 
 /// A named frame rigidly attached to a body (`None`: the base).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,8 +77,17 @@ pub struct Frame {
 /// The compiled robot: kinematic tree, inertias, drive and friction data, gravity and frames.
 #[derive(Clone, Debug)]
 pub struct Model {
-    /// Number of bodies = number of joint coordinates.
+    /// Number of bodies = number of degrees of freedom (nv; velocity coordinates).
     pub n: usize,
+    /// Length of a configuration q (= n without multi-DOF joints).
+    pub nq: usize,
+    /// Where each body's joint reads q.
+    pub coordinates: Vec<Coordinates>,
+    /// The first and last body of the joint each body belongs to (i, i for a 1-DOF joint).
+    pub group_first: Vec<usize>,
+    pub group_last: Vec<usize>,
+    /// No multi-DOF joint: body i's coordinate is q[i] (the fast paths).
+    pub plain: bool,
     /// Parent body of each body (`None` = base); `parent[i] < i`.
     pub parent: Vec<Option<usize>>,
     pub joints: Vec<Joint>,
@@ -146,6 +215,11 @@ impl Model {
         let placement_rotation = parent_from_joint.iter().map(|x| AxisRotation::classify(&x.rot)).collect();
         Ok(Self {
             n,
+            nq: n,
+            coordinates: (0..n).map(|at| Coordinates::Scalar { at }).collect(),
+            group_first: (0..n).collect(),
+            group_last: (0..n).collect(),
+            plain: true,
             parent,
             joints,
             offset,
@@ -162,6 +236,145 @@ impl Model {
             subtree_end,
             subtrees_contiguous,
         })
+    }
+
+    /// The model with multi-DOF joints: `coordinates[i]` says where body i reads q (see the module
+    /// documentation for the layout of a multi-DOF joint's bodies, which is checked here).
+    pub fn with_coordinates(mut self, coordinates: Vec<Coordinates>) -> Result<Self> {
+        let n = self.n;
+        if coordinates.len() != n {
+            return Err(Error::InvalidModel(format!("coordinates has {} entries for {n} bodies", coordinates.len())));
+        }
+        let bad = |i: usize, why: String| Err(Error::InvalidModel(format!("body {i}: {why}")));
+        let (mut nq, mut first, mut last) = (0usize, (0..n).collect::<Vec<_>>(), (0..n).collect::<Vec<_>>());
+        let mut i = 0;
+        while i < n {
+            match coordinates[i] {
+                Coordinates::Member => return bad(i, "a multi-DOF member without its head body before it".into()),
+                Coordinates::Scalar { at } => {
+                    if at != nq {
+                        return bad(i, format!("reads q[{at}], expected q[{nq}] (blocks in body order)"));
+                    }
+                    nq += 1;
+                    i += 1;
+                }
+                Coordinates::Head { block, at } => {
+                    if at != nq {
+                        return bad(i, format!("reads q[{at}..], expected q[{nq}..] (blocks in body order)"));
+                    }
+                    let end = i + block.nv();
+                    if end > n {
+                        return bad(i, format!("a {block:?} joint needs {} bodies, only {} remain", block.nv(), n - i));
+                    }
+                    self.check_block(i, block, &coordinates)?;
+                    for k in i..end {
+                        (first[k], last[k]) = (i, end - 1);
+                    }
+                    nq += block.nq();
+                    i = end;
+                }
+            }
+        }
+        // a multi-DOF joint's bodies before its last carry nothing: no child, no frame
+        for (k, p) in self.parent.iter().enumerate() {
+            if let Some(p) = *p {
+                if last[p] != p && !(k == p + 1 && first[k] == first[p]) {
+                    return bad(k, format!("its parent {p} is an inner body of a multi-DOF joint (attach to body {})", last[p]));
+                }
+            }
+        }
+        for (k, f) in self.frames.iter().enumerate() {
+            if let Some(b) = f.body {
+                if last[b] != b {
+                    return Err(Error::InvalidModel(format!("frame {k} is attached to inner body {b} of a multi-DOF joint")));
+                }
+            }
+        }
+        self.plain = coordinates.iter().all(|c| matches!(c, Coordinates::Scalar { .. }));
+        (self.nq, self.coordinates, self.group_first, self.group_last) = (nq, coordinates, first, last);
+        Ok(self)
+    }
+
+    /// The bodies `i..i + block.nv()` form one multi-DOF joint: columns as [`Block`] says, members at
+    /// the identity on the body before, massless except the last, no drive or friction data.
+    fn check_block(&self, i: usize, block: Block, coordinates: &[Coordinates]) -> Result<()> {
+        use crate::joint::JointKind::{Prismatic, Revolute};
+        let nv = block.nv();
+        let unit = |k: usize| crate::spatial::Vec3::ith(k, 1.0);
+        let expected: Vec<(crate::joint::JointKind, Vec3)> = match block {
+            Block::FreeFlyer => (0..6).map(|k| (if k < 3 { Prismatic } else { Revolute }, unit(k % 3))).collect(),
+            Block::Spherical => (0..3).map(|k| (Revolute, unit(k))).collect(),
+            Block::Planar => {
+                let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
+                vec![(Prismatic, e1), (Prismatic, e2), (Revolute, e1.cross(&e2))]
+            }
+        };
+        let bad = |k: usize, why: &str| Err(Error::InvalidModel(format!("body {k} ({block:?} joint starting at body {i}): {why}")));
+        if block == Block::Planar && self.joints[i].axis.dot(&self.joints[i + 1].axis).abs() > 1e-12 {
+            return bad(i, "the planar joint's in-plane axes are not orthogonal");
+        }
+        for (m, (kind, axis)) in expected.iter().enumerate() {
+            let k = i + m;
+            let joint = &self.joints[k];
+            if joint.kind != *kind || (joint.axis - axis).norm() > 1e-12 {
+                return bad(k, &format!("column {m} must be {kind:?} along {:?}", axis.as_slice()));
+            }
+            if m > 0 {
+                if coordinates[k] != Coordinates::Member || self.parent[k] != Some(k - 1) {
+                    return bad(k, "must be a member whose parent is the body before");
+                }
+                if self.parent_from_joint[k] != Transform::identity() {
+                    return bad(k, "a member's placement must be the identity");
+                }
+            }
+            if m + 1 < nv && self.inertia[k].to_parameters().iter().any(|x| *x != 0.0) {
+                return bad(k, "only the last body of a multi-DOF joint has inertia");
+            }
+            if self.offset[k] != 0.0 || self.armature[k] != 0.0 || self.viscous[k] != 0.0 || self.coulomb[k] != 0.0 {
+                return bad(k, "a multi-DOF joint has no offset, armature or friction");
+            }
+        }
+        Ok(())
+    }
+
+    /// The joint transform `joint_from_body` of the multi-DOF joint whose head is body i, from its
+    /// block of q (Pinocchio's conventions: quaternion (x, y, z, w), assumed unit; planar (cos, sin)).
+    #[inline]
+    pub fn block_transform(&self, i: usize, block: Block, qb: &[f64]) -> Transform {
+        match block {
+            Block::FreeFlyer => Transform::new(quaternion_matrix(&qb[3..7]), Vec3::new(qb[0], qb[1], qb[2])),
+            Block::Spherical => Transform::new(quaternion_matrix(&qb[0..4]), Vec3::zeros()),
+            Block::Planar => {
+                let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
+                let n = e1.cross(&e2);
+                let (c, s) = (qb[2], qb[3]);
+                // rotation about n by th: R = c 1 + s [n]x + (1 - c) n n^T
+                let rot = Mat3::identity() * c + crate::spatial::skew(&n) * s + n * n.transpose() * (1.0 - c);
+                Transform::new(rot, e1 * qb[0] + e2 * qb[1])
+            }
+        }
+    }
+
+    /// The velocity product `c_J` of body i (RBDA eq. 5.8's `v_i x v_J` for `cJ = 0`): `v_i x s_i qd_i`
+    /// for a 1-DOF joint; for a multi-DOF joint `v_i x (S qd)` of the whole joint on its last body,
+    /// zero on the others (massless: their accelerations never act).
+    #[inline(always)]
+    pub fn velocity_product(&self, i: usize, v: &Motion, qd: &[f64]) -> Motion {
+        if self.plain {
+            return self.joints[i].cross(v, qd[i]);
+        }
+        let (first, last) = (self.group_first[i], self.group_last[i]);
+        if first == last {
+            self.joints[i].cross(v, qd[i])
+        } else if i != last {
+            Motion::zero()
+        } else {
+            let mut vj = Motion::zero();
+            for l in first..=last {
+                vj += self.joints[l].motion(qd[l]);
+            }
+            v.cross_motion(&vj)
+        }
     }
 
     /// The model with direction-dependent Coulomb friction: `levels[i]` (>= 0) acts against

@@ -119,6 +119,9 @@ pub fn solve_ik<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     guarded("solve_ik", || {
     let m: &Model = &model.model;
+    if !m.plain {
+        return Err(PyValueError::new_err("numeric inverse kinematics handles 1-DOF joints only (this model has a floating, spherical or planar joint)"));
+    }
     let n = m.n;
     let frame = model.frame(frame)?;
     let (targets, batch, position) = gather_targets(&targets)?;

@@ -18,6 +18,7 @@ use guard::{guarded, shape_text};
 
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
+use kinedyn_core::model::{Block, Coordinates};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -254,6 +255,7 @@ impl<'a> Batch<'a> {
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
+        m.check_configurations(&self.values[0])?;
         // numbers per state (1 for a scalar result, 0 for an empty one such as no frames)
         let per_state: usize = out_shape.iter().product();
         // the outputs' shape, [N,] + out_shape, in a fixed array (ndarray keeps up to 4 dims inline)
@@ -433,6 +435,38 @@ impl PyModel {
         self.model.n
     }
 
+    /// Every multi-DOF joint's block of q (all states of `q`, nq numbers each) is unit where it must
+    /// be (a quaternion, or (cos, sin) of a planar joint) to 1e-6: the algorithms read it as a
+    /// rotation, so any other number would give a silently wrong result.
+    fn check_configurations(&self, q: &[f64]) -> PyResult<()> {
+        let model = &self.model;
+        if model.plain || model.nq == 0 {
+            return Ok(());
+        }
+        for (k, state) in q.chunks(model.nq).enumerate() {
+            for (i, c) in model.coordinates.iter().enumerate() {
+                if let Coordinates::Head { block, at } = *c {
+                    let (unit, what) = match block {
+                        Block::FreeFlyer => (&state[at + 3..at + 7], "quaternion (qx, qy, qz, qw)"),
+                        Block::Spherical => (&state[at..at + 4], "quaternion (qx, qy, qz, qw)"),
+                        Block::Planar => (&state[at + 2..at + 4], "(cos, sin) pair"),
+                    };
+                    let norm = unit.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if (norm - 1.0).abs() > 1e-6 {
+                        let batch = if q.len() > model.nq { format!(" of state {k}") } else { String::new() };
+                        return Err(PyValueError::new_err(format!(
+                            "q[{}..{}]{batch}, the {what} of the {block:?} joint at body {i}, has norm {norm}, not 1 \
+                             (to 1e-6): normalise it (robot.normalize(q))",
+                            at + if block == Block::FreeFlyer { 3 } else if block == Block::Planar { 2 } else { 0 },
+                            at + block.nq()
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn frame(&self, frame: i64) -> PyResult<usize> {
         let nf = self.model.frames.len();
         if frame < 0 || frame as usize >= nf {
@@ -458,7 +492,7 @@ impl PyModel {
 impl PyModel {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None))]
+    #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None, blocks=None))]
     fn new(
         parent: Vec<i64>,
         kind: Vec<i64>,
@@ -473,6 +507,7 @@ impl PyModel {
         frame_body: Vec<i64>,
         frame_placement: PyReadonlyArrayDyn<f64>,
         coulomb_negative: Option<Vec<f64>>,
+        blocks: Option<Vec<i64>>,
     ) -> PyResult<Self> {
         guarded("Model.__new__", || {
             let n = parent.len();
@@ -521,6 +556,32 @@ impl PyModel {
             if let Some(levels) = coulomb_negative {
                 model = model.with_coulomb_negative(levels).map_err(core_err)?;
             }
+            if let Some(codes) = blocks {
+                // per body: 0 a 1-DOF joint, 1 / 2 / 3 the head of a free-flyer / spherical / planar
+                // joint, -1 a further member of the multi-DOF joint before it
+                if codes.len() != n {
+                    return Err(PyValueError::new_err(format!("blocks has {} entries for {n} bodies", codes.len())));
+                }
+                let mut at = 0;
+                let mut coordinates = Vec::with_capacity(n);
+                for (i, &code) in codes.iter().enumerate() {
+                    let c = match code {
+                        0 => Coordinates::Scalar { at },
+                        1 => Coordinates::Head { block: Block::FreeFlyer, at },
+                        2 => Coordinates::Head { block: Block::Spherical, at },
+                        3 => Coordinates::Head { block: Block::Planar, at },
+                        -1 => Coordinates::Member,
+                        _ => return Err(PyValueError::new_err(format!("body {i}: unknown block code {code}"))),
+                    };
+                    at += match c {
+                        Coordinates::Scalar { .. } => 1,
+                        Coordinates::Head { block, .. } => block.nq(),
+                        Coordinates::Member => 0,
+                    };
+                    coordinates.push(c);
+                }
+                model = model.with_coordinates(coordinates).map_err(core_err)?;
+            }
             let data = Mutex::new(Data::new(&model));
             Ok(Self { model, data })
         })
@@ -529,6 +590,12 @@ impl PyModel {
     #[getter(n)]
     fn get_n(&self) -> usize {
         self.model.n
+    }
+
+    /// Length of a configuration q.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nq
     }
 
     #[getter]
@@ -541,8 +608,8 @@ impl PyModel {
         guarded("Model.frame_poses", || {
             // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
             let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let nq = self.model.nq;
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("frame_poses", "pose"), &[ids.len(), 4, 4], |model, data, x, out| {
                 algorithms::forward_kinematics(model, data, x[0]);
                 for (k, &f) in ids.iter().enumerate() {
@@ -558,8 +625,8 @@ impl PyModel {
     fn jacobian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jacobian", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("jacobian", "J"), &[6, n], |model, data, x, out| {
                 algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
                 Ok(())
@@ -572,8 +639,8 @@ impl PyModel {
     fn jacobian_hessian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jacobian_hessian", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("jacobian_hessian", "dJ/dq"), &[n, 6, n], |model, data, x, out| {
                 algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
                 Ok(())
@@ -586,8 +653,8 @@ impl PyModel {
     fn frame_velocity<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.frame_velocity", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run(py, self, ("frame_velocity", "twist"), &[6], |model, data, x, out| {
                 out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
                 Ok(())
@@ -600,8 +667,8 @@ impl PyModel {
     fn jdot_qd<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jdot_qd", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run(py, self, ("jdot_qd", "dJ/dt qd"), &[6], |model, data, x, out| {
                 out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
                 Ok(())
@@ -619,11 +686,11 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
             let qdd = f64_array("qdd", &qdd)?;
-            let n = self.n();
+            let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
-                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
             batch.run_out(py, self, ("inverse_dynamics", "tau"), &[n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
@@ -637,8 +704,8 @@ impl PyModel {
     fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.mass_matrix", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run_out(py, self, ("mass_matrix", "M"), &[n, n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::crba(model, data, x[0]));
                 Ok(())
@@ -651,8 +718,8 @@ impl PyModel {
     fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.mass_matrix_inverse", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run_out(py, self, ("mass_matrix_inverse", "M^-1"), &[n, n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
                 Ok(())
@@ -668,11 +735,11 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
             let tau = f64_array("tau", &tau)?;
-            let n = self.n();
+            let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
-                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
             batch.run_out(py, self, ("forward_dynamics", "qdd"), &[n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
@@ -687,11 +754,11 @@ impl PyModel {
         guarded("Model.inverse_dynamics_derivatives", || {
             let (q, qd, qdd) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("qdd", &qdd)?);
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
-            let n = self.n();
+            let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
-                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
+                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
             let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, m]| {
                 algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
@@ -707,11 +774,11 @@ impl PyModel {
         guarded("Model.forward_dynamics_derivatives", || {
             let (q, qd, tau) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("tau", &tau)?);
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
-            let n = self.n();
+            let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
-                None => Batch::gather(&[("q", &q, &s1), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
+                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
             let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, dtau]| {
                 algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
@@ -726,8 +793,8 @@ impl PyModel {
         guarded("Model.coriolis_matrix", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run_out(py, self, ("coriolis_matrix", "C"), &[n, n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
                 Ok(())
@@ -739,8 +806,8 @@ impl PyModel {
     fn christoffel<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.christoffel", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("christoffel", "c"), &[n, n, n], |model, data, x, out| {
                 algorithms::christoffel(model, data, x[0], out);
                 Ok(())
@@ -753,8 +820,8 @@ impl PyModel {
     fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.gravity_torque", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run_out(py, self, ("gravity_torque", "g"), &[n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
                 Ok(())
@@ -768,8 +835,8 @@ impl PyModel {
         guarded("Model.bias_torque", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run_out(py, self, ("bias_torque", "bias"), &[n], out, |model, data, x, out| {
                 out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
                 Ok(())
@@ -782,8 +849,8 @@ impl PyModel {
         guarded("Model.kinetic_energy", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run(py, self, ("kinetic_energy", "K"), &[], |model, data, x, out| {
                 out[0] = algorithms::kinetic_energy(model, data, x[0], x[1]);
                 Ok(())
@@ -795,8 +862,8 @@ impl PyModel {
     fn potential_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.potential_energy", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let nq = self.model.nq;
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("potential_energy", "P"), &[], |model, data, x, out| {
                 out[0] = algorithms::potential_energy(model, data, x[0]);
                 Ok(())
@@ -810,8 +877,8 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
             let qdd = f64_array("qdd", &qdd)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
             batch.run(py, self, ("regressor", "Y"), &[n, 10 * n], |model, data, x, out| {
                 algorithms::regressor(model, data, x[0], x[1], x[2], out);
                 Ok(())
@@ -823,10 +890,23 @@ impl PyModel {
     fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.center_of_mass", || {
             let q = f64_array("q", &q)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n])])?;
+            let nq = self.model.nq;
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
             batch.run(py, self, ("center_of_mass", "com"), &[3], |model, data, x, out| {
                 out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
+                Ok(())
+            })
+        })
+    }
+
+    /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
+    fn centroidal_momentum_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        guarded("Model.centroidal_momentum_matrix", || {
+            let q = f64_array("q", &q)?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq])])?;
+            batch.run(py, self, ("centroidal_momentum_matrix", "A_G"), &[6, n], |model, data, x, out| {
+                algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
                 Ok(())
             })
         })
@@ -837,8 +917,8 @@ impl PyModel {
         guarded("Model.momentum", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
-            let n = self.n();
-            let batch = Batch::gather(&[("q", &q, &[n]), ("qd", &qd, &[n])])?;
+            let (n, nq) = (self.n(), self.model.nq);
+            let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
             batch.run(py, self, ("momentum", "h"), &[6], |model, data, x, out| {
                 out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
                 Ok(())

@@ -255,7 +255,10 @@ class Inertia:
         symbolic = self.is_symbolic or other.is_symbolic
         m = self.mass + other.mass
         if not symbolic and float(m) == 0.0:
-            return Inertia(0.0)
+            # massless bodies may still have rotational inertia (a rotor, Corke's PUMA link 1): the
+            # tensors about the common origin add; with no mass the centre of mass is moot (origin)
+            Io = np.array(self.inertia_about_origin(), dtype=float) + np.array(other.inertia_about_origin(), dtype=float)
+            return Inertia(0.0, (0.0, 0.0, 0.0), 0.5 * (Io + Io.T))
         c = tuple((self.mass * a + other.mass * b) / m for a, b in zip(self.com, other.com))
         # sum about the common origin, then shift back to the new centre of mass
         Io = [[a + b for a, b in zip(ra, rb)] for ra, rb in zip(self.inertia_about_origin(), other.inertia_about_origin())]

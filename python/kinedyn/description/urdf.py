@@ -56,11 +56,15 @@ from .tool import default_tool
 
 __all__ = ["robot_from_urdf", "MAX_DEPTH"]
 
-_SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+_SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+#: the name Pinocchio gives the free-flyer joint that ``floating_base=True`` adds above the root link
+ROOT_JOINT = "root_joint"
+#: the fixed frame a floating base moves in (Pinocchio's name for it)
+FLOATING_BASE_FRAME = "universe"
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
-def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", mimic: str = "reduce"):
+def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", floating_base: bool = False, mimic: str = "reduce"):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
@@ -68,6 +72,10 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     used as ``robot.tool``; by default a link the file names as its tool (``tool0`` of a UR arm,
     ``panda_hand_tcp`` of the Panda), else the end of the longest chain
     (:func:`kinedyn.description.tool.default_tool`). The root link's inertia is ignored (fixed base).
+    ``floating_base=True``: the root link moves freely instead, on a free-flyer joint named
+    ``root_joint`` from the fixed frame ``universe`` (Pinocchio's ``JointModelFreeFlyer`` root: q starts
+    with the root's position and unit quaternion (x, y, z, w), v with its [linear; angular] velocity
+    in its own frame); a URDF without any moving joint (a drone) loads this way.
     ``inertia``: the policy for an inertia no rigid body can have, ``"warn"`` (default), ``"repair"``
     or ``"strict"`` (see :func:`kinedyn.description.inertia.judge` and docs/model-files.md).
 
@@ -85,6 +93,12 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     joints = [_joint(j, src) for j in root.iterfind("joint")]
     base, ordered = _order(joints, list(link_elements), src)
     links = []
+    if floating_base:
+        if FLOATING_BASE_FRAME in link_elements:
+            raise ValueError(f"{src.label}: floating_base=True names the fixed frame '{FLOATING_BASE_FRAME}', "
+                             f"but the URDF has a link of that name")
+        links.append(Link(base, None, Joint(ROOT_JOINT, "floating"), np.eye(4), inertia=_inertial(link_elements[base], src)))
+        base = FLOATING_BASE_FRAME
     for j in ordered:
         element = link_elements[j["child"]]
         body = _inertial(element, src)
@@ -280,7 +294,7 @@ def _joint(element, src: _Source) -> dict:
         raise src.error(
             element,
             f"{what} has type '{kind}', which is not supported "
-            f"(supported: {', '.join(_SUPPORTED)}; kinedyn robots have a fixed base and 1-DOF joints)",
+            f"(supported: {', '.join(_SUPPORTED)})",
         )
     ends = {}
     for end in ("parent", "child"):
@@ -292,8 +306,10 @@ def _joint(element, src: _Source) -> dict:
     axis_element = element.find("axis")
     if axis_element is not None:
         axis = _floats(axis_element.get("xyz"), 3, axis, f"{what} axis", axis_element, src)
-    limits = _limits(element.find("limit"), kind, what, src)
-    friction = _dynamics(element.find("dynamics"), what, src)
+    # a floating or planar joint has no scalar limits or friction (its <limit>/<dynamics> are ignored)
+    multi = kind in ("floating", "planar")
+    limits = {} if multi else _limits(element.find("limit"), kind, what, src)
+    friction = {} if multi else _dynamics(element.find("dynamics"), what, src)
     # a fixed joint has no coordinate to follow with: its <mimic> is ignored (Talos's talos_left_arm.urdf has one)
     mimic = _mimic(element.find("mimic"), what, src) if kind != "fixed" else None
     try:

@@ -29,14 +29,18 @@ __all__ = ["default_configuration", "collect", "build_report", "write_report", "
 def default_configuration(robot) -> np.ndarray:
     """A generic (non-singular) configuration: 0.5, -0.7, 0.5, -0.7, ... rad (m for prismatic joints,
     x 0.2), clipped to the joint limits."""
-    q = np.array([(0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2) for i, j in enumerate(robot.joints)])
+    q, start = robot.neutral(), 0
+    for i, j in enumerate(robot.joints):
+        if not j.is_multi_dof:  # a multi-DOF joint keeps its neutral block (identity rotation)
+            q[start] = (0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2)
+        start += j.nq
     return np.clip(q, robot.lower_limits, robot.upper_limits)
 
 
 def _has_dynamics(robot) -> bool:
     """Whether this build of kinedyn has the numeric dynamics (the native core's mass matrix)."""
     try:
-        robot.mass_matrix(np.zeros(robot.n))
+        robot.mass_matrix(robot.neutral())
         return True
     except (AttributeError, NotImplementedError):
         return False
@@ -231,7 +235,8 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     from ..kinematics import singularity_report
 
     steps.step("kinematics")
-
+    # the report's simulation, sliders and per-joint tables read one coordinate per joint
+    robot.require_one_dof_joints("the report")
     q = default_configuration(robot) if q is None else np.asarray(q, dtype=float)
     qd = np.zeros(robot.n) if qd is None else np.asarray(qd, dtype=float)
     if q.shape != (robot.n,) or qd.shape != (robot.n,):

@@ -492,6 +492,9 @@ def simulate(
     if method in ADAPTIVE_METHODS and not (rtol > 0 and atol > 0 and math.isfinite(rtol) and math.isfinite(atol)):
         raise ValueError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
     robot = _is_robot(system)
+    if robot:
+        # the integrators step q += h qd: a quaternion or (cos, sin) block needs the Lie-group step
+        cast("Robot", system).require_one_dof_joints("simulation")
     mech = None if robot else _as_mechanical(system, params, baumgarte, points)
     target = system if robot else mech
     n = system.n if mech is None else mech.n

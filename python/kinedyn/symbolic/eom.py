@@ -449,7 +449,14 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
     ``form``: how the renderings (``str``, ``to_latex`` ...) show M, C, g: ``"expanded"``, ``"cse"``
     (named intermediate variables, Khalil & Dombre's way; :mod:`kinedyn.symbolic.cse`) or ``"auto"``
     (CSE for a large model, e.g. a 6-joint arm with general inertias). ``eom.M`` etc. are the same.
+
+    Floating, spherical and planar joints are derived in minimal coordinates: position and ZYX Euler
+    angles (x, y, z, yaw, pitch, roll), (yaw, pitch, roll), (x, y, theta), with their rates as the
+    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot).
     """
+    from ..description.parametrise import euler_parametrised
+
+    robot = euler_parametrised(robot)
     if isinstance(parameters, str):
         if parameters != "general":
             raise ValueError(f"parameters must be 'general' or a list of per-body 10-vectors, got {parameters!r}")

@@ -32,6 +32,13 @@ def joint_symbols(robot) -> List[sp.Symbol]:
     return state_symbols(robot)[0]
 
 
+def _minimal(robot):
+    """The robot in minimal coordinates (multi-DOF joints as Euler-angle chains)."""
+    from ..description.parametrise import euler_parametrised
+
+    return euler_parametrised(robot)
+
+
 def _model(robot, frame: Optional[str] = None, point=None) -> RingModel:
     """The exact kinematics, with the frame's placement and the point among the ring's parameters."""
     q, qd, qdd = state_symbols(robot)
@@ -94,7 +101,9 @@ def pose(robot, frame: Optional[str] = None, simplify: bool = True, abbreviation
     joint symbols of ``robot.equations_of_motion().q`` and the robot's parameter symbols.
 
     ``simplify=False`` gives the raw product form (sin/cos of single joints); ``abbreviations=True``
-    writes cos(q1 + q2) as ``c12`` (see :func:`abbreviate`)."""
+    writes cos(q1 + q2) as ``c12`` (see :func:`abbreviate`). A multi-DOF joint is written in its
+    position and ZYX Euler angles (:mod:`kinedyn.description.parametrise`)."""
+    robot = _minimal(robot)
     model = _model(robot, frame)
     R, p, _, _, _ = _frame(robot, model, frame)
     ring = model.ring
@@ -115,6 +124,7 @@ def jacobian(robot, frame: Optional[str] = None, reference: str = "world", point
         raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'")
     if point is not None and len(list(point)) != 3:
         raise ValueError(f"point must be 3 coordinates in the frame's axes, got {point!r}")
+    robot = _minimal(robot)
     model = _model(robot, frame, point)
     ring, n = model.ring, model.n
     R, p, Rf, pf, body = _frame(robot, model, frame)

@@ -50,7 +50,7 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
             None => vj,
         };
         data.v[i] = v;
-        data.c[i] = joint.cross(&v, qd[i]);
+        data.c[i] = model.velocity_product(i, &v, qd);
         // I^A_i = I_i ;  p^A_i = v_i x* I_i v_i - ^iX_0^* f^x_i
         let inertia = &model.inertia[i];
         data.ia[i] = ArticulatedInertia::from(inertia);

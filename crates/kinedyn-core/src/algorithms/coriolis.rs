@@ -59,9 +59,10 @@ fn coriolis_from_world(model: &Model, data: &mut Data, out: &mut [f64], rs: usiz
     let n = model.n;
     for i in 0..n {
         // ds_i/dt = v_i x s_i ;  I^c_i = I_i ;  dI^c_i/dt = (v_i x*) I_i - I_i (v_i x) ;  h^c_i = I_i v_i
+        // (a column of a multi-DOF joint is fixed in the joint's child, the group's last body)
         let v = data.v_w[i];
         let inertia = data.i_w[i];
-        data.sd_w[i] = v.cross_motion(&data.s_w[i]);
+        data.sd_w[i] = data.v_w[model.group_last[i]].cross_motion(&data.s_w[i]);
         data.ic_w[i] = inertia;
         data.icd_w[i] = inertia_rate(&inertia, &v);
         data.hc_w[i] = inertia.mul_motion(&v);

@@ -98,6 +98,7 @@ fn mass_matrix_from_world(model: &Model, data: &Data, m: &mut [f64]) {
 /// against (and for anyone who wants to cross-check a result).
 #[allow(clippy::too_many_arguments)]
 pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+    assert!(model.plain, "the tangent-sweep derivatives are written for 1-DOF joints; use rnea_derivatives");
     // the RNEA's own pass: parent_from_body, v_i, a_i and the composite forces f^c_i in data.f
     // (and world_from_body when f_ext is given)
     rnea(model, data, q, qd, qdd, f_ext);
@@ -158,7 +159,10 @@ fn world_pass(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: Option
         let s = x.act_motion(&data.s[i]);
         let (vp, ap) = parent[i].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
         let v = vp + s * qd[i];
-        let mut a = ap + vp.cross_motion(&s) * qd[i];
+        // the velocity product of a multi-DOF joint's column is v_λ x s with λ the joint's parent
+        // (summed over the joint: v_λ x v_J = v_child x v_J), not the partial twist of the body before
+        let v_lambda = if model.plain { vp } else { parent[model.group_first[i]].map_or(Motion::zero(), |p| v_w[p]) };
+        let mut a = ap + v_lambda.cross_motion(&s) * qd[i];
         if let Some(qdd) = qdd {
             a += s * qdd[i];
         }
@@ -232,13 +236,18 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
     dtau_dqd[..n * n].fill(0.0);
     for j in 0..n {
         let s = s_w[j];
-        let (vp, ap) = parent[j].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
+        // a column of a multi-DOF joint moves the joint's child and subtree with the joint's parent λ
+        // and its local velocity held (Pinocchio's q ⊕ δ): the 1-DOF formulas with p = λ, the columns
+        // of the whole joint in the "subtree", and the rate 2 ds/dt = 2 v_p x s becoming
+        // (v_λ + v_child) x s (equal for a 1-DOF joint)
+        let head = model.group_first[j];
+        let (vp, ap) = parent[head].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
         let u = s.cross_motion(&vp);
         let w = u.cross_motion(&vp) - s.cross_motion(&ap);
-        let sdot = vp.cross_motion(&s);
+        let sdot = if head == j && model.group_last[j] == j { vp.cross_motion(&s) } else { (vp + v_w[model.group_last[j]]).cross_motion(&s) * 0.5 };
         // the subtree of j: three dot products per entry
-        for k in j..n {
-            if k != j && model.support[k].binary_search(&j).is_err() {
+        for k in head..n {
+            if k != head && model.support[k].binary_search(&head).is_err() {
                 continue;
             }
             dtau_dq[k * n + j] = w.dot(&alpha[k]) + u.dot(&(sigma[k] - beta[k]));
@@ -249,7 +258,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
         }
         dtau_dqd[j * n + j] += model.viscous[j];
         // the ancestors of j: dtau_k = S_k . dF_j
-        if parent[j].is_none() {
+        if parent[head].is_none() {
             continue;
         }
         let mut df_q = s.cross_force(&fc[j]) + ic[j].mul_motion(&w) - u.cross_force(&hc[j]) - icd[j].mul_motion(&u);
@@ -257,7 +266,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
             df_q += wrench_term(j, &s.ang);
         }
         let df_qd = ic[j].mul_motion(&sdot) * 2.0 + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
-        let mut k = parent[j];
+        let mut k = parent[head];
         while let Some(kk) = k {
             dtau_dq[kk * n + j] = s_w[kk].dot(&df_q);
             dtau_dqd[kk * n + j] = s_w[kk].dot(&df_qd);

@@ -308,6 +308,9 @@ pub fn numeric_ik(
 /// `frame` is carried by the last body of a serial chain moved by every joint (`parent[i] = i - 1`).
 pub fn chain_screws(model: &Model, data: &mut Data, frame: usize) -> Option<(Vec<Screw>, Transform)> {
     let n = model.n;
+    if !model.plain {
+        return None; // a multi-DOF joint is no screw
+    }
     if model.frames[frame].body != Some(n.checked_sub(1)?) || (0..n).any(|i| model.parent[i] != i.checked_sub(1)) {
         return None;
     }

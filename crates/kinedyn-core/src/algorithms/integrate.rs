@@ -436,6 +436,9 @@ pub fn integrate(
     out: Record<'_>,
 ) -> Result<Outcome> {
     let n = model.n;
+    if !model.plain {
+        return Err(Error::InvalidInput("simulation of multi-DOF joints (floating, spherical, planar) needs Lie-group integration, not implemented yet".into()));
+    }
     let h = settings.dt;
     let every = settings.record_every;
     if !(h > 0.0) || !h.is_finite() {

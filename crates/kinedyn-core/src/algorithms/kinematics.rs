@@ -4,19 +4,31 @@
 //! `v_i = ^iX_p v_p + S_i qd_i`, `a_i = ^iX_p a_p + S_i qdd_i + v_i x S_i qd_i`.
 
 use crate::data::Data;
-use crate::model::Model;
+use crate::model::{Coordinates, Model};
 use crate::joint::JointKind;
 use crate::spatial::{AxisRotation, Inertia, Transform};
 
-/// Joint coordinate seen by `jcalc`: q plus the model's offset.
-#[inline]
+/// Joint coordinate seen by `jcalc`: q plus the model's offset (0 for the bodies of a multi-DOF
+/// joint, whose transform [`parent_from_body_trig`] takes from the joint's block of q).
+#[inline(always)]
 fn joint_coordinate(model: &Model, q: &[f64], i: usize) -> f64 {
-    q[i] + model.offset[i]
+    if model.plain {
+        return q[i] + model.offset[i];
+    }
+    match model.coordinates[i] {
+        Coordinates::Scalar { at } => q[at] + model.offset[i],
+        _ => 0.0,
+    }
 }
 
 /// `parent_from_body` of body i at q: `parent_from_joint[i] * joint_from_body(q_i + offset_i)`.
 #[inline(always)]
 pub fn parent_from_body(model: &Model, q: &[f64], i: usize) -> Transform {
+    if !model.plain {
+        if let Coordinates::Head { block, at } = model.coordinates[i] {
+            return model.parent_from_joint[i] * model.block_transform(i, block, &q[at..at + block.nq()]);
+        }
+    }
     model.joints[i].compose(&model.parent_from_joint[i], joint_coordinate(model, q, i))
 }
 
@@ -28,16 +40,28 @@ pub fn parent_from_body(model: &Model, q: &[f64], i: usize) -> Transform {
 #[inline]
 pub fn joint_trig(model: &Model, data: &mut Data, q: &[f64]) {
     let n = model.n;
-    let (q, offset, sin, cos) = (&q[..n], &model.offset[..n], &mut data.sin[..n], &mut data.cos[..n]);
-    for i in 0..n {
-        sin[i] = q[i] + offset[i];
+    if model.plain {
+        let (q, offset, sin, cos) = (&q[..n], &model.offset[..n], &mut data.sin[..n], &mut data.cos[..n]);
+        for i in 0..n {
+            sin[i] = q[i] + offset[i];
+        }
+        crate::trig::sin_cos_in_place(sin, cos);
+        return;
     }
-    crate::trig::sin_cos_in_place(sin, cos);
+    for i in 0..n {
+        data.sin[i] = joint_coordinate(model, q, i);
+    }
+    crate::trig::sin_cos_in_place(&mut data.sin[..n], &mut data.cos[..n]);
 }
 
 /// `parent_from_body` of body i with the joint's sine and cosine from `joint_trig`.
 #[inline(always)]
 pub fn parent_from_body_trig(model: &Model, q: &[f64], sin: &[f64], cos: &[f64], i: usize) -> Transform {
+    if !model.plain {
+        if let Coordinates::Head { block, at } = model.coordinates[i] {
+            return model.parent_from_joint[i] * model.block_transform(i, block, &q[at..at + block.nq()]);
+        }
+    }
     model.joints[i].compose_trig(&model.parent_from_joint[i], joint_coordinate(model, q, i), sin[i], cos[i])
 }
 
@@ -50,7 +74,7 @@ pub fn parent_from_body_trig(model: &Model, q: &[f64], sin: &[f64], cos: &[f64],
 #[inline(always)]
 pub fn inertia_to_parent(model: &Model, i: usize, x: &Transform, s: f64, c: f64, inertia: &Inertia) -> Inertia {
     let (joint, placement) = (&model.joints[i], &model.placement_rotation[i]);
-    if matches!(placement, AxisRotation::General) {
+    if matches!(placement, AxisRotation::General) || (!model.plain && matches!(model.coordinates[i], Coordinates::Head { .. })) {
         return x.act_inertia(inertia);
     }
     let a = &joint.axis;
@@ -108,7 +132,7 @@ pub fn forward_acceleration(model: &Model, data: &mut Data, q: &[f64], qd: &[f64
     forward_velocity(model, data, q, qd);
     for i in 0..model.n {
         // a_i = ^iX_p a_p + S_i qdd_i + v_i x S_i qd_i
-        let mut ai = data.v[i].cross_motion(&(data.s[i] * qd[i]));
+        let mut ai = model.velocity_product(i, &data.v[i], qd);
         if let Some(qdd) = qdd {
             ai += data.s[i] * qdd[i];
         }

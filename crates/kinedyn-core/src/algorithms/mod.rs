@@ -24,6 +24,6 @@ pub use gravity::gravity_torque;
 pub use jacobian::{frame_jacobian, frame_jacobian_hessian, frame_pose_at, frame_velocity, jacobian_dot_qd, Reference};
 pub use kinematics::{forward_acceleration, forward_kinematics, forward_velocity, frame_pose, parent_from_body};
 pub use minv::mass_matrix_inverse;
-pub use momentum::{center_of_mass, spatial_momentum};
+pub use momentum::{center_of_mass, centroidal_momentum_matrix, spatial_momentum};
 pub use regressor::regressor;
 pub use rnea::{bias_torque, rnea, rnea_with, RneaTerms};

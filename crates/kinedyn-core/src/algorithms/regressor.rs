@@ -59,7 +59,7 @@ pub fn regressor(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f
             None => (vj, x_up.inv_act_motion(&a0)),
         };
         data.v[i] = v;
-        data.a[i] = a + data.s[i] * qdd[i] + v.cross_motion(&vj);
+        data.a[i] = a + data.s[i] * qdd[i] + model.velocity_product(i, &v, qd);
     }
     for i in 0..n {
         // A_i = d f_i / d pi_i ;  Y[i][10 i + c] = s_i . A_i[c]

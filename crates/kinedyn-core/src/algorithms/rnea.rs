@@ -72,7 +72,7 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
             None => (Motion::zero(), x.inv_act_motion(&a0)),
         };
         let vi = vp + joint.motion(qd[i]);
-        let ai = ap + joint.motion(qdd[i]) + joint.cross(&vi, qd[i]);
+        let ai = ap + joint.motion(qdd[i]) + model.velocity_product(i, &vi, qd);
         // f_i = I_i a_i + v_i x* I_i v_i - ^iX_0^* f^x_i
         let body = &inertia[i];
         let mut fi = body.mul_motion(&ai) + vi.cross_force(&body.mul_motion(&vi));
