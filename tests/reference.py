@@ -37,13 +37,17 @@ def joint_motion(kind: str, axis, x) -> np.ndarray:
 
 
 def body_poses(robot, q) -> list:
-    """world_from_body for every body of the compiled tree."""
+    """world_from_body for every body of the compiled tree (a reduced mimic follower at
+    multiplier * q[leader] + offset)."""
     q = np.asarray(q, dtype=float)
     assert q.shape == (robot.n,)
+    names, follows = robot.joint_names, robot.mimic_joints
     poses = []
-    for i, body in enumerate(robot.tree.bodies):
+    for body in robot.tree.bodies:
         parent = np.eye(4) if body.parent < 0 else poses[body.parent]
-        x = q[i] + float(body.joint.offset)
+        relation = follows.get(body.joint.name)
+        value = q[names.index(body.joint.name)] if relation is None else relation.multiplier * q[names.index(relation.leader)] + relation.offset
+        x = value + float(body.joint.offset)
         poses.append(parent @ np.asarray(body.placement, dtype=float) @ joint_motion(body.joint.kind, body.joint.axis, x))
     return poses
 

@@ -155,7 +155,7 @@ def test_ur5_urdf_matches_raw_chain():
 
 def test_panda_nine_joints_lock_fingers():
     path = erd(*PANDA)
-    robot = robot_from_urdf(path)
+    robot = robot_from_urdf(path, mimic="independent")  # the second finger a coordinate of its own (tests/test_mimic.py reduces it)
     assert robot.n == 9
     assert robot.joint_names[:7] == [f"panda_joint{i}" for i in range(1, 8)]
     arm = robot.lock_joints({"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0})
@@ -184,7 +184,7 @@ def _urdf_masses(path):
 def test_panda_inertias_agree_with_pinocchio():
     pin = pytest.importorskip("pinocchio", reason="pinocchio (pip: pin) is not installed")
     path = erd(*PANDA)
-    robot = robot_from_urdf(path)
+    robot = robot_from_urdf(path, mimic="independent")  # as Pinocchio's model without mimic=True
     model = pin.buildModelFromUrdf(path)
     assert model.nq == robot.n
     # sum of masses of moving bodies (pinocchio's body 0 is the universe, holding the root)
@@ -204,7 +204,7 @@ def test_panda_inertias_agree_with_pinocchio():
 def test_panda_kinematics_agree_with_pinocchio():
     pin = pytest.importorskip("pinocchio", reason="pinocchio (pip: pin) is not installed")
     path = erd(*PANDA)
-    robot = robot_from_urdf(path)
+    robot = robot_from_urdf(path, mimic="independent")  # as Pinocchio's model without mimic=True
     model = pin.buildModelFromUrdf(path)
     data = model.createData()
     q = random_q(robot, np.random.default_rng(5))
@@ -331,7 +331,7 @@ def test_default_tool_without_a_tool_name_is_the_end_of_the_longest_chain():
 
 
 def test_default_tool_of_the_panda_is_its_tcp():
-    robot = robot_from_urdf(erd(*PANDA))
+    robot = robot_from_urdf(erd(*PANDA), mimic="independent")
     assert robot.tool == "panda_hand_tcp"
     J = robot.jacobian(np.zeros(robot.n))
     np.testing.assert_allclose(J[:, 7:], 0.0, atol=1e-12)  # the fingers do not move the tool

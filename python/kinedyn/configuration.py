@@ -397,7 +397,7 @@ class ConfigurationSpace:
         """The configuration space of ``robot`` (built once per robot and remembered)."""
         found = _SPACES.get(robot)
         if found is None:
-            found = _SPACES[robot] = cls([b.joint for b in robot.tree.bodies])
+            found = _SPACES[robot] = cls(list(robot.joints))  # the coordinates' joints (no reduced mimic followers)
         return found
 
     # ------------------------------------------------------------------------------ arguments

@@ -24,6 +24,7 @@ from .description.geometry import Visual
 from .description.joint import Joint
 from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
+from .description.mimic import mimic_map as _mimic_map
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -137,6 +138,7 @@ class Robot:
         inertia: str = "warn",
         visuals: Sequence[Visual] = (),
         collisions: Sequence[Visual] = (),
+        mimic: str = "reduce",
     ):
         self.name = name
         # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
@@ -155,6 +157,10 @@ class Robot:
         self.tree: KinematicTree = build_tree(self.links, self.frames, base)
         if self.tree.n == 0:
             raise ValueError(f"robot '{name}' has no moving joint")
+        # mimic joints (Joint.mimic): "reduce" removes the followers' coordinates, "independent" keeps
+        # them (kinedyn.description.mimic); None when no joint follows another
+        self.mimic_mode = mimic
+        self._mimic = _mimic_map([b.joint for b in self.tree.bodies], [link.joint for link in self.links], mimic, name)
         names = [f.name for f in self.tree.frames]
         if tool is None:
             from .description.tool import default_tool
@@ -195,12 +201,15 @@ class Robot:
     @classmethod
     def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
                   floating_base: bool = False, xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False,
-                  package_dirs: Sequence[PathLike] = ()) -> "Robot":
+                  package_dirs: Sequence[PathLike] = (), mimic: str = "reduce") -> "Robot":
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
         or ``"strict"`` (ValueError); see docs/model-files.md. ``floating_base=True``: the root link
         moves on a free-flyer joint ``root_joint`` (Pinocchio's ``JointModelFreeFlyer``; nq = nv + 1).
+        ``mimic``: ``"reduce"`` (default) removes the coordinates of ``<mimic>`` joints (q_follower =
+        multiplier * q_leader + offset), or ``"independent"`` keeps each one a coordinate of its own
+        (docs/model-files.md, "Mimic joints").
 
         A path ending in ``.xacro`` is expanded by the ``xacro`` package first, with ``xacro_args``
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
@@ -212,10 +221,10 @@ class Robot:
         if is_xacro(path_or_string):
             text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
             return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base,
-                                   source_path=os.fsdecode(path_or_string))
+                                   source_path=os.fsdecode(path_or_string), mimic=mimic)
         if xacro_args:
             raise ValueError("xacro_args are for a .xacro file")
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base)
+        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic)
 
     @classmethod
     def from_mjcf(cls, path_or_string: Union[PathLike, bytes], *, gravity: Optional[ArrayLike] = None, tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
@@ -241,6 +250,7 @@ class Robot:
             inertia=self.inertia_policy,
             visuals=self.visuals,
             collisions=self.collisions,
+            mimic=self.mimic_mode,
         )
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
@@ -268,11 +278,16 @@ class Robot:
             if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
                 raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
-        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names)
+        followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
+        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
         if unknown:
-            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names})")
+            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
         values: dict = {}
+        follower_values: dict = {}
         for key, value in items:
+            if isinstance(key, str) and key in followers:
+                follower_values[key] = value
+                continue
             if isinstance(key, str):
                 i = names.index(key)
             elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
@@ -294,6 +309,10 @@ class Robot:
             if not math.isfinite(v):
                 raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
             values[names[i]] = v
+        if followers:
+            from .description.mimic import lock_followers
+
+            values = lock_followers(followers, values, follower_values)
         links = []
         for link in self.links:
             j = link.joint
@@ -312,7 +331,7 @@ class Robot:
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
     # pickled or copied, and built again on first use on the other side (DESIGN.md: "a Robot
     # pickles"). Everything else is the frozen description: numbers, NumPy arrays, SymPy objects.
-    _NATIVE_STATE = ("_model", "_ik_chains")
+    _NATIVE_STATE = ("_model", "_ik_chains", "_independent_robot")
 
     def __getstate__(self) -> dict:
         return {k: v for k, v in self.__dict__.items() if k not in self._NATIVE_STATE}
@@ -331,12 +350,12 @@ class Robot:
     @property
     def nq(self) -> int:
         """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
-        return sum(b.joint.nq for b in self.tree.bodies)
+        return sum(j.nq for j in self.joints)
 
     @property
     def nv(self) -> int:
         """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
-        return sum(b.joint.nv for b in self.tree.bodies)
+        return sum(j.nv for j in self.joints)
 
     @property
     def has_multi_dof_joints(self) -> bool:
@@ -354,11 +373,30 @@ class Robot:
 
     @property
     def joints(self) -> tuple:
-        return tuple(b.joint for b in self.tree.bodies)
+        """The joints of the coordinates, in q's order: every moving joint, less the mimic followers
+        when they are reduced (:attr:`mimic_joints`)."""
+        bodies = self.tree.bodies
+        if self._mimic is None:
+            return tuple(b.joint for b in bodies)
+        return tuple(bodies[i].joint for i in self._mimic.independent)
 
     @property
     def joint_names(self) -> list:
-        return [b.joint.name for b in self.tree.bodies]
+        return [j.name for j in self.joints]
+
+    @property
+    def mimic_joints(self) -> dict:
+        """The reduced mimic followers: ``{follower: Mimic(leader, multiplier, offset)}`` with each
+        leader an independent joint (chains resolved); empty without them or with mimic="independent"."""
+        return {} if self._mimic is None else dict(self._mimic.relations)
+
+    def require_no_mimic_joints(self, feature: str) -> None:
+        """Raise a ValueError naming a follower when ``feature`` does not handle reduced mimic joints."""
+        if self._mimic is not None:
+            follower, relation = next(iter(self._mimic.relations.items()))
+            raise ValueError(
+                f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
+                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)")
 
     @property
     def body_names(self) -> list:
@@ -403,23 +441,39 @@ class Robot:
     @property
     def armature(self) -> np.ndarray:
         """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "armature")
         return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
 
     @property
     def viscous(self) -> np.ndarray:
         """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
         (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "viscous")
         return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
 
     @property
     def coulomb(self) -> np.ndarray:
         """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "coulomb")
         return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
 
     @property
     def coulomb_negative(self) -> np.ndarray:
         """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
         symmetric friction)."""
+        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
+            from .description.mimic import reduced_coefficient
+
+            return reduced_coefficient(self, "coulomb_negative")
         return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
 
     @cached_property
@@ -497,6 +551,7 @@ class Robot:
             joint = Joint(
                 j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
                 j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb), f(j.coulomb_negative),
+                mimic=j.mimic,
             )
             try:
                 inertia = link.inertia.subs(mapping)
@@ -597,7 +652,7 @@ class Robot:
         placement: list = []
         blocks: list = []
         link_inertia = self.inertial_parameters().reshape(len(bodies), 10)
-        inertia = np.zeros((self.nv, 10))
+        inertia = np.zeros((len(self._dof_body), 10))  # every native body (mimic followers' too)
         for b, body in enumerate(bodies):
             joint = body.joint
             first = len(parent)
@@ -614,18 +669,27 @@ class Robot:
                 axis.append(a)
             blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
             inertia[last[b]] = link_inertia[b]
-        armature, viscous, coulomb = self.armature, self.viscous, self.coulomb
+        # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
+        def per_dof(value):
+            return np.array([x for body in bodies for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])])
+
+        armature, viscous, coulomb = (per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb"))
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
         frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
         frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
         # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-        coulomb_negative = self.coulomb_negative
+        coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
         asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        return _core.Model(np.array(parent, dtype=np.int64), np.array(kind, dtype=np.int64), np.array(axis, dtype=float).reshape(-1, 3),
-                           np.array(offset), np.array(placement).reshape(-1, 4, 4), inertia, armature, viscous, coulomb, gravity,
-                           frame_body, frame_placement, coulomb_negative=asymmetric,
-                           blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None)
+        native = _core.Model(np.array(parent, dtype=np.int64), np.array(kind, dtype=np.int64), np.array(axis, dtype=float).reshape(-1, 3),
+                             np.array(offset), np.array(placement).reshape(-1, 4, 4), inertia, armature, viscous, coulomb, gravity,
+                             frame_body, frame_placement, coulomb_negative=asymmetric,
+                             blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None)
+        if self._mimic is None:
+            return native
+        from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
+
+        return ReducedModel(native, self._mimic, self.name)
 
     @cached_property
     def _multi_dof(self) -> bool:
@@ -735,6 +799,10 @@ class Robot:
             from ._dask import lazy_inverse_kinematics
 
             return lazy_inverse_kinematics(self, target if is_dask_array(target) else _dask_targets(target, q0), q0, mask, method, respect_limits, kwargs)
+        if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
+            from ._mimic import inverse_kinematics
+
+            return inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
         solve = _IK_SOLVE or _load_ik()
         return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
@@ -771,11 +839,11 @@ class Robot:
                 f = f.copy()
                 f[..., 3:] += np.cross(np.einsum("...ij,...j->...i", R, u), f[..., :3])
             # the native model has a body per degree of freedom: the link's wrench acts on its last
-            full = np.zeros(f.shape[:-2] + (self.nv, 6))
+            full = np.zeros(f.shape[:-2] + (len(self._dof_body), 6))  # every native body
             full[..., self._body_last_dof, :] = f
             return full
         u = self._link_origin_in_body
-        if u is None or f.shape[-2:] != (self.n, 6) or f.ndim != np.ndim(q) + 1:
+        if u is None or f.shape[-2:] != (links, 6) or f.ndim != np.ndim(q) + 1:
             return f  # (wrong shapes are reported by the core)
         R = self.forward_kinematics(q)[..., :3, :3]
         d = np.einsum("...ij,...j->...i", R, u)

@@ -407,6 +407,8 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
             viscous, coulomb = float(j.viscous), _coulomb(j, "URDF")
             if viscous or coulomb:
                 ET.SubElement(el, "dynamics", damping=_f(viscous), friction=_f(coulomb))
+            if j.mimic is not None:  # q = multiplier * q_leader + offset (docs/model-files.md, "Mimic joints")
+                ET.SubElement(el, "mimic", joint=j.mimic.leader, multiplier=_f(j.mimic.multiplier), offset=_f(j.mimic.offset))
             if float(j.armature) != 0:
                 tr = ET.Element("transmission", name=_unique(f"{j.name}_transmission", set(joint_names)))
                 ET.SubElement(tr, "type").text = "transmission_interface/SimpleTransmission"

@@ -49,7 +49,8 @@ _TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
 _ROW_KEYS = {"theta", "d", "a", "alpha", "type", "name", "limits", "mass", "com", "inertia",
              "gear_ratio", "rotor_inertia", "viscous", "coulomb"}
 _LINK_KEYS = {"name", "parent", "joint", "inertial", "post"}
-_JOINT_KEYS = {"name", "type", "axis", "origin", "offset", "limits", "gear_ratio", "rotor_inertia", "viscous", "coulomb"}
+_JOINT_KEYS = {"name", "type", "axis", "origin", "offset", "limits", "gear_ratio", "rotor_inertia", "viscous", "coulomb", "mimic"}
+_MIMIC_KEYS = {"joint", "multiplier", "offset"}  # URDF's <mimic> attributes (docs/model-files.md#mimic-joints)
 _INERTIAL_KEYS = {"mass", "com", "inertia"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _POSE_KEYS = {"xyz", "rpy"}
@@ -617,6 +618,7 @@ def _tree_link(r: _Reader, raw, i: int) -> Link:
         offset=offset_reader(j.get("offset", 0.0), f"{ctx}.joint.offset"),
         **r.limits(j.get("limits", {}), revolute, f"{ctx}.joint.limits"),
         **r.drive(j, f"{ctx}.joint"),
+        mimic=_mimic(r, j["mimic"], f"{ctx}.joint.mimic") if "mimic" in j else None,
     )
     placement = r.pose(j["origin"], f"{ctx}.joint.origin") if "origin" in j else np.eye(4)
     post = r.pose(raw["post"], f"{ctx}.post") if "post" in raw else np.eye(4)
@@ -783,6 +785,20 @@ def _dh_mapping(robot: Robot, base_pose) -> dict:
     return out
 
 
+def _mimic(r, raw, ctx: str):
+    """``mimic: {joint: leader, multiplier: m, offset: o}`` (multiplier 1 and offset 0 by default)."""
+    from .joint import Mimic
+
+    m = r.check_keys(raw, _MIMIC_KEYS, ctx)
+    if "joint" not in m:
+        r.fail(ctx, "needs 'joint': the name of the joint it follows")
+    values = [r.value(m.get(k, default), f"{ctx}.{k}") for k, default in (("multiplier", 1.0), ("offset", 0.0))]
+    try:
+        return Mimic(r.text(m["joint"], f"{ctx}.joint"), *values)
+    except ValueError as e:
+        r.fail(ctx, str(e))
+
+
 def _tree_mapping(robot: Robot) -> dict:
     out: dict = {"base": robot.base, "tool": robot.tool, "units": {"angle": "rad"}}
     links = []
@@ -797,6 +813,8 @@ def _tree_mapping(robot: Robot) -> dict:
         if limits:
             joint["limits"] = limits
         joint.update(_drive_mapping(j))
+        if j.mimic is not None:
+            joint["mimic"] = {"joint": j.mimic.leader, "multiplier": j.mimic.multiplier, "offset": j.mimic.offset}
         entry: dict = {"name": link.name}
         if link.parent is not None:
             entry["parent"] = link.parent

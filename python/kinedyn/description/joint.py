@@ -11,18 +11,24 @@ Coulomb friction may differ with the direction of motion (Corke's PUMA 560 motor
 ``coulomb`` the level for qd > 0; then tau_f = viscous * qd + (coulomb if qd > 0, -coulomb_negative
 if qd < 0, 0 at rest). ``coulomb=(positive, negative)`` is accepted as a shorthand for both levels.
 Unset (None), ``coulomb_negative`` equals ``coulomb``: the symmetric case.
+
+``mimic`` (a :class:`Mimic`, URDF's ``<mimic joint multiplier offset>``): this revolute or prismatic
+joint follows another 1-DOF joint, its leader, with ``q = multiplier * q_leader + offset`` (both in
+kinedyn's coordinates ``q``, before the joint's ``offset`` is added). Whether the robot removes the
+follower's coordinate or keeps it independent is the Robot's choice (``Robot(..., mimic=...)``,
+:mod:`kinedyn.description.mimic`); the joint only records the relation.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping, Optional
 
 from .._math import is_symbolic
 from .checks import number, real, vector
 
-__all__ = ["Joint", "JOINT_KINDS", "JOINT_SIZES", "MULTI_DOF_KINDS"]
+__all__ = ["Joint", "Mimic", "JOINT_KINDS", "JOINT_SIZES", "MULTI_DOF_KINDS"]
 
 JOINT_KINDS = ("revolute", "prismatic", "fixed", "floating", "spherical", "planar")
 
@@ -33,6 +39,48 @@ JOINT_KINDS = ("revolute", "prismatic", "fixed", "floating", "spherical", "plana
 #: child's frame.
 JOINT_SIZES = {"revolute": (1, 1), "prismatic": (1, 1), "fixed": (0, 0), "floating": (7, 6), "spherical": (4, 3), "planar": (4, 3)}
 MULTI_DOF_KINDS = ("floating", "spherical", "planar")
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """``q_follower = multiplier * q_leader + offset`` (URDF ``<mimic joint multiplier offset>``;
+    the URDF defaults are multiplier 1, offset 0)."""
+
+    leader: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+    def __post_init__(self):
+        if not isinstance(self.leader, str) or not self.leader:
+            raise ValueError(f"a mimic relation names its leader joint (a non-empty string), got {self.leader!r}")
+        what = f"mimic of joint '{self.leader}'"
+        multiplier = real(self.multiplier, f"{what}: multiplier")
+        if multiplier == 0:
+            raise ValueError(f"{what}: multiplier must be non-zero (a follower with multiplier 0 is a fixed joint)")
+        object.__setattr__(self, "multiplier", multiplier)
+        object.__setattr__(self, "offset", real(self.offset, f"{what}: offset"))
+
+    @classmethod
+    def of(cls, value) -> "Mimic":
+        """A Mimic from a Mimic, a mapping ``{leader (or joint), multiplier, offset}`` or a tuple
+        ``(leader[, multiplier[, offset]])``."""
+        if isinstance(value, Mimic):
+            return value
+        if isinstance(value, str):
+            return cls(value)
+        if isinstance(value, Mapping):
+            unknown = sorted(set(value) - {"leader", "joint", "multiplier", "offset"})
+            if unknown or ("leader" in value) == ("joint" in value):
+                raise ValueError(f"mimic must be a mapping with 'leader' (or 'joint'), optional 'multiplier' and 'offset'; got keys {sorted(value)}")
+            return cls(value.get("leader", value.get("joint")), value.get("multiplier", 1.0), value.get("offset", 0.0))
+        if isinstance(value, (tuple, list)) and 1 <= len(value) <= 3:
+            return cls(*value)
+        raise ValueError(f"mimic must be a Mimic, a leader name, a mapping or a tuple (leader, multiplier, offset), got {value!r}")
+
+    def then(self, outer: "Mimic") -> "Mimic":
+        """The relation of a follower of a follower: ``outer`` follows the joint this relation
+        describes, which follows ``self.leader``; the result follows ``self.leader`` directly."""
+        return Mimic(self.leader, outer.multiplier * self.multiplier, outer.multiplier * self.offset + outer.offset)
 
 
 @dataclass(frozen=True)
@@ -51,6 +99,8 @@ class Joint:
     coulomb: Any = 0.0
     #: Coulomb level for qd < 0 (magnitude); None = the same as ``coulomb`` (symmetric friction)
     coulomb_negative: Any = None
+    #: this joint follows another (URDF <mimic>): q = multiplier * q_leader + offset; None = independent
+    mimic: Optional[Mimic] = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -103,6 +153,13 @@ class Joint:
                     raise ValueError(f"{what}: a {self.kind} joint takes no {name} (got {getattr(self, name)})")
             if self.coulomb_negative is not None:
                 raise ValueError(f"{what}: a {self.kind} joint takes no coulomb_negative")
+        if self.mimic is not None:
+            mimic = Mimic.of(self.mimic)
+            if self.kind not in ("revolute", "prismatic"):
+                raise ValueError(f"{what}: only a revolute or prismatic joint can mimic another; this one is {self.kind}")
+            if mimic.leader == self.name:
+                raise ValueError(f"{what}: a joint cannot mimic itself")
+            object.__setattr__(self, "mimic", mimic)
         # limits: numbers, +-inf allowed (no limit), never NaN
         for name in ("lower", "upper", "velocity_limit", "effort_limit"):
             object.__setattr__(self, name, real(getattr(self, name), f"{what}: {name}", infinite=True))

@@ -20,9 +20,13 @@ Reads the kinematic and inertial parts of a URDF (ROS wiki, "urdf/XML/joint" and
   are not read here: they are found and read when the robot is drawn.
 
 Ignored: ``<texture>``, ``<transmission>``, ``<gazebo>``, ``<calibration>``,
-``<safety_controller>``; ``<mimic>`` is ignored too, so a mimic joint becomes an independent
-coordinate (as Pinocchio's ``buildModelFromUrdf`` does by default). Floating and planar joints are
-rejected.
+``<safety_controller>``. Floating and planar joints are rejected.
+
+- ``<joint><mimic joint multiplier offset>`` (multiplier default 1, offset 0): the joint follows
+  ``joint`` with ``q = multiplier * q_joint + offset`` (-> ``Joint.mimic``). ``mimic="reduce"``
+  (default) removes the followers' coordinates (as Pinocchio 3's ``buildModelFromUrdf(path,
+  mimic=True)``); ``mimic="independent"`` keeps each a coordinate of its own (Pinocchio's default,
+  and kinedyn's before mimic support), see :mod:`kinedyn.description.mimic`.
 
 The robot has a fixed base: the root link (the one link that is no joint's child) is the Robot's
 ``base`` and its inertia is ignored. Joints are numbered in depth-first order from the root,
@@ -46,7 +50,7 @@ from .._math import matmul, rpy_to_matrix, translation
 from .checks import LARGEST
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
-from .joint import Joint
+from .joint import Joint, Mimic
 from .link import Link
 from .tool import default_tool
 
@@ -61,7 +65,7 @@ MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guard
 
 
 def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", floating_base: bool = False,
-                    source_path: Optional[str] = None):
+                    source_path: Optional[str] = None, mimic: str = "reduce"):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
@@ -115,7 +119,8 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia, visuals=visuals, collisions=collisions)
+            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia, visuals=visuals, collisions=collisions,
+                          mimic=mimic)
     except ValueError as e:
         raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None
     for w in caught:
@@ -307,11 +312,27 @@ def _joint(element, src: _Source) -> dict:
     multi = kind in ("floating", "planar")
     limits = {} if multi else _limits(element.find("limit"), kind, what, src)
     friction = {} if multi else _dynamics(element.find("dynamics"), what, src)
+    # a fixed joint has no coordinate to follow with: its <mimic> is ignored (Talos's talos_left_arm.urdf has one)
+    mimic = _mimic(element.find("mimic"), what, src) if kind != "fixed" else None
     try:
-        joint = Joint(name, "revolute" if kind == "continuous" else kind, axis, **limits, **friction)
+        joint = Joint(name, "revolute" if kind == "continuous" else kind, axis, **limits, **friction, mimic=mimic)
     except ValueError as e:
         raise src.error(element, str(e)) from None
     return {"name": name, **ends, "placement": _origin(element, what, src), "joint": joint, "element": element}
+
+
+def _mimic(element, what: str, src: _Source) -> Optional[Mimic]:
+    """``<mimic joint multiplier offset>`` (URDF defaults: multiplier 1, offset 0), or None."""
+    if element is None:
+        return None
+    leader = element.get("joint")
+    if not leader:
+        raise src.error(element, f"{what}: <mimic> has no joint attribute (the joint it follows)")
+    multiplier, offset = _float(element, "multiplier", 1.0, f"{what} <mimic>", src), _float(element, "offset", 0.0, f"{what} <mimic>", src)
+    try:
+        return Mimic(leader, multiplier, offset)
+    except ValueError as e:
+        raise src.error(element, f"{what}: {e}") from None
 
 
 def _limits(limit, kind: str, what: str, src: _Source) -> dict:

@@ -139,6 +139,7 @@ class _Chain:
     def __init__(self, robot: Robot, frame: str):
         from .. import _core
 
+        robot.require_no_mimic_joints("inverse kinematics")  # the native solvers take the full model
         self.frame = robot.frame_index(frame)
         self.n = robot.n
         self.model = robot._model

@@ -67,6 +67,11 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
             "offset": float(b.joint.offset),
             "placement": np.asarray(b.placement, dtype=float).ravel().tolist(),
         })
+    if robot.mimic_joints:  # each body's coordinate: q[q] for its own, scale * q[q] + shift for a mimic follower
+        from ..description.mimic import body_coordinates
+
+        for body, coordinate in zip(bodies, body_coordinates(robot)):
+            body.update(coordinate)
     frames = [{"name": f.name, "body": int(f.body), "placement": np.asarray(f.placement, dtype=float).ravel().tolist()} for f in tree.frames]
     # size of the scene: the farthest frame origin over q and a few random configurations
     qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
@@ -92,6 +97,7 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
         "bodies": bodies,
         "frames": frames,
         "joint_names": robot.joint_names,
+        "joint_kinds": [j.kind for j in robot.joints],
         "lower": [float(x) if math.isfinite(x) else None for x in robot.lower_limits],
         "upper": [float(x) if math.isfinite(x) else None for x in robot.upper_limits],
         "q": [float(x) for x in q],
@@ -198,6 +204,9 @@ def _symbolic_eom(robot, name: Optional[str], max_joints: int):
             subject = robot
     if not hasattr(subject, "equations_of_motion"):
         return None, "This kinedyn has no symbolic engine."
+    if getattr(subject, "mimic_joints", None):
+        follower, relation = next(iter(subject.mimic_joints.items()))
+        return None, f"The symbolic engine does not handle mimic joints yet (joint '{follower}' follows '{relation.leader}')."
     try:
         # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
         eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")

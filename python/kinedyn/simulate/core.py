@@ -544,11 +544,13 @@ def simulate(
         fext_fn = None
     count = batch or 1
     work = steps * count * (4 if method == "rk4" else 1)
-    native = robot and method in FIXED_METHODS and fext_fn is None
+    # a robot with reduced mimic joints runs the Python loop on its reduced methods (the native
+    # integrators take the full model)
+    native = robot and method in FIXED_METHODS and fext_fn is None and not getattr(system, "mimic_joints", None)
     if multi_dof and not native:
-        why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext"
+        why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext or mimic joints"
         raise ValueError(f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
-                         f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext); {why} needs the Python loop, which steps q + h qd")
+                         f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext or mimic joints); {why} needs the Python loop, which steps q + h qd")
     pure_native = native and u_fn is None and controller is None
     delay = 0.0
     if progress is None:

@@ -69,6 +69,8 @@ def state_symbols(robot):
     shoulder -> shoulderdot, shoulderddot (see :func:`kinedyn.symbolic.render.rate_names`)."""
     from .render import rate_names
 
+    if getattr(robot, "mimic_joints", None):  # one symbol per coordinate: mimic followers have none
+        robot.require_no_mimic_joints("the symbolic engine")
     q, qd, qdd = [], [], []
     taken = {str(s) for s in robot.symbols}
     for name in robot.joint_names:

@@ -226,7 +226,7 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
     for i, b in enumerate(tree.bodies):
         if b.joint.kind != "prismatic":
             continue
-        lo, hi = float(robot.lower_limits[i]), float(robot.upper_limits[i])
+        lo, hi = float(b.joint.lower), float(b.joint.upper)  # this body's joint (robot.lower_limits has no mimic followers)
         lo, hi = (lo if np.isfinite(lo) else -0.5 * reach), (hi if np.isfinite(hi) else 0.5 * reach)
         offset = float(b.joint.offset)
         placement = np.asarray(b.placement, dtype=float)

@@ -38,7 +38,8 @@
     const body = [];
     for (let i = 0; i < n; i++) {
       const b = model.bodies[i];
-      const x = q[i] + b.offset;
+      // a mimic follower (kinedyn.description.mimic) moves by scale * q[its leader] + shift
+      const x = (b.scale === undefined ? q[i] : b.scale * q[b.q] + b.shift) + b.offset;
       const motion = b.kind === "revolute" ? rotation(b.axis, x) : translation(b.axis, x);
       body.push(mul(mul(b.parent < 0 ? I4 : body[b.parent], b.placement), motion));
     }
@@ -156,7 +157,8 @@
 
   // ---------------------------------------------------------------- readouts: tool position, pose table, q
   const fmt = (v) => { if (Math.abs(v) < 1e-13) v = 0; const s = Number(v.toPrecision(6)).toString(); return s; };
-  const revolute = model.bodies.map((b) => b.kind === "revolute");
+  const coordinates = model.joint_names.length;  // fewer than the bodies when mimic followers are reduced
+  const revolute = (model.joint_kinds || model.bodies.map((b) => b.kind)).map((kind) => kind === "revolute");
   function readouts(tool) {
     const t = origin(tool);
     const out = document.getElementById("kinedyn-tool");
@@ -189,7 +191,7 @@
     document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[i]; el.nextElementSibling.textContent = label(i); });
   }
   if (sliders) {
-    for (let i = 0; i < n; i++) {
+    for (let i = 0; i < coordinates; i++) {
       const row = document.createElement("label");
       const span = revolute[i] ? Math.PI : model.reach;
       const lo = Number.isFinite(model.lower[i]) ? model.lower[i] : -span;
