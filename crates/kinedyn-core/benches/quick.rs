@@ -3,6 +3,11 @@
 //!   cargo bench -p kinedyn-core --bench quick [-- FILTER]
 //! Prints `model/algorithm  ns`, one line each. Copy the binary from `target/release/deps` to
 //! compare two builds back to back.
+//!
+//! `KINEDYN_BENCH_TREES=a.tree:b.tree` adds floating-base robots read from `benches/cpp/dump_tree.py`
+//! files (issue 14; Pinocchio's C++ harness builds its models from the same files): rnea, crba and
+//! aba on the file's state, with `<robot>/check_<algorithm>` lines of their results for
+//! `benches/cpp/compare_core.sh` to compare across the two sides.
 
 mod models;
 
@@ -77,4 +82,37 @@ fn main() {
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
     }
+    let trees = std::env::var("KINEDYN_BENCH_TREES").unwrap_or_default();
+    for path in trees.split(':').filter(|p| !p.is_empty()) {
+        bench_tree(&models::read_tree(path), &filter);
+    }
+}
+
+fn print_check(key: &str, x: &[f64]) {
+    let values: Vec<String> = x.iter().map(|v| format!("{v:e}")).collect();
+    println!("{key} {}", values.join(" "));
+}
+
+/// rnea, crba and aba of a floating-base robot from a tree file, after their results for the check.
+fn bench_tree(tree: &models::TreeFile, filter: &str) {
+    let (model, name) = (&tree.model, &tree.name);
+    let (q, v, a) = (&tree.q, &tree.v, &tree.a);
+    let n = model.n;
+    let mut data = Data::new(model);
+    let tau = alg::rnea(model, &mut data, q, v, a, None).to_vec();
+    print_check(&format!("{name}/check_rnea"), &tau);
+    let m = alg::crba(model, &mut data, q).to_vec();
+    let upper: Vec<f64> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).map(|(i, j)| m[i * n + j]).collect();
+    print_check(&format!("{name}/check_crba"), &upper);
+    print_check(&format!("{name}/check_aba"), alg::aba(model, &mut data, q, v, &tau, None).unwrap());
+    let d = &mut data;
+    let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {
+        let key = format!("{name}/{alg}");
+        if key.contains(filter) {
+            println!("{key:28} {:8.1}", min_ns(|| f(&mut *d)));
+        }
+    };
+    run("rnea", &mut |d| _ = black_box(alg::rnea(model, d, black_box(q), black_box(v), black_box(a), None)[0]));
+    run("crba", &mut |d| _ = black_box(alg::crba(model, d, black_box(q))[0]));
+    run("aba", &mut |d| _ = black_box(alg::aba(model, d, black_box(q), black_box(v), black_box(&tau), None).unwrap()[0]));
 }
