@@ -4,6 +4,9 @@ without a URDF parser.
 
     PYTHONPATH=python python benches/cpp/dump_tree.py OUT_DIR [ROBOT ...]   (default: talos solo12 anymal)
 
+A name ending in ``_fixed`` (``talos_fixed``) is the same URDF with its root link fixed to the world
+(no free-flyer): beside the floating robot it shows what the free-flyer itself costs on each side.
+
 Bodies in kinedyn's order (``robot.tree.bodies``: fixed joints merged, parents before children).
 Format, one record a line, numbers in full precision (``%.17g``):
 
@@ -42,7 +45,8 @@ def fmt(values) -> str:
 def dump(name: str, path: Path, seed: int = 14) -> None:
     import kinedyn as kd
 
-    robot = without_friction(kd.Robot.from_urdf(str(erd_robots_dir() / FLOATING_URDFS[name]), floating_base=True))
+    urdf = name.removesuffix("_fixed")
+    robot = without_friction(kd.Robot.from_urdf(str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name))
     if np.any(np.asarray(robot.armature) != 0):
         raise SystemExit(f"{name}: the harnesses leave rotor inertia (armature) out; this robot has some")
     bodies = robot.tree.bodies
