@@ -73,4 +73,7 @@ print(f"{'':28s} {'Pinocchio C++':>14s} {'kinedyn-core':>13s}   speed-up")
 for key, c in cpp.items():
     if key in rust:
         print(f"{key:28s} {c:11.0f} ns {rust[key]:10.0f} ns   {c / rust[key]:6.2f}x")
+for key, r in rust.items():
+    if key not in cpp and "free_flyer" in key:  # profiling lines of the Rust side alone (see quick.rs)
+        print(f"{key:28s} {'':14s} {r:10.0f} ns")
 PY
