@@ -27,10 +27,10 @@ RUST=$(ls -t "$OUT"/target/release/deps/quick-* | grep -v '\.d$' | head -1)
 PYTHONPATH=${PYTHONPATH:-python} python benches/cpp/dump_tree.py "$OUT/trees" "$@" > "$OUT/trees.txt"
 mapfile -t TREES < "$OUT/trees.txt"
 export KINEDYN_BENCH_TREES=$(IFS=:; echo "${TREES[*]}")
-# the two sides alternate, three times each, and each keeps its fastest run (both report the minimum
+# the two sides alternate, KINEDYN_BENCH_ROUNDS (default 3) times each, and each keeps its fastest run (both report the minimum
 # over rounds of ~0.3 ms): the machine's speed drifts by tens of percent from one run to the next
 : > "$OUT/cpp.txt"; : > "$OUT/rust.txt"
-for round in 1 2 3; do
+for round in $(seq "${KINEDYN_BENCH_ROUNDS:-3}"); do
   "$OUT/pinocchio_dynamics" "${TREES[@]}" >> "$OUT/cpp.txt"
   "$RUST" --bench >> "$OUT/rust.txt"
 done
