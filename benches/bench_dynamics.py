@@ -26,24 +26,9 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import fmt_us, load_pair  # noqa: E402
+from common import fmt_us, load_pair, paired  # noqa: E402
 
 BATCH = 10_000
-
-
-def paired(a, b, rounds: int = 15, number: int = 300):
-    """Seconds per call of ``a`` and ``b``, timed alternately; the fastest of ``rounds`` runs each."""
-    import time
-
-    a(), b()
-    best = [float("inf"), float("inf")]
-    for _ in range(rounds):
-        for k, fn in enumerate((a, b)):
-            t0 = time.perf_counter()
-            for _ in range(number):
-                fn()
-            best[k] = min(best[k], (time.perf_counter() - t0) / number)
-    return best
 
 
 def sym(M):

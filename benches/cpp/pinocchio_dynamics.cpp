@@ -1,6 +1,11 @@
 // Pinocchio's C++ dynamics on the same UR5 and Panda models as kinedyn-core's criterion bench
 // (crates/kinedyn-core/benches/core.rs builds them from the same DH tables and numbers).
 // Benchmark only, never built in CI: see compare_core.sh. Prints "<robot>/<algorithm> <ns>".
+// Arguments: tree files written by dump_tree.py (floating-base robots, issue 14): each becomes a
+// pinocchio::Model built joint by joint (JointModelFreeFlyer, axis-aligned or unaligned revolute and
+// prismatic joints, as Pinocchio's URDF parser picks them); rnea, crba and aba are timed on the file's
+// state and their results printed on "<robot>/check_<algorithm>" lines for compare_core.sh to compare
+// with the Rust side's.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -11,7 +16,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <functional>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -73,7 +82,129 @@ static double min_ns(F&& f, int rounds = 400) {
   return best;
 }
 
-int main() {
+// a robot read from a dump_tree.py file: the model and the state (q, v, a) to compute on
+struct TreeFile {
+  std::string name;
+  Model model;
+  Eigen::VectorXd q, v, a;
+};
+
+static std::vector<double> numbers(std::istringstream& in, std::size_t count, const std::string& what) {
+  std::vector<double> out(count);
+  for (auto& x : out)
+    if (!(in >> x)) throw std::runtime_error("too few numbers in " + what);
+  return out;
+}
+
+static Eigen::VectorXd vector_line(std::istream& file, const std::string& key, int size, const std::string& path) {
+  std::string line, word;
+  std::getline(file, line);
+  std::istringstream in(line);
+  in >> word;
+  if (word != key) throw std::runtime_error(path + ": expected a '" + key + "' line, got '" + word + "'");
+  auto x = numbers(in, size, path + " " + key);
+  return Eigen::Map<Eigen::VectorXd>(x.data(), size);
+}
+
+static JointModel joint_model(const std::string& kind, const Vector3d& axis, const std::string& path) {
+  // axis-aligned types for +x, +y, +z (what Pinocchio's URDF parser chooses), unaligned otherwise
+  auto is = [&](const Vector3d& e) { return (axis - e).norm() < 1e-12; };
+  if (kind == "free") return JointModelFreeFlyer();
+  if (kind == "revolute") {
+    if (is(Vector3d::UnitX())) return JointModelRX();
+    if (is(Vector3d::UnitY())) return JointModelRY();
+    if (is(Vector3d::UnitZ())) return JointModelRZ();
+    return JointModelRevoluteUnaligned(axis);
+  }
+  if (kind == "prismatic") {
+    if (is(Vector3d::UnitX())) return JointModelPX();
+    if (is(Vector3d::UnitY())) return JointModelPY();
+    if (is(Vector3d::UnitZ())) return JointModelPZ();
+    return JointModelPrismaticUnaligned(axis);
+  }
+  throw std::runtime_error(path + ": unknown joint kind '" + kind + "'");
+}
+
+static TreeFile read_tree(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error("cannot open " + path);
+  TreeFile out;
+  std::string line, word;
+  int nq = 0, nv = 0, nbodies = 0;
+  std::getline(file, line);
+  std::istringstream(line) >> word >> out.name;
+  std::getline(file, line);
+  std::istringstream(line) >> word >> nq >> nv >> nbodies;
+  std::getline(file, line);
+  {
+    std::istringstream in(line);
+    in >> word;
+    auto g = numbers(in, 3, path + " gravity");
+    out.model.gravity.linear(Vector3d(g[0], g[1], g[2]));
+  }
+  std::vector<JointIndex> ids;
+  for (int b = 0; b < nbodies; ++b) {
+    std::getline(file, line);
+    std::istringstream in(line);
+    int parent = 0;
+    std::string kind;
+    in >> word >> parent >> kind;
+    if (word != "body" || parent >= b) throw std::runtime_error(path + ": bad body line " + std::to_string(b));
+    auto x = numbers(in, 3 + 9 + 3 + 1 + 3 + 9, path + " body " + std::to_string(b));
+    Vector3d axis(x[0], x[1], x[2]);
+    Matrix3d rot;
+    rot << x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11];
+    Vector3d trans(x[12], x[13], x[14]), com(x[16], x[17], x[18]);
+    Matrix3d inertia;
+    inertia << x[19], x[20], x[21], x[22], x[23], x[24], x[25], x[26], x[27];
+    JointIndex parent_id = parent < 0 ? 0 : ids[parent];
+    JointIndex id = out.model.addJoint(parent_id, joint_model(kind, axis, path), SE3(rot, trans), "joint" + std::to_string(b));
+    out.model.appendBodyToJoint(id, Inertia(x[15], com, inertia), SE3::Identity());
+    ids.push_back(id);
+  }
+  if (out.model.nq != nq || out.model.nv != nv)
+    throw std::runtime_error(path + ": built nq, nv = " + std::to_string(out.model.nq) + ", " + std::to_string(out.model.nv) +
+                             ", the file says " + std::to_string(nq) + ", " + std::to_string(nv));
+  out.q = vector_line(file, "q", nq, path);
+  out.v = vector_line(file, "v", nv, path);
+  out.a = vector_line(file, "a", nv, path);
+  return out;
+}
+
+static void print_check(const std::string& key, const Eigen::VectorXd& x) {
+  std::printf("%s", key.c_str());
+  for (Eigen::Index i = 0; i < x.size(); ++i) std::printf(" %.17g", x[i]);
+  std::printf("\n");
+}
+
+// rnea, crba and aba of a floating-base robot from a tree file, with their results for the check
+static void bench_tree(const TreeFile& tree) {
+  const Model& model = tree.model;
+  Data data(model);
+  const auto &q = tree.q, &v = tree.v, &a = tree.a;
+  const std::string& name = tree.name;
+  int n = model.nv;
+  Eigen::VectorXd tau = rnea(model, data, q, v, a);
+  print_check(name + "/check_rnea", tau);
+  crba(model, data, q);
+  Eigen::VectorXd upper(n * (n + 1) / 2);  // Pinocchio fills the upper triangle of M
+  for (int i = 0, k = 0; i < n; ++i)
+    for (int j = i; j < n; ++j) upper[k++] = data.M(i, j);
+  print_check(name + "/check_crba", upper);
+  print_check(name + "/check_aba", aba(model, data, q, v, tau));
+  std::printf("%s/rnea %.1f\n", name.c_str(), min_ns([&] { rnea(model, data, q, v, a); }));
+  std::printf("%s/crba %.1f\n", name.c_str(), min_ns([&] { crba(model, data, q); }));
+  std::printf("%s/aba %.1f\n", name.c_str(), min_ns([&] { aba(model, data, q, v, tau); }));
+}
+
+int main(int argc, char** argv) {
+  std::vector<TreeFile> trees;
+  try {
+    for (int k = 1; k < argc; ++k) trees.push_back(read_tree(argv[k]));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pinocchio_dynamics: %s\n", e.what());
+    return 2;
+  }
   for (auto& [name, model] : {std::pair<std::string, Model>{"ur5", ur5()}, {"panda", panda()}}) {
     Data data(model);
     int n = model.nv;
@@ -92,5 +223,6 @@ int main() {
     std::printf("%s/rnea_derivatives %.1f\n", name.c_str(), min_ns([&] { computeRNEADerivatives(model, data, q, v, a, d1, d2, d3); }));
     std::printf("%s/aba_derivatives %.1f\n", name.c_str(), min_ns([&] { computeABADerivatives(model, data, q, v, tau, d1, d2, d3); }));
   }
+  for (const auto& tree : trees) bench_tree(tree);
   return 0;
 }

@@ -3,6 +3,11 @@
 //!   cargo bench -p kinedyn-core --bench quick [-- FILTER]
 //! Prints `model/algorithm  ns`, one line each. Copy the binary from `target/release/deps` to
 //! compare two builds back to back.
+//!
+//! `KINEDYN_BENCH_TREES=a.tree:b.tree` adds floating-base robots read from `benches/cpp/dump_tree.py`
+//! files (issue 14; Pinocchio's C++ harness builds its models from the same files): rnea, crba and
+//! aba on the file's state, with `<robot>/check_<algorithm>` lines of their results for
+//! `benches/cpp/compare_core.sh` to compare across the two sides.
 
 mod models;
 
@@ -77,4 +82,95 @@ fn main() {
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
     }
+    let trees = std::env::var("KINEDYN_BENCH_TREES").unwrap_or_default();
+    for path in trees.split(':').filter(|p| !p.is_empty()) {
+        bench_tree(&models::read_tree(path), &filter);
+    }
+}
+
+fn print_check(key: &str, x: &[f64]) {
+    let values: Vec<String> = x.iter().map(|v| format!("{v:e}")).collect();
+    println!("{key} {}", values.join(" "));
+}
+
+/// rnea, crba and aba of a floating-base robot from a tree file, after their results for the check.
+fn bench_tree(tree: &models::TreeFile, filter: &str) {
+    let (model, name) = (&tree.model, &tree.name);
+    let (q, v, a) = (&tree.q, &tree.v, &tree.a);
+    let n = model.n;
+    let mut data = Data::new(model);
+    let tau = alg::rnea(model, &mut data, q, v, a, None).to_vec();
+    print_check(&format!("{name}/check_rnea"), &tau);
+    let m = alg::crba(model, &mut data, q).to_vec();
+    let upper: Vec<f64> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).map(|(i, j)| m[i * n + j]).collect();
+    print_check(&format!("{name}/check_crba"), &upper);
+    print_check(&format!("{name}/check_aba"), alg::aba(model, &mut data, q, v, &tau, None).unwrap());
+    let d = &mut data;
+    let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {
+        let key = format!("{name}/{alg}");
+        if key.contains(filter) {
+            println!("{key:28} {:8.1}", min_ns(|| f(&mut *d)));
+        }
+    };
+    run("rnea", &mut |d| _ = black_box(alg::rnea(model, d, black_box(q), black_box(v), black_box(a), None)[0]));
+    run("crba", &mut |d| _ = black_box(alg::crba(model, d, black_box(q))[0]));
+    run("aba", &mut |d| _ = black_box(alg::aba(model, d, black_box(q), black_box(v), black_box(&tau), None).unwrap()[0]));
+    free_flyer_crba_share(model, d, tree, filter);
+}
+
+/// Profile (kinedyn-core only, no Pinocchio peer): the part of `crba` (the `crba_blocks` pass of
+/// src/algorithms/crba.rs) spent on a root free-flyer's member bodies 2..=5, whose parent is not a
+/// root: each forms its transform (the identity, as a member's placement and joint are), carries its
+/// composite inertia to the parent, and transforms the force columns of its whole subtree (about nv
+/// of them) by it. Pinocchio's free-flyer is one joint: it does this once for 6 columns together.
+/// The same calls as crba_blocks, on the model's own data, without the rest of the algorithm.
+fn free_flyer_crba_share(model: &kinedyn_core::Model, data: &mut Data, tree: &models::TreeFile, filter: &str) {
+    use kinedyn_core::algorithms::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
+    use kinedyn_core::model::{Block, Coordinates};
+    use kinedyn_core::spatial::{Force, Inertia, Vec3};
+    if !matches!(model.coordinates.first(), Some(Coordinates::Head { block: Block::FreeFlyer, .. })) || model.parent[0].is_some() {
+        return;
+    }
+    let key = format!("{}/crba_free_flyer_members", tree.name);
+    if !key.contains(filter) {
+        return;
+    }
+    let (n, q) = (model.n, &tree.q);
+    joint_trig(model, data, q);
+    let (sin, cos) = (data.sin.clone(), data.cos.clone());
+    let ic: Vec<Inertia> = model.inertia.clone();
+    let mut to_parent = vec![Inertia::zero(); n];
+    let mut f: Vec<Force> = (0..n).map(|k| Force::new(Vec3::new(k as f64, 1.0, -2.0), Vec3::new(0.5, k as f64, 3.0))).collect();
+    let ns = min_ns(|| {
+        for i in (2..=5).rev() {
+            let x = parent_from_body_trig(model, black_box(q), &sin, &cos, i);
+            to_parent[i - 1] = inertia_to_parent(model, i, &x, sin[i], cos[i], &ic[i]);
+            for fk in &mut f[i..n] {
+                *fk = x.act_force(fk);
+            }
+        }
+        black_box((&to_parent, &f));
+    });
+    println!("{key:28} {ns:8.1}");
+    // the free-flyer's six rows of M: members 1..=5 project their subtree's columns (s_i^T F_k, both
+    // triangles written, the column strided), the root's row comes from body 1 (w^T F_k)
+    let m = &mut data.m;
+    let w = kinedyn_core::spatial::Motion::new(Vec3::new(0.3, -0.2, 0.1), Vec3::new(0.5, 0.7, -0.4));
+    let rows = min_ns(|| {
+        for i in 1..=5 {
+            let joint = &model.joints[i];
+            for k in i..n {
+                let h = joint.project(black_box(&f[k]));
+                m[i * n + k] = h;
+                m[k * n + i] = h;
+            }
+        }
+        for k in 1..n {
+            let h = w.dot(black_box(&f[k]));
+            m[k] = h;
+            m[k * n] = h;
+        }
+        black_box(&m);
+    });
+    println!("{:28} {rows:8.1}", format!("{}/crba_free_flyer_rows", tree.name));
 }

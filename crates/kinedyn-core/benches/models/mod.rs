@@ -66,3 +66,103 @@ pub fn state(n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let qdd = (0..n).map(|i| -0.5 + 0.3 * i as f64).collect();
     (q, qd, qdd)
 }
+
+/// A floating-base robot read from a tree file of `benches/cpp/dump_tree.py` (the C++ harness builds
+/// Pinocchio's model from the same file): its name, model and state `(q, v, a)`.
+#[allow(dead_code)]
+pub struct TreeFile {
+    pub name: String,
+    pub model: Model,
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    /// kinedyn's Python `inverse_dynamics` at the state (a third side of the check).
+    pub expect_rnea: Vec<f64>,
+}
+
+#[allow(dead_code)]
+fn parse_numbers(path: &str, line: &str, words: &mut std::str::SplitWhitespace, count: usize) -> Vec<f64> {
+    let out: Vec<f64> = words.by_ref().take(count).map(|w| w.parse().unwrap_or_else(|e| panic!("{path}: '{w}' in '{line:.40}...': {e}"))).collect();
+    assert_eq!(out.len(), count, "{path}: too few numbers in '{line:.40}...'");
+    out
+}
+
+/// Build the kinedyn-core model of a tree file: a free-flyer body becomes six native bodies (linear
+/// x, y, z then angular x, y, z of the child frame, the head reading q's block, the last carrying the
+/// link), as `python/kinedyn/robot.py`'s `_model` compiles it; revolute and prismatic joints one each.
+#[allow(dead_code)]
+pub fn read_tree(path: &str) -> TreeFile {
+    use kinedyn_core::model::{Block, Coordinates};
+    use kinedyn_core::JointKind::{Prismatic, Revolute};
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+    let mut lines = text.lines();
+    let mut next = |key: &str| -> (String, Vec<String>) {
+        let line = lines.next().unwrap_or_else(|| panic!("{path}: ends before its '{key}' line")).to_string();
+        let mut words = line.split_whitespace();
+        let got = words.next().unwrap_or("");
+        assert_eq!(got, key, "{path}: expected a '{key}' line");
+        let rest = words.map(str::to_string).collect();
+        (line, rest)
+    };
+    let name = next("robot").1[0].clone();
+    let sizes: Vec<usize> = next("sizes").1.iter().map(|w| w.parse().unwrap()).collect();
+    let (nq, nv, nbodies) = (sizes[0], sizes[1], sizes[2]);
+    let g: Vec<f64> = next("gravity").1.iter().map(|w| w.parse().unwrap()).collect();
+    let (mut parent, mut joints, mut placements, mut inertias, mut coordinates) = (vec![], vec![], vec![], vec![], vec![]);
+    let mut last_of_body: Vec<usize> = vec![];
+    let mut at = 0usize;
+    for b in 0..nbodies {
+        let (line, words) = next("body");
+        let joined = words.join(" ");
+        let mut w = joined.split_whitespace();
+        let p: i64 = w.next().unwrap().parse().unwrap();
+        let kind = w.next().unwrap().to_string();
+        let x = parse_numbers(path, &line, &mut w, 28);
+        let axis = Vec3::new(x[0], x[1], x[2]);
+        let rot = Mat3::new(x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11]);
+        let placement = Transform::new(rot, Vec3::new(x[12], x[13], x[14]));
+        let (mass, c) = (x[15], Vec3::new(x[16], x[17], x[18]));
+        let i_c = Mat3::new(x[19], x[20], x[21], x[22], x[23], x[24], x[25], x[26], x[27]);
+        let sc = kinedyn_core::spatial::skew(&c);
+        let inertia = Inertia::new(mass, mass * c, i_c - mass * sc * sc); // about the body origin
+        let parent_body = if p < 0 { None } else { Some(last_of_body[p as usize]) };
+        let first = parent.len();
+        match kind.as_str() {
+            "free" => {
+                for k in 0..6 {
+                    let column = Joint { kind: if k < 3 { Prismatic } else { Revolute }, axis: Vec3::ith(k % 3, 1.0) };
+                    joints.push(column);
+                    parent.push(if k == 0 { parent_body } else { Some(first + k - 1) });
+                    placements.push(if k == 0 { placement } else { Transform::identity() });
+                    inertias.push(if k == 5 { inertia } else { Inertia::zero() });
+                    coordinates.push(if k == 0 { Coordinates::Head { block: Block::FreeFlyer, at } } else { Coordinates::Member });
+                }
+                at += 7;
+            }
+            "revolute" | "prismatic" => {
+                joints.push(Joint { kind: if kind == "revolute" { Revolute } else { Prismatic }, axis });
+                parent.push(parent_body);
+                placements.push(placement);
+                inertias.push(inertia);
+                coordinates.push(Coordinates::Scalar { at });
+                at += 1;
+            }
+            other => panic!("{path}: body {b} has unknown joint kind '{other}'"),
+        }
+        last_of_body.push(parent.len() - 1);
+    }
+    let n = parent.len();
+    assert_eq!((at, n), (nq, nv), "{path}: built nq, nv = {at}, {n}, the file says {nq}, {nv}");
+    let z = vec![0.0; n];
+    let model = Model::new(parent, joints, z.clone(), placements, inertias, z.clone(), z.clone(), z, Vec3::new(g[0], g[1], g[2]), vec![])
+        .and_then(|m| m.with_coordinates(coordinates))
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut vector = |key: &str, len: usize| -> Vec<f64> {
+        let (line, words) = next(key);
+        let joined = words.join(" ");
+        parse_numbers(path, &line, &mut joined.split_whitespace(), len)
+    };
+    let (q, v, a) = (vector("q", nq), vector("v", nv), vector("a", nv));
+    let expect_rnea = vector("expect_rnea", nv);
+    TreeFile { name, model, q, v, a, expect_rnea }
+}
