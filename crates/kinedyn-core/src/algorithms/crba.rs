@@ -14,7 +14,7 @@
 
 use super::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
 use crate::data::Data;
-use crate::model::Model;
+use crate::model::{Coordinates, Model};
 
 /// `M(q)` written row-major to `data.m` (n x n), armature included.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
@@ -70,6 +70,13 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
             m[k * n + i] = h;
         }
         m[i * n + i] += armature[i];
+        if !model.plain && model.coordinates[i] == Coordinates::Member && parent[p].is_some() {
+            // a further body of a multi-DOF joint sits at the identity on the body before it: the
+            // composite inertia and the subtree's force columns carry over unchanged
+            let c = ic[i];
+            ic[p] += c;
+            continue;
+        }
         // ^λX_i = X_T(i) X_J(q_i), used on forces (its dual inverse)
         let x = parent_from_body_trig(model, q, sin, cos, i);
         if parent[p].is_none() {
