@@ -47,7 +47,7 @@ import kinedyn as kd  # noqa: E402
 def load_floating(name: str):
     """(kinedyn robot, Pinocchio model, q index map, v index map): ``q_pin = q[q_map]``, ``v_pin = v[v_map]``."""
     path = str(erd_robots_dir() / FLOATING_URDFS[name])
-    robot = without_friction(kd.Robot.from_urdf(path, floating_base=True))
+    robot = without_friction(kd.Robot.from_urdf(path, floating_base=True, mimic="independent"))  # as Pinocchio builds it
     model = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
     assert (model.nq, model.nv) == (robot.nq, robot.nv), (name, model.nq, model.nv, robot.nq, robot.nv)
     q_at = np.cumsum([0] + [j.nq for j in robot.joints])

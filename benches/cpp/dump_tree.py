@@ -46,7 +46,8 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
     import kinedyn as kd
 
     urdf = name.removesuffix("_fixed")
-    robot = without_friction(kd.Robot.from_urdf(str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name))
+    # every joint its own coordinate, as Pinocchio builds the file (mimic="independent")
+    robot = without_friction(kd.Robot.from_urdf(str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name, mimic="independent"))
     if np.any(np.asarray(robot.armature) != 0):
         raise SystemExit(f"{name}: the harnesses leave rotor inertia (armature) out; this robot has some")
     bodies = robot.tree.bodies
