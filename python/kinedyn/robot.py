@@ -90,10 +90,9 @@ def _locked_block(joint, block) -> np.ndarray:
         T[:3, :3] = c * np.eye(3) + s * K + (1 - c) * np.outer(n, n)
         T[:3, 3] = b[0] * e1 + b[1] * e2
         return T
-    x, y, z, w = b[-4:]
-    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    from .configuration import quaternion_to_matrix
+
+    T[:3, :3] = quaternion_to_matrix(b[-4:])
     if joint.kind == "floating":
         T[:3, 3] = b[:3]
     return T

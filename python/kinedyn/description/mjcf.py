@@ -53,13 +53,12 @@ import math
 import os
 import types
 import warnings
-import xml.etree.ElementTree as ET
 from typing import Optional
-from xml.parsers import expat
 
 import numpy as np
 
 from .checks import LARGEST
+from .bounded_xml import parse_bounded
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
@@ -190,44 +189,11 @@ def _read(path: str, src: _Sources, element=None) -> bytes:
 
 def _parse_xml(data: bytes, label: str, src: _Sources):
     """The root element of ``data``, parsed by expat without entity declarations and with bounded depth."""
-    builder = ET.TreeBuilder()
-    parser = expat.ParserCreate()
-    depth = 0
 
-    def start(tag, attributes):
-        nonlocal depth
-        depth += 1
-        if depth > MAX_DEPTH:
-            raise ValueError(f"{label}:{parser.CurrentLineNumber}: elements nested deeper than {MAX_DEPTH} levels")
-        src.where[id(builder.start(tag, attributes))] = (label, parser.CurrentLineNumber)
+    def record(element, line):
+        src.where[id(element)] = (label, line)
 
-    def end(tag):
-        nonlocal depth
-        depth -= 1
-        builder.end(tag)
-
-    def doctype(name, system_id, public_id, has_internal_subset):
-        if has_internal_subset or system_id or public_id:
-            raise ValueError(
-                f"{label}:{parser.CurrentLineNumber}: a DOCTYPE with declarations or an external DTD is not accepted "
-                "in an MJCF model (entity expansion is unbounded work); remove it"
-            )
-
-    def entity(name, *args):
-        raise ValueError(f"{label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in an MJCF model")
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.StartDoctypeDeclHandler = doctype
-    parser.EntityDeclHandler = entity
-    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
-    try:
-        parser.Parse(data, True)
-    except expat.ExpatError as e:
-        raise ValueError(f"{label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}") from None
-    except LookupError as e:
-        raise ValueError(f"{label}: the XML declaration names an unknown encoding ({e})") from None
-    return builder.close()
+    return parse_bounded(data, label, "an MJCF model", MAX_DEPTH, record)
 
 
 def _expand_includes(element, src: _Sources, folder: Optional[str], depth: int) -> None:

@@ -40,14 +40,13 @@ import os
 import re
 import types
 import warnings
-import xml.etree.ElementTree as ET
 from typing import Optional
-from xml.parsers import expat
 
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
 from .checks import LARGEST
+from .bounded_xml import parse_bounded
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint, Mimic
@@ -185,46 +184,11 @@ def _parse(path_or_string, source_path: Optional[str] = None):
                 data = f.read()  # bytes: expat honours the file's encoding declaration
         except OSError as e:
             raise ValueError(f"{text}: cannot read URDF file ({e.strerror or e})") from None
-    builder = ET.TreeBuilder()
-    parser = expat.ParserCreate()
-    depth = 0
 
-    def start(tag, attributes):
-        nonlocal depth
-        depth += 1
-        if depth > MAX_DEPTH:
-            raise ValueError(f"{src.label}:{parser.CurrentLineNumber}: elements nested deeper than {MAX_DEPTH} levels")
-        src.lines[id(builder.start(tag, attributes))] = parser.CurrentLineNumber
+    def record(element, line):
+        src.lines[id(element)] = line
 
-    def end(tag):
-        nonlocal depth
-        depth -= 1
-        builder.end(tag)
-
-    def doctype(name, system_id, public_id, has_internal_subset):
-        if has_internal_subset or system_id or public_id:
-            raise ValueError(
-                f"{src.label}:{parser.CurrentLineNumber}: a DOCTYPE with declarations or an external DTD is not "
-                "accepted in a URDF (entity expansion is unbounded work); remove it"
-            )
-
-    def entity(name, *args):
-        raise ValueError(f"{src.label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in a URDF")
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.StartDoctypeDeclHandler = doctype
-    parser.EntityDeclHandler = entity
-    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
-    try:
-        parser.Parse(data, True)
-    except expat.ExpatError as e:
-        raise ValueError(
-            f"{src.label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}"
-        ) from None
-    except LookupError as e:  # an XML declaration naming an encoding Python does not know
-        raise ValueError(f"{src.label}: the XML declaration names an unknown encoding ({e})") from None
-    return src, builder.close()
+    return src, parse_bounded(data, src.label, "a URDF", MAX_DEPTH, record)
 
 
 def _floats(text: Optional[str], n: int, default, what: str, element, src: _Source) -> tuple:
