@@ -81,10 +81,41 @@ fn main() {
         run("rnea_derivatives_f_ext", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), Some(&fx), &mut d1, &mut d2, None));
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
+        bench_batches(name, &model, &filter);
     }
     let trees = std::env::var("KINEDYN_BENCH_TREES").unwrap_or_default();
     for path in trees.split(':').filter(|p| !p.is_empty()) {
         bench_tree(&models::read_tree(path), &filter);
+    }
+}
+
+/// Per state, batches of 1024 random states on one thread (issue 17): rnea, crba and aba with
+/// each lane kind this CPU runs (`<model>/<alg>_batch_<kind>`; `off` is one state at a time).
+fn bench_batches(name: &str, model: &kinedyn_core::Model, filter: &str) {
+    use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
+    const STATES: usize = 1024;
+    let mut rng = kinedyn_core::testing::Rng::new(17);
+    let q: Vec<f64> = (0..STATES).flat_map(|_| kinedyn_core::testing::random_configuration(model, &mut rng)).collect();
+    let (qd, qdd) = (rng.vector(STATES * model.n, -2.0, 2.0), rng.vector(STATES * model.n, -2.0, 2.0));
+    let mut scratch = Scratch::new(model);
+    let mut tau = vec![0.0; STATES * model.n];
+    let x3 = [Input { values: &q, width: model.nq }, Input { values: &qd, width: model.n }, Input { values: &qdd, width: model.n }];
+    batch::run(model, &mut scratch, &kernels::InverseDynamics, &x3, &mut tau, Simd::Off).unwrap();
+    let aba_in = [x3[0], x3[1], Input { values: &tau, width: model.n }];
+    for simd in [Simd::Off, Simd::Portable, Simd::Avx2, Simd::Avx512].into_iter().filter(|s| s.is_supported()) {
+        let mut time = |alg: &str, kernel: &dyn Fn(&mut Scratch)| {
+            let key = format!("{name}/{alg}_batch_{}", simd.name());
+            if key.contains(filter) {
+                println!("{key:28} {:8.1}", min_ns(|| kernel(&mut scratch)) / STATES as f64);
+            }
+        };
+        fn go<K: Kernel>(model: &kinedyn_core::Model, s: &mut Scratch, k: &K, x: &[Input], simd: Simd) {
+            let mut out = vec![0.0; STATES * k.output_len(model)];
+            batch::run(model, s, k, x, black_box(&mut out), simd).unwrap();
+        }
+        time("rnea", &|s| go(model, s, &kernels::InverseDynamics, &x3, simd));
+        time("crba", &|s| go(model, s, &kernels::MassMatrix, &x3[..1], simd));
+        time("aba", &|s| go(model, s, &kernels::ForwardDynamics, &aba_in, simd));
     }
 }
 

@@ -1,6 +1,6 @@
 //! Joint kinds and the one function that decodes them, `jcalc` (RBDA §4.4, Table 4.1).
 
-use crate::spatial::{Force, Inertia, Mat3, Motion, Transform, Vec3};
+use crate::spatial::{cross, mm, mv, splat3, Force, Inertia, Mat3, Motion, Real, Transform, Vec3};
 
 /// The closed set of joint kinds of the compiled model (fixed joints are merged at build time).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,9 +26,10 @@ pub fn axis_angle(a: &Vec3, angle: f64) -> Mat3 {
 }
 
 /// `axis_angle` from the sine and cosine of the angle.
-#[inline]
-fn axis_angle_trig(a: &Vec3, s: f64, c: f64) -> Mat3 {
-    let v = 1.0 - c;
+#[inline(always)]
+fn axis_angle_trig<T: Real>(a: &Vec3, s: T, c: T) -> Mat3<T> {
+    let v = T::one() - c;
+    let a = &splat3::<T>(a);
     Mat3::new(
         c + a.x * a.x * v,
         a.x * a.y * v - a.z * s,
@@ -45,7 +46,7 @@ fn axis_angle_trig(a: &Vec3, s: f64, c: f64) -> Mat3 {
 /// `R` with columns i and j replaced by `c r_i + s r_j` and `c r_j - s r_i` (`R Rz(x)` for
 /// `(i, j) = (0, 1)`, `R Rx(x)` for `(1, 2)`, `R Ry(x)` for `(2, 0)`).
 #[inline(always)]
-fn rotate_columns<const I: usize, const J: usize>(r: &Mat3, c: f64, s: f64) -> Mat3 {
+fn rotate_columns<const I: usize, const J: usize, T: Real>(r: &Mat3<T>, c: T, s: T) -> Mat3<T> {
     let mut rot = *r;
     for k in 0..3 {
         let (ri, rj) = (r[(k, I)], r[(k, J)]);
@@ -85,76 +86,80 @@ impl Joint {
     /// `compose` with `(s, c) = (sin x, cos x)` given (computed for all joints at once by
     /// `kinematics::joint_trig`, so that their polynomial evaluations overlap).
     #[inline(always)]
-    pub fn compose_trig(&self, parent_from_joint: &Transform, x: f64, s: f64, c: f64) -> Transform {
-        let r = &parent_from_joint.rot;
+    pub fn compose_trig<T: Real>(&self, parent_from_joint: &Transform, x: T, s: T, c: T) -> Transform<T> {
+        let placement = parent_from_joint.splat::<T>();
+        let r = &placement.rot;
         match self.kind {
-            JointKind::Prismatic => Transform::new(*r, parent_from_joint.trans + r * (self.axis * x)),
+            JointKind::Prismatic => Transform::new(*r, placement.trans + mv(r, &(splat3::<T>(&self.axis) * x))),
             JointKind::Revolute => {
                 let a = &self.axis;
                 // columns (i, j) rotated into each other; constant indices let the compiler
                 // emit 12 multiplications and no index arithmetic
                 let rot = if a.x == 0.0 && a.y == 0.0 {
-                    Some(rotate_columns::<0, 1>(r, c, s * a.z))
+                    Some(rotate_columns::<0, 1, T>(r, c, s * T::splat(a.z)))
                 } else if a.y == 0.0 && a.z == 0.0 {
-                    Some(rotate_columns::<1, 2>(r, c, s * a.x))
+                    Some(rotate_columns::<1, 2, T>(r, c, s * T::splat(a.x)))
                 } else if a.x == 0.0 && a.z == 0.0 {
-                    Some(rotate_columns::<2, 0>(r, c, s * a.y))
+                    Some(rotate_columns::<2, 0, T>(r, c, s * T::splat(a.y)))
                 } else {
                     None
                 };
                 match rot {
-                    Some(rot) => Transform::new(rot, parent_from_joint.trans),
-                    None => Transform::new(r * axis_angle_trig(a, s, c), parent_from_joint.trans),
+                    Some(rot) => Transform::new(rot, placement.trans),
+                    None => Transform::new(mm(r, &axis_angle_trig(a, s, c)), placement.trans),
                 }
             }
         }
     }
 
     /// `s x`: the joint's twist at rate `x` (`[0; a x]` revolute, `[a x; 0]` prismatic).
-    #[inline]
-    pub fn motion(&self, x: f64) -> Motion {
+    #[inline(always)]
+    pub fn motion<T: Real>(&self, x: T) -> Motion<T> {
+        let ax = splat3::<T>(&self.axis) * x;
         match self.kind {
-            JointKind::Revolute => Motion::new(Vec3::zeros(), self.axis * x),
-            JointKind::Prismatic => Motion::new(self.axis * x, Vec3::zeros()),
+            JointKind::Revolute => Motion::new(Vec3::zeros(), ax),
+            JointKind::Prismatic => Motion::new(ax, Vec3::zeros()),
         }
     }
 
     /// `s^T f`: the component of a force along the joint (3 products instead of 6).
-    #[inline]
-    pub fn project(&self, f: &Force) -> f64 {
+    #[inline(always)]
+    pub fn project<T: Real>(&self, f: &Force<T>) -> T {
+        let a = splat3::<T>(&self.axis);
         match self.kind {
-            JointKind::Revolute => self.axis.dot(&f.ang),
-            JointKind::Prismatic => self.axis.dot(&f.lin),
+            JointKind::Revolute => a.dot(&f.ang),
+            JointKind::Prismatic => a.dot(&f.lin),
         }
     }
 
     /// `v x (s x)` (RBDA's velocity-product term), using the zero half of `s`:
     /// revolute `[v_lin x w; v_ang x w]` with `w = a x`, prismatic `[v_ang x l; 0]` with `l = a x`.
-    #[inline]
-    pub fn cross(&self, v: &Motion, x: f64) -> Motion {
-        let ax = self.axis * x;
+    #[inline(always)]
+    pub fn cross<T: Real>(&self, v: &Motion<T>, x: T) -> Motion<T> {
+        let ax = splat3::<T>(&self.axis) * x;
         match self.kind {
-            JointKind::Revolute => Motion::new(v.lin.cross(&ax), v.ang.cross(&ax)),
-            JointKind::Prismatic => Motion::new(v.ang.cross(&ax), Vec3::zeros()),
+            JointKind::Revolute => Motion::new(cross(&v.lin, &ax), cross(&v.ang, &ax)),
+            JointKind::Prismatic => Motion::new(cross(&v.ang, &ax), Vec3::zeros()),
         }
     }
 
     /// `I s` for a rigid-body inertia: revolute `[a x h; I_o a]`, prismatic `[m a; h x a]`.
-    #[inline]
-    pub fn inertia_times_s(&self, i: &Inertia) -> Force {
-        let a = &self.axis;
+    #[inline(always)]
+    pub fn inertia_times_s<T: Real>(&self, i: &Inertia<T>) -> Force<T> {
+        let a = &splat3::<T>(&self.axis);
         match self.kind {
-            JointKind::Revolute => Force::new(a.cross(&i.h), i.i_o * a),
-            JointKind::Prismatic => Force::new(a * i.mass, i.h.cross(a)),
+            JointKind::Revolute => Force::new(cross(a, &i.h), mv(&i.i_o, a)),
+            JointKind::Prismatic => Force::new(a * i.mass, cross(&i.h, a)),
         }
     }
 
     /// The motion subspace `s` in the body frame (independent of q for these kinds).
-    #[inline]
-    pub fn subspace(&self) -> Motion {
+    #[inline(always)]
+    pub fn subspace<T: Real>(&self) -> Motion<T> {
+        let a = splat3::<T>(&self.axis);
         match self.kind {
-            JointKind::Revolute => Motion::new(Vec3::zeros(), self.axis),
-            JointKind::Prismatic => Motion::new(self.axis, Vec3::zeros()),
+            JointKind::Revolute => Motion::new(Vec3::zeros(), a),
+            JointKind::Prismatic => Motion::new(a, Vec3::zeros()),
         }
     }
 }

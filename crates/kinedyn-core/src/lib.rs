@@ -5,12 +5,14 @@
 //! Featherstone's RBDA and Pinocchio. Spatial vectors are `[linear; angular]` (DESIGN.md).
 
 pub mod algorithms;
+pub mod batch;
 pub mod data;
 pub mod error;
 pub mod joint;
 pub mod lie;
 pub mod model;
 pub mod rng;
+pub mod scalar;
 pub mod spatial;
 pub mod testing;
 pub mod trig;
@@ -19,3 +21,4 @@ pub use data::Data;
 pub use error::{Error, Result};
 pub use joint::{Joint, JointKind};
 pub use model::{Frame, Model};
+pub use scalar::{Lanes, Real};

@@ -16,16 +16,17 @@
 
 use crate::error::{Error, Result};
 use crate::joint::Joint;
-use crate::spatial::{AxisRotation, Inertia, Mat3, Motion, Transform, Vec3};
+use crate::spatial::{splat3, AxisRotation, Inertia, Mat3, Motion, Real, Transform, Vec3};
 
 /// The rotation matrix of a unit quaternion `(x, y, z, w)`.
-#[inline]
-pub fn quaternion_matrix(q: &[f64]) -> Mat3 {
+#[inline(always)]
+pub fn quaternion_matrix<T: Real>(q: &[T]) -> Mat3<T> {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    let (one, two) = (T::one(), T::splat(2.0));
     Mat3::new(
-        1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w),
-        2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w),
-        2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y),
+        one - two * (y * y + z * z), two * (x * y - z * w), two * (x * z + y * w),
+        two * (x * y + z * w), one - two * (x * x + z * z), two * (y * z - x * w),
+        two * (x * z - y * w), two * (y * z + x * w), one - two * (x * x + y * y),
     )
 }
 
@@ -339,8 +340,8 @@ impl Model {
 
     /// The joint transform `joint_from_body` of the multi-DOF joint whose head is body i, from its
     /// block of q (Pinocchio's conventions: quaternion (x, y, z, w), assumed unit; planar (cos, sin)).
-    #[inline]
-    pub fn block_transform(&self, i: usize, block: Block, qb: &[f64]) -> Transform {
+    #[inline(always)]
+    pub fn block_transform<T: Real>(&self, i: usize, block: Block, qb: &[T]) -> Transform<T> {
         match block {
             Block::FreeFlyer => Transform::new(quaternion_matrix(&qb[3..7]), Vec3::new(qb[0], qb[1], qb[2])),
             Block::Spherical => Transform::new(quaternion_matrix(&qb[0..4]), Vec3::zeros()),
@@ -349,8 +350,9 @@ impl Model {
                 let n = e1.cross(&e2);
                 let (c, s) = (qb[2], qb[3]);
                 // rotation about n by th: R = c 1 + s [n]x + (1 - c) n n^T
-                let rot = Mat3::identity() * c + crate::spatial::skew(&n) * s + n * n.transpose() * (1.0 - c);
-                Transform::new(rot, e1 * qb[0] + e2 * qb[1])
+                let (skew_n, nn) = (crate::spatial::splat33::<T>(&crate::spatial::skew(&n)), crate::spatial::splat33::<T>(&(n * n.transpose())));
+                let rot = Mat3::identity() * c + skew_n * s + nn * (T::one() - c);
+                Transform::new(rot, splat3::<T>(&e1) * qb[0] + splat3::<T>(&e2) * qb[1])
             }
         }
     }
@@ -416,7 +418,7 @@ impl Model {
     /// for a 1-DOF joint; for a multi-DOF joint `v_i x (S qd)` of the whole joint on its last body,
     /// zero on the others (massless: their accelerations never act).
     #[inline(always)]
-    pub fn velocity_product(&self, i: usize, v: &Motion, qd: &[f64]) -> Motion {
+    pub fn velocity_product<T: Real>(&self, i: usize, v: &Motion<T>, qd: &[T]) -> Motion<T> {
         if self.plain {
             return self.joints[i].cross(v, qd[i]);
         }
@@ -450,15 +452,9 @@ impl Model {
 
     /// Coulomb friction torque of joint i at rate `qd`: `coulomb_i` for `qd > 0`,
     /// `-coulomb_negative_i` for `qd < 0`, 0 at rest (`coulomb_i sign(qd)` when symmetric).
-    #[inline]
-    pub fn coulomb_torque(&self, i: usize, qd: f64) -> f64 {
-        if qd > 0.0 {
-            self.coulomb[i]
-        } else if qd < 0.0 {
-            -self.coulomb_negative.as_ref().map_or(self.coulomb[i], |c| c[i])
-        } else {
-            0.0
-        }
+    #[inline(always)]
+    pub fn coulomb_torque<T: Real>(&self, i: usize, qd: T) -> T {
+        qd.signed_level(self.coulomb[i], self.coulomb_negative.as_ref().map_or(self.coulomb[i], |c| c[i]))
     }
 
     /// Whether joint i has Coulomb friction in either direction.

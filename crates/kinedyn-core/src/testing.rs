@@ -103,3 +103,100 @@ pub const UR5_DH: [(f64, f64, f64); 6] = [
     (0.09465, 0.0, -std::f64::consts::FRAC_PI_2),
     (0.0823, 0.0, 0.0),
 ];
+
+/// `random_model(seed, n, branching)` on a free-flyer base (six bodies: linear x, y, z then
+/// angular x, y, z, the last carrying a random inertia), with a spherical joint in place of its
+/// second body when `n >= 2`: the multi-DOF layout of `Model::with_coordinates`.
+pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
+    use crate::model::{Block, Coordinates};
+    let tail = random_model(seed, n, branching);
+    let mut rng = Rng::new(seed ^ 0x5eed);
+    let unit = |k: usize| Vec3::ith(k % 3, 1.0);
+    // (parent, joint, placement, inertia, coordinates) per body
+    let mut bodies: Vec<(Option<usize>, Joint, Transform, Inertia, Coordinates)> = Vec::new();
+    for k in 0..6usize {
+        let kind = if k < 3 { JointKind::Prismatic } else { JointKind::Revolute };
+        let inertia = if k == 5 { random_inertia(&mut rng) } else { Inertia::zero() };
+        let c = if k == 0 { Coordinates::Head { block: Block::FreeFlyer, at: 0 } } else { Coordinates::Member };
+        bodies.push((k.checked_sub(1), Joint { kind, axis: unit(k) }, Transform::identity(), inertia, c));
+    }
+    // tail body i -> its (last) body here; tail body 1 (if any) becomes a spherical joint
+    let mut index = vec![0usize; n];
+    let mut at = 7;
+    for i in 0..n {
+        let p = tail.parent[i].map_or(5, |p| index[p]);
+        if i == 1 {
+            for k in 0..3 {
+                let inertia = if k == 2 { tail.inertia[i] } else { Inertia::zero() };
+                let (parent, x, c) = match k {
+                    0 => (p, tail.parent_from_joint[i], Coordinates::Head { block: Block::Spherical, at }),
+                    _ => (bodies.len() - 1, Transform::identity(), Coordinates::Member),
+                };
+                bodies.push((Some(parent), Joint { kind: JointKind::Revolute, axis: unit(k) }, x, inertia, c));
+            }
+            at += 4;
+        } else {
+            bodies.push((Some(p), tail.joints[i], tail.parent_from_joint[i], tail.inertia[i], Coordinates::Scalar { at }));
+            at += 1;
+        }
+        index[i] = bodies.len() - 1;
+    }
+    let count = bodies.len();
+    // drive data of the 1-DOF joints only (a multi-DOF joint has none)
+    let scalar_only = |v: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; count];
+        for (i, x) in v.iter().enumerate().filter(|(i, _)| *i != 1) {
+            out[index[i]] = *x;
+        }
+        out
+    };
+    let frames = (0..n).map(|b| Frame { body: Some(index[b]), body_from_frame: tail.frames[b].body_from_frame }).collect();
+    Model::new(
+        bodies.iter().map(|b| b.0).collect(),
+        bodies.iter().map(|b| b.1).collect(),
+        scalar_only(&tail.offset),
+        bodies.iter().map(|b| b.2).collect(),
+        bodies.iter().map(|b| b.3).collect(),
+        scalar_only(&tail.armature),
+        scalar_only(&tail.viscous),
+        scalar_only(&tail.coulomb),
+        tail.gravity,
+        frames,
+    )
+    .and_then(|m| m.with_coordinates(bodies.iter().map(|b| b.4).collect()))
+    .expect("random floating models are valid by construction")
+}
+
+/// A random configuration of `model` (nq numbers): joint coordinates in `[-3, 3]`, unit quaternions
+/// for free-flyer and spherical joints, `(cos, sin)` of a random angle for planar ones.
+pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
+    use crate::model::{Block, Coordinates};
+    let mut q = vec![0.0; model.nq];
+    for c in &model.coordinates {
+        match *c {
+            Coordinates::Scalar { at } => q[at] = rng.uniform(-3.0, 3.0),
+            Coordinates::Head { block, at } => {
+                let (start, quaternion) = match block {
+                    Block::FreeFlyer => (at + 3, true),
+                    Block::Spherical => (at, true),
+                    Block::Planar => (at + 2, false),
+                };
+                for k in at..start {
+                    q[k] = rng.uniform(-1.0, 1.0);
+                }
+                if quaternion {
+                    let v: Vec<f64> = (0..4).map(|_| rng.uniform(-1.0, 1.0)).collect();
+                    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    for k in 0..4 {
+                        q[start + k] = v[k] / norm;
+                    }
+                } else {
+                    let th = rng.uniform(-3.0, 3.0);
+                    (q[start], q[start + 1]) = (th.cos(), th.sin());
+                }
+            }
+            Coordinates::Member => {}
+        }
+    }
+    q
+}

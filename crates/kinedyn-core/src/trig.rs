@@ -39,7 +39,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 
 /// `x[i] <- sin x[i]`, `cos[i] <- cos x[i]` for every i: the same numbers as [`sin_cos`], in a
 /// branch-free loop the compiler vectorises when every `|x| < 1e5` (joint angles always are).
-#[inline]
+#[inline(always)]
 pub fn sin_cos_in_place(x: &mut [f64], cos: &mut [f64]) {
     let cos = &mut cos[..x.len()];
     if x.iter().all(|v| v.abs() < LIMIT) {

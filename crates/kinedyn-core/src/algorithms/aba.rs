@@ -22,7 +22,7 @@ use super::rnea::friction;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::{ArticulatedInertia, Force, Motion};
+use crate::spatial::{mtv, splat3, ArticulatedInertia, Force, Motion, Real, Vec3};
 
 /// Relative size under which `D_i` counts as zero (`D_i <= EPS_D * trace(IA_i)`).
 const EPS_D: f64 = 1e-13;
@@ -31,7 +31,8 @@ const EPS_D: f64 = 1e-13;
 const HUGE_TRACE: f64 = 1e200;
 
 /// `qdd = aba(q, qd, tau, f_ext)` written to `data.qdd`; `f_ext` as in [`super::rnea::rnea`].
-pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[f64], f_ext: Option<&[f64]>) -> Result<&'d [f64]> {
+#[inline(always)]
+pub fn aba<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], tau: &[T], f_ext: Option<&[T]>) -> Result<&'d [T]> {
     let n = model.n;
     if f_ext.is_some() {
         forward_kinematics(model, data, q);
@@ -52,13 +53,13 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         data.v[i] = v;
         data.c[i] = model.velocity_product(i, &v, qd);
         // I^A_i = I_i ;  p^A_i = v_i x* I_i v_i - ^iX_0^* f^x_i
-        let inertia = &model.inertia[i];
+        let inertia = &model.inertia[i].splat::<T>();
         data.ia[i] = ArticulatedInertia::from(inertia);
         let mut pa = v.cross_force(&inertia.mul_motion(&v));
         if let Some(fx) = f_ext {
             let r = &data.world_from_body[i].rot;
-            let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
-            pa -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
+            let fw = Force::new(Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+            pa -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
         }
         data.pa[i] = pa;
     }
@@ -68,9 +69,12 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         let ia = data.ia[i];
         // U_i = I^A_i s_i ;  D_i = s_i^T U_i + armature_i ;  u_i = tau_i - friction_i - s_i^T p^A_i
         let u_f = ia.times_s(joint);
-        let d = joint.project(&u_f) + model.armature[i];
-        if !(d > EPS_D * (ia.trace() + model.armature[i])) || !d.is_finite() {
-            let trace = ia.trace() + model.armature[i];
+        let armature = model.armature[i];
+        let d = joint.project(&u_f) + T::splat(armature);
+        let trace = ia.trace() + T::splat(armature);
+        // the pivot test lane by lane (one lane per state of a batch)
+        if let Some(k) = (0..T::LANES).find(|&k| !(d.lane(k) > EPS_D * trace.lane(k)) || !d.lane(k).is_finite()) {
+            let (d, trace) = (d.lane(k), trace.lane(k));
             let why = if !d.is_finite() || !trace.is_finite() || trace.abs().max(d.abs()) > HUGE_TRACE {
                 "an inertia or a state too large for float64".to_string()
             } else if d < 0.0 {
@@ -90,7 +94,7 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
                 "joint {i} has articulated inertia D = {d:e} about its axis ({why}); forward dynamics is undefined"
             )));
         }
-        let d_inv = 1.0 / d;
+        let d_inv = T::one() / d;
         let u = tau[i] - friction(model, i, qd[i]) - joint.project(&data.pa[i]);
         data.u_f[i] = u_f;
         data.d_inv[i] = d_inv;
@@ -111,7 +115,7 @@ pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], tau: &[
         }
     }
     // pass 3, root to leaves
-    let a0 = Motion::new(-model.gravity, Default::default());
+    let a0 = Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros());
     for i in 0..n {
         // a'_i = ^iX_λ a_λ + c_i ;  qdd_i = D_i^-1 (u_i - U_i^T a'_i) ;  a_i = a'_i + s_i qdd_i
         let ap = match model.parent[i] {

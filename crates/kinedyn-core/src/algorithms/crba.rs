@@ -15,9 +15,11 @@
 use super::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
 use crate::data::Data;
 use crate::model::{Coordinates, Model};
+use crate::spatial::Real;
 
 /// `M(q)` written row-major to `data.m` (n x n), armature included.
-pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
+#[inline(always)]
+pub fn crba<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T]) -> &'d [T] {
     if model.subtrees_contiguous {
         crba_blocks(model, data, q);
     } else {
@@ -32,31 +34,34 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
 /// `s_i^T F_k` over the range, and one transform `^λX_i^*` moves the block to the parent. The
 /// transforms are computed in the same backward pass (no separate forward pass, nothing stored),
 /// and the column loops have independent iterations (no chain of dependent transforms per entry).
-fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
+#[inline(always)]
+fn crba_blocks<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     let n = model.n;
     joint_trig(model, data, q);
     let (parent, joints, armature, end) = (&model.parent[..n], &model.joints[..n], &model.armature[..n], &model.subtree_end[..n]);
     let (ic, m, f) = (&mut data.ic[..n], &mut data.m[..n * n], &mut data.f[..n]);
     let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
     // I^c_i = I_i ;  H_rr = 0 for the roots r (their children add to it, see below)
-    ic.copy_from_slice(&model.inertia[..n]);
+    for (c, i) in ic.iter_mut().zip(&model.inertia[..n]) {
+        *c = i.splat();
+    }
     for (r, p) in parent.iter().enumerate() {
         if p.is_none() {
-            m[r * n + r] = 0.0;
+            m[r * n + r] = T::zero();
         }
     }
     for i in (0..n).rev() {
         let (joint, e) = (&joints[i], end[i]);
         // bodies after the subtree are on other branches: H_ik = H_ki = 0
         for k in e..n {
-            m[i * n + k] = 0.0;
-            m[k * n + i] = 0.0;
+            m[i * n + k] = T::zero();
+            m[k * n + i] = T::zero();
         }
         let p = match parent[i] {
             None => {
                 // a root: its row beyond the diagonal came from its children;
                 // H_ii += s_i^T I_i s_i (+ armature_i)
-                m[i * n + i] += joint.project(&joint.inertia_times_s(&ic[i])) + armature[i];
+                m[i * n + i] += joint.project(&joint.inertia_times_s(&ic[i])) + T::splat(armature[i]);
                 continue;
             }
             Some(p) => p,
@@ -69,7 +74,7 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
             m[i * n + k] = h;
             m[k * n + i] = h;
         }
-        m[i * n + i] += armature[i];
+        m[i * n + i] += T::splat(armature[i]);
         if !model.plain && model.coordinates[i] == Coordinates::Member && parent[p].is_some() {
             // a further body of a multi-DOF joint sits at the identity on the body before it: the
             // composite inertia and the subtree's force columns carry over unchanged
@@ -83,7 +88,7 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
             // the parent is a root: only its row is left to compute, and s_λ^T ^λX_i^* F_k is
             // w^T F_k with w = ^iX_λ s_λ (s_λ in body i's frame); its composite inertia enters
             // only H_λλ = s_λ^T I_λ s_λ + sum over children of w^T I^c_i w
-            let w = x.inv_act_motion(&joints[p].subspace());
+            let w = x.inv_act_motion(&joints[p].subspace::<T>());
             for k in i..e {
                 let h = w.dot(&f[k]);
                 m[p * n + k] = h;
@@ -103,7 +108,8 @@ fn crba_blocks(model: &Model, data: &mut Data, q: &[f64]) {
 }
 
 /// RBDA Table 6.2 entry by entry, `F` carried up the support of each body (any numbering).
-fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
+#[inline(always)]
+fn crba_chains<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     let n = model.n;
     joint_trig(model, data, q);
     // per-body arrays sliced to n once (no bounds checks in the loops below)
@@ -113,7 +119,7 @@ fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
     for i in 0..n {
         // X_J = jcalc(q_i);  ^iX_λ(i) = X_J X_T(i);  I^c_i = I_i
         x_up[i] = parent_from_body_trig(model, q, sin, cos, i);
-        ic[i] = model.inertia[i];
+        ic[i] = model.inertia[i].splat();
     }
     for i in (0..n).rev() {
         // I^c_λ(i) += ^λX_i^* I^c_i ^iX_λ
@@ -123,7 +129,7 @@ fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
         }
         // F = I^c_i s_i ;  H_ii = s_i^T F (+ armature_i)
         let mut f = joints[i].inertia_times_s(&ic[i]);
-        m[i * n + i] = joints[i].project(&f) + armature[i];
+        m[i * n + i] = joints[i].project(&f) + T::splat(armature[i]);
         // j = i; while λ(j) != 0: F = ^λX_j^* F; j = λ(j); H_ij = H_ji = F^T s_j
         let mut j = i;
         while let Some(p) = parent[j] {
@@ -139,13 +145,14 @@ fn crba_chains(model: &Model, data: &mut Data, q: &[f64]) {
 }
 
 /// Zero `M[i][j]` for joints i, j where neither supports the other (branching trees only).
-fn zero_unrelated(model: &Model, m: &mut [f64]) {
+#[inline(always)]
+fn zero_unrelated<T: Real>(model: &Model, m: &mut [T]) {
     let n = model.n;
     for i in 0..n {
         for j in 0..i {
             if !is_ancestor(model, j, i) {
-                m[i * n + j] = 0.0;
-                m[j * n + i] = 0.0;
+                m[i * n + j] = T::zero();
+                m[j * n + i] = T::zero();
             }
         }
     }

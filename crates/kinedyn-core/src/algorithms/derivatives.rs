@@ -47,14 +47,14 @@ use super::rnea::rnea;
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Vec3};
+use crate::spatial::{Force, Motion, Real, Vec3};
 
 /// The derivatives of one body's twist, acceleration and composite force along one coordinate.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Tangent {
-    pub dv: Motion,
-    pub da: Motion,
-    pub dfc: Force,
+pub struct Tangent<T: Real = f64> {
+    pub dv: Motion<T>,
+    pub da: Motion<T>,
+    pub dfc: Force<T>,
 }
 
 /// `dtau/dq` and `dtau/dqd` (row-major n x n: `[i * n + j] = dtau_i / dx_j`) at `(q, qd, qdd)`,

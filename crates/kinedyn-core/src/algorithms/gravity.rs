@@ -16,9 +16,11 @@ use super::kinematics::joint_transforms;
 use crate::data::Data;
 use crate::joint::JointKind;
 use crate::model::Model;
+use crate::spatial::{cross, mtv, mv, splat3, Real};
 
 /// `g(q)` written to `data.tau`.
-pub fn gravity_torque<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
+#[inline(always)]
+pub fn gravity_torque<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T]) -> &'d [T] {
     let n = model.n;
     joint_transforms(model, data, q);
     for i in 0..n {
@@ -26,25 +28,26 @@ pub fn gravity_torque<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [
         let x_up = data.parent_from_body[i];
         let g_parent = match model.parent[i] {
             Some(p) => data.g_b[p],
-            None => model.gravity,
+            None => splat3(&model.gravity),
         };
-        data.g_b[i] = x_up.rot.tr_mul(&g_parent);
-        data.mc[i] = model.inertia[i].mass;
-        data.hc[i] = model.inertia[i].h;
+        data.g_b[i] = mtv(&x_up.rot, &g_parent);
+        data.mc[i] = T::splat(model.inertia[i].mass);
+        data.hc[i] = splat3(&model.inertia[i].h);
     }
     for i in (0..n).rev() {
         // tau_i = s_i . [-m^c_i g_i ; -h^c_i x g_i]
-        let axis = &model.joints[i].axis;
+        let axis = &splat3::<T>(&model.joints[i].axis);
         data.tau[i] = match model.joints[i].kind {
-            JointKind::Revolute => -axis.dot(&data.hc[i].cross(&data.g_b[i])),
-            JointKind::Prismatic => -data.mc[i] * axis.dot(&data.g_b[i]),
+            JointKind::Revolute => -axis.dot(&cross(&data.hc[i], &data.g_b[i])),
+            JointKind::Prismatic => -(data.mc[i] * axis.dot(&data.g_b[i])),
         };
         // m^c_λ += m^c_i ;  h^c_λ += R h^c_i + m^c_i t   (first moment moved to the parent frame)
         if let Some(p) = model.parent[i] {
             let x = &data.parent_from_body[i];
-            let h = x.rot * data.hc[i] + data.mc[i] * x.trans;
+            let h = mv(&x.rot, &data.hc[i]) + x.trans * data.mc[i];
             data.hc[p] += h;
-            data.mc[p] += data.mc[i];
+            let m = data.mc[i];
+            data.mc[p] += m;
         }
     }
     &data.tau

@@ -17,13 +17,13 @@
 use super::kinematics::{forward_kinematics, joint_transforms};
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{Force, Motion};
+use crate::spatial::{mtv, splat3, Force, Motion, Real, Vec3};
 
 /// Joint friction `viscous qd + coulomb sign(qd)` of joint i (with direction-dependent Coulomb
 /// levels: [`Model::coulomb_torque`]).
-#[inline]
-pub(crate) fn friction(model: &Model, i: usize, qd: f64) -> f64 {
-    model.viscous[i] * qd + model.coulomb_torque(i, qd)
+#[inline(always)]
+pub(crate) fn friction<T: Real>(model: &Model, i: usize, qd: T) -> T {
+    T::splat(model.viscous[i]) * qd + model.coulomb_torque(i, qd)
 }
 
 /// What `rnea_with` includes besides the rigid-body terms.
@@ -43,12 +43,14 @@ impl RneaTerms {
 /// `tau = rnea(q, qd, qdd, f_ext)` with gravity, friction and armature (written to `data.tau`).
 ///
 /// `f_ext`: `n * 6` numbers, per body `[force; moment]` in base axes about the body-frame origin.
-pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>) -> &'d [f64] {
+#[inline(always)]
+pub fn rnea<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>) -> &'d [T] {
     rnea_with(model, data, q, qd, qdd, f_ext, RneaTerms::ALL)
 }
 
 /// RNEA with a choice of terms (the bias `C qd + g` is `rnea_with(q, qd, 0, None, RIGID)`).
-pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, terms: RneaTerms) -> &'d [f64] {
+#[inline(always)]
+pub fn rnea_with<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>, terms: RneaTerms) -> &'d [T] {
     let n = model.n;
     if f_ext.is_some() {
         // world_from_body rotations are needed to bring f_ext into body axes
@@ -61,7 +63,7 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
     let (qd, qdd) = (&qd[..n], &qdd[..n]);
     let (x_up, v, a, f) = (&mut data.parent_from_body[..n], &mut data.v[..n], &mut data.a[..n], &mut data.f[..n]);
     // a_0 = -g (a fictitious upward acceleration of the base replaces gravity)
-    let a0 = if terms.gravity { Motion::new(-model.gravity, Default::default()) } else { Motion::zero() };
+    let a0 = if terms.gravity { Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros()) } else { Motion::zero() };
     for i in 0..n {
         // X_J, s = jcalc(q_i);  ^iX_λ = X_J X_T (stored as its inverse, parent_from_body)
         let x = x_up[i];
@@ -74,12 +76,12 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
         let vi = vp + joint.motion(qd[i]);
         let ai = ap + joint.motion(qdd[i]) + model.velocity_product(i, &vi, qd);
         // f_i = I_i a_i + v_i x* I_i v_i - ^iX_0^* f^x_i
-        let body = &inertia[i];
+        let body = &inertia[i].splat::<T>();
         let mut fi = body.mul_motion(&ai) + vi.cross_force(&body.mul_motion(&vi));
         if let Some(fx) = f_ext {
             let r = &data.world_from_body[i].rot;
-            let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
-            fi -= Force::new(r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
+            let fw = Force::new(Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+            fi -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
         }
         v[i] = vi;
         a[i] = ai;
@@ -90,7 +92,7 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
         // tau_i = s_i^T f_i (+ armature qdd_i + friction(qd_i))
         let mut t = joints[i].project(&f[i]);
         if terms.drives {
-            t += model.armature[i] * qdd[i] + friction(model, i, qd[i]);
+            t += T::splat(model.armature[i]) * qdd[i] + friction(model, i, qd[i]);
         }
         tau[i] = t;
         // f_λ(i) += ^λX_i^* f_i
@@ -103,11 +105,12 @@ pub fn rnea_with<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64], q
 }
 
 /// The bias torque `C(q, qd) qd + g(q)`: RNEA at `qdd = 0` without friction (written to `data.tau`).
-pub fn bias_torque<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64]) -> &'d [f64] {
+#[inline(always)]
+pub fn bias_torque<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T]) -> &'d [T] {
     let n = model.n;
     // qdd = 0 is passed through data.x (no allocation)
     let mut zero = std::mem::take(&mut data.x);
-    zero[..n].fill(0.0);
+    zero[..n].fill(T::zero());
     rnea_with(model, data, q, qd, &zero, None, RneaTerms::RIGID);
     data.x = zero;
     &data.tau

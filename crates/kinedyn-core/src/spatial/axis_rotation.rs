@@ -1,4 +1,4 @@
-use super::{Inertia, Mat3};
+use super::{Inertia, Mat3, Real};
 
 /// A fixed rotation recognised as the identity or a rotation about one coordinate axis (what DH
 /// tables and most URDF `rpy` placements produce), so that moving an inertia through it costs
@@ -42,13 +42,13 @@ impl AxisRotation {
 
     /// `R I R^T` (and `R h`) with `r` the matrix this was classified from.
     #[inline(always)]
-    pub fn rotate_inertia(&self, r: &Mat3, i: &Inertia) -> Inertia {
+    pub fn rotate_inertia<T: Real>(&self, r: &Mat3, i: &Inertia<T>) -> Inertia<T> {
         match *self {
             Self::Identity => *i,
-            Self::Z { c, s } => i.rotated_about::<0, 1>(c, s),
-            Self::X { c, s } => i.rotated_about::<1, 2>(c, s),
-            Self::Y { c, s } => i.rotated_about::<2, 0>(c, s),
-            Self::General => i.rotated(r),
+            Self::Z { c, s } => i.rotated_about::<0, 1>(T::splat(c), T::splat(s)),
+            Self::X { c, s } => i.rotated_about::<1, 2>(T::splat(c), T::splat(s)),
+            Self::Y { c, s } => i.rotated_about::<2, 0>(T::splat(c), T::splat(s)),
+            Self::General => i.rotated(&super::splat33(r)),
         }
     }
 }

@@ -1,4 +1,4 @@
-use super::{Force, Inertia, Mat3, Motion, Vec3};
+use super::{cross, mm, mtv, mv, Force, Inertia, Mat3, Motion, Real, Vec3};
 use std::ops::Mul;
 
 /// A rigid transform `a_from_b`: the pose of frame b in frame a, `p_a = rot * p_b + trans`.
@@ -7,25 +7,22 @@ use std::ops::Mul;
 /// motion transform `^B X_A` (RBDA eq. 2.24) is `a_from_b.inverse()` acting on motions; the
 /// `act_*` methods map a quantity given in b's coordinates into a's, the `inv_act_*` back.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Transform {
-    pub rot: Mat3,
-    pub trans: Vec3,
+pub struct Transform<T: Real = f64> {
+    pub rot: Mat3<T>,
+    pub trans: Vec3<T>,
 }
 
-impl Default for Transform {
+impl<T: Real> Default for Transform<T> {
     fn default() -> Self {
         Self::identity()
     }
 }
 
 impl Transform {
-    #[inline]
-    pub fn new(rot: Mat3, trans: Vec3) -> Self {
-        Self { rot, trans }
-    }
-    #[inline]
-    pub fn identity() -> Self {
-        Self::new(Mat3::identity(), Vec3::zeros())
+    /// This constant transform broadcast to every lane of `T`.
+    #[inline(always)]
+    pub fn splat<T: Real>(&self) -> Transform<T> {
+        Transform::new(super::splat33(&self.rot), super::splat3(&self.trans))
     }
     /// From a row-major 4x4 homogeneous matrix (the bottom row is not read).
     pub fn from_homogeneous(m: &[f64]) -> Self {
@@ -44,66 +41,74 @@ impl Transform {
             0.0, 0.0, 0.0, 1.0,
         ]
     }
+}
+
+impl<T: Real> Transform<T> {
+    #[inline(always)]
+    pub fn new(rot: Mat3<T>, trans: Vec3<T>) -> Self {
+        Self { rot, trans }
+    }
+    #[inline(always)]
+    pub fn identity() -> Self {
+        Self::new(Mat3::identity(), Vec3::zeros())
+    }
     /// `b_from_a`.
-    #[inline]
+    #[inline(always)]
     pub fn inverse(&self) -> Self {
-        let rt = self.rot.transpose();
-        Self::new(rt, -(rt * self.trans))
+        Self::new(self.rot.transpose(), -mtv(&self.rot, &self.trans))
     }
     /// A point given in b, in a.
-    #[inline]
-    pub fn act_point(&self, p: &Vec3) -> Vec3 {
-        self.rot * p + self.trans
+    #[inline(always)]
+    pub fn act_point(&self, p: &Vec3<T>) -> Vec3<T> {
+        mv(&self.rot, p) + self.trans
     }
     /// A motion given in b's frame, expressed in a's: `w_a = R w_b`, `v_a = R v_b + t x w_a`.
-    #[inline]
-    pub fn act_motion(&self, m: &Motion) -> Motion {
-        let ang = self.rot * m.ang;
-        Motion::new(self.rot * m.lin + self.trans.cross(&ang), ang)
+    #[inline(always)]
+    pub fn act_motion(&self, m: &Motion<T>) -> Motion<T> {
+        let ang = mv(&self.rot, &m.ang);
+        Motion::new(mv(&self.rot, &m.lin) + cross(&self.trans, &ang), ang)
     }
     /// A motion given in a's frame, expressed in b's (RBDA's `^B X_A m`).
-    #[inline]
-    pub fn inv_act_motion(&self, m: &Motion) -> Motion {
-        let rt = self.rot.transpose();
-        Motion::new(rt * (m.lin - self.trans.cross(&m.ang)), rt * m.ang)
+    #[inline(always)]
+    pub fn inv_act_motion(&self, m: &Motion<T>) -> Motion<T> {
+        Motion::new(mtv(&self.rot, &(m.lin - cross(&self.trans, &m.ang))), mtv(&self.rot, &m.ang))
     }
     /// A force given in b's frame, expressed in a's: `f_a = R f_b`, `n_a = R n_b + t x f_a`.
-    #[inline]
-    pub fn act_force(&self, f: &Force) -> Force {
-        let lin = self.rot * f.lin;
-        Force::new(lin, self.rot * f.ang + self.trans.cross(&lin))
+    #[inline(always)]
+    pub fn act_force(&self, f: &Force<T>) -> Force<T> {
+        let lin = mv(&self.rot, &f.lin);
+        Force::new(lin, mv(&self.rot, &f.ang) + cross(&self.trans, &lin))
     }
     /// A force given in a's frame, expressed in b's (RBDA's `^B X_A^* f`).
-    #[inline]
-    pub fn inv_act_force(&self, f: &Force) -> Force {
-        let rt = self.rot.transpose();
-        Force::new(rt * f.lin, rt * (f.ang - self.trans.cross(&f.lin)))
+    #[inline(always)]
+    pub fn inv_act_force(&self, f: &Force<T>) -> Force<T> {
+        Force::new(mtv(&self.rot, &f.lin), mtv(&self.rot, &(f.ang - cross(&self.trans, &f.lin))))
     }
     /// A rigid-body inertia given in b's frame, expressed in a's (RBDA eq. 2.66).
-    #[inline]
-    pub fn act_inertia(&self, i: &Inertia) -> Inertia {
+    #[inline(always)]
+    pub fn act_inertia(&self, i: &Inertia<T>) -> Inertia<T> {
         i.rotated(&self.rot).translated(&self.trans)
     }
     /// A rigid-body inertia given in a's frame, expressed in b's.
-    #[inline]
-    pub fn inv_act_inertia(&self, i: &Inertia) -> Inertia {
+    #[inline(always)]
+    pub fn inv_act_inertia(&self, i: &Inertia<T>) -> Inertia<T> {
         self.inverse().act_inertia(i)
     }
 }
 
-impl Mul for Transform {
-    type Output = Transform;
+impl<T: Real> Mul for Transform<T> {
+    type Output = Transform<T>;
     /// `a_from_b * b_from_c = a_from_c`.
-    #[inline]
-    fn mul(self, o: Transform) -> Transform {
-        Transform::new(self.rot * o.rot, self.rot * o.trans + self.trans)
+    #[inline(always)]
+    fn mul(self, o: Transform<T>) -> Transform<T> {
+        Transform::new(mm(&self.rot, &o.rot), mv(&self.rot, &o.trans) + self.trans)
     }
 }
 
-impl Mul<&Transform> for &Transform {
-    type Output = Transform;
-    #[inline]
-    fn mul(self, o: &Transform) -> Transform {
-        Transform::new(self.rot * o.rot, self.rot * o.trans + self.trans)
+impl<T: Real> Mul<&Transform<T>> for &Transform<T> {
+    type Output = Transform<T>;
+    #[inline(always)]
+    fn mul(self, o: &Transform<T>) -> Transform<T> {
+        Transform::new(mm(&self.rot, &o.rot), mv(&self.rot, &o.trans) + self.trans)
     }
 }
