@@ -73,6 +73,8 @@ class Model:
 class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""
 
+def simd() -> tuple[str, int]: ...  # (kind, states per block) of batches: "avx512" | "avx2" | "portable" | "off"
+
 def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
     """TEST-ONLY: panics inside a guarded binding (on a batch worker thread if ``in_worker``), to
     check that a panic reaches Python as a RuntimeError."""

@@ -328,6 +328,8 @@ mod tests {
             ("tree", random_model(3, 9, true)),
             ("floating", random_floating_model(4, 5, false)),
             ("floating tree", random_floating_model(5, 6, true)),
+            // direction-dependent Coulomb levels (the lanes' compare-and-blend friction)
+            ("asymmetric friction", random_model(6, 4, false).with_coulomb_negative(vec![0.05, 0.7, 0.2, 0.4]).unwrap()),
         ]
     }
 

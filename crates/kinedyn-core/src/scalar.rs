@@ -357,7 +357,7 @@ pub mod x86 {
                 }
                 #[inline(always)]
                 fn signed_level(self, a: f64, b: f64) -> Self {
-                    Self::from_array(self.to_array().map(|x| x.signed_level(a, b)))
+                    self.select_signed(a, b)
                 }
                 #[inline(always)]
                 fn lane(self, k: usize) -> f64 {
@@ -371,6 +371,36 @@ pub mod x86 {
                 }
             }
         };
+    }
+
+    impl F64x4 {
+        /// `a` where > 0, `-b` where < 0, else 0 (NaN included), by compare masks and blends.
+        #[inline(always)]
+        fn select_signed(self, a: f64, b: f64) -> Self {
+            // SAFETY: AVX, as for every operation of this type
+            unsafe {
+                let zero = _mm256_setzero_pd();
+                let positive = _mm256_cmp_pd::<_CMP_GT_OQ>(self.0, zero);
+                let negative = _mm256_cmp_pd::<_CMP_LT_OQ>(self.0, zero);
+                let r = _mm256_blendv_pd(zero, _mm256_set1_pd(a), positive);
+                Self(_mm256_blendv_pd(r, _mm256_set1_pd(-b), negative))
+            }
+        }
+    }
+
+    impl F64x8 {
+        /// `a` where > 0, `-b` where < 0, else 0 (NaN included), by compare masks and blends.
+        #[inline(always)]
+        fn select_signed(self, a: f64, b: f64) -> Self {
+            // SAFETY: AVX-512F, as for every operation of this type
+            unsafe {
+                let zero = _mm512_setzero_pd();
+                let positive = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(self.0, zero);
+                let negative = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(self.0, zero);
+                let r = _mm512_mask_blend_pd(positive, zero, _mm512_set1_pd(a));
+                Self(_mm512_mask_blend_pd(negative, r, _mm512_set1_pd(-b)))
+            }
+        }
     }
 
     lane_type!(F64x4, __m256d, 4, _mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd, _mm256_div_pd, _mm256_set1_pd, _mm256_xor_pd, _mm256_setzero_pd);

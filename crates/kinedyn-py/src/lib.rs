@@ -19,6 +19,7 @@ use guard::{guarded, shape_text};
 use kinedyn_core::algorithms::{self, Reference};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::model::{Block, Coordinates};
+use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -134,6 +135,8 @@ struct Batch<'a> {
     /// At most `MAX_INPUTS` inputs, kept in arrays (no heap allocation per call).
     values: [Cow<'a, [f64]>; MAX_INPUTS],
     width: [usize; MAX_INPUTS],
+    /// How many of them the call was given.
+    count: usize,
 }
 
 impl<'a> Batch<'a> {
@@ -179,7 +182,7 @@ impl<'a> Batch<'a> {
             values[k] = data;
             width[k] = w;
         }
-        Ok(Self { batch: batch.flatten(), values, width })
+        Ok(Self { batch: batch.flatten(), values, width, count: inputs.len() })
     }
 
     /// The inputs of state `k` (at most 4 arguments per call).
@@ -216,7 +219,18 @@ impl<'a> Batch<'a> {
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
         let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
-        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], |model, data, x, [out]| kernel(model, data, x, out))?;
+        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], None, |model, data, x, [out]| kernel(model, data, x, out))?;
+        Ok(array)
+    }
+
+    /// `run_out` for a core [`Kernel`]: a batch computes several states at once in SIMD lanes
+    /// (`kinedyn_core::batch`, the lane kind chosen from the CPU), a single state with the cached
+    /// `Data`.
+    fn run_kernel<'py, Kn: Kernel>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: Kn) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
+        let simd = Simd::detected();
+        let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernel, x, out, simd);
+        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], Some(&lanes), |model, data, x, [out]| kernel.run(model, data, x, out))?;
         Ok(array)
     }
 
@@ -251,7 +265,10 @@ impl<'a> Batch<'a> {
     }
 
     /// `run` for kernels with K outputs of the same per-state shape, returned as K arrays.
-    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, what: Outputs<K>, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
+    ///
+    /// `lanes`, when given (K = 1), computes a range of a batch's states at once (`run_kernel`).
+    #[allow(clippy::too_many_arguments)]
+    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, what: Outputs<K>, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], lanes: Option<&LaneRange>, kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
@@ -292,10 +309,7 @@ impl<'a> Batch<'a> {
         let check = guard::CHECK_FINITE.load(Ordering::Relaxed);
         // states [a, b): the kernel on each, then one scan of the outputs they wrote (contiguous,
         // still in cache: a chunk of 64 states of M is 18 KiB for n = 6)
-        let states_range = |data: &mut Data, a: usize, b: usize| -> Result<(), Fault> {
-            for k in a..b {
-                kernel(&m.model, data, &self.state(k), outputs(k))?;
-            }
+        let check_range = |a: usize, b: usize| -> Result<(), Fault> {
             if check && per_state > 0 {
                 for (o, base) in bases.iter().enumerate() {
                     // SAFETY: the range just written by this thread (see `outputs`)
@@ -308,18 +322,38 @@ impl<'a> Batch<'a> {
             }
             Ok(())
         };
+        let states_range = |scratch: &mut Scratch, a: usize, b: usize| -> Result<(), Fault> {
+            match lanes {
+                Some(lanes) if K == 1 && b - a > 1 => {
+                    let inputs: [Input; MAX_INPUTS] = std::array::from_fn(|k| {
+                        let w = self.width[k];
+                        Input { values: self.values[k].get(a * w..b * w).unwrap_or(&[]), width: w }
+                    });
+                    // SAFETY: the range [a per_state, b per_state) of the one output, written by this thread only
+                    let out = unsafe { std::slice::from_raw_parts_mut(bases[0].0.add(a * per_state), (b - a) * per_state) };
+                    lanes(&m.model, scratch, &inputs[..self.count], out).map_err(|e| Fault::Core(e.error))?;
+                }
+                _ => {
+                    for k in a..b {
+                        kernel(&m.model, &mut scratch.data, &self.state(k), outputs(k))?;
+                    }
+                }
+            }
+            check_range(a, b)
+        };
         let result: Result<(), Fault> = match self.batch {
             None => {
                 let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-                states_range(&mut guard, 0, 1)
+                (0..1).try_for_each(|k| kernel(&m.model, &mut guard, &self.state(k), outputs(k)).map_err(Fault::from))
+                    .and_then(|()| check_range(0, 1))
             }
             Some(states) => py.detach(|| {
                 const CHUNK: usize = 64;
                 // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
                 guard::install(|| {
                     (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
-                        || Data::new(&m.model),
-                        |data, c| states_range(data, c * CHUNK, ((c + 1) * CHUNK).min(states)),
+                        || Scratch::new(&m.model),
+                        |scratch, c| states_range(scratch, c * CHUNK, ((c + 1) * CHUNK).min(states)),
                     )
                 })
                 .unwrap_or_else(|e| Err(Fault::Py(e)))
@@ -358,6 +392,9 @@ impl<'a> Batch<'a> {
         )
     }
 }
+
+/// Computes states `[a, b)` of a batch at once: (model, scratch, their inputs, their output).
+type LaneRange<'f> = dyn Fn(&Model, &mut Scratch, &[Input], &mut [f64]) -> Result<(), batch::StateError> + Sync + 'f;
 
 /// Names of a call and of its result(s), for error messages: ("mass_matrix", "M").
 type Output = (&'static str, &'static str);
@@ -692,10 +729,7 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
-            batch.run_out(py, self, ("inverse_dynamics", "tau"), &[n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("inverse_dynamics", "tau"), &[n], out, kernels::InverseDynamics)
         })
     }
 
@@ -706,10 +740,7 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_out(py, self, ("mass_matrix", "M"), &[n, n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::crba(model, data, x[0]));
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("mass_matrix", "M"), &[n, n], out, kernels::MassMatrix)
         })
     }
 
@@ -741,10 +772,7 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
-            batch.run_out(py, self, ("forward_dynamics", "qdd"), &[n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("forward_dynamics", "qdd"), &[n], out, kernels::ForwardDynamics)
         })
     }
 
@@ -760,7 +788,7 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
-            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, m]| {
+            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], None, |model, data, x, [dq, dqd, m]| {
                 algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
                 Ok(())
             })?;
@@ -780,7 +808,7 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
-            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], |model, data, x, [dq, dqd, dtau]| {
+            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], None, |model, data, x, [dq, dqd, dtau]| {
                 algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
             })?;
             Ok((dq, dqd, dtau))
@@ -822,10 +850,7 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_out(py, self, ("gravity_torque", "g"), &[n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::gravity_torque(model, data, x[0]));
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("gravity_torque", "g"), &[n], out, kernels::Gravity)
         })
     }
 
@@ -837,10 +862,7 @@ impl PyModel {
             let qd = f64_array("qd", &qd)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
-            batch.run_out(py, self, ("bias_torque", "bias"), &[n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::bias_torque(model, data, x[0], x[1]));
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("bias_torque", "bias"), &[n], out, kernels::Bias)
         })
     }
 
@@ -927,9 +949,19 @@ impl PyModel {
     }
 }
 
+/// How batches run on this machine: (kind, states per block); the kind is "avx512", "avx2",
+/// "portable" or "off", chosen from the CPU once per process, or by the environment variable
+/// KINEDYN_SIMD when the CPU supports the kind it names.
+#[pyfunction]
+fn simd() -> (&'static str, usize) {
+    let s = Simd::detected();
+    (s.name(), s.lanes())
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
+    m.add_function(wrap_pyfunction!(simd, m)?)?;
     guard::register(m)?;
     ik::register(m)?;
     simulate::register(m)?;
