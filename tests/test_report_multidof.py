@@ -70,7 +70,7 @@ def test_report_of_every_joint_kind_shows_q_by_block_and_velocities_by_degree_of
     sim = np.array(d["simulation"]["q"])
     assert sim.shape[1] == robot.nq and np.allclose(np.linalg.norm(sim[:, 3:7], axis=1), 1.0)
     dynamics = _section(page, "dynamics")
-    for title in ("joint positions", "positions of the multi-DOF joints", "rotations of the multi-DOF joints"):
+    for title in ("joint positions", "positions of the multi-DOF joints", "orientations of the multi-DOF joints"):
         assert f'aria-label="{title}' in dynamics
     assert "id='free-fall-note'" in dynamics
     # the equations: skipped for size, saying how to get them
@@ -143,3 +143,16 @@ def test_kinedyn_report_floating_base_on_real_robots(capsys, tmp_path, urdf, joi
     q = robot.random_configuration(1)
     assert main(["report", path, "--floating-base", "-o", str(out), "--t", "0.1", "--json", "--q", *map(str, q)]) == 0
     np.testing.assert_allclose(json.loads(capsys.readouterr().out)["q"], q)
+
+
+def test_the_equations_of_a_small_multi_dof_robot_are_typeset_in_euler_angles():
+    """A ball-jointed pendulum (nv = 3): the symbolic section derives the equations in the engine's
+    ZYX Euler angles and says so, naming its coordinates (they are not the numeric q)."""
+    ball = kd.Robot([kd.Link("bob", None, kd.Joint("shoulder", "spherical"), inertia=kd.Inertia(1.0, (0, 0, -0.3), np.diag([0.02, 0.03, 0.01])))],
+                    name="ball_pendulum")
+    page = build_report(ball, t_end=0.2)
+    equations = _section(page, "equations")
+    assert "(shoulder_yaw, shoulder_pitch, shoulder_roll)" in equations and "ZYX Euler angles" in equations
+    assert equations.count("<math") >= 4
+    d = _block(page, "kinedyn-data")
+    assert (d["nq"], d["nv"]) == (4, 3) and all(p["ok"] for p in d["properties"])

@@ -390,8 +390,9 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     else:
         eom, note = _symbolic_eom(robot, name, eom_joints)
         if eom is not None and robot.has_multi_dof_joints:
-            note += ("; each multi-DOF joint in position and ZYX Euler angles (R = Rz(yaw) Ry(pitch) Rx(roll)), the symbolic engine's "
-                     "minimal coordinates: not the numeric q (quaternions) and v above (docs/floating-base.md)")
+            note += (f"; in the coordinates ({', '.join(map(str, eom.q))}): each multi-DOF joint in position and ZYX Euler angles "
+                     "(R = Rz(yaw) Ry(pitch) Rx(roll)), the symbolic engine's minimal coordinates, not the numeric q (quaternions) and "
+                     "q̇ above (docs/floating-base.md)")
     data["_eom"] = eom
     data["eom_note"] = note
     return data
@@ -590,8 +591,8 @@ def _motion_plots(robot, t, qs, labels) -> List[str]:
     if positions:
         plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in positions], "positions of the multi-DOF joints", "t [s]", "position [m]"))
     rotations = [k for k, (m, u) in enumerate(zip(named, units)) if m and not u]
-    plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in rotations], "rotations of the multi-DOF joints (unit quaternions x, y, z, w; cos θ, sin θ)",
-                          "t [s]", "entry of q"))
+    plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in rotations], "orientations of the multi-DOF joints", "t [s]",
+                          "quaternion (x, y, z, w) or (cos θ, sin θ)"))
     return plots
 
 
@@ -670,7 +671,7 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
     else:
         looks = f"{model['shapes_drawn']} of the {model['shapes']} {geometry} shapes of the description are drawn."
     missing = "".join(f"<li>{html.escape(m)}</li>" for m in model["missing"])
-    view = ["<section id='view'><h2>The arm at q</h2><div class='grid'><div>",
+    view = [f"<section id='view'><h2>The {'robot' if multi else 'arm'} at q</h2><div class='grid'><div>",
             '<div id="kinedyn-view" role="img" aria-label="3-D view of the arm"></div>',
             "<div id='kinedyn-playback' hidden><button id='kinedyn-play' type='button'>▶ play</button> "
             "<input id='kinedyn-time' type='range' aria-label='simulation time'> <span id='kinedyn-clock'></span>"
@@ -750,8 +751,9 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
         plots.append(svg_plot(t, [("kinetic K", s["K"]), ("potential P", s["P"]), ("total H", s["H"])], "energy", "t [s]", "energy [J]"))
         dyn.append(f"<h3>Free motion under gravity (τ = 0) for {_f(t[-1], 3)} s from q, q̇ = 0</h3>")
         if any(j.kind == "floating" for j in robot.joints):
-            dyn.append("<p class='note' id='free-fall-note'>Nothing holds a floating joint: no contact or ground is modelled, so the base falls "
-                       "freely under gravity while the joints swing (its position is plotted with the other multi-DOF coordinates).</p>")
+            dyn.append("<p class='note' id='free-fall-note'>Nothing holds a floating joint: no contact or ground is modelled, so the robot falls "
+                       "freely (its position is plotted with the other multi-DOF coordinates); in free fall, uniform gravity alone does not "
+                       "move the joints relative to each other, only a starting q̇ (--qd) does.</p>")
         if s.get("note"):
             dyn.append(f"<p class='bad' id='simulation-cut-short'>{html.escape(s['note'])}</p>")
         dyn.append("<div class='plots'>" + "".join(plots) + "</div>")
