@@ -97,13 +97,18 @@ def test_the_viewer_moves_every_joint_kind_as_the_library_does(browser, every_ki
     q, _, page = every_kind_page
     path = tmp_path / "every_kind.html"
     path.write_text(page, encoding="utf-8")
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    context = browser.new_context(viewport={"width": 1000, "height": 900})
     tab = context.new_page()
     errors = []
     tab.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
     tab.on("pageerror", lambda e: errors.append(str(e)))
     tab.goto(path.resolve().as_uri())
     tab.wait_for_function("window.kinedyn && window.kinedyn.ready()")
+    # the new tables and notes fit their cards at 1000 px, slider labels stay clear (test_report_layout's checks)
+    from test_report_layout import OVERFLOWS, SLIDER_OVERLAPS
+
+    assert tab.evaluate("document.documentElement.scrollWidth") <= 1000
+    assert tab.evaluate(OVERFLOWS) == [] and tab.evaluate(SLIDER_OVERLAPS) == []
     for qs in robot.random_configuration(np.random.default_rng(4), size=3):
         frames = tab.evaluate("(q) => window.kinedyn.fk(q).frames", qs.tolist())
         for name, pose in zip(robot.frame_names, robot.frame_poses(qs)):
