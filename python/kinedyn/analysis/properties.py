@@ -9,11 +9,15 @@ each measured with its residual.
   bounds exist because M depends on q only through sines and cosines).
 - Skew symmetry of ``dM/dt - 2C`` (Spong Prop. 9.1, eqs. 9.109-9.112) and ``dM/dt = C + C^T`` (which
   skew symmetry alone does not imply: a transposed C is also skew-consistent), dM/dt by central
-  differences along qd.
+  differences along qd (on the configuration manifold, q ⊕ t qd: :func:`mass_matrix_rate`).
 - Passivity / energy balance (Spong eqs. 9.113-9.118): along a simulated trajectory
   ``int_0^T qd . tau dt = H(T) - H(0)`` (+ the energy friction dissipates).
 - Linearity in the parameters (Spong §9.5.3, eq. 9.121): ``Y(q, qd, qdd) pi == tau`` (rigid-body
   part; rotor inertia and friction are separate known terms).
+
+Robots with floating, spherical and planar joints (q of nq entries, qd of nv) are measured on their
+configuration manifold: random configurations with uniformly distributed rotations, dM/dt along
+q ⊕ t qd, the inertia bounds searched in the coordinates of :class:`_ManifoldChart`.
 
 :func:`check_properties` measures these on the numeric engine (status "sampled", "searched" or
 "simulated"); :func:`prove_properties` (``eom.check_properties()``) proves the identities of a symbolic

@@ -8,6 +8,11 @@ positive definite, dM/dt - 2C skew and dM/dt = C + C^T by finite differences, th
 tau, RNEA = M qdd + C qd + g); and plots (inline SVG) of a short free motion under gravity with its
 energy. Every script and style is inlined; nothing is fetched. All numbers shown are also in the JSON
 block ``#kinedyn-data`` (and ``kinedyn report --json``).
+
+Robots with floating, spherical and planar joints: q (nq entries) is shown joint block by joint block
+(position, unit quaternion x y z w; planar x, y, cos θ, sin θ), velocities, M, J and g per degree of
+freedom (nv), dM/dt along q ⊕ t qd; the viewer moves each block, and what does not apply (sliders for
+rotations, equations of a large robot) says so on the page.
 """
 
 from __future__ import annotations
