@@ -14,6 +14,13 @@ def cmd_check(args) -> int:
     from .properties import check_properties
 
     robot = load_robot(args.robot or robots.DEFAULT)
+    if getattr(args, "prove", False) and robot.has_multi_dof_joints:
+        joint = next(j for j in robot.joints if j.is_multi_dof)
+        raise ValueError(
+            f"kinedyn check --prove handles revolute and prismatic joints only; robot '{robot.name}' has the {joint.kind} joint "
+            f"'{joint.name}': the symbolic engine writes it in ZYX Euler angles, whose D(q) is singular at pitch = ±pi/2, so no inertia "
+            f"bounds exist in them, and a floating base's derivation is large. Run 'kinedyn check' without --prove (the numeric "
+            f"checks handle multi-DOF joints), or call robot.equations_of_motion().check_properties() in Python for the identities")
     report = check_properties(robot, samples=args.samples, seed=args.seed, T=args.t)
     if getattr(args, "prove", False):
         from dataclasses import replace

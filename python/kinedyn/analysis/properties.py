@@ -9,11 +9,15 @@ each measured with its residual.
   bounds exist because M depends on q only through sines and cosines).
 - Skew symmetry of ``dM/dt - 2C`` (Spong Prop. 9.1, eqs. 9.109-9.112) and ``dM/dt = C + C^T`` (which
   skew symmetry alone does not imply: a transposed C is also skew-consistent), dM/dt by central
-  differences along qd.
+  differences along qd (on the configuration manifold, q ⊕ t qd: :func:`mass_matrix_rate`).
 - Passivity / energy balance (Spong eqs. 9.113-9.118): along a simulated trajectory
   ``int_0^T qd . tau dt = H(T) - H(0)`` (+ the energy friction dissipates).
 - Linearity in the parameters (Spong §9.5.3, eq. 9.121): ``Y(q, qd, qdd) pi == tau`` (rigid-body
   part; rotor inertia and friction are separate known terms).
+
+Robots with floating, spherical and planar joints (q of nq entries, qd of nv) are measured on their
+configuration manifold: random configurations with uniformly distributed rotations, dM/dt along
+q ⊕ t qd, the inertia bounds searched in the coordinates of :class:`_ManifoldChart`.
 
 :func:`check_properties` measures these on the numeric engine (status "sampled", "searched" or
 "simulated"); :func:`prove_properties` (``eom.check_properties()``) proves the identities of a symbolic
@@ -24,14 +28,14 @@ and random states find no counterexample, and "failed" with the state that shows
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["Check", "PropertiesReport", "InertiaBounds", "check_properties", "global_inertia_bounds", "prove_properties"]
+__all__ = ["Check", "PropertiesReport", "InertiaBounds", "check_properties", "global_inertia_bounds", "mass_matrix_rate", "prove_properties"]
 
 
 #: how a check was decided: exact simplification, numbers at random states, a global optimisation, a
@@ -119,9 +123,14 @@ class InertiaBounds:
     lower: np.ndarray
     upper: np.ndarray
     periodic: np.ndarray
+    #: how the configurations were searched, when not the box ``lower``/``upper`` of the coordinates
+    #: themselves (a robot with multi-DOF joints: the chart of :class:`_ManifoldChart`)
+    space: str = ""
 
     def describe(self) -> str:
-        box = ", ".join(("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic))
+        box = self.space or ", ".join(("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic))
+        if self.starts == 0 and self.space:  # nothing to search (M constant)
+            return f"lambda_min = {self.lambda_min:.8g}, lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)} ({self.space})"
         return (f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
                 f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
                 f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
@@ -135,7 +144,8 @@ def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
 
 
 def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_matrix_gradient: Callable[[np.ndarray], np.ndarray],
-                          lower, upper, periodic=None, samples: int = 256, starts: int = 12, seed: int = 0) -> InertiaBounds:
+                          lower, upper, periodic=None, samples: int = 256, starts: int = 12, seed: int = 0,
+                          wrap: Optional[Callable[[np.ndarray], np.ndarray]] = None) -> InertiaBounds:
     """The least and greatest eigenvalue of M(q) over the box ``lower <= q <= upper`` (coordinates
     marked ``periodic`` are searched without bounds, M being 2 pi-periodic in them, and reported in
     [-pi, pi)), by a multistart local optimisation: ``samples`` uniform random configurations, then
@@ -143,8 +153,10 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
     loaded machine) from the ``starts`` best of them (and as many more random ones), minimising lambda_min(q)
     and -lambda_max(q) with the analytic gradient of a simple eigenvalue, d lambda / dq_k = v^T (dM/dq_k) v
     (v its unit eigenvector). ``mass_matrix(q)``: (n, n) for one q, (N, n, n) for a batch (N, n);
-    ``mass_matrix_gradient(q)``: (n_q, n, n), dM/dq_k stacked. A search, not a proof: the reported
-    bounds are attained (at the returned configurations) and no worse than every sample."""
+    ``mass_matrix_gradient(q)``: (n_q, n, n), dM/dq_k stacked. ``wrap(q)``: the representative of a
+    searched point to report (default: periodic coordinates into [-pi, pi)); the box of the periodic
+    coordinates is where the samples are drawn. A search, not a proof: the reported bounds are
+    attained (at the returned configurations) and no worse than every sample."""
     from scipy.optimize import minimize
 
     lower = np.asarray(lower, dtype=float)
@@ -175,7 +187,7 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
             res = minimize(f, Q[k], jac=True, method="TNC", bounds=bounds, options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12))
             x = np.array(res.x, dtype=float)
             x[~periodic] = np.clip(x[~periodic], lower[~periodic], upper[~periodic])
-            x = _wrap(x, periodic)
+            x = _wrap(x, periodic) if wrap is None else wrap(x)
             val = sign * np.linalg.eigvalsh(np.asarray(mass_matrix(x), dtype=float))[column]
             if val < best:
                 best, best_q = val, x
@@ -186,21 +198,242 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
     return InertiaBounds(float(lmin), qmin, float(lmax), qmax, float(lo_s.min()), float(hi_s.max()), samples, starts, lower, upper, periodic)
 
 
-def _configuration_box(robot: Robot):
-    """The box random_configuration draws from: finite joint limits, else [-pi, pi] (revolute, then
-    periodic) or [-1, 1] (prismatic)."""
-    lo = np.array(robot.lower_limits, dtype=float)
-    hi = np.array(robot.upper_limits, dtype=float)
-    periodic = np.zeros(robot.n, dtype=bool)
-    for i, j in enumerate(robot.joints):
-        span = np.pi if j.kind == "revolute" else 1.0
-        if j.kind == "revolute" and not np.isfinite(lo[i]) and not np.isfinite(hi[i]):
-            periodic[i] = True
-        if not np.isfinite(lo[i]):
-            lo[i] = min(-span, hi[i] - 2 * span) if np.isfinite(hi[i]) else -span
-        if not np.isfinite(hi[i]):
-            hi[i] = max(span, lo[i] + 2 * span)
+def _joint_box(joint) -> tuple:
+    """(lower, upper, periodic) of a 1-DOF joint's coordinate as random_configuration draws it: its
+    finite limits, else [-pi, pi] (revolute, then periodic) or [-1, 1] (prismatic)."""
+    lo, hi = float(joint.lower), float(joint.upper)
+    span = np.pi if joint.kind == "revolute" else 1.0
+    periodic = joint.kind == "revolute" and not np.isfinite(lo) and not np.isfinite(hi)
+    if not np.isfinite(lo):
+        lo = min(-span, hi - 2 * span) if np.isfinite(hi) else -span
+    if not np.isfinite(hi):
+        hi = max(span, lo + 2 * span)
     return lo, hi, periodic
+
+
+def _configuration_box(robot: Robot):
+    """The box random_configuration draws from, for a robot of 1-DOF joints (:func:`_joint_box` each)."""
+    lo, hi, periodic = zip(*(_joint_box(j) for j in robot.joints)) if robot.joints else ((), (), ())
+    return np.array(lo, dtype=float), np.array(hi, dtype=float), np.array(periodic, dtype=bool)
+
+
+def _right_jacobian_so3(r: np.ndarray) -> np.ndarray:
+    """J_r(r) with Exp(r + d) = Exp(r) Exp(J_r(r) d + O(d^2)): I - a [r]x + b [r]x^2, a = (1 - cos t)/t^2,
+    b = (t - sin t)/t^3, t = |r| (Sola, Deray & Atchuthan 2018, eq. 143); their series below t = 1e-3."""
+    t = float(np.linalg.norm(r))
+    if t < 1e-3:
+        a, b = 0.5 - t * t / 24, 1 / 6 - t * t / 120
+    else:
+        a, b = (1 - np.cos(t)) / t**2, (t - np.sin(t)) / t**3
+    K = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+    return np.eye(3) - a * K + b * K @ K
+
+
+def _shortest_rotation_vector(r: np.ndarray) -> np.ndarray:
+    """The rotation vector of the same rotation as ``r`` with |r| <= pi."""
+    t = float(np.linalg.norm(r))
+    if t <= np.pi:
+        return r
+    t_short = (t + np.pi) % (2 * np.pi) - np.pi  # in [-pi, pi): the same rotation about r / |r|
+    return r * (t_short / t)
+
+
+class _ManifoldChart:
+    """Coordinates x of a robot's configurations for the inertia-bound search when it has multi-DOF
+    joints, whose q (nq) is no box: a 1-DOF joint's x is its q; a free-flyer's x is its position
+    (x, y, z) in the parent frame, then the rotation vector r of its rotation R = Exp(r); a spherical
+    joint's x is r; a planar joint's x is (x, y, theta). The positions lie in the box
+    random_configuration draws from (the joint's limits, else [-1, 1]); rotation vectors and angles
+    are searched unbounded (a rotation vector reported with |r| <= pi). A multi-DOF joint on the fixed
+    base (a floating base) is held at its identity: with velocities in the child's frame every body's
+    velocity, hence M, does not depend on its configuration (the kinetic energy is left-invariant).
+
+    :meth:`tangent` is the map T from dx to the velocity v (q(x + dx) = q(x) ⊕ T dx + O(dx^2)), so
+    dM/dx_k = sum_j T_jk D_j M with D_j M the derivative along q ⊕ t e_j (robot.christoffel: c + c^T)."""
+
+    def __init__(self, robot: Robot):
+        from ..configuration import _sampling_range
+
+        self.robot = robot
+        roots = {b.joint.name for b in robot.tree.bodies if b.parent < 0}
+        self.blocks = []  # (joint, iq, iv, ix); ix None: held at its identity
+        lower, upper, periodic = [], [], []
+        iq = iv = ix = 0
+        for j in robot.joints:
+            held = j.is_multi_dof and j.name in roots
+            self.blocks.append((j, iq, iv, None if held else ix))
+            iq, iv = iq + j.nq, iv + j.nv
+            if held:
+                continue
+            ix += j.nv
+            if j.kind in ("floating", "planar"):
+                k = 3 if j.kind == "floating" else 2
+                lo, hi = _sampling_range([j], position=True)
+                lower += [float(lo[0])] * k
+                upper += [float(hi[0])] * k
+                periodic += [False] * k
+            if j.is_multi_dof:
+                k = 1 if j.kind == "planar" else 3
+                lower += [-np.pi] * k
+                upper += [np.pi] * k
+                periodic += [True] * k
+            else:  # 1-DOF: its own coordinate, in the box random_configuration draws from
+                lo_j, hi_j, periodic_j = _joint_box(j)
+                lower.append(lo_j)
+                upper.append(hi_j)
+                periodic.append(periodic_j)
+        self.lower, self.upper, self.periodic = np.array(lower), np.array(upper), np.array(periodic, dtype=bool)
+        self.nq, self.nv, self.nx = iq, iv, ix
+        self.neutral = robot.neutral()
+
+    def configuration(self, x) -> np.ndarray:
+        """q (nq,) of x (nx,), or (N, nq) of (N, nx)."""
+        from ..configuration import exp3
+
+        x = np.asarray(x, dtype=float)
+        q = np.broadcast_to(self.neutral, x.shape[:-1] + (self.nq,)).copy()
+        for j, iq, iv, ix in self.blocks:
+            if ix is None:
+                continue
+            if j.kind == "floating":
+                q[..., iq:iq + 3] = x[..., ix:ix + 3]
+                q[..., iq + 3:iq + 7] = exp3(x[..., ix + 3:ix + 6])
+            elif j.kind == "spherical":
+                q[..., iq:iq + 4] = exp3(x[..., ix:ix + 3])
+            elif j.kind == "planar":
+                q[..., iq:iq + 2] = x[..., ix:ix + 2]
+                q[..., iq + 2], q[..., iq + 3] = np.cos(x[..., ix + 2]), np.sin(x[..., ix + 2])
+            else:
+                q[..., iq] = x[..., ix]
+        return q
+
+    def tangent(self, x) -> np.ndarray:
+        """T (nv, nx) at one x: column k is the velocity v with q(x + t e_k) = q(x) ⊕ t v + O(t^2)."""
+        from ..configuration import exp3, quaternion_to_matrix
+
+        x = np.asarray(x, dtype=float)
+        T = np.zeros((self.nv, self.nx))
+        for j, iq, iv, ix in self.blocks:
+            if ix is None:
+                continue
+            if j.kind == "floating":  # ⊕ [rho; 0] moves the position by R rho; ⊕ [0; w] turns R to R Exp(w)
+                T[iv:iv + 3, ix:ix + 3] = quaternion_to_matrix(exp3(x[ix + 3:ix + 6])).T
+                T[iv + 3:iv + 6, ix + 3:ix + 6] = _right_jacobian_so3(x[ix + 3:ix + 6])
+            elif j.kind == "spherical":
+                T[iv:iv + 3, ix:ix + 3] = _right_jacobian_so3(x[ix:ix + 3])
+            elif j.kind == "planar":  # in SE(2): ⊕ (rho, 0) moves the position by R(theta) rho
+                c, s_ = np.cos(x[ix + 2]), np.sin(x[ix + 2])
+                T[iv:iv + 2, ix:ix + 2] = np.array([[c, s_], [-s_, c]])
+                T[iv + 2, ix + 2] = 1.0
+            else:
+                T[iv, ix] = 1.0
+        return T
+
+    def wrap(self, x) -> np.ndarray:
+        """The reported representative of x: angles in [-pi, pi), rotation vectors with |r| <= pi."""
+        x = np.array(x, dtype=float)
+        for j, iq, iv, ix in self.blocks:
+            if ix is None:
+                continue
+            if j.kind == "floating":
+                x[ix + 3:ix + 6] = _shortest_rotation_vector(x[ix + 3:ix + 6])
+            elif j.kind == "spherical":
+                x[ix:ix + 3] = _shortest_rotation_vector(x[ix:ix + 3])
+            elif j.kind == "planar":
+                x[ix + 2] = (x[ix + 2] + np.pi) % (2 * np.pi) - np.pi
+            elif self.periodic[ix]:
+                x[ix] = (x[ix] + np.pi) % (2 * np.pi) - np.pi
+        return x
+
+    def describe(self) -> str:
+        parts = []
+        for j, iq, iv, ix in self.blocks:
+            if ix is None:
+                parts.append(f"{j.name}: held at its identity (M does not depend on a {j.kind} joint on the fixed base)")
+            elif j.kind in ("floating", "planar"):
+                k = 3 if j.kind == "floating" else 2
+                parts.append(f"{j.name}: position in [{self.lower[ix]:.3g}, {self.upper[ix]:.3g}]^{k}, "
+                             + ("every rotation" if j.kind == "floating" else "every angle"))
+            elif j.kind == "spherical":
+                parts.append(f"{j.name}: every rotation")
+            elif self.periodic[ix]:
+                parts.append(f"{j.name}: periodic")
+            else:
+                parts.append(f"{j.name}: [{self.lower[ix]:.3g}, {self.upper[ix]:.3g}]")
+        if self.nx == 0:
+            return "; ".join(parts)
+        return ("; ".join(parts) + " (searched in coordinates of the manifold: positions, rotation vectors, angles; "
+                "the configurations above are q, quaternions (x, y, z, w))")
+
+
+def _inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> InertiaBounds:
+    """:func:`global_inertia_bounds` over the robot's configurations: over the box of its coordinates
+    for 1-DOF joints, over the coordinates of :class:`_ManifoldChart` with multi-DOF joints (whose
+    configurations are then reported as q, nq numbers). dM/dq_i = c_i + c_i^T from the engine's
+    Christoffel symbols (c[i, j, k] + c[i, k, j] = dM_kj/dq_i, Spong eq. 9.58; along q ⊕ t e_i)."""
+
+    def tangent_dM(q):
+        c = np.asarray(robot.christoffel(q), dtype=float)
+        return c + np.swapaxes(c, 1, 2)
+
+    if not robot.has_multi_dof_joints:
+        box_lo, box_hi, periodic = _configuration_box(robot)
+        return global_inertia_bounds(robot.mass_matrix, tangent_dM, box_lo, box_hi, periodic, samples=samples, starts=starts, seed=seed)
+    chart = _ManifoldChart(robot)
+    if chart.nx == 0:  # a floating body alone (a drone): M is one constant matrix
+        q0 = chart.neutral
+        eig = np.linalg.eigvalsh(robot.mass_matrix(q0))
+        return InertiaBounds(float(eig[0]), q0, float(eig[-1]), q0, float(eig[0]), float(eig[-1]), 1, 0, chart.lower, chart.upper, chart.periodic,
+                             space=chart.describe() + ": M is constant, its extreme eigenvalues are the bounds")
+
+    def dM_dx(x):
+        return np.einsum("jk,jab->kab", chart.tangent(x), tangent_dM(chart.configuration(x)))
+
+    b = global_inertia_bounds(lambda x: robot.mass_matrix(chart.configuration(x)), dM_dx, chart.lower, chart.upper, chart.periodic,
+                              samples=samples, starts=starts, seed=seed, wrap=chart.wrap)
+    b.q_lambda_min = chart.configuration(b.q_lambda_min)
+    b.q_lambda_max = chart.configuration(b.q_lambda_max)
+    b.space = chart.describe()
+    return b
+
+
+def _joint_pd_gravity(robot: Robot, kp: np.ndarray, kd: np.ndarray, goal: np.ndarray):
+    """``tau = Kp (goal - q) - Kd qd + g(q)`` on the 1-DOF joints' coordinates, ``-Kd v + g`` on the
+    multi-DOF joints' (damped, not steered: their error would need robot.difference at every step,
+    20x the cost of the rest): the input of the passivity check on a robot with multi-DOF joints, whose
+    q (nq) and qd (nv) do not line up."""
+    from ..simulate.control import Controller
+
+    iq, iv = [], []
+    start_q = start_v = 0
+    for j in robot.joints:
+        if not j.is_multi_dof:
+            iq.append(start_q)
+            iv.append(start_v)
+        start_q, start_v = start_q + j.nq, start_v + j.nv
+    q_index, v_index = np.array(iq, dtype=np.intp), np.array(iv, dtype=np.intp)
+    kp_joints = np.asarray(kp, dtype=float)[v_index]
+    kd = np.asarray(kd, dtype=float)
+    goal_joints = np.asarray(goal, dtype=float)[q_index]
+
+    class JointPDGravity(Controller):
+        name = "PD on the 1-DOF joints, damping on the multi-DOF joints, + gravity compensation"
+        n = robot.nv
+
+        def __call__(self, t, q, qd):
+            tau = robot.gravity_torque(q) - kd * np.asarray(qd, dtype=float)
+            tau[..., v_index] += kp_joints * (goal_joints - np.asarray(q, dtype=float)[..., q_index])
+            return tau
+
+    return JointPDGravity()
+
+
+def mass_matrix_rate(robot: Robot, q, qd, h: float = 1e-6) -> np.ndarray:
+    """dM/dt = d/dt M(q ⊕ t qd) at t = 0 by central differences (step ``h``), along the configuration
+    manifold (robot.integrate): for 1-DOF joints M(q + t qd); with multi-DOF joints q has nq entries
+    and qd nv, and a quaternion moves by q ⊗ Exp(t omega), not by adding rates to its entries.
+    ``q`` (nq,) or (N, nq), ``qd`` (nv,) or (N, nv)."""
+    return (robot.mass_matrix(robot.integrate(q, qd, h)) - robot.mass_matrix(robot.integrate(q, qd, -h))) / (2 * h)
 
 
 def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
@@ -209,9 +442,6 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     ``Kp = wn^2 m_i``, ``Kd = 2 wn m_i`` with wn = 5 rad/s and m_i the least M_ii over the goal and 64
     configurations drawn from the seed). The trajectory depends on ``seed`` only, not on ``samples``."""
     from ..simulate import PDGravity, SimulationError, simulate
-
-    # its PD set point, search box and finite differences are per joint coordinate
-    robot.require_one_dof_joints("the properties report (kinedyn check)")
 
     rng = np.random.default_rng(seed)
     n = robot.n
@@ -231,15 +461,8 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
         f"max |M - M^T| / max |M| = {sym:.2g}; smallest eigenvalue {lo.min():.6g} > 0", "Spong eq. 9.42",
         dict(min_eigenvalue=float(lo.min())), status="sampled",
     ))
-    # inertia bounds: a global search over the configuration box, dM/dq_i = c_i + c_i^T from the
-    # engine's Christoffel symbols (c[i, j, k] + c[i, k, j] = dM_kj/dq_i, Spong eq. 9.58)
-    box_lo, box_hi, periodic = _configuration_box(robot)
-
-    def dM(q):
-        c = np.asarray(robot.christoffel(q), dtype=float)
-        return c + np.swapaxes(c, 1, 2)
-
-    b = global_inertia_bounds(robot.mass_matrix, dM, box_lo, box_hi, periodic, samples=max(samples, 64), starts=8, seed=seed)
+    # inertia bounds: a global search over the configurations (on the manifold with multi-DOF joints)
+    b = _inertia_bounds(robot, samples=max(samples, 64), starts=8, seed=seed)
     checks.append(Check(
         "inertia bounds lambda_min I <= M(q) <= lambda_max I", bool(b.lambda_min > 0), float(max(0.0, -b.lambda_min)), 0.0,
         b.describe() + f"; condition number <= {b.lambda_max / b.lambda_min:.4g}" if b.lambda_min > 0 else b.describe(),
@@ -249,9 +472,9 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
         status="searched",
     ))
 
-    # dM/dt - 2C skew, dM/dt == C + C^T (central differences along qd)
+    # dM/dt - 2C skew, dM/dt == C + C^T (central differences along qd, on the manifold: q ⊕ t qd)
     C = robot.coriolis_matrix(Q, QD)
-    Mdot = (robot.mass_matrix(Q + h * QD) - robot.mass_matrix(Q - h * QD)) / (2 * h)
+    Mdot = mass_matrix_rate(robot, Q, QD, h)
     N = Mdot - 2 * C
     ref = max(1.0, float(np.abs(Mdot).max()))
     skew = float(np.abs(N + np.swapaxes(N, 1, 2)).max() / ref)
@@ -259,7 +482,8 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     tol_fd = 1e-6
     checks.append(Check(
         "dM/dt - 2C skew-symmetric", bool(skew <= tol_fd), skew, tol_fd,
-        f"max |N + N^T| / max(1, |dM/dt|) with N = dM/dt - 2C, dM/dt by central differences (h = {h:g})", "Spong Prop. 9.1, eq. 9.109",
+        f"max |N + N^T| / max(1, |dM/dt|) with N = dM/dt - 2C, dM/dt by central differences (h = {h:g})"
+        + (" along q ⊕ t qd (robot.integrate: quaternions turned by Exp, not added to)" if robot.has_multi_dof_joints else ""), "Spong Prop. 9.1, eq. 9.109",
         status="sampled",
     ))
     checks.append(Check(
@@ -290,7 +514,7 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     # trajectory depends on the seed only, not on how many samples were drawn above
     rng_trajectory = np.random.default_rng([seed, 1])
     goal = robot.random_configuration(rng_trajectory)
-    x0 = np.concatenate([robot.random_configuration(rng_trajectory), rng_trajectory.uniform(-1.0, 1.0, n)])
+    x0 = np.concatenate([robot.random_configuration(rng_trajectory), rng_trajectory.uniform(-1.0, 1.0, n)])  # q (nq), qd (nv)
     # gains from the smallest inertia each joint shows (at the goal and 64 seeded configurations): each
     # joint's loop at most a critically damped 5 rad/s one, so a configuration where an axis carries
     # little inertia (elbow_3r upright) does not make the loop too stiff for RK4 at dt
@@ -306,7 +530,10 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     step = dt
     for refinement in range(3):
         try:
-            traj = simulate(robot, T, x0, controller=PDGravity(robot, wn**2 * d, 2 * wn * d, goal), dt=step)
+            if robot.has_multi_dof_joints:  # PD on the 1-DOF joints only (q and qd do not line up); RK4 as the detail says
+                traj = simulate(robot, T, x0, controller=_joint_pd_gravity(robot, wn**2 * d, 2 * wn * d, goal), dt=step, method="rk4")
+            else:
+                traj = simulate(robot, T, x0, controller=PDGravity(robot, wn**2 * d, 2 * wn * d, goal), dt=step)
         except (SimulationError, RuntimeError, np.linalg.LinAlgError) as e:
             checks.append(Check(name, False, float("inf"), 0.0, f"the simulation failed: {e}", "Spong eqs. 9.113-9.117"))
             return PropertiesReport(robot.name, samples, checks)

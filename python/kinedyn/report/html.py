@@ -8,6 +8,11 @@ positive definite, dM/dt - 2C skew and dM/dt = C + C^T by finite differences, th
 tau, RNEA = M qdd + C qd + g); and plots (inline SVG) of a short free motion under gravity with its
 energy. Every script and style is inlined; nothing is fetched. All numbers shown are also in the JSON
 block ``#kinedyn-data`` (and ``kinedyn report --json``).
+
+Robots with floating, spherical and planar joints: q (nq entries) is shown joint block by joint block
+(position, unit quaternion x y z w; planar x, y, cos θ, sin θ), velocities, M, J and g per degree of
+freedom (nv), dM/dt along q ⊕ t qd; the viewer moves each block, and what does not apply (sliders for
+rotations, equations of a large robot) says so on the page.
 """
 
 from __future__ import annotations
@@ -37,6 +42,53 @@ def default_configuration(robot) -> np.ndarray:
     return np.clip(q, robot.lower_limits, robot.upper_limits)
 
 
+#: the names of a joint's entries of q and of qd (docs/conventions.md, "Configurations and velocities")
+Q_ENTRIES = {"floating": ("x", "y", "z", "qx", "qy", "qz", "qw"), "spherical": ("qx", "qy", "qz", "qw"), "planar": ("x", "y", "cos θ", "sin θ")}
+V_ENTRIES = {"floating": ("vx", "vy", "vz", "ωx", "ωy", "ωz"), "spherical": ("ωx", "ωy", "ωz"), "planar": ("vx", "vy", "ω")}
+
+
+def coordinate_labels(robot) -> List[str]:
+    """One label per entry of q (nq): a 1-DOF joint's name, ``joint.x`` ... ``joint.qw`` for a
+    multi-DOF joint's block."""
+    return [label for j in robot.joints for label in ([f"{j.name}.{e}" for e in Q_ENTRIES[j.kind]] if j.is_multi_dof else [j.name])]
+
+
+def velocity_labels(robot) -> List[str]:
+    """One label per degree of freedom (nv: entries of qd, rows and columns of M, columns of J): a
+    1-DOF joint's name, ``joint.vx`` ... ``joint.ωz`` for a multi-DOF joint (velocities in its child's frame)."""
+    return [label for j in robot.joints for label in ([f"{j.name}.{e}" for e in V_ENTRIES[j.kind]] if j.is_multi_dof else [j.name])]
+
+
+def _coordinate_units(robot) -> List[str]:
+    """Per entry of q: "rad", "m", or "" (a quaternion's or a (cos θ, sin θ) pair's entries)."""
+    out: List[str] = []
+    for j in robot.joints:
+        if j.kind == "floating":
+            out += ["m"] * 3 + [""] * 4
+        elif j.kind == "spherical":
+            out += [""] * 4
+        elif j.kind == "planar":
+            out += ["m"] * 2 + [""] * 2
+        else:
+            out.append("rad" if j.kind == "revolute" else "m")
+    return out
+
+
+def _in_multi_dof_block(robot) -> List[bool]:
+    """Per entry of q: whether it belongs to a multi-DOF joint's block."""
+    return [j.is_multi_dof for j in robot.joints for _ in range(j.nq)]
+
+
+def _q_text(q, labels: Sequence[str], units: Sequence[str], named: Sequence[bool]) -> str:
+    """q as the report writes it: "0.5 rad (28.6°), 0.2 m" for 1-DOF joints; the entries of a
+    multi-DOF joint's block are named ("root_joint.z = 0.3 m, root_joint.qw = 1")."""
+    parts = []
+    for v, label, unit, name in zip(q, labels, units, named):
+        value = f"{_f(v)} rad ({_f(math.degrees(v), 5)}°)" if unit == "rad" else (f"{_f(v)} m" if unit == "m" else _f(v))
+        parts.append(f"{label} = {value}" if name else value)
+    return ", ".join(parts)
+
+
 def _has_dynamics(robot) -> bool:
     """Whether this build of kinedyn has the numeric dynamics (the native core's mass matrix)."""
     try:
@@ -57,21 +109,46 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MissingMeshWarning)  # said in the report instead (model["missing"])
         scene = robot_scene(robot, geometry, DEFAULT_BUDGET if budget is None else budget)
+    from ..robot import _planar_basis
+
     tree = robot.tree
+    # where each joint's block starts in q: a multi-DOF joint's q[start:start + nq] moves its body as a
+    # whole (viewer.js: position, then a unit quaternion; planar x, y, cos, sin)
+    starts, start = {}, 0
+    for j in robot.joints:
+        starts[j.name] = start
+        start += j.nq
     bodies = []
     for b in tree.bodies:
-        bodies.append({
+        body = {
             "parent": int(b.parent),
+            "name": b.joint.name,
             "kind": b.joint.kind,
             "axis": [float(a) for a in b.joint.axis],
             "offset": float(b.joint.offset),
             "placement": np.asarray(b.placement, dtype=float).ravel().tolist(),
-        })
+        }
+        if b.joint.name in starts:
+            body["q"] = starts[b.joint.name]
+        if b.joint.kind == "planar":  # the plane's in-plane axes (x along e1, y along e2; the rotation about e1 x e2)
+            e1, e2 = _planar_basis(np.asarray(b.joint.axis, dtype=float))
+            body["e1"], body["e2"] = e1.tolist(), e2.tolist()
+        bodies.append(body)
     if robot.mimic_joints:  # each body's coordinate: q[q] for its own, scale * q[q] + shift for a mimic follower
         from ..description.mimic import body_coordinates
 
+        names = robot.joint_names
         for body, coordinate in zip(bodies, body_coordinates(robot)):
             body.update(coordinate)
+            body["q"] = starts[names[coordinate["q"]]]  # body_coordinates numbers the joints; q numbers their entries
+    # a slider per 1-DOF coordinate and per position entry of a floating or planar joint (a rotation
+    # has none: it is shown at q and moves in the playback)
+    labels, units = coordinate_labels(robot), _coordinate_units(robot)
+    sliders = []
+    for k, (label, unit, lo, hi) in enumerate(zip(labels, units, robot.lower_limits, robot.upper_limits)):
+        if unit:
+            sliders.append({"name": label, "q": k, "revolute": unit == "rad",
+                            "lower": float(lo) if math.isfinite(lo) else None, "upper": float(hi) if math.isfinite(hi) else None})
     frames = [{"name": f.name, "body": int(f.body), "placement": np.asarray(f.placement, dtype=float).ravel().tolist()} for f in tree.frames]
     # size of the scene: the farthest frame origin over q and a few random configurations
     qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
@@ -98,6 +175,10 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: Optional[int] = 
         "frames": frames,
         "joint_names": robot.joint_names,
         "joint_kinds": [j.kind for j in robot.joints],
+        "coordinate_labels": labels,
+        "coordinate_units": units,
+        "coordinate_named": _in_multi_dof_block(robot),
+        "sliders": sliders,
         "lower": [float(x) if math.isfinite(x) else None for x in robot.lower_limits],
         "upper": [float(x) if math.isfinite(x) else None for x in robot.upper_limits],
         "q": [float(x) for x in q],
@@ -165,13 +246,15 @@ def _properties(robot, q, qd, rng) -> List[dict]:
     asym = float(np.max(np.abs(M - M.T)))
     out.append({"property": "M(q) symmetric", "measure": "max |M - M^T|", "value": asym, "ok": asym <= 1e-12 * scale})
     out.append({"property": "M(q) positive definite", "measure": "smallest eigenvalue of M", "value": float(eig[0]), "ok": bool(eig[0] > 0)})
-    h = 1e-6
-    Mdot = (robot.mass_matrix(q + h * qd) - robot.mass_matrix(q - h * qd)) / (2 * h)
+    from ..analysis.properties import mass_matrix_rate
+
+    Mdot = mass_matrix_rate(robot, q, qd)  # along q ⊕ t qd: quaternions turned by Exp, not added to
     C = robot.coriolis_matrix(q, qd)
     N = Mdot - 2 * C
     tol = 1e-6 * max(1.0, float(np.max(np.abs(Mdot))), float(np.max(np.abs(C))))
     skew = float(np.max(np.abs(N + N.T)))
-    out.append({"property": "dM/dt - 2C skew-symmetric", "measure": "max |N + N^T|, dM/dt by central differences", "value": skew, "ok": skew <= tol})
+    how = "max |N + N^T|, dM/dt by central differences" + (" along q ⊕ t q̇" if robot.has_multi_dof_joints else "")
+    out.append({"property": "dM/dt - 2C skew-symmetric", "measure": how, "value": skew, "ok": skew <= tol})
     cct = float(np.max(np.abs(Mdot - C - C.T)))
     out.append({"property": "dM/dt = C + C^T", "measure": "max |dM/dt - C - C^T|", "value": cct, "ok": cct <= tol})
     qdd = rng.uniform(-1, 1, n)
@@ -215,6 +298,19 @@ def _symbolic_eom(robot, name: Optional[str], max_joints: int):
     return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
 
 
+def _joint_rows(robot) -> List[dict]:
+    """The joints table's data: kind, axis, offset, limits, and where the joint's entries sit in q and qd."""
+    rows, iq, iv = [], 0, 0
+    for j in robot.joints:
+        row = {"name": j.name, "type": j.kind, "axis": [float(a) for a in j.axis], "offset": float(j.offset),
+               "lower": float(j.lower), "upper": float(j.upper), "q_index": iq, "nq": j.nq, "v_index": iv, "nv": j.nv}
+        if j.is_multi_dof:
+            row["q_entries"], row["v_entries"] = list(Q_ENTRIES[j.kind]), list(V_ENTRIES[j.kind])
+        rows.append(row)
+        iq, iv = iq + j.nq, iv + j.nv
+    return rows
+
+
 def collect(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, seed: int = 0,
             time_budget: Optional[float] = SIMULATION_BUDGET, progress: Optional[bool] = False, steps=None) -> dict:
     """Every number of the report (JSON-friendly, plus the symbolic equations under "_eom").
@@ -235,12 +331,13 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     from ..kinematics import singularity_report
 
     steps.step("kinematics")
-    # the report's simulation, sliders and per-joint tables read one coordinate per joint
-    robot.require_one_dof_joints("the report")
     q = default_configuration(robot) if q is None else np.asarray(q, dtype=float)
-    qd = np.zeros(robot.n) if qd is None else np.asarray(qd, dtype=float)
-    if q.shape != (robot.n,) or qd.shape != (robot.n,):
-        raise ValueError(f"q and qd need {robot.n} values for robot '{robot.name}'")
+    qd = np.zeros(robot.nv) if qd is None else np.asarray(qd, dtype=float)
+    if q.shape != (robot.nq,) or qd.shape != (robot.nv,):
+        sizes = f"q needs {robot.nq} values and qd {robot.nv}" if robot.has_multi_dof_joints else f"q and qd need {robot.n} values"
+        raise ValueError(f"{sizes} for robot '{robot.name}', got q of shape {q.shape} and qd of shape {qd.shape}")
+    if robot.has_multi_dof_joints:
+        robot.integrate(q, qd, 0.0)  # a ValueError naming the joint for a quaternion or (cos, sin) pair that is not unit
     rng = np.random.default_rng(seed)
     T = robot.pose(q)
     J = robot.jacobian(q)
@@ -249,7 +346,11 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         "robot": robot.name,
         "source": robot.source,
         "n": robot.n,
+        "nq": robot.nq,
+        "nv": robot.nv,
         "joint_names": robot.joint_names,
+        "coordinate_labels": coordinate_labels(robot),
+        "velocity_labels": velocity_labels(robot),
         "gravity": [float(x) for x in robot.gravity],
         "q": q.tolist(),
         "qd": qd.tolist(),
@@ -261,8 +362,7 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         "singular": rep.singular,
         "condition_number": rep.condition_number,
         "singularity": rep.summary(),
-        "joints": [{"name": j.name, "type": j.kind, "axis": [float(a) for a in j.axis], "offset": float(j.offset),
-                    "lower": float(j.lower), "upper": float(j.upper)} for j in robot.joints],
+        "joints": _joint_rows(robot),
         "dh_convention": robot.dh_convention,
         "dh": None if robot.dh is None else [{"theta": float(r.theta), "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha), "type": r.kind} for r in robot.dh],
         "bodies": [{"link": b.name, "mass": float(b.inertia.mass), "com": [float(c) for c in b.inertia.com]} for b in robot.tree.bodies],
@@ -288,7 +388,16 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
                                        "value": data["simulation"]["energy_drift"], "ok": data["simulation"]["energy_drift"] <= 1e-6 * max(1.0, float(np.max(np.abs(H))))
                                        or friction})
     steps.step("equations of motion")
-    eom, note = _symbolic_eom(robot, name, eom_joints)
+    if robot.has_multi_dof_joints and robot.n > eom_joints:
+        eom, note = None, (f"The symbolic equations of motion are typeset for up to {eom_joints} degrees of freedom (this robot has {robot.n}, "
+                           f"its multi-DOF joints included); `kinedyn report --eom-joints {robot.n}` derives them anyway, with each multi-DOF "
+                           "joint in position and ZYX Euler angles (docs/floating-base.md).")
+    else:
+        eom, note = _symbolic_eom(robot, name, eom_joints)
+        if eom is not None and robot.has_multi_dof_joints:
+            note += (f"; in the coordinates ({', '.join(map(str, eom.q))}): each multi-DOF joint in position and ZYX Euler angles "
+                     "(R = Rz(yaw) Ry(pitch) Rx(roll)), the symbolic engine's minimal coordinates, not the numeric q (quaternions) and "
+                     "q̇ above (docs/floating-base.md)")
     data["_eom"] = eom
     data["eom_note"] = note
     return data
@@ -447,6 +556,51 @@ def _json_script(obj, element_id: str) -> str:
     return f'<script type="application/json" id="{html.escape(element_id)}">{script_json(obj)}</script>'
 
 
+def _configuration_table(robot, q, d) -> str:
+    """Per joint: its block of q (named entries; a rotation also as angle and axis) and the names of its
+    velocities, with why the sliders leave rotations out."""
+    from ..configuration import log3
+
+    rows = []
+    for j in d["joints"]:
+        block = np.asarray(q[j["q_index"]:j["q_index"] + j["nq"]], dtype=float)
+        names = j.get("q_entries") or [j["name"]]
+        values = ", ".join(f"{n} = {_f(v)}" for n, v in zip(names, block)) if j["nq"] > 1 else _f(block[0])
+        if j["type"] in ("floating", "spherical"):
+            r = log3(block[-4:])
+            angle = float(np.linalg.norm(r))
+            axis = r / angle if angle > 0 else np.array([0.0, 0.0, 1.0])
+            values += f" (a rotation of {_f(math.degrees(angle), 5)}° about ({', '.join(_f(a, 4) for a in axis)}))"
+        elif j["type"] == "planar":
+            values += f" (θ = {_f(math.degrees(math.atan2(block[3], block[2])), 5)}°)"
+        velocities = ", ".join(j.get("v_entries") or [j["name"]])
+        rows.append([j["name"], j["type"], values, velocities])
+    rotations = [j["name"] for j in d["joints"] if j["type"] in ("floating", "spherical", "planar")]
+    return ("<h3>Configuration by joint</h3>" + _table(["joint", "type", "q", "q̇ entries"], rows, numeric_from=2, cls="configuration")
+            + f"<p class='note' id='sliders-note'>The sliders move the 1-DOF joints and the positions of the floating and planar joints; "
+            f"the rotations of {', '.join(html.escape(n) for n in rotations)} have no slider (a unit quaternion or angle is no single "
+            "coordinate): they are drawn at q and move in the simulation's playback.</p>")
+
+
+def _motion_plots(robot, t, qs, labels) -> List[str]:
+    """The simulated coordinates: the 1-DOF joints' in one plot; with multi-DOF joints, their positions
+    (m) and their unit quaternions / (cos θ, sin θ) pairs in two more."""
+    units, named = _coordinate_units(robot), _in_multi_dof_block(robot)
+    if not any(named):
+        return [svg_plot(t, [(nm, qs[:, k]) for k, nm in enumerate(labels)], "joint positions", "t [s]", "q [rad or m]")]
+    plots = []
+    joints = [k for k, m in enumerate(named) if not m]
+    if joints:
+        plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in joints], "joint positions", "t [s]", "q [rad or m]"))
+    positions = [k for k, (m, u) in enumerate(zip(named, units)) if m and u == "m"]
+    if positions:
+        plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in positions], "positions of the multi-DOF joints", "t [s]", "position [m]"))
+    rotations = [k for k, (m, u) in enumerate(zip(named, units)) if m and not u]
+    plots.append(svg_plot(t, [(labels[k], qs[:, k]) for k in rotations], "orientations of the multi-DOF joints", "t [s]",
+                          "quaternion (x, y, z, w) or (cos θ, sin θ)"))
+    return plots
+
+
 def build_report(robot, q=None, qd=None, *, name: Optional[str] = None, t_end: float = 3.0, eom_joints: int = 3, data: Optional[dict] = None,
                  tutorial: bool = False, progress: Optional[bool] = False, time_budget: Optional[float] = SIMULATION_BUDGET, geometry: str = "visual") -> str:
     """The report as one HTML string (see the module docstring); ``tutorial``: add the seed
@@ -477,12 +631,31 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
     q = np.asarray(d["q"])
     eom = d.pop("_eom", None)
     parts: List[str] = []
-    revolute = [j["type"] == "revolute" for j in d["joints"]]
-    q_text = ", ".join(f"{_f(v)} rad ({_f(math.degrees(v), 5)}°)" if r else f"{_f(v)} m" for v, r in zip(q, revolute))
+    multi = robot.has_multi_dof_joints
+    q_labels, v_labels = d.get("coordinate_labels") or coordinate_labels(robot), d.get("velocity_labels") or velocity_labels(robot)
+    q_text = _q_text(q, q_labels, _coordinate_units(robot), _in_multi_dof_block(robot))
 
     # --- description
-    rows = [[j["name"], j["type"], " ".join(_f(a) for a in j["axis"]), _f(j["offset"]), f"[{_f(j['lower'])}, {_f(j['upper'])}]"] for j in d["joints"]]
-    sec = ["<section id='description'><h2>Joints and links</h2>", _table(["joint", "type", "axis", "offset", "limits"], rows, numeric_from=2, cls="joints")]
+    if multi:  # where each joint sits in q and qd; a multi-DOF joint has no single axis, offset or limits
+        rows = []
+        for j in d["joints"]:
+            q_block = f"q[{j['q_index']}]" if j["nq"] == 1 else f"q[{j['q_index']}:{j['q_index'] + j['nq']}] = ({', '.join(j['q_entries'])})"
+            v_block = f"q̇[{j['v_index']}]" if j["nv"] == 1 else f"q̇[{j['v_index']}:{j['v_index'] + j['nv']}] = ({', '.join(j['v_entries'])})"
+            if j["type"] in ("floating", "spherical"):
+                axis_offset_limits = ["—", "—", "—"]
+            elif j["type"] == "planar":
+                axis_offset_limits = ["normal " + " ".join(_f(a) for a in j["axis"]), "—", "—"]
+            else:
+                axis_offset_limits = [" ".join(_f(a) for a in j["axis"]), _f(j["offset"]), f"[{_f(j['lower'])}, {_f(j['upper'])}]"]
+            rows.append([j["name"], j["type"], *axis_offset_limits, q_block, v_block])
+        sec = ["<section id='description'><h2>Joints and links</h2>",
+               _table(["joint", "type", "axis", "offset", "limits", "in q", "in q̇"], rows, numeric_from=2, cls="joints"),
+               f"<p class='note' id='multi-dof-note'>q has nq = {d['nq']} entries and q̇ nv = {d['nv']}: a floating joint's block is its position "
+               "then a unit quaternion (x, y, z, w), a spherical joint's a unit quaternion, a planar joint's (x, y, cos θ, sin θ); their "
+               "velocities are in the child's frame, [linear; angular] (Pinocchio's conventions, docs/conventions.md).</p>"]
+    else:
+        rows = [[j["name"], j["type"], " ".join(_f(a) for a in j["axis"]), _f(j["offset"]), f"[{_f(j['lower'])}, {_f(j['upper'])}]"] for j in d["joints"]]
+        sec = ["<section id='description'><h2>Joints and links</h2>", _table(["joint", "type", "axis", "offset", "limits"], rows, numeric_from=2, cls="joints")]
     if d["dh"] is not None:
         dh_rows = []
         for i, r in enumerate(d["dh"], 1):
@@ -503,7 +676,7 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
     else:
         looks = f"{model['shapes_drawn']} of the {model['shapes']} {geometry} shapes of the description are drawn."
     missing = "".join(f"<li>{html.escape(m)}</li>" for m in model["missing"])
-    view = ["<section id='view'><h2>The arm at q</h2><div class='grid'><div>",
+    view = [f"<section id='view'><h2>The {'robot' if multi else 'arm'} at q</h2><div class='grid'><div>",
             '<div id="kinedyn-view" role="img" aria-label="3-D view of the arm"></div>',
             "<div id='kinedyn-playback' hidden><button id='kinedyn-play' type='button'>▶ play</button> "
             "<input id='kinedyn-time' type='range' aria-label='simulation time'> <span id='kinedyn-clock'></span>"
@@ -512,11 +685,12 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
             f"<ul class='bad' id='kinedyn-missing'>{missing}</ul>" if missing else "",
             "</div><div><h3>Joints</h3><div id='kinedyn-sliders'></div><p><button id='kinedyn-reset' type='button'>reset</button> <span id='kinedyn-tool'></span></p>",
             f"<p class='note' id='kinedyn-q'>q = ({html.escape(q_text)})</p>",
+            _configuration_table(robot, q, d) if multi else "",
             "<h3>Tool pose</h3>", _matrix_table(d["tool_pose"], ["", "", "", ""], ["", "", "", ""], "pose"),
             "</div></div>"]
     names = ["vx", "vy", "vz", "ωx", "ωy", "ωz"]
     view.append(f"<h3>Jacobian of '{html.escape(d['tool'])}' (base axes, rows [v; ω])</h3>")
-    view.append(_matrix_table(d["jacobian"], names, d["joint_names"], "jacobian"))
+    view.append(_matrix_table(d["jacobian"], names, v_labels, "jacobian"))
     view.append(_table(["", *[f"σ{k + 1}" for k in range(len(d["singular_values"]))]], [["singular values", *(_f(s) for s in d["singular_values"])]], cls="singular-values"))
     cls = "bad" if d["singular"] else "ok"
     view.append(f"<p>Rank {d['rank']}, condition number {_f(d['condition_number'], 4)}: <span class='{cls}'>{html.escape(d['singularity'])}</span></p></section>")
@@ -569,8 +743,8 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
     # --- dynamics: numbers, properties, simulation
     if d["dynamics"]:
         dyn = ["<section id='dynamics'><h2>Dynamics at q</h2>",
-               "<h3>Mass matrix M(q)</h3>", _matrix_table(d["mass_matrix"], d["joint_names"], d["joint_names"], "mass-matrix"),
-               _table(["", *d["joint_names"]], [["eigenvalues of M", *(_f(v) for v in d["mass_matrix_eigenvalues"])], ["gravity torque g(q) [N m]", *(_f(v) for v in d["gravity_torque"])]], cls="gravity"),
+               "<h3>Mass matrix M(q)</h3>", _matrix_table(d["mass_matrix"], v_labels, v_labels, "mass-matrix"),
+               _table(["", *v_labels], [["eigenvalues of M", *(_f(v) for v in d["mass_matrix_eigenvalues"])], ["gravity torque g(q) [N m]", *(_f(v) for v in d["gravity_torque"])]], cls="gravity"),
                "<h3>Properties check</h3>",
                f"<p class='note'>at q above and q̇ = ({', '.join(_f(v, 4) for v in d['properties_qd'])}).</p>"]
         prow = [[p["property"], p["measure"], _f(p["value"], 3), _Raw("<span class='ok'>holds</span>" if p["ok"] else "<span class='bad'>FAILS</span>")] for p in d["properties"]]
@@ -578,9 +752,13 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
         s = d["simulation"]
         t = np.asarray(s["t"])
         qs = np.asarray(s["q"])
-        plots = [svg_plot(t, [(nm, qs[:, k]) for k, nm in enumerate(d["joint_names"])], "joint positions", "t [s]", "q [rad or m]"),
-                 svg_plot(t, [("kinetic K", s["K"]), ("potential P", s["P"]), ("total H", s["H"])], "energy", "t [s]", "energy [J]")]
+        plots = _motion_plots(robot, t, qs, q_labels)
+        plots.append(svg_plot(t, [("kinetic K", s["K"]), ("potential P", s["P"]), ("total H", s["H"])], "energy", "t [s]", "energy [J]"))
         dyn.append(f"<h3>Free motion under gravity (τ = 0) for {_f(t[-1], 3)} s from q, q̇ = 0</h3>")
+        if any(j.kind == "floating" for j in robot.joints):
+            dyn.append("<p class='note' id='free-fall-note'>Nothing holds a floating joint: no contact or ground is modelled, so the robot falls "
+                       "freely (its position is plotted with the other multi-DOF coordinates); in free fall, uniform gravity alone does not "
+                       "move the joints relative to each other, only a starting q̇ (--qd) does.</p>")
         if s.get("note"):
             dyn.append(f"<p class='bad' id='simulation-cut-short'>{html.escape(s['note'])}</p>")
         dyn.append("<div class='plots'>" + "".join(plots) + "</div>")
@@ -606,7 +784,7 @@ def _build_report(robot, q, qd, name, t_end, eom_joints, data, tutorial, progres
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{html.escape(title)}</title>
 <style>{_asset("report.css")}</style></head>
-<body><header><h1>{html.escape(d['robot'])}</h1><p>{d['n']} joints · {html.escape(d['source'] or 'robot file')} · kinedyn {html.escape(kinedyn.__version__)}</p></header>
+<body><header><h1>{html.escape(d['robot'])}</h1><p>{len(d['joints']) if multi else d['n']} joints{f" · nq = {d['nq']}, nv = {d['nv']}" if multi else ""} · {html.escape(d['source'] or 'robot file')} · kinedyn {html.escape(kinedyn.__version__)}</p></header>
 <main>{view_html}{description}{eq_html}{dyn_html}{tutorial_html}</main>
 <footer>Generated by <code>kinedyn report</code>. Self-contained: no network access, every script and style is in this file.</footer>
 {_json_script(model, "kinedyn-model")}

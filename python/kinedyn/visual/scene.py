@@ -166,7 +166,7 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
     """Cylinders for a robot without visuals: one along each joint axis at the joint, and links from
     each body's joint to the joints and frames it carries (DH robots: along d, then a)."""
     tree = robot.tree
-    qs = np.vstack([np.zeros(robot.n), robot.random_configuration(np.random.default_rng(1), size=32)])
+    qs = np.vstack([robot.neutral(), robot.random_configuration(np.random.default_rng(1), size=32)])  # nq entries with multi-DOF joints
     reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 0.05)
     r = 0.03 * reach
     out: List[Tuple[str, Part]] = []
@@ -214,6 +214,8 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
                 start = c
     # joints: a short, wider cylinder along each joint axis
     for i, b in enumerate(tree.bodies):
+        if b.joint.is_multi_dof:  # no single axis to draw along (a floating base, a ball joint)
+            continue
         frame, body_from_frame = body_pose_frame(i)
         axis = np.asarray(b.joint.axis, dtype=float)
         axis /= np.linalg.norm(axis)

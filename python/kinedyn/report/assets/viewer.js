@@ -33,15 +33,34 @@
   function translation(axis, d) {
     return [1, 0, 0, axis[0] * d, 0, 1, 0, axis[1] * d, 0, 0, 1, axis[2] * d, 0, 0, 0, 1];
   }
+  // the rotation of a unit quaternion (x, y, z, w) (scalar last, as kinedyn's q), moved by p
+  function quaternionPose(x, y, z, w, p) {
+    return [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), p[0],
+            2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), p[1],
+            2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), p[2], 0, 0, 0, 1];
+  }
+  // a joint's motion at q: its block starts at q[b.q] (b.q absent: the body's own index)
+  function motion(b, i, q) {
+    const k = b.q === undefined ? i : b.q;
+    if (b.kind === "floating") return quaternionPose(q[k + 3], q[k + 4], q[k + 5], q[k + 6], [q[k], q[k + 1], q[k + 2]]);
+    if (b.kind === "spherical") return quaternionPose(q[k], q[k + 1], q[k + 2], q[k + 3], [0, 0, 0]);
+    if (b.kind === "planar") {  // (x, y) along the plane's axes e1, e2; the rotation (cos, sin) about e1 x e2
+      const e1 = b.e1, e2 = b.e2, c = q[k + 2], s = q[k + 3];
+      const nrm = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+      const T = rotation(nrm, Math.atan2(s, c));
+      for (let r = 0; r < 3; r++) T[4 * r + 3] = q[k] * e1[r] + q[k + 1] * e2[r];
+      return T;
+    }
+    // a mimic follower (kinedyn.description.mimic) moves by scale * q[its leader] + shift
+    const x = (b.scale === undefined ? q[k] : b.scale * q[k] + b.shift) + b.offset;
+    return b.kind === "revolute" ? rotation(b.axis, x) : translation(b.axis, x);
+  }
   // forward kinematics: body poses and named frame poses in the base
   function fk(q) {
     const body = [];
     for (let i = 0; i < n; i++) {
       const b = model.bodies[i];
-      // a mimic follower (kinedyn.description.mimic) moves by scale * q[its leader] + shift
-      const x = (b.scale === undefined ? q[i] : b.scale * q[b.q] + b.shift) + b.offset;
-      const motion = b.kind === "revolute" ? rotation(b.axis, x) : translation(b.axis, x);
-      body.push(mul(mul(b.parent < 0 ? I4 : body[b.parent], b.placement), motion));
+      body.push(mul(mul(b.parent < 0 ? I4 : body[b.parent], b.placement), motion(b, i, q)));
     }
     const frames = {};
     for (const f of model.frames) frames[f.name] = mul(f.body < 0 ? I4 : body[f.body], f.placement);
@@ -134,8 +153,9 @@
     for (let i = 0; i < n; i++) {
       const p = origin(K.body[i]);
       jx.push(p[0]); jy.push(p[1]); jz.push(p[2]);
-      jc.push(model.bodies[i].kind === "revolute" ? "#ff9800" : "#8e24aa");
-      jt.push(plain(model.joint_names[i]));
+      const kind = model.bodies[i].kind;
+      jc.push(kind === "revolute" ? "#ff9800" : kind === "prismatic" ? "#8e24aa" : "#00897b");
+      jt.push(plain(model.bodies[i].name === undefined ? model.joint_names[i] : model.bodies[i].name));
     }
     out.push({ type: "scatter3d", mode: model.label_joints ? "markers+text" : "markers", x: jx, y: jy, z: jz, text: jt, textposition: "bottom right",
                textfont: { size: 11, color: "#333" }, marker: { size: 4, color: jc, line: { color: "#4e342e", width: 1 } }, hovertemplate: "%{text}<extra></extra>" });
@@ -157,8 +177,16 @@
 
   // ---------------------------------------------------------------- readouts: tool position, pose table, q
   const fmt = (v) => { if (Math.abs(v) < 1e-13) v = 0; const s = Number(v.toPrecision(6)).toString(); return s; };
-  const coordinates = model.joint_names.length;  // fewer than the bodies when mimic followers are reduced
-  const revolute = (model.joint_kinds || model.bodies.map((b) => b.kind)).map((kind) => kind === "revolute");
+  // per entry of q: "rad", "m", or "" (a quaternion's, a planar (cos, sin) pair's); named: in a multi-DOF joint's block
+  const units = model.coordinate_units || (model.joint_kinds || model.bodies.map((b) => b.kind)).map((kind) => kind === "revolute" ? "rad" : "m");
+  const named = model.coordinate_named || units.map(() => false);
+  const labels = model.coordinate_labels || model.joint_names;
+  const entry = (v, i) => {
+    const value = units[i] === "rad" ? fmt(v) + " rad (" + Number((v * 180 / Math.PI).toPrecision(5)) + "°)" : units[i] === "m" ? fmt(v) + " m" : fmt(v);
+    return named[i] ? labels[i] + " = " + value : value;
+  };
+  // one slider per 1-DOF coordinate and per position of a floating or planar joint (model.sliders)
+  const sliderList = model.sliders || model.joint_names.map((name, i) => ({ name: name, q: i, revolute: units[i] === "rad", lower: model.lower[i], upper: model.upper[i] }));
   function readouts(tool) {
     const t = origin(tool);
     const out = document.getElementById("kinedyn-tool");
@@ -166,7 +194,7 @@
     const cells = document.querySelectorAll("table.pose tbody td.num");
     if (cells.length === 16) cells.forEach((cell, k) => { cell.textContent = fmt(tool[k]); });
     const qText = document.getElementById("kinedyn-q");
-    if (qText) qText.textContent = "q = (" + q.map((v, i) => revolute[i] ? fmt(v) + " rad (" + Number((v * 180 / Math.PI).toPrecision(5)) + "°)" : fmt(v) + " m").join(", ") + ")";
+    if (qText) qText.textContent = "q = (" + q.map(entry).join(", ") + ")";
   }
 
   let pending = false, ready = null;
@@ -184,27 +212,30 @@
 
   // ---------------------------------------------------------------- sliders, reset, playback
   const sliders = document.getElementById("kinedyn-sliders");
-  function label(i) {
-    return revolute[i] ? (q[i] * 180 / Math.PI).toFixed(1) + "\u00b0" : q[i].toFixed(3) + " m";
+  function label(s) {
+    const v = q[s.q];
+    return s.revolute ? (v * 180 / Math.PI).toFixed(1) + "\u00b0" : v.toFixed(3) + " m";
   }
   function syncSliders() {
-    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[i]; el.nextElementSibling.textContent = label(i); });
+    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[sliderList[i].q]; el.nextElementSibling.textContent = label(sliderList[i]); });
   }
   if (sliders) {
-    for (let i = 0; i < coordinates; i++) {
+    for (const s of sliderList) {
       const row = document.createElement("label");
-      const span = revolute[i] ? Math.PI : model.reach;
-      const lo = Number.isFinite(model.lower[i]) ? model.lower[i] : -span;
-      const hi = Number.isFinite(model.upper[i]) ? model.upper[i] : span;
+      const span = s.revolute ? Math.PI : model.reach;
+      const finite = (x) => typeof x === "number" && Number.isFinite(x);
+      // a position without limits (a floating base's x, y, z): one reach either side of where it is
+      const lo = finite(s.lower) ? s.lower : (s.revolute ? -span : Math.min(-span, q[s.q] - span));
+      const hi = finite(s.upper) ? s.upper : (s.revolute ? span : Math.max(span, q[s.q] + span));
       row.innerHTML = "<span class='jn'></span><input type='range'><output></output>";
-      row.querySelector(".jn").textContent = model.joint_names[i];
-      row.title = model.joint_names[i];
+      row.querySelector(".jn").textContent = s.name;
+      row.title = s.name;
       const input = row.querySelector("input");
-      input.min = lo; input.max = hi; input.step = (hi - lo) / 1000; input.value = q[i];
-      input.setAttribute("aria-label", model.joint_names[i]);
+      input.min = lo; input.max = hi; input.step = (hi - lo) / 1000; input.value = q[s.q];
+      input.setAttribute("aria-label", s.name);
       const out = row.querySelector("output");
-      out.textContent = label(i);
-      input.addEventListener("input", () => { stop(); q[i] = parseFloat(input.value); out.textContent = label(i); draw(); });
+      out.textContent = label(s);
+      input.addEventListener("input", () => { stop(); q[s.q] = parseFloat(input.value); out.textContent = label(s); draw(); });
       sliders.appendChild(row);
     }
   }
