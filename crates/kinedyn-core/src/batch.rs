@@ -301,6 +301,49 @@ pub mod kernels {
         }
     }
 
+    /// The poses of `frames` (4 x 4 row-major each) after forward kinematics.
+    pub struct FramePoses<'a> {
+        pub frames: &'a [usize],
+    }
+    impl Kernel for FramePoses<'_> {
+        fn output_len(&self, _model: &Model) -> usize {
+            16 * self.frames.len()
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            alg::forward_kinematics(model, data, x[0]);
+            for (slot, &f) in out.chunks_exact_mut(16).zip(self.frames) {
+                let pose = alg::frame_pose(model, data, f);
+                let (r, t) = (&pose.rot, &pose.trans);
+                let (zero, one) = (T::zero(), T::one());
+                slot.copy_from_slice(&[
+                    r[(0, 0)], r[(0, 1)], r[(0, 2)], t.x,
+                    r[(1, 0)], r[(1, 1)], r[(1, 2)], t.y,
+                    r[(2, 0)], r[(2, 1)], r[(2, 2)], t.z,
+                    zero, zero, zero, one,
+                ]);
+            }
+            Ok(())
+        }
+    }
+
+    /// The 6 x n Jacobian of a frame (or of a point fixed in it), row-major.
+    pub struct Jacobian {
+        pub frame: usize,
+        pub reference: alg::Reference,
+        pub point: Option<crate::spatial::Vec3>,
+    }
+    impl Kernel for Jacobian {
+        fn output_len(&self, model: &Model) -> usize {
+            6 * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            alg::frame_jacobian(model, data, x[0], self.frame, self.reference, self.point.as_ref(), out);
+            Ok(())
+        }
+    }
+
     /// `C(q, qd) qd + g(q)` (no friction).
     pub struct Bias;
     impl Kernel for Bias {
@@ -319,6 +362,7 @@ pub mod kernels {
 mod tests {
     use super::kernels::*;
     use super::*;
+    use crate::algorithms as alg;
     use crate::testing::{dh_model, random_configuration, random_floating_model, random_model, Rng, UR5_DH};
 
     fn models() -> Vec<(&'static str, Model)> {
@@ -389,6 +433,17 @@ mod tests {
     fn gravity_and_bias_in_lanes() {
         lanes_equal_single_calls(Gravity, 1);
         lanes_equal_single_calls(Bias, 2);
+    }
+
+    #[test]
+    fn frame_poses_and_jacobians_in_lanes() {
+        // every model above has frames 0 (a body's) ..; frame 0 is on a moving body
+        lanes_equal_single_calls(FramePoses { frames: &[0] }, 1);
+        let point = Some(crate::spatial::Vec3::new(0.1, -0.2, 0.3));
+        for reference in [alg::Reference::World, alg::Reference::Local, alg::Reference::Spatial] {
+            lanes_equal_single_calls(Jacobian { frame: 0, reference, point }, 1);
+            lanes_equal_single_calls(Jacobian { frame: 0, reference, point: None }, 1);
+        }
     }
 
     /// A state that makes the ABA fail fails the batch with the single call's error, naming it.

@@ -13,7 +13,7 @@
 use super::kinematics::{forward_acceleration, forward_kinematics, forward_velocity, frame_pose};
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{Mat3, Motion, Transform, Vec3};
+use crate::spatial::{cross, mtv, Mat3, Motion, Real, Transform, Vec3};
 
 /// How a frame's twist and Jacobian are expressed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,25 +44,24 @@ fn express(reference: Reference, world_from_frame: &Transform, local: &Motion) -
 }
 
 /// The Jacobian of `frame` (or of a point fixed in it) at `q`, written row-major `6 x n` to `out`.
-pub fn frame_jacobian(model: &Model, data: &mut Data, q: &[f64], frame: usize, reference: Reference, point: Option<&Vec3>, out: &mut [f64]) {
+#[inline(always)]
+pub fn frame_jacobian<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], frame: usize, reference: Reference, point: Option<&Vec3>, out: &mut [T]) {
     let n = model.n;
-    out[..6 * n].fill(0.0);
+    out[..6 * n].fill(T::zero());
     forward_kinematics(model, data, q);
     let Some(body) = model.frames[frame].body else { return };
-    let world_from_frame = data.world_from_body[body] * body_from_point(model, frame, point);
+    let world_from_frame = data.world_from_body[body] * body_from_point(model, frame, point).splat();
     let (r, p) = (world_from_frame.rot, world_from_frame.trans);
     for &j in &model.support[body] {
         // spatial column: s_j in world coordinates
         let sw = data.world_from_body[j].act_motion(&data.s[j]);
         let col = match reference {
             Reference::Spatial => sw,
-            Reference::World => Motion::new(sw.lin + sw.ang.cross(&p), sw.ang),
-            Reference::Local => {
-                let rt = r.transpose();
-                Motion::new(rt * (sw.lin + sw.ang.cross(&p)), rt * sw.ang)
-            }
+            Reference::World => Motion::new(sw.lin + cross(&sw.ang, &p), sw.ang),
+            Reference::Local => Motion::new(mtv(&r, &(sw.lin + cross(&sw.ang, &p))), mtv(&r, &sw.ang)),
         };
-        for (k, value) in col.to_array().iter().enumerate() {
+        let values = [col.lin.x, col.lin.y, col.lin.z, col.ang.x, col.ang.y, col.ang.z];
+        for (k, value) in values.iter().enumerate() {
             out[k * n + j] = *value;
         }
     }
