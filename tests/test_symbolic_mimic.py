@@ -178,3 +178,30 @@ def test_panda_closed_form_with_its_mimic_finger():
     for name, reference in (("M", robot.mass_matrix(q)), ("C", robot.coriolis_matrix(q, qd)), ("g", robot.gravity_torque(q))):
         block = np.array([float(x) for x in evaluate_block(cse[name], at)]).reshape(reference.shape)
         np.testing.assert_allclose(block, reference, atol=1e-10, err_msg=name)
+
+
+def test_general_parameters_are_per_body_and_the_regressor_reproduces_tau():
+    robot = arm()
+    eom = robot.equations_of_motion(parameters="general")  # ten symbols per body: 5 bodies, 3 coordinates
+    Y, theta = eom.regressor()
+    assert Y.shape[0] == 3
+    from kinedyn.symbolic.robot_eom import general_parameters
+
+    numbers = {s: v for row, values in zip(general_parameters(robot), robot.inertial_parameters().reshape(-1, 10)) for s, v in zip(row, values)}
+    for q, qd, qdd in states(robot, seed=6):
+        at = values(eom, q, qd, qdd)
+        tau = np.array((Y * sp.Matrix(theta)).xreplace(at).xreplace(numbers).evalf(), dtype=float).ravel()
+        np.testing.assert_allclose(tau, robot.inverse_dynamics(q, qd, qdd) - robot.friction_torque(qd), atol=1e-10)
+
+
+def test_cli_derives_a_mimic_robot(tmp_path, capsys):
+    import json
+
+    from kinedyn.cli import main
+
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.replace("MULT", "-1.5").replace("OFF", "0.2"))
+    assert main(["derive", str(path), "--json", "--no-simplify"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["q"] == ["j1", "j2", "finger_left"] and len(out["M"]) == 3
+    assert "3*j2/2" in out["M"][1][1]

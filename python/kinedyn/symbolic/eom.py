@@ -463,8 +463,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
         from .robot_eom import general_parameters
 
         parameters = general_parameters(robot)
-    if parameters is not None and (len(parameters) != robot.n or any(len(p) != 10 for p in parameters)):
-        raise ValueError(f"parameters must hold {robot.n} vectors of 10 inertial parameters")
+    bodies = len(robot.tree.bodies)  # robot.n, or more with reduced mimic joints
+    if parameters is not None and (len(parameters) != bodies or any(len(p) != 10 for p in parameters)):
+        raise ValueError(f"parameters must hold {bodies} vectors of 10 inertial parameters (one per moving body)")
     if method == "lagrange":
         from .robot_eom import lagrange_eom
 

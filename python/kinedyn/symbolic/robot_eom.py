@@ -19,7 +19,7 @@ def general_parameters(robot):
     """Per-body symbols [M_j, MX_j, MY_j, MZ_j, XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j] (Khalil & Dombre's
     names for the standard parameters about the body origin): a robot with general symbolic inertias."""
     out = []
-    for j in range(1, robot.n + 1):
+    for j in range(1, len(robot.tree.bodies) + 1):  # per body: mimic followers' too
         out.append(list(sp.symbols(f"M{j} MX{j} MY{j} MZ{j} XX{j} XY{j} YY{j} XZ{j} YZ{j} ZZ{j}", real=True)))
     return out
 
