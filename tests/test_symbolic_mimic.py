@@ -205,3 +205,12 @@ def test_cli_derives_a_mimic_robot(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["q"] == ["j1", "j2", "finger_left"] and len(out["M"]) == 3
     assert "3*j2/2" in out["M"][1][1]
+
+
+def test_property_search_does_not_take_a_fractional_multiple_for_2pi_periodic():
+    from kinedyn.analysis import prove_properties
+
+    report = prove_properties(arm().equations_of_motion(steps=False), samples=2, starts=2)
+    bounds = next(c for c in report.checks if c.name.startswith("inertia bounds"))
+    # j1 only in cos/sin of integer multiples: periodic; j2 in cos(3 j2 / 2): 4 pi-periodic, searched in a range
+    assert bounds.detail.endswith("q in periodic, [-1, 1], [-1, 1])") and bounds.passed
