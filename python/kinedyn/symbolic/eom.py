@@ -452,7 +452,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
 
     Floating, spherical and planar joints are derived in minimal coordinates: position and ZYX Euler
     angles (x, y, z, yaw, pitch, roll), (yaw, pitch, roll), (x, y, theta), with their rates as the
-    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot).
+    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot). Reduced mimic
+    joints stay reduced: a follower's joint variable is ``m q_leader + o`` (docs/symbolic.md, "Mimic
+    joints"; :mod:`kinedyn.symbolic.lagrange`).
     """
     from ..description.parametrise import euler_parametrised
 
