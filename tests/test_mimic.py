@@ -399,10 +399,8 @@ def test_simulation_runs_on_the_reduced_dynamics():
 
 def test_symbolic_engine_and_ik_refuse_naming_the_follower():
     robot = kd.Robot.from_urdf(gripper_urdf())
-    with pytest.raises(ValueError, match=r"the symbolic engine does not handle mimic joints yet; robot 'gripper' has the follower joint 'right_finger'"):
-        robot.equations_of_motion()
-    with pytest.raises(ValueError, match=r"the symbolic engine .*'right_finger'"):
-        kd.symbolic.kinematics.pose(robot)
+    # the symbolic engine handles them now (tests/test_symbolic_mimic.py): in the reduced coordinates
+    assert robot.equations_of_motion(simplify=False).M.shape == (3, 3)
     with pytest.raises(ValueError, match=r"inverse kinematics of frame 'right' does not handle mimic joints yet: the follower joint 'right_finger'.*mimic='independent'"):
         robot.inverse_kinematics(np.eye(4), frame="right")
     with pytest.raises(ValueError, match=r"inverse kinematics does not handle mimic joints yet; robot 'gripper' has the follower joint 'right_finger'"):
@@ -417,7 +415,7 @@ def test_report_on_a_mimic_robot(tmp_path):
 
     robot = kd.Robot.from_urdf(gripper_urdf())
     data = collect(robot, name="gripper", t_end=0.2)
-    assert "symbolic engine does not handle mimic joints yet (joint 'right_finger' follows 'left_finger')" in repr(data)
+    assert data["_eom"] is not None and data["_eom"].n == 3  # the symbolic engine reduces the follower too
 
 
 def test_the_reports_viewer_moves_the_followers(browser, tmp_path):

@@ -678,7 +678,10 @@ def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: 
                             "Spong eqs. 9.119-9.120", status="skipped"))
         return PropertiesReport(eom.name or "equations of motion", samples, checks)
     limits = by_name(limits, q) if limits else {}
-    periodic = np.array([not Dn.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1)).has(c) for c in q])
+    # 2 pi-periodic: only inside sines and cosines, with integer multiples (a mimic follower's cos(3 q/2) is not)
+    angles = [sp.expand(f.args[0]) for f in Dn.atoms(sp.sin, sp.cos)]
+    periodic = np.array([not Dn.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1)).has(c)
+                         and all(a.coeff(c).is_integer for a in angles) for c in q])
     lower = np.array([-np.pi if p else float(limits.get(c, (-1.0, 1.0))[0]) for c, p in zip(q, periodic)])
     upper = np.array([np.pi if p else float(limits.get(c, (-1.0, 1.0))[1]) for c, p in zip(q, periodic)])
     f_D = sp.lambdify([q], Dn, "numpy")

@@ -287,9 +287,6 @@ def _symbolic_eom(robot, name: Optional[str], max_joints: int):
             subject = robot
     if not hasattr(subject, "equations_of_motion"):
         return None, "This kinedyn has no symbolic engine."
-    if getattr(subject, "mimic_joints", None):
-        follower, relation = next(iter(subject.mimic_joints.items()))
-        return None, f"The symbolic engine does not handle mimic joints yet (joint '{follower}' follows '{relation.leader}')."
     try:
         # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
         eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")

@@ -452,7 +452,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
 
     Floating, spherical and planar joints are derived in minimal coordinates: position and ZYX Euler
     angles (x, y, z, yaw, pitch, roll), (yaw, pitch, roll), (x, y, theta), with their rates as the
-    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot).
+    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot). Reduced mimic
+    joints stay reduced: a follower's joint variable is ``m q_leader + o`` (docs/symbolic.md, "Mimic
+    joints"; :mod:`kinedyn.symbolic.lagrange`).
     """
     from ..description.parametrise import euler_parametrised
 
@@ -463,8 +465,9 @@ def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, 
         from .robot_eom import general_parameters
 
         parameters = general_parameters(robot)
-    if parameters is not None and (len(parameters) != robot.n or any(len(p) != 10 for p in parameters)):
-        raise ValueError(f"parameters must hold {robot.n} vectors of 10 inertial parameters")
+    bodies = len(robot.tree.bodies)  # robot.n, or more with reduced mimic joints
+    if parameters is not None and (len(parameters) != bodies or any(len(p) != 10 for p in parameters)):
+        raise ValueError(f"parameters must hold {bodies} vectors of 10 inertial parameters (one per moving body)")
     if method == "lagrange":
         from .robot_eom import lagrange_eom
 

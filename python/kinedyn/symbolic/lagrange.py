@@ -15,6 +15,16 @@ angular velocity (3 x n), ``pi`` = [m, h = m c, I_o] the ten inertial parameters
     tau_k = d/dt dL/dqd_k - dL/dq_k,  L = K - P                                   (Spong 9.40)
     c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2,  C_kj = sum_i c_ijk qd_i   (Spong 9.58, 9.62)
 
+Mimic joints (reduced, ``robot.mimic_joints``): a follower body's joint coordinate is
+``m q_k + o`` (m, o its relation to the independent leader k; :func:`body_coordinates`), its rate
+``m qd_k``. The kinematics above then run per body with that coordinate, and a body's joint adds
+``m a_i`` to the Jacobian column of its leader (``J_reduced = J_full G``, G the constant map
+``qd_full = G qd`` of :mod:`kinedyn.description.mimic`). D, K, P and L are formed in the reduced
+coordinates only, and Lagrange's equations, the Christoffel symbols and C follow from them by the
+same formulas, derivatives taken by the chain rule (:class:`~kinedyn.symbolic.simplify.TrigRing`:
+cos(m q_k) for a fractional m is a generator differentiated as a function of q_k). A follower's
+rotor inertia adds ``m^2 r^2 J_m`` to its leader's diagonal entry (``G^T diag G``).
+
 All arithmetic is exact, in the normal form of :class:`kinedyn.symbolic.simplify.TrigRing`.
 """
 
@@ -27,7 +37,7 @@ import sympy as sp
 
 from .simplify import TrigRing
 
-__all__ = ["RingModel", "state_symbols", "derive_lagrange"]
+__all__ = ["RingModel", "state_symbols", "derive_lagrange", "body_coordinates"]
 
 
 def _exact(value):
@@ -69,9 +79,7 @@ def state_symbols(robot):
     shoulder -> shoulderdot, shoulderddot (see :func:`kinedyn.symbolic.render.rate_names`)."""
     from .render import rate_names
 
-    if getattr(robot, "mimic_joints", None):  # one symbol per coordinate: mimic followers have none
-        robot.require_no_mimic_joints("the symbolic engine")
-    q, qd, qdd = [], [], []
+    q, qd, qdd = [], [], []  # one per coordinate: reduced mimic followers have none (body_coordinates)
     taken = {str(s) for s in robot.symbols}
     for name in robot.joint_names:
         names = (name, *rate_names(name))
@@ -82,6 +90,44 @@ def state_symbols(robot):
         qd.append(sp.Symbol(names[1], real=True))
         qdd.append(sp.Symbol(names[2], real=True))
     return q, qd, qdd
+
+
+def mimic_multiplier(value):
+    """A mimic relation's multiplier as an exact value: the small rational a decimal from a file stands
+    for (-1.5 -> -3/2) when it is exactly that float, else the float (so that cos(3 q/2) prints as
+    such, and an integer multiplier is recognised)."""
+    if isinstance(value, sp.Basic) and not value.is_number:
+        return value
+    f = float(value)
+    return sp.Integer(int(f)) if f.is_integer() else _rational(f)
+
+
+def body_coordinates(robot) -> list:
+    """Per body of ``robot.tree.bodies``: ``(k, m, o)``, its joint's coordinate being ``m q[k] + o``
+    (exact SymPy numbers; 1 and 0 for an independent joint, k its own index in q). Followers are
+    ``robot.mimic_joints`` (reduced mimic joints, chains resolved to an independent leader)."""
+    names = list(robot.joint_names)
+    relations = getattr(robot, "mimic_joints", None) or {}
+    one, zero = sp.Integer(1), sp.Integer(0)
+    out = []
+    for b in robot.tree.bodies:
+        relation = relations.get(b.joint.name)
+        if relation is None:
+            out.append((names.index(b.joint.name), one, zero))
+        else:
+            out.append((names.index(relation.leader), mimic_multiplier(relation.multiplier), _exact(relation.offset)))
+    return out
+
+
+def body_states(robot, q, qd, qdd) -> tuple:
+    """Per body: its joint's coordinate, rate and acceleration as SymPy expressions in the symbols
+    ``q``, ``qd``, ``qdd`` of the coordinates (``m q_k + o``, ``m qd_k``, ``m qdd_k`` for a follower)."""
+    qb, qdb, qddb = [], [], []
+    for k, m, o in body_coordinates(robot):
+        qb.append(m * q[k] + o)
+        qdb.append(m * qd[k])
+        qddb.append(m * qdd[k])
+    return qb, qdb, qddb
 
 
 def latex_names(q, qd, qdd) -> dict:
@@ -106,7 +152,15 @@ class RingModel:
         point given with symbols) for :mod:`kinedyn.symbolic.kinematics`."""
         self.robot = robot
         bodies = robot.tree.bodies
-        self.n = n = len(bodies)
+        self.n_bodies = len(bodies)
+        self.n = len(q)  # coordinates (fewer than the bodies with reduced mimic joints)
+        # per body: its joint coordinate is scale * q[column] + shift (body_coordinates)
+        self.column, self.scale, self.shift = [], [], []
+        for k, m, o in body_coordinates(robot):
+            self.column.append(k)
+            self.scale.append(m)
+            self.shift.append(o)
+        kinds = [j.kind for j in robot.joints]  # of the coordinates
         # ---- the description as exact SymPy values
         self.place_R, self.place_p, self.axis, self.offset, self.pi = [], [], [], [], []
         self.com, self.armature, self.viscous, self.coulomb = [], [], [], []
@@ -126,16 +180,26 @@ class RingModel:
             self.viscous.append(_exact(b.joint.viscous))
             self.coulomb.append(_exact(b.joint.coulomb))
             leaves += sum(self.place_R[-1], []) + self.place_p[-1] + self.axis[-1] + pi + [self.armature[-1]]
+            phase = off + self.shift[k]  # the joint variable is scale q + phase
             if b.joint.kind == "revolute":
-                leaves += [sp.cos(off), sp.sin(off)] if not off.has(sp.Float) else []
+                leaves += [sp.cos(phase), sp.sin(phase)] if not phase.has(sp.Float) else []
             else:
-                leaves.append(off)
+                leaves.append(phase)
+            if self.scale[k] != 1:
+                leaves.append(self.scale[k])
         self.gravity = [_exact(g) for g in robot.gravity]
         leaves += self.gravity
         leaves += [_exact(x) for x in extra_leaves]
         self.leaves = leaves
-        kinds = [b.joint.kind for b in bodies]
-        self.ring = TrigRing(list(zip(q, kinds)), qd, qdd, leaves)
+        # generators for the followers' coordinates that are no polynomial in their leader's (simplify.py)
+        multiples, angles = [], []
+        for k, b in enumerate(bodies):
+            col, m = self.column[k], self.scale[k]
+            if b.joint.kind == "revolute" and not (kinds[col] == "revolute" and m.is_Integer):
+                multiples.append((col, m))
+            elif b.joint.kind == "prismatic" and kinds[col] == "revolute":
+                angles.append(col)
+        self.ring = TrigRing(list(zip(q, kinds)), qd, qdd, leaves, multiples=multiples, angles=angles)
         self.q, self.qd, self.qdd = q, qd, qdd
         self._kinematics()
 
@@ -163,10 +227,21 @@ class RingModel:
         """Rodrigues: R = C I + S [a]x + (1 - C) a a^T, with C, S the cosine/sine of q_i + offset."""
         ring = self.ring
         a = [self._c(x) for x in self.axis[i]]
-        C, S = ring.cos(i, self.offset[i]), ring.sin(i, self.offset[i])
+        C, S = self.joint_cos(i), self.joint_sin(i)
         one_c = ring.one - C
         ax = self._skew(a)
         return [[ring.reduce((C if r == k else ring.zero) + S * ax[r][k] + one_c * a[r] * a[k]) for k in range(3)] for r in range(3)]
+
+    def joint_cos(self, i):
+        """cos of body i's joint angle (its coordinate plus the joint offset)."""
+        return self.ring.cos_multiple(self.column[i], self.scale[i], self.offset[i] + self.shift[i])
+
+    def joint_sin(self, i):
+        return self.ring.sin_multiple(self.column[i], self.scale[i], self.offset[i] + self.shift[i])
+
+    def joint_displacement(self, i):
+        """Body i's prismatic joint variable (its coordinate plus the joint offset), a polynomial."""
+        return self.ring.angle(self.column[i]) * self._c(self.scale[i]) + self._c(self.offset[i] + self.shift[i])
 
     # ------------------------------------------------------------------ kinematics
     def _kinematics(self):
@@ -189,7 +264,7 @@ class RingModel:
                 r = P_p
             else:
                 E = P_R
-                d = ring.coordinate(i) + self._c(self.offset[i])
+                d = self.joint_displacement(i)
                 r = [P_p[k] + ring.dot(P_R[k], [x * d for x in a]) for k in range(3)]
             parent = b.parent
             if parent < 0:
@@ -205,12 +280,11 @@ class RingModel:
                 Sr = self._skew(r)
                 SJ = self._mat(Sr, self.Jw[parent])
                 Jv = self._matT(E, [[self.Jv[parent][k][j] - SJ[k][j] for j in range(n)] for k in range(3)])
-            if b.joint.kind == "revolute":
-                for k in range(3):
-                    Jw[k][i] = Jw[k][i] + a[k]
-            else:
-                for k in range(3):
-                    Jv[k][i] = Jv[k][i] + a[k]
+            # the joint's own column: its axis times d(joint coordinate)/d(q[column]) = scale
+            col, scale = self.column[i], self._c(self.scale[i])
+            J_own = Jw if b.joint.kind == "revolute" else Jv
+            for k in range(3):
+                J_own[k][col] = J_own[k][col] + a[k] * scale
             self.E.append(E)
             self.r.append(r)
             self.R.append(R)
@@ -241,13 +315,14 @@ class RingModel:
     def mass_matrix(self):
         ring, n = self.ring, self.n
         D = [[ring.zero] * n for _ in range(n)]
-        for i in range(n):
+        for i in range(self.n_bodies):
             Di = self.body_mass_matrix(i)
             for r in range(n):
                 for c in range(n):
                     D[r][c] = D[r][c] + Di[r][c]
-        for i in range(n):
-            D[i][i] = D[i][i] + self._c(self.armature[i])
+        for i in range(self.n_bodies):  # rotor inertia on G^T diag(armature) G: scale^2 on the leader's entry
+            col = self.column[i]
+            D[col][col] = D[col][col] + self._c(self.armature[i]) * self._c(self.scale[i]) ** 2
         return D
 
     def potential_energy(self):
@@ -255,7 +330,7 @@ class RingModel:
         ring = self.ring
         g = [self._c(x) for x in self.gravity]
         P = ring.zero
-        for i in range(self.n):
+        for i in range(self.n_bodies):
             m = self._c(self.pi[i][0])
             h = [self._c(x) for x in self.pi[i][1:4]]
             Rh = self._vec(self.R[i], h)
@@ -265,7 +340,7 @@ class RingModel:
     def com_positions(self):
         """World positions of the centres of mass, p_ci = p_i + R_i c_i (for the derivation's steps)."""
         out = []
-        for i in range(self.n):
+        for i in range(self.n_bodies):
             c = [self._c(x) for x in self.com[i]]
             Rc = self._vec(self.R[i], c)
             out.append([self.ring.reduce(self.p[i][k] + Rc[k]) for k in range(3)])

@@ -17,6 +17,12 @@ rotation, ``ET`` its transpose, ``r`` = body origin in parent axes, ``a`` = join
     n_j   = N_j + sum_children (E_c n_c + r_c x (E_c f_c))
     tau_j = a . n_j (revolute) or a . f_j (prismatic) + r^2 J_m qdd_j + viscous qd_j + coulomb sign(qd_j)
 
+With reduced mimic joints (``robot.mimic_joints``) the recursion runs over every body, a follower's
+joint variables being ``m q_k + o``, ``m qd_k``, ``m qdd_k`` (its leader k;
+:func:`kinedyn.symbolic.lagrange.body_states`), and the generalised forces of the coordinates are
+``tau = G^T tau_joints`` (principle of virtual work: a follower's joint force adds ``m tau_j`` to its
+leader's; ``qd_joints = G qd``).
+
 Two reductions of the customised model (``group=True``), neither of which changes tau:
 
 * **Grouped parameters** (K&D ch. 9, the grouping rules of the base inertial parameters; Gautier & Khalil 1990,
@@ -226,12 +232,15 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
     (about the body origin, body axes) replacing the description's inertias (e.g. general symbols).
     ``group``: use grouped parameters and the U-form of the moment (same tau, fewer operations).
     ``exact``: the value converter (kinedyn.symbolic.lagrange._exact)."""
-    from .lagrange import _exact, _matrix
+    from .lagrange import _exact, _matrix, body_coordinates, body_states
 
     exact = exact or _exact
     bodies = robot.tree.bodies
     n = len(bodies)
-    prog = Program(reserved=set(robot.symbols) | set(q) | set(qd) | set(qdd))
+    coordinates = body_coordinates(robot)
+    q_coordinates, qd_coordinates, qdd_coordinates = q, qd, qdd
+    q, qd, qdd = body_states(robot, q, qd, qdd)  # per body (the coordinates' own symbols without mimic joints)
+    prog = Program(reserved=set(robot.symbols) | set(q_coordinates) | set(qd_coordinates) | set(qdd_coordinates))
     let = prog.let
     zero = sp.Integer(0)
     children: Dict[int, list] = {i: [] for i in range(-1, n)}
@@ -333,7 +342,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
     # ---- backward recursion: f_j = F_j + sum E_c f_c ; n_j = N_j + sum (E_c n_c + r_c x E_c f_c)
     f: Dict[int, Any] = {}
     nn: Dict[int, Any] = {}
-    tau: List[Any] = [None] * n
+    joint_force: List[Any] = [None] * n
     for j in reversed(range(n)):
         J = j + 1
         prog.tag = ("backward", J)
@@ -353,7 +362,13 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         t = t + exact(b.joint.armature) * qdd[j]
         if friction:
             t = t + exact(b.joint.viscous) * qd[j] + b.joint.coulomb_torque(qd[j], exact)
-        tau[j] = t
+        joint_force[j] = t
+    # tau = G^T tau_joints: each joint's force on its coordinate, a follower's times its multiplier
+    tau: List[Any] = [zero] * len(q_coordinates)
+    for j, (k, m, _) in enumerate(coordinates):
+        tau[k] = tau[k] + m * joint_force[j]
+    if len(tau) < n:  # mimic joints: the joint forces, for the step-by-step display
+        prog.vectors[("joint_forces",)] = joint_force
     prog.outputs["tau"] = tau
     return prog.prune()
 
@@ -444,6 +459,7 @@ def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
                 st.equations.append((name(f"{latex}_{{{J}}}", f"{text}{J}", latex, str(J)), V(key, j)))
         steps.append(st)
     tau = prog.outputs.get("tau", [])
+    joint_forces = prog.vectors.get(("joint_forces",))  # mimic joints: per joint, then tau = G^T of them
     for j in reversed(range(n)):
         J = j + 1
         st = Step(
@@ -455,7 +471,21 @@ def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
         for key in ("f", "n"):
             if V(key, j) is not None:
                 st.equations.append((name(f"{key}_{{{J}}}", f"{key}{J}", key, str(J)), V(key, j)))
-        if j < len(tau):
+        if joint_forces is not None:
+            st.equations.append((name(f"Q_{{{J}}}", f"Q_{J}", "Q", str(J)), joint_forces[j]))
+        elif j < len(tau):
             st.equations.append((name(f"\\tau_{{{J}}}", f"tau_{J}", "tau", str(J)), tau[j]))
         steps.append(st)
+    if joint_forces is not None:
+        from .lagrange import body_coordinates
+
+        number = lambda x: f"{float(x):g}" if x.is_number else str(x)
+        follows = [f"joint {j + 1}: {b.joint.name} = {number(m)} {robot.joint_names[k]} + {number(o)}"
+                   for j, (b, (k, m, o)) in enumerate(zip(robot.tree.bodies, body_coordinates(robot))) if b.joint.name not in robot.joint_names]
+        steps.append(Step(
+            "Mimic joints: the forces on the coordinates, tau = G^T Q",
+            "Q_j is joint j's force from the recursion; a follower joint moves as m q_k + o, so by virtual work its force adds m Q_j "
+            f"to its leader's coordinate k ({'; '.join(follows)}).",
+            [(name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), t) for k, t in enumerate(tau)],
+        ))
     return steps

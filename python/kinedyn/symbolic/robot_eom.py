@@ -19,7 +19,7 @@ def general_parameters(robot):
     """Per-body symbols [M_j, MX_j, MY_j, MZ_j, XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j] (Khalil & Dombre's
     names for the standard parameters about the body origin): a robot with general symbolic inertias."""
     out = []
-    for j in range(1, robot.n + 1):
+    for j in range(1, len(robot.tree.bodies) + 1):  # per body: mimic followers' too
         out.append(list(sp.symbols(f"M{j} MX{j} MY{j} MZ{j} XX{j} XY{j} YY{j} XZ{j} YZ{j} ZZ{j}", real=True)))
     return out
 
@@ -37,7 +37,15 @@ class _Inertias:
 
 
 def _friction(robot, qd):
-    return sp.Matrix([_exact(b.joint.viscous) * v + b.joint.coulomb_torque(v, _exact) for b, v in zip(robot.tree.bodies, qd)])
+    """Each joint's friction at its rate; with reduced mimic joints G^T of those (a follower's, at
+    ``m qd_k``, adds m times itself to its leader's)."""
+    from .lagrange import body_coordinates
+
+    out = [sp.Integer(0)] * len(qd)
+    for b, (k, m, _) in zip(robot.tree.bodies, body_coordinates(robot)):
+        v = m * qd[k]
+        out[k] = out[k] + m * (_exact(b.joint.viscous) * v + b.joint.coulomb_torque(v, _exact))
+    return sp.Matrix(out)
 
 
 def _outputs(model, d, simplify):
@@ -55,11 +63,11 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
     try:
         pc = model.com_positions()
         st = Step("Centre-of-mass positions r_ci(q) in the base frame", "Each link's centre of mass, from the forward kinematics.")
-        for i in range(n):
+        for i in range(model.n_bodies):
             st.equations.append((name(f"r_{{c{i + 1}}}", f"r_c{i + 1}", "r", f"c{i + 1}"), vec(pc[i])))
         steps.append(st)
         st = Step("Velocity Jacobians", "v_ci = J_vci(q) qd and omega_i = J_wi(q) qd (Spong eq. 9.45); J_vci = d r_ci / dq.")
-        for i in range(n):
+        for i in range(model.n_bodies):
             Jvc = [[ring.diff_q(pc[i][k], j) for j in range(n)] for k in range(3)]
             st.equations.append((_jac_name("v", f"c{i + 1}"), mat(Jvc)))
             st.equations.append((_jac_name("omega", f"{i + 1}"), mat(model.world_angular_jacobian(i))))
@@ -245,13 +253,14 @@ def _ring_converter(model):
             if e in model.qdd:
                 return ring.acceleration(model.qdd.index(e))
             if e in qset:
-                return ring.coordinate(model.q.index(e))
+                return ring.angle(model.q.index(e))
             return ring.const(e)
-        if isinstance(e, (sp.sin, sp.cos)):
-            arg = e.args[0]
+        if isinstance(e, (sp.sin, sp.cos)):  # of m q_i + offset (m = 1 but for a mimic follower)
+            arg = sp.expand(e.args[0])
             i = next(k for k, x in enumerate(model.q) if arg.has(x))
-            off = sp.expand(arg - model.q[i])
-            return ring.cos(i, off) if isinstance(e, sp.cos) else ring.sin(i, off)
+            m = arg.coeff(model.q[i])
+            off = sp.expand(arg - m * model.q[i])
+            return ring.cos_multiple(i, m, off) if isinstance(e, sp.cos) else ring.sin_multiple(i, m, off)
         if not (e.free_symbols & (set(env) | qset | set(model.qd) | set(model.qdd))):
             return ring.const(e)
         if e.is_Add:

@@ -11,6 +11,16 @@ and keeps every element in the normal form modulo the ideal (s_i^2 + c_i^2 - 1):
 with a power above one (s_i^2 is rewritten 1 - c_i^2 as soon as it is formed). Two expressions are
 equal exactly when their normal forms are equal, so "simplifies to zero" is a dictionary comparison.
 
+Mimic joints (a joint whose coordinate is ``m q_i + o``) need more: cos(m q_i) for an integer m is a
+polynomial in c_i, s_i (angle addition), but for a fractional m (or a prismatic q_i) it is not, so
+such a multiple gets generators of its own, ``cos(m q_i)`` and ``sin(m q_i)`` (``multiples``), and a
+prismatic follower of a revolute q_i needs q_i itself (``angles``). They are functions of q_i, not
+new coordinates: :meth:`TrigRing.diff_q` differentiates them by the chain rule,
+``d cos(m q_i)/dq_i = -m sin(m q_i)``, a derivation of the ring (it maps cos^2 + sin^2 - 1 to 0), so
+every identity of the derivation (Lagrange's equations, Christoffel symbols) holds exactly; only the
+normal form is no longer unique across such generators (cos(q_i) and cos(3 q_i / 2) are not
+independent functions), which the printed output leaves to SymPy's term collection.
+
 Output (:meth:`TrigRing.to_sympy`) linearises each trigonometric monomial by the product-to-sum
 formulas into the unique Fourier form  sum_k a_k cos(k.q) + b_k sin(k.q)  (k an integer vector with its
 first non-zero entry positive). This is the textbook form: cos(q1 + q2) rather than c1 c2 - s1 s2,
@@ -41,10 +51,13 @@ class TrigRing:
     ``coordinates``: list of (symbol, kind) with kind ``"revolute"`` or ``"prismatic"``;
     ``velocities``, ``accelerations``: symbol lists of the same length; ``leaves``: SymPy expressions
     of the parameters that will be converted into the ring (used to find the parameter generators
-    and the coefficient domain).
+    and the coefficient domain). ``multiples``: pairs (i, m), exact non-zero constants m, whose
+    cos(m q_i), sin(m q_i) get generators of their own (needed for a fractional m of a revolute q_i,
+    any m of a prismatic one); ``angles``: revolute coordinates i whose q_i itself is a generator
+    (see the module docstring: mimic joints).
     """
 
-    def __init__(self, coordinates, velocities, accelerations, leaves: Iterable = (), extra_symbols=()):
+    def __init__(self, coordinates, velocities, accelerations, leaves: Iterable = (), extra_symbols=(), multiples=(), angles=()):
         self.q = [c for c, _ in coordinates]
         self.kinds = [k for _, k in coordinates]
         self.qd = list(velocities)
@@ -92,6 +105,26 @@ class TrigRing:
                 gens.append(qi)
             else:
                 raise ValueError(f"coordinate kind must be 'revolute' or 'prismatic', got {kind!r}")
+        # trigonometric pairs (c, s generator indices, angle): each coordinate's own, then the multiples
+        self._pairs = [(self.c_idx[i], self.s_idx[i], self.q[i]) for i in sorted(self.c_idx)]
+        self.m_idx: dict = {}  # (i, m) -> (c index, s index) of cos(m q_i), sin(m q_i)
+        for i, m in multiples:
+            m = sp.sympify(m)
+            if (i, m) in self.m_idx:
+                continue
+            if m == 0 or (i in self.c_idx and m.is_Integer):
+                raise ValueError(f"multiple {m} of coordinate {self.q[i]}: an integer multiple of a revolute coordinate needs no generator")
+            c_m, s_m = sp.Dummy(f"c{i + 1}m"), sp.Dummy(f"s{i + 1}m")
+            self.m_idx[i, m] = (len(gens), len(gens) + 1)
+            gens += [c_m, s_m]
+            self._pairs.append((len(gens) - 2, len(gens) - 1, m * self.q[i]))
+        self.a_idx: dict = {}  # revolute i -> index of the generator q_i
+        for i in angles:
+            if i not in self.c_idx:
+                raise ValueError(f"coordinate {self.q[i]} is not revolute: it is a generator already")
+            if i not in self.a_idx:
+                self.a_idx[i] = len(gens)
+                gens.append(self.q[i])
         self.qd_idx = list(range(len(gens), len(gens) + self.n))
         gens += self.qd
         self.qdd_idx = list(range(len(gens), len(gens) + self.n))
@@ -101,7 +134,8 @@ class TrigRing:
         self.nparams = len(pgens)
         self.zero, self.one = self.R.zero, self.R.one
         self._param_ring = PolyRing(pgens, domain) if pgens else None
-        self._one_minus_c2 = {i: self.one - self.gens[self.c_idx[i]] ** 2 for i in self.c_idx}
+        # s^2 -> 1 - c^2 for every trigonometric pair: (s index, 1 - c^2)
+        self._s_rules = [(j_s, self.one - self.gens[j_c] ** 2) for j_c, j_s, _ in self._pairs]
         self._cache: dict = {}
 
     # ------------------------------------------------------------------ conversion in
@@ -141,6 +175,10 @@ class TrigRing:
 
     def _trig(self, i, offset, which):
         c, s = self.gens[self.c_idx[i]], self.gens[self.s_idx[i]]
+        return self._shifted(c, s, offset, which)
+
+    def _shifted(self, c, s, offset, which):
+        """cos or sin of (x + offset) from c = cos x, s = sin x."""
         if isinstance(offset, float) or (isinstance(offset, sp.Basic) and offset.is_number and offset.has(sp.Float)):
             import math
 
@@ -149,6 +187,49 @@ class TrigRing:
             co, so = self.const(sp.cos(offset)), self.const(sp.sin(offset))
         # cos(q + o) = c cos o - s sin o ; sin(q + o) = s cos o + c sin o
         return c * co - s * so if which == "cos" else s * co + c * so
+
+    def cos_multiple(self, i, m, offset=0):
+        """cos(m q_i + offset): by angle addition for an integer m of a revolute q_i, else through the
+        generators of the multiple (i, m) given to the constructor."""
+        return self._multiple(i, m, offset, "cos")
+
+    def sin_multiple(self, i, m, offset=0):
+        return self._multiple(i, m, offset, "sin")
+
+    def _multiple(self, i, m, offset, which):
+        m = sp.sympify(m)
+        if i in self.c_idx and m == 1:
+            return self._trig(i, offset, which)
+        if i in self.c_idx and m.is_Integer:
+            c, s = self._integer_multiple(i, int(m))
+        elif (i, m) in self.m_idx:
+            j_c, j_s = self.m_idx[i, m]
+            c, s = self.gens[j_c], self.gens[j_s]
+        elif (i, -m) in self.m_idx:  # cos(-x) = cos x, sin(-x) = -sin x (SymPy writes cos(3 q/2 - o))
+            j_c, j_s = self.m_idx[i, -m]
+            c, s = self.gens[j_c], -self.gens[j_s]
+        else:
+            raise ValueError(f"cos({m} {self.q[i]}) is not in this ring (pass ({i}, {m}) in multiples)")
+        return self.reduce(self._shifted(c, s, offset, which))
+
+    def _integer_multiple(self, i, k):
+        """(cos(k q_i), sin(k q_i)) by repeated angle addition."""
+        ci, si = self.gens[self.c_idx[i]], self.gens[self.s_idx[i]]
+        if k < 0:
+            si = -si
+        C, S = self.one, self.zero
+        for _ in range(abs(k)):
+            C, S = self.reduce(C * ci - S * si), self.reduce(S * ci + C * si)
+        return C, S
+
+    def angle(self, i):
+        """q_i as a polynomial: the generator of a prismatic coordinate, or of a revolute one given in
+        ``angles``."""
+        if i in self.p_idx:
+            return self.gens[self.p_idx[i]]
+        if i in self.a_idx:
+            return self.gens[self.a_idx[i]]
+        raise ValueError(f"the revolute coordinate {self.q[i]} itself is not in this ring (pass {i} in angles)")
 
     def coordinate(self, i):
         return self.gens[self.p_idx[i]]
@@ -181,9 +262,9 @@ class TrigRing:
         for i, qi in enumerate(qs):
             k = arg.coeff(qi)
             if k != 0:
-                if i not in self.c_idx or not (k.is_Integer):
+                if not ((i in self.c_idx and k.is_Integer) or (i, k) in self.m_idx):
                     raise ValueError(f"{f}: argument must be an integer combination of revolute coordinates")
-                coeffs[i] = int(k)
+                coeffs[i] = k
                 rest -= k * qi
         rest = sp.expand(rest)
         if rest.free_symbols & (set(self.q) | set(self.qd) | set(self.qdd)):
@@ -191,11 +272,8 @@ class TrigRing:
         # cos/sin of sum k_i q_i via repeated angle addition, then the constant phase
         C, S = self.one, self.zero
         for i, k in coeffs.items():
-            ci, si = self.gens[self.c_idx[i]], self.gens[self.s_idx[i]]
-            if k < 0:
-                si = -si
-            for _ in range(abs(k)):
-                C, S = self.reduce(C * ci - S * si), self.reduce(S * ci + C * si)
+            ci, si = self.cos_multiple(i, k), self.sin_multiple(i, k)
+            C, S = self.reduce(C * ci - S * si), self.reduce(S * ci + C * si)
         co, so = self.const(sp.cos(rest)), self.const(sp.sin(rest))
         if isinstance(f, sp.cos):
             return self.reduce(C * co - S * so)
@@ -213,8 +291,8 @@ class TrigRing:
             if e in self.qdd:
                 return self.acceleration(self.qdd.index(e))
             i = self.q.index(e)
-            if i in self.p_idx:
-                return self.coordinate(i)
+            if i in self.p_idx or i in self.a_idx:
+                return self.angle(i)
             raise ValueError(f"revolute coordinate {e} appears outside sin/cos")
         if e.is_Add:
             out = self.zero
@@ -237,24 +315,24 @@ class TrigRing:
     # ------------------------------------------------------------------ arithmetic
     def reduce(self, p):
         """Normal form modulo s_i^2 + c_i^2 - 1 (every s_i to a power of at most one)."""
-        if not self.s_idx:
+        rules = self._s_rules
+        if not rules:
             return p
-        sidx = list(self.s_idx.items())
-        if all(m[j] < 2 for m in p.keys() for _, j in sidx):
+        if all(m[j] < 2 for m in p.keys() for j, _ in rules):
             return p
         clean: dict = {}
         dirty = self.zero
         for m, c in p.items():
-            if all(m[j] < 2 for _, j in sidx):
+            if all(m[j] < 2 for j, _ in rules):
                 clean[m] = clean.get(m, 0) + c
                 continue
             mm = list(m)
             factor = self.one
-            for i, j in sidx:
+            for j, one_minus_c2 in rules:
                 e = mm[j]
                 if e >= 2:
                     mm[j] = e % 2
-                    factor = factor * self._one_minus_c2[i] ** (e // 2)
+                    factor = factor * one_minus_c2 ** (e // 2)
             dirty += self.R.from_dict({tuple(mm): c}) * factor
         return self.R.from_dict(clean) + dirty if clean else dirty
 
@@ -285,11 +363,20 @@ class TrigRing:
         return self.reduce(out)
 
     def diff_q(self, p, i):
-        """d p / d q_i (chain rule through c_i, s_i for a revolute coordinate)."""
+        """d p / d q_i (chain rule through c_i, s_i for a revolute coordinate, and through the
+        generators of its multiples, d cos(m q_i)/dq_i = -m sin(m q_i), and its angle generator)."""
         if i in self.p_idx:
-            return p.diff(self.gens[self.p_idx[i]])
-        c, s = self.gens[self.c_idx[i]], self.gens[self.s_idx[i]]
-        return self.reduce(-p.diff(c) * s + p.diff(s) * c)
+            out = p.diff(self.gens[self.p_idx[i]])
+        else:
+            c, s = self.gens[self.c_idx[i]], self.gens[self.s_idx[i]]
+            out = -p.diff(c) * s + p.diff(s) * c
+            if i in self.a_idx:
+                out += p.diff(self.gens[self.a_idx[i]])
+        for (k, m), (j_c, j_s) in self.m_idx.items():
+            if k == i:
+                c, s = self.gens[j_c], self.gens[j_s]
+                out += (-p.diff(c) * s + p.diff(s) * c) * self.const(m)
+        return self.reduce(out)
 
     def diff_qd(self, p, i):
         return p.diff(self.gens[self.qd_idx[i]])
@@ -316,7 +403,7 @@ class TrigRing:
 
     # ------------------------------------------------------------------ conversion out
     def _symbol_map(self):
-        return {self.c_sym[i]: sp.cos(self.q[i]) for i in self.c_sym} | {self.s_sym[i]: sp.sin(self.q[i]) for i in self.s_sym}
+        return {self.R.symbols[j_c]: sp.cos(angle) for j_c, _, angle in self._pairs} | {self.R.symbols[j_s]: sp.sin(angle) for _, j_s, angle in self._pairs}
 
     def to_product_form(self, p):
         """SymPy expression with sin(q_i), cos(q_i) products (no angle sums)."""
@@ -327,14 +414,14 @@ class TrigRing:
         p = self.chop(p)
         if not p:
             return sp.Integer(0)
-        trig_js = sorted(list(self.c_idx.values()) + list(self.s_idx.values()))
-        rev = sorted(self.c_idx)
+        trig_js = sorted([j for j_c, j_s, _ in self._pairs for j in (j_c, j_s)])
+        angles = [angle for _, _, angle in self._pairs]
         nparam = self.nparams
         groups: Dict[tuple, Dict[tuple, Any]] = {}
         to_sym = self.domain.to_sympy
         for m, c in p.items():
             pm = m[:nparam]
-            trig = tuple((m[self.c_idx[i]], m[self.s_idx[i]]) for i in rev)
+            trig = tuple((m[j_c], m[j_s]) for j_c, j_s, _ in self._pairs)
             other = tuple(e if j not in trig_js else 0 for j, e in enumerate(m) if j >= nparam)
             for (k, kind), w in _linearise(trig).items():
                 key = (other, k, kind)
@@ -352,7 +439,7 @@ class TrigRing:
             if factor and self.domain != sp.RR and len(sp.Add.make_args(coeff)) <= 8:
                 coeff = sp.factor_terms(sp.factor(coeff))
             state = sp.Mul(*[g.as_expr() ** e for g, e in zip(other_gens, other) if e])
-            angle = sum((kk * self.q[i] for kk, i in zip(k, rev)), sp.Integer(0))
+            angle = sum((kk * a for kk, a in zip(k, angles)), sp.Integer(0))
             trig = sp.Integer(1) if all(kk == 0 for kk in k) else (sp.cos(angle) if kind == "cos" else sp.sin(angle))
             terms.append(coeff * trig * state)
         return sp.Add(*terms)
