@@ -45,11 +45,16 @@ def _calls(robot, q, v, a):
         "inverse_dynamics": (lambda *x: model.inverse_dynamics(*x), (q, v, a)),
         "inverse_dynamics f_ext": (lambda *x: model.inverse_dynamics(*x), (q, v, a, f_ext)),
         "mass_matrix": (lambda *x: model.mass_matrix(*x), (q,)),
+        "mass_matrix_inverse": (lambda *x: model.mass_matrix_inverse(*x), (q,)),
         "forward_dynamics": (lambda *x: model.forward_dynamics(*x), (q, v, tau)),
         "forward_dynamics f_ext": (lambda *x: model.forward_dynamics(*x), (q, v, tau, f_ext)),
         "gravity_torque": (lambda *x: model.gravity_torque(*x), (q,)),
         "bias_torque": (lambda *x: model.bias_torque(*x), (q, v)),
+        "frame_poses": (lambda q: model.frame_poses(q, np.arange(model.n_frames)), (q,)),
     }
+    for reference in range(3):  # world, local, spatial
+        calls[f"jacobian {reference}"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r), (q,))
+        calls[f"jacobian {reference} at a point"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r, np.array([0.1, -0.2, 0.3])), (q,))
     for name, (fn, args) in calls.items():
         yield name, fn(*args), np.array([fn(*(x[k] for x in args)) for k in range(len(q))])
 

@@ -275,6 +275,19 @@ pub mod kernels {
         }
     }
 
+    /// `M(q)^-1` (n x n, row-major).
+    pub struct MassMatrixInverse;
+    impl Kernel for MassMatrixInverse {
+        fn output_len(&self, model: &Model) -> usize {
+            model.n * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            out.copy_from_slice(alg::mass_matrix_inverse(model, data, x[0])?);
+            Ok(())
+        }
+    }
+
     /// `qdd = aba(q, qd, tau[, f_ext])`.
     pub struct ForwardDynamics;
     impl Kernel for ForwardDynamics {
@@ -422,6 +435,11 @@ mod tests {
     #[test]
     fn mass_matrix_in_lanes() {
         lanes_equal_single_calls(MassMatrix, 1);
+    }
+
+    #[test]
+    fn mass_matrix_inverse_in_lanes() {
+        lanes_equal_single_calls(MassMatrixInverse, 1);
     }
 
     #[test]

@@ -647,13 +647,7 @@ impl PyModel {
             let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
             let nq = self.model.nq;
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("frame_poses", "pose"), &[ids.len(), 4, 4], |model, data, x, out| {
-                algorithms::forward_kinematics(model, data, x[0]);
-                for (k, &f) in ids.iter().enumerate() {
-                    out[16 * k..16 * k + 16].copy_from_slice(&algorithms::frame_pose(model, data, f).to_homogeneous());
-                }
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("frame_poses", "pose"), &[ids.len(), 4, 4], None, kernels::FramePoses { frames: &ids })
         })
     }
 
@@ -664,10 +658,7 @@ impl PyModel {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("jacobian", "J"), &[6, n], |model, data, x, out| {
-                algorithms::frame_jacobian(model, data, x[0], f, r, p.as_ref(), out);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("jacobian", "J"), &[6, n], None, kernels::Jacobian { frame: f, reference: r, point: p })
         })
     }
 
@@ -751,10 +742,7 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_out(py, self, ("mass_matrix_inverse", "M^-1"), &[n, n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::mass_matrix_inverse(model, data, x[0])?);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("mass_matrix_inverse", "M^-1"), &[n, n], out, kernels::MassMatrixInverse)
         })
     }
 

@@ -15,6 +15,7 @@ use super::crba::crba;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::spatial::Real;
 
 /// Relative size under which a pivot `D_k` counts as zero: against its own diagonal entry `M_kk`
 /// (the factorisation cancelled the joint's inertia away: `M` is singular to working precision).
@@ -28,16 +29,25 @@ const EPS_M: f64 = 1e-26;
 const HUGE_M: f64 = 1e200;
 
 /// Factor `data.m` (= M) into `data.m2` as `L^T D L` (RBDA Table 6.3).
-pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
+#[inline(always)]
+pub fn ltdl<T: Real>(model: &Model, data: &mut Data<T>) -> Result<()> {
     let n = model.n;
     let h = &mut data.m2;
     h.copy_from_slice(&data.m[..n * n]);
-    let scale: f64 = (0..n).map(|i| data.m[i * n + i]).fold(0.0, f64::max);
+    // the largest diagonal entry, lane by lane (one lane per state of a batch)
+    let mut scale = [0.0f64; 16];
+    for l in 0..T::LANES {
+        scale[l] = (0..n).map(|i| data.m[i * n + i].lane(l)).fold(0.0, f64::max);
+    }
     for k in (0..n).rev() {
         let (hkk, mkk) = (h[k * n + k], data.m[k * n + k]);
         // D_k must be a positive part of M_kk, and M_kk a positive part of the scale of M
-        if !(hkk > EPS_D * mkk && mkk > EPS_M * scale) || !hkk.is_finite() || !scale.is_finite() {
-            return Err(Error::SingularMassMatrix(singular_pivot(data, n, k, hkk, scale)));
+        for l in 0..T::LANES {
+            let (hkk, mkk, scale) = (hkk.lane(l), mkk.lane(l), scale[l]);
+            if !(hkk > EPS_D * mkk && mkk > EPS_M * scale) || !hkk.is_finite() || !scale.is_finite() {
+                let diagonal: Vec<f64> = (0..n).map(|i| data.m[i * n + i].lane(l)).collect();
+                return Err(Error::SingularMassMatrix(singular_pivot(&diagonal, k, hkk, scale)));
+            }
         }
         // for i = λ(k) up the tree: a = H_ki / H_kk ; H_ij -= a H_kj for j = i, λ(i), ... ; H_ki = a
         let mut i = model.parent[k];
@@ -45,7 +55,8 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
             let a = h[k * n + ii] / hkk;
             let mut j = Some(ii);
             while let Some(jj) = j {
-                h[ii * n + jj] -= a * h[k * n + jj];
+                let hkj = h[k * n + jj];
+                h[ii * n + jj] -= a * hkj;
                 j = model.parent[jj];
             }
             h[k * n + ii] = a;
@@ -58,9 +69,10 @@ pub fn ltdl(model: &Model, data: &mut Data) -> Result<()> {
 /// What a pivot `D_k` of `M` below `EPS_D` times its largest diagonal entry means: the joint's
 /// subtree has no inertia about its axis (massless, no rotor inertia), or the inertias are so far
 /// apart (more than `1 / EPS_D`) that `M` is singular in float64, or M is not positive definite.
-fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> String {
-    let mkk = data.m[k * n + k];
-    let largest = (0..n).fold(0, |b, i| if data.m[i * n + i] > data.m[b * n + b] { i } else { b });
+/// Why pivot k failed, from M's diagonal.
+fn singular_pivot(diagonal: &[f64], k: usize, hkk: f64, scale: f64) -> String {
+    let mkk = diagonal[k];
+    let largest = (0..diagonal.len()).fold(0, |b, i| if diagonal[i] > diagonal[b] { i } else { b });
     let head = format!("M is not positive definite to float64 precision at joint {k}: its pivot D = {hkk:e} in the L^T D L factorisation");
     if !hkk.is_finite() || !scale.is_finite() {
         format!("{head}; M has a non-finite entry (an inertia or a configuration too large for float64)")
@@ -92,20 +104,22 @@ fn singular_pivot(data: &Data, n: usize, k: usize, hkk: f64, scale: f64) -> Stri
 }
 
 /// `M(q)^-1` written row-major to `data.m` (n x n); `data.m2` holds the factors of `M`.
-pub fn mass_matrix_inverse<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d [f64]> {
+#[inline(always)]
+pub fn mass_matrix_inverse<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T]) -> Result<&'d [T]> {
     crba(model, data, q);
     inverse_of_mass_matrix(model, data)
 }
 
 /// The inverse of the mass matrix in `data.m`, written over it (`data.m2`: its factors).
-pub fn inverse_of_mass_matrix<'d>(model: &Model, data: &'d mut Data) -> Result<&'d [f64]> {
+#[inline(always)]
+pub fn inverse_of_mass_matrix<'d, T: Real>(model: &Model, data: &'d mut Data<T>) -> Result<&'d [T]> {
     let n = model.n;
     ltdl(model, data)?;
     let (l, x, out) = (&data.m2, &mut data.x, &mut data.m);
     for col in 0..n {
         // b = e_col
-        x[..n].fill(0.0);
-        x[col] = 1.0;
+        x[..n].fill(T::zero());
+        x[col] = T::one();
         // L^T z = b: for i = n-1..0, z_i = b_i; b_j -= L_ij z_i for the ancestors j of i
         for i in (0..n).rev() {
             let zi = x[i];
@@ -117,7 +131,7 @@ pub fn inverse_of_mass_matrix<'d>(model: &Model, data: &'d mut Data) -> Result<&
         }
         // w = D^-1 z
         for i in 0..n {
-            x[i] /= l[i * n + i];
+            x[i] = x[i] / l[i * n + i];
         }
         // L y = w: y_i = w_i - sum_{j ancestors of i} L_ij y_j
         for i in 0..n {
