@@ -53,6 +53,12 @@ pub fn sin_cos_in_place(x: &mut [f64], cos: &mut [f64]) {
     }
 }
 
+/// [`sin_cos_in_place`] as a function of its own (the single-state algorithms call it so).
+#[inline(never)]
+pub fn sin_cos_in_place_outlined(x: &mut [f64], cos: &mut [f64]) {
+    sin_cos_in_place(x, cos);
+}
+
 /// Inputs at least this large (or non-finite) go to the standard library.
 const LIMIT: f64 = 1e5;
 

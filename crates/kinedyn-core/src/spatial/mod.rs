@@ -144,5 +144,7 @@ pub fn splat3<T: Real>(v: &Vec3) -> Vec3<T> {
 /// A constant 3x3 matrix broadcast to every lane of `T`.
 #[inline(always)]
 pub fn splat33<T: Real>(m: &Mat3) -> Mat3<T> {
-    m.map(T::splat)
+    // written out, not `m.map(T::splat)`: for f64 a plain copy the optimiser can drop
+    let e = |i: usize, j: usize| T::splat(m[(i, j)]);
+    Mat3::new(e(0, 0), e(0, 1), e(0, 2), e(1, 0), e(1, 1), e(1, 2), e(2, 0), e(2, 1), e(2, 2))
 }
