@@ -54,9 +54,14 @@ def test_random_robots_with_multi_dof_joints(kind, options):
     assert any(j.is_multi_dof for j in robot.joints) and robot.nq > robot.nv
     rng = np.random.default_rng(7)
     for _ in range(3):
-        target = robot.pose(robot.random_configuration(rng))
+        q_goal = robot.random_configuration(rng)
+        target = robot.pose(q_goal)
         result = robot.inverse_kinematics(target, q0=robot.random_configuration(rng))
         assert_solves(robot, result, target, robot.tool)
+        # near the goal, Gauss-Newton steps q ⊕ dq with the Jacobian of the same velocity: few iterations
+        near = robot.inverse_kinematics(target, q0=robot.integrate(q_goal, 0.05 * rng.normal(size=robot.nv)))
+        assert_solves(robot, near, target, robot.tool)
+        assert near.iterations <= 5, near.iterations
 
 
 def test_a_batch_and_no_limits_keep_quaternions_whole():
@@ -64,12 +69,15 @@ def test_a_batch_and_no_limits_keep_quaternions_whole():
     robot = random_robot(5, n=5, floating=True, spherical=0.4)
     rng = np.random.default_rng(1)
     targets = robot.pose(robot.random_configuration(rng, size=3))
-    batch = robot.inverse_kinematics(targets, respect_limits=False)
+    revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)])
+    assert revolute.any()
+    start = robot.neutral()
+    start[revolute] = 2 * np.pi + 0.3  # solutions near the start need wrapping
+    batch = robot.inverse_kinematics(targets, q0=start, respect_limits=False)
     assert batch.q.shape == (3, robot.nq) and batch.success.all()
     np.testing.assert_allclose(robot.pose(batch.q), targets, atol=1e-9)
     for q in batch.q:
         np.testing.assert_allclose(unit_parts(robot, q), 1.0, atol=1e-12)
-    revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)])
     assert np.all(np.abs(batch.q[:, revolute]) <= np.pi)
 
 
@@ -160,6 +168,11 @@ def test_a_frame_a_mimic_follower_moves_is_solved_in_reduced_coordinates(frame, 
     assert_solves(robot, result, target, frame)
     # the same pose on the robot with independent joints, the followers set from the relations
     np.testing.assert_allclose(full.pose(expand_by_hand(robot, full, result.q), frame), target, atol=1e-9)
+    # near the goal the steps are Gauss-Newton steps with the exact Jacobian J G: a few iterations
+    # (a Jacobian that misses the followers' multipliers takes from 13 to over a thousand)
+    near = robot.inverse_kinematics(target, frame=frame, q0=robot.integrate(q_goal, 0.05 * rng.normal(size=robot.nv)))
+    assert_solves(robot, near, target, frame)
+    assert near.iterations <= 5, near.iterations
     with pytest.raises(ValueError, match="closed forms solve chains of revolute and prismatic joints only; use method='numeric'"):
         robot.inverse_kinematics(target, frame=frame, method="analytic")
 
