@@ -772,6 +772,113 @@ mod tests {
         }
     }
 
+    /// A free-flyer (bodies 0-5), a spherical joint (6-8) and a revolute joint (9) carrying frame 0:
+    /// nq = 12, nv = 10.
+    fn floating_model() -> Model {
+        use crate::joint::Joint;
+        use crate::model::{Block, Frame};
+        use crate::spatial::Inertia;
+        let mut rng = Rng::new(4);
+        let unit = |k: usize| Vec3::ith(k, 1.0);
+        let mut joints: Vec<Joint> = (0..6).map(|k| Joint { kind: if k < 3 { JointKind::Prismatic } else { JointKind::Revolute }, axis: unit(k % 3) }).collect();
+        joints.extend((0..3).map(|k| Joint { kind: JointKind::Revolute, axis: unit(k) }));
+        joints.push(Joint { kind: JointKind::Revolute, axis: rng.unit() });
+        let parent = (0..10).map(|i: usize| i.checked_sub(1)).collect();
+        let mut placements = vec![Transform::identity(); 10];
+        placements[6] = Transform::new(rng.rotation(), rng.vec3(-0.5, 0.5));
+        placements[9] = Transform::new(rng.rotation(), rng.vec3(-0.5, 0.5));
+        let mut inertia = vec![Inertia::zero(); 10];
+        for i in [5, 8, 9] {
+            inertia[i] = crate::testing::random_inertia(&mut rng);
+        }
+        let frames = vec![Frame { body: Some(9), body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)) }];
+        let coordinates = [Coordinates::Head { block: Block::FreeFlyer, at: 0 }]
+            .into_iter()
+            .chain([Coordinates::Member; 5])
+            .chain([Coordinates::Head { block: Block::Spherical, at: 7 }, Coordinates::Member, Coordinates::Member, Coordinates::Scalar { at: 11 }])
+            .collect();
+        Model::new(parent, joints, vec![0.0; 10], placements, inertia, vec![0.0; 10], vec![0.0; 10], vec![0.0; 10], Vec3::new(0.0, 0.0, -9.81), frames)
+            .and_then(|m| m.with_coordinates(coordinates))
+            .expect("a valid floating model")
+    }
+
+    #[test]
+    fn levenberg_marquardt_on_the_manifold_reaches_poses_with_unit_quaternions() {
+        let model = floating_model();
+        assert_eq!((model.nq, model.n), (12, 10));
+        let mut data = Data::new(&model);
+        let space = Space::new(&model, None);
+        let (lower, upper) = (vec![f64::NEG_INFINITY; 12], vec![f64::INFINITY; 12]);
+        let mut neutral = vec![0.0; 12];
+        (neutral[6], neutral[10]) = (1.0, 1.0);
+        let mut rng = Rng::new(9);
+        let mut goal = vec![0.0; 12];
+        for trial in 0..5 {
+            space.random(&lower, &upper, &neutral, &mut rng, &mut goal);
+            let target = frame_pose_at(&model, &mut data, &goal, 0);
+            let out = numeric_ik(&model, &mut data, 0, &target, &neutral, &lower, &upper, &Settings::default(), trial);
+            assert!(out.success, "trial {trial}: {out:?}");
+            let e = pose_error(&frame_pose_at(&model, &mut data, &out.q, 0), &target);
+            assert!(e.iter().all(|x| x.abs() < 1e-9), "trial {trial}: {e:?}");
+            for unit in [&out.q[3..7], &out.q[7..11]] {
+                assert!((unit.iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs() < 1e-12, "{unit:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_start_with_a_non_unit_quaternion_or_limits_on_a_free_flyer_is_refused() {
+        let model = floating_model();
+        let (lower, upper) = (vec![f64::NEG_INFINITY; 12], vec![f64::INFINITY; 12]);
+        let mut q = vec![0.0; 12];
+        (q[6], q[10]) = (1.0, 1.0);
+        assert!(check_start(&model, None, &q, &lower, &upper).is_ok());
+        q[10] = 1.1;
+        let e = check_start(&model, None, &q, &lower, &upper).unwrap_err();
+        assert!(e.contains("q0[7:11], the quaternion (qx, qy, qz, qw) of the spherical joint at body 6, has norm 1.1"), "{e}");
+        q[10] = 1.0;
+        let mut limited = lower.clone();
+        limited[2] = -1.0;
+        let e = check_start(&model, None, &q, &limited, &upper).unwrap_err();
+        assert!(e.contains("limits of coordinate 2") && e.contains("body 0"), "{e}");
+    }
+
+    #[test]
+    fn a_mimic_reduction_solves_in_reduced_coordinates() {
+        // three revolute joints; the second follows the first: q1 = -2 q0 + 0.1
+        let model = crate::testing::random_model(3, 3, false);
+        let reduction = Reduction::new(&model, vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)], vec![(0, 1.0), (0, -2.0), (1, 1.0)], vec![0, 2], 2).unwrap();
+        let mut data = Data::new(&model);
+        let (lower, upper) = (vec![f64::NEG_INFINITY; 2], vec![f64::INFINITY; 2]);
+        let frame = 2; // on the last body
+        for (trial, goal) in [[0.4, -0.7], [-1.2, 2.0], [2.5, 0.3]].iter().enumerate() {
+            let full = [goal[0], -2.0 * goal[0] + 0.1, goal[1]];
+            let target = frame_pose_at(&model, &mut data, &full, frame);
+            let out = numeric_ik_reduced(&model, Some(&reduction), &mut data, frame, &target, &[0.0, 0.0], &lower, &upper, &Settings::default(), trial as u64);
+            assert!(out.success && out.q.len() == 2, "{out:?}");
+            let reached = [out.q[0], -2.0 * out.q[0] + 0.1, out.q[1]];
+            let e = pose_error(&frame_pose_at(&model, &mut data, &reached, frame), &target);
+            assert!(e.iter().all(|x| x.abs() < 1e-9), "trial {trial}: {e:?}");
+        }
+        // a follower that is not copied back, or a kept coordinate that does not copy itself: refused
+        assert!(Reduction::new(&model, vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)], vec![(0, 1.0), (0, -2.0), (1, 1.0)], vec![1, 2], 2).is_err());
+    }
+
+    #[test]
+    fn uniform_quaternions_are_unit_and_average_to_no_rotation() {
+        // a uniform distribution over rotations has E[R] = 0 (each column is a uniform unit vector)
+        let mut rng = Rng::new(1);
+        let mut mean = Mat3::zeros();
+        let count = 20_000;
+        for _ in 0..count {
+            let q = lie::uniform_quaternion([rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)]);
+            assert!(((q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt() - 1.0).abs() < 1e-14);
+            mean += crate::model::quaternion_matrix(&q) / count as f64;
+        }
+        // each entry's standard deviation is 1/sqrt(3 count) ~ 0.004
+        assert!(mean.abs().max() < 0.03, "{mean}");
+    }
+
     #[test]
     fn wrap_prefers_the_reference_inside_limits() {
         assert!((wrap_angle(3.0 * PI / 2.0, -PI, PI, 0.0) + PI / 2.0).abs() < 1e-12);
