@@ -233,3 +233,6 @@ def test_cli_ik_of_a_floating_robot(capsys):
     assert main(["ik", path, "--floating-base", "--frame", "FR_FOOT", "--xyz", "0.2", "-0.1", "-0.2", "--deg"]) == 0
     table = capsys.readouterr().out
     assert "q1.qw" in table and "q1 = root_joint" in table
+    bad = ["0"] * 6 + ["2"] + ["0"] * 12  # a quaternion of norm 2
+    assert main(["ik", path, "--floating-base", "--frame", "FR_FOOT", "--xyz", "0.2", "-0.1", "-0.2", "--q0", *bad]) == 1
+    assert "--q0[3:7] of floating joint 'root_joint' is the quaternion" in capsys.readouterr().err
