@@ -26,6 +26,13 @@
 //! would cross (an active set); a run that stalls restarts from a random
 //! configuration inside the limits (seeded, so batches are reproducible).
 //!
+//! **On the configuration manifold** (floating, spherical, planar joints): q has nq entries, the
+//! step `dq` and the Jacobian's columns nv (one per velocity coordinate, the joint's velocity in its
+//! child frame), and the update is `q ⊕ dq` ([`Model::integrate_configuration`]: `M Exp(dq)` on
+//! SE(3), SO(3) or SE(2)), so quaternions stay unit; `e` is unchanged, and to first order
+//! `e(q ⊕ dq) = e(q) - J dq`. Only 1-DOF coordinates have limits; restarts draw uniform rotations.
+//! With a [`Reduction`] (mimic joints) the solver works in the reduced coordinates, with `J G`.
+//!
 //! **Closed forms** (`analytic`, `subproblems`): candidates from the Paden-Kahan subproblems, mapped
 //! to q (`q = theta - offset`, revolute angles moved by 2 pi k into the limits, nearest the caller's
 //! reference), verified by forward kinematics and refined by a few Gauss-Newton steps
@@ -35,7 +42,7 @@
 //! |----------|---------------|----------------------------------------------------------|
 //! | `e`      | `e: [f64; 6]` | pose error `[p_d - p; log(R_d R^T)]`, base axes          |
 //! | `W`      | `weights`     | diagonal weights (mask) of the six error components      |
-//! | `J`      | `jac`         | world-aligned geometric Jacobian, 6 x n row-major         |
+//! | `J`      | `jac`         | world-aligned geometric Jacobian, 6 x nv row-major        |
 //! | `lambda` | `lambda`      | damping                                                  |
 
 pub mod analytic;
@@ -177,6 +184,11 @@ impl Reduction {
         for (k, &i) in q_keep.iter().enumerate() {
             if i >= nq_full || q_source[i] != (k, 1.0, 0.0) {
                 return Err(format!("reduction: reduced coordinate {k} is kept at full coordinate {i}, which does not copy it"));
+            }
+        }
+        for (qi, vi) in model.scalar_coordinates() {
+            if q_keep[q_source[qi].0] == qi && v_source[vi].1 != 1.0 {
+                return Err(format!("reduction: the independent joint at body {vi} must copy its velocity (multiplier 1, got {})", v_source[vi].1));
             }
         }
         for (i, c) in model.coordinates.iter().enumerate() {
