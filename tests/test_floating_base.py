@@ -309,14 +309,6 @@ def test_identities_and_base_parameters_hold_on_a_floating_tree():
     _close("Y_base pi_base", Y[:, base.indices] @ base.values, Y @ robot.inertial_parameters(), 10.0)
 
 
-def test_what_does_not_take_multi_dof_joints_yet_says_so():
-    robot = random_robot(1, n=3, floating=True, friction=False)
-    q = robot.neutral()
-    for call, feature in ((lambda: robot.inverse_kinematics(np.eye(4), q0=q), "inverse kinematics"),):
-        with pytest.raises(ValueError, match=f"{feature} handles revolute and prismatic joints only.*floating joint 'j1'"):
-            call()
-
-
 # ------------------------------------------------------------------ simulation on the manifold
 def test_a_tumbling_floating_tree_keeps_its_energy_and_momentum():
     """No gravity, no torque, no friction: the core's RK4 on the manifold (Runge-Kutta-Munthe-Kaas:

@@ -397,14 +397,11 @@ def test_simulation_runs_on_the_reduced_dynamics():
     np.testing.assert_allclose(traj.qdd[5], no_friction.forward_dynamics(traj.q[5], traj.qd[5], np.zeros(3)), atol=1e-9)
 
 
-def test_symbolic_engine_and_ik_refuse_naming_the_follower():
+def test_symbolic_engine_takes_reduced_mimic_joints():
     robot = kd.Robot.from_urdf(gripper_urdf())
-    # the symbolic engine handles them now (tests/test_symbolic_mimic.py): in the reduced coordinates
+    # the symbolic engine handles them (tests/test_symbolic_mimic.py): in the reduced coordinates
     assert robot.equations_of_motion(simplify=False).M.shape == (3, 3)
-    with pytest.raises(ValueError, match=r"inverse kinematics of frame 'right' does not handle mimic joints yet: the follower joint 'right_finger'.*mimic='independent'"):
-        robot.inverse_kinematics(np.eye(4), frame="right")
-    with pytest.raises(ValueError, match=r"inverse kinematics does not handle mimic joints yet; robot 'gripper' has the follower joint 'right_finger'"):
-        kd.ik.inverse_kinematics(robot, np.eye(4), frame="left")  # the native solvers directly: refused
+    # (inverse kinematics solves in the reduced coordinates: tests/test_ik_manifold.py)
     # with the followers kept independent, both run
     full = kd.Robot.from_urdf(gripper_urdf(), mimic="independent")
     assert full.equations_of_motion(simplify=False).M.shape == (5, 5)

@@ -88,9 +88,9 @@ def solve_ik(
     model: Model,
     frame: int,
     targets: F64,  # (4, 4) pose or (3,) position, or a batch (N, 4, 4) | (N, 3)
-    q0: F64,  # (n,) | (N, n)
-    lower: F64,  # (n,)
-    upper: F64,  # (n,)
+    q0: F64,  # (nq,) | (N, nq): configurations (reduced ones with `reduction`), unit quaternions
+    lower: F64,  # (nq,), infinite on a multi-DOF joint's entries
+    upper: F64,  # (nq,)
     weights: F64,  # (6,) for [x, y, z, rx, ry, rz]
     max_iterations: int = 50,
     restarts: int = 50,
@@ -100,6 +100,8 @@ def solve_ik(
     max_step: float = 0.5,
     seed: int = 0,
     first_index: int = 0,  # index of targets[0] in the whole batch (each target's random restarts follow from seed and its index)
+    # reduced mimic coordinates: (q_source (nq_full,), q_multiplier, q_offset, v_source (nv_full,), v_multiplier, q_keep (nq,), nv)
+    reduction: Optional[tuple[list[int], list[float], list[float], list[int], list[float], list[int], int]] = None,
 ) -> tuple[Any, Any, Any, Any, Any]: ...  # (q, success, position_error, orientation_error, iterations), leading N for a batch
 
 class AnalyticIk:

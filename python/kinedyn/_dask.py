@@ -255,12 +255,12 @@ def lazy_inverse_kinematics(robot: "Robot", target, q0, mask, method: str, respe
         raise ValueError(f"target must be a batch of 4x4 poses (N, 4, 4) or positions (N, 3), got a dask array of shape {target.shape}")
     target = target.astype(np.float64)
     arrays, names = [target], ["target"]
-    n = robot.n
+    n = robot.nq  # a configuration's size (7 for a free-flyer)
     if q0 is not None and (is_dask_array(q0) or np.ndim(q0) == 2):
         q0 = q0 if is_dask_array(q0) else da.from_array(np.asarray(q0, dtype=np.float64), chunks=(target.chunks[0], -1))
         _check_chunks("q0", q0)
         if q0.shape != (target.shape[0], n):
-            raise ValueError(f"q0 must be one start (n,) = ({n},) or one per target ({target.shape[0]}, {n}), got {q0.shape}")
+            raise ValueError(f"q0 must be one start (nq,) = ({n},) or one per target ({target.shape[0]}, {n}), got {q0.shape}")
         arrays.append(q0.astype(np.float64).rechunk({0: target.chunks[0], 1: -1}))
         names.append("q0")
         q0 = None

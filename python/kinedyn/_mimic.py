@@ -232,13 +232,18 @@ class ReducedModel:
 
 
 def inverse_kinematics(robot, target, q0, mask, method, respect_limits, **kwargs):
-    """``Robot.inverse_kinematics`` of a robot with reduced mimic joints, for a frame that no follower
-    moves (the Panda's ``panda_hand_tcp``, not a finger): solved on the same robot with every joint
-    independent (the native solvers take the full model), the followers' coordinates then dropped.
-    Exact: the frame's pose depends only on the joints between it and the base, none a follower, so a
-    full solution's independent coordinates put the frame at the target in the reduced robot too
-    (a leader on that path moves its followers elsewhere, which the frame does not see).
-    ValueError naming the follower for a frame a follower moves."""
+    """``Robot.inverse_kinematics`` of a robot with reduced mimic joints.
+
+    - A frame that no follower moves (the Panda's ``panda_hand_tcp``, not a finger): solved on the
+      same robot with every joint independent (where the closed forms also apply), the followers'
+      coordinates then dropped. Exact: the frame's pose depends only on the joints between it and
+      the base, none a follower, so a full solution's independent coordinates put the frame at the
+      target in the reduced robot too (a leader on that path moves its followers elsewhere, which
+      the frame does not see).
+    - A frame that a follower moves (a finger): the numeric solver in the reduced coordinates, with
+      the Jacobian ``J G`` (chain rule, ``v_full = G v``) and the update ``q_full ⊕ G dq`` read back
+      at the independent coordinates (crates/kinedyn-core/src/algorithms/ik.rs, ``Reduction``);
+      limits are those of the independent joints."""
     import dataclasses
 
     frame = kwargs.get("frame") or robot.tool
@@ -246,11 +251,10 @@ def inverse_kinematics(robot, target, q0, mask, method, respect_limits, **kwargs
     tree = robot.tree
     body = tree.frames[robot.frame_index(frame)].body
     while body >= 0:
-        joint = tree.bodies[body].joint
-        if joint.name in m.relations:
-            raise ValueError(
-                f"inverse kinematics of frame '{frame}' does not handle mimic joints yet: the follower joint '{joint.name}' "
-                f"(mimics '{m.relations[joint.name].leader}') moves it; load the robot with mimic='independent', or lock the leader")
+        if tree.bodies[body].joint.name in m.relations:
+            from .ik.solve import inverse_kinematics as solve
+
+            return solve(robot, target, q0, mask, method, respect_limits, **kwargs)
         body = tree.bodies[body].parent
     full = robot.__dict__.get("_independent_robot")
     if full is None:

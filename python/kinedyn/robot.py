@@ -793,7 +793,6 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
-        self.require_one_dof_joints("inverse kinematics")
         if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             from ._dask import lazy_inverse_kinematics
 

@@ -316,6 +316,26 @@ pub fn normalize_block(block: Block, q: &mut [f64]) {
     }
 }
 
+/// The block kind of a model's multi-DOF joint ([`crate::model::Block`], which has no `Scalar`).
+impl From<crate::model::Block> for Block {
+    fn from(block: crate::model::Block) -> Self {
+        match block {
+            crate::model::Block::FreeFlyer => Block::FreeFlyer,
+            crate::model::Block::Spherical => Block::Spherical,
+            crate::model::Block::Planar => Block::Planar,
+        }
+    }
+}
+
+/// A unit quaternion from three numbers `u` uniform in [0, 1): uniformly distributed over rotations
+/// (Shoemake, "Uniform random rotations", Graphics Gems III, 1992: with a = √(1-u0), b = √u0,
+/// (a sin 2πu1, a cos 2πu1, b sin 2πu2, b cos 2πu2) is uniform on the unit 3-sphere).
+pub fn uniform_quaternion(u: [f64; 3]) -> Quat {
+    let (a, b) = ((1.0 - u[0]).sqrt(), u[0].sqrt());
+    let (t1, t2) = (2.0 * std::f64::consts::PI * u[1], 2.0 * std::f64::consts::PI * u[2]);
+    [a * t1.sin(), a * t1.cos(), b * t2.sin(), b * t2.cos()]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

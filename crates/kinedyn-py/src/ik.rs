@@ -91,13 +91,31 @@ fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
     Ok(())
 }
 
-/// Levenberg-Marquardt inverse kinematics of `frame` for one target or a batch.
+/// The reduced coordinates of a model with mimic joints, from their Python description:
+/// (q_source (nq_full,), q_multiplier, q_offset, v_source (nv_full,), v_multiplier, q_keep (nq,), nv).
+type ReductionArgs = (Vec<i64>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<f64>, Vec<i64>, usize);
+
+fn reduction(model: &Model, args: Option<ReductionArgs>) -> PyResult<Option<ik::Reduction>> {
+    let Some((q_source, q_multiplier, q_offset, v_source, v_multiplier, q_keep, nv)) = args else { return Ok(None) };
+    let index = |x: i64| usize::try_from(x).unwrap_or(usize::MAX);
+    if q_multiplier.len() != q_source.len() || q_offset.len() != q_source.len() || v_multiplier.len() != v_source.len() {
+        return Err(PyValueError::new_err("reduction: q_source, q_multiplier and q_offset (and v_source, v_multiplier) must have one length"));
+    }
+    let q = q_source.iter().zip(&q_multiplier).zip(&q_offset).map(|((k, m), b)| (index(*k), *m, *b)).collect();
+    let v = v_source.iter().zip(&v_multiplier).map(|(k, m)| (index(*k), *m)).collect();
+    ik::Reduction::new(model, q, v, q_keep.into_iter().map(index).collect(), nv).map(Some).map_err(PyValueError::new_err)
+}
+
+/// Levenberg-Marquardt inverse kinematics of `frame` for one target or a batch, on the
+/// configuration manifold (multi-DOF joints: q ⊕ dq; see `kinedyn_core::algorithms::ik`).
 ///
 /// targets: (4, 4) | (3,) | (N, 4, 4) | (N, 3) (positions use weights on x, y, z only);
-/// q0: (n,) or (N, n); lower, upper: (n,); weights: (6,) for [x, y, z, rx, ry, rz].
+/// q0: (nq,) or (N, nq); lower, upper: (nq,) (infinite on multi-DOF joints' entries);
+/// weights: (6,) for [x, y, z, rx, ry, rz]; reduction: the mimic joints' reduced coordinates
+/// (then q0, lower, upper and the answers are reduced configurations).
 /// Returns (q, success, position_error, orientation_error, iterations) with a leading N for a batch.
 #[pyfunction]
-#[pyo3(signature = (model, frame, targets, q0, lower, upper, weights, max_iterations=50, restarts=50, position_tolerance=1e-10, orientation_tolerance=1e-10, lambda_min=1e-6, max_step=0.5, seed=0, first_index=0))]
+#[pyo3(signature = (model, frame, targets, q0, lower, upper, weights, max_iterations=50, restarts=50, position_tolerance=1e-10, orientation_tolerance=1e-10, lambda_min=1e-6, max_step=0.5, seed=0, first_index=0, reduction=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn solve_ik<'py>(
     py: Python<'py>,
@@ -116,13 +134,14 @@ pub fn solve_ik<'py>(
     max_step: f64,
     seed: u64,
     first_index: u64,
+    reduction: Option<ReductionArgs>,
 ) -> PyResult<Bound<'py, PyAny>> {
     guarded("solve_ik", || {
     let m: &Model = &model.model;
-    if !m.plain {
-        return Err(PyValueError::new_err("numeric inverse kinematics handles 1-DOF joints only (this model has a floating, spherical or planar joint)"));
-    }
-    let n = m.n;
+    let reduced = self::reduction(m, reduction)?;
+    let reduced = reduced.as_ref();
+    // configurations have n entries (nq), steps nv
+    let (n, _) = ik::solver_sizes(m, reduced);
     let frame = model.frame(frame)?;
     let (targets, batch, position) = gather_targets(&targets)?;
     let count = targets.len();
@@ -147,13 +166,16 @@ pub fn solve_ik<'py>(
     if q0s.iter().any(|x| !x.is_finite()) {
         return Err(PyValueError::new_err("q0 contains a non-finite value"));
     }
+    for (k, start) in q0s.chunks(n.max(1)).enumerate() {
+        ik::check_start(m, reduced, start, &lower, &upper).map_err(|e| PyValueError::new_err(if per_target { format!("{e} (start {k})") } else { e }))?;
+    }
     let settings = Settings { weights, max_iterations, restarts, position_tolerance, orientation_tolerance, lambda_min, max_step };
     let solve_one = |data: &mut Data, k: usize| {
         let start = if per_target { &q0s[k * n..(k + 1) * n] } else { &q0s[..] };
         // a seed per target, from its index in the whole batch (`first_index` + k when the caller
         // sends the batch in chunks): results do not depend on how the batch is split
         let index = first_index.wrapping_add(k as u64);
-        ik::numeric_ik(m, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(index))
+        ik::numeric_ik_reduced(m, reduced, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(index))
     };
     // the results, allocated fallibly before the work (MemoryError, not an abort), each target
     // writing its own row
@@ -227,6 +249,9 @@ impl PyAnalyticIk {
     fn detect(model: &PyModel, frame: i64, lower: Bound<'_, PyArrayDyn<f64>>, upper: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Option<Self>> {
         guarded("AnalyticIk.detect", || {
         let frame = model.frame(frame)?;
+        if !model.model.plain {
+            return Ok(None); // a multi-DOF joint is no screw: no closed form here
+        }
         let m = model.model.clone();
         let lower = vector("lower", &lower, m.n)?;
         let upper = vector("upper", &upper, m.n)?;

@@ -81,7 +81,10 @@ def run_ik(args) -> int:
         q0 = parse_q(args.q0, robot, args.deg, "--q0")
     result = inverse_kinematics(robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame)
     shown = result.solutions if args.all else result.solutions[:1]
-    revolute = np.array([j.kind == "revolute" for j in robot.joints])
+    # per q coordinate: revolute angles (--deg) and the column names (a multi-DOF joint's block:
+    # q1.x, q1.y, q1.z, q1.qx, ..., q1.qw for a free-flyer that is joint q1)
+    revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)], dtype=bool)
+    labels = _coordinate_labels(robot)
 
     def angles(q):
         return np.where(revolute, np.degrees(q), q) if args.deg else q
@@ -114,17 +117,17 @@ def run_ik(args) -> int:
         c.print(f"[bold]{esc(robot.name)}[/bold]: '{esc(payload['frame'])}' to {what}; solver {result.solver}")
         if len(shown):
             unit = "deg" if args.deg else "rad"
-            c.width = max(c.width, 12 * (robot.n + 3))  # never truncate the numbers
+            c.width = max(c.width, 12 * (robot.nq + 3))  # never truncate the numbers
             table = Table(title=f"{len(result.solutions)} solution(s) ({unit}, m), nearest q0 first" + ("" if args.all else " (--all lists every one)"), title_justify="left")
             table.add_column("#", justify="right")
-            for k, j in enumerate(robot.joints):
-                table.add_column(f"q{k + 1}", justify="right")
+            for label in labels:
+                table.add_column(label, justify="right")
             table.add_column("|dp| m", justify="right")
             table.add_column("|dR| rad", justify="right")
             for k, q in enumerate(shown):
                 table.add_row(str(k + 1), *(f"{v:.4f}" for v in angles(q)), f"{result.position_error[k]:.0e}", f"{result.orientation_error[k]:.0e}")
             c.print(table)
-            if robot.joint_names != [f"q{k + 1}" for k in range(robot.n)]:
+            if robot.joint_names != [f"q{k + 1}" for k in range(len(robot.joints))]:
                 c.print("joints: " + ", ".join(f"q{k + 1} = {esc(name)}" for k, name in enumerate(robot.joint_names)))
         style = "green" if result.success else "bold red"
         c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
@@ -133,3 +136,14 @@ def run_ik(args) -> int:
 
     emit(args, payload, render)
     return 0 if result.success else 2
+
+
+def _coordinate_labels(robot) -> list:
+    """A column name per q coordinate: ``q<k>`` for the k-th joint, ``q<k>.<part>`` inside a floating,
+    spherical or planar joint's block (``q1.x`` ... ``q1.qw``; docs/conventions.md)."""
+    from ..configuration import _Q_NAMES
+
+    labels = []
+    for k, j in enumerate(robot.joints):
+        labels.extend([f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}" for part in _Q_NAMES[j.kind]] if j.is_multi_dof else [f"q{k + 1}"])
+    return labels

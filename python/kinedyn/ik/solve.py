@@ -132,27 +132,48 @@ def _max(a) -> float:
 
 # ------------------------------------------------------------------ per-robot cache
 class _Chain:
-    """What one (robot, frame) pair needs at every call, computed once."""
+    """What one (robot, frame) pair needs at every call, computed once. ``n`` is the size of a
+    configuration (nq; reduced coordinates for a robot with reduced mimic joints)."""
 
-    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute", "position_ok")
+    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute", "position_ok",
+                 "reduction", "multi_dof")
 
     def __init__(self, robot: Robot, frame: str):
         from .. import _core
 
-        robot.require_no_mimic_joints("inverse kinematics")  # the native solvers take the full model
         self.frame = robot.frame_index(frame)
-        self.n = robot.n
-        self.model = robot._model
+        self.n = robot.nq
+        model = robot._model
+        # reduced mimic joints: the native solver works on the reduced coordinates (ik.rs Reduction)
+        self.reduction = None if robot._mimic is None else _reduction(robot._mimic)
+        self.model = model if robot._mimic is None else model.native
+        self.multi_dof = robot.has_multi_dof_joints
         self.lower = np.ascontiguousarray(robot.lower_limits, dtype=float)
         self.upper = np.ascontiguousarray(robot.upper_limits, dtype=float)
         self.free_lower = np.full(self.n, -np.inf)
         self.free_upper = np.full(self.n, np.inf)
-        # default start / reference: zeros, moved at least 10 % of the range away from finite limits
+        # default start / reference: the neutral configuration (zeros, identity rotations), 1-DOF
+        # joints moved at least 10 % of the range away from finite limits
         span = np.where(np.isfinite(self.upper - self.lower), self.upper - self.lower, 0.0)
-        self.start = np.clip(np.zeros(self.n), self.lower + 0.1 * span, self.upper - 0.1 * span)
-        self.revolute = np.array([j.kind == "revolute" for j in robot.joints])
-        self.solver = _core.AnalyticIk.detect(self.model, self.frame, self.lower, self.upper)
+        self.start = np.clip(robot.neutral(), self.lower + 0.1 * span, self.upper - 0.1 * span)
+        # the q entries that are revolute angles (wrapped into (-pi, pi] when limits are not kept)
+        self.revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)], dtype=bool)
+        plain = not self.multi_dof and self.reduction is None
+        self.solver = _core.AnalyticIk.detect(self.model, self.frame, self.lower, self.upper) if plain else None
         self.position_ok = self.solver is not None and self.solver.solves_position
+
+
+def _reduction(m) -> tuple:
+    """The native solver's description of a :class:`~kinedyn.description.mimic.MimicMap`: each full q
+    entry is one reduced entry times a multiplier plus an offset, each full velocity one reduced
+    velocity times a multiplier (the one nonzero of a row of ``Gq`` / ``G``)."""
+    Gq = np.asarray(m.Gq_T, dtype=float).T  # (nq_full, nq)
+    G = np.asarray(m.G, dtype=float)  # (nv_full, nv)
+    q_source = np.argmax(np.abs(Gq), axis=1) if m.nq else np.zeros(len(Gq), dtype=np.intp)
+    v_source = np.argmax(np.abs(G), axis=1) if m.nv else np.zeros(len(G), dtype=np.intp)
+    rows_q, rows_v = np.arange(len(Gq)), np.arange(len(G))
+    return ([int(k) for k in q_source], [float(x) for x in Gq[rows_q, q_source]], [float(x) for x in np.asarray(m.b, dtype=float)],
+            [int(k) for k in v_source], [float(x) for x in G[rows_v, v_source]], [int(k) for k in m.q_keep], int(m.nv))
 
 
 def _chain(robot: Robot, frame: Optional[str]) -> _Chain:
@@ -217,16 +238,22 @@ def _mask(mask) -> Optional[tuple]:
     return tuple(float(v) for v in m)
 
 
-def _q0(q0, chain: _Chain, batch: Optional[int]) -> np.ndarray:
+def _q0(q0, chain: _Chain, batch: Optional[int], robot: Optional[Robot] = None) -> np.ndarray:
     if q0 is None:
         return chain.start
     q = real_array(q0, "q0")
     n = chain.n
     if q.shape != (n,) and not (batch is not None and q.shape == (batch, n)):
         want = f"({n},)" + (f" or ({batch}, {n})" if batch is not None else "")
-        raise ValueError(f"q0 must have shape {want}, got {q.shape}")
+        what = " (nq: a configuration; a free-flyer takes 7 entries, a spherical or planar joint 4)" if chain.multi_dof else ""
+        raise ValueError(f"q0 must have shape {want}{what}, got {q.shape}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q0 contains a non-finite value (NaN or inf)")
+    if chain.multi_dof and robot is not None:
+        # unit quaternions and (cos, sin) pairs, the error naming the joint (kinedyn.configuration)
+        from ..configuration import space
+
+        space(robot).check(q, "q0")
     return q
 
 
@@ -270,7 +297,7 @@ def inverse_kinematics(
     if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype is _F64 and chain.solver is not None:
         shape = target.shape
         if shape == (4, 4) or (shape == (3,) and chain.position_ok):
-            q_ref = chain.start if q0 is None else _q0(q0, chain, None)
+            q_ref = chain.start if q0 is None else _q0(q0, chain, None, robot)
             return _analytic(robot, chain, target, q_ref, shape == (3,), respect_limits, tolerance, seed)
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
@@ -290,7 +317,7 @@ def inverse_kinematics(
         raise ValueError(_why_not_analytic(robot, chain, position, weights))
     use_analytic = analytic_ok and method != "numeric"
     nb = len(t) if batch else None
-    q_start = _q0(q0, chain, nb)
+    q_start = _q0(q0, chain, nb, robot)
     if batch:
         return _batch(robot, chain, t, q_start, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress)
     if use_analytic:
@@ -319,6 +346,9 @@ def _check_settings(tolerance, max_iterations, restarts, seed) -> tuple:
 
 
 def _why_not_analytic(robot: Robot, chain: _Chain, position: bool, weights) -> str:
+    if chain.multi_dof or chain.reduction is not None:
+        what = "floating, spherical or planar joints" if chain.multi_dof else "reduced mimic joints moving this frame"
+        return f"robot '{robot.name}' has {what}: the closed forms solve chains of revolute and prismatic joints only; use method='numeric'"
     if chain.solver is None:
         return (
             f"robot '{robot.name}' has no closed-form inverse kinematics here: its axes match none of the "
@@ -376,7 +406,8 @@ def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, toleranc
     def solve(first: int, stop: Optional[int]):
         tk = t if stop is None else t[first:stop]
         qk = q0 if (stop is None or q0.ndim == 1) else q0[first:stop]
-        return _core.solve_ik(chain.model, chain.frame, tk, qk, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed, first)
+        return _core.solve_ik(chain.model, chain.frame, tk, qk, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed, first,
+                              reduction=chain.reduction)
 
     count = len(t) if t.ndim == 3 or (t.ndim == 2 and t.shape[1] == 3) else 0  # a batch: (N, 4, 4) poses or (N, 3) points
     if count <= IK_CHUNK or not wanted(progress):
