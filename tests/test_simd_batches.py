@@ -50,6 +50,8 @@ def _calls(robot, q, v, a):
         "forward_dynamics f_ext": (lambda *x: model.forward_dynamics(*x), (q, v, tau, f_ext)),
         "gravity_torque": (lambda *x: model.gravity_torque(*x), (q,)),
         "bias_torque": (lambda *x: model.bias_torque(*x), (q, v)),
+        "coriolis_matrix": (lambda *x: model.coriolis_matrix(*x), (q, v)),
+        "christoffel": (lambda *x: model.christoffel(*x), (q,)),
         "frame_poses": (lambda q: model.frame_poses(q, np.arange(model.n_frames)), (q,)),
     }
     for reference in range(3):  # world, local, spatial

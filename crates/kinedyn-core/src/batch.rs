@@ -357,6 +357,32 @@ pub mod kernels {
         }
     }
 
+    /// The Coriolis matrix `C(q, qd)` (n x n, row-major; Christoffel-consistent).
+    pub struct Coriolis;
+    impl Kernel for Coriolis {
+        fn output_len(&self, model: &Model) -> usize {
+            model.n * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            out.copy_from_slice(alg::coriolis_matrix(model, data, x[0], x[1]));
+            Ok(())
+        }
+    }
+
+    /// Christoffel symbols of the first kind `c[i][j][k]` (n x n x n).
+    pub struct Christoffel;
+    impl Kernel for Christoffel {
+        fn output_len(&self, model: &Model) -> usize {
+            model.n * model.n * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            alg::christoffel(model, data, x[0], out);
+            Ok(())
+        }
+    }
+
     /// `C(q, qd) qd + g(q)` (no friction).
     pub struct Bias;
     impl Kernel for Bias {
@@ -435,6 +461,12 @@ mod tests {
     #[test]
     fn mass_matrix_in_lanes() {
         lanes_equal_single_calls(MassMatrix, 1);
+    }
+
+    #[test]
+    fn coriolis_and_christoffel_in_lanes() {
+        lanes_equal_single_calls(Coriolis, 2);
+        lanes_equal_single_calls(Christoffel, 1);
     }
 
     #[test]

@@ -811,10 +811,7 @@ impl PyModel {
             let qd = f64_array("qd", &qd)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
-            batch.run_out(py, self, ("coriolis_matrix", "C"), &[n, n], out, |model, data, x, out| {
-                out.copy_from_slice(algorithms::coriolis_matrix(model, data, x[0], x[1]));
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("coriolis_matrix", "C"), &[n, n], out, kernels::Coriolis)
         })
     }
 
@@ -824,10 +821,7 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("christoffel", "c"), &[n, n, n], |model, data, x, out| {
-                algorithms::christoffel(model, data, x[0], out);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("christoffel", "c"), &[n, n, n], None, kernels::Christoffel)
         })
     }
 

@@ -28,34 +28,39 @@
 use super::kinematics::{forward_kinematics, forward_velocity};
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{Inertia, Mat3, Motion};
+use crate::spatial::{cross, outer, Inertia, Mat3, Motion, Real, Vec3};
 
 /// `dI/dt` of a rigid body with inertia `i` (about the world origin) moving with twist `v`
 /// (world coordinates): `(v x*) I - I (v x)` in parameters: mass rate 0,
 /// `dh/dt = m v_o + w x h`, `dI_o/dt = 2 (h . v_o) 1 - v_o h^T - h v_o^T + [w]x I_o - I_o [w]x`.
-#[inline]
-pub(crate) fn inertia_rate(i: &Inertia, v: &Motion) -> Inertia {
+#[inline(always)]
+pub(crate) fn inertia_rate<T: Real>(i: &Inertia<T>, v: &Motion<T>) -> Inertia<T> {
     let (vo, w, h) = (&v.lin, &v.ang, &i.h);
     // [w]x I_o - I_o [w]x = A + A^T with A = [w]x I_o (I_o symmetric): columns w x (I_o e_k)
-    let a = Mat3::from_columns(&[w.cross(&i.i_o.column(0).into_owned()), w.cross(&i.i_o.column(1).into_owned()), w.cross(&i.i_o.column(2).into_owned())]);
-    let vh = vo * h.transpose();
-    let sym = a - vh;
-    let io_dot = Mat3::from_diagonal_element(2.0 * h.dot(vo)) + sym + sym.transpose();
-    Inertia::new(0.0, i.mass * vo + w.cross(h), io_dot)
+    let io = &i.i_o;
+    let c0 = cross(w, &Vec3::new(io[(0, 0)], io[(1, 0)], io[(2, 0)]));
+    let c1 = cross(w, &Vec3::new(io[(0, 1)], io[(1, 1)], io[(2, 1)]));
+    let c2 = cross(w, &Vec3::new(io[(0, 2)], io[(1, 2)], io[(2, 2)]));
+    let a = Mat3::new(c0.x, c1.x, c2.x, c0.y, c1.y, c2.y, c0.z, c1.z, c2.z);
+    let sym = a - outer(vo, h);
+    let io_dot = Mat3::from_diagonal_element(T::splat(2.0) * h.dot(vo)) + sym + sym.transpose();
+    Inertia::new(T::zero(), vo * i.mass + cross(w, h), io_dot)
 }
 
 /// World-coordinate kinematics shared by `coriolis_matrix` and `christoffel`: `s_w`, `i_w`.
-fn world_subspaces_and_inertias(model: &Model, data: &mut Data) {
+#[inline(always)]
+fn world_subspaces_and_inertias<T: Real>(model: &Model, data: &mut Data<T>) {
     for i in 0..model.n {
         let x = &data.world_from_body[i];
         data.s_w[i] = x.act_motion(&data.s[i]);
-        data.i_w[i] = x.act_inertia(&model.inertia[i]);
+        data.i_w[i] = x.act_inertia(&model.inertia[i].splat());
     }
 }
 
 /// `C` from `data.s_w`, `data.v_w`, `data.i_w` (world), written to `out[j * rs + k * cs]`
 /// (so that the Christoffel layout can be written without a transpose).
-fn coriolis_from_world(model: &Model, data: &mut Data, out: &mut [f64], rs: usize, cs: usize) {
+#[inline(always)]
+fn coriolis_from_world<T: Real>(model: &Model, data: &mut Data<T>, out: &mut [T], rs: usize, cs: usize) {
     let n = model.n;
     for i in 0..n {
         // ds_i/dt = v_i x s_i ;  I^c_i = I_i ;  dI^c_i/dt = (v_i x*) I_i - I_i (v_i x) ;  h^c_i = I_i v_i
@@ -78,7 +83,7 @@ fn coriolis_from_world(model: &Model, data: &mut Data, out: &mut [f64], rs: usiz
     }
     for k in 0..n {
         for j in 0..n {
-            out[j * rs + k * cs] = 0.0;
+            out[j * rs + k * cs] = T::zero();
         }
     }
     for k in 0..n {
@@ -87,8 +92,8 @@ fn coriolis_from_world(model: &Model, data: &mut Data, out: &mut [f64], rs: usiz
         // B^c_k s_k = 1/2 (dI^c_k/dt s_k + s_k x* h^c_k) ;  B^c_k^T s_k = 1/2 (dI^c_k/dt s_k - s_k x* h^c_k)
         let icd_s = icd.mul_motion(&s);
         let s_h = s.cross_force(hc);
-        let b_s = (icd_s + s_h) * 0.5;
-        let bt_s = (icd_s - s_h) * 0.5;
+        let b_s = (icd_s + s_h) * T::splat(0.5);
+        let bt_s = (icd_s - s_h) * T::splat(0.5);
         // F1 = I^c_k ds_k/dt + B^c_k s_k ;  F2 = I^c_k s_k
         let f1 = ic.mul_motion(&sd) + b_s;
         let f2 = ic.mul_motion(&s);
@@ -105,7 +110,8 @@ fn coriolis_from_world(model: &Model, data: &mut Data, out: &mut [f64], rs: usiz
 }
 
 /// `C(q, qd)` written row-major to `data.m` (n x n).
-pub fn coriolis_matrix<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64]) -> &'d [f64] {
+#[inline(always)]
+pub fn coriolis_matrix<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T]) -> &'d [T] {
     let n = model.n;
     // v_i (body) by the velocity pass, then everything in world coordinates
     forward_velocity(model, data, q, qd);
@@ -121,7 +127,8 @@ pub fn coriolis_matrix<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f
 
 /// Christoffel symbols of the first kind, `out[i][j][k] = c_ijk` (n x n x n, row-major), with
 /// `c_ijk = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k)`, from `C(q, e_i)[k][j] = c_ijk`.
-pub fn christoffel(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) {
+#[inline(always)]
+pub fn christoffel<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], out: &mut [T]) {
     let n = model.n;
     forward_kinematics(model, data, q);
     world_subspaces_and_inertias(model, data);
