@@ -59,6 +59,14 @@ def _calls(robot, q, v, a):
         calls[f"jacobian {reference} at a point"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r, np.array([0.1, -0.2, 0.3])), (q,))
     for name, (fn, args) in calls.items():
         yield name, fn(*args), np.array([fn(*(x[k] for x in args)) for k in range(len(q))])
+    for name, fn, args in [("inverse_dynamics_derivatives", model.inverse_dynamics_derivatives, (q, v, a)),
+                           ("inverse_dynamics_derivatives f_ext", model.inverse_dynamics_derivatives, (q, v, a, f_ext)),
+                           ("forward_dynamics_derivatives", model.forward_dynamics_derivatives, (q, v, tau)),
+                           ("forward_dynamics_derivatives f_ext", model.forward_dynamics_derivatives, (q, v, tau, f_ext))]:
+        batch = fn(*args)
+        single = [fn(*(x[k] for x in args)) for k in range(len(q))]
+        for part in range(3):  # each of the three results
+            yield f"{name} [{part}]", batch[part], np.array([s[part] for s in single])
 
 
 def _assert_close(name, got, expected):

@@ -107,6 +107,8 @@ impl Simd {
 /// transposed inputs and output of one block.
 pub struct Scratch {
     pub data: Data,
+    /// Free for the caller (the Python binding gathers several outputs of a state here).
+    pub buffer: Vec<f64>,
     portable: Option<Block<Lanes<4>>>,
     #[cfg(target_arch = "x86_64")]
     avx2: Option<Block<F64x4>>,
@@ -125,6 +127,7 @@ impl Scratch {
     pub fn new(model: &Model) -> Self {
         Self {
             data: Data::new(model),
+            buffer: Vec::new(),
             portable: None,
             #[cfg(target_arch = "x86_64")]
             avx2: None,
@@ -383,6 +386,37 @@ pub mod kernels {
         }
     }
 
+    /// `dtau/dq`, `dtau/dqd` and `M` (n x n each, one after the other) at `(q, qd, qdd[, f_ext])`.
+    pub struct InverseDynamicsDerivatives;
+    impl Kernel for InverseDynamicsDerivatives {
+        fn output_len(&self, model: &Model) -> usize {
+            3 * model.n * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            let nn = model.n * model.n;
+            let (dq, rest) = out.split_at_mut(nn);
+            let (dqd, m) = rest.split_at_mut(nn);
+            alg::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
+            Ok(())
+        }
+    }
+
+    /// `dqdd/dq`, `dqdd/dqd` and `M^-1` (n x n each, one after the other) at `(q, qd, tau[, f_ext])`.
+    pub struct ForwardDynamicsDerivatives;
+    impl Kernel for ForwardDynamicsDerivatives {
+        fn output_len(&self, model: &Model) -> usize {
+            3 * model.n * model.n
+        }
+        #[inline(always)]
+        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+            let nn = model.n * model.n;
+            let (dq, rest) = out.split_at_mut(nn);
+            let (dqd, minv) = rest.split_at_mut(nn);
+            alg::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, minv)
+        }
+    }
+
     /// `C(q, qd) qd + g(q)` (no friction).
     pub struct Bias;
     impl Kernel for Bias {
@@ -416,12 +450,12 @@ mod tests {
         ]
     }
 
-    /// `states` random states of `model`: q (nq each), then three n-vectors per state.
+    /// `states` random states of `model`: q (nq each), two n-vectors and external wrenches (6 n).
     fn states(model: &Model, states: usize, seed: u64) -> [Vec<f64>; 4] {
         let mut rng = Rng::new(seed);
         let q: Vec<f64> = (0..states).flat_map(|_| random_configuration(model, &mut rng)).collect();
-        let [a, b, c] = std::array::from_fn(|_| rng.vector(states * model.n, -2.0, 2.0));
-        [q, a, b, c]
+        let [a, b] = std::array::from_fn(|_| rng.vector(states * model.n, -2.0, 2.0));
+        [q, a, b, rng.vector(states * 6 * model.n, -5.0, 5.0)]
     }
 
     /// Every supported lane kind gives the single call's numbers (to 1e-13 relative to the largest
@@ -432,7 +466,7 @@ mod tests {
         for (name, model) in models() {
             for count in [1usize, 5, 13] {
                 let values = states(&model, count, 7 + count as u64);
-                let widths = [model.nq, model.n, model.n, model.n];
+                let widths = [model.nq, model.n, model.n, 6 * model.n];
                 let x: Vec<Input> = (0..inputs).map(|k| Input { values: &values[k], width: widths[k] }).collect();
                 let width = kernel.output_len(&model);
                 let mut expected = vec![f64::NAN; count * width];
@@ -456,6 +490,7 @@ mod tests {
     #[test]
     fn inverse_dynamics_in_lanes() {
         lanes_equal_single_calls(InverseDynamics, 3);
+        lanes_equal_single_calls(InverseDynamics, 4);
     }
 
     #[test]
@@ -470,6 +505,14 @@ mod tests {
     }
 
     #[test]
+    fn derivatives_in_lanes() {
+        lanes_equal_single_calls(InverseDynamicsDerivatives, 3);
+        lanes_equal_single_calls(InverseDynamicsDerivatives, 4);
+        lanes_equal_single_calls(ForwardDynamicsDerivatives, 3);
+        lanes_equal_single_calls(ForwardDynamicsDerivatives, 4);
+    }
+
+    #[test]
     fn mass_matrix_inverse_in_lanes() {
         lanes_equal_single_calls(MassMatrixInverse, 1);
     }
@@ -477,6 +520,7 @@ mod tests {
     #[test]
     fn forward_dynamics_in_lanes() {
         lanes_equal_single_calls(ForwardDynamics, 3);
+        lanes_equal_single_calls(ForwardDynamics, 4);
     }
 
     #[test]
@@ -503,7 +547,8 @@ mod tests {
         let massless = model.n - 1;
         model.inertia[massless] = crate::spatial::Inertia::zero();
         model.armature[massless] = 0.0;
-        let [q, qd, tau, _] = states(&model, 6, 1);
+        let [q, qd, _, _] = states(&model, 6, 1);
+        let tau = qd.clone();
         let x = [Input { values: &q, width: 4 }, Input { values: &qd, width: 4 }, Input { values: &tau, width: 4 }];
         for simd in [Simd::Off, Simd::Portable] {
             let mut out = vec![0.0; 6 * 4];

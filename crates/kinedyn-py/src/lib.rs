@@ -324,14 +324,28 @@ impl<'a> Batch<'a> {
         };
         let states_range = |scratch: &mut Scratch, a: usize, b: usize| -> Result<(), Fault> {
             match lanes {
-                Some(lanes) if K == 1 && b - a > 1 => {
+                Some(lanes) if b - a > 1 => {
                     let inputs: [Input; MAX_INPUTS] = std::array::from_fn(|k| {
                         let w = self.width[k];
                         Input { values: self.values[k].get(a * w..b * w).unwrap_or(&[]), width: w }
                     });
-                    // SAFETY: the range [a per_state, b per_state) of the one output, written by this thread only
-                    let out = unsafe { std::slice::from_raw_parts_mut(bases[0].0.add(a * per_state), (b - a) * per_state) };
-                    lanes(&m.model, scratch, &inputs[..self.count], out).map_err(|e| Fault::Core(e.error))?;
+                    if K == 1 {
+                        // SAFETY: the range [a per_state, b per_state) of the one output, written by this thread only
+                        let out = unsafe { std::slice::from_raw_parts_mut(bases[0].0.add(a * per_state), (b - a) * per_state) };
+                        lanes(&m.model, scratch, &inputs[..self.count], out).map_err(|e| Fault::Core(e.error))?;
+                    } else {
+                        // the kernel writes a state's K outputs one after the other: gathered in the
+                        // scratch's buffer, then copied to the K arrays
+                        let mut buffer = std::mem::take(&mut scratch.buffer);
+                        buffer.resize((b - a) * K * per_state, 0.0);
+                        lanes(&m.model, scratch, &inputs[..self.count], &mut buffer).map_err(|e| Fault::Core(e.error))?;
+                        for (state, values) in (a..b).zip(buffer.chunks_exact(K * per_state.max(1))) {
+                            for (out, part) in outputs(state).into_iter().zip(values.chunks_exact(per_state.max(1))) {
+                                out.copy_from_slice(part);
+                            }
+                        }
+                        scratch.buffer = buffer;
+                    }
                 }
                 _ => {
                     for k in a..b {
@@ -776,7 +790,9 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
-            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], None, |model, data, x, [dq, dqd, m]| {
+            let simd = Simd::detected();
+            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernels::InverseDynamicsDerivatives, x, out, simd);
+            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], Some(&lanes), |model, data, x, [dq, dqd, m]| {
                 algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
                 Ok(())
             })?;
@@ -796,7 +812,9 @@ impl PyModel {
                 Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
-            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], None, |model, data, x, [dq, dqd, dtau]| {
+            let simd = Simd::detected();
+            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernels::ForwardDynamicsDerivatives, x, out, simd);
+            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], Some(&lanes), |model, data, x, [dq, dqd, dtau]| {
                 algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
             })?;
             Ok((dq, dqd, dtau))

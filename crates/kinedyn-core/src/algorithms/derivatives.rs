@@ -47,7 +47,7 @@ use super::rnea::rnea;
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Real, Vec3};
+use crate::spatial::{cross, mv, outer, splat3, Force, Motion, Real, Vec3};
 
 /// The derivatives of one body's twist, acceleration and composite force along one coordinate.
 #[derive(Clone, Copy, Debug, Default)]
@@ -61,16 +61,17 @@ pub struct Tangent<T: Real = f64> {
 /// for the same `tau` as [`rnea`] (gravity, friction, armature, `f_ext`), and when asked for,
 /// `dtau/dqdd = M` (a by-product of the pass: the CRBA in world coordinates).
 #[allow(clippy::too_many_arguments)]
-pub fn rnea_derivatives(
+#[inline(always)]
+pub fn rnea_derivatives<T: Real>(
     model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    qd: &[f64],
-    qdd: &[f64],
-    f_ext: Option<&[f64]>,
-    dtau_dq: &mut [f64],
-    dtau_dqd: &mut [f64],
-    mass_matrix: Option<&mut [f64]>,
+    data: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    f_ext: Option<&[T]>,
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
+    mass_matrix: Option<&mut [T]>,
 ) {
     rnea_derivatives_world(model, data, q, qd, qdd, f_ext, dtau_dq, dtau_dqd);
     if let Some(m) = mass_matrix {
@@ -80,16 +81,17 @@ pub fn rnea_derivatives(
 
 /// `M` from the world-coordinate pass: `H_jk = S_j . (I^c_k S_k) = S_j . alpha_k` for j supporting
 /// k (the CRBA in world coordinates, RBDA §6.2), plus the armature on the diagonal.
-fn mass_matrix_from_world(model: &Model, data: &Data, m: &mut [f64]) {
+#[inline(always)]
+fn mass_matrix_from_world<T: Real>(model: &Model, data: &Data<T>, m: &mut [T]) {
     let n = model.n;
-    m[..n * n].fill(0.0);
+    m[..n * n].fill(T::zero());
     for k in 0..n {
         for &j in &model.support[k] {
             let h = data.s_w[j].dot(&data.alpha[k]);
             m[j * n + k] = h;
             m[k * n + j] = h;
         }
-        m[k * n + k] += model.armature[k];
+        m[k * n + k] += T::splat(model.armature[k]);
     }
 }
 
@@ -138,17 +140,19 @@ pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &
 /// `E_k(w_j) = (w_j x sum f_i, w_j x sum n_i + w_j tr(P_k) - P_k w_j)`, `P_k = sum f_i p_i^T` over
 /// subtree k, to `dF_k/dq_j` (Jacobi: `w x (p x f) - (w x p) x f = p x (w x f)`).
 #[allow(clippy::too_many_arguments)]
-fn rnea_derivatives_world(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+#[inline(always)]
+fn rnea_derivatives_world<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>, dtau_dq: &mut [T], dtau_dqd: &mut [T]) {
     world_pass(model, data, q, qd, Some(qdd), f_ext);
     world_derivatives(model, data, f_ext.is_some(), dtau_dq, dtau_dqd);
 }
 
 /// The world-coordinate quantities of [`rnea_derivatives_world`] at `(q, qd, qdd)` (`qdd = None`:
 /// zero), composite over each subtree, and `alpha`, `beta`, `sigma`; body inertias kept in `i_w`.
-fn world_pass(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: Option<&[f64]>, f_ext: Option<&[f64]>) {
+#[inline(always)]
+fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: Option<&[T]>, f_ext: Option<&[T]>) {
     let n = model.n;
     forward_kinematics(model, data, q);
-    let a0 = Motion::new(-model.gravity, Default::default());
+    let a0 = Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros());
     let parent = &model.parent[..n];
     let (s_w, v_w, a_w, i_w) = (&mut data.s_w[..n], &mut data.v_w[..n], &mut data.a_w[..n], &mut data.i_w[..n]);
     let (ic, icd, hc, fc) = (&mut data.ic_w[..n], &mut data.icd_w[..n], &mut data.hc_w[..n], &mut data.fc_w[..n]);
@@ -166,16 +170,16 @@ fn world_pass(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: Option
         if let Some(qdd) = qdd {
             a += s * qdd[i];
         }
-        let inertia = x.act_inertia(&model.inertia[i]);
+        let inertia = x.act_inertia(&model.inertia[i].splat());
         let h = inertia.mul_motion(&v);
         (s_w[i], v_w[i], a_w[i], i_w[i]) = (s, v, a, inertia);
         (ic[i], icd[i], hc[i], fc[i]) = (inertia, inertia_rate(&inertia, &v), h, inertia.mul_motion(&a) + v.cross_force(&h));
         if let Some(fx) = f_ext {
             // the wrench about the world origin, and its parts for the composite sums E_k
-            let (f, m) = (Vec3::from_column_slice(&fx[6 * i..6 * i + 3]), Vec3::from_column_slice(&fx[6 * i + 3..6 * i + 6]));
+            let (f, m) = (Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
             let p = x.trans;
-            fc[i] -= Force::new(f, m + p.cross(&f));
-            (data.ext_f[i], data.ext_n[i], data.ext_p[i]) = (f, m, f * p.transpose());
+            fc[i] -= Force::new(f, m + cross(&p, &f));
+            (data.ext_f[i], data.ext_n[i], data.ext_p[i]) = (f, m, outer(&f, &p));
         }
     }
     // backward: composite sums over each subtree
@@ -202,7 +206,8 @@ fn world_pass(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: Option
 
 /// After `world_pass` at `qdd = 0`: the accelerations and composite forces at `qdd` (the
 /// accelerations are linear in qdd: `a_i += sum over the joints k supporting i of S_k qdd_k`).
-fn add_joint_accelerations(model: &Model, data: &mut Data, qdd: &[f64]) {
+#[inline(always)]
+fn add_joint_accelerations<T: Real>(model: &Model, data: &mut Data<T>, qdd: &[T]) {
     let n = model.n;
     let (s_w, a_w, i_w, fc) = (&data.s_w[..n], &mut data.a_w[..n], &data.i_w[..n], &mut data.fc_w[..n]);
     let (da, df) = (&mut data.dpsi[..n], &mut data.dfc_w[..n]);
@@ -222,18 +227,22 @@ fn add_joint_accelerations(model: &Model, data: &mut Data, qdd: &[f64]) {
 }
 
 /// The derivative loops of [`rnea_derivatives_world`], from the quantities `world_pass` left in `data`.
-fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+#[inline(always)]
+fn world_derivatives<T: Real>(model: &Model, data: &Data<T>, wrenches: bool, dtau_dq: &mut [T], dtau_dqd: &mut [T]) {
     let n = model.n;
-    let a0 = Motion::new(-model.gravity, Default::default());
+    let a0 = Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros());
     let parent = &model.parent[..n];
     let (s_w, v_w, a_w) = (&data.s_w[..n], &data.v_w[..n], &data.a_w[..n]);
     let (ic, icd, hc, fc) = (&data.ic_w[..n], &data.icd_w[..n], &data.hc_w[..n], &data.fc_w[..n]);
     let (alpha, beta, sigma) = (&data.alpha[..n], &data.beta[..n], &data.sigma[..n]);
     // E_k(w): how the subtree's wrenches change as coordinate j (axis w) turns it (see above)
     let (ext_f, ext_n, ext_p) = (&data.ext_f[..n], &data.ext_n[..n], &data.ext_p[..n]);
-    let wrench_term = |k: usize, w: &Vec3| Force::new(w.cross(&ext_f[k]), w.cross(&ext_n[k]) + w * ext_p[k].trace() - ext_p[k] * w);
-    dtau_dq[..n * n].fill(0.0);
-    dtau_dqd[..n * n].fill(0.0);
+    let wrench_term = |k: usize, w: &Vec3<T>| -> Force<T> {
+        let trace = ext_p[k][(0, 0)] + ext_p[k][(1, 1)] + ext_p[k][(2, 2)];
+        Force::new(cross(w, &ext_f[k]), cross(w, &ext_n[k]) + w * trace - mv(&ext_p[k], w))
+    };
+    dtau_dq[..n * n].fill(T::zero());
+    dtau_dqd[..n * n].fill(T::zero());
     for j in 0..n {
         let s = s_w[j];
         // a column of a multi-DOF joint moves the joint's child and subtree with the joint's parent λ
@@ -244,7 +253,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
         let (vp, ap) = parent[head].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
         let u = s.cross_motion(&vp);
         let w = u.cross_motion(&vp) - s.cross_motion(&ap);
-        let sdot = if head == j && model.group_last[j] == j { vp.cross_motion(&s) } else { (vp + v_w[model.group_last[j]]).cross_motion(&s) * 0.5 };
+        let sdot = if head == j && model.group_last[j] == j { vp.cross_motion(&s) } else { (vp + v_w[model.group_last[j]]).cross_motion(&s) * T::splat(0.5) };
         // the subtree of j: three dot products per entry
         for k in head..n {
             if k != head && model.support[k].binary_search(&head).is_err() {
@@ -254,9 +263,9 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
             if wrenches {
                 dtau_dq[k * n + j] += s_w[k].dot(&wrench_term(k, &s.ang));
             }
-            dtau_dqd[k * n + j] = 2.0 * sdot.dot(&alpha[k]) + s.dot(&(beta[k] - sigma[k]));
+            dtau_dqd[k * n + j] = T::splat(2.0) * sdot.dot(&alpha[k]) + s.dot(&(beta[k] - sigma[k]));
         }
-        dtau_dqd[j * n + j] += model.viscous[j];
+        dtau_dqd[j * n + j] += T::splat(model.viscous[j]);
         // the ancestors of j: dtau_k = S_k . dF_j
         if parent[head].is_none() {
             continue;
@@ -265,7 +274,7 @@ fn world_derivatives(model: &Model, data: &Data, wrenches: bool, dtau_dq: &mut [
         if wrenches {
             df_q += wrench_term(j, &s.ang);
         }
-        let df_qd = ic[j].mul_motion(&sdot) * 2.0 + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
+        let df_qd = ic[j].mul_motion(&sdot) * T::splat(2.0) + icd[j].mul_motion(&s) + s.cross_force(&hc[j]);
         let mut k = parent[head];
         while let Some(kk) = k {
             dtau_dq[kk * n + j] = s_w[kk].dot(&df_q);
@@ -346,16 +355,17 @@ fn tangent_sweeps(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f6
 /// `dqdd/dq`, `dqdd/dqd` and `dqdd/dtau = M^-1` (row-major n x n each) at `(q, qd, tau)`, for the
 /// same `qdd` as the ABA (`f_ext` included). An error for a singular mass matrix.
 #[allow(clippy::too_many_arguments)]
-pub fn aba_derivatives(
+#[inline(always)]
+pub fn aba_derivatives<T: Real>(
     model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    qd: &[f64],
-    tau: &[f64],
-    f_ext: Option<&[f64]>,
-    dqdd_dq: &mut [f64],
-    dqdd_dqd: &mut [f64],
-    dqdd_dtau: &mut [f64],
+    data: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    tau: &[T],
+    f_ext: Option<&[T]>,
+    dqdd_dq: &mut [T],
+    dqdd_dqd: &mut [T],
+    dqdd_dtau: &mut [T],
 ) -> Result<()> {
     let n = model.n;
     // one world pass at qdd = 0 gives M (composite inertias) and the bias b = tau(q, qd, 0)
@@ -369,12 +379,12 @@ pub fn aba_derivatives(
     let minv = &dqdd_dtau[..n * n];
     let qdd = &mut data.qdd_fd[..n];
     for (r, value) in qdd.iter_mut().enumerate() {
-        *value = (0..n)
-            .map(|k| {
-                let bias = data.s_w[k].dot(&data.fc_w[k]) + super::rnea::friction(model, k, qd[k]);
-                minv[r * n + k] * (tau[k] - bias)
-            })
-            .sum();
+        let mut sum = T::zero();
+        for k in 0..n {
+            let bias = data.s_w[k].dot(&data.fc_w[k]) + super::rnea::friction(model, k, qd[k]);
+            sum += minv[r * n + k] * (tau[k] - bias);
+        }
+        *value = sum;
     }
     let qdd = std::mem::take(&mut data.qdd_fd);
     add_joint_accelerations(model, data, &qdd[..n]);
@@ -386,13 +396,13 @@ pub fn aba_derivatives(
 
     let scratch = &mut data.m[..n * n];
     for out in [dqdd_dq, dqdd_dqd] {
-        scratch.fill(0.0);
+        scratch.fill(T::zero());
         for r in 0..n {
             let row = &mut scratch[r * n..(r + 1) * n];
             for k in 0..n {
                 let c = -minv[r * n + k];
                 for (value, d) in row.iter_mut().zip(&out[k * n..(k + 1) * n]) {
-                    *value += c * d;
+                    *value += c * *d;
                 }
             }
         }
