@@ -76,4 +76,12 @@ for key, c in cpp.items():
 for key, r in rust.items():
     if key not in cpp and "free_flyer" in key:  # profiling lines of the Rust side alone (see quick.rs)
         print(f"{key:28s} {'':14s} {r:10.0f} ns")
+# issue 17: per state of a 1024-state batch on one thread (quick.rs's bench_batches), beside
+# Pinocchio's C++ per call of the same algorithm
+print(f"{'batch, per state':28s} {'Pinocchio C++':>14s} {'kinedyn-core':>13s}   speed-up")
+for key, r in rust.items():
+    if "_batch_" in key:
+        single = key.split("_batch_")[0]
+        if single in cpp:
+            print(f"{key:28s} {cpp[single]:11.1f} ns {r:10.1f} ns   {cpp[single] / r:6.2f}x")
 PY

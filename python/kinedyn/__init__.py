@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ._core import NonFiniteResultError
+from ._core import simd  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
@@ -46,5 +47,5 @@ def load(path: PathLike, **kwargs) -> Robot:
 
 __all__ = [
     "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "sweep", "PhysicalConsistencyWarning", "NonFiniteResultError", "__version__", *_SUBMODULES,
+    "Trajectory", "sweep", "PhysicalConsistencyWarning", "NonFiniteResultError", "simd", "__version__", *_SUBMODULES,
 ]

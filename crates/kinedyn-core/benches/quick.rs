@@ -82,6 +82,9 @@ fn main() {
         run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
         run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
         bench_batches(name, &model, &filter);
+        if filter == "flops" {
+            print_flops(name, &model);
+        }
     }
     let trees = std::env::var("KINEDYN_BENCH_TREES").unwrap_or_default();
     for path in trees.split(':').filter(|p| !p.is_empty()) {
@@ -204,4 +207,116 @@ fn free_flyer_crba_share(model: &kinedyn_core::Model, data: &mut Data, tree: &mo
         black_box(&m);
     });
     println!("{:28} {rows:8.1}", format!("{}/crba_free_flyer_rows", tree.name));
+}
+
+/// The floating-point operations of one call (issue 17's "fraction of the arithmetic floor"): the
+/// algorithms run on `Counted`, an f64 that counts its + - * / (a negation is a sign flip, not
+/// counted; sin/cos pairs counted apart, as one call each).
+mod flops {
+    use kinedyn_core::Real;
+    use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+    pub static OPS: AtomicU64 = AtomicU64::new(0);
+    pub static SIN_COS: AtomicU64 = AtomicU64::new(0);
+
+    #[derive(Clone, Copy, Debug, Default, PartialEq)]
+    pub struct Counted(pub f64);
+
+    macro_rules! counted {
+        ($t:ident, $m:ident, $at:ident, $am:ident, $op:tt) => {
+            impl $t for Counted {
+                type Output = Counted;
+                fn $m(self, o: Counted) -> Counted {
+                    OPS.fetch_add(1, Relaxed);
+                    Counted(self.0 $op o.0)
+                }
+            }
+            impl $at for Counted {
+                fn $am(&mut self, o: Counted) {
+                    *self = *self $op o;
+                }
+            }
+        };
+    }
+    counted!(Add, add, AddAssign, add_assign, +);
+    counted!(Sub, sub, SubAssign, sub_assign, -);
+    counted!(Mul, mul, MulAssign, mul_assign, *);
+    impl Div for Counted {
+        type Output = Counted;
+        fn div(self, o: Counted) -> Counted {
+            OPS.fetch_add(1, Relaxed);
+            Counted(self.0 / o.0)
+        }
+    }
+    impl Neg for Counted {
+        type Output = Counted;
+        fn neg(self) -> Counted {
+            Counted(-self.0)
+        }
+    }
+    impl num_traits::Zero for Counted {
+        fn zero() -> Self {
+            Counted(0.0)
+        }
+        fn is_zero(&self) -> bool {
+            self.0 == 0.0
+        }
+    }
+    impl num_traits::One for Counted {
+        fn one() -> Self {
+            Counted(1.0)
+        }
+    }
+    impl Real for Counted {
+        const LANES: usize = 1;
+        fn splat(x: f64) -> Self {
+            Counted(x)
+        }
+        fn sin_cos(self) -> (Self, Self) {
+            SIN_COS.fetch_add(1, Relaxed);
+            let (s, c) = self.0.sin_cos();
+            (Counted(s), Counted(c))
+        }
+        fn sin_cos_in_place(x: &mut [Self], cos: &mut [Self]) {
+            for (s, c) in x.iter_mut().zip(cos.iter_mut()) {
+                (*s, *c) = s.sin_cos();
+            }
+        }
+        fn signed_level(self, a: f64, b: f64) -> Self {
+            Counted(self.0.signed_level(a, b))
+        }
+        fn lane(self, _k: usize) -> f64 {
+            self.0
+        }
+        fn set_lane(&mut self, _k: usize, x: f64) {
+            self.0 = x;
+        }
+    }
+
+    /// `(operations, sin/cos pairs)` of `f`.
+    pub fn count(f: impl FnOnce()) -> (u64, u64) {
+        OPS.store(0, Relaxed);
+        SIN_COS.store(0, Relaxed);
+        f();
+        (OPS.load(Relaxed), SIN_COS.load(Relaxed))
+    }
+}
+
+/// `<model>/<alg>_flops`: operations per call of rnea, crba and aba, and sin/cos pairs.
+fn print_flops(name: &str, model: &kinedyn_core::Model) {
+    use flops::{count, Counted};
+    let mut rng = kinedyn_core::testing::Rng::new(3);
+    let lift = |v: Vec<f64>| v.into_iter().map(Counted).collect::<Vec<_>>();
+    let q = lift(kinedyn_core::testing::random_configuration(model, &mut rng));
+    let (qd, qdd) = (lift(rng.vector(model.n, -1.0, 1.0)), lift(rng.vector(model.n, -1.0, 1.0)));
+    let mut data = Data::<Counted>::new(model);
+    let d = &mut data;
+    for (alg, (ops, trig)) in [
+        ("rnea", count(|| _ = alg::rnea(model, d, &q, &qd, &qdd, None))),
+        ("crba", count(|| _ = alg::crba(model, d, &q))),
+        ("aba", count(|| _ = alg::aba(model, d, &q, &qd, &qdd, None).unwrap())),
+    ] {
+        println!("{name}/{alg}_flops {ops} {trig}");
+    }
 }
