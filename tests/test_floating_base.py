@@ -380,3 +380,13 @@ def test_the_command_line_takes_a_floating_base(capsys):
     assert main(["check", path, "--floating-base", "--prove"]) != 0
     assert "kinedyn check --prove handles revolute and prismatic joints only" in capsys.readouterr().err
     assert main(["info", "planar_2r", "--floating-base"]) != 0
+
+
+def test_identification_from_joint_logs_refuses_multi_dof_joints_naming_them():
+    from kinedyn.analysis import identification
+
+    robot = random_robot(1, n=3, floating=True, friction=False)
+    with pytest.raises(ValueError, match="excitation trajectory .*floating joint 'j1'"):
+        identification.excitation(robot)
+    with pytest.raises(ValueError, match="identification from joint logs handles revolute and prismatic joints only.*floating joint 'j1'"):
+        identification.identify(robot, None)

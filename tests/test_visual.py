@@ -417,3 +417,29 @@ visuals:
         (tmp_path / "bad.yaml").write_text(text.replace(bad, bad + ", sphere: 1" if "box" in bad else "link: nope"))
         with pytest.raises(ValueError, match=message):
             kd.load(tmp_path / "bad.yaml")
+
+
+def test_live_viewer_of_a_floating_robot():
+    """A free-flyer, spherical and planar robot in the live viewer: q has nq entries, a slider per
+    1-DOF joint moves its own entry of q (not the quaternion's), the tool follows the library's pose."""
+    pytest.importorskip("viser", reason="the viz extra is not installed")
+    from kinedyn.testing import random_robot
+
+    robot = random_robot(seed=0, n=6, floating=True, spherical=0.3, planar=0.3)  # every joint kind
+    q = robot.random_configuration(1)
+    viewer = robot.show(q, block=False, port=free_port(), verbose=False)
+    try:
+        one_dof = [k for k, j in enumerate(robot.joints) if not j.is_multi_dof]
+        starts = np.cumsum([0] + [j.nq for j in robot.joints])[:-1]
+        assert viewer._slider_coordinates == [int(starts[k]) for k in one_dof] and len(viewer._sliders) == len(one_dof)
+        k, i = len(viewer._sliders) - 1, viewer._slider_coordinates[-1]
+        viewer._sliders[k].value = 0.3  # as a user moving the last slider
+        expected = q.copy()
+        expected[i] = 0.3
+        np.testing.assert_array_equal(viewer.q, expected)
+        tool = robot.frame_poses(expected)[robot.frame_names.index(robot.tool)]
+        np.testing.assert_allclose(viewer._tool.position, tool[:3, 3], atol=1e-12)
+        with pytest.raises(ValueError, match=f"q needs {robot.nq} finite values"):
+            viewer.set_q(np.zeros(robot.nv))
+    finally:
+        viewer.close()

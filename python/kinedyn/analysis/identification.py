@@ -344,6 +344,7 @@ def excitation(robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude
     """A random Fourier excitation for ``robot`` (Swevers et al. 1997): ``harmonics`` harmonics of
     the base frequency 2 pi / period, each joint's excursion ``amplitude`` about ``q0`` (default: the
     middle of finite joint limits, else 0)."""
+    robot.require_one_dof_joints("an excitation trajectory (one Fourier series per joint coordinate)")
     if q0 is None:
         lo, hi = robot.lower_limits, robot.upper_limits
         finite = np.isfinite(lo) & np.isfinite(hi)
@@ -401,6 +402,9 @@ def identify(
     ``rotor``: estimate the armature ``r^2 J_m`` of every joint whose model has a gear ratio or a
     rotor inertia (:func:`geared_joints`; see the module docstring), or take it as known (False);
     default: estimated for a log, known for Measurements."""
+    # joint logs hold one number per coordinate and a fixed base; a floating base needs its pose
+    # and the contact wrenches in the log, which this workflow does not read
+    robot.require_one_dof_joints("identification from joint logs")
     from .logs import Log, load_log
 
     n = robot.n

@@ -84,12 +84,12 @@ class Viewer:
         self.robot = robot
         self.trajectory = trajectory
         self.q = np.asarray(default_configuration(robot) if q is None else q, dtype=float).copy()
-        if self.q.shape != (robot.n,):
-            raise ValueError(f"q needs {robot.n} values for robot '{robot.name}', got shape {self.q.shape}")
+        if self.q.shape != (robot.nq,):
+            raise ValueError(f"q needs {robot.nq} values for robot '{robot.name}', got shape {self.q.shape}")
         if trajectory is not None:
             tq = np.asarray(trajectory.q, dtype=float)
-            if tq.ndim != 2 or tq.shape[1] != robot.n:
-                raise ValueError(f"the trajectory's q must have shape (N, {robot.n}), got {tq.shape}")
+            if tq.ndim != 2 or tq.shape[1] != robot.nq:
+                raise ValueError(f"the trajectory's q must have shape (N, {robot.nq}), got {tq.shape}")
         self.scene = robot_scene(robot, geometry, budget)
         self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '0.0.0.0', '::') else host}:{self.server.get_port()}"
@@ -150,8 +150,8 @@ class Viewer:
     def set_q(self, q) -> None:
         """Move the robot to ``q`` (and its sliders with it)."""
         q = np.asarray(q, dtype=float)
-        if q.shape != (self.robot.n,) or not np.all(np.isfinite(q)):
-            raise ValueError(f"q needs {self.robot.n} finite values, got {q!r}")
+        if q.shape != (self.robot.nq,) or not np.all(np.isfinite(q)):
+            raise ValueError(f"q needs {self.robot.nq} finite values, got {q!r}")
         with self._lock:
             self.q = q.copy()
             poses = self.robot.frame_poses(q)
@@ -163,7 +163,7 @@ class Viewer:
                 T = poses[self._frame_index[self.robot.tool]]
                 self._tool.wxyz, self._tool.position = _wxyz(T[:3, :3]), T[:3, 3]
                 self._stick.points = self._stick_points(q)
-            for i, s in enumerate(self._sliders):
+            for i, s in zip(self._slider_coordinates, self._sliders):
                 value = float(q[i])
                 if abs(s.value - value) > 1e-12:
                     self._quiet = True
@@ -176,9 +176,16 @@ class Viewer:
     def _gui(self, robot) -> None:
         gui = self.server.gui
         self._sliders: List[Any] = []
+        self._slider_coordinates: List[int] = []  # the entry of q each slider moves
         self._quiet = False
         with gui.add_folder("Joints"):
-            for i, j in enumerate(robot.joints):
+            start = 0
+            for j in robot.joints:
+                i, start = start, start + j.nq
+                if j.is_multi_dof:
+                    # a quaternion or (cos, sin) block is no slider: it stays where q puts it
+                    gui.add_markdown(f"{j.kind} joint `{j.name}`: held at q[{i}:{start}]")
+                    continue
                 span = math.pi if j.kind == "revolute" else self._reach
                 lo = float(robot.lower_limits[i]) if math.isfinite(robot.lower_limits[i]) else -span
                 hi = float(robot.upper_limits[i]) if math.isfinite(robot.upper_limits[i]) else span
@@ -186,8 +193,9 @@ class Viewer:
                     lo, hi = lo - 1e-3, lo + 1e-3
                 value = float(np.clip(self.q[i], lo, hi))
                 slider = gui.add_slider(j.name, min=lo, max=hi, step=(hi - lo) / 1000, initial_value=value)
-                slider.on_update(self._slider_moved(i))
+                slider.on_update(self._slider_moved(len(self._sliders), i))
                 self._sliders.append(slider)
+                self._slider_coordinates.append(i)
             reset = gui.add_button("reset")
             start = self.q.copy()
             reset.on_click(lambda _: self.set_q(start))
@@ -202,12 +210,13 @@ class Viewer:
                 play = gui.add_button("play / pause")
                 play.on_click(lambda _: self.play() if not self._playing else self.pause())
 
-    def _slider_moved(self, i: int):
+    def _slider_moved(self, k: int, i: int):
+        """Slider k moves q[i]."""
         def moved(_event) -> None:
             if self._quiet:
                 return
             q = self.q.copy()
-            q[i] = float(self._sliders[i].value)
+            q[i] = float(self._sliders[k].value)
             self.set_q(q)
         return moved
 

@@ -66,8 +66,8 @@ def animation_page(robot, t, q, title: str = "") -> str:
 
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
-    if q.ndim != 2 or q.shape != (len(t), robot.n):
-        raise ValueError(f"animation_page needs q of shape ({len(t)}, {robot.n}), got {q.shape}")
+    if q.ndim != 2 or q.shape != (len(t), robot.nq):
+        raise ValueError(f"animation_page needs q of shape ({len(t)}, {robot.nq}), got {q.shape}")
     model = _model_for_view(robot, q[0])
     data = {"simulation": {"t": t.tolist(), "q": q.tolist()}}
     name = html.escape(title or robot.name)
