@@ -122,13 +122,33 @@ impl Joint {
         }
     }
 
-    /// `s^T f`: the component of a force along the joint (3 products instead of 6).
+    /// `Some(k)` when the axis is `+-e_k` (DH joints, most URDF joints): a product with it is one
+    /// entry of the other factor, times `axis[k]` (+-1, so the result equals the general product).
+    #[inline(always)]
+    pub fn coordinate_axis(&self) -> Option<usize> {
+        let a = &self.axis;
+        if a.x == 0.0 && a.y == 0.0 {
+            Some(2)
+        } else if a.y == 0.0 && a.z == 0.0 {
+            Some(0)
+        } else if a.x == 0.0 && a.z == 0.0 {
+            Some(1)
+        } else {
+            None
+        }
+    }
+
+    /// `s^T f`: the component of a force along the joint (3 products instead of 6; one for a
+    /// coordinate axis).
     #[inline(always)]
     pub fn project<T: Real>(&self, f: &Force<T>) -> T {
-        let a = splat3::<T>(&self.axis);
-        match self.kind {
-            JointKind::Revolute => a.dot(&f.ang),
-            JointKind::Prismatic => a.dot(&f.lin),
+        let v = match self.kind {
+            JointKind::Revolute => &f.ang,
+            JointKind::Prismatic => &f.lin,
+        };
+        match self.coordinate_axis() {
+            Some(k) => v[k] * T::splat(self.axis[k]),
+            None => splat3::<T>(&self.axis).dot(v),
         }
     }
 
@@ -146,6 +166,23 @@ impl Joint {
     /// `I s` for a rigid-body inertia: revolute `[a x h; I_o a]`, prismatic `[m a; h x a]`.
     #[inline(always)]
     pub fn inertia_times_s<T: Real>(&self, i: &Inertia<T>) -> Force<T> {
+        if let Some(k) = self.coordinate_axis() {
+            // a = sign e_k: a x h = sign (e_k x h), I_o a = sign (column k of I_o), m a = sign m e_k
+            let sign = T::splat(self.axis[k]);
+            let ek_cross_h = match k {
+                0 => Vec3::new(T::zero(), -i.h.z, i.h.y),
+                1 => Vec3::new(i.h.z, T::zero(), -i.h.x),
+                _ => Vec3::new(-i.h.y, i.h.x, T::zero()),
+            };
+            return match self.kind {
+                JointKind::Revolute => Force::new(ek_cross_h * sign, Vec3::new(i.i_o[(0, k)], i.i_o[(1, k)], i.i_o[(2, k)]) * sign),
+                JointKind::Prismatic => {
+                    let mut lin = Vec3::zeros();
+                    lin[k] = i.mass * sign;
+                    Force::new(lin, -(ek_cross_h * sign))
+                }
+            };
+        }
         let a = &splat3::<T>(&self.axis);
         match self.kind {
             JointKind::Revolute => Force::new(cross(a, &i.h), mv(&i.i_o, a)),
@@ -167,6 +204,24 @@ impl Joint {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The coordinate-axis products equal the general ones (`s . f`, `I s` by the spatial algebra).
+    #[test]
+    fn coordinate_axis_products_equal_the_general_ones() {
+        let inertia = crate::testing::random_inertia(&mut crate::rng::Rng::new(4));
+        let f = Force::new(Vec3::new(0.3, -1.2, 2.5), Vec3::new(-0.7, 0.4, 1.9));
+        for axis in [Vec3::x(), Vec3::y(), Vec3::z(), -Vec3::x(), -Vec3::y(), -Vec3::z()] {
+            for kind in [JointKind::Revolute, JointKind::Prismatic] {
+                let joint = Joint { kind, axis };
+                assert!(joint.coordinate_axis().is_some());
+                let s = joint.subspace::<f64>();
+                assert_eq!(joint.project(&f), s.dot(&f), "{kind:?} {axis:?}");
+                let (fast, general) = (joint.inertia_times_s(&inertia), inertia.mul_motion(&s));
+                assert!((fast.lin - general.lin).norm() + (fast.ang - general.ang).norm() < 1e-15, "{kind:?} {axis:?}");
+            }
+        }
+        assert!(Joint { kind: JointKind::Revolute, axis: Vec3::new(0.6, 0.8, 0.0) }.coordinate_axis().is_none());
+    }
 
     /// The specialised composition equals the general `placement * jcalc(x)` for every axis case.
     #[test]
