@@ -200,3 +200,111 @@ pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
     }
     q
 }
+
+/// A forward-mode dual number `re + eps ε` (ε² = 0): the algorithms run on it (they are generic
+/// over [`crate::Real`]) give a value and its exact directional derivative, the second,
+/// independent route the analytical derivatives are tested against (no step size, no truncation).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Dual {
+    pub re: f64,
+    pub eps: f64,
+}
+
+impl Dual {
+    pub fn new(re: f64, eps: f64) -> Self {
+        Self { re, eps }
+    }
+    /// `x` with `eps = 1` at index `k` and 0 elsewhere (the direction e_k).
+    pub fn seeded(x: &[f64], k: Option<usize>) -> Vec<Dual> {
+        x.iter().enumerate().map(|(i, &v)| Dual::new(v, if Some(i) == k { 1.0 } else { 0.0 })).collect()
+    }
+}
+
+mod dual_ops {
+    use super::Dual;
+    use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+    impl Add for Dual {
+        type Output = Dual;
+        fn add(self, o: Dual) -> Dual {
+            Dual::new(self.re + o.re, self.eps + o.eps)
+        }
+    }
+    impl Sub for Dual {
+        type Output = Dual;
+        fn sub(self, o: Dual) -> Dual {
+            Dual::new(self.re - o.re, self.eps - o.eps)
+        }
+    }
+    impl Mul for Dual {
+        type Output = Dual;
+        fn mul(self, o: Dual) -> Dual {
+            Dual::new(self.re * o.re, self.re * o.eps + self.eps * o.re)
+        }
+    }
+    impl Div for Dual {
+        type Output = Dual;
+        fn div(self, o: Dual) -> Dual {
+            Dual::new(self.re / o.re, (self.eps * o.re - self.re * o.eps) / (o.re * o.re))
+        }
+    }
+    impl Neg for Dual {
+        type Output = Dual;
+        fn neg(self) -> Dual {
+            Dual::new(-self.re, -self.eps)
+        }
+    }
+    impl AddAssign for Dual {
+        fn add_assign(&mut self, o: Dual) {
+            *self = *self + o;
+        }
+    }
+    impl SubAssign for Dual {
+        fn sub_assign(&mut self, o: Dual) {
+            *self = *self - o;
+        }
+    }
+    impl MulAssign for Dual {
+        fn mul_assign(&mut self, o: Dual) {
+            *self = *self * o;
+        }
+    }
+    impl num_traits::Zero for Dual {
+        fn zero() -> Dual {
+            Dual::new(0.0, 0.0)
+        }
+        fn is_zero(&self) -> bool {
+            self.re == 0.0 && self.eps == 0.0
+        }
+    }
+    impl num_traits::One for Dual {
+        fn one() -> Dual {
+            Dual::new(1.0, 0.0)
+        }
+    }
+}
+
+impl crate::Real for Dual {
+    const LANES: usize = 1;
+    fn splat(x: f64) -> Self {
+        Dual::new(x, 0.0)
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = crate::trig::sin_cos(self.re);
+        (Dual::new(s, c * self.eps), Dual::new(c, -s * self.eps))
+    }
+    fn sin_cos_in_place(x: &mut [Self], cos: &mut [Self]) {
+        for (s, c) in x.iter_mut().zip(cos.iter_mut()) {
+            (*s, *c) = s.sin_cos();
+        }
+    }
+    fn signed_level(self, a: f64, b: f64) -> Self {
+        // piecewise constant in the rate: no derivative
+        Dual::new(self.re.signed_level(a, b), 0.0)
+    }
+    fn lane(self, _k: usize) -> f64 {
+        self.re
+    }
+    fn set_lane(&mut self, _k: usize, x: f64) {
+        self.re = x;
+    }
+}

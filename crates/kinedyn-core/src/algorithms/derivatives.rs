@@ -417,6 +417,52 @@ mod tests {
     use crate::algorithms::aba::aba;
     use crate::testing::{random_model, Rng};
 
+    /// Forward-mode dual numbers through the generic RNEA and ABA (a second route, exact to
+    /// rounding): each column of the analytical derivatives equals the dual part of tau (qdd) with
+    /// the column's coordinate seeded. Chains and trees; the rate and torque columns also on
+    /// floating bases (their configuration derivative is on the manifold, q ⊕ dq, not along q's
+    /// coordinates, so it is left to the finite differences below).
+    #[test]
+    fn derivatives_equal_forward_mode_dual_numbers() {
+        use crate::testing::{random_configuration, random_floating_model, Dual};
+        let models = [random_model(31, 7, false), random_model(32, 8, true), random_floating_model(33, 5, false)];
+        for model in models {
+            let n = model.n;
+            let mut rng = Rng::new(5);
+            let q = random_configuration(&model, &mut rng);
+            let (qd, qdd) = (rng.vector(n, -2.0, 2.0), rng.vector(n, -2.0, 2.0));
+            let fx = rng.vector(6 * n, -3.0, 3.0);
+            let mut data = Data::new(&model);
+            let (mut dq, mut dqd) = (vec![0.0; n * n], vec![0.0; n * n]);
+            rnea_derivatives(&model, &mut data, &q, &qd, &qdd, Some(&fx), &mut dq, &mut dqd, None);
+            let tau = crate::algorithms::rnea(&model, &mut data, &q, &qd, &qdd, Some(&fx)).to_vec();
+            let (mut fq, mut fqd, mut minv) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+            aba_derivatives(&model, &mut data, &q, &qd, &tau, Some(&fx), &mut fq, &mut fqd, &mut minv).unwrap();
+            let mut dual = Data::<Dual>::new(&model);
+            let fx_d = Dual::seeded(&fx, None);
+            let column = |m: &[f64], j: usize| -> Vec<f64> { (0..n).map(|i| m[i * n + j]).collect() };
+            for j in 0..n {
+                // rates: qd_j seeded
+                let (qv, qdv, qddv, tauv) = (Dual::seeded(&q, None), Dual::seeded(&qd, Some(j)), Dual::seeded(&qdd, None), Dual::seeded(&tau, None));
+                let t: Vec<f64> = crate::algorithms::rnea(&model, &mut dual, &qv, &qdv, &qddv, Some(&fx_d)).iter().map(|d| d.eps).collect();
+                dual_close("dtau/dqd (dual)", &t, &column(&dqd, j));
+                let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &qdv, &tauv, Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                dual_close("dqdd/dqd (dual)", &a, &column(&fqd, j));
+                // torques: tau_j seeded
+                let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &Dual::seeded(&tau, Some(j)), Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                dual_close("dqdd/dtau (dual)", &a, &column(&minv, j));
+                if model.plain {
+                    // configurations: q_j seeded (1-DOF joints: the coordinate itself)
+                    let qv = Dual::seeded(&q, Some(j));
+                    let t: Vec<f64> = crate::algorithms::rnea(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &qddv, Some(&fx_d)).iter().map(|d| d.eps).collect();
+                    dual_close("dtau/dq (dual)", &t, &column(&dq, j));
+                    let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &tauv, Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                    dual_close("dqdd/dq (dual)", &a, &column(&fq, j));
+                }
+            }
+        }
+    }
+
     /// Central differences of `f` along each coordinate (columns of an n x n matrix).
     fn central_difference(n: usize, x: &[f64], mut f: impl FnMut(&[f64]) -> Vec<f64>) -> Vec<f64> {
         let h = 1e-6;
@@ -431,6 +477,14 @@ mod tests {
             }
         }
         out
+    }
+
+    /// Equal to rounding (1e-11 of the column's scale): two exact routes.
+    fn dual_close(what: &str, got: &[f64], expected: &[f64]) {
+        let scale = expected.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+        for (k, (g, e)) in got.iter().zip(expected).enumerate() {
+            assert!((g - e).abs() <= 1e-11 * scale, "{what}[{k}]: {g} vs analytical {e}");
+        }
     }
 
     fn assert_close(what: &str, got: &[f64], expected: &[f64]) {
