@@ -28,6 +28,10 @@ def _robots():
     yield "chain", testing.random_robot(seed=11, n=7)
     yield "tree", testing.random_robot(seed=12, n=8, branching=True)
     yield "floating", testing.random_robot(seed=13, n=7, floating=True, spherical=0.3, planar=0.2)
+    folder = testing.example_robot_data_dir()
+    if folder is not None:  # URDFs: the Panda (its finger mimic reduced) and Solo-12 on a free-flyer
+        yield "panda", kd.Robot.from_urdf(os.path.join(folder, "panda_description/urdf/panda.urdf"))
+        yield "solo12", kd.Robot.from_urdf(os.path.join(folder, "solo_description/robots/solo12.urdf"), floating_base=True)
 
 
 def _states(robot, count: int, seed: int):
@@ -38,8 +42,9 @@ def _states(robot, count: int, seed: int):
 
 def _calls(robot, q, v, a):
     """(name, batch result, per-state results) of every batched algorithm."""
-    f_ext = np.random.default_rng(1).normal(size=(len(q), robot._model.n, 6))
     model = robot._model
+    bodies = getattr(model, "native", model).n  # f_ext is per body (a mimic follower's too)
+    f_ext = np.random.default_rng(1).normal(size=(len(q), bodies, 6))
     tau = model.inverse_dynamics(q, v, a)
     calls = {
         "inverse_dynamics": (lambda *x: model.inverse_dynamics(*x), (q, v, a)),
