@@ -246,76 +246,62 @@ pub mod kernels {
     use crate::model::Model;
     use crate::scalar::Real;
 
+    /// A kernel without parameters: `kernel!(/// doc, Name, |model| output length, |model, data, x, out| body)`
+    /// (the body returns `crate::Result<()>`, generic over the scalar `T`).
+    macro_rules! kernel {
+        ($(#[$doc:meta])* $name:ident, |$m:ident| $len:expr, |$model:ident, $data:ident, $x:ident, $out:ident| $body:block) => {
+            $(#[$doc])*
+            pub struct $name;
+            impl Kernel for $name {
+                fn output_len(&self, $m: &Model) -> usize {
+                    $len
+                }
+                #[inline(always)]
+                fn run<T: Real>(&self, $model: &Model, $data: &mut Data<T>, $x: &[&[T]], $out: &mut [T]) -> crate::Result<()> $body
+            }
+        };
+    }
+
     /// The optional input `k` (`f_ext`), when given.
     #[inline(always)]
     fn optional<'a, T>(x: &[&'a [T]], k: usize) -> Option<&'a [T]> {
         x.get(k).copied().filter(|v| !v.is_empty())
     }
-
-    /// `tau = rnea(q, qd, qdd[, f_ext])`, friction and armature included.
-    pub struct InverseDynamics;
-    impl Kernel for InverseDynamics {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    kernel!(
+        /// `tau = rnea(q, qd, qdd[, f_ext])`, friction and armature included.
+        InverseDynamics, |model| model.n, |model, data, x, out| {
             out.copy_from_slice(alg::rnea(model, data, x[0], x[1], x[2], optional(x, 3)));
             Ok(())
         }
-    }
-
-    /// `M(q)` (n x n, row-major).
-    pub struct MassMatrix;
-    impl Kernel for MassMatrix {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `M(q)` (n x n, row-major).
+        MassMatrix, |model| model.n * model.n, |model, data, x, out| {
             out.copy_from_slice(alg::crba(model, data, x[0]));
             Ok(())
         }
-    }
-
-    /// `M(q)^-1` (n x n, row-major).
-    pub struct MassMatrixInverse;
-    impl Kernel for MassMatrixInverse {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `M(q)^-1` (n x n, row-major).
+        MassMatrixInverse, |model| model.n * model.n, |model, data, x, out| {
             out.copy_from_slice(alg::mass_matrix_inverse(model, data, x[0])?);
             Ok(())
         }
-    }
-
-    /// `qdd = aba(q, qd, tau[, f_ext])`.
-    pub struct ForwardDynamics;
-    impl Kernel for ForwardDynamics {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `qdd = aba(q, qd, tau[, f_ext])`.
+        ForwardDynamics, |model| model.n, |model, data, x, out| {
             out.copy_from_slice(alg::aba(model, data, x[0], x[1], x[2], optional(x, 3))?);
             Ok(())
         }
-    }
-
-    /// `g(q)`.
-    pub struct Gravity;
-    impl Kernel for Gravity {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `g(q)`.
+        Gravity, |model| model.n, |model, data, x, out| {
             out.copy_from_slice(alg::gravity_torque(model, data, x[0]));
             Ok(())
         }
-    }
+    );
 
     /// The poses of `frames` (4 x 4 row-major each) after forward kinematics.
     pub struct FramePoses<'a> {
@@ -359,76 +345,46 @@ pub mod kernels {
             Ok(())
         }
     }
-
-    /// The Coriolis matrix `C(q, qd)` (n x n, row-major; Christoffel-consistent).
-    pub struct Coriolis;
-    impl Kernel for Coriolis {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    kernel!(
+        /// The Coriolis matrix `C(q, qd)` (n x n, row-major; Christoffel-consistent).
+        Coriolis, |model| model.n * model.n, |model, data, x, out| {
             out.copy_from_slice(alg::coriolis_matrix(model, data, x[0], x[1]));
             Ok(())
         }
-    }
-
-    /// Christoffel symbols of the first kind `c[i][j][k]` (n x n x n).
-    pub struct Christoffel;
-    impl Kernel for Christoffel {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n * model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// Christoffel symbols of the first kind `c[i][j][k]` (n x n x n).
+        Christoffel, |model| model.n * model.n * model.n, |model, data, x, out| {
             alg::christoffel(model, data, x[0], out);
             Ok(())
         }
-    }
-
-    /// `dtau/dq`, `dtau/dqd` and `M` (n x n each, one after the other) at `(q, qd, qdd[, f_ext])`.
-    pub struct InverseDynamicsDerivatives;
-    impl Kernel for InverseDynamicsDerivatives {
-        fn output_len(&self, model: &Model) -> usize {
-            3 * model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `dtau/dq`, `dtau/dqd` and `M` (n x n each, one after the other) at `(q, qd, qdd[, f_ext])`.
+        InverseDynamicsDerivatives, |model| 3 * model.n * model.n, |model, data, x, out| {
             let nn = model.n * model.n;
             let (dq, rest) = out.split_at_mut(nn);
             let (dqd, m) = rest.split_at_mut(nn);
             alg::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
             Ok(())
         }
-    }
-
-    /// `dqdd/dq`, `dqdd/dqd` and `M^-1` (n x n each, one after the other) at `(q, qd, tau[, f_ext])`.
-    pub struct ForwardDynamicsDerivatives;
-    impl Kernel for ForwardDynamicsDerivatives {
-        fn output_len(&self, model: &Model) -> usize {
-            3 * model.n * model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `dqdd/dq`, `dqdd/dqd` and `M^-1` (n x n each, one after the other) at `(q, qd, tau[, f_ext])`.
+        ForwardDynamicsDerivatives, |model| 3 * model.n * model.n, |model, data, x, out| {
             let nn = model.n * model.n;
             let (dq, rest) = out.split_at_mut(nn);
             let (dqd, minv) = rest.split_at_mut(nn);
             alg::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, minv)
         }
-    }
-
-    /// `C(q, qd) qd + g(q)` (no friction).
-    pub struct Bias;
-    impl Kernel for Bias {
-        fn output_len(&self, model: &Model) -> usize {
-            model.n
-        }
-        #[inline(always)]
-        fn run<T: Real>(&self, model: &Model, data: &mut Data<T>, x: &[&[T]], out: &mut [T]) -> crate::Result<()> {
+    );
+    kernel!(
+        /// `C(q, qd) qd + g(q)` (no friction).
+        Bias, |model| model.n, |model, data, x, out| {
             out.copy_from_slice(alg::bias_torque(model, data, x[0], x[1]));
             Ok(())
         }
-    }
+    );
 }
 
 #[cfg(test)]
