@@ -16,7 +16,9 @@ def load(prefix):
     d=collections.defaultdict(lambda: 1e99)
     for k in (1,2):
         for line in open(f"/tmp/ab_{prefix}{k}.txt"):
-            key,v=line.split(); d[key]=min(d[key],float(v))
+            parts=line.split()
+            if len(parts)!=2: continue  # the trees' check lines and the flop counts carry more numbers
+            key,v=parts; d[key]=min(d[key],float(v))
     return d
 a=load('a'); b=load('b')
 for key in a:
