@@ -57,6 +57,7 @@ def _calls(robot, q, v, a):
         "bias_torque": (lambda *x: model.bias_torque(*x), (q, v)),
         "coriolis_matrix": (lambda *x: model.coriolis_matrix(*x), (q, v)),
         "christoffel": (lambda *x: model.christoffel(*x), (q,)),
+        "regressor": (lambda *x: model.regressor(*x), (q, v, a)),
         "frame_poses": (lambda q: model.frame_poses(q, np.arange(model.n_frames)), (q,)),
     }
     for reference in range(3):  # world, local, spatial

@@ -275,6 +275,13 @@ pub mod kernels {
         }
     );
     kernel!(
+        /// The regressor `Y(q, qd, qdd)` (n x 10 n, row-major): `tau = Y pi` without drive terms.
+        Regressor, |model| 10 * model.n * model.n, |model, data, x, out| {
+            alg::regressor(model, data, x[0], x[1], x[2], out);
+            Ok(())
+        }
+    );
+    kernel!(
         /// `M(q)` (n x n, row-major).
         MassMatrix, |model| model.n * model.n, |model, data, x, out| {
             out.copy_from_slice(alg::crba(model, data, x[0]));
@@ -441,6 +448,11 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn regressor_in_lanes() {
+        lanes_equal_single_calls(Regressor, 3);
     }
 
     #[test]

@@ -901,10 +901,7 @@ impl PyModel {
             let qdd = f64_array("qdd", &qdd)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n]), ("qdd", &qdd, &[n])])?;
-            batch.run(py, self, ("regressor", "Y"), &[n, 10 * n], |model, data, x, out| {
-                algorithms::regressor(model, data, x[0], x[1], x[2], out);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("regressor", "Y"), &[n, 10 * n], None, kernels::Regressor)
         })
     }
 

@@ -17,38 +17,39 @@
 use super::kinematics::joint_transforms;
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{Force, Mat3, Motion, Vec3};
+use crate::spatial::{cross, mv, splat3, Force, Mat3, Motion, Real, Vec3};
 
 /// Columns of `A_i = d f / d pi` for a body with twist `v` and acceleration `a`.
-#[inline]
-fn body_columns(v: &Motion, a: &Motion) -> [Force; 10] {
+#[inline(always)]
+fn body_columns<T: Real>(v: &Motion<T>, a: &Motion<T>) -> [Force<T>; 10] {
     let (vl, w, al, aw) = (&v.lin, &v.ang, &a.lin, &a.ang);
     let mut cols = [Force::zero(); 10];
     // m: f = [a_o + w x v_o; 0]
-    cols[0] = Force::new(al + w.cross(vl), Vec3::zeros());
+    cols[0] = Force::new(al + cross(w, vl), Vec3::zeros());
     // h = e_k: f = [a_w x e + w x (w x e); e x a_o + w x (e x v_o) + v_o x (w x e)]
     for k in 0..3 {
-        let e = Vec3::ith(k, 1.0);
-        let we = w.cross(&e);
-        cols[1 + k] = Force::new(aw.cross(&e) + w.cross(&we), e.cross(al) + w.cross(&e.cross(vl)) + vl.cross(&we));
+        let e = splat3::<T>(&Vec3::ith(k, 1.0));
+        let we = cross(w, &e);
+        cols[1 + k] = Force::new(cross(aw, &e) + cross(w, &we), cross(&e, al) + cross(w, &cross(&e, vl)) + cross(vl, &we));
     }
     // I_o = E (Ixx, Ixy, Iyy, Ixz, Iyz, Izz): f = [0; E a_w + w x (E w)]
     const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)];
     for (c, &(r, s)) in PAIRS.iter().enumerate() {
         let mut e = Mat3::zeros();
-        e[(r, s)] = 1.0;
-        e[(s, r)] = 1.0;
-        cols[4 + c] = Force::new(Vec3::zeros(), e * aw + w.cross(&(e * w)));
+        e[(r, s)] = T::one();
+        e[(s, r)] = T::one();
+        cols[4 + c] = Force::new(Vec3::zeros(), mv(&e, aw) + cross(w, &mv(&e, w)));
     }
     cols
 }
 
 /// `Y(q, qd, qdd)` written row-major to `out` (n x 10 n).
-pub fn regressor(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+#[inline(always)]
+pub fn regressor<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], out: &mut [T]) {
     let n = model.n;
     let w = 10 * n;
-    out[..n * w].fill(0.0);
-    let a0 = Motion::new(-model.gravity, Vec3::zeros());
+    out[..n * w].fill(T::zero());
+    let a0 = Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros());
     joint_transforms(model, data, q);
     for i in 0..n {
         // v_i = ^iX_λ v_λ + s_i qd_i ;  a_i = ^iX_λ a_λ + s_i qdd_i + v_i x s_i qd_i  (a_0 = -g)
