@@ -58,6 +58,8 @@ def _calls(robot, q, v, a):
         "coriolis_matrix": (lambda *x: model.coriolis_matrix(*x), (q, v)),
         "christoffel": (lambda *x: model.christoffel(*x), (q,)),
         "regressor": (lambda *x: model.regressor(*x), (q, v, a)),
+        "kinetic_energy": (lambda *x: model.kinetic_energy(*x), (q, v)),
+        "potential_energy": (lambda *x: model.potential_energy(*x), (q,)),
         "frame_poses": (lambda q: model.frame_poses(q, np.arange(model.n_frames)), (q,)),
     }
     for reference in range(3):  # world, local, spatial

@@ -282,6 +282,20 @@ pub mod kernels {
         }
     );
     kernel!(
+        /// The kinetic energy `K(q, qd)` (one number; rotor inertia included).
+        KineticEnergy, |_model| 1, |model, data, x, out| {
+            out[0] = alg::kinetic_energy(model, data, x[0], x[1]);
+            Ok(())
+        }
+    );
+    kernel!(
+        /// The potential energy `P(q)` (one number).
+        PotentialEnergy, |_model| 1, |model, data, x, out| {
+            out[0] = alg::potential_energy(model, data, x[0]);
+            Ok(())
+        }
+    );
+    kernel!(
         /// `M(q)` (n x n, row-major).
         MassMatrix, |model| model.n * model.n, |model, data, x, out| {
             out.copy_from_slice(alg::crba(model, data, x[0]));
@@ -448,6 +462,12 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn energies_in_lanes() {
+        lanes_equal_single_calls(KineticEnergy, 2);
+        lanes_equal_single_calls(PotentialEnergy, 1);
     }
 
     #[test]

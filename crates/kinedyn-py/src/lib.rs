@@ -873,10 +873,7 @@ impl PyModel {
             let qd = f64_array("qd", &qd)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
-            batch.run(py, self, ("kinetic_energy", "K"), &[], |model, data, x, out| {
-                out[0] = algorithms::kinetic_energy(model, data, x[0], x[1]);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("kinetic_energy", "K"), &[], None, kernels::KineticEnergy)
         })
     }
 
@@ -886,10 +883,7 @@ impl PyModel {
             let q = f64_array("q", &q)?;
             let nq = self.model.nq;
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("potential_energy", "P"), &[], |model, data, x, out| {
-                out[0] = algorithms::potential_energy(model, data, x[0]);
-                Ok(())
-            })
+            batch.run_kernel(py, self, ("potential_energy", "P"), &[], None, kernels::PotentialEnergy)
         })
     }
 

@@ -14,23 +14,31 @@
 use super::kinematics::{forward_kinematics, forward_velocity};
 use crate::data::Data;
 use crate::model::Model;
+use crate::spatial::{mv, splat3, Real};
 
 /// `K(q, qd) = 1/2 sum_i v_i . I_i v_i + 1/2 sum_i armature_i qd_i^2 (= 1/2 qd^T M qd)`.
-pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
+#[inline(always)]
+pub fn kinetic_energy<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T]) -> T {
     forward_velocity(model, data, q, qd);
     // K = sum_i 1/2 v_i . I_i v_i + 1/2 J_m r^2 qd_i^2
-    (0..model.n).map(|i| model.inertia[i].kinetic_energy(&data.v[i]) + 0.5 * model.armature[i] * qd[i] * qd[i]).sum()
+    let mut k = T::zero();
+    for i in 0..model.n {
+        k += model.inertia[i].splat::<T>().kinetic_energy(&data.v[i]) + T::splat(0.5 * model.armature[i]) * qd[i] * qd[i];
+    }
+    k
 }
 
 /// `P(q) = -sum_i m_i g . c_i` (zero at the base origin), so that `g(q) = dP/dq`.
-pub fn potential_energy(model: &Model, data: &mut Data, q: &[f64]) -> f64 {
+#[inline(always)]
+pub fn potential_energy<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) -> T {
     forward_kinematics(model, data, q);
     // P = -g . sum_i (R_i h_i + m_i p_i)
-    -(0..model.n)
-        .map(|i| {
-            let x = &data.world_from_body[i];
-            let inertia = &model.inertia[i];
-            model.gravity.dot(&(x.rot * inertia.h + inertia.mass * x.trans))
-        })
-        .sum::<f64>()
+    let g = splat3::<T>(&model.gravity);
+    let mut p = T::zero();
+    for i in 0..model.n {
+        let x = &data.world_from_body[i];
+        let inertia = &model.inertia[i];
+        p += g.dot(&(mv(&x.rot, &splat3(&inertia.h)) + x.trans * T::splat(inertia.mass)));
+    }
+    -p
 }
