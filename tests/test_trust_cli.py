@@ -537,13 +537,20 @@ def test_subprocess_bad_file_bad_output_and_debug(tmp_path, bad_files):
 
 
 def test_subprocess_ctrl_c_exits_130_without_a_traceback(tmp_path):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]),
+               PYTHONFAULTHANDLER="1")
     proc = subprocess.Popen([sys.executable, "-m", "kinedyn", "simulate", "planar_2r", "--t", "1e6", "--dt", "0.5", "--method", "rk45", "--json"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     time.sleep(4.0)
     assert proc.poll() is None, proc.communicate()
     proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=60)
+    try:
+        out, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        # where the child is stuck: SIGABRT makes its faulthandler (PYTHONFAULTHANDLER) print every thread
+        proc.send_signal(signal.SIGABRT)
+        out, err = proc.communicate(timeout=60)
+        pytest.fail(f"the child did not exit within 60 s of SIGINT; its threads when aborted:\n{err[-8000:]}")
     assert proc.returncode == 130 and "Traceback" not in err and "KeyboardInterrupt" not in err, err
 
 
