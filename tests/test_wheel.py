@@ -7,7 +7,7 @@ and must: import its own compiled core, reproduce known numbers, and run the REA
 
 Which wheel: $KINEDYN_WHEEL (set by .ci/run, which builds the wheel once per run; missing file =
 failure), else the one in dist/. Without either the test is skipped with the command to build one.
-The venv sees the host's site-packages for the dependencies (numpy, sympy, ...: no download), but
+The venv sees the running interpreter's site-packages (not its base's) for the dependencies (numpy, sympy, ...: no download), but
 kinedyn itself is installed into the venv (--ignore-installed) and the test checks it is imported
 from there; the wheel's declared dependencies are checked against what the venv imports.
 """
@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import site
 import subprocess
 import sys
 import textwrap
@@ -80,6 +81,26 @@ SMOKE = textwrap.dedent(
 )
 
 
+def _see_host_packages(env_dir: Path) -> None:
+    """Let the venv import what the running interpreter imports, after its own site-packages.
+
+    `venv --system-site-packages` would expose the *base* interpreter's packages: from inside a
+    virtual environment (how most people run the suite) that base has none of the dependencies,
+    whereas a conda-like or system interpreter has them in its own prefix. `site.getsitepackages()`
+    names exactly the folders this interpreter reads (its venv's, and its base's when that venv
+    sees them); `site.addsitedir` appends them and reads their .pth files, so kinedyn installed into
+    the new venv still comes first.
+    """
+    folders = [*site.getsitepackages(), site.getusersitepackages()]
+    folders = [f for f in dict.fromkeys(folders) if Path(f).is_dir()]
+    purelib = subprocess.run(
+        [str(env_dir / "bin" / "python"), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+        check=True, capture_output=True, text=True,
+    ).stdout.strip()
+    lines = [f"import site; site.addsitedir({f!r})" for f in folders]
+    (Path(purelib) / "_kinedyn_test_host_packages.pth").write_text("\n".join(lines) + "\n")
+
+
 @pytest.fixture(scope="module")
 def venv(tmp_path_factory):
     wheel = _wheel()
@@ -91,7 +112,8 @@ def venv(tmp_path_factory):
 
     home = tmp_path_factory.mktemp("wheel")
     env_dir = home / "venv"
-    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(env_dir)], check=True)
+    subprocess.run([sys.executable, "-m", "venv", str(env_dir)], check=True)
+    _see_host_packages(env_dir)
     bin_dir = env_dir / "bin"
     path = os.pathsep.join([str(bin_dir), "/usr/bin", "/bin"])
     for tool in ("cargo", "rustc", "maturin"):
@@ -114,9 +136,9 @@ def test_wheel_imports_its_own_core_and_computes_known_values(venv):
     done = _run(venv, str(env_dir / "bin" / "python"), "-c", SMOKE)
     assert done.returncode == 0, done.stderr
     where = json.loads(done.stdout)
-    site = str(env_dir.resolve())
-    assert where["kinedyn"].startswith(site), f"kinedyn imported from {where['kinedyn']}, not the venv"
-    assert where["core"].startswith(site) and where["core"].endswith(".abi3.so"), where["core"]
+    venv_root = str(env_dir.resolve())
+    assert where["kinedyn"].startswith(venv_root), f"kinedyn imported from {where['kinedyn']}, not the venv"
+    assert where["core"].startswith(venv_root) and where["core"].endswith(".abi3.so"), where["core"]
 
 
 def test_wheel_dependencies_are_met(venv):
