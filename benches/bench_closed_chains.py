@@ -32,7 +32,16 @@ QD = np.array([0.2, -0.17963733938852067, 0.1309060540601612])
 
 
 def sympy_four_bar(method: str):
-    from sympy.physics.mechanics import KanesMethod, LagrangesMethod, Lagrangian, Point, ReferenceFrame, RigidBody, dynamicsymbols, inertia
+    from sympy.physics.mechanics import (
+        KanesMethod,
+        LagrangesMethod,
+        Lagrangian,
+        Point,
+        ReferenceFrame,
+        RigidBody,
+        dynamicsymbols,
+        inertia,
+    )
 
     q, u, t = dynamicsymbols("q1:4"), dynamicsymbols("u1:4"), dynamicsymbols._t
     l1, l2, l3, l4, rho = sp.symbols("l1:5 rho")
@@ -55,25 +64,43 @@ def sympy_four_bar(method: str):
     if method == "lagranges":
         for C in centres:
             C.set_vel(N, C.pos_from(O).dt(N))
-        bodies = [RigidBody(f"B{k}", C, F, rho * L, (inertia(F, 0, 0, rho * L**3 / 12), C)) for k, (C, F, L) in enumerate(zip(centres, frames, (l2, l3, l4)))]
+        bodies = [
+            RigidBody(f"B{k}", C, F, rho * L, (inertia(F, 0, 0, rho * L**3 / 12), C))
+            for k, (C, F, L) in enumerate(zip(centres, frames, (l2, l3, l4)))
+        ]
         lm = LagrangesMethod(Lagrangian(N, *bodies), q, hol_coneqs=fh, frame=N)
         lm.form_lagranges_equations()
         Mf = sp.lambdify([q, qdot, params], lm.mass_matrix_full, cse=True)
         ff = sp.lambdify([q, qdot, params], lm.forcing_full, cse=True)
-        return lambda qv, qdv: np.linalg.solve(np.asarray(Mf(qv, qdv, values), float), np.asarray(ff(qv, qdv, values), float).ravel())[3:6]
+        return lambda qv, qdv: np.linalg.solve(
+            np.asarray(Mf(qv, qdv, values), float), np.asarray(ff(qv, qdv, values), float).ravel()
+        )[3:6]
     to_u = dict(zip(qdot, u))
     frames[0].set_ang_vel(N, u[0] * N.z)
     frames[1].set_ang_vel(frames[0], u[1] * frames[0].z)
     frames[2].set_ang_vel(frames[1], u[2] * frames[1].z)
     for C in centres:
         C.set_vel(N, C.pos_from(O).dt(N).subs(to_u))
-    bodies = [RigidBody(f"B{k}", C, F, rho * L, (inertia(F, 0, 0, rho * L**3 / 12), C)) for k, (C, F, L) in enumerate(zip(centres, frames, (l2, l3, l4)))]
-    kane = KanesMethod(N, q_ind=[q[0]], u_ind=[u[0]], q_dependent=q[1:], u_dependent=u[1:], kd_eqs=[a - b for a, b in zip(qdot, u)],
-                       configuration_constraints=fh, velocity_constraints=fh.diff(t).subs(to_u))
+    bodies = [
+        RigidBody(f"B{k}", C, F, rho * L, (inertia(F, 0, 0, rho * L**3 / 12), C))
+        for k, (C, F, L) in enumerate(zip(centres, frames, (l2, l3, l4)))
+    ]
+    kane = KanesMethod(
+        N,
+        q_ind=[q[0]],
+        u_ind=[u[0]],
+        q_dependent=q[1:],
+        u_dependent=u[1:],
+        kd_eqs=[a - b for a, b in zip(qdot, u)],
+        configuration_constraints=fh,
+        velocity_constraints=fh.diff(t).subs(to_u),
+    )
     kane.kanes_equations(bodies, [])
     Mf = sp.lambdify([q, u, params], kane.mass_matrix, cse=True)
     ff = sp.lambdify([q, u, params], kane.forcing, cse=True)
-    return lambda qv, qdv: np.linalg.solve(np.asarray(Mf(qv, qdv, values), float), np.asarray(ff(qv, qdv, values), float).ravel())
+    return lambda qv, qdv: np.linalg.solve(
+        np.asarray(Mf(qv, qdv, values), float), np.asarray(ff(qv, qdv, values), float).ravel()
+    )
 
 
 def timed(fn, repeat=2):
@@ -107,12 +134,18 @@ def main():
     agree = max(np.abs(kd_f(Q, QD) - kane(Q, QD)).max(), np.abs(kd_f(Q, QD) - lagr(Q, QD)).max())
     print("four-bar linkage (SymPy mechanics' test), one run; q'' agree to", f"{agree:.1e}")
     print(f"{'':28s}{'set-up first / best':>22s}{'per evaluation':>18s}")
-    for label, (first, best), e in (("kinedyn numeric (KKT)", t_kd, e_kd), ("kinedyn phase_space (sym.)", t_ps, None),
-                                    ("SymPy KanesMethod", t_kane, e_kane), ("SymPy LagrangesMethod", t_lagr, e_lagr)):
+    for label, (first, best), e in (
+        ("kinedyn numeric (KKT)", t_kd, e_kd),
+        ("kinedyn phase_space (sym.)", t_ps, None),
+        ("SymPy KanesMethod", t_kane, e_kane),
+        ("SymPy LagrangesMethod", t_lagr, e_lagr),
+    ):
         print(f"{label:28s}{first:10.2f}s /{best:7.2f}s" + (f"{e * 1e6:15.1f} us" if e else f"{'-':>18s}"))
     t_kd, t_kane, t_lagr = t_kd[1], t_kane[1], t_lagr[1]
-    print(f"ratios (SymPy / kinedyn): set-up (best) Kane {t_kane / t_kd:.2f}x, Lagrange {t_lagr / t_kd:.2f}x; "
-          f"per evaluation Kane {e_kane / e_kd:.2f}x, Lagrange {e_lagr / e_kd:.2f}x")
+    print(
+        f"ratios (SymPy / kinedyn): set-up (best) Kane {t_kane / t_kd:.2f}x, Lagrange {t_lagr / t_kd:.2f}x; "
+        f"per evaluation Kane {e_kane / e_kd:.2f}x, Lagrange {e_lagr / e_kd:.2f}x"
+    )
 
 
 if __name__ == "__main__":

@@ -66,27 +66,44 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=2, help="runs of each side; the best is kept")
     args = parser.parse_args()
 
-    import kinedyn
     from distributed import Client, LocalCluster
+
+    import kinedyn
 
     robot = kinedyn.robots.puma560()
     env = {"PYTHONPATH": os.pathsep.join([str(Path(kinedyn.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    with LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=":0", env=env,
-                      memory_limit="6GiB", silence_logs=40) as cluster, Client(cluster) as client:
+    with (
+        LocalCluster(
+            processes=True,
+            n_workers=2,
+            threads_per_worker=1,
+            dashboard_address=":0",
+            env=env,
+            memory_limit="6GiB",
+            silence_logs=40,
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         on_cluster(client, robot, 4 * args.chunk, args.chunk, "mass_matrix")  # workers warm: imports, model built
         rss_start = client.run(peak_rss_mib)
-        print(f"PUMA 560, {args.states:.3g} states, chunks of {args.chunk} states; best of {args.repeat}; "
-              f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
-        for quantity, per_state in (("inverse_dynamics", robot.n), ("mass_matrix", robot.n**2)):
+        print(
+            f"PUMA 560, {args.states:.3g} states, chunks of {args.chunk} states; best of {args.repeat}; "
+            f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}"
+        )
+        for quantity, _per_state in (("inverse_dynamics", robot.n), ("mass_matrix", robot.n**2)):
             local = min(in_process(robot, args.states, quantity) for _ in range(args.repeat))
             dask_s = min(on_cluster(client, robot, args.states, args.chunk, quantity) for _ in range(args.repeat))
-            print(f"  {quantity:17s} in-process {local:7.2f} s ({local / args.states * 1e9:6.1f} ns/state)   "
-                  f"2-worker LocalCluster {dask_s:7.2f} s   overhead {dask_s / local - 1:+.0%}")
+            print(
+                f"  {quantity:17s} in-process {local:7.2f} s ({local / args.states * 1e9:6.1f} ns/state)   "
+                f"2-worker LocalCluster {dask_s:7.2f} s   overhead {dask_s / local - 1:+.0%}"
+            )
         rss = client.run(peak_rss_mib)
         chunk_mib = args.chunk * robot.n**2 * 8 / 2**20
         whole_mib = args.states * robot.n**2 * 8 / 2**20
-        print(f"  worker peak RSS (MiB): {', '.join(f'{v:.0f} (after warm-up {rss_start[k]:.0f})' for k, v in rss.items())}; "
-              f"one chunk of M {chunk_mib:.0f} MiB, the whole M {whole_mib:.0f} MiB")
+        print(
+            f"  worker peak RSS (MiB): {', '.join(f'{v:.0f} (after warm-up {rss_start[k]:.0f})' for k, v in rss.items())}; "
+            f"one chunk of M {chunk_mib:.0f} MiB, the whole M {whole_mib:.0f} MiB"
+        )
     print(f"  this process's peak RSS (the in-process batch holds the whole result): {peak_rss_mib():.0f} MiB")
 
 

@@ -39,7 +39,19 @@ def bench(name: str) -> None:
     robot, model = load_pair(name)
     # Pinocchio leaves URDF damping out of its algorithms: compare the same equations
     robot = robot.replace(
-        links=[l if not l.joint.is_moving else l.__class__(l.name, l.parent, l.joint.__class__(**{**l.joint.__dict__, "viscous": 0.0, "coulomb": 0.0}), l.placement, l.post, l.inertia) for l in robot.links],
+        links=[
+            l
+            if not l.joint.is_moving
+            else l.__class__(
+                l.name,
+                l.parent,
+                l.joint.__class__(**{**l.joint.__dict__, "viscous": 0.0, "coulomb": 0.0}),
+                l.placement,
+                l.post,
+                l.inertia,
+            )
+            for l in robot.links
+        ],
         dh=None,
     )
     data = model.createData()
@@ -55,24 +67,67 @@ def bench(name: str) -> None:
     assert np.allclose(robot.forward_dynamics(q, qd, tau), pin.aba(model, data, q, qd, tau), atol=1e-9)
     assert np.allclose(robot.coriolis_matrix(q, qd), pin.computeCoriolisMatrix(model, data, q, qd), atol=1e-9)
     assert np.allclose(robot.gravity_torque(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
-    assert np.allclose(robot.inverse_dynamics_derivatives(q, qd, qdd)[0], pin.computeRNEADerivatives(model, data, q, qd, qdd)[0], atol=1e-8)
-    assert np.allclose(robot.forward_dynamics_derivatives(q, qd, tau)[0], pin.computeABADerivatives(model, data, q, qd, tau)[0], atol=1e-8)
+    assert np.allclose(
+        robot.inverse_dynamics_derivatives(q, qd, qdd)[0],
+        pin.computeRNEADerivatives(model, data, q, qd, qdd)[0],
+        atol=1e-8,
+    )
+    assert np.allclose(
+        robot.forward_dynamics_derivatives(q, qd, tau)[0],
+        pin.computeABADerivatives(model, data, q, qd, tau)[0],
+        atol=1e-8,
+    )
 
     cases = [
-        ("inverse_dynamics", lambda: robot.inverse_dynamics(q, qd, qdd), lambda: pin.rnea(model, data, q, qd, qdd),
-         lambda: robot.inverse_dynamics(Q, V, A), lambda: [pin.rnea(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
-        ("mass_matrix", lambda: robot.mass_matrix(q), lambda: pin.crba(model, data, q),
-         lambda: robot.mass_matrix(Q), lambda: [pin.crba(model, data, Q[k]) for k in range(BATCH)]),
-        ("forward_dynamics", lambda: robot.forward_dynamics(q, qd, tau), lambda: pin.aba(model, data, q, qd, tau),
-         lambda: robot.forward_dynamics(Q, V, A), lambda: [pin.aba(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
-        ("coriolis_matrix", lambda: robot.coriolis_matrix(q, qd), lambda: pin.computeCoriolisMatrix(model, data, q, qd),
-         lambda: robot.coriolis_matrix(Q, V), lambda: [pin.computeCoriolisMatrix(model, data, Q[k], V[k]) for k in range(BATCH)]),
-        ("gravity_torque", lambda: robot.gravity_torque(q), lambda: pin.computeGeneralizedGravity(model, data, q),
-         lambda: robot.gravity_torque(Q), lambda: [pin.computeGeneralizedGravity(model, data, Q[k]) for k in range(BATCH)]),
-        ("inverse_dynamics_derivatives", lambda: robot.inverse_dynamics_derivatives(q, qd, qdd), lambda: pin.computeRNEADerivatives(model, data, q, qd, qdd),
-         lambda: robot.inverse_dynamics_derivatives(Q, V, A), lambda: [pin.computeRNEADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
-        ("forward_dynamics_derivatives", lambda: robot.forward_dynamics_derivatives(q, qd, tau), lambda: pin.computeABADerivatives(model, data, q, qd, tau),
-         lambda: robot.forward_dynamics_derivatives(Q, V, A), lambda: [pin.computeABADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)]),
+        (
+            "inverse_dynamics",
+            lambda: robot.inverse_dynamics(q, qd, qdd),
+            lambda: pin.rnea(model, data, q, qd, qdd),
+            lambda: robot.inverse_dynamics(Q, V, A),
+            lambda: [pin.rnea(model, data, Q[k], V[k], A[k]) for k in range(BATCH)],
+        ),
+        (
+            "mass_matrix",
+            lambda: robot.mass_matrix(q),
+            lambda: pin.crba(model, data, q),
+            lambda: robot.mass_matrix(Q),
+            lambda: [pin.crba(model, data, Q[k]) for k in range(BATCH)],
+        ),
+        (
+            "forward_dynamics",
+            lambda: robot.forward_dynamics(q, qd, tau),
+            lambda: pin.aba(model, data, q, qd, tau),
+            lambda: robot.forward_dynamics(Q, V, A),
+            lambda: [pin.aba(model, data, Q[k], V[k], A[k]) for k in range(BATCH)],
+        ),
+        (
+            "coriolis_matrix",
+            lambda: robot.coriolis_matrix(q, qd),
+            lambda: pin.computeCoriolisMatrix(model, data, q, qd),
+            lambda: robot.coriolis_matrix(Q, V),
+            lambda: [pin.computeCoriolisMatrix(model, data, Q[k], V[k]) for k in range(BATCH)],
+        ),
+        (
+            "gravity_torque",
+            lambda: robot.gravity_torque(q),
+            lambda: pin.computeGeneralizedGravity(model, data, q),
+            lambda: robot.gravity_torque(Q),
+            lambda: [pin.computeGeneralizedGravity(model, data, Q[k]) for k in range(BATCH)],
+        ),
+        (
+            "inverse_dynamics_derivatives",
+            lambda: robot.inverse_dynamics_derivatives(q, qd, qdd),
+            lambda: pin.computeRNEADerivatives(model, data, q, qd, qdd),
+            lambda: robot.inverse_dynamics_derivatives(Q, V, A),
+            lambda: [pin.computeRNEADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)],
+        ),
+        (
+            "forward_dynamics_derivatives",
+            lambda: robot.forward_dynamics_derivatives(q, qd, tau),
+            lambda: pin.computeABADerivatives(model, data, q, qd, tau),
+            lambda: robot.forward_dynamics_derivatives(Q, V, A),
+            lambda: [pin.computeABADerivatives(model, data, Q[k], V[k], A[k]) for k in range(BATCH)],
+        ),
     ]
     print(f"\n{name} ({n} joints)")
     print(f"{'':46s} {'kinedyn':>12s} {'pinocchio':>12s}   speed-up")
@@ -85,7 +140,11 @@ def bench(name: str) -> None:
     # control-loop use: kinedyn writing into a preallocated array (out=), Pinocchio as above
     M_out, tau_out = np.empty((n, n)), np.empty(n)
     for label, kd_one, pin_one in [
-        ("inverse_dynamics, per call with out=", lambda: robot.inverse_dynamics(q, qd, qdd, out=tau_out), lambda: pin.rnea(model, data, q, qd, qdd)),
+        (
+            "inverse_dynamics, per call with out=",
+            lambda: robot.inverse_dynamics(q, qd, qdd, out=tau_out),
+            lambda: pin.rnea(model, data, q, qd, qdd),
+        ),
         ("mass_matrix, per call with out=", lambda: robot.mass_matrix(q, out=M_out), lambda: pin.crba(model, data, q)),
     ]:
         a, b = paired(kd_one, pin_one)
@@ -95,7 +154,12 @@ def bench(name: str) -> None:
     out = np.zeros((n, BATCH), order="F")
     pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out)
     assert np.allclose(out.T, robot.inverse_dynamics(Q, V, A), atol=1e-9)
-    a, b = paired(lambda: robot.inverse_dynamics(Q, V, A), lambda: pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out), rounds=9, number=1)
+    a, b = paired(
+        lambda: robot.inverse_dynamics(Q, V, A),
+        lambda: pin.rneaInParallel(1, pool, Q.T, V.T, A.T, out),
+        rounds=9,
+        number=1,
+    )
     a, b = a / BATCH, b / BATCH
     print(f"{'inverse_dynamics, per state vs rneaInParallel(1)':46s} {fmt_us(a)} {fmt_us(b)}   {b / a:6.2f}x")
 

@@ -47,7 +47,9 @@ import kinedyn as kd  # noqa: E402
 def load_floating(name: str):
     """(kinedyn robot, Pinocchio model, q index map, v index map): ``q_pin = q[q_map]``, ``v_pin = v[v_map]``."""
     path = str(erd_robots_dir() / FLOATING_URDFS[name])
-    robot = without_friction(kd.Robot.from_urdf(path, floating_base=True, mimic="independent"))  # as Pinocchio builds it
+    robot = without_friction(
+        kd.Robot.from_urdf(path, floating_base=True, mimic="independent")
+    )  # as Pinocchio builds it
     model = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
     assert (model.nq, model.nv) == (robot.nq, robot.nv), (name, model.nq, model.nv, robot.nq, robot.nv)
     q_at = np.cumsum([0] + [j.nq for j in robot.joints])
@@ -57,8 +59,10 @@ def load_floating(name: str):
     for j in range(1, model.njoints):
         k = names.index(model.names[j])
         if (model.nqs[j], model.nvs[j]) != (robot.joints[k].nq, robot.joints[k].nv):
-            raise SystemExit(f"{name}: joint '{model.names[j]}' has (nq, nv) = ({model.nqs[j]}, {model.nvs[j]}) in Pinocchio, "
-                             f"({robot.joints[k].nq}, {robot.joints[k].nv}) in kinedyn: no plain permutation")
+            raise SystemExit(
+                f"{name}: joint '{model.names[j]}' has (nq, nv) = ({model.nqs[j]}, {model.nvs[j]}) in Pinocchio, "
+                f"({robot.joints[k].nq}, {robot.joints[k].nv}) in kinedyn: no plain permutation"
+            )
         if not robot.joints[k].is_multi_dof and float(robot.joints[k].offset) != 0.0:
             raise SystemExit(f"{name}: joint '{model.names[j]}' has an offset")
         q_map.extend(range(q_at[k], q_at[k + 1]))
@@ -81,15 +85,27 @@ def bench(name: str) -> None:
 
     # the same numbers first, in kinedyn's order
     assert np.allclose(pin.rnea(model, data, qp, vp, ap), taup, rtol=0, atol=1e-9), "rnea differs"
-    assert np.allclose(sym(pin.crba(model, data, qp)), robot.mass_matrix(q)[np.ix_(v_map, v_map)], rtol=0, atol=1e-9), "crba differs"
-    assert np.allclose(pin.aba(model, data, qp, vp, taup), robot.forward_dynamics(q, v, tau)[v_map], rtol=0, atol=1e-9), "aba differs"
+    assert np.allclose(sym(pin.crba(model, data, qp)), robot.mass_matrix(q)[np.ix_(v_map, v_map)], rtol=0, atol=1e-9), (
+        "crba differs"
+    )
+    assert np.allclose(
+        pin.aba(model, data, qp, vp, taup), robot.forward_dynamics(q, v, tau)[v_map], rtol=0, atol=1e-9
+    ), "aba differs"
 
     print(f"\n{name} (nq = {robot.nq}, nv = {robot.nv}, {len(robot.joints)} joints)")
     print(f"{'':46s} {'kinedyn':>12s} {'pinocchio':>12s}   speed-up")
     for label, kd_one, pin_one in [
-        ("rnea (inverse_dynamics), per call", lambda: robot.inverse_dynamics(q, v, a), lambda: pin.rnea(model, data, qp, vp, ap)),
+        (
+            "rnea (inverse_dynamics), per call",
+            lambda: robot.inverse_dynamics(q, v, a),
+            lambda: pin.rnea(model, data, qp, vp, ap),
+        ),
         ("crba (mass_matrix), per call", lambda: robot.mass_matrix(q), lambda: pin.crba(model, data, qp)),
-        ("aba (forward_dynamics), per call", lambda: robot.forward_dynamics(q, v, tau), lambda: pin.aba(model, data, qp, vp, taup)),
+        (
+            "aba (forward_dynamics), per call",
+            lambda: robot.forward_dynamics(q, v, tau),
+            lambda: pin.aba(model, data, qp, vp, taup),
+        ),
     ]:
         t_kd, t_pin = paired(kd_one, pin_one, rounds=args.rounds)
         print(f"{label:46s} {fmt_us(t_kd)} {fmt_us(t_pin)}   {t_pin / t_kd:6.2f}x")
@@ -107,9 +123,21 @@ def bench(name: str) -> None:
     pin.abaInParallel(1, pool, Qp.T, Vp.T, TAUp.T, out)
     assert np.allclose(out.T, robot.forward_dynamics(Q, V, TAU)[:, v_map], rtol=0, atol=1e-7), "abaInParallel differs"
     for label, kd_batch, pin_batch in [
-        ("rnea, per state vs rneaInParallel(1)", lambda: robot.inverse_dynamics(Q, V, A), lambda: pin.rneaInParallel(1, pool, Qp.T, Vp.T, Ap.T, out)),
-        ("aba, per state vs abaInParallel(1)", lambda: robot.forward_dynamics(Q, V, TAU), lambda: pin.abaInParallel(1, pool, Qp.T, Vp.T, TAUp.T, out)),
-        ("crba, per state vs a Python loop of pin.crba", lambda: robot.mass_matrix(Q), lambda: [pin.crba(model, data, Qp[k]) for k in range(N)]),
+        (
+            "rnea, per state vs rneaInParallel(1)",
+            lambda: robot.inverse_dynamics(Q, V, A),
+            lambda: pin.rneaInParallel(1, pool, Qp.T, Vp.T, Ap.T, out),
+        ),
+        (
+            "aba, per state vs abaInParallel(1)",
+            lambda: robot.forward_dynamics(Q, V, TAU),
+            lambda: pin.abaInParallel(1, pool, Qp.T, Vp.T, TAUp.T, out),
+        ),
+        (
+            "crba, per state vs a Python loop of pin.crba",
+            lambda: robot.mass_matrix(Q),
+            lambda: [pin.crba(model, data, Qp[k]) for k in range(N)],
+        ),
     ]:
         t_kd, t_pin = paired(kd_batch, pin_batch, rounds=9, number=1)
         print(f"{label:46s} {fmt_us(t_kd / N)} {fmt_us(t_pin / N)}   {t_pin / t_kd:6.2f}x")
@@ -119,6 +147,8 @@ def bench(name: str) -> None:
 
 
 if __name__ == "__main__":
-    print(f"pinocchio {pin.__version__}; kinedyn batch threads: 1 (cores: {os.cpu_count()}; load average {os.getloadavg()[0]:.1f})")
+    print(
+        f"pinocchio {pin.__version__}; kinedyn batch threads: 1 (cores: {os.cpu_count()}; load average {os.getloadavg()[0]:.1f})"
+    )
     for robot_name in args.robots:
         bench(robot_name)

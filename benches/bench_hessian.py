@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-
 from common import fmt_us, load_pair, median_time
 
 BATCH = 10_000
@@ -40,7 +39,9 @@ def bench(name: str) -> None:
 
     def finite_differences():
         h = 1e-6
-        return np.stack([(robot.jacobian(q + h * e, body) - robot.jacobian(q - h * e, body)) / (2 * h) for e in np.eye(n)])
+        return np.stack(
+            [(robot.jacobian(q + h * e, body) - robot.jacobian(q - h * e, body)) / (2 * h) for e in np.eye(n)]
+        )
 
     rows = []
     t_kd = median_time(lambda: robot.jacobian_hessian(q, body))
@@ -52,7 +53,9 @@ def bench(name: str) -> None:
             pin_hessian(qi)
 
     t_kd = median_time(lambda: robot.jacobian_hessian(Q, body), repeat=5, number=3) / BATCH
-    rows.append(("hessian, per state in a batch (vs Pinocchio loop)", t_kd, median_time(pin_loop, repeat=3, number=1) / BATCH))
+    rows.append(
+        ("hessian, per state in a batch (vs Pinocchio loop)", t_kd, median_time(pin_loop, repeat=3, number=1) / BATCH)
+    )
 
     print(f"\n{name} ({n} joints)")
     print(f"{'':52s} {'kinedyn':>12s} {'other':>12s}   speed-up")

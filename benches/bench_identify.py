@@ -71,13 +71,21 @@ def main():
     cols, sigma = make_log(true, args.seconds, seed=1)
     held_out, _ = make_log(true, 20.0, seed=2)
     t_load, log = best(lambda: an.load_log(cols, n=prior.n), args.repeat)
-    print(f"Panda ({prior.n} joints), {args.seconds:g} s at 1 kHz -> {len(log)} samples after filtering "
-          f"(cut-off {log.cutoff:.3g} Hz, decimation {log.decimation})")
+    print(
+        f"Panda ({prior.n} joints), {args.seconds:g} s at 1 kHz -> {len(log)} samples after filtering "
+        f"(cut-off {log.cutoff:.3g} Hz, decimation {log.decimation})"
+    )
     print(f"load_log                     {t_load:8.3f} s")
-    for label, kw in (("identify OLS", {}), ("identify WLS", dict(weighted=True)), ("identify consistent (SDP)", dict(consistent=True))):
+    for label, kw in (
+        ("identify OLS", {}),
+        ("identify WLS", dict(weighted=True)),
+        ("identify consistent (SDP)", dict(consistent=True)),
+    ):
         t_fit, res = best(lambda: an.identify(prior, log, **kw), args.repeat)
         ratio = res.validate(held_out).rms / sigma
-        print(f"{label:<28} {t_fit:8.3f} s   load + fit {t_load + t_fit:8.3f} s   held-out RMS / noise per joint {np.round(ratio, 2)}")
+        print(
+            f"{label:<28} {t_fit:8.3f} s   load + fit {t_load + t_fit:8.3f} s   held-out RMS / noise per joint {np.round(ratio, 2)}"
+        )
 
 
 if __name__ == "__main__":

@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 import kinedyn as kd
-from kinedyn import _core
 from kinedyn.testing import example_robot_data_dir
 
 
@@ -46,7 +45,9 @@ def panda():
 
 def analytic_section(calls: int) -> None:
     print(f"\n== closed-form IK, all solutions, per call ({calls} targets) ==")
-    print(f"{'robot':10s} {'structure':28s} {'solutions':>9s} {'Python us':>10s} {'native us':>10s} {'batch us/target':>16s}")
+    print(
+        f"{'robot':10s} {'structure':28s} {'solutions':>9s} {'Python us':>10s} {'native us':>10s} {'batch us/target':>16s}"
+    )
     rng = np.random.default_rng(0)
     for name, position in (("elbow_3r", True), ("puma560", False), ("ur5", False)):
         robot = kd.robots.get(name)
@@ -63,7 +64,9 @@ def analytic_section(calls: int) -> None:
         t0 = time.perf_counter()
         chain.solver.solve_nearest(batch_in, refs, False, 1e-9)
         batch = (time.perf_counter() - t0) / calls
-        print(f"{name:10s} {chain.solver.structure:28s} {statistics.mean(counts):9.2f} {py * 1e6:10.2f} {native * 1e6:10.2f} {batch * 1e6:16.3f}")
+        print(
+            f"{name:10s} {chain.solver.structure:28s} {statistics.mean(counts):9.2f} {py * 1e6:10.2f} {native * 1e6:10.2f} {batch * 1e6:16.3f}"
+        )
     print("(solutions: mean count over 200 random targets without joint limits; batch: solve_nearest, all threads)")
 
 
@@ -81,7 +84,9 @@ def numeric_section(n_targets: int) -> None:
     peers = rtb_models()
     if peers is None:
         print("Robotics Toolbox is not installed (pip install roboticstoolbox-python): kinedyn figures only")
-    print(f"{'robot':6s} {'solver':26s} {'success':>8s} {'median us':>10s} {'mean us':>9s} {'ratio (RTB / kinedyn)':>22s}")
+    print(
+        f"{'robot':6s} {'solver':26s} {'success':>8s} {'median us':>10s} {'mean us':>9s} {'ratio (RTB / kinedyn)':>22s}"
+    )
     for name, (robot, frame) in arms.items():
         if robot is None:
             print(f"{name:6s} skipped: example-robot-data is not installed")
@@ -96,18 +101,25 @@ def numeric_section(n_targets: int) -> None:
             times.append(time.perf_counter() - t0)
             ok += r.success
         ours = statistics.median(times)
-        print(f"{name:6s} {'kinedyn numeric:lm':26s} {ok / n_targets:8.1%} {ours * 1e6:10.1f} {statistics.mean(times) * 1e6:9.1f} {'':>22s}")
+        print(
+            f"{name:6s} {'kinedyn numeric:lm':26s} {ok / n_targets:8.1%} {ours * 1e6:10.1f} {statistics.mean(times) * 1e6:9.1f} {'':>22s}"
+        )
         t0 = time.perf_counter()
         batch = robot.inverse_kinematics(T, frame=frame, method="numeric")
         dt = time.perf_counter() - t0
-        print(f"{name:6s} {'kinedyn batch (threads)':26s} {batch.success_rate:8.1%} {'':>10s} {dt / n_targets * 1e6:9.1f} {'':>22s}")
+        print(
+            f"{name:6s} {'kinedyn batch (threads)':26s} {batch.success_rate:8.1%} {'':>10s} {dt / n_targets * 1e6:9.1f} {'':>22s}"
+        )
         if peers is None:
             continue
         model = peers[name]
         lo, hi = model.qlim
         Qp = rng.uniform(lo, hi, size=(n_targets, model.n))
         Tp = [model.fkine(q) for q in Qp]
-        for label, solve in (("RTB ikine_LM (Python)", model.ikine_LM), ("RTB ik_LM (C++)", getattr(model, "ik_LM", None))):
+        for label, solve in (
+            ("RTB ikine_LM (Python)", model.ikine_LM),
+            ("RTB ik_LM (C++)", getattr(model, "ik_LM", None)),
+        ):
             if solve is None:
                 continue
             times, ok = [], 0
@@ -117,7 +129,9 @@ def numeric_section(n_targets: int) -> None:
                 times.append(time.perf_counter() - t0)
                 ok += bool(s[1] if isinstance(s, tuple) else s.success)
             theirs = statistics.median(times)
-            print(f"{name:6s} {label:26s} {ok / n_targets:8.1%} {theirs * 1e6:10.1f} {statistics.mean(times) * 1e6:9.1f} {theirs / ours:21.1f}x")
+            print(
+                f"{name:6s} {label:26s} {ok / n_targets:8.1%} {theirs * 1e6:10.1f} {statistics.mean(times) * 1e6:9.1f} {theirs / ours:21.1f}x"
+            )
 
 
 def main() -> None:

@@ -35,8 +35,9 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args()
     if args.robot == "ur5":
-        from kinedyn.testing import example_robot_data_dir
         import os
+
+        from kinedyn.testing import example_robot_data_dir
 
         robot = kd.Robot.from_urdf(os.path.join(example_robot_data_dir(), "ur_description", "urdf", "ur5_robot.urdf"))
     else:
@@ -67,13 +68,17 @@ def main() -> None:
         ("M    rust batch", best(lambda: robot.mass_matrix(Q), args.repeat)),
         (f"M    compile({fc.backend})", best(lambda: fc.M(Q), args.repeat)),
     ]
-    print(f"{robot.name}: n = {n}, {N} states, JAX {jax.__version__} on {jax.devices()[0].platform}; "
-          f"build {t_build:.2f} s, jit compile (tau + M) {t_jit:.2f} s; max |tau_jax - tau_rust| = {err:.1e}")
+    print(
+        f"{robot.name}: n = {n}, {N} states, JAX {jax.__version__} on {jax.devices()[0].platform}; "
+        f"build {t_build:.2f} s, jit compile (tau + M) {t_jit:.2f} s; max |tau_jax - tau_rust| = {err:.1e}"
+    )
     per = dict(rows)
     for label, s in rows:
         print(f"  {label:22s} {s * 1e9 / N:9.1f} ns/state")
-    print(f"  ratio jax/rust: tau {per['tau  jax jit(vmap)'] / per['tau  rust batch']:.2f}, "
-          f"M {per['M    jax jit(vmap)'] / per['M    rust batch']:.2f}")
+    print(
+        f"  ratio jax/rust: tau {per['tau  jax jit(vmap)'] / per['tau  rust batch']:.2f}, "
+        f"M {per['M    jax jit(vmap)'] / per['M    rust batch']:.2f}"
+    )
 
 
 if __name__ == "__main__":

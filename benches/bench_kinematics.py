@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-
 from common import fmt_us, load_pair, median_time
 
 BATCH = 10_000

@@ -64,7 +64,9 @@ def main() -> None:
     if args.pinocchio:
         import pinocchio as pin
     warnings.simplefilter("ignore")
-    header = f"{'shape':<12} {'links':>6} {'kinedyn s':>10} {'us/link':>8} {'CPU us/link':>12}" + (f" {'pinocchio s':>12}" if pin else "")
+    header = f"{'shape':<12} {'links':>6} {'kinedyn s':>10} {'us/link':>8} {'CPU us/link':>12}" + (
+        f" {'pinocchio s':>12}" if pin else ""
+    )
     print(header)
     for shape in ("fixed chain", "moving chain", "wide tree"):
         for n in sizes:

@@ -33,17 +33,25 @@ def main() -> None:
 
     erd = _erd()
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"kinedyn report (default robot, with the tutorial): {_report([], os.path.join(tmp, 'default.html')):.1f} s")
+        print(
+            f"kinedyn report (default robot, with the tutorial): {_report([], os.path.join(tmp, 'default.html')):.1f} s"
+        )
         if erd is None:
             print("example-robot-data is not installed: no Talos or Panda figures")
             return
         talos = os.path.join(erd, "talos_data", "robots", "talos_full_v2.urdf")
-        print(f"kinedyn report talos_full_v2.urdf (44 joints): {_report([talos], os.path.join(tmp, 'talos.html')):.1f} s (the issue's bound: 60 s)")
+        print(
+            f"kinedyn report talos_full_v2.urdf (44 joints): {_report([talos], os.path.join(tmp, 'talos.html')):.1f} s (the issue's bound: 60 s)"
+        )
     panda = kd.load(os.path.join(erd, "panda_description", "urdf", "panda.urdf"))
     goal = np.array([0.3, -0.5, 0.4, -1.5, 0.3, 1.2, 0.2, 0.01, 0.01])
     start = time.perf_counter()
-    traj = kd.simulate(panda, 4.0, np.zeros(18), controller=kd.simulate.PDGravity(panda, 100.0, 20.0, goal), record_every=10)
-    print(f"Panda PD + gravity, 4 s at dt = 1 ms, method {traj.method}: {time.perf_counter() - start:.2f} s wall, final error {np.abs(traj.q[-1] - goal).max():.2g} rad")
+    traj = kd.simulate(
+        panda, 4.0, np.zeros(18), controller=kd.simulate.PDGravity(panda, 100.0, 20.0, goal), record_every=10
+    )
+    print(
+        f"Panda PD + gravity, 4 s at dt = 1 ms, method {traj.method}: {time.perf_counter() - start:.2f} s wall, final error {np.abs(traj.q[-1] - goal).max():.2g} rad"
+    )
 
 
 if __name__ == "__main__":

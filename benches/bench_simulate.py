@@ -22,9 +22,9 @@ import time
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
+from common import PEER_URDFS, erd_robots_dir, load_pair  # noqa: E402
 
 import kinedyn as kd  # noqa: E402
-from common import PEER_URDFS, erd_robots_dir, load_pair  # noqa: E402
 
 DT = 1e-3
 
@@ -36,7 +36,7 @@ def pin_from_kinedyn(robot):
     model = pin.Model()
     model.gravity.linear = np.array(robot.gravity, dtype=float)
     ids = [0]
-    for k, b in enumerate(robot.tree.bodies):
+    for _k, b in enumerate(robot.tree.bodies):
         T = np.asarray(b.placement, dtype=float)
         j = b.joint
         if float(j.offset) != 0.0:
@@ -46,7 +46,13 @@ def pin_from_kinedyn(robot):
         parent = ids[b.parent + 1] if b.parent >= 0 else 0
         jid = model.addJoint(parent, jm, pin.SE3(T[:3, :3], T[:3, 3]), j.name)
         inertia = b.inertia
-        model.appendBodyToJoint(jid, pin.Inertia(float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)), pin.SE3.Identity())
+        model.appendBodyToJoint(
+            jid,
+            pin.Inertia(
+                float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)
+            ),
+            pin.SE3.Identity(),
+        )
         ids.append(jid)
     model.armature = np.array([float(j.armature) for j in robot.joints])
     return model
@@ -76,7 +82,11 @@ def mujoco_model(name):
 
     text = (erd_robots_dir() / PEER_URDFS[name]).read_text()
     text = re.sub(r"<visual>.*?</visual>|<collision>.*?</collision>", "", text, flags=re.S)
-    text = text.replace("<robot ", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" ', 1) if "xmlns:xacro" not in text else text
+    text = (
+        text.replace("<robot ", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" ', 1)
+        if "xmlns:xacro" not in text
+        else text
+    )
     m = mujoco.MjModel.from_xml_string(text)
     m.opt.timestep = DT
     m.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
@@ -95,7 +105,6 @@ def main():
     ap.add_argument("--batch", type=int, default=1000)
     ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds of a single kinedyn run")
     args = ap.parse_args()
-    import pinocchio as pin
 
     rows = []
     for name in ("puma560", "panda"):
@@ -106,7 +115,9 @@ def main():
             robot, pmodel = load_pair("panda")
         n = robot.n
         rng = np.random.default_rng(0)
-        X = np.column_stack([robot.random_configuration(rng, size=args.batch) * 0.5, rng.normal(size=(args.batch, n)) * 0.5])
+        X = np.column_stack(
+            [robot.random_configuration(rng, size=args.batch) * 0.5, rng.normal(size=(args.batch, n)) * 0.5]
+        )
         # agreement check: kinedyn RK4 == Pinocchio-driven RK4 on the same model after 0.1 s
         traj = kd.simulate(robot, 0.1, X[0], dt=DT)
         qp, vp = rk4_pinocchio(pmodel, pmodel.createData(), X[0, :n].copy(), X[0, n:].copy(), 100)
@@ -120,7 +131,15 @@ def main():
         pin_single = 0.5 / timed(lambda: rk4_pinocchio(pmodel, pdata, X[0, :n].copy(), X[0, n:].copy(), 500))
         nb = min(args.batch, 200)  # Pinocchio batch: states one after the other (rate per state is what counts)
         Tp = 0.05
-        pin_batch = nb * Tp / timed(lambda: [rk4_pinocchio(pmodel, pdata, X[i, :n].copy(), X[i, n:].copy(), int(Tp / DT)) for i in range(nb)])
+        pin_batch = (
+            nb
+            * Tp
+            / timed(
+                lambda: [
+                    rk4_pinocchio(pmodel, pdata, X[i, :n].copy(), X[i, n:].copy(), int(Tp / DT)) for i in range(nb)
+                ]
+            )
+        )
         mj_single = mj_batch = None
         mj_note = "no URDF for the PUMA 560"
         if name in PEER_URDFS:
@@ -153,19 +172,29 @@ def main():
                     mujoco.mj_getState(m, d, init[i], spec)
                 nstep = int(Tb / DT)
                 datas = [mujoco.MjData(m) for _ in range(os.cpu_count() or 1)]
-                mj_batch = args.batch * Tb / timed(lambda: rollout.rollout(m, datas, init, np.zeros((args.batch, nstep, m.nu))))
+                mj_batch = (
+                    args.batch
+                    * Tb
+                    / timed(lambda: rollout.rollout(m, datas, init, np.zeros((args.batch, nstep, m.nu))))
+                )
             except Exception as e:  # noqa: BLE001 - report and go on
                 mj_note = f"not loaded: {type(e).__name__}: {e}"[:120]
         rows.append((name, n, agree, kd_single, kd_batch, pin_single, pin_batch, mj_single, mj_batch, mj_note))
 
-    print(f"RK4 at {1 / DT:g} Hz, free motion; simulated seconds per wall second (higher is better); batch = {args.batch} initial states")
+    print(
+        f"RK4 at {1 / DT:g} Hz, free motion; simulated seconds per wall second (higher is better); batch = {args.batch} initial states"
+    )
     print(f"{'robot':<9} {'':<22} {'single':>10} {'batch':>10}")
-    for name, n, agree, ks, kb, ps, pb, ms, mb, note in rows:
+    for name, _n, agree, ks, kb, ps, pb, ms, mb, note in rows:
         print(f"{name:<9} {'kinedyn (Rust core)':<22} {ks:10.1f} {kb:10.1f}")
         print(f"{'':<9} {'pinocchio.aba from Py':<22} {ps:10.1f} {pb:10.1f}")
-        print(f"{'':<9} {'mujoco RK4':<22} {ms if ms else float('nan'):10.1f} {mb if mb else float('nan'):10.1f}   {note}")
-        print(f"{'':<9} ratios kinedyn / pinocchio-from-Python: single {ks / ps:.1f}x, batch {kb / pb:.1f}x"
-              + (f"; kinedyn / mujoco: single {ks / ms:.2f}x, batch {kb / mb:.2f}x" if ms and mb else ""))
+        print(
+            f"{'':<9} {'mujoco RK4':<22} {ms if ms else float('nan'):10.1f} {mb if mb else float('nan'):10.1f}   {note}"
+        )
+        print(
+            f"{'':<9} ratios kinedyn / pinocchio-from-Python: single {ks / ps:.1f}x, batch {kb / pb:.1f}x"
+            + (f"; kinedyn / mujoco: single {ks / ms:.2f}x, batch {kb / mb:.2f}x" if ms and mb else "")
+        )
         print(f"{'':<9} kinedyn RK4 vs pinocchio-driven RK4 after 0.1 s: max |dq| = {agree:.2e}")
 
 

@@ -46,7 +46,11 @@ def elbow_symbolic():
         L1, L2, L3, m1, m2, m3, g = sp.symbols("L1 L2 L3 m1 m2 m3 g", positive=True)
         rod = lambda m, L: Inertia(m, (L / 2 - L, 0, 0), ((0, 0, 0), (0, m * L**2 / 12, 0), (0, 0, m * L**2 / 12)))
         link1 = Inertia(m1, (0, -L1 / 2, 0), ((m1 * L1**2 / 12, 0, 0), (0, 0, 0), (0, 0, m1 * L1**2 / 12)))
-        rows = [DHRow(d=L1, alpha=math.pi / 2, inertia=link1), DHRow(a=L2, inertia=rod(m2, L2)), DHRow(a=L3, inertia=rod(m3, L3))]
+        rows = [
+            DHRow(d=L1, alpha=math.pi / 2, inertia=link1),
+            DHRow(a=L2, inertia=rod(m2, L2)),
+            DHRow(a=L3, inertia=rod(m3, L3)),
+        ]
         return kd.Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_3r")
 
 
@@ -85,7 +89,9 @@ def mechanics_model(robot):
         com.set_vel(N, com.pos_from(O).dt(N))
         I = [[_exact(x) for x in row] for row in inert.inertia]
         m = _exact(inert.mass)
-        body = RigidBody(f"b{i + 1}", com, B, m, (inertia(B, I[0][0], I[1][1], I[2][2], I[0][1], I[1][2], I[0][2]), com))
+        body = RigidBody(
+            f"b{i + 1}", com, B, m, (inertia(B, I[0][0], I[1][1], I[2][2], I[0][1], I[1][2], I[0][2]), com)
+        )
         body.potential_energy = -m * gN.dot(com.pos_from(O))
         frames.append(B)
         origins.append(bo)
@@ -138,8 +144,9 @@ def row(name, what, seconds, exprs):
 
 
 def panda_robot():
-    from kinedyn.testing import example_robot_data_dir
     import os
+
+    from kinedyn.testing import example_robot_data_dir
 
     path = os.path.join(example_robot_data_dir(), "panda_description/urdf/panda.urdf")
     return kd.Robot.from_urdf(path).lock_joints({"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0})
@@ -193,7 +200,9 @@ def cse_section(expanded=False):
     base = cli_seconds(["--version"])
     print(f"{'kinedyn --version (start-up only)':58s} {fmt(base)}", flush=True)
     for output in ("text", "latex", "markdown", "mathml", "python", "numpy", "c"):
-        sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--format", output, "-o", "/dev/null"])
+        sec = cli_seconds(
+            ["derive", "puma560", "--general", "--method", "newton_euler", "--format", output, "-o", "/dev/null"]
+        )
         print(f"{'derive puma560 --general --method newton_euler --format ' + output:58s} {fmt(sec)}", flush=True)
     sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--json"])
     print(f"{'derive puma560 --general --method newton_euler --json':58s} {fmt(sec)}", flush=True)
@@ -206,14 +215,19 @@ def cse_section(expanded=False):
     print(f"{'report puma560 --eom-joints 6':58s} {fmt(sec)}", flush=True)
     if expanded:  # the former path: every entry expanded and printed (minutes)
         try:
-            sec = cli_seconds(["derive", "puma560", "--general", "--method", "newton_euler", "--form", "expanded", "-o", "/dev/null"], timeout=900)
+            sec = cli_seconds(
+                ["derive", "puma560", "--general", "--method", "newton_euler", "--form", "expanded", "-o", "/dev/null"],
+                timeout=900,
+            )
             print(f"{'  same, --form expanded (the former output)':58s} {fmt(sec)}", flush=True)
         except subprocess.TimeoutExpired:
             print(f"{'  same, --form expanded (the former output)':58s} > 900 s (stopped)", flush=True)
     for name, robot in (("puma560", kd.robots.puma560()), ("panda", panda_robot())):
         ours_sec, ops = closed_form_time(robot)
         try:
-            out = subprocess.run([sys.executable, __file__, "--child", f"kanes-{name}"], capture_output=True, text=True, timeout=400)
+            out = subprocess.run(
+                [sys.executable, __file__, "--child", f"kanes-{name}"], capture_output=True, text=True, timeout=400
+            )
             kane = float(out.stdout.split()[-1])
             peer = f"KanesMethod {kane:8.2f} s   ratio Kane/kinedyn {kane / ours_sec:6.1f}"
         except subprocess.TimeoutExpired:
@@ -225,13 +239,21 @@ def cse_section(expanded=False):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--puma-lagranges", action="store_true", help="also run LagrangesMethod on the PUMA 560 (minutes; once, capped)")
+    ap.add_argument(
+        "--puma-lagranges", action="store_true", help="also run LagrangesMethod on the PUMA 560 (minutes; once, capped)"
+    )
     ap.add_argument("--child", help=argparse.SUPPRESS)
-    ap.add_argument("--cse-only", action="store_true", help="only the issue 12 §5 cases (CSE form, CLI wall times, Panda)")
-    ap.add_argument("--expanded", action="store_true", help="also time derive PUMA --general --form expanded (the former output; minutes)")
+    ap.add_argument(
+        "--cse-only", action="store_true", help="only the issue 12 §5 cases (CSE form, CLI wall times, Panda)"
+    )
+    ap.add_argument(
+        "--expanded",
+        action="store_true",
+        help="also time derive PUMA --general --form expanded (the former output; minutes)",
+    )
     args = ap.parse_args(argv)
     if args.child and args.child.startswith("kanes-"):
-        kanes_child(args.child[len("kanes-"):])
+        kanes_child(args.child[len("kanes-") :])
         return
     if args.cse_only:
         cse_section(args.expanded)
@@ -240,7 +262,11 @@ def main(argv=None):
         sec, eqs = lagranges(kd.robots.puma560())
         print(f"{sec:.3f} {_ops(eqs)['total']}")
         return
-    arms = [("planar_2r", kd.robots.planar_2r(symbolic=True)), ("planar_3r", kd.robots.planar_3r(symbolic=True)), ("elbow_3r", elbow_symbolic())]
+    arms = [
+        ("planar_2r", kd.robots.planar_2r(symbolic=True)),
+        ("planar_3r", kd.robots.planar_3r(symbolic=True)),
+        ("elbow_3r", elbow_symbolic()),
+    ]
     print(f"{'robot':10s} {'method':34s} {'time':>11s}")
     for name, robot in arms:
         sec, exprs, _ = ours(robot, "lagrange")
@@ -255,8 +281,10 @@ def main(argv=None):
     sec, exprs, eom = ours(puma, "lagrange")
     row("puma560", "kinedyn lagrange (simplified tau)", sec, exprs)
     t = time.perf_counter()
-    M, g = eom.M, eom.g
-    print(f"{'puma560':10s} {'  of which M and g closed form':34s} (M, g ready {time.perf_counter() - t:.3f} s after tau)")
+    eom.M, eom.g  # noqa: B018 (computed on first access: the time printed below)
+    print(
+        f"{'puma560':10s} {'  of which M and g closed form':34s} (M, g ready {time.perf_counter() - t:.3f} s after tau)"
+    )
     sec, exprs, ne = ours(puma, "newton_euler")
     row("puma560", "kinedyn newton_euler (numbers)", sec, exprs)
     print(f"{'':10s} {'  ops of the customised model':34s} {ne.op_count()}")
@@ -270,7 +298,9 @@ def main(argv=None):
     row("puma560", "sympy KanesMethod", sec, eqs)
     if args.puma_lagranges:
         try:
-            out = subprocess.run([sys.executable, __file__, "--child", "puma-lagranges"], capture_output=True, text=True, timeout=400)
+            out = subprocess.run(
+                [sys.executable, __file__, "--child", "puma-lagranges"], capture_output=True, text=True, timeout=400
+            )
             sec, ops = out.stdout.split()
             print(f"{'puma560':10s} {'sympy LagrangesMethod':34s} {float(sec):9.3f} s   ops {int(ops):8d}")
         except subprocess.TimeoutExpired:
@@ -290,7 +320,9 @@ def main(argv=None):
     t = time.perf_counter()
     f.tau(Q, QD, QDD)
     c_batch = (time.perf_counter() - t) / 10000 * 1e6
-    print(f"generated C (PUMA tau): {c_single:.2f} us per call from Python, {c_batch:.3f} us per state in a batch of 10000 ({f.backend})")
+    print(
+        f"generated C (PUMA tau): {c_single:.2f} us per call from Python, {c_batch:.3f} us per state in a batch of 10000 ({f.backend})"
+    )
     try:
         puma.inverse_dynamics(q, qd, qdd)
         t = time.perf_counter()
@@ -300,7 +332,9 @@ def main(argv=None):
         t = time.perf_counter()
         puma.inverse_dynamics(Q, QD, QDD)
         n_batch = (time.perf_counter() - t) / 10000 * 1e6
-        print(f"numeric engine RNEA  : {n_single:.2f} us per call from Python, {n_batch:.3f} us per state in a batch of 10000")
+        print(
+            f"numeric engine RNEA  : {n_single:.2f} us per call from Python, {n_batch:.3f} us per state in a batch of 10000"
+        )
         print(f"ratio numeric/generated: single {n_single / c_single:.2f}, batch {n_batch / c_batch:.2f}")
     except Exception as exc:  # the native module may not be built
         print(f"numeric engine unavailable: {exc}")

@@ -28,5 +28,7 @@ tau_fd = np.array([F @ (robot.pose(q + h * e)[:2, 3] - robot.pose(q - h * e)[:2,
 assert np.allclose(v, v_fd, atol=1e-7) and np.allclose(tau, tau_fd, atol=1e-6)
 
 # joint rates for a wanted tool velocity, and the singular pose
-print("qd for v = (0, 1) m/s:", np.round(kin.joint_velocities(robot, q, [0.0, 1.0], task="planar", method="inverse"), 4))
+print(
+    "qd for v = (0, 1) m/s:", np.round(kin.joint_velocities(robot, q, [0.0, 1.0], task="planar", method="inverse"), 4)
+)
 print("at theta2 = 0:", kin.singularity_report(robot, [0.4, 0.0], task="planar").summary())

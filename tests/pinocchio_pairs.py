@@ -33,11 +33,11 @@ class PinPair:
         out = np.zeros(self.model.nq)
         for i, nq, k, knq, offset in self.blocks:
             if nq == knq:
-                out[i:i + nq] = q[k:k + nq]
+                out[i : i + nq] = q[k : k + nq]
                 out[i] += offset  # a 1-DOF joint's offset (0 for multi-DOF blocks)
             else:  # Pinocchio's unbounded revolute: (cos, sin) of the angle
                 assert (nq, knq) == (2, 1)
-                out[i:i + 2] = np.cos(q[k] + offset), np.sin(q[k] + offset)
+                out[i : i + 2] = np.cos(q[k] + offset), np.sin(q[k] + offset)
         return out
 
     def random_state(self, rng):
@@ -87,8 +87,13 @@ def pinocchio_model(robot):
         parent = 0 if body.parent < 0 else ids[body.parent]
         jid = model.addJoint(parent, jm, pin.SE3(T[:3, :3], T[:3, 3]), j.name)
         inertia = body.inertia
-        model.appendBodyToJoint(jid, pin.Inertia(float(inertia.mass), np.array(inertia.com, dtype=float),
-                                                 np.array(inertia.inertia, dtype=float)), pin.SE3.Identity())
+        model.appendBodyToJoint(
+            jid,
+            pin.Inertia(
+                float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)
+            ),
+            pin.SE3.Identity(),
+        )
         ids.append(jid)
     model.armature = np.asarray(robot.armature, dtype=float)  # reflected rotor inertia (Pinocchio 3 adds it to M)
     return model

@@ -46,9 +46,15 @@ def body_poses(robot, q) -> list:
     for body in robot.tree.bodies:
         parent = np.eye(4) if body.parent < 0 else poses[body.parent]
         relation = follows.get(body.joint.name)
-        value = q[names.index(body.joint.name)] if relation is None else relation.multiplier * q[names.index(relation.leader)] + relation.offset
+        value = (
+            q[names.index(body.joint.name)]
+            if relation is None
+            else relation.multiplier * q[names.index(relation.leader)] + relation.offset
+        )
         x = value + float(body.joint.offset)
-        poses.append(parent @ np.asarray(body.placement, dtype=float) @ joint_motion(body.joint.kind, body.joint.axis, x))
+        poses.append(
+            parent @ np.asarray(body.placement, dtype=float) @ joint_motion(body.joint.kind, body.joint.axis, x)
+        )
     return poses
 
 
@@ -115,6 +121,9 @@ def symbolic_backend_robots() -> dict:
     ``puma560_drives`` has viscous and direction-dependent Coulomb friction (sign(qd)) and rotor inertia."""
     import kinedyn as kd
 
-    return {"planar_2r": kd.robots.planar_2r, "puma560": kd.robots.puma560,
-            "ur5": lambda: kd.Robot.from_urdf(erd(*UR5)),
-            "puma560_drives": lambda: kd.robots.puma560(friction=True, motors=True)}
+    return {
+        "planar_2r": kd.robots.planar_2r,
+        "puma560": kd.robots.puma560,
+        "ur5": lambda: kd.Robot.from_urdf(erd(*UR5)),
+        "puma560_drives": lambda: kd.robots.puma560(friction=True, motors=True),
+    }

@@ -164,7 +164,9 @@ def test_identification_without_used_rows_means_all_base_parameters():
     rng = np.random.default_rng(3)
     q, qd, qdd = rng.normal(size=(5, 2)), rng.normal(size=(5, 2)), rng.normal(size=(5, 2))
     np.testing.assert_allclose(everything.predict(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
-    np.testing.assert_allclose(everything.robot.inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8)
+    np.testing.assert_allclose(
+        everything.robot.inverse_dynamics(q, qd, qdd), robot.inverse_dynamics(q, qd, qdd), atol=1e-8
+    )
 
 
 # ------------------------------------------------------------------ elbow_3r upright; check deterministic

@@ -9,7 +9,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-import sympy as sp
 
 import kinedyn as kd
 from kinedyn.robots import industrial
@@ -26,7 +25,10 @@ def test_joint_levels_symmetric_api_and_errors():
     assert s.coulomb_negative is None and s.coulomb_levels == (0.3, 0.3) and s.coulomb_is_symmetric
     assert kd.Joint("j", coulomb=(0.3, 0.3)) == s  # two equal levels are the symmetric joint
     assert (j.coulomb_torque(2.0), j.coulomb_torque(-2.0), j.coulomb_torque(0.0)) == (0.4, -0.7, 0.0)
-    with pytest.raises(ValueError, match=r"joint 'j': coulomb_negative must be >= 0, got -0.435 \(a level, not a signed torque: Corke's"):
+    with pytest.raises(
+        ValueError,
+        match=r"joint 'j': coulomb_negative must be >= 0, got -0.435 \(a level, not a signed torque: Corke's",
+    ):
         kd.Joint("j", coulomb=(0.395, -0.435))
     with pytest.raises(ValueError, match=r"joint 'j': coulomb must be one level or a pair"):
         kd.Joint("j", coulomb=(0.1, 0.2, 0.3))
@@ -40,8 +42,10 @@ def test_joint_levels_symmetric_api_and_errors():
 
 def puma_levels():
     """(|G| Tc+, |G| |Tc-|) per joint from the published motor table (RTB's Link.friction)."""
-    return (np.array([abs(g) * tc[0] for _, g, _, tc in industrial.PUMA560_MOTORS]),
-            np.array([abs(g) * -tc[1] for _, g, _, tc in industrial.PUMA560_MOTORS]))
+    return (
+        np.array([abs(g) * tc[0] for _, g, _, tc in industrial.PUMA560_MOTORS]),
+        np.array([abs(g) * -tc[1] for _, g, _, tc in industrial.PUMA560_MOTORS]),
+    )
 
 
 def test_puma_rnea_gives_each_direction_its_published_level():
@@ -62,7 +66,12 @@ def test_puma_rnea_gives_each_direction_its_published_level():
     assert not np.allclose(positive, negative)  # the model really is asymmetric
     # RTB's friction(qd) = -|G| (B |G| qd + Tc±) is minus kinedyn's friction_torque
     qd = np.array([0.5, -0.2, 0.1, -1.0, 1.0, -1.0])
-    rtb = np.array([-abs(g) * (b * abs(g) * w + (tc[0] if w > 0 else tc[1])) for (_, g, b, tc), w in zip(industrial.PUMA560_MOTORS, qd)])
+    rtb = np.array(
+        [
+            -abs(g) * (b * abs(g) * w + (tc[0] if w > 0 else tc[1]))
+            for (_, g, b, tc), w in zip(industrial.PUMA560_MOTORS, qd)
+        ]
+    )
     np.testing.assert_allclose(robot.friction_torque(qd), -rtb, rtol=1e-12)
 
 
@@ -74,7 +83,11 @@ def test_forward_dynamics_inverts_inverse_dynamics_with_asymmetric_friction():
     qdd = rng.normal(size=(5, 6))
     tau = robot.inverse_dynamics(q, qd, qdd)
     np.testing.assert_allclose(robot.forward_dynamics(q, qd, tau), qdd, atol=1e-8)
-    np.testing.assert_allclose(tau, np.einsum("kij,kj->ki", robot.mass_matrix(q), qdd) + robot.bias_torque(q, qd) + robot.friction_torque(qd), atol=1e-9)
+    np.testing.assert_allclose(
+        tau,
+        np.einsum("kij,kj->ki", robot.mass_matrix(q), qdd) + robot.bias_torque(q, qd) + robot.friction_torque(qd),
+        atol=1e-9,
+    )
 
 
 def test_native_model_rejects_bad_negative_levels():
@@ -82,9 +95,20 @@ def test_native_model_rejects_bad_negative_levels():
 
     robot = kd.robots.planar_2r()
     eye = np.eye(4)
-    args = dict(parent=np.array([-1]), kind=np.array([0]), axis=np.array([[0, 0, 1.0]]), offset=np.zeros(1), placement=eye[None].copy(),
-                inertia=np.array([[1.0, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1]]), armature=np.zeros(1), viscous=np.zeros(1),
-                coulomb=np.zeros(1), gravity=np.array([0, 0, -9.81]), frame_body=np.array([0]), frame_placement=eye[None].copy())
+    args = dict(
+        parent=np.array([-1]),
+        kind=np.array([0]),
+        axis=np.array([[0, 0, 1.0]]),
+        offset=np.zeros(1),
+        placement=eye[None].copy(),
+        inertia=np.array([[1.0, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1]]),
+        armature=np.zeros(1),
+        viscous=np.zeros(1),
+        coulomb=np.zeros(1),
+        gravity=np.array([0, 0, -9.81]),
+        frame_body=np.array([0]),
+        frame_placement=eye[None].copy(),
+    )
     with pytest.raises(ValueError, match="coulomb_negative of joint 0 is -1"):
         _core.Model(**args, coulomb_negative=np.array([-1.0]))
     with pytest.raises(ValueError, match="coulomb_negative has 2 entries for 1 bodies"):
@@ -113,7 +137,9 @@ def test_a_spinning_joint_decelerates_at_each_level_and_dissipates_energy(method
         # the implicit step sticks (friction stops a joint, it does not reverse it); explicit RK4
         # chatters about rest by at most one step's velocity change, max level / I * dt
         chatter = 0.0 if method == "implicit" else max(c_pos, c_neg) / inertia * 1e-3 * (1 + 1e-9)
-        assert np.all(np.abs(qd[t > stop + 0.01]) <= chatter + 1e-12), f"{method}: the joint must stop (qd0 {sign * v0})"
+        assert np.all(np.abs(qd[t > stop + 0.01]) <= chatter + 1e-12), (
+            f"{method}: the joint must stop (qd0 {sign * v0})"
+        )
         K = 0.5 * inertia * qd[t < stop] ** 2
         assert np.all(np.diff(K) < 0)
         balance = traj.energy_balance()
@@ -126,7 +152,11 @@ def test_symbolic_equations_carry_both_levels():
     eom = robot.equations_of_motion()
     qd = eom.qd[0]
     f = eom.friction[0]
-    assert float(f.subs(qd, 3)) == pytest.approx(0.2) and float(f.subs(qd, -3)) == pytest.approx(-0.5) and f.subs(qd, 0) == 0
+    assert (
+        float(f.subs(qd, 3)) == pytest.approx(0.2)
+        and float(f.subs(qd, -3)) == pytest.approx(-0.5)
+        and f.subs(qd, 0) == 0
+    )
     # tau evaluated at both signs equals the numeric RNEA
     puma = kd.robots.puma560(friction=True)
     e = puma.equations_of_motion(method="newton_euler")
@@ -161,7 +191,9 @@ def test_robot_file_errors_name_the_field(tmp_path):
     text = "name: r\njoints:\n  - {a: 1.0, coulomb: [0.4, -0.3]}\n"
     path = tmp_path / "r.yaml"
     path.write_text(text)
-    with pytest.raises(ValueError, match=r"r\.yaml.*joints row 1\.coulomb\[1\].*a Coulomb level is a magnitude >= 0, got -0\.3"):
+    with pytest.raises(
+        ValueError, match=r"r\.yaml.*joints row 1\.coulomb\[1\].*a Coulomb level is a magnitude >= 0, got -0\.3"
+    ):
         kd.load(path)
     path.write_text("name: r\njoints:\n  - {a: 1.0, coulomb: [0.4, 0.3, 0.1]}\n")
     with pytest.raises(ValueError, match=r"joints row 1\.coulomb.*two levels, got 3 values"):

@@ -6,10 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reference import symbolic_backend_robots
 
 import kinedyn as kd
-
-from reference import symbolic_backend_robots
 
 ca = pytest.importorskip("casadi")
 
@@ -57,7 +56,9 @@ def test_casadi_jacobians_equal_the_analytical_derivatives(robot_and_functions):
     robot, f = robot_and_functions
     q, qd, qdd = (ca.SX.sym(s, robot.n) for s in ("q", "qd", "qdd"))
     tau = f.tau(q, qd, qdd)
-    jac = ca.Function("tau_derivatives", [q, qd, qdd], [ca.jacobian(tau, q), ca.jacobian(tau, qd), ca.jacobian(tau, qdd)])
+    jac = ca.Function(
+        "tau_derivatives", [q, qd, qdd], [ca.jacobian(tau, q), ca.jacobian(tau, qd), ca.jacobian(tau, qdd)]
+    )
     for _ in range(3):
         x = RNG.uniform(-2, 2, size=(3, robot.n))
         dq, dqd, M = robot.inverse_dynamics_derivatives(*x)
@@ -132,6 +133,7 @@ def test_trajectory_optimisation_is_reproduced_by_simulate():
     # same trajectory up to rounding
     same = kd.simulate(robot, T, x0, u=U, method="rk4", dt=h)
     np.testing.assert_allclose(np.hstack([same.q, same.qd]), X, atol=1e-9)
+
     # 2. an accurate adaptive integration (DOP853, 1e-11) differs by the optimiser's RK4 discretisation
     # error; estimated by Richardson extrapolation (RK4 is 4th order: err(h) ~ 16/15 |x_h - x_h/2|),
     # integrating the same torques with two RK4 half steps per interval

@@ -9,10 +9,10 @@ import warnings
 
 import numpy as np
 import pytest
+from reference import UR5, all_frame_poses, erd, frame_pose, pose, random_q, rotation
 
 import kinedyn as kd
 from kinedyn.robots import industrial
-from reference import UR5, all_frame_poses, erd, frame_pose, pose, random_q, rotation
 
 X, Y, Z = np.eye(3)
 
@@ -144,9 +144,8 @@ def test_ur5_published_values():
 # ------------------------------------------------------------------------ PUMA, Stanford
 def test_puma_published_inertias_are_kept_with_a_warning():
     """The tabulated link-3 tensor fails the triangle inequality: kept as published, with a warning."""
-    from kinedyn.description.inertia import PhysicalConsistencyWarning
-
     from kinedyn.description import inertia
+    from kinedyn.description.inertia import PhysicalConsistencyWarning
 
     assert industrial.PUMA560_INERTIAS[2] == (0.066, 0.086, 0.0125)
     inertia._WARNED.clear()
@@ -250,8 +249,10 @@ def test_stanford_follows_the_published_model():
         (0.0, 0.0, 0.0, math.pi / 2, "revolute", 0.630, (0, 0.566, 0.003), (0.003, 0.0004, 0.0), 0.097),
         (0.0, 0.0, 0.0, 0.0, "revolute", 0.51, (0, 0, 1.554), (0.013, 0.013, 0.0003), 0.020),
     ]
-    rows = [DHRow(theta=th, d=d, a=a, alpha=al, kind=kind, inertia=Inertia(m, r, np.diag(I)), rotor_inertia=jm)
-            for th, d, a, al, kind, m, r, I, jm in table]
+    rows = [
+        DHRow(theta=th, d=d, a=a, alpha=al, kind=kind, inertia=Inertia(m, r, np.diag(I)), rotor_inertia=jm)
+        for th, d, a, al, kind, m, r, I, jm in table
+    ]
     tool = np.eye(4)
     tool[2, 3] = 0.263
     published = kd.Robot.from_dh(rows, gravity=(0, 0, -9.81), tool=tool)

@@ -133,15 +133,40 @@ def test_python_dash_m_kinedyn_is_the_command():
     import sys
     from pathlib import Path
 
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]))
-    done = subprocess.run([sys.executable, "-m", "kinedyn", "fk", "planar_2r", "--q", "0", "0", "--json"], capture_output=True, text=True, env=env, timeout=120)
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "kinedyn", "fk", "planar_2r", "--q", "0", "0", "--json"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["frames"]["tool"]["position"] == [5.0, 0.0, 0.0]
 
 
 def test_dynamics_json_equals_the_library(capsys):
-    q, qd, qdd, tau = [0.1, -0.4, 0.7, 0.2, -1.0, 0.5], [0.3, 0.2, -0.1, 0.4, 0.0, 1.0], [1.0, -2.0, 0.5, 0.0, 0.3, -0.2], [5.0, 40.0, 10.0, 1.0, 0.5, 0.1]
-    args = ["dynamics", "ur5", "--q", *map(str, q), "--qd", *map(str, qd), "--qdd", *map(str, qdd), "--tau", *map(str, tau), "--derivatives"]
+    q, qd, qdd, tau = (
+        [0.1, -0.4, 0.7, 0.2, -1.0, 0.5],
+        [0.3, 0.2, -0.1, 0.4, 0.0, 1.0],
+        [1.0, -2.0, 0.5, 0.0, 0.3, -0.2],
+        [5.0, 40.0, 10.0, 1.0, 0.5, 0.1],
+    )
+    args = [
+        "dynamics",
+        "ur5",
+        "--q",
+        *map(str, q),
+        "--qd",
+        *map(str, qd),
+        "--qdd",
+        *map(str, qdd),
+        "--tau",
+        *map(str, tau),
+        "--derivatives",
+    ]
     doc = run_json(capsys, *args)
     robot = kd.robots.ur5()
     np.testing.assert_allclose(doc["mass_matrix"], robot.mass_matrix(q), rtol=1e-13)
@@ -149,7 +174,9 @@ def test_dynamics_json_equals_the_library(capsys):
     np.testing.assert_allclose(doc["gravity_torque"], robot.gravity_torque(q), rtol=1e-13)
     np.testing.assert_allclose(doc["tau"], robot.inverse_dynamics(q, qd, qdd), rtol=1e-13)
     np.testing.assert_allclose(doc["forward_dynamics_qdd"], robot.forward_dynamics(q, qd, tau), rtol=1e-12)
-    np.testing.assert_allclose(doc["dtau_dq"], robot.inverse_dynamics_derivatives(q, qd, qdd)[0], rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(
+        doc["dtau_dq"], robot.inverse_dynamics_derivatives(q, qd, qdd)[0], rtol=1e-13, atol=1e-13
+    )
     assert doc["kinetic_energy"] == pytest.approx(robot.kinetic_energy(q, qd))
     code, text, _ = run(capsys, *args)
     assert code == 0 and "mass matrix" in text and "dtau/dq" in text
@@ -160,8 +187,15 @@ def test_jsonable_converts_every_numpy_scalar():
 
     from kinedyn.cli import _jsonable
 
-    payload = {"b": np.bool_(True), "i": np.int32(3), "f": np.float32(0.5), "nan": np.float64("nan"),
-               "inf": np.float64("inf"), "c": np.complex128(1 + 2j), "a": np.array([np.True_, np.False_])}
+    payload = {
+        "b": np.bool_(True),
+        "i": np.int32(3),
+        "f": np.float32(0.5),
+        "nan": np.float64("nan"),
+        "inf": np.float64("inf"),
+        "c": np.complex128(1 + 2j),
+        "a": np.array([np.True_, np.False_]),
+    }
     back = _json.loads(_json.dumps(_jsonable(payload)))
     assert back == {"b": True, "i": 3, "f": 0.5, "nan": None, "inf": "inf", "c": [1.0, 2.0], "a": [True, False]}
 
@@ -191,8 +225,12 @@ def test_simulate_energy_drift_at_rest_has_no_relative_value():
     from kinedyn.simulate.cli import _energy_drift
 
     still = SimpleNamespace(H=np.full(5, -3.0), K=np.zeros(5), P=np.full(5, -3.0))
-    assert _energy_drift(still) == {"energy_drift": 0.0, "energy_scale": 0.0, "energy_scale_basis": "max K + (max P - min P) over the run",
-                                    "energy_drift_relative": None}
+    assert _energy_drift(still) == {
+        "energy_drift": 0.0,
+        "energy_scale": 0.0,
+        "energy_scale_basis": "max K + (max P - min P) over the run",
+        "energy_drift_relative": None,
+    }
 
 
 def _elbow_linear_jacobian(q, L2=2.0, L3=1.0):

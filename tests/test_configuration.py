@@ -19,17 +19,41 @@ import kinedyn as kd
 from kinedyn import Joint, Link
 from kinedyn import configuration as cfg
 
-KINDS = [("root", "floating"), ("ball", "spherical"), ("slide_plane", "planar"), ("elbow", "revolute"), ("rail", "prismatic")]
-Q_SLICES = {"root": slice(0, 7), "ball": slice(7, 11), "slide_plane": slice(11, 15), "elbow": slice(15, 16), "rail": slice(16, 17)}
-V_SLICES = {"root": slice(0, 6), "ball": slice(6, 9), "slide_plane": slice(9, 12), "elbow": slice(12, 13), "rail": slice(13, 14)}
+KINDS = [
+    ("root", "floating"),
+    ("ball", "spherical"),
+    ("slide_plane", "planar"),
+    ("elbow", "revolute"),
+    ("rail", "prismatic"),
+]
+Q_SLICES = {
+    "root": slice(0, 7),
+    "ball": slice(7, 11),
+    "slide_plane": slice(11, 15),
+    "elbow": slice(15, 16),
+    "rail": slice(16, 17),
+}
+V_SLICES = {
+    "root": slice(0, 6),
+    "ball": slice(6, 9),
+    "slide_plane": slice(9, 12),
+    "elbow": slice(12, 13),
+    "rail": slice(13, 14),
+}
 
 
 def mixed_robot() -> kd.Robot:
     """A chain of every joint kind, with a fixed joint in the middle (merged: no block in q)."""
     links, parent = [], None
     for i, (name, kind) in enumerate(KINDS):
-        links.append(Link(f"l{i}", parent, Joint(name, kind=kind, axis=(1.0, 0, 0) if kind == "prismatic" else (0, 0, 1.0)),
-                          placement=np.eye(4)))
+        links.append(
+            Link(
+                f"l{i}",
+                parent,
+                Joint(name, kind=kind, axis=(1.0, 0, 0) if kind == "prismatic" else (0, 0, 1.0)),
+                placement=np.eye(4),
+            )
+        )
         parent = f"l{i}"
         if i == 2:
             links.append(Link("bracket", parent, Joint("weld", kind="fixed")))
@@ -44,8 +68,13 @@ ROBOT = mixed_robot()
 def pin_model():
     pin = pytest.importorskip("pinocchio", reason="Pinocchio (pip install pin) is an optional test oracle")
     model, parent = pin.Model(), 0
-    joint_models = {"floating": pin.JointModelFreeFlyer(), "spherical": pin.JointModelSpherical(),
-                    "planar": pin.JointModelPlanar(), "revolute": pin.JointModelRZ(), "prismatic": pin.JointModelPX()}
+    joint_models = {
+        "floating": pin.JointModelFreeFlyer(),
+        "spherical": pin.JointModelSpherical(),
+        "planar": pin.JointModelPlanar(),
+        "revolute": pin.JointModelRZ(),
+        "prismatic": pin.JointModelPX(),
+    }
     for name, kind in KINDS:
         parent = model.addJoint(parent, joint_models[kind], pin.SE3.Identity(), name)
     return pin, model
@@ -108,7 +137,12 @@ def test_difference_matches_pinocchio(pin_model, scale):
         mine, theirs = ROBOT.difference(q0, q1), pin.difference(model, q0, q1)
         rest = np.r_[0:9, 12:14]
         np.testing.assert_allclose(mine[rest], theirs[rest], atol=1e-12, rtol=0)
-        np.testing.assert_allclose(mine[planar], se2_log_50_digits(q0[Q_SLICES["slide_plane"]], q1[Q_SLICES["slide_plane"]]), atol=1e-14, rtol=0)
+        np.testing.assert_allclose(
+            mine[planar],
+            se2_log_50_digits(q0[Q_SLICES["slide_plane"]], q1[Q_SLICES["slide_plane"]]),
+            atol=1e-14,
+            rtol=0,
+        )
         np.testing.assert_allclose(mine[planar], theirs[planar], atol=1e-8, rtol=0)
 
 
@@ -242,10 +276,14 @@ def test_batches_equal_row_by_row():
     assert q0.shape == (7, ROBOT.nq)
     np.testing.assert_array_equal(ROBOT.integrate(q0, v), np.array([ROBOT.integrate(a, b) for a, b in zip(q0, v)]))
     np.testing.assert_array_equal(ROBOT.difference(q0, q1), np.array([ROBOT.difference(a, b) for a, b in zip(q0, q1)]))
-    np.testing.assert_array_equal(ROBOT.interpolate(q0, q1, t), np.array([ROBOT.interpolate(a, b, s) for a, b, s in zip(q0, q1, t)]))
+    np.testing.assert_array_equal(
+        ROBOT.interpolate(q0, q1, t), np.array([ROBOT.interpolate(a, b, s) for a, b, s in zip(q0, q1, t)])
+    )
     # one configuration against a batch of velocities, and a batch of time steps
     np.testing.assert_array_equal(ROBOT.integrate(q0[0], v), np.array([ROBOT.integrate(q0[0], b) for b in v]))
-    np.testing.assert_array_equal(ROBOT.integrate(q0[0], v[0], t), np.array([ROBOT.integrate(q0[0], v[0], s) for s in t]))
+    np.testing.assert_array_equal(
+        ROBOT.integrate(q0[0], v[0], t), np.array([ROBOT.integrate(q0[0], v[0], s) for s in t])
+    )
     # a path: one pair of ends, many t
     assert ROBOT.interpolate(q0[0], q1[0], np.linspace(0, 1, 5)).shape == (5, ROBOT.nq)
     assert ROBOT.random_configuration(0, size=0).shape == (0, ROBOT.nq)
@@ -280,11 +318,17 @@ def test_random_rotations_are_uniform():
 def test_random_configuration_of_one_dof_robots_is_unchanged():
     """The draws of 1-DOF robots are those of before (one uniform call over the joints' ranges), so
     seeded states elsewhere in the suite stay what they were."""
-    robot = kd.Robot([Link("a", None, Joint("j1", lower=-0.5, upper=2.0)),
-                      Link("b", "a", Joint("j2", kind="prismatic", lower=5.0)),
-                      Link("c", "b", Joint("j3"))])
+    robot = kd.Robot(
+        [
+            Link("a", None, Joint("j1", lower=-0.5, upper=2.0)),
+            Link("b", "a", Joint("j2", kind="prismatic", lower=5.0)),
+            Link("c", "b", Joint("j3")),
+        ]
+    )
     lo, hi = np.array([-0.5, 5.0, -math.pi]), np.array([2.0, 7.0, math.pi])
-    np.testing.assert_array_equal(robot.random_configuration(4, size=6), np.random.default_rng(4).uniform(lo, hi, size=(6, 3)))
+    np.testing.assert_array_equal(
+        robot.random_configuration(4, size=6), np.random.default_rng(4).uniform(lo, hi, size=(6, 3))
+    )
     np.testing.assert_array_equal(robot.random_configuration(4), np.random.default_rng(4).uniform(lo, hi, size=3))
 
 
@@ -298,8 +342,11 @@ def test_floating_position_respects_finite_limits():
 def test_non_unit_quaternion_is_refused_naming_the_joint():
     q = ROBOT.neutral()
     q[7:11] = [0.1, 0.0, 0.0, 1.0]
-    with pytest.raises(ValueError, match=r"q\[7:11\] of spherical joint 'ball' is the quaternion \(qx, qy, qz, qw\).*"
-                                         r"not 1 to within 1e-06.*robot\.normalize\(q\)"):
+    with pytest.raises(
+        ValueError,
+        match=r"q\[7:11\] of spherical joint 'ball' is the quaternion \(qx, qy, qz, qw\).*"
+        r"not 1 to within 1e-06.*robot\.normalize\(q\)",
+    ):
         ROBOT.integrate(q, np.zeros(ROBOT.nv))
     fixed = ROBOT.normalize(q)
     np.testing.assert_allclose(fixed[7:11], np.array([0.1, 0, 0, 1]) / math.hypot(0.1, 1), atol=1e-16)
@@ -316,7 +363,10 @@ def test_non_unit_quaternion_is_refused_naming_the_joint():
 def test_planar_pair_and_batch_state_are_named():
     q = ROBOT.random_configuration(0, size=4)
     q[2, 13:15] = [1.0, 1.0]
-    with pytest.raises(ValueError, match=r"q1\[13:15\] of planar joint 'slide_plane' is the \(cos theta, sin theta\) pair.* at state 2 of the batch"):
+    with pytest.raises(
+        ValueError,
+        match=r"q1\[13:15\] of planar joint 'slide_plane' is the \(cos theta, sin theta\) pair.* at state 2 of the batch",
+    ):
         ROBOT.difference(q[0], q)
 
 
@@ -353,18 +403,22 @@ def test_python_reproduces_the_vectors_shared_with_the_rust_core():
     from pathlib import Path
 
     source = (Path(__file__).parents[1] / "crates" / "kinedyn-core" / "src" / "lie.rs").read_text(encoding="utf-8")
-    shared = source[source.index("// BEGIN SHARED VECTORS"):source.index("// END SHARED VECTORS")]
+    shared = source[source.index("// BEGIN SHARED VECTORS") : source.index("// END SHARED VECTORS")]
     kinds = {"Scalar": "revolute", "Spherical": "spherical", "FreeFlyer": "floating", "Planar": "planar"}
 
     def numbers(text):
         return np.array([float(x) for x in text.split(",") if x.strip()])
 
     integrate_part, difference_part = shared.split("const DIFFERENCE_VECTORS")
-    rows = re.findall(r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*([-+.\deE]+),\s*&\[([^\]]*)\],?\s*\)", integrate_part)
+    rows = re.findall(
+        r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*([-+.\deE]+),\s*&\[([^\]]*)\],?\s*\)", integrate_part
+    )
     assert len(rows) == 16
     for kind, q, v, dt, expected in rows:
         space = cfg.ConfigurationSpace([Joint("j", kind=kinds[kind])])
-        np.testing.assert_allclose(space.integrate(numbers(q), numbers(v), float(dt)), numbers(expected), atol=1e-15, rtol=0)
+        np.testing.assert_allclose(
+            space.integrate(numbers(q), numbers(v), float(dt)), numbers(expected), atol=1e-15, rtol=0
+        )
     rows = re.findall(r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],?\s*\)", difference_part)
     assert len(rows) == 16
     for kind, q0, q1, expected in rows:
@@ -380,7 +434,8 @@ def test_mujoco_conversion_of_docs_conventions():
     mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is an optional test oracle")
     model = mujoco.MjModel.from_xml_string(
         "<mujoco><worldbody><body name='b'><freejoint/><geom size='.1' mass='1'/>"
-        "<body name='c'><joint type='ball'/><geom size='.1' mass='1' pos='0 0 .3'/></body></body></worldbody></mujoco>")
+        "<body name='c'><joint type='ball'/><geom size='.1' mass='1' pos='0 0 .3'/></body></body></worldbody></mujoco>"
+    )
     robot = kd.Robot([Link("b", None, Joint("free", kind="floating")), Link("c", "b", Joint("ball", kind="spherical"))])
     assert (model.nq, model.nv) == (robot.nq, robot.nv)
 
@@ -409,8 +464,10 @@ def tangent_columns(f, x, perturb, h=1e-6):
     """Central differences of f along each tangent direction of x: (f(x ⊕ h e_i) ⊖ f(x ⊕ -h e_i)) / 2h,
     measured in the tangent space at f(x) (so that the columns are in the same coordinates as v)."""
     here = f(x)
-    columns = [(ROBOT.difference(here, f(perturb(x, h * e))) - ROBOT.difference(here, f(perturb(x, -h * e)))) / (2 * h)
-               for e in np.eye(ROBOT.nv)]
+    columns = [
+        (ROBOT.difference(here, f(perturb(x, h * e))) - ROBOT.difference(here, f(perturb(x, -h * e)))) / (2 * h)
+        for e in np.eye(ROBOT.nv)
+    ]
     return np.array(columns).T
 
 
@@ -420,8 +477,12 @@ def test_integrate_jacobians_by_finite_differences(scale):
     for _ in range(10):
         q, v = ROBOT.random_configuration(rng), random_velocity(rng, scale)
         d_q, d_v = cfg.integrate_jacobians(ROBOT, q, v, 0.5)
-        np.testing.assert_allclose(d_q, tangent_columns(lambda x: ROBOT.integrate(x, v, 0.5), q, ROBOT.integrate), atol=1e-8, rtol=0)
-        np.testing.assert_allclose(d_v, tangent_columns(lambda w: ROBOT.integrate(q, w, 0.5), v, lambda w, e: w + e), atol=1e-8, rtol=0)
+        np.testing.assert_allclose(
+            d_q, tangent_columns(lambda x: ROBOT.integrate(x, v, 0.5), q, ROBOT.integrate), atol=1e-8, rtol=0
+        )
+        np.testing.assert_allclose(
+            d_v, tangent_columns(lambda w: ROBOT.integrate(q, w, 0.5), v, lambda w, e: w + e), atol=1e-8, rtol=0
+        )
 
 
 @pytest.mark.parametrize("scale", [1e-3, 0.3, 2.0])
@@ -513,12 +574,12 @@ def test_velocity_jacobian_is_the_series_of_the_adjoint(theta):
         v = with_rotation_angles(v, theta)
         _, d_v = cfg.integrate_jacobians(ROBOT, q, v)
         rho, omega = v[0:3], v[3:6]
-        ad = np.block([[skew(omega), skew(rho)], [np.zeros((3, 3)), skew(omega)]])   # [ρ; ω]: ad = [[ω×, ρ×], [0, ω×]]
+        ad = np.block([[skew(omega), skew(rho)], [np.zeros((3, 3)), skew(omega)]])  # [ρ; ω]: ad = [[ω×, ρ×], [0, ω×]]
         np.testing.assert_allclose(d_v[0:6, 0:6], series(ad), atol=1e-15 * max(1, np.abs(v).max() ** 2), rtol=0)
-        ad = skew(v[6:9])                                                            # SO(3): ad = ω×
+        ad = skew(v[6:9])  # SO(3): ad = ω×
         np.testing.assert_allclose(d_v[6:9, 6:9], series(ad), atol=1e-15, rtol=0)
         (vx, vy, w) = v[9:12]
-        ad = np.array([[0, -w, vy], [w, 0, -vx], [0, 0, 0]])                        # SE(2): [[ω J, -J ρ], [0, 0]]
+        ad = np.array([[0, -w, vy], [w, 0, -vx], [0, 0, 0]])  # SE(2): [[ω J, -J ρ], [0, 0]]
         np.testing.assert_allclose(d_v[9:12, 9:12], series(ad), atol=1e-15 * max(1, np.abs(v).max() ** 2), rtol=0)
 
 
@@ -533,7 +594,15 @@ def test_integrate_moves_every_body_with_the_cores_velocity():
         placement = np.eye(4)
         placement[:3, 3] = rng.normal(size=3) * 0.3
         axis = (1.0, 0, 0) if kind == "prismatic" else (0, 0, 1.0)
-        links.append(Link(f"l{i}", parent, Joint(name, kind=kind, axis=axis), placement=placement, inertia=kd.Inertia.box(1.0, (0.1, 0.2, 0.3))))
+        links.append(
+            Link(
+                f"l{i}",
+                parent,
+                Joint(name, kind=kind, axis=axis),
+                placement=placement,
+                inertia=kd.Inertia.box(1.0, (0.1, 0.2, 0.3)),
+            )
+        )
         parent = f"l{i}"
     robot = kd.Robot(links, name="mixed")
     h = 1e-6
@@ -544,6 +613,8 @@ def test_integrate_moves_every_body_with_the_cores_velocity():
             T, T_ahead, T_behind = robot.pose(q, body), robot.pose(ahead, body), robot.pose(behind, body)
             R = T[:3, :3]
             linear = R.T @ (T_ahead[:3, 3] - T_behind[:3, 3]) / (2 * h)
-            spin = R.T @ (T_ahead[:3, :3] - T_behind[:3, :3]) / (2 * h)   # [ω]× in the body's axes
+            spin = R.T @ (T_ahead[:3, :3] - T_behind[:3, :3]) / (2 * h)  # [ω]× in the body's axes
             angular = np.array([spin[2, 1], spin[0, 2], spin[1, 0]])
-            np.testing.assert_allclose(np.r_[linear, angular], robot.frame_velocity(q, v, body, reference="local"), atol=1e-7)
+            np.testing.assert_allclose(
+                np.r_[linear, angular], robot.frame_velocity(q, v, body, reference="local"), atol=1e-7
+            )

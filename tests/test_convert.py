@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from reference import PANDA, UR5, erd
 
 import kinedyn as kd
 from kinedyn._math import matmul, rot_axis, rpy_to_matrix, translation
@@ -21,7 +22,6 @@ from kinedyn.description.geometry import Cylinder
 from kinedyn.description.joint import Joint
 from kinedyn.description.link import Link
 from kinedyn.testing import random_robot
-from reference import PANDA, UR5, erd
 
 DH_BUILTINS = ["planar_2r", "elbow_3r", "cartesian_2p", "puma560", "stanford", "ur5"]
 
@@ -36,8 +36,16 @@ def with_posts(robot, seed):
     standard DH link has), so the writers' handling of ``post`` is exercised on trees too."""
     rng = np.random.default_rng(seed)
     links = [
-        Link(l.name, l.parent, l.joint, l.placement, matmul(translation(*rng.uniform(-0.3, 0.3, 3)), rot_axis(_unit(rng), rng.uniform(-3, 3))), l.inertia)
-        if l.joint.is_moving else l
+        Link(
+            l.name,
+            l.parent,
+            l.joint,
+            l.placement,
+            matmul(translation(*rng.uniform(-0.3, 0.3, 3)), rot_axis(_unit(rng), rng.uniform(-3, 3))),
+            l.inertia,
+        )
+        if l.joint.is_moving
+        else l
         for l in robot.links
     ]
     return robot.replace(links=links, name=f"{robot.name}_posts")
@@ -54,7 +62,10 @@ def same_robot(source, result, states=3, seed=0, armature_dropped=False, frames=
         extra = np.diag(source.armature) if armature_dropped else 0.0
         worst["M"] = max(worst["M"], float(np.abs(source.mass_matrix(q) - result.mass_matrix(q) - extra).max()))
         tau_extra = source.armature * qdd if armature_dropped else 0.0
-        worst["tau"] = max(worst["tau"], float(np.abs(source.inverse_dynamics(q, qd, qdd) - result.inverse_dynamics(q, qd, qdd) - tau_extra).max()))
+        worst["tau"] = max(
+            worst["tau"],
+            float(np.abs(source.inverse_dynamics(q, qd, qdd) - result.inverse_dynamics(q, qd, qdd) - tau_extra).max()),
+        )
     return worst
 
 
@@ -65,7 +76,9 @@ def from_urdf_text(source, text):
 
 
 # ---------------------------------------------------------------------------------------- rotations
-@pytest.mark.parametrize("pitch", [math.pi / 2, -math.pi / 2, math.pi / 2 - 1e-9, -math.pi / 2 + 3e-13, 0.3, math.pi / 2 - 1e-5])
+@pytest.mark.parametrize(
+    "pitch", [math.pi / 2, -math.pi / 2, math.pi / 2 - 1e-9, -math.pi / 2 + 3e-13, 0.3, math.pi / 2 - 1e-5]
+)
 def test_rpy_is_exact_at_and_near_gimbal_lock(pitch):
     rng = np.random.default_rng(1)
     for _ in range(20):
@@ -92,7 +105,10 @@ def test_quaternion_is_mujocos_w_x_y_z():
         assert w >= 0
         # q = (cos a/2, sin a/2 axis), up to the sign fixed by w >= 0
         expected = np.array([math.cos(angle / 2), *(math.sin(angle / 2) * axis)])
-        assert np.abs(np.array([w, x, y, z]) - expected).max() < 1e-12 or np.abs(np.array([w, x, y, z]) + expected).max() < 1e-12
+        assert (
+            np.abs(np.array([w, x, y, z]) - expected).max() < 1e-12
+            or np.abs(np.array([w, x, y, z]) + expected).max() < 1e-12
+        )
 
 
 # ---------------------------------------------------------------------------------------- URDF
@@ -110,7 +126,9 @@ def test_dh_builtins_to_urdf_keep_kinematics_and_dynamics(name):
     assert back.visuals and all(v.frame in back.frame_names for v in back.visuals)
 
 
-@pytest.mark.parametrize("robot", [random_robot(3), with_posts(random_robot(4, branching=True, fixed=2), 4)], ids=lambda r: r.name)
+@pytest.mark.parametrize(
+    "robot", [random_robot(3), with_posts(random_robot(4, branching=True, fixed=2), 4)], ids=lambda r: r.name
+)
 def test_random_trees_with_offsets_and_posts_to_urdf(robot):
     assert any(float(j.offset) for j in robot.joints)  # the folding of offsets is exercised
     back = from_urdf_text(robot, robot.to_urdf())
@@ -133,7 +151,9 @@ def test_urdf_written_is_what_pinocchio_reads():
     for _ in range(3):
         q = rng.uniform(-1, 1, robot.n)
         # a continuous joint's configuration in Pinocchio is (cos q, sin q)
-        q_pin = np.concatenate([[q[k]] if model.joints[i + 1].nq == 1 else [math.cos(q[k]), math.sin(q[k])] for i, k in enumerate(index)])
+        q_pin = np.concatenate(
+            [[q[k]] if model.joints[i + 1].nq == 1 else [math.cos(q[k]), math.sin(q[k])] for i, k in enumerate(index)]
+        )
         M = pin.crba(model, data, q_pin)
         M = np.triu(M) + np.triu(M, 1).T
         ours = robot.mass_matrix(q)[np.ix_(index, index)] - np.diag(robot.armature[index])
@@ -217,8 +237,13 @@ def mujoco_state(model_text, q, qd):
 
 @pytest.mark.parametrize(
     "robot",
-    [kd.robots.get("elbow_3r"), repaired("stanford"), kd.robots.get("planar_2r"), random_robot(6, branching=True),
-     with_posts(random_robot(7, branching=True, fixed=2), 7)],
+    [
+        kd.robots.get("elbow_3r"),
+        repaired("stanford"),
+        kd.robots.get("planar_2r"),
+        random_robot(6, branching=True),
+        with_posts(random_robot(7, branching=True, fixed=2), 7),
+    ],
     ids=lambda r: r.name,
 )
 def test_mjcf_agrees_with_mujoco(robot, tmp_path):
@@ -295,7 +320,9 @@ def test_dh_from_ur5_and_panda_urdfs(convention):
     ur5 = _erd_robot(UR5)
     check_dh_extraction(ur5, convention)
     panda = _erd_robot(PANDA)
-    with pytest.raises(ValueError, match="joint 'panda_finger_joint2' branches off link 'panda_link7'.*joint 'panda_finger_joint1'"):
+    with pytest.raises(
+        ValueError, match="joint 'panda_finger_joint2' branches off link 'panda_link7'.*joint 'panda_finger_joint1'"
+    ):
         dh_from_robot(panda, convention)
     found = check_dh_extraction(panda.lock_joints(["panda_finger_joint1", "panda_finger_joint2"]), convention)
     if convention == "modified":
@@ -309,11 +336,23 @@ def test_dh_from_ur5_and_panda_urdfs(convention):
 def test_dh_from_chains_with_parallel_and_intersecting_axes():
     # parallel axes (planar_3r, elbow_3r's joints 2 and 3), intersecting (puma's wrist), collinear
     # (a prismatic joint along the revolute axis before it)
-    collinear = kd.Robot.from_dh([(0.3, 0.2, 0.0, 0.0), (0.0, 0.4, 0.0, 0.0, "prismatic"), (0.2, 0.0, 0.5, 0.7)], name="collinear")
-    stacked = kd.Robot([  # parallel z axes whose joint origins climb: the d = 0 choice puts the heights into d_1 only
-        Link(f"l{i}", f"l{i - 1}" if i else None, Joint(f"j{i}"), translation(0.3, 0.1 * i, 0.2), np.eye(4), kd.Inertia(1.0, (0.1, 0, 0), np.eye(3) * 0.01))
-        for i in range(3)
-    ], name="stacked")
+    collinear = kd.Robot.from_dh(
+        [(0.3, 0.2, 0.0, 0.0), (0.0, 0.4, 0.0, 0.0, "prismatic"), (0.2, 0.0, 0.5, 0.7)], name="collinear"
+    )
+    stacked = kd.Robot(
+        [  # parallel z axes whose joint origins climb: the d = 0 choice puts the heights into d_1 only
+            Link(
+                f"l{i}",
+                f"l{i - 1}" if i else None,
+                Joint(f"j{i}"),
+                translation(0.3, 0.1 * i, 0.2),
+                np.eye(4),
+                kd.Inertia(1.0, (0.1, 0, 0), np.eye(3) * 0.01),
+            )
+            for i in range(3)
+        ],
+        name="stacked",
+    )
     found = check_dh_extraction(stacked, "standard")
     assert found.rows[1].d == 0.0  # (row 3 climbs to the tool frame, by the tool origin choice)
     for source in (kd.robots.get("planar_3r"), collinear):
@@ -321,7 +360,9 @@ def test_dh_from_chains_with_parallel_and_intersecting_axes():
             found = check_dh_extraction(source, convention)
             if source.name == "planar_3r":  # parallel axes: the common normal through the previous origin, d = 0
                 assert [r.d for r in found.rows] == [0.0, 0.0, 0.0]
-                lengths = [float(r.a) for r in source.dh]  # Craig's rows hold a_{i-1}: the last length is in the tool transform
+                lengths = [
+                    float(r.a) for r in source.dh
+                ]  # Craig's rows hold a_{i-1}: the last length is in the tool transform
                 expected = lengths if convention == "standard" else [0.0] + lengths[:-1]
                 assert [abs(r.a) for r in found.rows] == pytest.approx(expected, abs=1e-15)
 
@@ -354,7 +395,12 @@ def _read_back_errors(out: str):
 
 @pytest.mark.parametrize("name", ["elbow_3r", "puma560", "stanford"])
 def test_cli_converts_dh_builtins_to_urdf_mjcf_yaml(capsys, tmp_path, name):
-    for out, extra in (("r.urdf", []), ("r.xml", ["--inertia", "repair"]), ("r.yaml", []), ("r.toml", ["--to", "dh", "--convention", "modified"])):
+    for out, extra in (
+        ("r.urdf", []),
+        ("r.xml", ["--inertia", "repair"]),
+        ("r.yaml", []),
+        ("r.toml", ["--to", "dh", "--convention", "modified"]),
+    ):
         if name == "puma560" and out == "r.xml":  # a massless link with rotor inertia: MuJoCo cannot hold it
             code, _, err = convert_cli(capsys, name, tmp_path / out, *extra)
             assert code == 1 and "link 'link1' has rotational inertia without mass" in err
@@ -389,7 +435,17 @@ def test_cli_convert_to_dh_needs_a_serial_chain(capsys, tmp_path):
     panda = erd(*PANDA)
     code, _, err = convert_cli(capsys, panda, tmp_path / "p.yaml", "--to", "dh")
     assert code == 1 and "joint 'panda_finger_joint2' branches off link 'panda_link7'" in err
-    code, text, err = convert_cli(capsys, panda, tmp_path / "p.yaml", "--to", "dh", "--lock", "panda_finger_joint1", "--lock", "panda_finger_joint2")
+    code, text, err = convert_cli(
+        capsys,
+        panda,
+        tmp_path / "p.yaml",
+        "--to",
+        "dh",
+        "--lock",
+        "panda_finger_joint1",
+        "--lock",
+        "panda_finger_joint2",
+    )
     assert code == 0 and "(DH standard, 7 joints)" in text and max(_read_back_errors(text)) < 1e-9, err
     dh = kd.load(tmp_path / "p.yaml")
     assert dh.dh is not None and len(dh.dh) == 7
@@ -422,12 +478,22 @@ def test_convert_check_catches_a_wrong_writer(capsys, tmp_path, monkeypatch):
 def legged():
     box = kd.Inertia.box(2.0, (0.4, 0.2, 0.1))
     rod = kd.Inertia.cylinder(0.5, 0.03, 0.3, com=(0, 0, -0.15))
-    return kd.Robot([
-        Link("trunk", None, Joint("root_joint", "floating"), np.eye(4), np.eye(4), box),
-        Link("hip", "trunk", Joint("hip_ball", "spherical"), translation(0.2, 0.1, 0), np.eye(4), rod),
-        Link("knee", "hip", Joint("knee", axis=(0, 1, 0), lower=-2, upper=0.1), translation(0, 0, -0.3), np.eye(4), rod),
-        Link("slider", "trunk", Joint("rail", "planar"), translation(-0.2, 0, 0), np.eye(4), rod),
-    ], name="legged")
+    return kd.Robot(
+        [
+            Link("trunk", None, Joint("root_joint", "floating"), np.eye(4), np.eye(4), box),
+            Link("hip", "trunk", Joint("hip_ball", "spherical"), translation(0.2, 0.1, 0), np.eye(4), rod),
+            Link(
+                "knee",
+                "hip",
+                Joint("knee", axis=(0, 1, 0), lower=-2, upper=0.1),
+                translation(0, 0, -0.3),
+                np.eye(4),
+                rod,
+            ),
+            Link("slider", "trunk", Joint("rail", "planar"), translation(-0.2, 0, 0), np.eye(4), rod),
+        ],
+        name="legged",
+    )
 
 
 def test_floating_spherical_and_planar_joints_in_urdf_and_mjcf():
@@ -443,7 +509,10 @@ def test_floating_spherical_and_planar_joints_in_urdf_and_mjcf():
     assert [(j.get("name"), j.get("type")) for j in root.findall("joint")] == [("rail", "planar")]
     # ... or stays a URDF floating joint below the base
     root = ET.fromstring(no_ball.to_urdf(floating_base_as_root=False))
-    assert [(j.get("name"), j.get("type")) for j in root.findall("joint")] == [("root_joint", "floating"), ("rail", "planar")]
+    assert [(j.get("name"), j.get("type")) for j in root.findall("joint")] == [
+        ("root_joint", "floating"),
+        ("rail", "planar"),
+    ]
     # MJCF holds them all: free (nq 7, nv 6), ball (4, 3), hinge, planar as slide x, slide y, hinge
     mujoco = pytest.importorskip("mujoco")
     m = mujoco.MjModel.from_xml_string(robot.to_mjcf())

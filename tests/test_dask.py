@@ -30,8 +30,12 @@ CHUNK = 120  # five chunks of states, the last one short
 def client():
     """One LocalCluster of two worker processes (one thread each) for the module."""
     env = {"PYTHONPATH": os.pathsep.join([str(Path(kinedyn.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=":0",
-                                  env=env, silence_logs=40) as cluster, distributed.Client(cluster) as c:
+    with (
+        distributed.LocalCluster(
+            processes=True, n_workers=2, threads_per_worker=1, dashboard_address=":0", env=env, silence_logs=40
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
         yield c
 
 
@@ -116,7 +120,11 @@ def test_cluster_equals_in_process_batch(client, robot, states):
     M, tau = robot.mass_matrix(lazy(q)), robot.inverse_dynamics(lazy(q), lazy(qd), lazy(qdd))
     dq, dqd, Minv = robot.forward_dynamics_derivatives(lazy(q), lazy(qd), lazy(qdd))
     got = dask.compute(M, tau, dq, dqd, Minv, scheduler=client.get)
-    expected = (robot.mass_matrix(q), robot.inverse_dynamics(q, qd, qdd), *robot.forward_dynamics_derivatives(q, qd, qdd))
+    expected = (
+        robot.mass_matrix(q),
+        robot.inverse_dynamics(q, qd, qdd),
+        *robot.forward_dynamics_derivatives(q, qd, qdd),
+    )
     for g, e in zip(got, expected):
         np.testing.assert_array_equal(g, e)
     # the tasks really ran in the worker processes
@@ -186,7 +194,9 @@ def test_results_compose_and_stay_lazy(robot, states):
     v = robot.frame_velocity(lazy(q), lazy(qd))
     speed = da.linalg.norm(v[:, :3], axis=1)
     assert isinstance(speed, da.Array)
-    np.testing.assert_array_equal(speed.compute(scheduler="sync"), np.linalg.norm(robot.frame_velocity(q, qd)[:, :3], axis=1))
+    np.testing.assert_array_equal(
+        speed.compute(scheduler="sync"), np.linalg.norm(robot.frame_velocity(q, qd)[:, :3], axis=1)
+    )
 
 
 def test_batch_inverse_kinematics(client, robot, states):
@@ -212,7 +222,9 @@ def test_batch_inverse_kinematics(client, robot, states):
     assert success.all()
     np.testing.assert_allclose(robot.pose(solutions)[:, :3, 3], points, rtol=0, atol=1e-9)
     # NumPy targets with a dask batch of starts
-    np.testing.assert_array_equal(robot.inverse_kinematics(poses, q0=lazy(starts)).q.compute(scheduler="sync"), expected.q)
+    np.testing.assert_array_equal(
+        robot.inverse_kinematics(poses, q0=lazy(starts)).q.compute(scheduler="sync"), expected.q
+    )
     with pytest.raises(ValueError, match=r"target is chunked along axis 1"):
         robot.inverse_kinematics(da.from_array(poses, chunks=(100, 2, 4)))
 
@@ -229,7 +241,15 @@ def test_sweep_to_zarr_on_the_cluster(client, robot, tmp_path):
     and the sample is the same on the cluster as on threads."""
     seen = []
     quantities = {"M": "mass_matrix", "g": "gravity_torque", "P": "potential_energy", "manipulability": _manipulability}
-    store = kinedyn.sweep(robot, tmp_path / "cluster.zarr", quantities, samples=N, chunk=CHUNK, seed=7, progress=lambda d, t: seen.append((d, t)))
+    store = kinedyn.sweep(
+        robot,
+        tmp_path / "cluster.zarr",
+        quantities,
+        samples=N,
+        chunk=CHUNK,
+        seed=7,
+        progress=lambda d, t: seen.append((d, t)),
+    )
     q = store["q"][:]
     assert q.shape == (N, robot.n) and len(np.unique(q, axis=0)) == N
     lo, hi = robot.lower_limits, robot.upper_limits
@@ -241,7 +261,9 @@ def test_sweep_to_zarr_on_the_cluster(client, robot, tmp_path):
     assert [t for _, t in seen] == [N] * 5 and sorted(d for d, _ in seen) == [d for d, _ in seen] and seen[-1][0] == N
     assert store.attrs["robot"] == robot.name and store.attrs["joint_names"] == list(robot.joint_names)
     with dask.config.set(scheduler="threads"):
-        again = kinedyn.sweep(robot, tmp_path / "threads.zarr", ["gravity_torque"], samples=N, chunk=CHUNK, seed=7, progress=False)
+        again = kinedyn.sweep(
+            robot, tmp_path / "threads.zarr", ["gravity_torque"], samples=N, chunk=CHUNK, seed=7, progress=False
+        )
     np.testing.assert_array_equal(again["q"][:], q)
     with pytest.raises(Exception, match="exist"):  # never overwrites a store unless asked
         kinedyn.sweep(robot, tmp_path / "threads.zarr", ["gravity_torque"], samples=N, chunk=CHUNK, progress=False)
@@ -269,13 +291,21 @@ def test_kinedyn_never_imports_dask_itself():
     dispatch only looks at sys.modules."""
     import subprocess
 
-    use = ("import kinedyn, numpy as np\n"
-           "r = kinedyn.robots.puma560()\n"
-           "assert r.mass_matrix(np.zeros((3, 6))).shape == (3, 6, 6)\n"
-           "assert r.inverse_kinematics(r.pose(np.zeros((2, 6)))).q.shape == (2, 6)\n")
+    use = (
+        "import kinedyn, numpy as np\n"
+        "r = kinedyn.robots.puma560()\n"
+        "assert r.mass_matrix(np.zeros((3, 6))).shape == (3, 6, 6)\n"
+        "assert r.inverse_kinematics(r.pose(np.zeros((2, 6)))).q.shape == (2, 6)\n"
+    )
     env = dict(os.environ, PYTHONPATH=str(Path(kinedyn.__file__).parents[1]))
     # dask installed: still never imported
-    subprocess.run([sys.executable, "-c", "import sys\n" + use + "assert 'dask' not in sys.modules, 'kinedyn imported dask'\n"],
-                   env=env, check=True, timeout=120)
+    subprocess.run(
+        [sys.executable, "-c", "import sys\n" + use + "assert 'dask' not in sys.modules, 'kinedyn imported dask'\n"],
+        env=env,
+        check=True,
+        timeout=120,
+    )
     # dask not importable (as if not installed): everything works
-    subprocess.run([sys.executable, "-c", "import sys; sys.modules['dask'] = None\n" + use], env=env, check=True, timeout=120)
+    subprocess.run(
+        [sys.executable, "-c", "import sys; sys.modules['dask'] = None\n" + use], env=env, check=True, timeout=120
+    )

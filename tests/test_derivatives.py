@@ -4,14 +4,13 @@ tree (with drives and external wrenches), batches, and Pinocchio's derivatives a
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
+from test_dynamics import ROBOTS
 
 import kinedyn as kd
 from kinedyn.description.joint import Joint
 from kinedyn.description.link import Link
-from test_dynamics import ROBOTS
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
@@ -115,7 +114,22 @@ def test_same_derivatives_as_pinocchio():
                 q_ref[model.joints[model.getJointId(joint)].idx_q] = value
             model = pin.buildReducedModel(model, [model.getJointId(j) for j in locked], q_ref)
         # Pinocchio leaves URDF friction out of its algorithms: compare the rigid-body equations
-        robot = robot.replace(links=[l if not l.joint.is_moving else l.__class__(l.name, l.parent, l.joint.__class__(**{**l.joint.__dict__, "viscous": 0.0, "coulomb": 0.0}), l.placement, l.post, l.inertia) for l in robot.links], dh=None)
+        robot = robot.replace(
+            links=[
+                l
+                if not l.joint.is_moving
+                else l.__class__(
+                    l.name,
+                    l.parent,
+                    l.joint.__class__(**{**l.joint.__dict__, "viscous": 0.0, "coulomb": 0.0}),
+                    l.placement,
+                    l.post,
+                    l.inertia,
+                )
+                for l in robot.links
+            ],
+            dh=None,
+        )
         data = model.createData()
         rng = np.random.default_rng(3)
         for _ in range(3):

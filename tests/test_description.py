@@ -9,10 +9,10 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from reference import all_frame_poses, pose, rotation, rpy
 
 import kinedyn as kd
 from kinedyn import Frame, Inertia, Joint, Link
-from reference import all_frame_poses, pose, rotation, rpy
 
 
 # ---------------------------------------------------------------- point clouds as an oracle
@@ -86,7 +86,10 @@ def test_non_psd_inertia():
     by the inertia policy: strict raises, warn (the default) warns (docs/model-files.md)."""
     from kinedyn.description.inertia import _WARNED, PhysicalConsistencyWarning
 
-    for bad in (Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, -0.1])), Inertia.from_urdf(1.0, 1.0, 2.0, 0.0, 1.0, 0.0, 1.0)):
+    for bad in (
+        Inertia(1.0, (0, 0, 0), np.diag([1.0, 1.0, -0.1])),
+        Inertia.from_urdf(1.0, 1.0, 2.0, 0.0, 1.0, 0.0, 1.0),
+    ):
         assert not bad.consistency().positive  # |ixy| > ixx, iyy in the second
         with pytest.raises(ValueError, match="link 'a': inertia tensor is not positive semi-definite"):
             _one_link_robot(bad, inertia="strict")
@@ -160,7 +163,13 @@ def _chain():
     """base -> l1 (revolute z) -> l2 (fixed, offset) -> l3 (revolute y) and l1 -> tip (fixed)."""
     T12 = pose(rpy(0.2, 0.1, -0.3), [0.4, 0.0, 0.1])
     return [
-        Link("l1", None, Joint("j1"), pose(None, [0, 0, 0.3]), inertia=Inertia(2.0, (0.1, 0, 0), np.diag([0.1, 0.2, 0.25]))),
+        Link(
+            "l1",
+            None,
+            Joint("j1"),
+            pose(None, [0, 0, 0.3]),
+            inertia=Inertia(2.0, (0.1, 0, 0), np.diag([0.1, 0.2, 0.25])),
+        ),
         Link("l2", "l1", Joint("f2", "fixed"), T12, inertia=Inertia(1.0, (0, 0.2, 0), np.diag([0.05, 0.05, 0.08]))),
         Link("l3", "l2", Joint("j3", axis=(0, 1, 0)), pose(None, [0.2, 0, 0]), inertia=Inertia(0.5, (0.1, 0, 0))),
         Link("tip", "l1", Joint("f4", "fixed"), pose(rpy(0, 0, 1.0), [0, 0.5, 0]), inertia=Inertia(0.25)),
@@ -243,7 +252,9 @@ def test_subs_by_name_finds_symbols_with_assumptions():
     assert robot.subs({"m1": 2.0}).symbols == robot.symbols - {s for s in robot.symbols if s.name == "m1"}
     eom = robot.equations_of_motion()
     assert "m1" not in {str(s) for s in eom.subs({"m1": 2.0}).parameters}
-    np.testing.assert_allclose(np.array(eom.subs(values).M.subs({eom.q[1]: 0.3}), dtype=float), numeric.mass_matrix([0.0, 0.3]))
+    np.testing.assert_allclose(
+        np.array(eom.subs(values).M.subs({eom.q[1]: 0.3}), dtype=float), numeric.mass_matrix([0.0, 0.3])
+    )
 
 
 def test_subs_names_the_link_of_a_bad_value():

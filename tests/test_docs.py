@@ -4,7 +4,6 @@ is only compiled."""
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -39,8 +38,13 @@ INLINE_CALL = re.compile(r"`((?:kd|Inertia)\.[A-Za-z_][\w.]*)\(([^`]*)\)`")
 
 def _inline_calls() -> list:
     # from-pinocchio.md's `Inertia.` is Pinocchio's class, set beside kinedyn's
-    return [(page.name, m.group(1), m.group(2)) for page in PAGES if page.exists() for m in INLINE_CALL.finditer(page.read_text())
-            if not (page.name == "from-pinocchio.md" and m.group(1).startswith("Inertia."))]
+    return [
+        (page.name, m.group(1), m.group(2))
+        for page in PAGES
+        if page.exists()
+        for m in INLINE_CALL.finditer(page.read_text())
+        if not (page.name == "from-pinocchio.md" and m.group(1).startswith("Inertia."))
+    ]
 
 
 def test_inline_calls_match_the_signatures():
@@ -73,7 +77,14 @@ def test_inline_calls_match_the_signatures():
         call = ast.parse(f"f({text})", mode="eval").body
         assert isinstance(call, ast.Call)
         positional = list(call.args)
-        extra = 1 if (inspect.isclass(obj) or (inspect.isclass(owner) and inspect.isfunction(inspect.getattr_static(owner, parts[-1])))) else 0
+        extra = (
+            1
+            if (
+                inspect.isclass(obj)
+                or (inspect.isclass(owner) and inspect.isfunction(inspect.getattr_static(owner, parts[-1])))
+            )
+            else 0
+        )
         try:
             bound = sig.bind_partial if more else sig.bind
             bound(*([None] * (len(positional) + extra)), **{k.arg: None for k in call.keywords if k.arg})

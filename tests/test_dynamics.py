@@ -37,8 +37,15 @@ def branching_tree(seed: int = 3) -> kd.Robot:
         T[:3, :3] = _rot(rng.normal(size=3), rng.uniform(-2, 2))
         T[:3, 3] = rng.uniform(-0.4, 0.4, 3)
         kind = "prismatic" if i == 5 else "revolute"
-        joint = Joint(f"j{i}", kind, tuple(rng.normal(size=3)), viscous=rng.uniform(0, 0.3), coulomb=rng.uniform(0, 0.3),
-                      gear_ratio=rng.uniform(1, 50), rotor_inertia=rng.uniform(0, 1e-4))
+        joint = Joint(
+            f"j{i}",
+            kind,
+            tuple(rng.normal(size=3)),
+            viscous=rng.uniform(0, 0.3),
+            coulomb=rng.uniform(0, 0.3),
+            gear_ratio=rng.uniform(1, 50),
+            rotor_inertia=rng.uniform(0, 1e-4),
+        )
         R = _rot(rng.normal(size=3), rng.uniform(-2, 2))
         a, b = rng.uniform(0.01, 0.1, 2)
         principal = np.diag([a, b, rng.uniform(abs(a - b) + 1e-3, a + b)])
@@ -54,8 +61,13 @@ def with_drives(robot: kd.Robot, seed: int = 0) -> kd.Robot:
     for link in robot.links:
         j = link.joint
         if j.is_moving:
-            j = dataclasses.replace(j, gear_ratio=rng.uniform(10, 100), rotor_inertia=rng.uniform(1e-5, 1e-4),
-                                    viscous=rng.uniform(0, 0.5), coulomb=rng.uniform(0, 0.5))
+            j = dataclasses.replace(
+                j,
+                gear_ratio=rng.uniform(10, 100),
+                rotor_inertia=rng.uniform(1e-5, 1e-4),
+                viscous=rng.uniform(0, 0.5),
+                coulomb=rng.uniform(0, 0.5),
+            )
         links.append(dataclasses.replace(link, joint=j))
     return robot.replace(links=links, name=robot.name + "+drives", dh=None)
 
@@ -82,7 +94,7 @@ ROBOTS["puma560+drives"] = lambda: with_drives(kd.robots.puma560())
 ROBOTS["tree+drives"] = lambda: with_drives(branching_tree(4), 1)
 URDF = urdf_robots()
 for _name, _robot in URDF.items():
-    ROBOTS[_name] = (lambda r: (lambda: r))(_robot)
+    ROBOTS[_name] = (lambda r: lambda: r)(_robot)
 
 
 @pytest.fixture(params=list(ROBOTS), scope="module")
@@ -134,7 +146,11 @@ def test_forward_dynamics_inverts_inverse_dynamics(robot):
         close(Minv @ robot.mass_matrix(q), np.eye(robot.n), what="Minv M")
         assert np.array_equal(Minv, Minv.T)
         tau = rng.normal(size=robot.n)
-        close(robot.forward_dynamics(q, qd, tau), Minv @ (tau - robot.bias_torque(q, qd) - friction(robot, qd)), what="aba vs Minv")
+        close(
+            robot.forward_dynamics(q, qd, tau),
+            Minv @ (tau - robot.bias_torque(q, qd) - friction(robot, qd)),
+            what="aba vs Minv",
+        )
 
 
 def test_external_wrenches_are_body_wrenches_in_base_axes_at_the_body_origin(robot):
@@ -152,7 +168,9 @@ def test_gravity_and_potential_energy(robot):
         z = np.zeros(robot.n)
         g = robot.gravity_torque(q)
         close(g, robot.inverse_dynamics(q, z, z), what="g == rnea(q, 0, 0)")
-        dP = [(robot.potential_energy(q + h * e) - robot.potential_energy(q - h * e)) / (2 * h) for e in np.eye(robot.n)]
+        dP = [
+            (robot.potential_energy(q + h * e) - robot.potential_energy(q - h * e)) / (2 * h) for e in np.eye(robot.n)
+        ]
         close(g, dP, FD, "g == dP/dq")
 
 
@@ -165,7 +183,9 @@ def test_coriolis_matrix_against_finite_differences_of_m(robot):
         S = Mdot - 2 * C
         close(S, -S.T, FD, "dM/dt - 2C skew")
         close(qd @ C @ qd, 0.5 * qd @ Mdot @ qd, FD, "qd.C qd == 1/2 qd.dM/dt qd")
-        dM = np.array([(robot.mass_matrix(q + h * e) - robot.mass_matrix(q - h * e)) / (2 * h) for e in np.eye(robot.n)])
+        dM = np.array(
+            [(robot.mass_matrix(q + h * e) - robot.mass_matrix(q - h * e)) / (2 * h) for e in np.eye(robot.n)]
+        )
         c = 0.5 * (np.einsum("ikj->ijk", dM) + np.einsum("jki->ijk", dM) - np.einsum("kij->ijk", dM))
         close(robot.christoffel(q), c, FD, "christoffel vs FD of M")
         close(np.einsum("ijk,i->kj", robot.christoffel(q), qd), C, REL, "C[k,j] == sum_i c_ijk qd_i")
@@ -181,7 +201,10 @@ def test_energies_and_momentum(robot):
         links = [l for l in robot.links if robot.tree.frames[robot.frame_index(l.name)].body >= 0]
         total = sum(float(l.inertia.mass) for l in links)
         poses = robot.frame_poses(q, [l.name for l in links])
-        first = sum(float(l.inertia.mass) * (T[:3, :3] @ np.array(l.inertia.com, float) + T[:3, 3]) for l, T in zip(links, poses))
+        first = sum(
+            float(l.inertia.mass) * (T[:3, :3] @ np.array(l.inertia.com, float) + T[:3, 3])
+            for l, T in zip(links, poses)
+        )
         close(robot.center_of_mass(q), first / total, what="centre of mass")
         close(robot.potential_energy(q), -total * np.dot(robot.gravity, robot.center_of_mass(q)), what="P")
         cdot = (robot.center_of_mass(q + h * qd) - robot.center_of_mass(q - h * qd)) / (2 * h)
@@ -239,7 +262,9 @@ def test_power_balance_along_an_integrated_trajectory():
             u = tau(t)
             return np.concatenate([qd, robot.forward_dynamics(q, qd, u), [qd @ u]])
 
-        sol = solve_ivp(rhs, (0.0, 0.5), np.concatenate([q0, np.zeros(n), [0.0]]), method="DOP853", rtol=1e-12, atol=1e-12)
+        sol = solve_ivp(
+            rhs, (0.0, 0.5), np.concatenate([q0, np.zeros(n), [0.0]]), method="DOP853", rtol=1e-12, atol=1e-12
+        )
         assert sol.success
         q, qd, work = sol.y[:n, -1], sol.y[n : 2 * n, -1], sol.y[-1, -1]
         E0 = robot.potential_energy(q0)
@@ -249,7 +274,10 @@ def test_power_balance_along_an_integrated_trajectory():
 
 
 def _frictionless(robot):
-    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, viscous=0.0, coulomb=0.0)) if l.joint.is_moving else l for l in robot.links]
+    links = [
+        dataclasses.replace(l, joint=dataclasses.replace(l.joint, viscous=0.0, coulomb=0.0)) if l.joint.is_moving else l
+        for l in robot.links
+    ]
     return robot.replace(links=links, dh=None)
 
 
@@ -332,7 +360,9 @@ def test_massless_chain_is_a_clear_error_from_forward_dynamics():
     with pytest.raises(RuntimeError, match="singular mass matrix"):
         robot.mass_matrix_inverse(np.zeros(2))
     # rotor inertia alone makes the joints accelerate: qdd = tau / (r^2 J_m)
-    geared = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, gear_ratio=10.0, rotor_inertia=1e-3)) for l in links]
+    geared = [
+        dataclasses.replace(l, joint=dataclasses.replace(l.joint, gear_ratio=10.0, rotor_inertia=1e-3)) for l in links
+    ]
     close(kd.Robot(geared).forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2)), [10.0, 10.0])
 
 
@@ -342,7 +372,9 @@ def test_lists_and_integer_arrays_are_accepted():
     qf = np.array(q, float)
     assert np.array_equal(robot.mass_matrix(q), robot.mass_matrix(qf))
     assert np.array_equal(robot.inverse_dynamics(q, q, np.array(q)), robot.inverse_dynamics(qf, qf, qf))
-    assert np.array_equal(robot.gravity_torque(np.array(q, np.float32)), robot.gravity_torque(np.array(q, np.float32).astype(float)))
+    assert np.array_equal(
+        robot.gravity_torque(np.array(q, np.float32)), robot.gravity_torque(np.array(q, np.float32).astype(float))
+    )
     assert robot.potential_energy(q) == robot.potential_energy(qf)
 
 

@@ -25,6 +25,8 @@ def test_example_runs(script, tmp_path):
 
     env["PYTHONPATH"] = os.pathsep.join([str(Path(kinedyn.__file__).parents[1]), env.get("PYTHONPATH", "")])
     env["MPLBACKEND"] = "Agg"
-    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
     assert done.returncode == 0, f"{script.name} failed:\n{done.stdout}\n{done.stderr}"
     assert done.stdout.strip(), f"{script.name} printed nothing"

@@ -10,10 +10,10 @@ import re
 import numpy as np
 import pytest
 import sympy as sp
+from reference import PANDA, UR5, all_frame_poses, erd, random_q
 
 import kinedyn as kd
 from kinedyn.description.files import load, save
-from reference import PANDA, UR5, all_frame_poses, erd, random_q
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs" / "model-files.md"
 
@@ -27,7 +27,9 @@ def assert_same_robot(a, b, seed=0):
     for attr in ("lower_limits", "upper_limits", "velocity_limits", "effort_limits"):
         np.testing.assert_array_equal(getattr(a, attr), getattr(b, attr))
     for ja, jb in zip(a.joints, b.joints):
-        assert (ja.kind, ja.armature, ja.viscous, ja.coulomb) == pytest.approx((jb.kind, jb.armature, jb.viscous, jb.coulomb))
+        assert (ja.kind, ja.armature, ja.viscous, ja.coulomb) == pytest.approx(
+            (jb.kind, jb.armature, jb.viscous, jb.coulomb)
+        )
     rng = np.random.default_rng(seed)
     for _ in range(3):
         q = random_q(a, rng)
@@ -115,7 +117,9 @@ def test_degrees(tmp_path):
         base_pose=np.array([[0, -1, 0, 0], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]),
     )
     q = np.array([0.3, 0.2])
-    np.testing.assert_allclose(all_frame_poses(robot, q)["tool"], all_frame_poses(same_in_radians, q)["tool"], atol=1e-12)
+    np.testing.assert_allclose(
+        all_frame_poses(robot, q)["tool"], all_frame_poses(same_in_radians, q)["tool"], atol=1e-12
+    )
     np.testing.assert_allclose(robot.lower_limits, [-math.pi / 2, 0.1])
     np.testing.assert_allclose(robot.upper_limits, [math.pi / 4, 0.5])
     assert robot.velocity_limits[0] == pytest.approx(math.pi)
@@ -135,8 +139,10 @@ def test_symbolic_values(tmp_path):
     values = {"g": 9.81, "l1": 2.0, "m1": 3.0, "L2": 0.5, "I": 0.1}
     numeric = robot.subs(values)
     expected = kd.Robot.from_dh(
-        [dict(a=2.0, inertia=kd.Inertia(3.0, (-1.0, 0, 0), np.diag([0, 1.0, 1.0]))),
-         dict(a=0.5, alpha=math.pi / 2, inertia=kd.Inertia(2.0, (0, 0, 0), np.diag([0.1, 0.1, 0.1])))],
+        [
+            dict(a=2.0, inertia=kd.Inertia(3.0, (-1.0, 0, 0), np.diag([0, 1.0, 1.0]))),
+            dict(a=0.5, alpha=math.pi / 2, inertia=kd.Inertia(2.0, (0, 0, 0), np.diag([0.1, 0.1, 0.1]))),
+        ],
         gravity=(0, -9.81, 0),
     )
     assert_same_robot(numeric, expected)
@@ -191,9 +197,15 @@ def test_unknown_row_key_names_file_row_and_key(tmp_path):
 def test_unknown_nested_keys(tmp_path):
     cases = {
         "limits": ("joints:\n  - {a: 1, limits: {lowr: 0}}\n", r"joints row 1\.limits: unknown key 'lowr'"),
-        "inertia": ("joints:\n  - {a: 1, mass: 1, inertia: {ixx: 1, iyx: 0}}\n", r"joints row 1\.inertia: unknown key 'iyx'"),
+        "inertia": (
+            "joints:\n  - {a: 1, mass: 1, inertia: {ixx: 1, iyx: 0}}\n",
+            r"joints row 1\.inertia: unknown key 'iyx'",
+        ),
         "top": ("joints:\n  - {a: 1}\ngravty: [0, 0, -9.8]\n", r"top level: unknown key 'gravty'"),
-        "tree": ("links:\n  - {name: a, joint: {type: revolute, axes: [0, 0, 1]}}\n", r"links row 1 \('a'\)\.joint: unknown key 'axes'"),
+        "tree": (
+            "links:\n  - {name: a, joint: {type: revolute, axes: [0, 0, 1]}}\n",
+            r"links row 1 \('a'\)\.joint: unknown key 'axes'",
+        ),
         "link": ("links:\n  - {name: a, inertia: {}}\n", r"links row 1: unknown key 'inertia'"),
         "pose": ("base_pose: {xyz: [0, 0, 1], rot: [0, 0, 0]}\njoints: [{a: 1}]\n", r"base_pose: unknown key 'rot'"),
         "units": ("units: {angle: grad}\njoints: [{a: 1}]\n", r"units\.angle: must be 'deg' or 'rad'"),
@@ -207,12 +219,18 @@ def test_unknown_nested_keys(tmp_path):
 def test_bad_values(tmp_path):
     cases = {
         "neg": ("joints:\n  - {a: 1, mass: -2}\n", r"joints row 1: mass.* negative"),
-        "expr": ("joints:\n  - {a: '__import__(\"os\")'}\n", r"joints row 1\.a: .* not a number or an arithmetic expression"),
+        "expr": (
+            "joints:\n  - {a: '__import__(\"os\")'}\n",
+            r"joints row 1\.a: .* not a number or an arithmetic expression",
+        ),
         "vec": ("joints:\n  - {a: 1, com: [0, 0]}\n", r"joints row 1\.com: expected a list of 3 values"),
         "kind": ("joints:\n  - {type: fixed}\n", r"joints row 1\.type: must be 'revolute' or 'prismatic'"),
         "lim": ("joints:\n  - {limits: {lower: 1, upper: 0}}\n", r"lower limit 1\.0 exceeds upper limit 0\.0"),
         "symlim": ("joints:\n  - {limits: {lower: qmin}}\n", r"joints row 1\.limits\.lower: must be a number"),
-        "parent": ("links:\n  - {name: a, parent: ghost, joint: {type: revolute}}\n", r"parent link 'ghost' does not exist"),
+        "parent": (
+            "links:\n  - {name: a, parent: ghost, joint: {type: revolute}}\n",
+            r"parent link 'ghost' does not exist",
+        ),
         "both": ("joints: [{a: 1}]\nlinks: [{name: a}]\n", r"exactly one of 'joints'"),
         "list": ("- 1\n- 2\n", r"must hold a mapping"),
     }
@@ -231,13 +249,13 @@ def test_unknown_extension_and_missing_file(tmp_path):
         save(kd.robots.planar_2r(), tmp_path / "r.urdf")
 
 
-
 def test_toml_reader_imports_tomli_before_python_3_11(monkeypatch, tmp_path):
     """requires-python is 3.10, where the standard library has no tomllib: the file reader takes
     tomli (the same parser, a dependency there). Simulated here: the version says 3.10, tomllib
     cannot be imported and tomllib itself stands in for tomli."""
     import importlib.util
     import sys
+
     import tomllib
 
     import kinedyn.description.files as files

@@ -51,9 +51,15 @@ def compare(pair: PinPair, rng, states: int = 2, frames: int = 3, derivatives: b
     bodies = [f.name for f in model.frames if f.type == pin.BODY and f.name in links]
     if bodies:
         chosen = list(rng.choice(bodies, size=min(frames, len(bodies)), replace=False))
-        picked = [(name, model.getFrameId(name, pin.BODY), True) for name in dict.fromkeys([robot.tool, *chosen]) if name in bodies]
+        picked = [
+            (name, model.getFrameId(name, pin.BODY), True)
+            for name in dict.fromkeys([robot.tool, *chosen])
+            if name in bodies
+        ]
     else:
-        picked = [(robot.body_names[robot.joint_names.index(model.names[j])], j, False) for j in range(1, model.njoints)]
+        picked = [
+            (robot.body_names[robot.joint_names.index(model.names[j])], j, False) for j in range(1, model.njoints)
+        ]
     for _ in range(states):
         q, v, a = pair.random_state(rng)
         qp, vp, ap = pair.to_pin_q(q), v[P], a[P]
@@ -80,18 +86,27 @@ def compare(pair: PinPair, rng, states: int = 2, frames: int = 3, derivatives: b
         for name, index, is_frame in picked:
             pose = data.oMf[index] if is_frame else data.oMi[index]
             _close(f"pose of {name}", robot.pose(q, name), pose.homogeneous)
-            J = (pin.getFrameJacobian if is_frame else pin.getJointJacobian)(model, data, index, pin.LOCAL_WORLD_ALIGNED)
+            J = (pin.getFrameJacobian if is_frame else pin.getJointJacobian)(
+                model, data, index, pin.LOCAL_WORLD_ALIGNED
+            )
             _close(f"Jacobian of {name}", robot.jacobian(q, name)[:, P], J)
         # K = v M v / 2 with Pinocchio's M (armature included; its computeKineticEnergy treats the
         # rotors differently, so it is compared where there are none)
         _close("kinetic energy", robot.kinetic_energy(q, v), vp @ M @ vp / 2, scale)
         if not robot.armature.any():
-            _close("kinetic energy (Pinocchio)", robot.kinetic_energy(q, v), pin.computeKineticEnergy(model, data, qp, vp), scale)
+            _close(
+                "kinetic energy (Pinocchio)",
+                robot.kinetic_energy(q, v),
+                pin.computeKineticEnergy(model, data, qp, vp),
+                scale,
+            )
         _close("centre of mass", robot.center_of_mass(q), pin.centerOfMass(model, data, qp))
         A = pin.ccrba(model, data, qp, vp)
         _close("centroidal momentum matrix", robot.centroidal_momentum_matrix(q)[:, P], A, scale)
         _close("centroidal momentum", robot.centroidal_momentum_matrix(q) @ v, data.hg.vector, scale)
-        _close("centre-of-mass Jacobian", robot.center_of_mass_jacobian(q)[:, P], pin.jacobianCenterOfMass(model, data, qp))
+        _close(
+            "centre-of-mass Jacobian", robot.center_of_mass_jacobian(q)[:, P], pin.jacobianCenterOfMass(model, data, qp)
+        )
         # the acceleration drift J_dot v of each compared frame (a = 0): Pinocchio's classical acceleration
         pin.forwardKinematics(model, data, qp, vp, 0 * vp)
         for name, index, is_frame in picked[:2]:
@@ -106,8 +121,12 @@ def compare(pair: PinPair, rng, states: int = 2, frames: int = 3, derivatives: b
         Y = pin.computeJointTorqueRegressor(model, data, qp, vp, ap)
         pi = np.concatenate([model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)])
         _close("Y pi == tau (Pinocchio's regressor)", Y @ pi, tau - model.armature * ap, float(np.abs(tau).max()))
-        _close("Y pi == tau (kinedyn's regressor)", (robot.regressor(q, v, a) @ robot.inertial_parameters())[P],
-               tau - model.armature * ap, float(np.abs(tau).max()))
+        _close(
+            "Y pi == tau (kinedyn's regressor)",
+            (robot.regressor(q, v, a) @ robot.inertial_parameters())[P],
+            tau - model.armature * ap,
+            float(np.abs(tau).max()),
+        )
         if derivatives:
             dq, dv, _ = pin.computeRNEADerivatives(model, data, qp, vp, ap)
             Dq, Dv, Dqdd = robot.inverse_dynamics_derivatives(q, v, a)
@@ -134,13 +153,19 @@ def test_every_example_robot_data_urdf_agrees_with_pinocchio(rel):
         return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # some files' inertias are not physical (kinedyn warns)
-        floating = kd.Robot.from_urdf(path, floating_base=True, mimic="independent")  # as Pinocchio's model below (tests/test_mimic.py reduces them)
+        floating = kd.Robot.from_urdf(
+            path, floating_base=True, mimic="independent"
+        )  # as Pinocchio's model below (tests/test_mimic.py reduces them)
         try:
             fixed = kd.Robot.from_urdf(path, mimic="independent")
         except ValueError as e:  # a drone: the root link is the only body
             assert "no moving joint" in str(e)
             fixed = None
-    assert floating.nq == floating.nv + 1 and floating.joints[0].kind == "floating" and floating.joint_names[0] == "root_joint"
+    assert (
+        floating.nq == floating.nv + 1
+        and floating.joints[0].kind == "floating"
+        and floating.joint_names[0] == "root_joint"
+    )
     compare(PinPair(floating, pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())), rng)
     if fixed is not None:
         assert floating.nv == fixed.nv + 6
@@ -180,7 +205,9 @@ def test_non_unit_quaternion_and_wrong_lengths_are_named_errors():
     assert robot.nq == 7 + 4 * 3 and robot.nv == 6 + 3 * 3
     q = np.zeros(robot.nq)
     q[6] = 1.0
-    with pytest.raises(ValueError, match=r"q\[3\.\.7\], the quaternion .* FreeFlyer joint .* has norm 1\.0\d*.* normalise"):
+    with pytest.raises(
+        ValueError, match=r"q\[3\.\.7\], the quaternion .* FreeFlyer joint .* has norm 1\.0\d*.* normalise"
+    ):
         robot.mass_matrix(np.where(np.arange(robot.nq) == 6, 1.01, q))
     for k in range(7, robot.nq, 4):
         q[k + 3] = 1.0
@@ -216,7 +243,9 @@ def test_euler_parametrisation_has_the_same_dynamics_as_the_native_joints():
     with v = T(q_e) qd_e, M_e = T^T M T, g_e = T^T g, tau_e = T^T tau(q, v, T qdd_e + dT/dt qd_e)."""
     from kinedyn.description.parametrise import euler_parametrised, euler_to_native, euler_velocity_map
 
-    robot = random_robot(0, n=7, branching=True, floating=True, spherical=0.3, planar=0.2, prismatic=0.3, friction=False)
+    robot = random_robot(
+        0, n=7, branching=True, floating=True, spherical=0.3, planar=0.2, prismatic=0.3, friction=False
+    )
     assert {"floating", "spherical", "planar"} <= {j.kind for j in robot.joints}
     euler = euler_parametrised(robot)
     assert euler.nq == euler.nv == robot.nv and not euler.has_multi_dof_joints
@@ -314,7 +343,9 @@ def test_a_tumbling_floating_tree_keeps_its_energy_and_momentum():
     """No gravity, no torque, no friction: the core's RK4 on the manifold (Runge-Kutta-Munthe-Kaas:
     stages q ⊕ c k, k = dexp⁻¹(v)) keeps the energy and the spatial momentum, and is fourth order:
     the momentum's drift falls at least 10x when dt halves (16x in theory)."""
-    robot = random_robot(4, n=4, branching=True, floating=True, spherical=0.4, friction=False, fixed=0).replace(gravity=(0, 0, 0))
+    robot = random_robot(4, n=4, branching=True, floating=True, spherical=0.4, friction=False, fixed=0).replace(
+        gravity=(0, 0, 0)
+    )
     assert {"floating", "spherical"} <= {j.kind for j in robot.joints}
     q0 = robot.random_configuration(1)
     v0 = np.random.default_rng(2).normal(size=robot.nv)
@@ -340,7 +371,7 @@ def test_a_free_body_falls_on_its_parabola():
     c0, cdot0 = robot.center_of_mass(q0), robot.center_of_mass_jacobian(q0) @ v0
     for method, tol in (("rk4", 1e-9), ("semi_implicit_euler", 5e-2), ("implicit", 5e-2)):
         traj = kd.simulate(robot, (0.0, 0.5), np.concatenate([q0, v0]), dt=1e-3, method=method)
-        expected = c0 + np.outer(traj.t, cdot0) + 0.5 * np.outer(traj.t ** 2, robot.gravity)
+        expected = c0 + np.outer(traj.t, cdot0) + 0.5 * np.outer(traj.t**2, robot.gravity)
         assert np.abs(robot.center_of_mass(traj.q) - expected).max() < tol, method
 
 
@@ -388,5 +419,8 @@ def test_identification_from_joint_logs_refuses_multi_dof_joints_naming_them():
     robot = random_robot(1, n=3, floating=True, friction=False)
     with pytest.raises(ValueError, match="excitation trajectory .*floating joint 'j1'"):
         identification.excitation(robot)
-    with pytest.raises(ValueError, match="identification from joint logs handles revolute and prismatic joints only.*floating joint 'j1'"):
+    with pytest.raises(
+        ValueError,
+        match="identification from joint logs handles revolute and prismatic joints only.*floating joint 'j1'",
+    ):
         identification.identify(robot, None)

@@ -9,7 +9,6 @@ folder). Defect classes: see :mod:`fuzz.worker`; docs/testing.md explains the fi
 import os
 
 import pytest
-
 from fuzz import runner
 from fuzz.strategies import Case
 from fuzz.worker import CLASSES, DEFECTS
@@ -33,8 +32,14 @@ def figures():
 def test_the_harness_classifies_misbehaviour():
     """The classes themselves: a clean error, the canary evaluated, a segfault, an abort, a hang and
     a memory blow-up, each done on purpose inside a worker, are each seen as what they are."""
-    expected = {"clean": "clean_error", "canary": "code_exec", "segfault": "crash", "abort": "crash",
-                "hang": "hang", "memory": "memory"}
+    expected = {
+        "clean": "clean_error",
+        "canary": "code_exec",
+        "segfault": "crash",
+        "abort": "crash",
+        "hang": "hang",
+        "memory": "memory",
+    }
     cases = [Case(kind="selftest", seed="selftest", ops=(what,), data=what, index=i) for i, what in enumerate(expected)]
     results = runner.run(cases, jobs=JOBS, timeout=3.0, memory=MEMORY)
     got = {c.data: r["outcome"] for c, r in zip(cases, results)}
@@ -72,7 +77,9 @@ def test_the_cases_are_the_same_on_every_run():
     a = runner.generate("all", 60, SEED)
     assert _fingerprint(a) == _fingerprint(runner.generate("all", 60, SEED))
     code = f"import sys; sys.path[:0] = {sys.path!r}; from fuzz import runner; import test_fuzz; print(test_fuzz._fingerprint(runner.generate('all', 60, {SEED})))"
-    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=os.path.dirname(__file__))
+    other = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=os.path.dirname(__file__)
+    )
     assert other.stdout.strip() == _fingerprint(a), other.stderr[-2000:]
     assert {c.kind for c in a} == {"urdf", "yaml", "toml", "arrays"}
     assert len({c.ops for c in a}) > 50  # varied, not one mutation over and over
@@ -84,7 +91,10 @@ def test_no_defect(figures, defect):
     bad = [(c, r) for c, r in zip(cases, results) if r["outcome"] == defect]
     examples = "\n\n".join(runner.describe(c, r) for c, r in bad[:5])
     if bad:  # (pytest.fail: the message without a repr of the cases)
-        pytest.fail(f"{len(bad)} cases of '{defect}':\n{runner.format_table(table)}\n\nfirst of them:\n{examples}", pytrace=False)
+        pytest.fail(
+            f"{len(bad)} cases of '{defect}':\n{runner.format_table(table)}\n\nfirst of them:\n{examples}",
+            pytrace=False,
+        )
 
 
 def test_every_case_was_classified(figures):

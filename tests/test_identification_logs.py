@@ -166,7 +166,10 @@ def test_prediction_on_a_held_out_log_within_twice_the_noise(true_robot, logs, w
     prior = kd.robots.get("ur5")
     result = an.identify(prior, cols, weighted=weighted)
     # the prior model alone misses by far more than the noise
-    assert np.any(np.sqrt(np.mean((prior.inverse_dynamics(truth["q"], truth["qd"], truth["qdd"]) - truth["tau"]) ** 2, axis=0)) > 2 * truth["sigma"])
+    assert np.any(
+        np.sqrt(np.mean((prior.inverse_dynamics(truth["q"], truth["qd"], truth["qdd"]) - truth["tau"]) ** 2, axis=0))
+        > 2 * truth["sigma"]
+    )
     check = result.validate(held_out)
     assert np.all(check.rms < 2 * truth["sigma"]), check.rms / truth["sigma"]
     assert np.all(check.r2 > 0.99)
@@ -225,7 +228,20 @@ def test_cli_identify_from_a_log(tmp_path, logs, capsys):
     (cols, _), (held_out, truth) = logs
     write_csv(tmp_path / "log.csv", cols)
     write_csv(tmp_path / "other.csv", held_out)
-    assert main(["identify", "ur5", "--data", str(tmp_path / "log.csv"), "--validate", str(tmp_path / "other.csv"), "--json"]) == 0
+    assert (
+        main(
+            [
+                "identify",
+                "ur5",
+                "--data",
+                str(tmp_path / "log.csv"),
+                "--validate",
+                str(tmp_path / "other.csv"),
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert len(out["friction_estimates"]) == 12
     assert np.all(np.asarray(out["validation"]["rms"]) < 2 * truth["sigma"])
@@ -255,7 +271,9 @@ def test_optimised_excitation_lowers_the_condition_number(tmp_path):
     np.testing.assert_allclose(qdd[0], 0.0, atol=1e-12)
     lo, hi = robot.lower_limits, robot.upper_limits
     assert np.all(q >= np.where(np.isfinite(lo), lo, -np.pi)) and np.all(q <= np.where(np.isfinite(hi), hi, np.pi))
-    assert np.all(np.abs(qd) <= 1.5 * 1.05) and np.all(np.abs(qdd) <= 5.0 * 1.05)  # limits held at 40 samples, 5 % between
+    assert np.all(np.abs(qd) <= 1.5 * 1.05) and np.all(
+        np.abs(qdd) <= 5.0 * 1.05
+    )  # limits held at 40 samples, 5 % between
     write_trajectory_csv(best, tmp_path / "traj.csv", rate=100.0)
     table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
     assert table.shape == (1001, 1 + 18)
@@ -266,7 +284,24 @@ def test_cli_writes_an_excitation(tmp_path, capsys):
     from kinedyn.cli import main
 
     out = tmp_path / "traj.csv"
-    assert main(["identify", "planar_2r", "--excite", str(out), "--period", "4", "--harmonics", "3", "--rate", "50", "--json"]) == 0
+    assert (
+        main(
+            [
+                "identify",
+                "planar_2r",
+                "--excite",
+                str(out),
+                "--period",
+                "4",
+                "--harmonics",
+                "3",
+                "--rate",
+                "50",
+                "--json",
+            ]
+        )
+        == 0
+    )
     payload = json.loads(capsys.readouterr().out)
     assert payload["condition_number"] < payload["random_condition_number"]
     table = np.loadtxt(out, delimiter=",", skiprows=1)

@@ -40,7 +40,23 @@ def written(tmp_path_factory):
     true = kd.robots.planar_2r(m1=1.2, m2=0.9)
     fit_csv, other_csv = _write(folder / "log.csv", _log(true, 1)), _write(folder / "other.csv", _log(true, 2))
     out = folder / "identification.html"
-    assert main(["identify", "planar_2r", "--data", str(fit_csv), "--validate", str(other_csv), "--consistent", "-o", str(out), "--json"]) == 0
+    assert (
+        main(
+            [
+                "identify",
+                "planar_2r",
+                "--data",
+                str(fit_csv),
+                "--validate",
+                str(other_csv),
+                "--consistent",
+                "-o",
+                str(out),
+                "--json",
+            ]
+        )
+        == 0
+    )
     result = an.identify(kd.robots.planar_2r(), str(fit_csv), consistent=True)
     return out, result, fit_csv, other_csv
 
@@ -73,11 +89,19 @@ def test_report_parses_and_holds_the_results_numbers(written):
         np.testing.assert_allclose(d[key]["r2"], check.r2, rtol=1e-9)
     mc = d["mass_matrix_check"]
     states = result.data.q[np.unique(np.linspace(0, len(result.data.q) - 1, mc["states"]).round().astype(int))]
-    assert mc["consistent_min_eigenvalue"] == pytest.approx(np.linalg.eigvalsh(result.mass_matrix(states)).min(), rel=1e-6)
-    assert mc["unconstrained_min_eigenvalue"] == pytest.approx(np.linalg.eigvalsh(result.unconstrained.mass_matrix(states)).min(), rel=1e-6)
+    assert mc["consistent_min_eigenvalue"] == pytest.approx(
+        np.linalg.eigvalsh(result.mass_matrix(states)).min(), rel=1e-6
+    )
+    assert mc["unconstrained_min_eigenvalue"] == pytest.approx(
+        np.linalg.eigvalsh(result.unconstrained.mass_matrix(states)).min(), rel=1e-6
+    )
     # the tables show the same
     tables = {t.get("class"): t for t in doc.iter(f"{XHTML}table")}
-    cells = lambda cls, k: ["".join(tr.findall(f"{XHTML}td")[k].itertext()) for tr in tables[cls].iter(f"{XHTML}tr") if tr.find(f"{XHTML}td") is not None]
+    cells = lambda cls, k: [
+        "".join(tr.findall(f"{XHTML}td")[k].itertext())
+        for tr in tables[cls].iter(f"{XHTML}tr")
+        if tr.find(f"{XHTML}td") is not None
+    ]
     assert cells("parameters", 0) == list(result.names)
     np.testing.assert_allclose([float(v) for v in cells("parameters", 1)], result.estimates, rtol=1e-5, atol=1e-12)
     assert cells("friction", 0) == result.nominal.joint_names

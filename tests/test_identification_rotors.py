@@ -69,7 +69,9 @@ def test_rotor_columns_join_the_base_parameters(prior):
         assert base.grouping[row, 60 + k] == pytest.approx(1.0)
         assert np.count_nonzero(base.grouping[:, 60 + k]) == 1
     # and the rotor-aware torques are the robot's own (armature included)
-    np.testing.assert_allclose(Y[..., base.indices] @ base.values, prior.inverse_dynamics(q, qd, qdd) - prior.friction_torque(qd), atol=1e-8)
+    np.testing.assert_allclose(
+        Y[..., base.indices] @ base.values, prior.inverse_dynamics(q, qd, qdd) - prior.friction_torque(qd), atol=1e-8
+    )
 
 
 def test_identified_armatures_match_the_real_motors(prior, true_robot, fit):
@@ -81,7 +83,9 @@ def test_identified_armatures_match_the_real_motors(prior, true_robot, fit):
             assert r.armature is None and r.std is None
             assert r.grouped_into == (f"link{k + 1}.Izz",)
             i = fit.names.index(f"link{k + 1}.Izz")
-            truth = fit.base.grouping[fit.used][i] @ np.concatenate([true_robot.inertial_parameters(), true_robot.armature])
+            truth = fit.base.grouping[fit.used][i] @ np.concatenate(
+                [true_robot.inertial_parameters(), true_robot.armature]
+            )
             assert fit.estimates[i] == pytest.approx(truth, rel=0.02)
         else:
             assert r.armature == pytest.approx(true_robot.armature[k], rel=0.03), name

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reference import PANDA, UR5, erd
+from test_identification_logs import COULOMB, VISCOUS, perturbed, simulated_log
 
 import kinedyn as kd
 import kinedyn.analysis as an
-from reference import PANDA, UR5, erd
-from test_identification_logs import COULOMB, VISCOUS, perturbed, simulated_log
 
 ROBOTS = {"panda": PANDA, "ur5": UR5}
 
@@ -28,8 +28,14 @@ def urdf_robot(name):
 def case(request):
     prior = urdf_robot(request.param)
     true = perturbed(prior)
-    return dict(name=request.param, prior=prior, base=prior.base_parameters(), true=true,
-                log=simulated_log(true, seed=1, T=20.0), held_out=simulated_log(true, seed=7, T=10.0))
+    return dict(
+        name=request.param,
+        prior=prior,
+        base=prior.base_parameters(),
+        true=true,
+        log=simulated_log(true, seed=1, T=20.0),
+        held_out=simulated_log(true, seed=7, T=10.0),
+    )
 
 
 def test_held_out_torques_within_twice_the_noise(case):
@@ -41,9 +47,13 @@ def test_held_out_torques_within_twice_the_noise(case):
     assert not result.rotor_joints  # a URDF has no drive train
     check = result.validate(held_out)
     assert np.all(check.rms < 2 * truth["sigma"]), check.rms / truth["sigma"]
-    exact = result.predict_torque(truth["q"], truth["qd"], truth["qdd"])  # at the exact states, against the noise-free torques
+    exact = result.predict_torque(
+        truth["q"], truth["qd"], truth["qdd"]
+    )  # at the exact states, against the noise-free torques
     assert np.all(np.sqrt(np.mean((exact - truth["tau"]) ** 2, axis=0)) < 2 * truth["sigma"])
-    np.testing.assert_allclose(result.friction_estimates.reshape(prior.n, 2), np.tile([VISCOUS, COULOMB], (prior.n, 1)), rtol=0.1)
+    np.testing.assert_allclose(
+        result.friction_estimates.reshape(prior.n, 2), np.tile([VISCOUS, COULOMB], (prior.n, 1)), rtol=0.1
+    )
 
 
 def test_consistent_estimate_is_simulable_where_the_unconstrained_is_not():
@@ -94,7 +104,9 @@ def test_bad_logs_give_named_errors(case):
     prior, (cols, _) = case["prior"], case["log"]
     other = "ur5" if case["name"] == "panda" else "panda"
     n_other = 6 if other == "ur5" else 7
-    with pytest.raises(an.LogError, match=rf"{prior.n} position columns q1..q{prior.n} but the robot has {n_other} joints"):
+    with pytest.raises(
+        an.LogError, match=rf"{prior.n} position columns q1..q{prior.n} but the robot has {n_other} joints"
+    ):
         an.identify(urdf_robot(other), cols)
     still = dict(cols, q3=np.full_like(cols["q3"], cols["q3"][0]))
     with pytest.raises(ValueError, match=r"friction terms \['joint3.viscous', 'joint3.coulomb'\] have no excitation"):

@@ -68,7 +68,15 @@ def dh_7dof():
     h = math.pi / 2
     deg = math.pi / 180
     rows = []
-    for d, alpha, lim in [(0.36, -h, 170), (0.0, h, 120), (0.42, h, 170), (0.0, -h, 120), (0.4, -h, 170), (0.0, h, 120), (0.126, 0.0, 175)]:
+    for d, alpha, lim in [
+        (0.36, -h, 170),
+        (0.0, h, 120),
+        (0.42, h, 170),
+        (0.0, -h, 120),
+        (0.4, -h, 170),
+        (0.0, h, 120),
+        (0.126, 0.0, 175),
+    ]:
         rows.append(kd.DHRow(d=d, alpha=alpha, lower=-lim * deg, upper=lim * deg))
     return kd.Robot.from_dh(rows, name="dh7")
 
@@ -150,10 +158,13 @@ def distinct(solutions, robot, tol=1e-6) -> list:
     return out
 
 
-@pytest.mark.parametrize("name,q", [
-    ("puma560", [0.3, 0.6, -0.5, 0.4, 0.9, -0.3]),
-    ("ur5", [0.5, -1.0, 1.2, -0.3, 0.8, 2.0]),
-])
+@pytest.mark.parametrize(
+    "name,q",
+    [
+        ("puma560", [0.3, 0.6, -0.5, 0.4, 0.9, -0.3]),
+        ("ur5", [0.5, -1.0, 1.2, -0.3, 0.8, 2.0]),
+    ],
+)
 def test_eight_solutions_at_generic_poses(name, q):
     robot = kd.robots.get(name)
     rng = np.random.default_rng(11)
@@ -166,7 +177,9 @@ def test_eight_solutions_at_generic_poses(name, q):
         assert len(distinct(result.solutions, robot)) == len(result) == result.found <= 8
         # an independent count: the numeric solver from 400 random starts finds the same set
         starts = robot.random_configuration(rng, size=400)
-        numeric = robot.inverse_kinematics(np.broadcast_to(T, (400, 4, 4)), q0=starts, method="numeric", respect_limits=False, restarts=0)
+        numeric = robot.inverse_kinematics(
+            np.broadcast_to(T, (400, 4, 4)), q0=starts, method="numeric", respect_limits=False, restarts=0
+        )
         found = distinct(numeric.q[numeric.success], robot, 1e-6)
         assert len(found) == len(result), (len(found), len(result))
         assert all(contains(result.solutions, s, robot, 1e-6) for s in found)
@@ -185,7 +198,9 @@ def test_stanford_has_up_to_eight_and_limits_keep_the_prismatic_stroke():
     check_all(robot, free, T)
     limited = robot.inverse_kinematics(T)
     assert contains(limited.solutions, q, robot)
-    assert np.all(limited.solutions[:, 2] >= robot.lower_limits[2]) and np.all(limited.solutions[:, 2] <= robot.upper_limits[2])
+    assert np.all(limited.solutions[:, 2] >= robot.lower_limits[2]) and np.all(
+        limited.solutions[:, 2] <= robot.upper_limits[2]
+    )
 
 
 def test_solutions_are_wrapped_next_to_q0_within_limits():
@@ -232,7 +247,12 @@ def test_unreachable_pose_and_numeric_failure_are_reported():
     result = robot.inverse_kinematics(T)
     assert len(result) == 0 and result.reachable is False and not result.success
     numeric = robot.inverse_kinematics(T, method="numeric", restarts=2)
-    assert not numeric.success and len(numeric) == 0 and numeric.reachable is None and "did not converge" in numeric.message
+    assert (
+        not numeric.success
+        and len(numeric) == 0
+        and numeric.reachable is None
+        and "did not converge" in numeric.message
+    )
     # a 4x4 target for a 3-DOF arm: only the branches whose orientation matches survive
     arm = kd.robots.elbow_3r()
     q = np.array([0.2, -0.4, 0.9])
@@ -270,8 +290,12 @@ def test_detection_reads_geometry_not_names():
     assert ik.analytic_structure(renamed) == "three_parallel"
     # the elbow arm in modified DH (Craig), with a base pose and a tool offset along the forearm
     h = math.pi / 2
-    craig = kd.Robot.from_dh([(0, 3.0, 0, 0), (0, 0, 0, h), (0, 0, 2.0, 0)], convention="modified",
-                             tool=np.array(translation(1.0, 0.0, 0.0)), base_pose=np.array(rot_z(0.3)))
+    craig = kd.Robot.from_dh(
+        [(0, 3.0, 0, 0), (0, 0, 0, h), (0, 0, 2.0, 0)],
+        convention="modified",
+        tool=np.array(translation(1.0, 0.0, 0.0)),
+        base_pose=np.array(rot_z(0.3)),
+    )
     assert ik.analytic_structure(craig) == "arm_intersecting_shoulder"
     res = craig.inverse_kinematics(craig.pose(np.array([0.1, 0.5, -0.7]))[:3, 3])
     assert len(res) == 4
@@ -351,7 +375,16 @@ def test_numeric_single_target_and_masks():
     P = robot.pose(w.q)
     assert w.success and np.allclose(P[:2, 3], T2[:2, 3], atol=1e-9)
     # a joint held by its limits is never left
-    tight = robot.replace(links=[l if i != 1 else kd.Link(l.name, l.parent, kd.Joint(l.joint.name, lower=-0.1, upper=0.1), l.placement, l.post, l.inertia) for i, l in enumerate(robot.links)])
+    tight = robot.replace(
+        links=[
+            l
+            if i != 1
+            else kd.Link(
+                l.name, l.parent, kd.Joint(l.joint.name, lower=-0.1, upper=0.1), l.placement, l.post, l.inertia
+            )
+            for i, l in enumerate(robot.links)
+        ]
+    )
     res = tight.inverse_kinematics(T, restarts=3)
     assert not res.success or abs(res.q[1]) <= 0.1
     if res.nearest_q is not None:
@@ -368,7 +401,9 @@ def test_redundant_position_on_a_6r_goes_numeric():
         robot.inverse_kinematics(p, method="analytic")
 
 
-@pytest.mark.parametrize("name,kind", [("elbow_3r", "position"), ("puma560", "pose"), ("ur5", "pose"), ("stanford", "pose")])
+@pytest.mark.parametrize(
+    "name,kind", [("elbow_3r", "position"), ("puma560", "pose"), ("ur5", "pose"), ("stanford", "pose")]
+)
 def test_analytic_and_numeric_agree(name, kind):
     robot = kd.robots.get(name)
     rng = np.random.default_rng(21)
@@ -401,7 +436,9 @@ def test_batches():
     assert partial.success.tolist() == [False, True, True]
     # out of reach: the numeric solver's best attempt, finite, with its true residual (never a NaN row)
     assert np.isfinite(partial.q[0]).all() and partial.position_error[0] > 1.0
-    assert partial.position_error[0] == pytest.approx(np.linalg.norm(robot.pose(partial.q[0])[:3, 3] - T_out[0, :3, 3]), rel=1e-9)
+    assert partial.position_error[0] == pytest.approx(
+        np.linalg.norm(robot.pose(partial.q[0])[:3, 3] - T_out[0, :3, 3]), rel=1e-9
+    )
     elbow = kd.robots.elbow_3r()
     P = elbow.pose(elbow.random_configuration(rng, size=20))[:, :3, 3]
     pb = elbow.inverse_kinematics(P)
@@ -453,7 +490,10 @@ def test_bad_input_gives_clear_errors():
         robot.inverse_kinematics(T, mask=[1, 1, 1, 1, 1, 0.5], method="analytic")
 
 
-@pytest.mark.parametrize("setting", [dict(tolerance=-1e-9), dict(tolerance=float("nan")), dict(max_iterations=-1), dict(restarts=-1), dict(seed=-1)])
+@pytest.mark.parametrize(
+    "setting",
+    [dict(tolerance=-1e-9), dict(tolerance=float("nan")), dict(max_iterations=-1), dict(restarts=-1), dict(seed=-1)],
+)
 def test_bad_solver_settings_give_clear_errors(setting):
     """A NaN tolerance used to report success; negative counts an OverflowError from the binding."""
     robot = kd.robots.ur5()
@@ -481,7 +521,9 @@ def test_cli_ik_tutorial(capsys):
     assert code == 0 and "11.3099" in out and "4 solution(s)" in out
     code, out = run_cli(["ik", "elbow_3r", "--xyz", "9", "0", "0"], capsys)
     assert code == 2 and "out of reach" in out
-    code, out = run_cli(["ik", "ur5", "--xyz", "0.3", "0.2", "0.4", "--rpy", "180", "0", "0", "--deg", "--all", "--json"], capsys)
+    code, out = run_cli(
+        ["ik", "ur5", "--xyz", "0.3", "0.2", "0.4", "--rpy", "180", "0", "0", "--deg", "--all", "--json"], capsys
+    )
     payload = json.loads(out)
     assert code == 0 and payload["count"] == 8
     robot = kd.robots.ur5()

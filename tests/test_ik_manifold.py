@@ -24,7 +24,7 @@ def unit_parts(robot, q) -> list:
     """The norms of every quaternion and planar (cos, sin) pair of q (docs/conventions.md layout)."""
     norms, at = [], 0
     for j in robot.joints:
-        part = {"floating": q[at + 3:at + 7], "spherical": q[at:at + 4], "planar": q[at + 2:at + 4]}.get(j.kind)
+        part = {"floating": q[at + 3 : at + 7], "spherical": q[at : at + 4], "planar": q[at + 2 : at + 4]}.get(j.kind)
         if part is not None:
             norms.append(float(np.linalg.norm(part)))
         at += j.nq
@@ -43,12 +43,15 @@ def assert_solves(robot, result, target, frame, atol=1e-9):
 
 
 # ------------------------------------------------------------------ random trees of every joint kind
-@pytest.mark.parametrize("kind, options", [
-    ("floating", dict(floating=True)),
-    ("spherical", dict(spherical=0.5)),
-    ("planar", dict(planar=0.5)),
-    ("mixed tree", dict(floating=True, spherical=0.3, planar=0.3, branching=True)),
-])
+@pytest.mark.parametrize(
+    "kind, options",
+    [
+        ("floating", dict(floating=True)),
+        ("spherical", dict(spherical=0.5)),
+        ("planar", dict(planar=0.5)),
+        ("mixed tree", dict(floating=True, spherical=0.3, planar=0.3, branching=True)),
+    ],
+)
 def test_random_robots_with_multi_dof_joints(kind, options):
     robot = random_robot(3, n=6, **options)
     assert any(j.is_multi_dof for j in robot.joints) and robot.nq > robot.nv
@@ -145,7 +148,9 @@ def test_solo12_foot_with_a_floating_base_agrees_with_pinocchio():
 def gripper(floating: bool = False):
     from test_mimic import gripper_urdf  # right_finger = -left_finger + 0.01, knuckle_joint = 0.5 wrist + 0.2
 
-    return kd.Robot.from_urdf(gripper_urdf(), floating_base=floating), kd.Robot.from_urdf(gripper_urdf(), floating_base=floating, mimic="independent")
+    return kd.Robot.from_urdf(gripper_urdf(), floating_base=floating), kd.Robot.from_urdf(
+        gripper_urdf(), floating_base=floating, mimic="independent"
+    )
 
 
 def expand_by_hand(robot, full, q):
@@ -173,7 +178,9 @@ def test_a_frame_a_mimic_follower_moves_is_solved_in_reduced_coordinates(frame, 
     near = robot.inverse_kinematics(target, frame=frame, q0=robot.integrate(q_goal, 0.05 * rng.normal(size=robot.nv)))
     assert_solves(robot, near, target, frame)
     assert near.iterations <= 5, near.iterations
-    with pytest.raises(ValueError, match="closed forms solve chains of revolute and prismatic joints only; use method='numeric'"):
+    with pytest.raises(
+        ValueError, match="closed forms solve chains of revolute and prismatic joints only; use method='numeric'"
+    ):
         robot.inverse_kinematics(target, frame=frame, method="analytic")
 
 
@@ -194,24 +201,36 @@ def test_panda_finger_in_reduced_coordinates():
 def test_bad_starts_are_named():
     robot = random_robot(1, n=3, floating=True)
     target = robot.pose(robot.neutral())
-    with pytest.raises(ValueError, match=r"q0 must have shape \(9,\) \(nq: a configuration; a free-flyer takes 7 entries.*got \(8,\)"):
+    with pytest.raises(
+        ValueError, match=r"q0 must have shape \(9,\) \(nq: a configuration; a free-flyer takes 7 entries.*got \(8,\)"
+    ):
         robot.inverse_kinematics(target, q0=np.zeros(robot.nv))
     bad = robot.neutral()
     bad[6] = 2.0
-    with pytest.raises(ValueError, match=r"q0\[3:7\] of floating joint 'j1' is the quaternion \(qx, qy, qz, qw\) = .* of norm 2, not 1"):
+    with pytest.raises(
+        ValueError, match=r"q0\[3:7\] of floating joint 'j1' is the quaternion \(qx, qy, qz, qw\) = .* of norm 2, not 1"
+    ):
         robot.inverse_kinematics(target, q0=bad)
-    with pytest.raises(ValueError, match=r"robot 'random_chain_1' has floating, spherical or planar joints: the closed forms .*method='numeric'"):
+    with pytest.raises(
+        ValueError,
+        match=r"robot 'random_chain_1' has floating, spherical or planar joints: the closed forms .*method='numeric'",
+    ):
         robot.inverse_kinematics(target, method="analytic")
     # the native solver checks on its own: the quaternion, and limits on a multi-DOF joint's coordinates
     from kinedyn import _core
 
     model, frame = robot._model, robot.frame_index(robot.tool)
     lower, upper, w = robot.lower_limits, robot.upper_limits, np.ones(6)
-    with pytest.raises(ValueError, match=r"q0\[3:7\], the quaternion \(qx, qy, qz, qw\) of the floating joint at body 0, has norm 2\.0+, not 1"):
+    with pytest.raises(
+        ValueError,
+        match=r"q0\[3:7\], the quaternion \(qx, qy, qz, qw\) of the floating joint at body 0, has norm 2\.0+, not 1",
+    ):
         _core.solve_ik(model, frame, target, bad, lower, upper, w)
     limited = lower.copy()
     limited[0] = -1.0
-    with pytest.raises(ValueError, match=r"limits of coordinate 0 \(\[-1, inf\]\): it belongs to the multi-DOF joint at body 0"):
+    with pytest.raises(
+        ValueError, match=r"limits of coordinate 0 \(\[-1, inf\]\): it belongs to the multi-DOF joint at body 0"
+    ):
         _core.solve_ik(model, frame, target, robot.neutral(), limited, upper, w)
 
 
@@ -221,7 +240,24 @@ def test_cli_ik_of_a_floating_robot(capsys):
     from kinedyn.cli import main
 
     path = os.path.join(ERD, "solo_description", "robots", "solo12.urdf")
-    code = main(["ik", path, "--floating-base", "--frame", "FR_FOOT", "--xyz", "0.2", "-0.1", "-0.2", "--rpy", "0", "0", "0.3", "--json"])
+    code = main(
+        [
+            "ik",
+            path,
+            "--floating-base",
+            "--frame",
+            "FR_FOOT",
+            "--xyz",
+            "0.2",
+            "-0.1",
+            "-0.2",
+            "--rpy",
+            "0",
+            "0",
+            "0.3",
+            "--json",
+        ]
+    )
     out = capsys.readouterr()
     assert code == 0, out.err
     doc = json.loads(out.out)
@@ -234,5 +270,7 @@ def test_cli_ik_of_a_floating_robot(capsys):
     table = capsys.readouterr().out
     assert "q1.qw" in table and "q1 = root_joint" in table
     bad = ["0"] * 6 + ["2"] + ["0"] * 12  # a quaternion of norm 2
-    assert main(["ik", path, "--floating-base", "--frame", "FR_FOOT", "--xyz", "0.2", "-0.1", "-0.2", "--q0", *bad]) == 1
+    assert (
+        main(["ik", path, "--floating-base", "--frame", "FR_FOOT", "--xyz", "0.2", "-0.1", "-0.2", "--q0", *bad]) == 1
+    )
     assert "--q0[3:7] of floating joint 'root_joint' is the quaternion" in capsys.readouterr().err

@@ -11,10 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from reference import symbolic_backend_robots
 
 import kinedyn as kd
-
-from reference import symbolic_backend_robots
 
 jax = pytest.importorskip("jax")
 jnp = pytest.importorskip("jax.numpy")

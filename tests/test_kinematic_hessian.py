@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reference import PANDA, UR5, erd
 
 import kinedyn as kd
 from kinedyn import kinematics as kin
-
-from reference import PANDA, UR5, erd
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
@@ -26,7 +25,9 @@ def fd_hessian(robot, q, frame=None, reference="world", point=None, h=1e-6):
     for i in range(robot.n):
         dq = np.zeros(robot.n)
         dq[i] = h
-        H[i] = (robot.jacobian(q + dq, frame, reference, point) - robot.jacobian(q - dq, frame, reference, point)) / (2 * h)
+        H[i] = (robot.jacobian(q + dq, frame, reference, point) - robot.jacobian(q - dq, frame, reference, point)) / (
+            2 * h
+        )
     return H
 
 
@@ -47,7 +48,10 @@ def rtb_hessian_definition(J):
 
 
 def urdf_robots():
-    return {"ur5": kd.Robot.from_urdf(erd(*UR5)), "panda": kd.Robot.from_urdf(erd(*PANDA), mimic="independent")}  # 9 coordinates, as before mimic support
+    return {
+        "ur5": kd.Robot.from_urdf(erd(*UR5)),
+        "panda": kd.Robot.from_urdf(erd(*PANDA), mimic="independent"),
+    }  # 9 coordinates, as before mimic support
 
 
 @pytest.mark.parametrize("name", list(ROBOTS))
@@ -67,8 +71,18 @@ def test_hessian_of_example_robot_data_urdfs(reference):
     for name, robot in urdf_robots().items():
         q = robot.random_configuration(RNG)
         point = np.array([0.05, -0.02, 0.1])
-        np.testing.assert_allclose(robot.jacobian_hessian(q, reference=reference), fd_hessian(robot, q, None, reference), atol=1e-6, err_msg=name)
-        np.testing.assert_allclose(robot.jacobian_hessian(q, reference=reference, point=point), fd_hessian(robot, q, None, reference, point), atol=1e-6, err_msg=name)
+        np.testing.assert_allclose(
+            robot.jacobian_hessian(q, reference=reference),
+            fd_hessian(robot, q, None, reference),
+            atol=1e-6,
+            err_msg=name,
+        )
+        np.testing.assert_allclose(
+            robot.jacobian_hessian(q, reference=reference, point=point),
+            fd_hessian(robot, q, None, reference, point),
+            atol=1e-6,
+            err_msg=name,
+        )
 
 
 @pytest.mark.parametrize("name", ["puma560", "stanford", "ur5", "cartesian_2p"])
@@ -79,7 +93,9 @@ def test_hessian_contracted_with_qd_twice_is_the_acceleration_drift(name, refere
     q = robot.random_configuration(RNG)
     qd = RNG.normal(size=robot.n)
     H = robot.jacobian_hessian(q, reference=reference)
-    np.testing.assert_allclose(np.einsum("i,irj,j->r", qd, H, qd), robot.jacobian_dot_qd(q, qd, reference=reference), atol=1e-10)
+    np.testing.assert_allclose(
+        np.einsum("i,irj,j->r", qd, H, qd), robot.jacobian_dot_qd(q, qd, reference=reference), atol=1e-10
+    )
 
 
 # RTB's cross-product definition is for revolute joints only
@@ -88,14 +104,23 @@ def test_world_hessian_is_rtb_hessian0_and_frame_axes_is_rtb_hessiane(name):
     robot = ROBOTS[name]
     q = robot.random_configuration(RNG)
     np.testing.assert_allclose(robot.jacobian_hessian(q), rtb_hessian_definition(robot.jacobian(q)), atol=1e-12)
-    np.testing.assert_allclose(kin.hessian_in_frame_axes(robot, q), rtb_hessian_definition(robot.jacobian(q, reference="local")), atol=1e-12)
+    np.testing.assert_allclose(
+        kin.hessian_in_frame_axes(robot, q), rtb_hessian_definition(robot.jacobian(q, reference="local")), atol=1e-12
+    )
 
 
 def test_rtb_hessians_of_the_ur5_and_panda_urdfs():
     for name, robot in urdf_robots().items():
         q = robot.random_configuration(RNG)
-        np.testing.assert_allclose(robot.jacobian_hessian(q), rtb_hessian_definition(robot.jacobian(q)), atol=1e-12, err_msg=name)
-        np.testing.assert_allclose(kin.hessian_in_frame_axes(robot, q), rtb_hessian_definition(robot.jacobian(q, reference="local")), atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(
+            robot.jacobian_hessian(q), rtb_hessian_definition(robot.jacobian(q)), atol=1e-12, err_msg=name
+        )
+        np.testing.assert_allclose(
+            kin.hessian_in_frame_axes(robot, q),
+            rtb_hessian_definition(robot.jacobian(q, reference="local")),
+            atol=1e-12,
+            err_msg=name,
+        )
 
 
 def test_hessian_in_frame_axes_is_not_the_derivative_of_the_local_jacobian():
@@ -159,8 +184,18 @@ def rtb_jacobm_definition(J, H):
     return np.array([w * (J @ H[i].T).flatten("F") @ b.flatten("F") for i in range(H.shape[0])])
 
 
-@pytest.mark.parametrize("name,task", [("puma560", "full"), ("puma560", "position"), ("stanford", "full"), ("elbow_3r", "position"),
-                                       ("planar_2r", "planar"), ("ur5", "full"), ("planar_3r", "planar")])
+@pytest.mark.parametrize(
+    "name,task",
+    [
+        ("puma560", "full"),
+        ("puma560", "position"),
+        ("stanford", "full"),
+        ("elbow_3r", "position"),
+        ("planar_2r", "planar"),
+        ("ur5", "full"),
+        ("planar_3r", "planar"),
+    ],
+)
 def test_manipulability_jacobian_matches_finite_differences_and_rtb_definition(name, task):
     robot = ROBOTS[name]
     rows = kin.task_rows(task)
@@ -188,7 +223,10 @@ def test_manipulability_jacobian_batches_singularities_and_wide_tasks():
     for k in range(3):
         np.testing.assert_allclose(g[k], kin.manipulability_jacobian(robot, qs[k], task="planar"), atol=0)
     # at q2 = 0, w = l1 l2 |sin q2| has a kink: no derivative, a clear error (never NaN)
-    with pytest.raises(ValueError, match=r"w = sqrt\(det\(J J\^T\)\) is 0 at q = \[0\.3 0\. \] \(configuration 1 of the batch\) and has no derivative"):
+    with pytest.raises(
+        ValueError,
+        match=r"w = sqrt\(det\(J J\^T\)\) is 0 at q = \[0\.3 0\. \] \(configuration 1 of the batch\) and has no derivative",
+    ):
         kin.manipulability_jacobian(robot, [[0.1, 0.5], [0.3, 0.0]], task="planar")
     # more task rows than joints: w = 0 everywhere, so is its gradient
     np.testing.assert_array_equal(kin.manipulability_jacobian(robot, [0.1, 0.5], task="full"), np.zeros(2))

@@ -21,7 +21,9 @@ def dh_matrix(theta, d, a, alpha, convention):
     """One DH transform, written out element by element (Spong eq. 3.10; Craig eq. 3.6)."""
     ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
     if convention == "standard":  # Rz(theta) Tz(d) Tx(a) Rx(alpha)
-        return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1.0]])
+        return np.array(
+            [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1.0]]
+        )
     # modified: Rx(alpha) Tx(a) Rz(theta) Tz(d)
     return np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -sa * d], [st * sa, ct * sa, ca, ca * d], [0, 0, 0, 1.0]])
 
@@ -121,8 +123,12 @@ def test_velocity_and_drift_match_derivatives_of_J_qd(name, reference):
         J = robot.jacobian(q, reference=reference)
         np.testing.assert_allclose(robot.frame_velocity(q, qd, reference=reference), J @ qd, atol=1e-12)
         # d/dt (J(q) qd) at qdd = 0, along q(t) = q + t qd
-        rate = (robot.jacobian(q + h * qd, reference=reference) @ qd - robot.jacobian(q - h * qd, reference=reference) @ qd) / (2 * h)
-        np.testing.assert_allclose(robot.jacobian_dot_qd(q, qd, reference=reference), rate, atol=1e-6 * max(1, np.abs(rate).max()))
+        rate = (
+            robot.jacobian(q + h * qd, reference=reference) @ qd - robot.jacobian(q - h * qd, reference=reference) @ qd
+        ) / (2 * h)
+        np.testing.assert_allclose(
+            robot.jacobian_dot_qd(q, qd, reference=reference), rate, atol=1e-6 * max(1, np.abs(rate).max())
+        )
 
 
 def test_tutorial_two_link_arm_velocity_and_torques():
@@ -180,13 +186,23 @@ def test_velocity_and_force_maps_take_batches(method):
     robot = ROBOTS["puma560"]
     Q = robot.random_configuration(np.random.default_rng(3), size=5)
     V = np.random.default_rng(4).normal(size=(5, 6))
-    np.testing.assert_allclose(kin.tool_velocity(robot, Q, V), [kin.tool_velocity(robot, q, v) for q, v in zip(Q, V)], atol=1e-12)
-    np.testing.assert_allclose(kin.tool_velocity(robot, Q, V[0]), [kin.tool_velocity(robot, q, V[0]) for q in Q], atol=1e-12)
-    np.testing.assert_allclose(kin.joint_torques(robot, Q, V[0]), [kin.joint_torques(robot, q, V[0]) for q in Q], atol=1e-12)
+    np.testing.assert_allclose(
+        kin.tool_velocity(robot, Q, V), [kin.tool_velocity(robot, q, v) for q, v in zip(Q, V)], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        kin.tool_velocity(robot, Q, V[0]), [kin.tool_velocity(robot, q, V[0]) for q in Q], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        kin.joint_torques(robot, Q, V[0]), [kin.joint_torques(robot, q, V[0]) for q in Q], atol=1e-12
+    )
     qd = kin.joint_velocities(robot, Q, V, method=method)
     assert qd.shape == (5, 6)
-    np.testing.assert_allclose(qd, [kin.joint_velocities(robot, q, v, method=method) for q, v in zip(Q, V)], rtol=1e-9, atol=1e-9)
-    with pytest.raises(ValueError, match=r"wrench must have 6 components for this task, shape \(6,\) or \(5, 6\); got shape \(4, 6\)"):
+    np.testing.assert_allclose(
+        qd, [kin.joint_velocities(robot, q, v, method=method) for q, v in zip(Q, V)], rtol=1e-9, atol=1e-9
+    )
+    with pytest.raises(
+        ValueError, match=r"wrench must have 6 components for this task, shape \(6,\) or \(5, 6\); got shape \(4, 6\)"
+    ):
         kin.joint_torques(robot, Q, V[:4])
 
 
@@ -232,7 +248,9 @@ def test_bad_inputs_give_clear_errors():
         robot.pose([0.0, float("nan"), 0.0])
     with pytest.raises(ValueError, match="non-finite.*state 1"):
         robot.jacobian([[0.0, 0, 0], [0.0, float("inf"), 0]])
-    with pytest.raises(ValueError, match=r"qd has shape \(3, 3\), which does not match the other arguments \(a batch of 2 states\)"):
+    with pytest.raises(
+        ValueError, match=r"qd has shape \(3, 3\), which does not match the other arguments \(a batch of 2 states\)"
+    ):
         robot.frame_velocity(np.zeros((2, 3)), np.zeros((3, 3)))
     with pytest.raises(ValueError, match="unknown frame 'hand'"):
         robot.pose([0, 0, 0], "hand")
@@ -250,9 +268,18 @@ def test_native_model_rejects_bad_arrays_without_panicking():
 
     eye = np.eye(4)[None]
     good = dict(
-        parent=np.array([-1]), kind=np.array([0]), axis=np.array([[0, 0, 1.0]]), offset=np.zeros(1),
-        placement=eye.copy(), inertia=np.zeros((1, 10)), armature=np.zeros(1), viscous=np.zeros(1),
-        coulomb=np.zeros(1), gravity=np.array([0, 0, -9.81]), frame_body=np.array([0]), frame_placement=eye.copy(),
+        parent=np.array([-1]),
+        kind=np.array([0]),
+        axis=np.array([[0, 0, 1.0]]),
+        offset=np.zeros(1),
+        placement=eye.copy(),
+        inertia=np.zeros((1, 10)),
+        armature=np.zeros(1),
+        viscous=np.zeros(1),
+        coulomb=np.zeros(1),
+        gravity=np.array([0, 0, -9.81]),
+        frame_body=np.array([0]),
+        frame_placement=eye.copy(),
     )
     _core.Model(**good)
     cases = {
@@ -264,7 +291,7 @@ def test_native_model_rejects_bad_arrays_without_panicking():
         "mass": (dict(inertia=np.array([[-1.0] + [0] * 9])), "negative mass"),
         "nan": (dict(offset=np.array([np.nan])), "non-finite"),
     }
-    for what, (change, message) in cases.items():
+    for _what, (change, message) in cases.items():
         with pytest.raises(ValueError, match=message):
             _core.Model(**{**good, **change})
 

@@ -31,34 +31,75 @@ INERTIAL = """<inertial><origin xyz="{c}" rpy="0.1 -0.2 0.3"/><mass value="{m}"/
 
 def link(name, m=0.5, c="0.01 0.02 0.03", i=0.02, j=0.03, k=0.025):
     s = min(i, j, k)
-    return f'<link name="{name}">{INERTIAL.format(m=m, c=c, i=i, j=j, k=k, xy=0.05 * s, xz=-0.1 * s, yz=0.07 * s)}</link>'
+    return (
+        f'<link name="{name}">{INERTIAL.format(m=m, c=c, i=i, j=j, k=k, xy=0.05 * s, xz=-0.1 * s, yz=0.07 * s)}</link>'
+    )
 
 
 def joint(name, kind, parent, child, xyz="0 0 0.1", rpy="0 0 0", axis="0 0 1", mimic="", limit=True, dynamics=""):
     lim = '<limit lower="-1.5" upper="1.5" effort="10" velocity="2"/>' if limit else ""
-    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-            f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{lim}{mimic}{dynamics}</joint>')
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{lim}{mimic}{dynamics}</joint>'
+    )
 
 
 def gripper_urdf(chain: bool = False) -> str:
     """An arm joint, a wrist, and a parallel gripper: the right finger follows the left one with
     multiplier -1 and an offset, a revolute 'knuckle' follows the wrist with 0.5 and an offset (with
     friction of its own); with ``chain``, a 'tip' follows the knuckle (a follower of a follower)."""
-    parts = [link("base"), link("upper", 1.2, "0.1 0 0.05"), link("palm", 0.8, "0.02 -0.01 0.04"),
-             link("left", 0.1, "0 0.01 0.02", 0.001, 0.002, 0.0015), link("right", 0.12, "0 -0.01 0.02", 0.0012, 0.002, 0.0011),
-             link("knuckle", 0.2, "0.03 0 0.01"),
-             joint("shoulder", "revolute", "base", "upper", axis="0 0 1"),
-             joint("wrist", "revolute", "upper", "palm", xyz="0.3 0 0.05", rpy="0.3 0 0", axis="0 1 0"),
-             joint("left_finger", "prismatic", "palm", "left", xyz="0 0.02 0.08", axis="0 1 0",
-                   dynamics='<dynamics damping="0.3" friction="0.1"/>'),
-             joint("right_finger", "prismatic", "palm", "right", xyz="0 -0.02 0.08", axis="0 1 0",
-                   mimic='<mimic joint="left_finger" multiplier="-1" offset="0.01"/>', dynamics='<dynamics damping="0.2" friction="0.05"/>'),
-             joint("knuckle_joint", "revolute", "palm", "knuckle", xyz="0.05 0 0.02", axis="1 0 0",
-                   mimic='<mimic joint="wrist" multiplier="0.5" offset="0.2"/>', dynamics='<dynamics damping="0.4"/>')]
+    parts = [
+        link("base"),
+        link("upper", 1.2, "0.1 0 0.05"),
+        link("palm", 0.8, "0.02 -0.01 0.04"),
+        link("left", 0.1, "0 0.01 0.02", 0.001, 0.002, 0.0015),
+        link("right", 0.12, "0 -0.01 0.02", 0.0012, 0.002, 0.0011),
+        link("knuckle", 0.2, "0.03 0 0.01"),
+        joint("shoulder", "revolute", "base", "upper", axis="0 0 1"),
+        joint("wrist", "revolute", "upper", "palm", xyz="0.3 0 0.05", rpy="0.3 0 0", axis="0 1 0"),
+        joint(
+            "left_finger",
+            "prismatic",
+            "palm",
+            "left",
+            xyz="0 0.02 0.08",
+            axis="0 1 0",
+            dynamics='<dynamics damping="0.3" friction="0.1"/>',
+        ),
+        joint(
+            "right_finger",
+            "prismatic",
+            "palm",
+            "right",
+            xyz="0 -0.02 0.08",
+            axis="0 1 0",
+            mimic='<mimic joint="left_finger" multiplier="-1" offset="0.01"/>',
+            dynamics='<dynamics damping="0.2" friction="0.05"/>',
+        ),
+        joint(
+            "knuckle_joint",
+            "revolute",
+            "palm",
+            "knuckle",
+            xyz="0.05 0 0.02",
+            axis="1 0 0",
+            mimic='<mimic joint="wrist" multiplier="0.5" offset="0.2"/>',
+            dynamics='<dynamics damping="0.4"/>',
+        ),
+    ]
     if chain:
-        parts += [link("tip", 0.05, "0.01 0.01 0.01", 0.0005, 0.0006, 0.0007),
-                  joint("tip_joint", "revolute", "knuckle", "tip", xyz="0 0.04 0", axis="0 0 1",
-                        mimic='<mimic joint="knuckle_joint" multiplier="2.0" offset="-0.1"/>')]
+        parts += [
+            link("tip", 0.05, "0.01 0.01 0.01", 0.0005, 0.0006, 0.0007),
+            joint(
+                "tip_joint",
+                "revolute",
+                "knuckle",
+                "tip",
+                xyz="0 0.04 0",
+                axis="0 0 1",
+                mimic='<mimic joint="knuckle_joint" multiplier="2.0" offset="-0.1"/>',
+            ),
+        ]
     return '<robot name="gripper">' + "".join(parts) + "</robot>"
 
 
@@ -114,9 +155,14 @@ def test_urdf_mimic_is_read_and_reduced():
     robot = kd.Robot.from_urdf(gripper_urdf(chain=True))
     assert robot.joint_names == ["shoulder", "wrist", "left_finger"]
     assert robot.n == robot.nq == robot.nv == 3 and robot.lower_limits.shape == (3,)
-    assert robot.mimic_joints == {"right_finger": Mimic("left_finger", -1.0, 0.01), "knuckle_joint": Mimic("wrist", 0.5, 0.2),
-                                  "tip_joint": Mimic("wrist", 1.0, 0.30000000000000004)}
-    tip = next(j for j in kd.Robot.from_urdf(gripper_urdf(chain=True), mimic="independent").joints if j.name == "tip_joint")
+    assert robot.mimic_joints == {
+        "right_finger": Mimic("left_finger", -1.0, 0.01),
+        "knuckle_joint": Mimic("wrist", 0.5, 0.2),
+        "tip_joint": Mimic("wrist", 1.0, 0.30000000000000004),
+    }
+    tip = next(
+        j for j in kd.Robot.from_urdf(gripper_urdf(chain=True), mimic="independent").joints if j.name == "tip_joint"
+    )
     assert tip.mimic == Mimic("knuckle_joint", 2.0, -0.1)  # the joint records the file's relation
     assert _resolve_check() == Mimic("wrist", 1.0, 0.2 + 0.1)
     full = kd.Robot.from_urdf(gripper_urdf(chain=True), mimic="independent")
@@ -129,7 +175,9 @@ def test_urdf_mimic_is_read_and_reduced():
 @pytest.mark.filterwarnings("ignore::kinedyn.description.inertia.PhysicalConsistencyWarning")
 def test_a_fixed_joints_mimic_is_ignored():
     """Talos's talos_left_arm.urdf fixes gripper_left_inner_double_joint and keeps its <mimic>."""
-    fixed = gripper_urdf().replace('<joint name="right_finger" type="prismatic"', '<joint name="right_finger" type="fixed"')
+    fixed = gripper_urdf().replace(
+        '<joint name="right_finger" type="prismatic"', '<joint name="right_finger" type="fixed"'
+    )
     robot = kd.Robot.from_urdf(fixed)
     assert robot.joint_names == ["shoulder", "wrist", "left_finger"] and "right_finger" not in robot.mimic_joints
     arm = kd.Robot.from_urdf(erd_path("talos_data/robots/talos_left_arm.urdf"))
@@ -145,16 +193,24 @@ def test_mimic_errors_name_the_joint():
     zero = base.replace('multiplier="-1"', 'multiplier="0"')
     with pytest.raises(ValueError, match=r"URDF string>:\d+: joint 'right_finger': .*multiplier must be non-zero"):
         kd.Robot.from_urdf(zero)
-    with pytest.raises(ValueError, match=r"URDF string>:\d+: joint 'right_finger' <mimic> attribute 'multiplier' must be 1 finite numbers, got 'nan'$"):
+    with pytest.raises(
+        ValueError,
+        match=r"URDF string>:\d+: joint 'right_finger' <mimic> attribute 'multiplier' must be 1 finite numbers, got 'nan'$",
+    ):
         kd.Robot.from_urdf(base.replace('multiplier="-1"', 'multiplier="nan"'))
     with pytest.raises(ValueError, match=r"<mimic> has no joint attribute"):
-        kd.Robot.from_urdf(base.replace('mimic joint="left_finger"', 'mimic'))
+        kd.Robot.from_urdf(base.replace('mimic joint="left_finger"', "mimic"))
     fixed = base.replace('<joint name="left_finger" type="prismatic"', '<joint name="left_finger" type="fixed"')
     with pytest.raises(ValueError, match=r"joint 'right_finger' mimics joint 'left_finger', which is fixed"):
         kd.Robot.from_urdf(fixed)
-    cycle = base.replace('<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="10" velocity="2"/><dynamics damping="0.3"',
-                         '<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="10" velocity="2"/><mimic joint="right_finger"/><dynamics damping="0.3"')
-    with pytest.raises(ValueError, match=r"mimic joints form a cycle: (left_finger -> right_finger -> left_finger|right_finger -> left_finger -> right_finger)"):
+    cycle = base.replace(
+        '<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="10" velocity="2"/><dynamics damping="0.3"',
+        '<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="10" velocity="2"/><mimic joint="right_finger"/><dynamics damping="0.3"',
+    )
+    with pytest.raises(
+        ValueError,
+        match=r"mimic joints form a cycle: (left_finger -> right_finger -> left_finger|right_finger -> left_finger -> right_finger)",
+    ):
         kd.Robot.from_urdf(cycle)
     with pytest.raises(ValueError, match=r"mimic must be one of \['reduce', 'independent'\]"):
         kd.Robot.from_urdf(base, mimic="yes")
@@ -165,7 +221,10 @@ def test_mimic_errors_name_the_joint():
     with pytest.raises(ValueError, match="offset"):
         Mimic("a", 1.0, float("inf"))
     # a multi-DOF joint leads nothing
-    links = [Link("ball", None, Joint("ball_joint", "spherical")), Link("f", "ball", Joint("f_joint", mimic=Mimic("ball_joint")))]
+    links = [
+        Link("ball", None, Joint("ball_joint", "spherical")),
+        Link("f", "ball", Joint("f_joint", mimic=Mimic("ball_joint"))),
+    ]
     with pytest.raises(ValueError, match=r"joint 'f_joint' mimics joint 'ball_joint', which is spherical"):
         kd.Robot(links)
 
@@ -173,7 +232,13 @@ def test_mimic_errors_name_the_joint():
 def test_coordinate_maps_use_index_ranges_for_multi_dof_blocks():
     """A floating base and a spherical joint (nq 7 and 4, nv 6 and 3) before and between the
     1-DOF leader and followers: q and v copied block by block."""
-    joints = [Joint("root", "floating"), Joint("a"), Joint("ball", "spherical"), Joint("f", "prismatic", mimic=Mimic("a", -2.0, 0.5)), Joint("c")]
+    joints = [
+        Joint("root", "floating"),
+        Joint("a"),
+        Joint("ball", "spherical"),
+        Joint("f", "prismatic", mimic=Mimic("a", -2.0, 0.5)),
+        Joint("c"),
+    ]
     m = mimic_map(joints, joints)
     assert (m.nq_full, m.nv_full, m.nq, m.nv) == (14, 12, 13, 11)
     q = np.arange(13.0) + 1
@@ -192,22 +257,32 @@ def test_reduced_dynamics_equal_the_hand_reduced_model(pair):
         qf, qdf, qddf = G @ q + b, G @ qd, G @ qdd
         M = full.mass_matrix(qf)
         np.testing.assert_allclose(reduced.mass_matrix(q), G.T @ M @ G, atol=1e-12)
-        np.testing.assert_allclose(reduced.inverse_dynamics(q, qd, qdd), G.T @ full.inverse_dynamics(qf, qdf, qddf), atol=1e-12)
+        np.testing.assert_allclose(
+            reduced.inverse_dynamics(q, qd, qdd), G.T @ full.inverse_dynamics(qf, qdf, qddf), atol=1e-12
+        )
         np.testing.assert_allclose(reduced.gravity_torque(q), G.T @ full.gravity_torque(qf), atol=1e-12)
         np.testing.assert_allclose(reduced.bias_torque(q, qd), G.T @ full.bias_torque(qf, qdf), atol=1e-12)
         np.testing.assert_allclose(reduced.coriolis_matrix(q, qd), G.T @ full.coriolis_matrix(qf, qdf) @ G, atol=1e-12)
         np.testing.assert_allclose(reduced.friction_torque(qd), G.T @ full.friction_torque(qdf), atol=1e-12)
         np.testing.assert_allclose(reduced.regressor(q, qd, qdd), G.T @ full.regressor(qf, qdf, qddf), atol=1e-12)
-        np.testing.assert_allclose(reduced.christoffel(q), np.einsum("ai,bj,ck,abc->ijk", G, G, G, full.christoffel(qf)), atol=1e-12)
+        np.testing.assert_allclose(
+            reduced.christoffel(q), np.einsum("ai,bj,ck,abc->ijk", G, G, G, full.christoffel(qf)), atol=1e-12
+        )
         tau = G.T @ full.inverse_dynamics(qf, qdf, qddf)
         np.testing.assert_allclose(reduced.forward_dynamics(q, qd, tau), qdd, atol=1e-9)
         np.testing.assert_allclose(reduced.mass_matrix_inverse(q), np.linalg.inv(G.T @ M @ G), rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(reduced.frame_poses(q), full.frame_poses(qf), atol=1e-14)
         for frame in frames[1:]:
             for ref in ("world", "local", "spatial"):
-                np.testing.assert_allclose(reduced.jacobian(q, frame, ref), full.jacobian(qf, frame, ref) @ G, atol=1e-12)
-            np.testing.assert_allclose(reduced.frame_velocity(q, qd, frame), full.frame_velocity(qf, qdf, frame), atol=1e-12)
-            np.testing.assert_allclose(reduced.jacobian_dot_qd(q, qd, frame), full.jacobian_dot_qd(qf, qdf, frame), atol=1e-12)
+                np.testing.assert_allclose(
+                    reduced.jacobian(q, frame, ref), full.jacobian(qf, frame, ref) @ G, atol=1e-12
+                )
+            np.testing.assert_allclose(
+                reduced.frame_velocity(q, qd, frame), full.frame_velocity(qf, qdf, frame), atol=1e-12
+            )
+            np.testing.assert_allclose(
+                reduced.jacobian_dot_qd(q, qd, frame), full.jacobian_dot_qd(qf, qdf, frame), atol=1e-12
+            )
         H = reduced.jacobian_hessian(q, "left")
         np.testing.assert_allclose(H, np.einsum("ik,irj,jl->krl", G, full.jacobian_hessian(qf, "left"), G), atol=1e-12)
         assert reduced.kinetic_energy(q, qd) == pytest.approx(full.kinetic_energy(qf, qdf), abs=1e-13)
@@ -215,16 +290,28 @@ def test_reduced_dynamics_equal_the_hand_reduced_model(pair):
         np.testing.assert_allclose(reduced.center_of_mass(q), full.center_of_mass(qf), atol=1e-14)
         np.testing.assert_allclose(reduced.momentum(q, qd), full.momentum(qf, qdf), atol=1e-13)
         f_ext = np.random.default_rng(3).normal(size=(len(reduced.body_names), 6))
-        np.testing.assert_allclose(reduced.inverse_dynamics(q, qd, qdd, f_ext), G.T @ full.inverse_dynamics(qf, qdf, qddf, f_ext), atol=1e-12)
+        np.testing.assert_allclose(
+            reduced.inverse_dynamics(q, qd, qdd, f_ext), G.T @ full.inverse_dynamics(qf, qdf, qddf, f_ext), atol=1e-12
+        )
 
 
 def test_batches_and_out_arguments(pair):
     reduced, _, _, _ = pair
     rng = np.random.default_rng(5)
     Q, QD, QDD = (rng.uniform(-1, 1, (6, reduced.n)) for _ in range(3))
-    for method, args in (("mass_matrix", (Q,)), ("inverse_dynamics", (Q, QD, QDD)), ("forward_dynamics", (Q, QD, QDD)),
-                         ("gravity_torque", (Q,)), ("coriolis_matrix", (Q, QD)), ("bias_torque", (Q, QD)), ("jacobian", (Q,)),
-                         ("kinetic_energy", (Q, QD)), ("regressor", (Q, QD, QDD)), ("mass_matrix_inverse", (Q,)), ("christoffel", (Q,))):
+    for method, args in (
+        ("mass_matrix", (Q,)),
+        ("inverse_dynamics", (Q, QD, QDD)),
+        ("forward_dynamics", (Q, QD, QDD)),
+        ("gravity_torque", (Q,)),
+        ("coriolis_matrix", (Q, QD)),
+        ("bias_torque", (Q, QD)),
+        ("jacobian", (Q,)),
+        ("kinetic_energy", (Q, QD)),
+        ("regressor", (Q, QD, QDD)),
+        ("mass_matrix_inverse", (Q,)),
+        ("christoffel", (Q,)),
+    ):
         batch = getattr(reduced, method)(*args)
         one = np.array([getattr(reduced, method)(*(a[k] for a in args)) for k in range(len(Q))])
         np.testing.assert_allclose(batch, one, atol=1e-12, err_msg=method)
@@ -256,15 +343,35 @@ def test_identities_of_the_reduced_robot(pair):
         np.testing.assert_allclose(S, -S.T, atol=1e-7)
         dq, dqd, M = reduced.inverse_dynamics_derivatives(q, qd, qdd)
         tau = reduced.inverse_dynamics(q, qd, qdd)
-        fd_q = np.column_stack([(reduced.inverse_dynamics(q + h * e, qd, qdd) - reduced.inverse_dynamics(q - h * e, qd, qdd)) / (2 * h) for e in np.eye(reduced.n)])
-        fd_qd = np.column_stack([(reduced.inverse_dynamics(q, qd + h * e, qdd) - reduced.inverse_dynamics(q, qd - h * e, qdd)) / (2 * h) for e in np.eye(reduced.n)])
+        fd_q = np.column_stack(
+            [
+                (reduced.inverse_dynamics(q + h * e, qd, qdd) - reduced.inverse_dynamics(q - h * e, qd, qdd)) / (2 * h)
+                for e in np.eye(reduced.n)
+            ]
+        )
+        fd_qd = np.column_stack(
+            [
+                (reduced.inverse_dynamics(q, qd + h * e, qdd) - reduced.inverse_dynamics(q, qd - h * e, qdd)) / (2 * h)
+                for e in np.eye(reduced.n)
+            ]
+        )
         np.testing.assert_allclose(dq, fd_q, atol=1e-6)
         np.testing.assert_allclose(dqd, fd_qd, atol=1e-6)
         np.testing.assert_allclose(M, reduced.mass_matrix(q), atol=1e-12)
         fq, fqd, Minv = reduced.forward_dynamics_derivatives(q, qd, tau)
-        fd = np.column_stack([(reduced.forward_dynamics(q + h * e, qd, tau) - reduced.forward_dynamics(q - h * e, qd, tau)) / (2 * h) for e in np.eye(reduced.n)])
+        fd = np.column_stack(
+            [
+                (reduced.forward_dynamics(q + h * e, qd, tau) - reduced.forward_dynamics(q - h * e, qd, tau)) / (2 * h)
+                for e in np.eye(reduced.n)
+            ]
+        )
         np.testing.assert_allclose(fq, fd, atol=1e-6)
-        fd = np.column_stack([(reduced.forward_dynamics(q, qd + h * e, tau) - reduced.forward_dynamics(q, qd - h * e, tau)) / (2 * h) for e in np.eye(reduced.n)])
+        fd = np.column_stack(
+            [
+                (reduced.forward_dynamics(q, qd + h * e, tau) - reduced.forward_dynamics(q, qd - h * e, tau)) / (2 * h)
+                for e in np.eye(reduced.n)
+            ]
+        )
         np.testing.assert_allclose(fqd, fd, atol=1e-6)
         np.testing.assert_allclose(Minv, np.linalg.inv(M), atol=1e-9)
 
@@ -279,7 +386,7 @@ def _pin_q(model, robot, q):
     for name, value in zip(robot.joint_names, q):
         jm = model.joints[model.getJointId(name)]
         if jm.nq == 2:
-            out[jm.idx_q:jm.idx_q + 2] = np.cos(value), np.sin(value)
+            out[jm.idx_q : jm.idx_q + 2] = np.cos(value), np.sin(value)
         else:
             out[jm.idx_q] = value
     return out
@@ -291,7 +398,11 @@ def _pin_v_index(model, robot):
 
 def compare_with_pinocchio(path_or_xml, states_count=3, frames=None):
     robot = kd.Robot.from_urdf(path_or_xml)
-    model = pin.buildModelFromXML(path_or_xml, mimic=True) if path_or_xml.lstrip().startswith("<") else pin.buildModelFromUrdf(path_or_xml, mimic=True)
+    model = (
+        pin.buildModelFromXML(path_or_xml, mimic=True)
+        if path_or_xml.lstrip().startswith("<")
+        else pin.buildModelFromUrdf(path_or_xml, mimic=True)
+    )
     data = model.createData()
     assert model.nv == robot.n
     iv = _pin_v_index(model, robot)
@@ -309,7 +420,9 @@ def compare_with_pinocchio(path_or_xml, states_count=3, frames=None):
         M = pin.crba(model, data, pq)
         M = P @ (np.triu(M) + np.triu(M, 1).T) @ P.T
         np.testing.assert_allclose(robot.mass_matrix(q), M, atol=1e-9, rtol=1e-9)
-        np.testing.assert_allclose(robot.gravity_torque(q), P @ pin.computeGeneralizedGravity(model, data, pq), atol=1e-9, rtol=1e-9)
+        np.testing.assert_allclose(
+            robot.gravity_torque(q), P @ pin.computeGeneralizedGravity(model, data, pq), atol=1e-9, rtol=1e-9
+        )
         # Pinocchio's ABA has no mimic joints: its qdd is M^-1 (tau - nle)
         u = rng.uniform(-1, 1, robot.n)
         qdd_pin = np.linalg.solve(M, u - P @ pin.nonLinearEffects(model, data, pq, pv))
@@ -328,8 +441,12 @@ def test_gripper_agrees_with_pinocchios_mimic_model():
     compare_with_pinocchio(gripper_urdf())
 
 
-ERD_MIMIC = ["panda_description/urdf/panda.urdf", "baxter_description/urdf/baxter.urdf",
-             "pr2_description/urdf/pr2.urdf", "tiago_pro_description/robots/tiago_pro.urdf"]
+ERD_MIMIC = [
+    "panda_description/urdf/panda.urdf",
+    "baxter_description/urdf/baxter.urdf",
+    "pr2_description/urdf/pr2.urdf",
+    "tiago_pro_description/robots/tiago_pro.urdf",
+]
 
 
 def erd_path(rel):
@@ -365,7 +482,9 @@ def test_urdfs_pinocchio_cannot_reduce_agree_with_the_hand_reduced_model(rel):
         qd, qdd = rng.uniform(-1, 1, reduced.n), rng.uniform(-1, 1, reduced.n)
         qf = G @ q + b
         np.testing.assert_allclose(reduced.mass_matrix(q), G.T @ full.mass_matrix(qf) @ G, atol=1e-9)
-        np.testing.assert_allclose(reduced.inverse_dynamics(q, qd, qdd), G.T @ full.inverse_dynamics(qf, G @ qd, G @ qdd), atol=1e-9)
+        np.testing.assert_allclose(
+            reduced.inverse_dynamics(q, qd, qdd), G.T @ full.inverse_dynamics(qf, G @ qd, G @ qdd), atol=1e-9
+        )
         for frame in reduced.body_names[-2:]:
             np.testing.assert_allclose(reduced.jacobian(q, frame), full.jacobian(qf, frame) @ G, atol=1e-9)
 
@@ -374,21 +493,38 @@ def test_urdfs_pinocchio_cannot_reduce_agree_with_the_hand_reduced_model(rel):
 def test_lock_joints_locks_the_followers_with_their_leader():
     robot = kd.Robot.from_urdf(gripper_urdf())
     locked = robot.lock_joints({"left_finger": 0.015})
-    assert locked.joint_names == ["shoulder", "wrist"] and locked.mimic_joints == {"knuckle_joint": Mimic("wrist", 0.5, 0.2)}
+    assert locked.joint_names == ["shoulder", "wrist"] and locked.mimic_joints == {
+        "knuckle_joint": Mimic("wrist", 0.5, 0.2)
+    }
     q = np.array([0.3, -0.4])
     np.testing.assert_allclose(locked.frame_poses(q), robot.frame_poses(np.r_[q, 0.015]), atol=1e-14)
     np.testing.assert_allclose(locked.mass_matrix(q), robot.mass_matrix(np.r_[q, 0.015])[:2, :2], atol=1e-12)
     both = robot.lock_joints({"left_finger": 0.015, "right_finger": -0.005})  # as given
     np.testing.assert_allclose(both.frame_poses(q), robot.frame_poses(np.r_[q, 0.015]), atol=1e-14)
-    with pytest.raises(ValueError, match=r"joint 'right_finger' follows joint 'left_finger' \(mimic\); lock 'left_finger' too"):
+    with pytest.raises(
+        ValueError, match=r"joint 'right_finger' follows joint 'left_finger' \(mimic\); lock 'left_finger' too"
+    ):
         robot.lock_joints({"right_finger": 0.01})
     assert robot.lock_joints(["wrist"], at=[0.1, 0.2, 0.3]).joint_names == ["shoulder", "left_finger"]
 
 
 def test_simulation_runs_on_the_reduced_dynamics():
     robot = kd.Robot.from_urdf(gripper_urdf())
-    no_friction = robot.replace(links=[l if l.joint.kind == "fixed" else l.__class__(l.name, l.parent, Joint(
-        l.joint.name, l.joint.kind, l.joint.axis, mimic=l.joint.mimic), l.placement, l.post, l.inertia) for l in robot.links])
+    no_friction = robot.replace(
+        links=[
+            l
+            if l.joint.kind == "fixed"
+            else l.__class__(
+                l.name,
+                l.parent,
+                Joint(l.joint.name, l.joint.kind, l.joint.axis, mimic=l.joint.mimic),
+                l.placement,
+                l.post,
+                l.inertia,
+            )
+            for l in robot.links
+        ]
+    )
     x0 = np.r_[0.2, -0.3, 0.01, 0.5, -0.2, 0.1]
     traj = kd.simulate(no_friction, 0.5, x0, method="rk4", dt=1e-3)
     assert traj.q.shape[-1] == 3
@@ -452,7 +588,10 @@ def test_robot_files_read_and_write_mimic(tmp_path):
         assert kd.load(path, mimic="independent").n == 6
     text = (tmp_path / "gripper.yaml").read_text().replace("multiplier: -1.0", "multiplier: 0")
     (tmp_path / "bad.yaml").write_text(text)
-    with pytest.raises(ValueError, match=r"bad.yaml, line \d+: links row 4 \('right'\).joint.mimic: mimic of joint 'left_finger': multiplier must be non-zero"):
+    with pytest.raises(
+        ValueError,
+        match=r"bad.yaml, line \d+: links row 4 \('right'\).joint.mimic: mimic of joint 'left_finger': multiplier must be non-zero",
+    ):
         kd.load(tmp_path / "bad.yaml")
 
 
@@ -464,7 +603,9 @@ def test_ik_of_a_frame_no_follower_moves():
     result = robot.inverse_kinematics(target, q0=[0.3, -0.2, 0.01], frame="left")
     assert result.success and result.q.shape == (3,)
     np.testing.assert_allclose(robot.pose(result.q, "left"), target, atol=1e-8)
-    batch = robot.inverse_kinematics(np.stack([target, robot.pose(np.zeros(3), "left")]), q0=np.zeros((2, 3)), frame="left")
+    batch = robot.inverse_kinematics(
+        np.stack([target, robot.pose(np.zeros(3), "left")]), q0=np.zeros((2, 3)), frame="left"
+    )
     assert batch.q.shape == (2, 3) and batch.success.all()
     with pytest.raises(ValueError, match=r"q0 must have shape \(3,\) or a batch \(N, 3\), got \(5,\)"):
         robot.inverse_kinematics(target, q0=np.zeros(5), frame="left")

@@ -263,8 +263,10 @@ def test_inertia_from_geoms_agrees_with_mujoco():
 
 
 def test_inertiafromgeom_true_replaces_the_inertial_and_false_ignores_the_geoms():
-    body = ('<body name="b"><joint name="j" axis="1 0 0"/><inertial pos="0.1 0 0" mass="3" diaginertia="1 2 3"/>'
-            '<geom type="box" size="0.1 0.2 0.3" pos="0 0.1 0"/></body>')
+    body = (
+        '<body name="b"><joint name="j" axis="1 0 0"/><inertial pos="0.1 0 0" mass="3" diaginertia="1 2 3"/>'
+        '<geom type="box" size="0.1 0.2 0.3" pos="0 0.1 0"/></body>'
+    )
     for setting in ("true", "false", "auto"):
         xml = f'<mujoco><compiler inertiafromgeom="{setting}"/><worldbody>{body}</worldbody></mujoco>'
         robot, model, _ = both(xml)
@@ -282,7 +284,9 @@ def test_the_mujoco_test_model_with_its_free_and_ball_joints_turned_into_hinges_
     text = without_mesh_geom(text)
     text = text.replace('<weld body1="world" body2="cylinder"/>', "")
     text = re.sub(r"<keyframe>.*?</keyframe>", "", text, flags=re.S)  # its qpos is for free and ball joints
-    with pytest.warns(UserWarning, match=r"does not model.*<actuator>.*<sensor>.*<tendon>.*spring \(stiffness\) of joint 'hipy_0'"):
+    with pytest.warns(
+        UserWarning, match=r"does not model.*<actuator>.*<sensor>.*<tendon>.*spring \(stiffness\) of joint 'hipy_0'"
+    ):
         robot = robot_from_mjcf(text)
     model = mujoco.MjModel.from_xml_string(text)
     model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING)
@@ -307,7 +311,9 @@ def _mujoco_test_model() -> str:
 
 def test_the_mujoco_test_model_names_its_mesh_body_whose_inertia_is_not_computed():
     path = os.path.join(os.path.dirname(mujoco.__file__), "testdata", "model.xml")
-    with pytest.raises(ValueError, match=r"model\.xml:\d+: <geom> geom of body 'body9': kinedyn does not compute a mesh's inertia"):
+    with pytest.raises(
+        ValueError, match=r"model\.xml:\d+: <geom> geom of body 'body9': kinedyn does not compute a mesh's inertia"
+    ):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             robot_from_mjcf(path)
@@ -327,7 +333,11 @@ def test_ball_and_free_joints_parse_with_mujoco_sizes_placements_and_inertias():
     compare_inertias(robot, model)
     links = {link.name: link for link in robot.links}
     # a free body sits at qpos in the world: its placement is the identity (its pos/quat are qpos0)
-    assert np.array_equal(links["head"].placement, np.eye(4)) and links["head"].parent is None or links["head"].parent == "world"
+    assert (
+        np.array_equal(links["head"].placement, np.eye(4))
+        and links["head"].parent is None
+        or links["head"].parent == "world"
+    )
     # the ball joint's link: its body's pose in the parent, at the joint position (here 0)
     wheel = next(l for l in robot.links if l.joint.name == "wheel_0")
     b = model.jnt_bodyid[model.joint("wheel_0").id]
@@ -338,8 +348,10 @@ def test_ball_and_free_joints_parse_with_mujoco_sizes_placements_and_inertias():
 
 
 def test_a_ball_joint_off_its_body_origin_is_placed_at_the_joint():
-    xml = ('<mujoco><worldbody><body name="b" pos="1 2 3" euler="0 0 90"><joint name="ball" type="ball" pos="0.1 0.2 0.3"/>'
-           '<geom size="0.1"/></body></worldbody></mujoco>')
+    xml = (
+        '<mujoco><worldbody><body name="b" pos="1 2 3" euler="0 0 90"><joint name="ball" type="ball" pos="0.1 0.2 0.3"/>'
+        '<geom size="0.1"/></body></worldbody></mujoco>'
+    )
     link = robot_from_mjcf(xml).links[0]
     assert link.joint.kind == "spherical"
     np.testing.assert_allclose(link.placement[:3, 3], [1 - 0.2, 2 + 0.1, 3 + 0.3], atol=1e-12)
@@ -347,8 +359,12 @@ def test_a_ball_joint_off_its_body_origin_is_placed_at_the_joint():
 
 
 def test_a_free_joint_must_be_the_only_joint_of_a_top_level_body():
-    xml = '<mujoco><worldbody><body><geom size="1"/><body><freejoint/><geom size="1"/></body></body></worldbody></mujoco>'
-    with pytest.raises(ValueError, match=r"<MJCF string>:1: <freejoint> joint 'joint0': a free joint must be the only joint"):
+    xml = (
+        '<mujoco><worldbody><body><geom size="1"/><body><freejoint/><geom size="1"/></body></body></worldbody></mujoco>'
+    )
+    with pytest.raises(
+        ValueError, match=r"<MJCF string>:1: <freejoint> joint 'joint0': a free joint must be the only joint"
+    ):
         robot_from_mjcf(xml)
 
 
@@ -357,12 +373,14 @@ def test_kd_load_reads_an_mjcf_file_with_includes(tmp_path):
     (tmp_path / "parts").mkdir()
     (tmp_path / "parts" / "pole.xml").write_text(
         '<mujoco><body name="pole" pos="0 0 0.05"><joint name="hinge" axis="0 1 0"/>'
-        '<geom type="cylinder" fromto="0 0 0 0 0 0.8" size="0.02" mass="0.3"/></body></mujoco>')
+        '<geom type="cylinder" fromto="0 0 0 0 0 0.8" size="0.02" mass="0.3"/></body></mujoco>'
+    )
     (tmp_path / "defaults.xml").write_text('<mujoco><default><joint damping="0.25"/></default></mujoco>')
     (tmp_path / "model.xml").write_text(
         '<mujoco model="included"><include file="defaults.xml"/><worldbody><body name="cart">'
         '<joint name="slider" type="slide" axis="1 0 0"/><geom type="box" size="0.2 0.1 0.05"/>'
-        '<include file="parts/pole.xml"/></body></worldbody></mujoco>')
+        '<include file="parts/pole.xml"/></body></worldbody></mujoco>'
+    )
     robot = kd.load(tmp_path / "model.xml")
     assert robot.name == "included" and robot.joint_names == ["slider", "hinge"]
     assert [j.viscous for j in robot.joints] == [0.25, 0.25]
@@ -376,25 +394,33 @@ def test_an_include_may_not_leave_the_model_folder(tmp_path):
     (tmp_path / "secret.xml").write_text("<mujoco/>")
     (tmp_path / "m").mkdir()
     (tmp_path / "m" / "model.xml").write_text('<mujoco><include file="../secret.xml"/><worldbody/></mujoco>')
-    with pytest.raises(ValueError, match=r"model\.xml:1: <include> file='\.\./secret\.xml' is outside the model's folder"):
+    with pytest.raises(
+        ValueError, match=r"model\.xml:1: <include> file='\.\./secret\.xml' is outside the model's folder"
+    ):
         kd.load(tmp_path / "m" / "model.xml")
 
 
 def test_includes_are_depth_bounded(tmp_path):
     (tmp_path / "loop.xml").write_text('<mujoco><include file="loop.xml"/></mujoco>')
-    with pytest.raises(ValueError, match=rf"<include> file='loop\.xml': includes nested deeper than {MAX_INCLUDE_DEPTH} levels"):
+    with pytest.raises(
+        ValueError, match=rf"<include> file='loop\.xml': includes nested deeper than {MAX_INCLUDE_DEPTH} levels"
+    ):
         robot_from_mjcf(str(tmp_path / "loop.xml"))
 
 
 def test_a_string_cannot_include():
-    with pytest.raises(ValueError, match=r"<MJCF string>:1: <include> file='x\.xml': a model given as an XML string cannot include"):
+    with pytest.raises(
+        ValueError, match=r"<MJCF string>:1: <include> file='x\.xml': a model given as an XML string cannot include"
+    ):
         robot_from_mjcf('<mujoco><include file="x.xml"/></mujoco>')
 
 
 # ----------------------------------------------------------------------------------- security
 def test_entities_and_doctype_declarations_are_refused():
-    bomb = ('<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]>'
-            '<mujoco model="&b;"><worldbody/></mujoco>')
+    bomb = (
+        '<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]>'
+        '<mujoco model="&b;"><worldbody/></mujoco>'
+    )
     with pytest.raises(ValueError, match="DOCTYPE with declarations"):
         robot_from_mjcf(bomb)
 
@@ -409,17 +435,32 @@ def test_nesting_is_bounded():
     "inner, message",
     [
         ('<joint name="j" range="1 a"/>', r"<joint> attribute 'range' must be numbers, got '1 a'"),
-        ('<joint name="j" range="2 1" limited="true"/>', r"<joint> joint 'j': attribute 'range' has lower 2 above upper 1"),
+        (
+            '<joint name="j" range="2 1" limited="true"/>',
+            r"<joint> joint 'j': attribute 'range' has lower 2 above upper 1",
+        ),
         ('<joint name="j" type="universal"/>', r"<joint> joint 'j': attribute 'type' is 'universal'"),
         ('<joint name="j" axis="0 0 0"/>', r"<joint> joint 'j': axis .* zero"),
         ('<joint name="j" axis="0 0 nan"/>', r"<joint> attribute 'axis' must hold finite numbers"),
         ('<joint name="j" class="nope"/>', r"<joint> class='nope' names no <default> class"),
         ('<joint name="j"/><geom type="box" size="1 1"/>', r"<geom> geom: a box needs 3 positive size numbers"),
         ('<joint name="j"/><geom type="torus"/>', r"<geom> geom: attribute 'type' is 'torus'"),
-        ('<joint name="j"/><geom size="1" quat="1 0 0 0" euler="0 0 0"/>', r"<geom> gives its orientation twice \(quat, euler\)"),
-        ('<joint name="j"/><inertial pos="0 0 0" mass="1"/>', r"<inertial> of body 'b' has neither 'diaginertia' nor 'fullinertia'"),
-        ('<joint name="j"/><inertial mass="1" diaginertia="1 1 1"/>', r"<inertial> of body 'b' has no 'pos' attribute \(MuJoCo requires it\)"),
-        ('<joint name="j"/><inertial pos="0 0 0" mass="-1" diaginertia="1 1 1"/>', r"<inertial> of body 'b': attribute 'mass' is negative"),
+        (
+            '<joint name="j"/><geom size="1" quat="1 0 0 0" euler="0 0 0"/>',
+            r"<geom> gives its orientation twice \(quat, euler\)",
+        ),
+        (
+            '<joint name="j"/><inertial pos="0 0 0" mass="1"/>',
+            r"<inertial> of body 'b' has neither 'diaginertia' nor 'fullinertia'",
+        ),
+        (
+            '<joint name="j"/><inertial mass="1" diaginertia="1 1 1"/>',
+            r"<inertial> of body 'b' has no 'pos' attribute \(MuJoCo requires it\)",
+        ),
+        (
+            '<joint name="j"/><inertial pos="0 0 0" mass="-1" diaginertia="1 1 1"/>',
+            r"<inertial> of body 'b': attribute 'mass' is negative",
+        ),
         ('<joint name="j"/><geom type="mesh" mesh="m"/>', r"<geom> geom: mesh='m' names no <asset><mesh>"),
     ],
 )
@@ -455,11 +496,13 @@ def test_elements_that_generate_bodies_are_refused(tag):
 
 # --------------------------------------------------------------------------------- geometry
 def test_geoms_become_visuals_and_collisions():
-    xml = ('<mujoco><asset><material name="red" rgba="1 0 0 1"/><mesh name="part" file="part.stl" scale="2 2 2"/></asset>'
-           '<worldbody><geom name="floor" type="plane" size="1 1 1"/><body name="b"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
-           '<geom type="box" size="0.1 0.2 0.3" material="red" pos="1 0 0"/>'
-           '<geom type="capsule" size="0.1 0.5" contype="0" conaffinity="0" rgba="0 1 0 1"/>'
-           '<geom type="mesh" mesh="part" group="3"/></body></worldbody></mujoco>')
+    xml = (
+        '<mujoco><asset><material name="red" rgba="1 0 0 1"/><mesh name="part" file="part.stl" scale="2 2 2"/></asset>'
+        '<worldbody><geom name="floor" type="plane" size="1 1 1"/><body name="b"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+        '<geom type="box" size="0.1 0.2 0.3" material="red" pos="1 0 0"/>'
+        '<geom type="capsule" size="0.1 0.5" contype="0" conaffinity="0" rgba="0 1 0 1"/>'
+        '<geom type="mesh" mesh="part" group="3"/></body></worldbody></mujoco>'
+    )
     robot = robot_from_mjcf(xml)
     shapes = [(v.frame, v.describe(), v.rgba) for v in robot.visuals]
     assert shapes == [("b", "box", (1.0, 0.0, 0.0, 1.0)), ("b", "cylinder", (0.0, 1.0, 0.0, 1.0))]
@@ -470,9 +513,13 @@ def test_geoms_become_visuals_and_collisions():
 
 
 def test_the_warning_names_what_is_ignored_and_points_at_the_caller():
-    xml = ('<mujoco><worldbody><body gravcomp="1"><joint name="j" stiffness="3"/><geom size="1"/></body></worldbody>'
-           '<actuator><motor joint="j"/></actuator></mujoco>')
-    with pytest.warns(UserWarning, match=r"<actuator> \(1 elements\); gravcomp of body 'body1'; the spring \(stiffness\) of joint 'j'") as caught:
+    xml = (
+        '<mujoco><worldbody><body gravcomp="1"><joint name="j" stiffness="3"/><geom size="1"/></body></worldbody>'
+        '<actuator><motor joint="j"/></actuator></mujoco>'
+    )
+    with pytest.warns(
+        UserWarning, match=r"<actuator> \(1 elements\); gravcomp of body 'body1'; the spring \(stiffness\) of joint 'j'"
+    ) as caught:
         robot_from_mjcf(xml)
     assert len(caught) == 1 and caught[0].filename == __file__
 
@@ -486,7 +533,13 @@ def test_the_cli_reads_an_mjcf_file(tmp_path):
     path = tmp_path / "cart_pole.xml"
     path.write_text(CART_POLE)
     env = {**os.environ, "PYTHONPATH": str(Path(kd.__file__).parents[1])}
-    done = subprocess.run([sys.executable, "-m", "kinedyn", "info", str(path), "--json"], capture_output=True, text=True, env=env, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-m", "kinedyn", "info", str(path), "--json"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     assert "slider" in done.stdout and "hinge" in done.stdout and json.loads(done.stdout)
 
@@ -519,15 +572,21 @@ def random_model(seed: int) -> str:
         parts = [f'<body name="b{k}" pos="{vec(3)}"{orientation()}>']
         for j in range(rng.integers(0 if depth else 1, 4)):
             kind = rng.choice(["hinge", "slide"])
-            parts.append(f'<joint name="j{k}_{j}" type="{kind}" axis="{vec(3)}" pos="{vec(3)}" armature="{rng.uniform(0, 0.1):.4f}" damping="{rng.uniform(0, 1):.4f}"/>')
+            parts.append(
+                f'<joint name="j{k}_{j}" type="{kind}" axis="{vec(3)}" pos="{vec(3)}" armature="{rng.uniform(0, 0.1):.4f}" damping="{rng.uniform(0, 1):.4f}"/>'
+            )
         if rng.random() < 0.5:
             m = rng.uniform(0.5, 3)
             d = np.sort(rng.uniform(0.05, 0.2, 3))
-            parts.append(f'<inertial pos="{vec(3)}"{orientation()} mass="{m:.4f}" diaginertia="{d[0] + d[1]:.5f} {d[1] + d[2]:.5f} {d[0] + d[2]:.5f}"/>')
+            parts.append(
+                f'<inertial pos="{vec(3)}"{orientation()} mass="{m:.4f}" diaginertia="{d[0] + d[1]:.5f} {d[1] + d[2]:.5f} {d[0] + d[2]:.5f}"/>'
+            )
         else:
             for _ in range(rng.integers(1, 3)):
                 shape = rng.choice(["box", "sphere", "capsule", "cylinder", "ellipsoid"])
-                parts.append(f'<geom type="{shape}" size="{" ".join(f"{s:.4f}" for s in rng.uniform(0.02, 0.2, 3))}" pos="{vec(3)}"{orientation()}/>')
+                parts.append(
+                    f'<geom type="{shape}" size="{" ".join(f"{s:.4f}" for s in rng.uniform(0.02, 0.2, 3))}" pos="{vec(3)}"{orientation()}/>'
+                )
         return "\n".join(parts)
 
     text, open_bodies, k = [], 0, 0
@@ -539,7 +598,11 @@ def random_model(seed: int) -> str:
         text.append(body(k, open_bodies))
         open_bodies += 1
     text += ["</body>"] * open_bodies
-    return f'<mujoco><compiler angle="{angle}"/><option gravity="{vec(3)}"/><worldbody>' + "\n".join(text) + "</worldbody></mujoco>"
+    return (
+        f'<mujoco><compiler angle="{angle}"/><option gravity="{vec(3)}"/><worldbody>'
+        + "\n".join(text)
+        + "</worldbody></mujoco>"
+    )
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -566,14 +629,14 @@ def mujoco_to_pinocchio_state(model, qpos, qvel, qacc):
         a, b, kind = model.jnt_qposadr[j], model.jnt_dofadr[j], int(model.jnt_type[j])
         if kind == FREE:
             R = np.zeros(9)
-            mujoco.mju_quat2Mat(R, qpos[a + 3:a + 7])
+            mujoco.mju_quat2Mat(R, qpos[a + 3 : a + 7])
             R = R.reshape(3, 3)
-            q += [*qpos[a:a + 3], *qpos[a + 4:a + 7], qpos[a + 3]]
-            v[b:b + 3] = R.T @ qvel[b:b + 3]
-            vd[b:b + 3] = R.T @ qacc[b:b + 3] - np.cross(qvel[b + 3:b + 6], v[b:b + 3])
-            T[b:b + 3, b:b + 3] = R
+            q += [*qpos[a : a + 3], *qpos[a + 4 : a + 7], qpos[a + 3]]
+            v[b : b + 3] = R.T @ qvel[b : b + 3]
+            vd[b : b + 3] = R.T @ qacc[b : b + 3] - np.cross(qvel[b + 3 : b + 6], v[b : b + 3])
+            T[b : b + 3, b : b + 3] = R
         elif kind == BALL:
-            q += [*qpos[a + 1:a + 4], qpos[a]]
+            q += [*qpos[a + 1 : a + 4], qpos[a]]
         else:
             q.append(qpos[a])
     return np.array(q), v, vd, T
@@ -584,11 +647,11 @@ def random_qpos(model, rng):
     for j in range(model.njnt):
         a, kind = model.jnt_qposadr[j], int(model.jnt_type[j])
         if kind == FREE:
-            qpos[a:a + 3] = rng.normal(size=3)
+            qpos[a : a + 3] = rng.normal(size=3)
             a += 3
         if kind in (FREE, BALL):
             quat = rng.normal(size=4)
-            qpos[a:a + 4] = quat / np.linalg.norm(quat)
+            qpos[a : a + 4] = quat / np.linalg.norm(quat)
         else:
             qpos[a] = rng.uniform(-1.5, 1.5)
     return qpos
@@ -602,7 +665,7 @@ def pinocchio_model_of(robot):
     model = pin.Model()
     model.gravity.linear = np.array(robot.gravity, dtype=float)
     armature = []
-    for i, body in enumerate(robot.tree.bodies):
+    for _i, body in enumerate(robot.tree.bodies):
         j = body.joint
         if j.kind == "revolute":
             joint = pin.JointModelRevoluteUnaligned(np.array(j.axis, dtype=float))
@@ -616,7 +679,13 @@ def pinocchio_model_of(robot):
         placement = np.array(body.placement, dtype=float)
         index = model.addJoint(body.parent + 1, joint, pin.SE3(placement[:3, :3], placement[:3, 3]), j.name)
         inertia = body.inertia
-        model.appendBodyToJoint(index, pin.Inertia(float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)), pin.SE3.Identity())
+        model.appendBodyToJoint(
+            index,
+            pin.Inertia(
+                float(inertia.mass), np.array(inertia.com, dtype=float), np.array(inertia.inertia, dtype=float)
+            ),
+            pin.SE3.Identity(),
+        )
         armature += [float(j.armature)] * j.nv
         assert j.offset == 0  # (the models below have no ref)
     model.armature = np.array(armature)
@@ -646,7 +715,9 @@ def compare_multi_dof(robot, model, seed: int, states: int = 3):
         mujoco.mj_kinematics(model, data)
         for b in range(1, model.nbody):
             frame = robot.tree.frames[robot.tree.frame_index(model.body(b).name or f"body{b}")]
-            pose = (pd.oMi[frame.body + 1].homogeneous if frame.body >= 0 else np.eye(4)) @ np.array(frame.placement, dtype=float)
+            pose = (pd.oMi[frame.body + 1].homogeneous if frame.body >= 0 else np.eye(4)) @ np.array(
+                frame.placement, dtype=float
+            )
             np.testing.assert_allclose(pose[:3, 3], data.xpos[b], atol=TOL, rtol=0)
             np.testing.assert_allclose(pose[:3, :3], data.xmat[b].reshape(3, 3), atol=TOL, rtol=0)
 
@@ -694,19 +765,27 @@ def test_the_mujoco_test_model_with_free_and_ball_joints_agrees_through_pinocchi
     model.dof_damping[:] = 0  # Pinocchio's rnea has no damping (kinedyn's does: see the 1-DOF tests)
     for j in range(model.njnt):  # kinedyn ignores (and names in its warning) a ball joint's armature
         if int(model.jnt_type[j]) == BALL:
-            model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
+            model.dof_armature[model.jnt_dofadr[j] : model.jnt_dofadr[j] + 3] = 0
     compare_multi_dof(robot, model, seed=8)
 
 
 @pytest.mark.parametrize(
     "options, extra",
     [
-        ('boundmass="2" boundinertia="0.05"', '<body name="light" pos="0 0 1"><joint name="y"/><geom size="0.01" pos="0.1 0 0" mass="0.1"/></body>'),
+        (
+            'boundmass="2" boundinertia="0.05"',
+            '<body name="light" pos="0 0 1"><joint name="y"/><geom size="0.01" pos="0.1 0 0" mass="0.1"/></body>',
+        ),
         ('settotalmass="7"', ""),
-        ('balanceinertia="true"', '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/></body>'),
-        ('boundmass="0.5" boundinertia="0.01" settotalmass="3" balanceinertia="true"',
-         '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/>'
-         '<body name="empty"><joint name="y"/></body></body>'),
+        (
+            'balanceinertia="true"',
+            '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/></body>',
+        ),
+        (
+            'boundmass="0.5" boundinertia="0.01" settotalmass="3" balanceinertia="true"',
+            '<body name="flat" pos="0 0 1"><joint name="x"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.01 0.05"/>'
+            '<body name="empty"><joint name="y"/></body></body>',
+        ),
     ],
 )
 def test_compiler_inertia_adjustments_agree_with_mujoco(options, extra, tmp_path, monkeypatch):
@@ -776,10 +855,10 @@ def mujoco_acceleration(model, qpos, qvel, vd):
         a, b = model.jnt_qposadr[j], model.jnt_dofadr[j]
         if int(model.jnt_type[j]) == FREE:
             R = np.zeros(9)
-            mujoco.mju_quat2Mat(R, qpos[a + 3:a + 7])
+            mujoco.mju_quat2Mat(R, qpos[a + 3 : a + 7])
             R = R.reshape(3, 3)
-            v_lin = R.T @ qvel[b:b + 3]
-            qacc[b:b + 3] = R @ (vd[b:b + 3] + np.cross(qvel[b + 3:b + 6], v_lin))
+            v_lin = R.T @ qvel[b : b + 3]
+            qacc[b : b + 3] = R @ (vd[b : b + 3] + np.cross(qvel[b + 3 : b + 6], v_lin))
     return qacc
 
 
@@ -830,14 +909,16 @@ def test_the_mujoco_test_model_agrees_with_mujoco_in_kinedyns_engine():
     model.body_gravcomp[:] = 0
     for j in range(model.njnt):
         if int(model.jnt_type[j]) == BALL:
-            model.dof_armature[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
-            model.dof_damping[model.jnt_dofadr[j]:model.jnt_dofadr[j] + 3] = 0
+            model.dof_armature[model.jnt_dofadr[j] : model.jnt_dofadr[j] + 3] = 0
+            model.dof_damping[model.jnt_dofadr[j] : model.jnt_dofadr[j] + 3] = 0
     compare_multi_dof_kinedyn(robot, model, seed=12)
 
 
 def test_a_ball_joints_range_and_damping_are_named_as_ignored():
-    xml = ('<mujoco><worldbody><body><joint name="b" type="ball" range="0 30" damping="1"/><geom size="0.1"/></body>'
-           '</worldbody></mujoco>')
+    xml = (
+        '<mujoco><worldbody><body><joint name="b" type="ball" range="0 30" damping="1"/><geom size="0.1"/></body>'
+        "</worldbody></mujoco>"
+    )
     with pytest.warns(UserWarning, match=r"damping of the ball joint 'b'; the range \(a cone\) of the ball joint 'b'"):
         robot = robot_from_mjcf(xml)
     assert robot.joints[0].kind == "spherical" and robot.joints[0].viscous == 0

@@ -28,12 +28,16 @@ CELLS = {
     "ik": "result = robot.inverse_kinematics(robot.pose(np.full(6, 0.3)))\nresult",
     "trajectory": "traj = kd.simulate(kd.robots.elbow_3r(), (0.0, 0.5), np.r_[0.5, -0.7, 0.5, 0, 0, 0])\ntraj",
     "properties": "analysis.check_properties(kd.robots.planar_2r(), samples=20, T=0.2)",
-    "identification": ("r2 = kd.robots.planar_2r()\n"
-                       "ident = analysis.identify(r2, analysis.simulate_measurements(r2, analysis.excitation(r2, harmonics=3, period=2.0, seed=1), rate=50.0))\n"
-                       "ident"),
+    "identification": (
+        "r2 = kd.robots.planar_2r()\n"
+        "ident = analysis.identify(r2, analysis.simulate_measurements(r2, analysis.excitation(r2, harmonics=3, period=2.0, seed=1), rate=50.0))\n"
+        "ident"
+    ),
     # robot.show() in a kernel returns at once (a script blocks until Ctrl-C) with its server running
-    "viewer": ("import urllib.request\nviewer = kd.robots.planar_2r().show(port=8765)\n"
-               "status = urllib.request.urlopen(viewer.url, timeout=60).status\nviewer.close()\n(status, viewer.url)"),
+    "viewer": (
+        "import urllib.request\nviewer = kd.robots.planar_2r().show(port=8765)\n"
+        "status = urllib.request.urlopen(viewer.url, timeout=60).status\nviewer.close()\n(status, viewer.url)"
+    ),
 }
 
 
@@ -45,7 +49,9 @@ def outputs(tmp_path_factory, monkeypatch_module):
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     # the kernel imports the kinedyn under test (the wheel in CI, python/ here)
     monkeypatch_module.setenv("PYTHONPATH", str(Path(kd.__file__).parents[1]))
-    client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path_factory.mktemp("nb"))}})
+    client = nbclient.NotebookClient(
+        nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path_factory.mktemp("nb"))}}
+    )
     client.execute()
     out = {}
     for name, cell in zip(CELLS, nb.cells):
@@ -68,7 +74,10 @@ def cells_of(table_html: str, cls: str) -> list:
     """The rows of the table with class ``cls`` as lists of cell texts."""
     table = re.search(rf'<table class="{cls}">(.*?)</table>', table_html, re.S).group(1)
     body = table.split("<tbody>")[1]
-    return [[html.unescape(re.sub(r"<[^>]+>", "", c)) for c in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)] for row in re.findall(r"<tr>(.*?)</tr>", body, re.S)]
+    return [
+        [html.unescape(re.sub(r"<[^>]+>", "", c)) for c in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
+        for row in re.findall(r"<tr>(.*?)</tr>", body, re.S)
+    ]
 
 
 def assert_dotted_rates(page: str) -> None:
@@ -88,7 +97,12 @@ def test_robot_shows_its_joint_table_mass_and_a_picture(outputs):
     assert [r[0] for r in rows] == robot.joint_names
     total = sum(float(b.inertia.mass) for b in robot.tree.bodies)
     assert f"total moving mass {total:.6g} kg" in page
-    assert "<svg" in page and "<line" in page and "<script" not in page and "http" not in page.replace('xmlns="http://www.w3.org/2000/svg"', "")
+    assert (
+        "<svg" in page
+        and "<line" in page
+        and "<script" not in page
+        and "http" not in page.replace('xmlns="http://www.w3.org/2000/svg"', "")
+    )
     assert all(name in data["text/markdown"] for name in robot.joint_names)
 
 
@@ -97,7 +111,9 @@ def test_equations_of_motion_typeset_with_dotted_rates(outputs):
     assert {"text/html", "text/latex", "text/markdown"} <= set(data)
     eom = kd.robots.planar_2r().equations_of_motion()
     assert data["text/latex"] == eom.to_latex(steps=False)
-    assert r"\dot{q}_{1}" in data["text/latex"] and "qd_{1}" not in data["text/latex"] and "qd1" not in data["text/latex"]
+    assert (
+        r"\dot{q}_{1}" in data["text/latex"] and "qd_{1}" not in data["text/latex"] and "qd1" not in data["text/latex"]
+    )
     page = data["text/html"]
     assert page.count("<math") >= 4 and "<details>" in page
     assert_dotted_rates(page)
@@ -139,7 +155,9 @@ def test_property_and_identification_results_are_tables(outputs):
     assert [r[0] for r in rows] == [c.name for c in report.checks]
     np.testing.assert_allclose([float(r[1]) for r in rows], [c.residual for c in report.checks], rtol=5e-3, atol=1e-300)
     r2 = kd.robots.planar_2r()
-    ident = analysis.identify(r2, analysis.simulate_measurements(r2, analysis.excitation(r2, harmonics=3, period=2.0, seed=1), rate=50.0))
+    ident = analysis.identify(
+        r2, analysis.simulate_measurements(r2, analysis.excitation(r2, harmonics=3, period=2.0, seed=1), rate=50.0)
+    )
     rows = cells_of(outputs["identification"]["text/html"], "kinedyn-identification")
     assert [r[0] for r in rows] == list(ident.names)
     np.testing.assert_allclose([float(r[1]) for r in rows], ident.estimates, rtol=5e-6, atol=1e-12)

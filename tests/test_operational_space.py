@@ -7,18 +7,25 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reference import PANDA, erd
 
 import kinedyn as kd
 from kinedyn import dynamics as dyn
 from kinedyn import kinematics as kin
 
-from reference import PANDA, erd
-
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
 RNG = np.random.default_rng(20261202)
-CASES = [("puma560", "full"), ("puma560", "position"), ("stanford", "full"), ("ur5", "orientation"), ("elbow_3r", "position"),
-         ("planar_2r", "planar"), ("planar_3r", "planar_pose"), ("cartesian_2p", [1, 2])]
+CASES = [
+    ("puma560", "full"),
+    ("puma560", "position"),
+    ("stanford", "full"),
+    ("ur5", "orientation"),
+    ("elbow_3r", "position"),
+    ("planar_2r", "planar"),
+    ("planar_3r", "planar_pose"),
+    ("cartesian_2p", [1, 2]),
+]
 
 
 @pytest.mark.parametrize("name,task", CASES)
@@ -74,14 +81,18 @@ def test_batches_equal_loops():
     assert L.shape == (4, 3, 3) and Jbar.shape == (4, 6, 3)
     for k in range(4):
         np.testing.assert_allclose(L[k], dyn.operational_space_inertia(robot, qs[k], task="position"), rtol=1e-12)
-        np.testing.assert_allclose(Jbar[k], dyn.dynamically_consistent_inverse(robot, qs[k], task="position"), rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(
+            Jbar[k], dyn.dynamically_consistent_inverse(robot, qs[k], task="position"), rtol=1e-12, atol=1e-15
+        )
 
 
 def test_singular_configurations_give_an_error_or_the_documented_pseudo_inverse():
     robot = kd.robots.planar_2r()
     stretched = np.array([0.4, 0.0])
     for f in (dyn.operational_space_inertia, dyn.dynamically_consistent_inverse):
-        with pytest.raises(ValueError, match=r"the task Jacobian is singular at q = \[0\.4 0\. \].*the tool cannot move along"):
+        with pytest.raises(
+            ValueError, match=r"the task Jacobian is singular at q = \[0\.4 0\. \].*the tool cannot move along"
+        ):
             f(robot, stretched, task="planar")
         with pytest.raises(ValueError, match=r"configuration 1 of the batch"):
             f(robot, [[0.4, 1.0], stretched], task="planar")
@@ -104,8 +115,11 @@ def test_singular_configurations_give_an_error_or_the_documented_pseudo_inverse(
     np.testing.assert_allclose(P @ radial, 0.0, atol=1e-10)
     # away from the singularity pinv agrees with the inverse
     q = np.array([0.4, 1.2])
-    np.testing.assert_allclose(dyn.operational_space_inertia(robot, q, task="planar", method="pinv"),
-                               dyn.operational_space_inertia(robot, q, task="planar"), rtol=1e-9)
+    np.testing.assert_allclose(
+        dyn.operational_space_inertia(robot, q, task="planar", method="pinv"),
+        dyn.operational_space_inertia(robot, q, task="planar"),
+        rtol=1e-9,
+    )
     # more task rows than joints with pinv: finite, rank n
     L6 = dyn.operational_space_inertia(robot, q, method="pinv")
     assert np.all(np.isfinite(L6)) and np.linalg.matrix_rank(L6) == 2

@@ -96,9 +96,13 @@ def test_random_urdf_trees_agree_with_pinocchio(seed):
         np.testing.assert_allclose(robot.mass_matrix(q)[np.ix_(perm, perm)], M, atol=1e-9)
         C = pin.computeCoriolisMatrix(model, data, qp, qdp)
         np.testing.assert_allclose(robot.coriolis_matrix(q, qd)[np.ix_(perm, perm)], C, atol=1e-9)
-        np.testing.assert_allclose(robot.gravity_torque(q)[perm], pin.computeGeneralizedGravity(model, data, qp), atol=1e-9)
+        np.testing.assert_allclose(
+            robot.gravity_torque(q)[perm], pin.computeGeneralizedGravity(model, data, qp), atol=1e-9
+        )
         taus = rng.normal(size=robot.n)
-        np.testing.assert_allclose(robot.forward_dynamics(q, qd, taus)[perm], pin.aba(model, data, qp, qdp, taus[perm]), atol=1e-9)
+        np.testing.assert_allclose(
+            robot.forward_dynamics(q, qd, taus)[perm], pin.aba(model, data, qp, qdp, taus[perm]), atol=1e-9
+        )
         # analytical derivatives (Pinocchio differentiates in its tangent space: d/dq for 1-dof joints)
         block = np.ix_(perm, perm)
         dq, dqd, _ = robot.inverse_dynamics_derivatives(q, qd, qdd)

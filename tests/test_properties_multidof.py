@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import kinedyn as kd
-from kinedyn.analysis.properties import _ManifoldChart, _inertia_bounds, check_properties, mass_matrix_rate
+from kinedyn.analysis.properties import _inertia_bounds, _ManifoldChart, check_properties, mass_matrix_rate
 from kinedyn.testing import example_robot_data_dir, random_robot
 
 
@@ -28,16 +28,16 @@ def _naive_step(robot, q, v, t):
     iq = iv = 0
     for j in robot.joints:
         if j.kind == "floating":
-            q[..., iq:iq + 3] += t * v[..., iv:iv + 3]
-            quat = q[..., iq + 3:iq + 7]
-            quat[..., :3] += t * v[..., iv + 3:iv + 6]
+            q[..., iq : iq + 3] += t * v[..., iv : iv + 3]
+            quat = q[..., iq + 3 : iq + 7]
+            quat[..., :3] += t * v[..., iv + 3 : iv + 6]
             quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
         elif j.kind == "spherical":
-            quat = q[..., iq:iq + 4]
-            quat[..., :3] += t * v[..., iv:iv + 3]
+            quat = q[..., iq : iq + 4]
+            quat[..., :3] += t * v[..., iv : iv + 3]
             quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
         elif j.kind == "planar":
-            q[..., iq:iq + 2] += t * v[..., iv:iv + 2]
+            q[..., iq : iq + 2] += t * v[..., iv : iv + 2]
             angle = np.arctan2(q[..., iq + 3], q[..., iq + 2]) + t * v[..., iv + 2]
             q[..., iq + 2], q[..., iq + 3] = np.cos(angle), np.sin(angle)
         else:
@@ -57,14 +57,18 @@ def test_dM_dt_needs_the_manifold_derivative_on_a_floating_robot():
     QD = rng.uniform(-2.0, 2.0, size=(20, robot.nv))
     h = 1e-6
     manifold = _skew_residual(robot, Q, QD, mass_matrix_rate(robot, Q, QD, h))
-    naive_Mdot = (robot.mass_matrix(_naive_step(robot, Q, QD, h)) - robot.mass_matrix(_naive_step(robot, Q, QD, -h))) / (2 * h)
+    naive_Mdot = (
+        robot.mass_matrix(_naive_step(robot, Q, QD, h)) - robot.mass_matrix(_naive_step(robot, Q, QD, -h))
+    ) / (2 * h)
     naive = _skew_residual(robot, Q, QD, naive_Mdot)
     assert manifold < 1e-8, manifold
     assert naive > 1e-2, naive
     # on 1-DOF joints the manifold step is the old q + t qd, digit for digit
     arm = random_robot(5, n=4, friction=False)
     q, qd = arm.random_configuration(rng, size=3), rng.normal(size=(3, arm.nv))
-    np.testing.assert_array_equal(mass_matrix_rate(arm, q, qd, h), (arm.mass_matrix(q + h * qd) - arm.mass_matrix(q - h * qd)) / (2 * h))
+    np.testing.assert_array_equal(
+        mass_matrix_rate(arm, q, qd, h), (arm.mass_matrix(q + h * qd) - arm.mass_matrix(q - h * qd)) / (2 * h)
+    )
 
 
 def test_the_search_chart_moves_on_the_manifold():
@@ -80,9 +84,16 @@ def test_the_search_chart_moves_on_the_manifold():
         x = rng.uniform(chart.lower, chart.upper)
         x[chart.periodic] = rng.uniform(-3.0, 3.0, int(chart.periodic.sum()))  # rotation vectors past pi too
         h = 1e-6
-        numeric = np.array([robot.difference(chart.configuration(x - h * e), chart.configuration(x + h * e)) / (2 * h) for e in np.eye(chart.nx)]).T
+        numeric = np.array(
+            [
+                robot.difference(chart.configuration(x - h * e), chart.configuration(x + h * e)) / (2 * h)
+                for e in np.eye(chart.nx)
+            ]
+        ).T
         np.testing.assert_allclose(chart.tangent(x), numeric, atol=1e-8)
-        np.testing.assert_allclose(robot.difference(chart.configuration(x), chart.configuration(chart.wrap(x))), 0.0, atol=1e-12)
+        np.testing.assert_allclose(
+            robot.difference(chart.configuration(x), chart.configuration(chart.wrap(x))), 0.0, atol=1e-12
+        )
     Q = robot.random_configuration(rng, size=5)
     moved = Q.copy()
     moved[:, :7] = robot.random_configuration(rng, size=5)[:, :7]
@@ -105,11 +116,28 @@ def test_check_properties_on_multi_dof_robots_and_a_lone_floating_body():
     robot = random_robot(5, n=4, floating=True, spherical=0.4, planar=0.3, friction=False)
     report = check_properties(robot, samples=20, T=0.5)
     assert report.passed, str(report)
-    assert [c.status for c in report.checks] == ["sampled", "searched", "sampled", "sampled", "sampled", "sampled", "simulated"]
+    assert [c.status for c in report.checks] == [
+        "sampled",
+        "searched",
+        "sampled",
+        "sampled",
+        "sampled",
+        "sampled",
+        "simulated",
+    ]
     assert "along q ⊕ t qd" in report["dM/dt - 2C"].detail
     assert "held at its identity" in report["inertia bounds"].detail
     # a drone: nothing but the free-flyer, M constant
-    drone = kd.Robot([kd.Link("body", None, kd.Joint("root_joint", "floating"), inertia=kd.Inertia(1.5, (0, 0, 0.01), np.diag([0.02, 0.03, 0.04])))])
+    drone = kd.Robot(
+        [
+            kd.Link(
+                "body",
+                None,
+                kd.Joint("root_joint", "floating"),
+                inertia=kd.Inertia(1.5, (0, 0, 0.01), np.diag([0.02, 0.03, 0.04])),
+            )
+        ]
+    )
     report = check_properties(drone, samples=10, T=0.2)
     assert report.passed, str(report)
     eig = np.linalg.eigvalsh(drone.mass_matrix(drone.neutral()))

@@ -54,13 +54,21 @@ def test_symbolic_2r_identities_are_proved_and_bounds_equal_the_closed_form():
     assert bounds.data["lambda_min"] == pytest.approx(lo, rel=1e-10)
     assert bounds.data["lambda_max"] == pytest.approx(hi, rel=1e-10)
     # attained: the eigenvalue at the returned configuration is the reported bound
-    D = sp.lambdify([list(eom.q)], eom.M.xreplace({s: VALUES[s.name] for s in eom.M.free_symbols if s.name in VALUES}), "numpy")
-    assert np.linalg.eigvalsh(np.array(D(bounds.data["q_lambda_min"]), float))[0] == pytest.approx(bounds.data["lambda_min"], rel=1e-12)
-    assert np.linalg.eigvalsh(np.array(D(bounds.data["q_lambda_max"]), float))[-1] == pytest.approx(bounds.data["lambda_max"], rel=1e-12)
+    D = sp.lambdify(
+        [list(eom.q)], eom.M.xreplace({s: VALUES[s.name] for s in eom.M.free_symbols if s.name in VALUES}), "numpy"
+    )
+    assert np.linalg.eigvalsh(np.array(D(bounds.data["q_lambda_min"]), float))[0] == pytest.approx(
+        bounds.data["lambda_min"], rel=1e-12
+    )
+    assert np.linalg.eigvalsh(np.array(D(bounds.data["q_lambda_max"]), float))[-1] == pytest.approx(
+        bounds.data["lambda_max"], rel=1e-12
+    )
     # and no sampled configuration does better
     Q = np.random.default_rng(7).uniform(-np.pi, np.pi, size=(2000, 2))
     eig = np.linalg.eigvalsh(np.array([np.array(D(q), float) for q in Q]))
-    assert bounds.data["lambda_min"] <= eig[:, 0].min() + 1e-12 and bounds.data["lambda_max"] >= eig[:, -1].max() - 1e-12
+    assert (
+        bounds.data["lambda_min"] <= eig[:, 0].min() + 1e-12 and bounds.data["lambda_max"] >= eig[:, -1].max() - 1e-12
+    )
 
 
 def test_free_parameters_skip_the_bounds_and_say_which():
@@ -80,8 +88,12 @@ def test_numeric_check_bounds_are_global_attained_and_match_the_closed_form():
     ends = [np.linalg.eigvalsh(robot.mass_matrix(np.array([0.3, q2]))) for q2 in (0.0, math.pi)]
     assert b.data["lambda_min"] == pytest.approx(min(e[0] for e in ends), rel=1e-10)
     assert b.data["lambda_max"] == pytest.approx(max(e[-1] for e in ends), rel=1e-10)
-    assert np.linalg.eigvalsh(robot.mass_matrix(b.data["q_lambda_min"]))[0] == pytest.approx(b.data["lambda_min"], rel=1e-12)
-    assert np.linalg.eigvalsh(robot.mass_matrix(b.data["q_lambda_max"]))[-1] == pytest.approx(b.data["lambda_max"], rel=1e-12)
+    assert np.linalg.eigvalsh(robot.mass_matrix(b.data["q_lambda_min"]))[0] == pytest.approx(
+        b.data["lambda_min"], rel=1e-12
+    )
+    assert np.linalg.eigvalsh(robot.mass_matrix(b.data["q_lambda_max"]))[-1] == pytest.approx(
+        b.data["lambda_max"], rel=1e-12
+    )
     eig = np.linalg.eigvalsh(robot.mass_matrix(robot.random_configuration(3, size=3000)))
     assert b.data["lambda_min"] <= eig[:, 0].min() and b.data["lambda_max"] >= eig[:, -1].max()
 
@@ -95,7 +107,9 @@ def test_the_search_finds_what_sampling_misses_on_the_elbow():
     assert abs(abs(b.data["q_lambda_min"][1]) - math.pi / 2) < 1e-5
     assert b.data["lambda_min"] < 0.5 * b.data["sampled_min"]
     D = sp.lambdify([list(eom.q)], eom.M, "numpy")
-    assert np.linalg.eigvalsh(np.array(D(b.data["q_lambda_min"]), float))[0] == pytest.approx(b.data["lambda_min"], rel=1e-12)
+    assert np.linalg.eigvalsh(np.array(D(b.data["q_lambda_min"]), float))[0] == pytest.approx(
+        b.data["lambda_min"], rel=1e-12
+    )
 
 
 def test_global_inertia_bounds_rejects_a_bad_box():
@@ -137,10 +151,23 @@ def test_prove_properties_on_a_lagrangian_system_model():
     absolute angles p1, p2, eq. 9.92)."""
     p1, p2 = sp.symbols("p1 p2", real=True)
     m1, m2, l1, lc1, lc2, I1, I2, g = 2.0, 1.5, 1.3, 0.6, 0.35, 0.21, 0.13, 9.81
-    bodies = [dict(mass=m1, position=[lc1 * sp.cos(p1), lc1 * sp.sin(p1)], inertia=I1, angular_velocity=sp.Symbol("pd1", real=True)),
-              dict(mass=m2, position=[l1 * sp.cos(p1) + lc2 * sp.cos(p2), l1 * sp.sin(p1) + lc2 * sp.sin(p2)], inertia=I2,
-                   angular_velocity=sp.Symbol("pd2", real=True))]
-    system = kd.symbolic.LagrangianSystem.from_bodies([p1, p2], bodies, gravity=[0, -g], qd=sp.symbols("pd1 pd2", real=True))
+    bodies = [
+        dict(
+            mass=m1,
+            position=[lc1 * sp.cos(p1), lc1 * sp.sin(p1)],
+            inertia=I1,
+            angular_velocity=sp.Symbol("pd1", real=True),
+        ),
+        dict(
+            mass=m2,
+            position=[l1 * sp.cos(p1) + lc2 * sp.cos(p2), l1 * sp.sin(p1) + lc2 * sp.sin(p2)],
+            inertia=I2,
+            angular_velocity=sp.Symbol("pd2", real=True),
+        ),
+    ]
+    system = kd.symbolic.LagrangianSystem.from_bodies(
+        [p1, p2], bodies, gravity=[0, -g], qd=sp.symbols("pd1 pd2", real=True)
+    )
     report = prove_properties(system.equations_of_motion())
     assert all(report[n].status == "proved" for n in ("D symmetric", "dD/dt - 2C skew", "D qdd"))
     # D(p) = [[a, b cos(p2 - p1)], [b cos(p2 - p1), d]]: extremes at cos = +-1 give the same spectrum
@@ -171,7 +198,10 @@ def test_an_equal_C_in_another_trigonometric_form_is_still_proved():
     eom = _eom_2r()
     q1, q2 = eom.q
     disguised = eom.C.applyfunc(
-        lambda e: (e * (sp.sin(q1) ** 2 + sp.cos(q1) ** 2)).xreplace({sp.sin(q2): sp.sin(q1 + q2) * sp.cos(q1) - sp.cos(q1 + q2) * sp.sin(q1)}))
+        lambda e: (e * (sp.sin(q1) ** 2 + sp.cos(q1) ** 2)).xreplace(
+            {sp.sin(q2): sp.sin(q1 + q2) * sp.cos(q1) - sp.cos(q1 + q2) * sp.sin(q1)}
+        )
+    )
     assert sp.expand(disguised - eom.C) != sp.zeros(2, 2)
     report = _tampered(eom, disguised).check_properties()
     for name in ("dD/dt - 2C skew", "dD/dt == C + C^T", "D qdd + C qd + g"):

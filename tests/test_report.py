@@ -7,7 +7,6 @@ from __future__ import annotations
 import html
 import io
 import json
-import math
 import os
 import re
 
@@ -63,7 +62,7 @@ def test_default_report_works_the_tutorial(default_report):
     from kinedyn.report import tutorial
 
     page = default_report.read_text()
-    section = page[page.index("<section id='tutorial'>"):]
+    section = page[page.index("<section id='tutorial'>") :]
     section = section[: section.index("</section>")]
     answers = tutorial.work()
     for a in answers:
@@ -91,7 +90,9 @@ def test_report_needs_no_network(default_report):
 
 def test_report_json_and_options(capsys, tmp_path):
     out = tmp_path / "elbow.html"
-    code, text, err = run(capsys, "report", "elbow_3r", "-o", str(out), "--q", "10", "20", "-30", "--deg", "--t", "0.5", "--json")
+    code, text, err = run(
+        capsys, "report", "elbow_3r", "-o", str(out), "--q", "10", "20", "-30", "--deg", "--t", "0.5", "--json"
+    )
     assert code == 0, err
     d = json.loads(text)
     robot = kd.robots.elbow_3r()
@@ -161,7 +162,9 @@ def test_report_in_headless_chromium(browser, default_report, tmp_path):
     box = maths.first.bounding_box()
     assert box["width"] > 100 and box["height"] > 20
     assert nonblank(page.locator("#equations").screenshot()) > 0.01
-    page.screenshot(path=os.environ.get("KINEDYN_REPORT_SCREENSHOT", str(tmp_path / "report.png")), full_page=True)  # for a person to look at
+    page.screenshot(
+        path=os.environ.get("KINEDYN_REPORT_SCREENSHOT", str(tmp_path / "report.png")), full_page=True
+    )  # for a person to look at
 
     # its numbers equal the library's: the Jacobian table and the viewer's own forward kinematics
     robot = kd.robots.planar_2r()
@@ -170,7 +173,9 @@ def test_report_in_headless_chromium(browser, default_report, tmp_path):
     cells = page.locator("table.jacobian tbody tr").all()
     shown = np.array([[float(c.inner_text()) for c in row.locator("td.num").all()] for row in cells])
     np.testing.assert_allclose(shown, robot.jacobian(q), rtol=5e-6, atol=1e-6)
-    tool = page.evaluate("(q) => { const T = window.kinedyn.fk(q).frames['tool']; return [T[3], T[7], T[11]]; }", [0.3, 1.2])
+    tool = page.evaluate(
+        "(q) => { const T = window.kinedyn.fk(q).frames['tool']; return [T[3], T[7], T[11]]; }", [0.3, 1.2]
+    )
     np.testing.assert_allclose(tool, robot.pose([0.3, 1.2])[:3, 3], atol=1e-12)
     # moving a slider moves the arm: the readout is the library's FK at the new q
     slider = page.locator("#kinedyn-sliders input").first

@@ -15,11 +15,11 @@ import pytest
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
+from reference import PANDA, UR5, erd  # noqa: E402
+
 import kinedyn as kd  # noqa: E402
 from kinedyn.cli import main  # noqa: E402
 from kinedyn.report.html import svg_plot  # noqa: E402
-
-from reference import PANDA, UR5, erd  # noqa: E402
 
 TALOS = ("talos_data", "robots", "talos_full_v2.urdf")
 WIDTHS = (1000, 1400)
@@ -137,7 +137,11 @@ def test_talos_report_is_quick_and_its_big_tables_scroll(browser, reports):
 def test_joint_plot_legend_names_every_joint():
     """The 6-joint legend dropped q6 (fixed 95-px slots, past the right edge of the plot)."""
     t = np.linspace(0, 1, 5)
-    for names in (["q1", "q2", "q3", "q4", "q5", "q6"], [f"panda_joint{k}" for k in range(1, 10)], [f"arm_left_{k}_joint" for k in range(44)]):
+    for names in (
+        ["q1", "q2", "q3", "q4", "q5", "q6"],
+        [f"panda_joint{k}" for k in range(1, 10)],
+        [f"arm_left_{k}_joint" for k in range(44)],
+    ):
         svg = svg_plot(t, [(nm, t * k) for k, nm in enumerate(names)], "joint positions", "t", "q")
         width = float(re.search(r'width="(\d+)"', svg).group(1))
         labels = re.findall(r'<text x="([\d.]+)" y="[\d.]+" font-size="11" fill="#243238">([^<]*)</text>', svg)
@@ -167,7 +171,9 @@ def test_gravity_prints_as_a_vector(reports):
     page = path.read_text()
     assert "['0'" not in page
     g = kd.robots.planar_2r().gravity
-    assert re.search(r"gravity g = \(" + ", ".join(re.escape(f"{v:g}") for v in g) + r"\) m/s²", page), re.findall(r"gravity[^<]*", page)
+    assert re.search(r"gravity g = \(" + ", ".join(re.escape(f"{v:g}") for v in g) + r"\) m/s²", page), re.findall(
+        r"gravity[^<]*", page
+    )
 
 
 def test_report_frame_option_and_the_pandas_default_tool(tmp_path, capsys):
@@ -177,7 +183,10 @@ def test_report_frame_option_and_the_pandas_default_tool(tmp_path, capsys):
 
     path = erd(*PANDA)
     robot = kd.Robot.from_urdf(path)
-    for argv, frame in ((["report", path], "panda_hand_tcp"), (["report", path, "--frame", "panda_link7"], "panda_link7")):
+    for argv, frame in (
+        (["report", path], "panda_hand_tcp"),
+        (["report", path, "--frame", "panda_link7"], "panda_link7"),
+    ):
         assert main([*argv, "-o", str(tmp_path / "p.html"), "--t", "0.1", "--json"]) == 0
         d = json.loads(capsys.readouterr().out)
         assert d["tool"] == frame

@@ -26,7 +26,7 @@ def _block(page: str, element_id: str) -> dict:
 
 def _section(page: str, section_id: str) -> str:
     start = page.index(f"<section id='{section_id}'>")
-    return page[start:page.index("</section>", start)]
+    return page[start : page.index("</section>", start)]
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +51,11 @@ def test_report_of_every_joint_kind_shows_q_by_block_and_velocities_by_degree_of
     assert (d["nq"], d["nv"]) == (robot.nq, robot.nv) == (16, 13)
     np.testing.assert_array_equal(d["q"], q)
     assert d["coordinate_labels"][:7] == ["j1.x", "j1.y", "j1.z", "j1.qx", "j1.qy", "j1.qz", "j1.qw"]
-    assert d["velocity_labels"][3:6] == ["j1.ωx", "j1.ωy", "j1.ωz"] and d["velocity_labels"][-3:] == ["j4.vx", "j4.vy", "j4.ω"]
+    assert d["velocity_labels"][3:6] == ["j1.ωx", "j1.ωy", "j1.ωz"] and d["velocity_labels"][-3:] == [
+        "j4.vx",
+        "j4.vy",
+        "j4.ω",
+    ]
     assert len(d["coordinate_labels"]) == robot.nq and len(d["velocity_labels"]) == robot.nv
     # the joints table says where each joint sits in q and qd
     description = _section(page, "description")
@@ -125,8 +129,11 @@ def test_the_viewer_moves_every_joint_kind_as_the_library_does(browser, every_ki
     context.close()
 
 
-@pytest.mark.parametrize("urdf, joints", [("solo_description/robots/solo12.urdf", 13), ("hector_description/robots/quadrotor_base.urdf", 1)],
-                         ids=["solo12", "hector"])
+@pytest.mark.parametrize(
+    "urdf, joints",
+    [("solo_description/robots/solo12.urdf", 13), ("hector_description/robots/quadrotor_base.urdf", 1)],
+    ids=["solo12", "hector"],
+)
 def test_kinedyn_report_floating_base_on_real_robots(capsys, tmp_path, urdf, joints):
     root = example_robot_data_dir()
     if root is None:
@@ -153,8 +160,17 @@ def test_kinedyn_report_floating_base_on_real_robots(capsys, tmp_path, urdf, joi
 def test_the_equations_of_a_small_multi_dof_robot_are_typeset_in_euler_angles():
     """A ball-jointed pendulum (nv = 3): the symbolic section derives the equations in the engine's
     ZYX Euler angles and says so, naming its coordinates (they are not the numeric q)."""
-    ball = kd.Robot([kd.Link("bob", None, kd.Joint("shoulder", "spherical"), inertia=kd.Inertia(1.0, (0, 0, -0.3), np.diag([0.02, 0.03, 0.01])))],
-                    name="ball_pendulum")
+    ball = kd.Robot(
+        [
+            kd.Link(
+                "bob",
+                None,
+                kd.Joint("shoulder", "spherical"),
+                inertia=kd.Inertia(1.0, (0, 0, -0.3), np.diag([0.02, 0.03, 0.01])),
+            )
+        ],
+        name="ball_pendulum",
+    )
     page = build_report(ball, t_end=0.2)
     equations = _section(page, "equations")
     assert "(shoulder_yaw, shoulder_pitch, shoulder_roll)" in equations and "ZYX Euler angles" in equations

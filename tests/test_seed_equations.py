@@ -31,7 +31,9 @@ q1, q2, q3 = sp.symbols("q1 q2 q3", real=True)
 qd1, qd2, qd3 = sp.symbols("qd1 qd2 qd3", real=True)
 qdd1, qdd2, qdd3 = sp.symbols("qdd1 qdd2 qdd3", real=True)
 Q, QD, QDD = [q1, q2], [qd1, qd2], [qdd1, qdd2]
-m1, m2, m3, m4, l1, l2, lc1, lc2, lc3, lc4, I1, I2, I3, I4, g = sp.symbols("m1 m2 m3 m4 l1 l2 lc1 lc2 lc3 lc4 I1 I2 I3 I4 g", positive=True)
+m1, m2, m3, m4, l1, l2, lc1, lc2, lc3, lc4, I1, I2, I3, I4, g = sp.symbols(
+    "m1 m2 m3 m4 l1 l2 lc1 lc2 lc3 lc4 I1 I2 I3 I4 g", positive=True
+)
 
 
 def ddt(e, q=Q, qd=QD, qdd=QDD):
@@ -66,7 +68,14 @@ def at_random_state(e):
         concrete[fn] = a + b * sp.cos(u) + c * sp.sin(v) + d * sp.cos(u - 2 * v)
     if concrete:
         e = e.xreplace(concrete).doit()
-    vals = {s: (RNG.uniform(-math.pi, math.pi) if s.name.startswith("q") or s.name.startswith("th") else RNG.uniform(0.3, 1.7)) for s in e.free_symbols}
+    vals = {
+        s: (
+            RNG.uniform(-math.pi, math.pi)
+            if s.name.startswith("q") or s.name.startswith("th")
+            else RNG.uniform(0.3, 1.7)
+        )
+        for s in e.free_symbols
+    }
     return complex(e.xreplace(vals).evalf())
 
 
@@ -75,7 +84,9 @@ def misprint(printed, derived, corrected):
     corrected form equals it exactly."""
     printed, derived, corrected = sp.Matrix([printed]), sp.Matrix([derived]), sp.Matrix([corrected])
     assert all_zero(corrected - derived), (corrected - derived).applyfunc(sp.simplify)
-    assert max(abs(at_random_state(e)) for e in printed - derived for _ in range(3)) > 1e-6, "the printed form is not wrong"
+    assert max(abs(at_random_state(e)) for e in printed - derived for _ in range(3)) > 1e-6, (
+        "the printed form is not wrong"
+    )
 
 
 def planar_elbow_by_particles():
@@ -93,7 +104,13 @@ def planar_elbow_by_particles():
 def christoffel_spong(D, q):
     """c[i][j][k] of Spong (9.58) written from its definition."""
     n = len(q)
-    return [[[(sp.diff(D[k, j], q[i]) + sp.diff(D[k, i], q[j]) - sp.diff(D[i, j], q[k])) / 2 for k in range(n)] for j in range(n)] for i in range(n)]
+    return [
+        [
+            [(sp.diff(D[k, j], q[i]) + sp.diff(D[k, i], q[j]) - sp.diff(D[i, j], q[k])) / 2 for k in range(n)]
+            for j in range(n)
+        ]
+        for i in range(n)
+    ]
 
 
 def kinedyn_planar_elbow():
@@ -125,7 +142,12 @@ def test_tutorial_review_fk_and_q1a_jacobian_and_kinedyn():
     printed_fk = sp.Matrix([l1 * cos(th1) + l2 * cos(th1 + th2), l1 * sin(th1) + l2 * sin(th1 + th2)])
     assert all_zero(printed_fk - tip)
     J = tip.jacobian(TH)
-    printed_J = sp.Matrix([[-l1 * sin(th1) - l2 * sin(th1 + th2), -l2 * sin(th1 + th2)], [l1 * cos(th1) + l2 * cos(th1 + th2), l2 * cos(th1 + th2)]])
+    printed_J = sp.Matrix(
+        [
+            [-l1 * sin(th1) - l2 * sin(th1 + th2), -l2 * sin(th1 + th2)],
+            [l1 * cos(th1) + l2 * cos(th1 + th2), l2 * cos(th1 + th2)],
+        ]
+    )
     assert all_zero(printed_J - J)
     robot = kd.robots.planar_2r(symbolic=True)
     qs = kd.symbolic.joint_symbols(robot)
@@ -142,7 +164,12 @@ def test_tutorial_q1b_inverse_jacobian():
     """Q1b: 1/(L1 L2 s2) [[L2 c12, L2 s12], [-L1 c1 - L2 c12, -L1 s1 - L2 s12]] is J^-1 (J^-1 J = I) and
     kinedyn.symbolic.jacobian_inverse gives the same matrix and determinant l1 l2 s2."""
     J = tip_by_complex_numbers().jacobian(TH)
-    printed = sp.Matrix([[l2 * cos(th1 + th2), l2 * sin(th1 + th2)], [-l1 * cos(th1) - l2 * cos(th1 + th2), -l1 * sin(th1) - l2 * sin(th1 + th2)]]) / (l1 * l2 * sin(th2))
+    printed = sp.Matrix(
+        [
+            [l2 * cos(th1 + th2), l2 * sin(th1 + th2)],
+            [-l1 * cos(th1) - l2 * cos(th1 + th2), -l1 * sin(th1) - l2 * sin(th1 + th2)],
+        ]
+    ) / (l1 * l2 * sin(th2))
     assert all_zero(printed * J - sp.eye(2))
     inv = kd.symbolic.jacobian_inverse(J, [th1, th2])
     assert all_zero(inv.inverse - printed) and is_zero(inv.determinant - l1 * l2 * sin(th2))
@@ -156,7 +183,12 @@ def _q2_state(exact: bool):
         t1 = math.atan2(1, 1) - math.atan2(a2 * math.sin(t2), a1 + a2 * math.cos(t2))
     else:
         t1, t2 = math.radians(167.028), math.radians(-156.44)
-    J = np.array([[-a1 * math.sin(t1) - a2 * math.sin(t1 + t2), -a2 * math.sin(t1 + t2)], [a1 * math.cos(t1) + a2 * math.cos(t1 + t2), a2 * math.cos(t1 + t2)]])
+    J = np.array(
+        [
+            [-a1 * math.sin(t1) - a2 * math.sin(t1 + t2), -a2 * math.sin(t1 + t2)],
+            [a1 * math.cos(t1) + a2 * math.cos(t1 + t2), a2 * math.cos(t1 + t2)],
+        ]
+    )
     return (t1, t2), J
 
 
@@ -207,8 +239,19 @@ def test_tutorial_q3_steps_1_to_3():
     xD, yD, xDd, yDd, vD2, K, P, _ = _q3()
     assert is_zero(xDd - (-l1 * S1 * thd1 - l2 / 2 * S12 * (thd1 + thd2)))
     assert is_zero(yDd - (l1 * C1 * thd1 + l2 / 2 * C12 * (thd1 + thd2)))
-    assert is_zero(vD2 - (thd1**2 * (l1**2 + l2**2 / 4 + l1 * l2 * C2) + thd2**2 * l2**2 / 4 + thd1 * thd2 * (l2**2 / 2 + l1 * l2 * C2)))
-    K_pr = thd1**2 * (m1 * l1**2 / 6 + m2 * l2**2 / 6 + m2 * l1**2 / 2 + m2 * l1 * l2 * C2 / 2) + thd2**2 * m2 * l2**2 / 6 + thd1 * thd2 * (m2 * l2**2 / 3 + m2 * l1 * l2 * C2 / 2)
+    assert is_zero(
+        vD2
+        - (
+            thd1**2 * (l1**2 + l2**2 / 4 + l1 * l2 * C2)
+            + thd2**2 * l2**2 / 4
+            + thd1 * thd2 * (l2**2 / 2 + l1 * l2 * C2)
+        )
+    )
+    K_pr = (
+        thd1**2 * (m1 * l1**2 / 6 + m2 * l2**2 / 6 + m2 * l1**2 / 2 + m2 * l1 * l2 * C2 / 2)
+        + thd2**2 * m2 * l2**2 / 6
+        + thd1 * thd2 * (m2 * l2**2 / 3 + m2 * l1 * l2 * C2 / 2)
+    )
     assert is_zero(K - K_pr)
     assert is_zero(P - (m1 * g * l1 / 2 * S1 + m2 * g * (l1 * S1 + l2 / 2 * S12)))
 
@@ -217,8 +260,13 @@ def test_tutorial_q3_lagrangian_first_term_typo():
     """The Lagrangian's first term is printed theta-dot^2 (no index): theta-dot_1^2 is meant."""
     *_, L = _q3()
     thd = sp.Symbol("thetadot", real=True)
-    first = (m1 * l1**2 / 6 + m2 * l2**2 / 6 + m2 * l1**2 / 2 + m2 * l1 * l2 * C2 / 2)
-    rest = thd2**2 * m2 * l2**2 / 6 + thd1 * thd2 * (m2 * l2**2 / 3 + m2 * l1 * l2 * C2 / 2) - m1 * g * l1 / 2 * S1 - m2 * g * (l1 * S1 + l2 / 2 * S12)
+    first = m1 * l1**2 / 6 + m2 * l2**2 / 6 + m2 * l1**2 / 2 + m2 * l1 * l2 * C2 / 2
+    rest = (
+        thd2**2 * m2 * l2**2 / 6
+        + thd1 * thd2 * (m2 * l2**2 / 3 + m2 * l1 * l2 * C2 / 2)
+        - m1 * g * l1 / 2 * S1
+        - m2 * g * (l1 * S1 + l2 / 2 * S12)
+    )
     misprint(thd**2 * first + rest, L, thd1**2 * first + rest)
 
 
@@ -270,10 +318,17 @@ def test_tutorial_q3_step_4_lines_and_kinedyn():
     assert is_zero(ddt1 - (a11 * thdd1 + a12 * thdd2 - h * thd1 * thd2 - h / 2 * thd2**2))
     misprint(grav1, dL1, -grav1)
     assert is_zero(tau1 - (a11 * thdd1 + a12 * thdd2 - h * thd1 * thd2 - h / 2 * thd2**2 + grav1))
-    misprint(a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1**2 - h * thd1 * thd2, ddt2, a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1 * thd2)
+    misprint(
+        a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1**2 - h * thd1 * thd2,
+        ddt2,
+        a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1 * thd2,
+    )
     misprint(h * thd1 * thd2 + m2 * g * l2 * C12 / 2, dL2, -h / 2 * (thd1**2 + thd1 * thd2) - m2 * g * l2 * C12 / 2)
-    misprint(a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1**2 + m2 * g * l2 * C12 / 2, tau2,
-             a12 * thdd1 + m2 * l2**2 / 3 * thdd2 + h / 2 * thd1**2 + m2 * g * l2 * C12 / 2)
+    misprint(
+        a12 * thdd1 + m2 * l2**2 / 3 * thdd2 - h / 2 * thd1**2 + m2 * g * l2 * C12 / 2,
+        tau2,
+        a12 * thdd1 + m2 * l2**2 / 3 * thdd2 + h / 2 * thd1**2 + m2 * g * l2 * C12 / 2,
+    )
     # kinedyn: the same arm as Spong's planar elbow with lc = l/2, I = m l^2/12
     robot = kd.robots.planar_2r(symbolic=True, lc1=l1 / 2, lc2=l2 / 2, I1=m1 * l1**2 / 12, I2=m2 * l2**2 / 12)
     eom = robot.equations_of_motion(steps=False)
@@ -385,7 +440,10 @@ def test_spong_9_28_to_9_38_dalembert_to_euler_lagrange():
             assert all_zero(r.diff(Q[j]).applyfunc(ddt) - v.diff(Q[j]))  # (9.32)
             rhs_929 += ddt(mass * v.dot(r.diff(Q[j]))) - mass * v.dot(r.diff(Q[j]).applyfunc(ddt))
         assert is_zero(lhs - rhs_929)  # (9.29)
-        K_particles = sum(mass * (r.jacobian(Q) * sp.Matrix(QD)).dot(r.jacobian(Q) * sp.Matrix(QD)) / 2 for mass, r in ((m1, rc1), (m2, rc2)))
+        K_particles = sum(
+            mass * (r.jacobian(Q) * sp.Matrix(QD)).dot(r.jacobian(Q) * sp.Matrix(QD)) / 2
+            for mass, r in ((m1, rc1), (m2, rc2))
+        )
         assert is_zero(lhs - (ddt(sp.diff(K_particles, QD[j])) - sp.diff(K_particles, Q[j])))  # (9.35)
     # (9.31) as printed (dv_i/dqd_i, the particle index on qd) is not dr/dq_j: for particle 2, j = 2
     v2 = rc2.jacobian(Q) * sp.Matrix(QD)
@@ -452,14 +510,22 @@ def test_spong_example_9_2_box_and_kinedyn_inertia_box():
     x, yy, z, a, b, c, rho = sp.symbols("x y z a b c rho", positive=True)
     box = lambda e: sp.integrate(e * rho, (x, -a / 2, a / 2), (yy, -b / 2, b / 2), (z, -c / 2, c / 2))
     I = [sp.factor(box(e)) for e in (yy**2 + z**2, x**2 + z**2, x**2 + yy**2)]
-    printed = [rho * a * b * c / 12 * (b**2 + c**2), rho * a * b * c / 12 * (a**2 + c**2), rho * a * b * c / 12 * (a**2 + b**2)]
+    printed = [
+        rho * a * b * c / 12 * (b**2 + c**2),
+        rho * a * b * c / 12 * (a**2 + c**2),
+        rho * a * b * c / 12 * (a**2 + b**2),
+    ]
     assert all(sp.simplify(u - w) == 0 for u, w in zip(I, printed))
     assert box(-x * yy) == 0 and box(-x * z) == 0 and box(-yy * z) == 0
     from kinedyn.description.inertia import Inertia
 
     vals = dict(rho=1.3, a=0.4, b=0.7, c=0.2)
     inertia = Inertia.box(1.3 * 0.4 * 0.7 * 0.2, (0.4, 0.7, 0.2))
-    np.testing.assert_allclose(np.diag(np.asarray(inertia.inertia, float)), [float(e.subs({sp.Symbol(k, positive=True): v for k, v in vals.items()})) for e in I], rtol=1e-12)
+    np.testing.assert_allclose(
+        np.diag(np.asarray(inertia.inertia, float)),
+        [float(e.subs({sp.Symbol(k, positive=True): v for k, v in vals.items()})) for e in I],
+        rtol=1e-12,
+    )
 
 
 def test_spong_9_45_to_9_49_kinetic_and_potential_energy_of_an_arm():
@@ -475,7 +541,9 @@ def test_spong_9_45_to_9_49_kinetic_and_potential_energy_of_an_arm():
     for i, body in enumerate(robot.tree.bodies):
         motion = np.eye(4)
         motion[:3, :3] = _rot(body.joint.axis, q[i] + float(body.joint.offset))
-        poses.append((poses[body.parent] if body.parent >= 0 else np.eye(4)) @ np.asarray(body.placement, float) @ motion)
+        poses.append(
+            (poses[body.parent] if body.parent >= 0 else np.eye(4)) @ np.asarray(body.placement, float) @ motion
+        )
     D = np.zeros((3, 3))
     P = 0.0
     for i, body in enumerate(robot.tree.bodies):
@@ -508,7 +576,9 @@ def test_spong_9_50_to_9_54_derivatives_of_the_lagrangian():
     assert sp.expand(K - (sp.Matrix(QD).T * DG * sp.Matrix(QD))[0] / 2) == 0
     for k in range(2):
         assert sp.expand(sp.diff(LG, QD[k]) - sum(DG[k, j] * QD[j] for j in range(2))) == 0
-        rhs = sum(DG[k, j] * QDD[j] for j in range(2)) + sum(sp.diff(DG[k, j], Q[i]) * QD[i] * QD[j] for i in range(2) for j in range(2))
+        rhs = sum(DG[k, j] * QDD[j] for j in range(2)) + sum(
+            sp.diff(DG[k, j], Q[i]) * QD[i] * QD[j] for i in range(2) for j in range(2)
+        )
         assert sp.expand(ddt(sp.diff(LG, QD[k])) - rhs) == 0
         rhs54 = sum(sp.diff(DG[i, j], Q[k]) * QD[i] * QD[j] for i in range(2) for j in range(2)) / 2 - sp.diff(Pf, Q[k])
         assert sp.expand(sp.diff(LG, Q[k]) - rhs54) == 0
@@ -519,7 +589,9 @@ def test_spong_9_55_sign_of_the_potential_term_misprint():
     d/dt dL/dqd_k - dL/dq_k has -(-dP/dq_k) = +dP/dq_k: the printed minus is a sign misprint (9.59)-
     (9.61) then carry +phi_k, as they should)."""
     for k in range(2):
-        quad = sum((sp.diff(DG[k, j], Q[i]) - sp.diff(DG[i, j], Q[k]) / 2) * QD[i] * QD[j] for i in range(2) for j in range(2))
+        quad = sum(
+            (sp.diff(DG[k, j], Q[i]) - sp.diff(DG[i, j], Q[k]) / 2) * QD[i] * QD[j] for i in range(2) for j in range(2)
+        )
         inertial = sum(DG[k, j] * QDD[j] for j in range(2))
         misprint(inertial + quad - sp.diff(Pf, Q[k]), ELG[k], inertial + quad + sp.diff(Pf, Q[k]))
         assert sp.expand(inertial + quad - sp.diff(Pf, Q[k]) - ELG[k]) == sp.expand(-2 * sp.diff(Pf, Q[k]))
@@ -532,9 +604,14 @@ def test_spong_9_56_to_9_63_christoffel_symbols_and_C():
     c = christoffel_spong(DG, Q)
     for k in range(2):
         s1 = sum(sp.diff(DG[k, j], Q[i]) * QD[i] * QD[j] for i in range(2) for j in range(2))
-        s2 = sum((sp.diff(DG[k, j], Q[i]) + sp.diff(DG[k, i], Q[j])) * QD[i] * QD[j] for i in range(2) for j in range(2)) / 2
+        s2 = (
+            sum((sp.diff(DG[k, j], Q[i]) + sp.diff(DG[k, i], Q[j])) * QD[i] * QD[j] for i in range(2) for j in range(2))
+            / 2
+        )
         assert sp.expand(s1 - s2) == 0  # (9.56)
-        lhs57 = sum((sp.diff(DG[k, j], Q[i]) - sp.diff(DG[i, j], Q[k]) / 2) * QD[i] * QD[j] for i in range(2) for j in range(2))
+        lhs57 = sum(
+            (sp.diff(DG[k, j], Q[i]) - sp.diff(DG[i, j], Q[k]) / 2) * QD[i] * QD[j] for i in range(2) for j in range(2)
+        )
         assert sp.expand(lhs57 - sum(c[i][j][k] * QD[i] * QD[j] for i in range(2) for j in range(2))) == 0  # (9.57)
         for i in range(2):
             for j in range(2):
@@ -542,7 +619,13 @@ def test_spong_9_56_to_9_63_christoffel_symbols_and_C():
     C = sp.Matrix(2, 2, lambda k, j: sum(c[i][j][k] * QD[i] for i in range(2)))  # (9.62)
     phi = sp.Matrix([sp.diff(Pf, x) for x in Q])
     assert all_zero(DG * sp.Matrix(QDD) + C * sp.Matrix(QD) + phi - sp.Matrix(ELG))  # (9.60)-(9.61)
-    C_963 = sp.Matrix(2, 2, lambda k, j: sum((sp.diff(DG[k, j], Q[j]) + sp.diff(DG[k, i], Q[j]) - sp.diff(DG[i, j], Q[k])) / 2 * QD[i] for i in range(2)))
+    C_963 = sp.Matrix(
+        2,
+        2,
+        lambda k, j: sum(
+            (sp.diff(DG[k, j], Q[j]) + sp.diff(DG[k, i], Q[j]) - sp.diff(DG[i, j], Q[k])) / 2 * QD[i] for i in range(2)
+        ),
+    )
     assert not all_zero(C_963 - C)
     # the index-typo check of (9.60): summing d_kj qdd_j over i (j free) is not the inertial term
     assert sp.expand(sum(DG[0, 1] * QDD[1] for _ in range(2)) - sum(DG[0, j] * QDD[j] for j in range(2))) != 0
@@ -573,8 +656,10 @@ def test_spong_9_65_to_9_73_two_link_cartesian():
     pytest.importorskip("kinedyn._core")
     from kinedyn.description.inertia import Inertia
 
-    rows = [dict(theta=0, d=0, a=0, alpha=-math.pi / 2, kind="prismatic", inertia=Inertia(2.0, (0.1, 0.2, -0.3))),
-            dict(theta=0, d=0, a=0, alpha=0, kind="prismatic", inertia=Inertia(0.7, (0.05, -0.1, 0.2)))]
+    rows = [
+        dict(theta=0, d=0, a=0, alpha=-math.pi / 2, kind="prismatic", inertia=Inertia(2.0, (0.1, 0.2, -0.3))),
+        dict(theta=0, d=0, a=0, alpha=0, kind="prismatic", inertia=Inertia(0.7, (0.05, -0.1, 0.2))),
+    ]
     robot = kd.Robot.from_dh(rows, gravity=(0, 0, -9.81))
     qn = RNG.normal(size=2)
     np.testing.assert_allclose(robot.mass_matrix(qn), np.diag([2.7, 0.7]), atol=1e-12)
@@ -590,22 +675,52 @@ def test_spong_9_74_to_9_88_planar_elbow_and_kinedyn():
     rc1, rc2, K, P, D = planar_elbow_by_particles()
     J1, J2 = rc1.jacobian(Q), rc2.jacobian(Q)
     assert all_zero(J1 - sp.Matrix([[-lc1 * sin(q1), 0], [lc1 * cos(q1), 0]]))
-    assert all_zero(J2 - sp.Matrix([[-l1 * sin(q1) - lc2 * sin(q1 + q2), -lc2 * sin(q1 + q2)], [l1 * cos(q1) + lc2 * cos(q1 + q2), lc2 * cos(q1 + q2)]]))
+    assert all_zero(
+        J2
+        - sp.Matrix(
+            [
+                [-l1 * sin(q1) - lc2 * sin(q1 + q2), -lc2 * sin(q1 + q2)],
+                [l1 * cos(q1) + lc2 * cos(q1 + q2), lc2 * cos(q1 + q2)],
+            ]
+        )
+    )
     assert all_zero(m1 * J1.T * J1 + m2 * J2.T * J2 + sp.Matrix([[I1 + I2, I2], [I2, I2]]) - D)  # (9.81)
-    D_pr = sp.Matrix([[m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * cos(q2)) + I1 + I2, m2 * (lc2**2 + l1 * lc2 * cos(q2)) + I2],
-                      [m2 * (lc2**2 + l1 * lc2 * cos(q2)) + I2, m2 * lc2**2 + I2]])
+    D_pr = sp.Matrix(
+        [
+            [
+                m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * cos(q2)) + I1 + I2,
+                m2 * (lc2**2 + l1 * lc2 * cos(q2)) + I2,
+            ],
+            [m2 * (lc2**2 + l1 * lc2 * cos(q2)) + I2, m2 * lc2**2 + I2],
+        ]
+    )
     assert all_zero(D - D_pr)
     c = christoffel_spong(D, Q)
     h = -m2 * l1 * lc2 * sin(q2)
-    printed_c = {(0, 0, 0): 0, (0, 1, 0): h, (1, 0, 0): h, (1, 1, 0): h, (0, 0, 1): -h, (0, 1, 1): 0, (1, 0, 1): 0, (1, 1, 1): 0}
+    printed_c = {
+        (0, 0, 0): 0,
+        (0, 1, 0): h,
+        (1, 0, 0): h,
+        (1, 1, 0): h,
+        (0, 0, 1): -h,
+        (0, 1, 1): 0,
+        (1, 0, 1): 0,
+        (1, 1, 1): 0,
+    }
     assert all(is_zero(c[i][j][k] - v) for (i, j, k), v in printed_c.items())
     phi = sp.Matrix([sp.diff(P, x) for x in Q])
-    assert all_zero(phi - sp.Matrix([(m1 * lc1 + m2 * l1) * g * cos(q1) + m2 * lc2 * g * cos(q1 + q2), m2 * lc2 * g * cos(q1 + q2)]))
+    assert all_zero(
+        phi - sp.Matrix([(m1 * lc1 + m2 * l1) * g * cos(q1) + m2 * lc2 * g * cos(q1 + q2), m2 * lc2 * g * cos(q1 + q2)])
+    )
     C = sp.Matrix(2, 2, lambda k, j: sum(c[i][j][k] * QD[i] for i in range(2)))
     assert all_zero(C - sp.Matrix([[h * qd2, h * qd2 + h * qd1], [-h * qd1, 0]]))  # (9.88)
     tau = sp.Matrix(euler_lagrange(K - P))
-    eq87 = sp.Matrix([D_pr[0, 0] * qdd1 + D_pr[0, 1] * qdd2 + 2 * h * qd1 * qd2 + h * qd2**2 + phi[0],
-                      D_pr[1, 0] * qdd1 + D_pr[1, 1] * qdd2 - h * qd1**2 + phi[1]])
+    eq87 = sp.Matrix(
+        [
+            D_pr[0, 0] * qdd1 + D_pr[0, 1] * qdd2 + 2 * h * qd1 * qd2 + h * qd2**2 + phi[0],
+            D_pr[1, 0] * qdd1 + D_pr[1, 1] * qdd2 - h * qd1**2 + phi[1],
+        ]
+    )
     assert all_zero(tau - eq87)
     eom, rename = kinedyn_planar_elbow()
     assert all_zero(eom.M.xreplace(rename) - D)
@@ -622,8 +737,14 @@ def test_spong_9_74_to_9_88_planar_elbow_and_kinedyn():
     robot = kd.robots.planar_2r(l1=1.3, l2=0.9, **{k: v for k, v in vals.items() if k != "l1"})
     state = RNG.normal(size=6)
     sub = {**{s: vals[s.name] for s in (m1, m2, l1, lc1, lc2, I1, I2)}, g: 9.81, **dict(zip(Q + QD + QDD, state))}
-    np.testing.assert_allclose(robot.inverse_dynamics(state[:2], state[2:4], state[4:]), np.array(tau.xreplace(sub), float).ravel(), rtol=1e-10)
-    np.testing.assert_allclose(robot.christoffel(state[:2]), np.array([[[float(c[i][j][k].xreplace(sub)) for k in range(2)] for j in range(2)] for i in range(2)]), atol=1e-12)
+    np.testing.assert_allclose(
+        robot.inverse_dynamics(state[:2], state[2:4], state[4:]), np.array(tau.xreplace(sub), float).ravel(), rtol=1e-10
+    )
+    np.testing.assert_allclose(
+        robot.christoffel(state[:2]),
+        np.array([[[float(c[i][j][k].xreplace(sub)) for k in range(2)] for j in range(2)] for i in range(2)]),
+        atol=1e-12,
+    )
 
 
 p1, p2, pd1, pd2, pdd1, pdd2 = sp.symbols("p1 p2 pd1 pd2 pdd1 pdd2", real=True)
@@ -644,21 +765,45 @@ def test_spong_9_89_to_9_95_remotely_driven_link():
     v1, v2 = rc1.jacobian(PP) * sp.Matrix(PD), J2 * sp.Matrix(PD)
     K = m1 * v1.dot(v1) / 2 + m2 * v2.dot(v2) / 2 + I1 * pd1**2 / 2 + I2 * pd2**2 / 2  # (9.90): w1 = pd1, w2 = pd2
     D = sp.hessian(K, PD)
-    D_pr = sp.Matrix([[m1 * lc1**2 + m2 * l1**2 + I1, m2 * l1 * lc2 * cos(p2 - p1)], [m2 * l1 * lc2 * cos(p2 - p1), m2 * lc2**2 + I2]])
+    D_pr = sp.Matrix(
+        [
+            [m1 * lc1**2 + m2 * l1**2 + I1, m2 * l1 * lc2 * cos(p2 - p1)],
+            [m2 * l1 * lc2 * cos(p2 - p1), m2 * lc2**2 + I2],
+        ]
+    )
     assert all_zero(D - D_pr)
     c = christoffel_spong(D, PP)
     s_ = m2 * l1 * lc2 * sin(p2 - p1)
-    printed = {(0, 0, 0): 0, (0, 1, 0): 0, (1, 0, 0): 0, (1, 1, 0): -s_, (0, 0, 1): s_, (1, 1, 1): 0, (0, 1, 1): 0, (1, 0, 1): 0}
+    printed = {
+        (0, 0, 0): 0,
+        (0, 1, 0): 0,
+        (1, 0, 0): 0,
+        (1, 1, 0): -s_,
+        (0, 0, 1): s_,
+        (1, 1, 1): 0,
+        (0, 1, 1): 0,
+        (1, 0, 1): 0,
+    }
     assert all(is_zero(c[i][j][k] - v) for (i, j, k), v in printed.items())
     P = m1 * g * rc1[1] + m2 * g * rc2[1]
     assert is_zero(P - (m1 * g * lc1 * sin(p1) + m2 * g * (l1 * sin(p1) + lc2 * sin(p2))))
     phi = [sp.diff(P, x) for x in PP]
     assert is_zero(phi[0] - (m1 * lc1 + m2 * l1) * g * cos(p1)) and is_zero(phi[1] - m2 * lc2 * g * cos(p2))
     tau = euler_lagrange(K - P, PP, PD, PDD)
-    eq95 = [D_pr[0, 0] * pdd1 + D_pr[0, 1] * pdd2 + c[1][1][0] * pd2**2 + phi[0], D_pr[1, 0] * pdd1 + D_pr[1, 1] * pdd2 + c[0][0][1] * pd1**2 + phi[1]]
+    eq95 = [
+        D_pr[0, 0] * pdd1 + D_pr[0, 1] * pdd2 + c[1][1][0] * pd2**2 + phi[0],
+        D_pr[1, 0] * pdd1 + D_pr[1, 1] * pdd2 + c[0][0][1] * pd1**2 + phi[1],
+    ]
     assert all(is_zero(a - b) for a, b in zip(tau, eq95))
-    system = LagrangianSystem.from_bodies(PP, [dict(mass=m1, position=list(rc1), inertia=I1, angular_velocity=pd1),
-                                               dict(mass=m2, position=list(rc2), inertia=I2, angular_velocity=pd2)], gravity=[0, -g], qd=PD)
+    system = LagrangianSystem.from_bodies(
+        PP,
+        [
+            dict(mass=m1, position=list(rc1), inertia=I1, angular_velocity=pd1),
+            dict(mass=m2, position=list(rc2), inertia=I2, angular_velocity=pd2),
+        ],
+        gravity=[0, -g],
+        qd=PD,
+    )
     eom = system.equations_of_motion()
     assert all_zero(eom.M - D) and all_zero(eom.tau.xreplace(dict(zip(eom.qdd, PDD))) - sp.Matrix(tau))
     planar, rename = kinedyn_planar_elbow()
@@ -680,13 +825,23 @@ def test_spong_9_96_to_9_108_five_bar_linkage():
     misprint(list(r3_printed), list(r[2]), list(l2 * u2 + lc3 * u1))
     J = [ri.jacobian(Q) for ri in r]
     assert all_zero(J[2] - sp.Matrix([[-lc3 * sin(q1), -l2 * sin(q2)], [lc3 * cos(q1), l2 * cos(q2)]]))
-    misprint(list(sp.Matrix([[-l1 * sin(q1), lc4 * sin(q2)], [l1 * cos(q1), lc4 * cos(q2)]])), list(J[3]),
-             list(sp.Matrix([[-l1 * sin(q1), lc4 * sin(q2)], [l1 * cos(q1), -lc4 * cos(q2)]])))
+    misprint(
+        list(sp.Matrix([[-l1 * sin(q1), lc4 * sin(q2)], [l1 * cos(q1), lc4 * cos(q2)]])),
+        list(J[3]),
+        list(sp.Matrix([[-l1 * sin(q1), lc4 * sin(q2)], [l1 * cos(q1), -lc4 * cos(q2)]])),
+    )
     masses, inertias, omegas = [m1, m2, m3, m4], [I1, I2, I3, I4], [qd1, qd2, qd1, qd2]
-    K = sum(mi * (Ji * sp.Matrix(QD)).dot(Ji * sp.Matrix(QD)) / 2 + Ii * w**2 / 2 for mi, Ji, Ii, w in zip(masses, J, inertias, omegas))
+    K = sum(
+        mi * (Ji * sp.Matrix(QD)).dot(Ji * sp.Matrix(QD)) / 2 + Ii * w**2 / 2
+        for mi, Ji, Ii, w in zip(masses, J, inertias, omegas)
+    )
     D = sp.hessian(K, QD)
-    D_pr = sp.Matrix([[m1 * lc1**2 + m3 * lc3**2 + m4 * l1**2 + I1 + I3, (m3 * l2 * lc3 - m4 * l1 * lc4) * cos(q2 - q1)],
-                      [(m3 * l2 * lc3 - m4 * l1 * lc4) * cos(q2 - q1), m2 * lc2**2 + m3 * l2**2 + m4 * lc4**2 + I2 + I4]])
+    D_pr = sp.Matrix(
+        [
+            [m1 * lc1**2 + m3 * lc3**2 + m4 * l1**2 + I1 + I3, (m3 * l2 * lc3 - m4 * l1 * lc4) * cos(q2 - q1)],
+            [(m3 * l2 * lc3 - m4 * l1 * lc4) * cos(q2 - q1), m2 * lc2**2 + m3 * l2**2 + m4 * lc4**2 + I2 + I4],
+        ]
+    )
     assert all_zero(D - D_pr)
     decoupled = {m4: m3 * l2 * lc3 / (l1 * lc4)}  # (9.105)
     Dd = D.xreplace(decoupled)
@@ -696,10 +851,17 @@ def test_spong_9_96_to_9_108_five_bar_linkage():
     assert is_zero(P - (s1_part + s2_part))
     assert not is_zero(g * sum(ri[1] for ri in r) - P)  # "g sum y_ci" leaves out the masses
     phi = [sp.diff(P, x) for x in Q]
-    assert is_zero(phi[0] - g * cos(q1) * (m1 * lc1 + m3 * lc3 + m4 * l1)) and is_zero(phi[1] - g * cos(q2) * (m2 * lc2 + m3 * l2 - m4 * lc4))
+    assert is_zero(phi[0] - g * cos(q1) * (m1 * lc1 + m3 * lc3 + m4 * l1)) and is_zero(
+        phi[1] - g * cos(q2) * (m2 * lc2 + m3 * l2 - m4 * lc4)
+    )
     tau = [e.xreplace(decoupled) for e in euler_lagrange(K - P)]
-    assert is_zero(tau[0] - (Dd[0, 0] * qdd1 + phi[0].xreplace(decoupled))) and is_zero(tau[1] - (Dd[1, 1] * qdd2 + phi[1].xreplace(decoupled)))
-    bodies = [dict(mass=mi, position=list(ri), inertia=Ii, angular_velocity=w) for mi, ri, Ii, w in zip(masses, r, inertias, omegas)]
+    assert is_zero(tau[0] - (Dd[0, 0] * qdd1 + phi[0].xreplace(decoupled))) and is_zero(
+        tau[1] - (Dd[1, 1] * qdd2 + phi[1].xreplace(decoupled))
+    )
+    bodies = [
+        dict(mass=mi, position=list(ri), inertia=Ii, angular_velocity=w)
+        for mi, ri, Ii, w in zip(masses, r, inertias, omegas)
+    ]
     eom = LagrangianSystem.from_bodies(Q, bodies, gravity=[0, -g], qd=QD).equations_of_motion()
     assert all_zero(eom.M - D)
     assert all_zero(eom.C.xreplace(decoupled))
@@ -713,7 +875,9 @@ def test_spong_9_109_to_9_118_skew_symmetry_and_passivity():
     C = sp.Matrix(2, 2, lambda k, j: sum(c[i][j][k] * QD[i] for i in range(2)))
     Ddot = DG.applyfunc(ddt)
     N = Ddot - 2 * C
-    N_pr = sp.Matrix(2, 2, lambda k, j: sum((sp.diff(DG[i, j], Q[k]) - sp.diff(DG[k, i], Q[j])) * QD[i] for i in range(2)))
+    N_pr = sp.Matrix(
+        2, 2, lambda k, j: sum((sp.diff(DG[i, j], Q[k]) - sp.diff(DG[k, i], Q[j])) * QD[i] for i in range(2))
+    )
     assert all_zero(N - N_pr) and all_zero(N + N.T)
     eom, rename = kinedyn_planar_elbow()
     M, Ck, gk = (x.xreplace(rename) for x in (eom.M, eom.C, eom.g))
@@ -739,15 +903,39 @@ def test_spong_9_121_to_9_133_regressor_misprints():
     tau = sp.Matrix(euler_lagrange(K - P))
     Th_pr = [m1 * lc1**2 + m2 * (l1**2 + lc2**2) + I1 + I2, m2 * l1 * lc2, m2 * l1 * lc2, m1 * lc1 + m2 * l1, m2 * l2]
     Th = [Th_pr[0], Th_pr[1], m2 * lc2**2 + I2, Th_pr[3], m2 * lc2]
-    assert is_zero(D[0, 0] - (Th[0] + 2 * Th[1] * cos(q2))) and is_zero(D[0, 1] - (Th[2] + Th[1] * cos(q2))) and is_zero(D[1, 1] - Th[2])
+    assert (
+        is_zero(D[0, 0] - (Th[0] + 2 * Th[1] * cos(q2)))
+        and is_zero(D[0, 1] - (Th[2] + Th[1] * cos(q2)))
+        and is_zero(D[1, 1] - Th[2])
+    )
     misprint(Th_pr[2], D[1, 1], Th[2])
     phi = [sp.diff(P, x) for x in Q]
     assert is_zero(phi[0] - (Th[3] * g * cos(q1) + Th[4] * g * cos(q1 + q2)))
     misprint(Th_pr[4] * cos(q1 + q2), phi[1], Th[4] * g * cos(q1 + q2))
-    Y_pr = sp.Matrix([[qdd1, cos(q2) * (2 * qdd1 + qdd2) + sin(q2) * (qd1**2 - 2 * qd1 * qd2), qdd2, g * cos(q1), g * cos(q1 + q2)],
-                      [0, cos(q2) * qdd1 + sin(q2) * qd1**2, qdd2, 0, g * cos(q1 + q2)]])
-    Y = sp.Matrix([[qdd1, cos(q2) * (2 * qdd1 + qdd2) - sin(q2) * (qd2**2 + 2 * qd1 * qd2), qdd2, g * cos(q1), g * cos(q1 + q2)],
-                   [0, cos(q2) * qdd1 + sin(q2) * qd1**2, qdd1 + qdd2, 0, g * cos(q1 + q2)]])
+    Y_pr = sp.Matrix(
+        [
+            [
+                qdd1,
+                cos(q2) * (2 * qdd1 + qdd2) + sin(q2) * (qd1**2 - 2 * qd1 * qd2),
+                qdd2,
+                g * cos(q1),
+                g * cos(q1 + q2),
+            ],
+            [0, cos(q2) * qdd1 + sin(q2) * qd1**2, qdd2, 0, g * cos(q1 + q2)],
+        ]
+    )
+    Y = sp.Matrix(
+        [
+            [
+                qdd1,
+                cos(q2) * (2 * qdd1 + qdd2) - sin(q2) * (qd2**2 + 2 * qd1 * qd2),
+                qdd2,
+                g * cos(q1),
+                g * cos(q1 + q2),
+            ],
+            [0, cos(q2) * qdd1 + sin(q2) * qd1**2, qdd1 + qdd2, 0, g * cos(q1 + q2)],
+        ]
+    )
     misprint(list(Y_pr * sp.Matrix(Th)), list(tau), list(Y * sp.Matrix(Th)))
     assert max(abs(at_random_state(e)) for e in Y_pr * sp.Matrix(Th_pr) - tau) > 1e-6
     eom, rename = kinedyn_planar_elbow()
@@ -766,7 +954,10 @@ def test_spong_9_119_9_120_eigenvalue_bounds_at_a_configuration():
         D = np.array(f(qq), float)
         lam = np.linalg.eigvalsh(D)
         assert lam[0] > 0
-        assert np.linalg.eigvalsh(D - lam[0] * np.eye(2)).min() > -1e-12 and np.linalg.eigvalsh(lam[-1] * np.eye(2) - D).min() > -1e-12
+        assert (
+            np.linalg.eigvalsh(D - lam[0] * np.eye(2)).min() > -1e-12
+            and np.linalg.eigvalsh(lam[-1] * np.eye(2) - D).min() > -1e-12
+        )
 
 
 # ============================================================================================== LaValle §13.4
@@ -790,7 +981,9 @@ def test_lavalle_13_114_to_13_118_first_variation_and_integration_by_parts():
     first = sp.integrate(dLdx * G + dLdxd * sp.diff(G, tt), (tt, 0, 1))
     change = sp.expand(Phi(X + G) - Phi(X))
     assert sp.simplify(change.coeff(eps, 1) - first.coeff(eps, 1)) == 0
-    by_parts = sp.integrate(dLdx * G - sp.diff(dLdxd, tt) * G, (tt, 0, 1)) + (dLdxd * G).subs(tt, 1) - (dLdxd * G).subs(tt, 0)
+    by_parts = (
+        sp.integrate(dLdx * G - sp.diff(dLdxd, tt) * G, (tt, 0, 1)) + (dLdxd * G).subs(tt, 1) - (dLdxd * G).subs(tt, 0)
+    )
     assert sp.simplify(by_parts - first) == 0
     boundary = (dLdxd * G).subs(tt, 1) - (dLdxd * G).subs(tt, 0)
     right = sp.integrate(dLdxd * sp.diff(G, tt), (tt, 0, 1)) + sp.integrate(sp.diff(dLdxd, tt) * G, (tt, 0, 1))
@@ -845,7 +1038,13 @@ def test_lavalle_13_131_to_13_135_falling_particle_and_13_136_13_137():
     eom = LagrangianSystem(list(qs), K=K, P=Vp, qd=list(vs)).equations_of_motion()
     assert all_zero(eom.tau.xreplace(dict(zip(eom.qdd, acc))) - sp.Matrix(el))
     Mg = sp.Matrix(3, 3, lambda i, j: sp.Function(f"m{i}{j}")(*qs) if i <= j else sp.Function(f"m{j}{i}")(*qs))
-    assert sp.expand((sp.Matrix(vs).T * Mg * sp.Matrix(vs))[0] / 2 - sum(Mg[i, j] * vs[i] * vs[j] for i in range(3) for j in range(3)) / 2) == 0
+    assert (
+        sp.expand(
+            (sp.Matrix(vs).T * Mg * sp.Matrix(vs))[0] / 2
+            - sum(Mg[i, j] * vs[i] * vs[j] for i in range(3) for j in range(3)) / 2
+        )
+        == 0
+    )
 
 
 def test_lavalle_example_13_12_planar_body_kinetic_energy_misprint():
@@ -862,7 +1061,9 @@ def test_lavalle_example_13_12_planar_body_kinetic_energy_misprint():
     pts = RNG.normal(size=(30, 2))
     mp = RNG.uniform(0.1, 1.0, size=30)
     c = mp @ pts / mp.sum()
-    K_particles = 0.5 * sum(mi * ((vx - w * (p_[1] - c[1])) ** 2 + (vy + w * (p_[0] - c[0])) ** 2) for mi, p_ in zip(mp, pts))
+    K_particles = 0.5 * sum(
+        mi * ((vx - w * (p_[1] - c[1])) ** 2 + (vy + w * (p_[0] - c[0])) ** 2) for mi, p_ in zip(mp, pts)
+    )
     Izz = sum(mi * ((p_ - c) @ (p_ - c)) for mi, p_ in zip(mp, pts))
     num = {m: mp.sum(), Ib: Izz, vs[0]: vx, vs[1]: vy, vs[2]: w}
     assert float(corrected.xreplace(num)) == pytest.approx(K_particles, rel=1e-12)
@@ -885,11 +1086,18 @@ def test_lavalle_13_140_to_13_147_general_form_and_christoffel_index_order():
     cL = lambda i, j, k: (sp.diff(M[i, j], Q[k]) + sp.diff(M[i, k], Q[j]) - sp.diff(M[j, k], Q[i])) / 2
     C = sp.Matrix(2, 2, lambda i, j: sum(cL(i, j, k) * QD[k] for k in range(2)))
     for i in range(2):
-        form = sum(M[i, j] * QDD[j] for j in range(2)) + sum(h(i, j, k) * QD[j] * QD[k] for j in range(2) for k in range(2)) + sp.diff(Pf, Q[i])
+        form = (
+            sum(M[i, j] * QDD[j] for j in range(2))
+            + sum(h(i, j, k) * QD[j] * QD[k] for j in range(2) for k in range(2))
+            + sp.diff(Pf, Q[i])
+        )
         assert sp.expand(form - ELG[i]) == 0
         hsum = sum(h(i, j, k) * QD[j] * QD[k] for j in range(2) for k in range(2))
-        rewritten = sum(sp.diff(M[i, j], Q[k]) * QD[j] * QD[k] for j in range(2) for k in range(2)) / 2 + sum(
-            (sp.diff(M[i, j], Q[k]) - sp.diff(M[j, k], Q[i])) * QD[j] * QD[k] for j in range(2) for k in range(2)) / 2
+        rewritten = (
+            sum(sp.diff(M[i, j], Q[k]) * QD[j] * QD[k] for j in range(2) for k in range(2)) / 2
+            + sum((sp.diff(M[i, j], Q[k]) - sp.diff(M[j, k], Q[i])) * QD[j] * QD[k] for j in range(2) for k in range(2))
+            / 2
+        )
         assert sp.expand(hsum - rewritten) == 0  # (13.145)
         assert sp.expand((C * sp.Matrix(QD))[i] - hsum) == 0  # (13.143), (13.146)
     cS = christoffel_spong(M, Q)
@@ -897,7 +1105,12 @@ def test_lavalle_13_140_to_13_147_general_form_and_christoffel_index_order():
     eom, rename = kinedyn_planar_elbow()
     Mk = eom.M.xreplace(rename)
     cLk = lambda i, j, k: (sp.diff(Mk[i, j], Q[k]) + sp.diff(Mk[i, k], Q[j]) - sp.diff(Mk[j, k], Q[i])) / 2
-    assert all(is_zero(eom.christoffel[k][j][i].xreplace(rename) - cLk(i, j, k)) for i in range(2) for j in range(2) for k in range(2))
+    assert all(
+        is_zero(eom.christoffel[k][j][i].xreplace(rename) - cLk(i, j, k))
+        for i in range(2)
+        for j in range(2)
+        for k in range(2)
+    )
 
 
 def test_lavalle_13_148_phase_form_and_the_numeric_core():
@@ -908,7 +1121,9 @@ def test_lavalle_13_148_phase_form_and_the_numeric_core():
     q, qd, u = RNG.uniform(-1, 1, 6), RNG.normal(size=6), RNG.normal(size=6)
     M, C, gv = robot.mass_matrix(q), robot.coriolis_matrix(q, qd), robot.gravity_torque(q)
     qdd = robot.forward_dynamics(q, qd, u)
-    np.testing.assert_allclose(qdd, np.linalg.solve(M, u - C @ qd - gv - robot.friction_torque(qd)), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(
+        qdd, np.linalg.solve(M, u - C @ qd - gv - robot.friction_torque(qd)), rtol=1e-9, atol=1e-9
+    )
 
 
 d1s, ell1, ell2 = sp.symbols("d1 ell1 ell2", positive=True)
@@ -938,8 +1153,15 @@ def test_lavalle_example_13_13_two_link_manipulator():
     misprint(m2 * g * (d1s * sin(th1) + ell2 * sin(th2)), V2, m2 * g * (d1s * sin(th1) + ell2 * sin(th1 + th2)))
     L = K1 + K2 - m1 * g * rc1[1] - V2
     M = sp.hessian(K1 + K2, THD)
-    M_pr = sp.Matrix([[I1 + m1 * ell1**2 + I2 + m2 * (d1s**2 + ell2**2 + 2 * d1s * ell2 * cos(th2)), I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2))],
-                      [I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2)), I2 + m2 * ell2**2]])
+    M_pr = sp.Matrix(
+        [
+            [
+                I1 + m1 * ell1**2 + I2 + m2 * (d1s**2 + ell2**2 + 2 * d1s * ell2 * cos(th2)),
+                I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2)),
+            ],
+            [I2 + m2 * (ell2**2 + d1s * ell2 * cos(th2)), I2 + m2 * ell2**2],
+        ]
+    )
     assert all_zero(M - M_pr)
     cL = lambda i, j, k: (sp.diff(M[i, j], TH[k]) + sp.diff(M[i, k], TH[j]) - sp.diff(M[j, k], TH[i])) / 2
     r = m2 * d1s * ell2 * sin(th2)
@@ -953,10 +1175,18 @@ def test_lavalle_example_13_13_two_link_manipulator():
     g_ok = [(m1 * ell1 + m2 * d1s) * g * cos(th1) + m2 * ell2 * g * cos(th1 + th2), m2 * ell2 * g * cos(th1 + th2)]
     misprint(g_pr, list(gv), g_ok)
     C = sp.Matrix(2, 2, lambda i, j: sum(cL(i, j, k) * THD[k] for k in range(2)))
-    misprint(list(-m2 * ell1 * ell2 * p2_printed * sp.Matrix([[thd2, thd1 + thd2], [thd1, 0]])), list(C), list(-r * sp.Matrix([[thd2, thd1 + thd2], [-thd1, 0]])))
+    misprint(
+        list(-m2 * ell1 * ell2 * p2_printed * sp.Matrix([[thd2, thd1 + thd2], [thd1, 0]])),
+        list(C),
+        list(-r * sp.Matrix([[thd2, thd1 + thd2], [-thd1, 0]])),
+    )
     tau = euler_lagrange(L, TH, THD, THDD)
     assert is_zero(tau[0] - (M[0, 0] * thdd1 + M[0, 1] * thdd2 - 2 * r * thd1 * thd2 - r * thd2**2 + gv[0]))
-    misprint(M[1, 1] * thdd1 + M[1, 0] * thdd2 + r * thd1**2 + gv[1], tau[1], M[1, 0] * thdd1 + M[1, 1] * thdd2 + r * thd1**2 + gv[1])
+    misprint(
+        M[1, 1] * thdd1 + M[1, 0] * thdd2 + r * thd1**2 + gv[1],
+        tau[1],
+        M[1, 0] * thdd1 + M[1, 1] * thdd2 + r * thd1**2 + gv[1],
+    )
     eom, rename = kinedyn_planar_elbow()
     to_lavalle = {q1: th1, q2: th2, qd1: thd1, qd2: thd2, lc1: ell1, lc2: ell2, l1: d1s}
     assert all_zero(eom.M.xreplace(rename).xreplace(to_lavalle) - M)
@@ -971,7 +1201,10 @@ def test_lavalle_13_162_to_13_171_multipliers_and_pfaffian_constraints():
     g_i = 0; (13.170)-(13.171): d/dt g(q) = sum dg/dq_j qd_j (the sphere's 13.176)."""
     xx, yy, lam = sp.symbols("x y lambda", real=True)
     sols = sp.solve([1 + lam * 2 * xx, 1 + lam * 2 * yy, xx**2 + yy**2 - 1], [xx, yy, lam], dict=True)
-    assert {(s[xx], s[yy], s[lam]) for s in sols} == {(sp.sqrt(2) / 2, sp.sqrt(2) / 2, -sp.sqrt(2) / 2), (-sp.sqrt(2) / 2, -sp.sqrt(2) / 2, sp.sqrt(2) / 2)}
+    assert {(s[xx], s[yy], s[lam]) for s in sols} == {
+        (sp.sqrt(2) / 2, sp.sqrt(2) / 2, -sp.sqrt(2) / 2),
+        (-sp.sqrt(2) / 2, -sp.sqrt(2) / 2, sp.sqrt(2) / 2),
+    }
     qs, vs = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True)
     gsph = sum(c**2 for c in qs) - 1
     Lc = sum(v**2 for v in vs) + lam * gsph
@@ -989,7 +1222,11 @@ def test_lavalle_example_13_14_sphere_and_13_172_13_173():
     great circle): checked on an RK4 run with lambda eliminated (lambda = |qd|^2 on the unit sphere).
     (13.173) differs from (13.172) by the multiplier's sign only. kinedyn's LagrangianSystem gives the
     same multiplier."""
-    qs, vs, acc = list(sp.symbols("q1:4", real=True)), list(sp.symbols("qd1:4", real=True)), list(sp.symbols("qdd1:4", real=True))
+    qs, vs, acc = (
+        list(sp.symbols("q1:4", real=True)),
+        list(sp.symbols("qd1:4", real=True)),
+        list(sp.symbols("qdd1:4", real=True)),
+    )
     lam = sp.Symbol("lambda1", real=True)
     L = sum(v**2 for v in vs)  # m/2 |qd|^2 with m = 2
     G = [2 * c for c in qs]
@@ -1003,7 +1240,12 @@ def test_lavalle_example_13_14_sphere_and_13_172_13_173():
     assert sp.simplify(lam_solved.subs(qs[0] ** 2, 1 - qs[1] ** 2 - qs[2] ** 2) - sum(v**2 for v in vs)) == 0
     system = LagrangianSystem(qs, K=L, qd=vs, holonomic=[sum(c**2 for c in qs) - 1], forces=[0, 0, 0])
     (lam_k,) = system.multipliers()
-    assert sp.simplify((lam_k - sum(v**2 for v in vs) / sum(c**2 for c in qs)).subs(qs[0] ** 2, 1 - qs[1] ** 2 - qs[2] ** 2)) == 0
+    assert (
+        sp.simplify(
+            (lam_k - sum(v**2 for v in vs) / sum(c**2 for c in qs)).subs(qs[0] ** 2, 1 - qs[1] ** 2 - qs[2] ** 2)
+        )
+        == 0
+    )
 
     def f(s):
         x, v = s[:3], s[3:]
@@ -1013,7 +1255,10 @@ def test_lavalle_example_13_14_sphere_and_13_172_13_173():
     c = np.cross(s[:3], s[3:])
     h_ = 1e-3
     for _ in range(3000):
-        k1 = f(s); k2 = f(s + h_ / 2 * k1); k3 = f(s + h_ / 2 * k2); k4 = f(s + h_ * k3)
+        k1 = f(s)
+        k2 = f(s + h_ / 2 * k1)
+        k3 = f(s + h_ / 2 * k2)
+        k4 = f(s + h_ * k3)
         s = s + h_ / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     assert abs(c @ s[:3]) < 1e-12 and abs(np.linalg.norm(s[:3]) - 1) < 1e-9
 
@@ -1040,7 +1285,9 @@ def test_lavalle_13_179_to_13_184_constrained_dynamics():
     on_sphere = {qs[0] ** 2: 1 - qs[1] ** 2 - qs[2] ** 2}
     assert sp.simplify(derived[0].subs(on_sphere) - sum(v**2 for v in vs)) == 0
     assert printed_180[0] == 0
-    system = LagrangianSystem(qs, K=sum(v**2 for v in vs), qd=vs, holonomic=[sum(c**2 for c in qs) - 1], forces=[0, 0, 0])
+    system = LagrangianSystem(
+        qs, K=sum(v**2 for v in vs), qd=vs, holonomic=[sum(c**2 for c in qs) - 1], forces=[0, 0, 0]
+    )
     assert sp.simplify((system.multipliers()[0] - derived[0]).subs(on_sphere)) == 0
     # the general formula: qdd from (13.179) with this lambda keeps G qdd + Gdot qd = 0 (gravity g and B = N included)
     gv = sp.Matrix([0, 0, 2 * g])

@@ -31,7 +31,10 @@ def _robots():
     folder = testing.example_robot_data_dir()
     if folder is not None:  # URDFs: the Panda (its finger mimic reduced) and Solo-12 on a free-flyer
         yield "panda", kd.Robot.from_urdf(os.path.join(folder, "panda_description/urdf/panda.urdf"))
-        yield "solo12", kd.Robot.from_urdf(os.path.join(folder, "solo_description/robots/solo12.urdf"), floating_base=True)
+        yield (
+            "solo12",
+            kd.Robot.from_urdf(os.path.join(folder, "solo_description/robots/solo12.urdf"), floating_base=True),
+        )
 
 
 def _states(robot, count: int, seed: int):
@@ -64,13 +67,18 @@ def _calls(robot, q, v, a):
     }
     for reference in range(3):  # world, local, spatial
         calls[f"jacobian {reference}"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r), (q,))
-        calls[f"jacobian {reference} at a point"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r, np.array([0.1, -0.2, 0.3])), (q,))
+        calls[f"jacobian {reference} at a point"] = (
+            lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r, np.array([0.1, -0.2, 0.3])),
+            (q,),
+        )
     for name, (fn, args) in calls.items():
         yield name, fn(*args), np.array([fn(*(x[k] for x in args)) for k in range(len(q))])
-    for name, fn, args in [("inverse_dynamics_derivatives", model.inverse_dynamics_derivatives, (q, v, a)),
-                           ("inverse_dynamics_derivatives f_ext", model.inverse_dynamics_derivatives, (q, v, a, f_ext)),
-                           ("forward_dynamics_derivatives", model.forward_dynamics_derivatives, (q, v, tau)),
-                           ("forward_dynamics_derivatives f_ext", model.forward_dynamics_derivatives, (q, v, tau, f_ext))]:
+    for name, fn, args in [
+        ("inverse_dynamics_derivatives", model.inverse_dynamics_derivatives, (q, v, a)),
+        ("inverse_dynamics_derivatives f_ext", model.inverse_dynamics_derivatives, (q, v, a, f_ext)),
+        ("forward_dynamics_derivatives", model.forward_dynamics_derivatives, (q, v, tau)),
+        ("forward_dynamics_derivatives f_ext", model.forward_dynamics_derivatives, (q, v, tau, f_ext)),
+    ]:
         batch = fn(*args)
         single = [fn(*(x[k] for x in args)) for k in range(len(q))]
         for part in range(3):  # each of the three results
@@ -80,7 +88,9 @@ def _calls(robot, q, v, a):
 def _assert_close(name, got, expected):
     scale = np.max(np.abs(expected), axis=tuple(range(1, expected.ndim)), keepdims=True)
     err = np.abs(got - expected) / np.maximum(scale, 1e-300)
-    assert np.all(err <= REL), f"{name}: state {np.unravel_index(np.argmax(err), err.shape)[0]} differs by {err.max():.2e} (relative)"
+    assert np.all(err <= REL), (
+        f"{name}: state {np.unravel_index(np.argmax(err), err.shape)[0]} differs by {err.max():.2e} (relative)"
+    )
 
 
 @pytest.mark.parametrize("count", [5, 13, 64 + 3])
@@ -114,7 +124,13 @@ def test_every_lane_kind_gives_the_same_numbers():
     env = {**os.environ, "PYTHONPATH": str(Path(kd.__file__).parents[1])}
     results = {}
     for kind in ["off", "portable", "avx2", "avx512"]:
-        child = subprocess.run([sys.executable, "-c", _CHILD], env={**env, "KINEDYN_SIMD": kind}, capture_output=True, text=True, timeout=120)
+        child = subprocess.run(
+            [sys.executable, "-c", _CHILD],
+            env={**env, "KINEDYN_SIMD": kind},
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert child.returncode == 0, child.stderr[-2000:]
         results[kind] = json.loads(child.stdout)
     assert results["off"]["simd"] == ["off", 1] and results["portable"]["simd"] == ["portable", 4]
@@ -132,8 +148,14 @@ def test_a_singular_mass_matrix_fails_the_batch_as_a_single_call():
     one state at a time to name it), not with numbers."""
     robot = testing.random_robot(seed=5, n=4, fixed=0)
     leaf = robot.links[-1]
-    massless = leaf.__class__(leaf.name, leaf.parent, leaf.joint.__class__(**{**leaf.joint.__dict__, "rotor_inertia": 0.0}),
-                              leaf.placement, leaf.post, None)
+    massless = leaf.__class__(
+        leaf.name,
+        leaf.parent,
+        leaf.joint.__class__(**{**leaf.joint.__dict__, "rotor_inertia": 0.0}),
+        leaf.placement,
+        leaf.post,
+        None,
+    )
     robot = robot.replace(links=[*robot.links[:-1], massless])
     q, v, a = _states(robot, 12, seed=3)
     model = robot._model

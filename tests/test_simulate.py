@@ -153,7 +153,9 @@ def test_computed_torque_tracks_a_quintic_on_an_exact_model(puma):
     assert np.abs(traj.qd - qdr).max() < 1e-7
     # a model with 10 % heavier links does not track to that precision (the check can fail)
     wrong = kd.robots.puma560(friction=False, masses=[1.1 * m for m in kd.robots.industrial.PUMA560_MASSES])
-    traj2 = kd.simulate(puma, 2.5, np.r_[q0, np.zeros(6)], controller=ComputedTorque(puma, 100.0, 20.0, ref, model=wrong), dt=1e-3)
+    traj2 = kd.simulate(
+        puma, 2.5, np.r_[q0, np.zeros(6)], controller=ComputedTorque(puma, 100.0, 20.0, ref, model=wrong), dt=1e-3
+    )
     assert np.abs(traj2.q - qr).max() > 1e-6
 
 
@@ -174,7 +176,11 @@ def test_pd_gravity_compensation_converges_and_plain_pd_does_not(puma):
 
 def test_references_derivatives_match_finite_differences():
     h = 1e-6
-    for ref in (Cubic([0, 1], [2, -1], 1.5, t0=0.2), Quintic([0, 1], [2, -1], 1.5), Fourier.random(3, harmonics=4, seed=2)):
+    for ref in (
+        Cubic([0, 1], [2, -1], 1.5, t0=0.2),
+        Quintic([0, 1], [2, -1], 1.5),
+        Fourier.random(3, harmonics=4, seed=2),
+    ):
         t = np.linspace(0.05, 1.5, 40)
         q, qd, qdd = ref(t)
         qp, qdp, _ = ref(t + h)
@@ -199,7 +205,10 @@ def test_passivity_integral_equals_the_energy_change(puma):
     import dataclasses
 
     rough = kd.robots.puma560(friction=True)
-    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, coulomb=0.0, coulomb_negative=None)) for l in rough.links]
+    links = [
+        dataclasses.replace(l, joint=dataclasses.replace(l.joint, coulomb=0.0, coulomb_negative=None))
+        for l in rough.links
+    ]
     rough = rough.replace(links=links)
     assert rough.joints[0].viscous > 0
     traj = kd.simulate(rough, 1.0, X0_PUMA, controller=PDGravity(rough, 60.0, 8.0, np.zeros(6)), dt=1e-3)
@@ -276,8 +285,32 @@ def closed_five_bar(g: float = 0.0):
         dict(mass=m[3], position=l1 * u(a1) - lc4 * u(a4), inertia=I[3], angular_velocity=d4),
     ]
     closure = list(l2 * u(a2) + l1 * u(a3) - (l1 * u(a1) + l2 * u(a4)))
-    system = LagrangianSystem.from_bodies([a1, a2, a3, a4], bodies, qd=[d1, d2, d3, d4], gravity=(0, -g), holonomic=closure, forces=[0] * 4, name="five-bar (closed)")
-    params = dict(l1=l1, l2=l2, lc1=lc1, lc2=lc2, lc3=lc3, lc4=lc4, g=g, m1=m[0], m2=m[1], m3=m[2], m4=m[3], I1=I[0], I2=I[1], I3=I[2], I4=I[3])
+    system = LagrangianSystem.from_bodies(
+        [a1, a2, a3, a4],
+        bodies,
+        qd=[d1, d2, d3, d4],
+        gravity=(0, -g),
+        holonomic=closure,
+        forces=[0] * 4,
+        name="five-bar (closed)",
+    )
+    params = dict(
+        l1=l1,
+        l2=l2,
+        lc1=lc1,
+        lc2=lc2,
+        lc3=lc3,
+        lc4=lc4,
+        g=g,
+        m1=m[0],
+        m2=m[1],
+        m3=m[2],
+        m4=m[3],
+        I1=I[0],
+        I2=I[1],
+        I3=I[2],
+        I4=I[3],
+    )
     return system, params
 
 
@@ -350,7 +383,9 @@ def test_non_finite_controller_torque_is_reported(puma):
         return tau
 
     for method in ("rk4", "rk45"):
-        with pytest.raises(NonFiniteTorqueError, match=r"non-finite torque \(nan\) at joint 2 \('q3'\) at t = 0\.0[5-9]") as info:
+        with pytest.raises(
+            NonFiniteTorqueError, match=r"non-finite torque \(nan\) at joint 2 \('q3'\) at t = 0\.0[5-9]"
+        ) as info:
             kd.simulate(puma, 0.2, X0_PUMA, controller=bad, method=method)
         assert isinstance(info.value, ValueError)
     with pytest.raises(ValueError, match="returned torques of shape"):
@@ -360,7 +395,9 @@ def test_non_finite_controller_torque_is_reported(puma):
 def test_blow_up_stops_with_when_and_where(puma):
     # a destabilising "controller" (positive velocity feedback) drives joint speeds past max_speed
     ctl = lambda t, q, qd: 500.0 * qd  # noqa: E731
-    with pytest.raises(SimulationError, match=r"blew up at t = [0-9.]+ s \(step \d+ of 3000\).*joint \d \('q\d'\)") as info:
+    with pytest.raises(
+        SimulationError, match=r"blew up at t = [0-9.]+ s \(step \d+ of 3000\).*joint \d \('q\d'\)"
+    ) as info:
         kd.simulate(puma, 3.0, X0_PUMA, controller=ctl, max_speed=1e3)
     err = info.value
     partial = err.trajectory
@@ -413,7 +450,22 @@ def test_cli_simulate_json_and_files(tmp_path, capsys):
     from kinedyn.cli import main
 
     png = tmp_path / "out.png"
-    code = main(["simulate", "planar_2r", "--t", "1", "--controller", "pdg", "--goal", "0.5", "-0.3", "--plot", str(png), "--json"])
+    code = main(
+        [
+            "simulate",
+            "planar_2r",
+            "--t",
+            "1",
+            "--controller",
+            "pdg",
+            "--goal",
+            "0.5",
+            "-0.3",
+            "--plot",
+            str(png),
+            "--json",
+        ]
+    )
     doc = json.loads(capsys.readouterr().out)
     assert code == 0 and png.stat().st_size > 1000
     assert doc["controller"] == "PD + gravity compensation" and doc["samples"] == 1001

@@ -51,7 +51,9 @@ def _fk(robot, q):
 
 def _com_and_R(robot, q):
     Ts = _fk(robot, q)
-    return [T[:3, :3] @ np.asarray(b.inertia.com, float) + T[:3, 3] for T, b in zip(Ts, robot.tree.bodies)], [T[:3, :3] for T in Ts]
+    return [T[:3, :3] @ np.asarray(b.inertia.com, float) + T[:3, 3] for T, b in zip(Ts, robot.tree.bodies)], [
+        T[:3, :3] for T in Ts
+    ]
 
 
 def numeric_M(robot, q):
@@ -62,8 +64,10 @@ def numeric_M(robot, q):
     bodies = robot.tree.bodies
     Ts = _fk(robot, q)
     z, o = [], []
-    for i, b in enumerate(bodies):
-        F = (Ts[b.parent] if b.parent >= 0 else np.eye(4)) @ np.asarray(b.placement, float)  # joint frame, before motion
+    for b in bodies:
+        F = (Ts[b.parent] if b.parent >= 0 else np.eye(4)) @ np.asarray(
+            b.placement, float
+        )  # joint frame, before motion
         z.append(F[:3, :3] @ np.asarray(b.joint.axis, float))
         o.append(F[:3, 3])
     D = np.diag([float(b.joint.armature) for b in bodies])
@@ -133,7 +137,11 @@ def symbolic_elbow():
     L1, L2, L3, m1, m2, m3, g = sp.symbols("L1 L2 L3 m1 m2 m3 g", positive=True)
     rod = lambda m, L: Inertia(m, (L / 2 - L, 0, 0), ((0, 0, 0), (0, m * L**2 / 12, 0), (0, 0, m * L**2 / 12)))
     link1 = Inertia(m1, (0, -L1 / 2, 0), ((m1 * L1**2 / 12, 0, 0), (0, 0, 0), (0, 0, m1 * L1**2 / 12)))
-    rows = [DHRow(d=L1, alpha=math.pi / 2, inertia=link1), DHRow(a=L2, inertia=rod(m2, L2)), DHRow(a=L3, inertia=rod(m3, L3))]
+    rows = [
+        DHRow(d=L1, alpha=math.pi / 2, inertia=link1),
+        DHRow(a=L2, inertia=rod(m2, L2)),
+        DHRow(a=L3, inertia=rod(m3, L3)),
+    ]
     return kd.Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_sym")
 
 
@@ -163,7 +171,9 @@ def test_matches_independent_numeric_euler_lagrange(name, robot, values):
         qdd = RNG.normal(size=robot.n)
         M = evaluate(eom, eom.M, q, values=values)
         np.testing.assert_allclose(M, numeric_M(numeric, q), rtol=1e-7, atol=1e-8)
-        np.testing.assert_allclose(evaluate(eom, eom.g, q, values=values).ravel(), numeric_g(numeric, q), rtol=1e-7, atol=1e-7)
+        np.testing.assert_allclose(
+            evaluate(eom, eom.g, q, values=values).ravel(), numeric_g(numeric, q), rtol=1e-7, atol=1e-7
+        )
         C = evaluate(eom, eom.C, q, qd, values=values)
         np.testing.assert_allclose(C, numeric_C(numeric, q, qd), rtol=1e-5, atol=1e-6)
         tau = evaluate(eom, eom.tau, q, qd, qdd, values=values).ravel()
@@ -204,11 +214,16 @@ def test_catalogue_matches_numeric_engine(name):
     tau = np.einsum("nij,nj->ni", M, qdd) + np.einsum("nij,nj->ni", C, qd) + g + f.friction(qd)
     assert rel(tau, robot.inverse_dynamics(q, qd, qdd)) < 1e-10
     for k in range(len(q)):
-        assert abs(K(q[k], qd[k]) - robot.kinetic_energy(q[k], qd[k])) < 1e-10 * max(1.0, abs(robot.kinetic_energy(q[k], qd[k])))
+        assert abs(K(q[k], qd[k]) - robot.kinetic_energy(q[k], qd[k])) < 1e-10 * max(
+            1.0, abs(robot.kinetic_energy(q[k], qd[k]))
+        )
         assert abs(P(q[k]) - robot.potential_energy(q[k])) < 1e-10 * max(1.0, abs(robot.potential_energy(q[k])))
     if robot.n <= 3:  # the symbolic tau itself, including friction
         ft = sp.lambdify([list(eom.q), list(eom.qd), list(eom.qdd)], eom.tau, "numpy")
-        assert rel(np.array(ft(q[0], qd[0], qdd[0]), dtype=float).ravel(), robot.inverse_dynamics(q[0], qd[0], qdd[0])) < 1e-10
+        assert (
+            rel(np.array(ft(q[0], qd[0], qdd[0]), dtype=float).ravel(), robot.inverse_dynamics(q[0], qd[0], qdd[0]))
+            < 1e-10
+        )
 
 
 def test_puma_matches_independent_numeric_lagrange():
@@ -223,7 +238,11 @@ def test_puma_matches_independent_numeric_lagrange():
 
 # ----------------------------------------------------------------------------------------------
 # Lagrange vs Newton-Euler
-@pytest.mark.parametrize("robot", [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()], ids=["2r", "3r", "elbow"])
+@pytest.mark.parametrize(
+    "robot",
+    [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()],
+    ids=["2r", "3r", "elbow"],
+)
 def test_lagrange_and_newton_euler_agree_symbolically(robot):
     lag = robot.equations_of_motion(method="lagrange")
     ne = robot.equations_of_motion(method="newton_euler")
@@ -308,10 +327,16 @@ def test_planar_elbow_closed_forms():
     assert (eom.C - C_expected).applyfunc(sp.expand) == sp.zeros(2, 2)
     # g = dP/dq of the hand-written potential energy
     Ph = P.xreplace(rename)
-    assert (eom.g - sp.Matrix([sp.diff(Ph, x) for x in q])).applyfunc(lambda e: sp.expand(sp.expand_trig(e))) == sp.zeros(2, 1)
+    assert (eom.g - sp.Matrix([sp.diff(Ph, x) for x in q])).applyfunc(
+        lambda e: sp.expand(sp.expand_trig(e))
+    ) == sp.zeros(2, 1)
 
 
-@pytest.mark.parametrize("robot", [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()], ids=["2r", "3r", "elbow"])
+@pytest.mark.parametrize(
+    "robot",
+    [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()],
+    ids=["2r", "3r", "elbow"],
+)
 def test_skew_symmetry_symbolic(robot):
     """N = dD/dt - 2C is skew-symmetric, and dD/dt = C + C^T (which a transposed C would fail)."""
     eom = robot.equations_of_motion(steps=False)
@@ -325,11 +350,17 @@ def test_skew_symmetry_symbolic(robot):
 
 # ----------------------------------------------------------------------------------------------
 # regressor
-@pytest.mark.parametrize("robot", [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()], ids=["2r", "3r", "elbow"])
+@pytest.mark.parametrize(
+    "robot",
+    [kd.robots.planar_2r(symbolic=True), kd.robots.planar_3r(symbolic=True), symbolic_elbow()],
+    ids=["2r", "3r", "elbow"],
+)
 def test_regressor_reproduces_tau_exactly(robot):
     eom = robot.equations_of_motion(steps=False)
     Y, Theta = eom.regressor()
-    assert (Y * Theta - (eom.tau - eom.friction)).applyfunc(lambda e: sp.expand(sp.expand_trig(e))) == sp.zeros(robot.n, 1)
+    assert (Y * Theta - (eom.tau - eom.friction)).applyfunc(lambda e: sp.expand(sp.expand_trig(e))) == sp.zeros(
+        robot.n, 1
+    )
     # minimal: Y sampled at many states has full column rank
     syms = list(eom.q) + list(eom.qd) + list(eom.qdd)
     known = {s: 9.81 for s in Y.free_symbols if s.name == "g"}
@@ -344,7 +375,13 @@ def test_planar_elbow_five_parameters():
     eom = kd.robots.planar_2r(symbolic=True).equations_of_motion(steps=False)
     Y, Theta = eom.regressor()
     l1, lc1, lc2, m1, m2, I1, I2 = sp.symbols("l1 lc1 lc2 m1 m2 I1 I2", positive=True)
-    expected = [m1 * lc1**2 + m2 * (l1**2 + lc2**2) + I1 + I2, m2 * l1 * lc2, m2 * lc2**2 + I2, m1 * lc1 + m2 * l1, m2 * lc2]
+    expected = [
+        m1 * lc1**2 + m2 * (l1**2 + lc2**2) + I1 + I2,
+        m2 * l1 * lc2,
+        m2 * lc2**2 + I2,
+        m1 * lc1 + m2 * l1,
+        m2 * lc2,
+    ]
     assert Theta.shape == (5, 1)
     assert [sp.expand(t) for t in Theta] == [sp.expand(e) for e in expected]
     # the printed (wrong) third and fifth parameters cannot reproduce tau with this Y
@@ -388,7 +425,10 @@ def test_rotor_inertia_and_friction_enter_as_documented():
     J_l, J_m, r, B_m, M, g, ell = sp.symbols("J_l J_m r B_m M g ell", positive=True)
     assert sp.expand(eom.M[0, 0] - (J_l + r**2 * J_m)) == 0
     assert sp.expand(eom.friction[0] - r**2 * B_m * eom.qd[0]) == 0
-    assert sp.expand(eom.tau[0] - (eom.M[0, 0] * eom.qdd[0] + M * g * ell * sp.cos(eom.q[0]) + r**2 * B_m * eom.qd[0])) == 0
+    assert (
+        sp.expand(eom.tau[0] - (eom.M[0, 0] * eom.qdd[0] + M * g * ell * sp.cos(eom.q[0]) + r**2 * B_m * eom.qd[0]))
+        == 0
+    )
 
 
 def test_bad_method_is_refused():
@@ -402,7 +442,10 @@ def test_hamiltons_equations_reproduce_the_lagrangian_equations():
     import dataclasses
 
     robot = kd.robots.planar_2r()
-    links = [dataclasses.replace(l, joint=dataclasses.replace(l.joint, viscous=0.3, coulomb=0.2)) if l.joint.is_moving else l for l in robot.links]
+    links = [
+        dataclasses.replace(l, joint=dataclasses.replace(l.joint, viscous=0.3, coulomb=0.2)) if l.joint.is_moving else l
+        for l in robot.links
+    ]
     eom = robot.replace(links=links, dh=None).equations_of_motion()
     p, H, qdot, pdot = eom.hamiltonian()
     x, f, u = eom.phase_space()
@@ -412,7 +455,7 @@ def test_hamiltons_equations_reproduce_the_lagrangian_equations():
     at_p = {**values, **dict(zip(p, M * sp.Matrix(eom.qd).subs(values)))}
     qd = np.array(sp.Matrix(eom.qd).subs(values), dtype=float).ravel()
     np.testing.assert_allclose(np.array(qdot.subs(at_p), dtype=float).ravel(), qd, atol=1e-12)
-    qdd = np.array(f[eom.n:, :].subs(values), dtype=float).ravel()
+    qdd = np.array(f[eom.n :, :].subs(values), dtype=float).ravel()
     Mdot = sum((sp.diff(eom.M, qi) * vi for qi, vi in zip(eom.q, qd)), sp.zeros(eom.n, eom.n)).subs(values)
     expected = np.array(Mdot, dtype=float) @ qd + np.array(M, dtype=float) @ qdd
     np.testing.assert_allclose(np.array(pdot.subs(at_p), dtype=float).ravel(), expected, atol=1e-10)
@@ -426,10 +469,21 @@ def _numeric_M_g(eom, subs, q):
     return M, g
 
 
-@pytest.mark.parametrize("build, given, rest", [
-    (kd.robots.planar_2r, {"lc1": 0.7, "I1": 0.4, "m2": 2.5}, {"l1": 2.0, "l2": 3.0, "m1": 1.0, "lc2": 1.2, "I2": 0.9, "g": 9.81}),
-    (kd.robots.elbow_3r, {"L2": 1.5, "m3": 0.8}, {"L1": 3.0, "L3": 1.0, "m1": 1.0, "m2": 1.2, "g": 9.81, "radius": 0.07}),
-])
+@pytest.mark.parametrize(
+    "build, given, rest",
+    [
+        (
+            kd.robots.planar_2r,
+            {"lc1": 0.7, "I1": 0.4, "m2": 2.5},
+            {"l1": 2.0, "l2": 3.0, "m1": 1.0, "lc2": 1.2, "I2": 0.9, "g": 9.81},
+        ),
+        (
+            kd.robots.elbow_3r,
+            {"L2": 1.5, "m3": 0.8},
+            {"L1": 3.0, "L3": 1.0, "m1": 1.0, "m2": 1.2, "g": 9.81, "radius": 0.07},
+        ),
+    ],
+)
 def test_symbolic_builtin_keeps_the_values_given(build, given, rest):
     """planar_2r(symbolic=True, lc1=..., I1=...) once ignored the values (every parameter became a symbol):
     the given ones must not appear as symbols, the rest must, and M, g with the rest substituted equal

@@ -44,8 +44,10 @@ def test_symbolic_and_numeric_base_parameter_counts_agree(name):
 def _geared_2r():
     """A planar 2R arm whose drives have numeric rotor inertia: the known part of tau."""
     rod = lambda m, L: Inertia(m, (-L / 2, 0, 0), ((0, 0, 0), (0, m * L**2 / 12, 0), (0, 0, m * L**2 / 12)))
-    rows = [DHRow(a=1.0, inertia=rod(2.0, 1.0), gear_ratio=10.0, rotor_inertia=1e-3),
-            DHRow(a=0.5, inertia=rod(1.0, 0.5), gear_ratio=5.0, rotor_inertia=2e-3)]
+    rows = [
+        DHRow(a=1.0, inertia=rod(2.0, 1.0), gear_ratio=10.0, rotor_inertia=1e-3),
+        DHRow(a=0.5, inertia=rod(1.0, 0.5), gear_ratio=5.0, rotor_inertia=2e-3),
+    ]
     return kd.Robot.from_dh(rows, gravity=(0, -9.81, 0), name="geared_2r")
 
 
@@ -56,7 +58,9 @@ def test_regressor_splits_off_the_known_rotor_inertia():
     Y, theta = r  # still unpacks as a pair
     qdd = eom.qdd
     # the rotor terms r^2 J_m qdd_k are known numbers, not parameters
-    assert sp.expand(r.tau_known - sp.Matrix([0.1 * qdd[0], 0.05 * qdd[1]])).applyfunc(lambda e: sp.nsimplify(e, tolerance=1e-12)) == sp.zeros(2, 1)
+    assert sp.expand(r.tau_known - sp.Matrix([0.1 * qdd[0], 0.05 * qdd[1]])).applyfunc(
+        lambda e: sp.nsimplify(e, tolerance=1e-12)
+    ) == sp.zeros(2, 1)
     assert len(theta) == len(robot.base_parameters().names)
     # Y Theta + tau_known == tau at random states and parameter values
     res = Y * theta + r.tau_known - (eom.tau - eom.friction)
@@ -100,7 +104,16 @@ def _coordinate_axis_tree(seed):
         kind = "prismatic" if i in (1, 4) else "revolute"
         joint = Joint(f"j{i + 1}", kind, tuple(axis), offset=float(rng.uniform(-0.5, 0.5)))
         parent = None if i == 0 else names[int(rng.integers(0, i))]
-        links.append(Link(f"link{i + 1}", parent, joint, homogeneous(_rotation(rng), rng.uniform(-0.5, 0.5, 3)), np.eye(4), random_inertia(rng)))
+        links.append(
+            Link(
+                f"link{i + 1}",
+                parent,
+                joint,
+                homogeneous(_rotation(rng), rng.uniform(-0.5, 0.5, 3)),
+                np.eye(4),
+                random_inertia(rng),
+            )
+        )
         names.append(f"link{i + 1}")
     return kd.Robot(links, [], gravity=(0.0, -9.81, 0.0), name=f"axes_tree_{seed}")
 
@@ -131,11 +144,19 @@ def test_grouped_model_equals_ungrouped_and_numeric(seed):
         taus.append(np.array([float(sp.sympify(t).xreplace(state).xreplace(env)) for t in prog.outputs["tau"]]))
         if group:
             grouped = {str(s): e for s, e in prog.assignments if prog.tags[s][0] == "parameters"}
-    assert sum(name[:2] in ("MX", "MY", "MZ", "MR") for name in grouped) >= 2 and any("XR" in name for name in grouped), sorted(grouped)
+    assert sum(name[:2] in ("MX", "MY", "MZ", "MR") for name in grouped) >= 2 and any(
+        "XR" in name for name in grouped
+    ), sorted(grouped)
     np.testing.assert_allclose(taus[0], taus[1], rtol=1e-10, atol=1e-10)
     try:
         from kinedyn import _core  # noqa: F401
     except ImportError:
         return
     x = [np.array([state[s] for s in v]) for v in (q, qd, qdd)]
-    np.testing.assert_allclose(taus[0] + [float(b.joint.viscous) * v + float(b.joint.coulomb) * np.sign(v) for b, v in zip(robot.tree.bodies, x[1])], robot.inverse_dynamics(*x), rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(
+        taus[0]
+        + [float(b.joint.viscous) * v + float(b.joint.coulomb) * np.sign(v) for b, v in zip(robot.tree.bodies, x[1])],
+        robot.inverse_dynamics(*x),
+        rtol=1e-10,
+        atol=1e-10,
+    )

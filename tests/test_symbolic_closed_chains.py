@@ -39,16 +39,28 @@ def four_bar() -> LagrangianSystem:
     bodies = [
         dict(mass=rho * l2, position=j1 + l2 / 2 * _u(q1), inertia=rho * l2**3 / 12, angular_velocity=u1),
         dict(mass=rho * l3, position=j2 + l3 / 2 * _u(q1 + q2), inertia=rho * l3**3 / 12, angular_velocity=u1 + u2),
-        dict(mass=rho * l4, position=j3 + l4 / 2 * _u(q1 + q2 + q3), inertia=rho * l4**3 / 12, angular_velocity=u1 + u2 + u3),
+        dict(
+            mass=rho * l4,
+            position=j3 + l4 / 2 * _u(q1 + q2 + q3),
+            inertia=rho * l4**3 / 12,
+            angular_velocity=u1 + u2 + u3,
+        ),
     ]
     closure = end - sp.Matrix([-l1 / 2, 0])
-    return LagrangianSystem.from_bodies([q1, q2, q3], bodies, qd=[u1, u2, u3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar")
+    return LagrangianSystem.from_bodies(
+        [q1, q2, q3], bodies, qd=[u1, u2, u3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar"
+    )
 
 
 def _closure_numeric(q):
     l1, l2, l3, l4 = (PARAMS[k] for k in ("l1", "l2", "l3", "l4"))
     a = np.cumsum(q)
-    return np.array([l1 + l2 * np.cos(a[0]) + l3 * np.cos(a[1]) + l4 * np.cos(a[2]), l2 * np.sin(a[0]) + l3 * np.sin(a[1]) + l4 * np.sin(a[2])])
+    return np.array(
+        [
+            l1 + l2 * np.cos(a[0]) + l3 * np.cos(a[1]) + l4 * np.cos(a[2]),
+            l2 * np.sin(a[0]) + l3 * np.sin(a[1]) + l4 * np.sin(a[2]),
+        ]
+    )
 
 
 def _consistent_states(count, seed):
@@ -59,7 +71,9 @@ def _consistent_states(count, seed):
         q1 = Q_REF[0] + rng.uniform(-0.3, 0.3)
         q = np.r_[q1, fsolve(lambda x: _closure_numeric(np.r_[q1, x]), Q_REF[1:])]
         for _ in range(3):  # Newton steps to round-off
-            J = np.column_stack([(_closure_numeric(q + 1e-7 * e) - _closure_numeric(q - 1e-7 * e)) / 2e-7 for e in np.eye(3)[1:]])
+            J = np.column_stack(
+                [(_closure_numeric(q + 1e-7 * e) - _closure_numeric(q - 1e-7 * e)) / 2e-7 for e in np.eye(3)[1:]]
+            )
             q[1:] -= np.linalg.solve(J, _closure_numeric(q))
         assert np.abs(_closure_numeric(q)).max() < 1e-12
         h = 1e-7
@@ -73,7 +87,16 @@ def _consistent_states(count, seed):
 def sympy_four_bar():
     """The same mechanism in SymPy mechanics (frames and points), solved by LagrangesMethod (with
     multipliers) and KanesMethod (dependent speeds): functions (q, qd) -> (qdd, lambda) and -> qdd."""
-    from sympy.physics.mechanics import KanesMethod, LagrangesMethod, Lagrangian, Point, ReferenceFrame, RigidBody, dynamicsymbols, inertia
+    from sympy.physics.mechanics import (
+        KanesMethod,
+        LagrangesMethod,
+        Lagrangian,
+        Point,
+        ReferenceFrame,
+        RigidBody,
+        dynamicsymbols,
+        inertia,
+    )
 
     q = dynamicsymbols("q1:4")
     u = dynamicsymbols("u1:4")
@@ -119,8 +142,16 @@ def sympy_four_bar():
     for C in (C2, C3, C4):
         C.set_vel(N, C.pos_from(O).dt(N).subs(to_u))
     fhd = fh.diff(t).subs(to_u)
-    kane = KanesMethod(N, q_ind=[q[0]], u_ind=[u[0]], q_dependent=q[1:], u_dependent=u[1:], kd_eqs=[qd - ui for qd, ui in zip(qdot, u)],
-                       configuration_constraints=fh, velocity_constraints=fhd)
+    kane = KanesMethod(
+        N,
+        q_ind=[q[0]],
+        u_ind=[u[0]],
+        q_dependent=q[1:],
+        u_dependent=u[1:],
+        kd_eqs=[qd - ui for qd, ui in zip(qdot, u)],
+        configuration_constraints=fh,
+        velocity_constraints=fhd,
+    )
     kane.kanes_equations([rigid("B2", C2, F2, l2), rigid("B3", C3, F3, l3), rigid("B4", C4, F4, l4)], [])
     k_M = sp.lambdify([q, u, p_syms], kane.mass_matrix)
     k_f = sp.lambdify([q, u, p_syms], kane.forcing)
@@ -159,7 +190,11 @@ def test_four_bar_solution_satisfies_the_constrained_equations_derived_here():
         qdd, _ = accelerations(0.0, q, qd)
         # d2/dt2 closure(q(t)) = 0, by a central difference of the closure along the motion
         h = 1e-4
-        second = (_closure_numeric(q + h * qd + h * h / 2 * qdd) - 2 * _closure_numeric(q) + _closure_numeric(q - h * qd + h * h / 2 * qdd)) / h**2
+        second = (
+            _closure_numeric(q + h * qd + h * h / 2 * qdd)
+            - 2 * _closure_numeric(q)
+            + _closure_numeric(q - h * qd + h * h / 2 * qdd)
+        ) / h**2
         assert np.abs(second).max() < 1e-5
     q0, qd0 = _consistent_states(1, seed=7)[0]
     sol = solve_ivp(system.numeric(PARAMS), (0, 2.0), np.r_[q0, 20 * qd0], rtol=1e-10, atol=1e-12)
@@ -177,14 +212,19 @@ def test_baumgarte_pulls_a_drifted_state_back():
     stabilised = system.numeric(PARAMS, baumgarte=(20.0, 20.0))
     q0, qd0 = _consistent_states(1, seed=11)[0]
     x0 = np.r_[q0 + np.array([0.0, 2e-3, -1e-3]), qd0]  # off the manifold
-    drift = [np.abs(_closure_numeric(solve_ivp(f, (0, 1.0), x0, rtol=1e-10, atol=1e-12).y[:3, -1])).max() for f in (plain, stabilised)]
+    drift = [
+        np.abs(_closure_numeric(solve_ivp(f, (0, 1.0), x0, rtol=1e-10, atol=1e-12).y[:3, -1])).max()
+        for f in (plain, stabilised)
+    ]
     assert drift[1] < 1e-2 * drift[0]
 
 
 def test_singular_configuration_is_named():
     (x, y), (xd, yd) = coordinates("x y")
     # two copies of one constraint: A has rank 1, the KKT matrix is singular
-    system = LagrangianSystem([x, y], K=(xd**2 + yd**2) / 2, qd=[xd, yd], holonomic=[x - y, 2 * x - 2 * y], forces=[0, 0])
+    system = LagrangianSystem(
+        [x, y], K=(xd**2 + yd**2) / 2, qd=[xd, yd], holonomic=[x - y, 2 * x - 2 * y], forces=[0, 0]
+    )
     with pytest.raises(ValueError, match="singular"):
         system.numeric_accelerations()(0.0, [0.1, 0.1], [0.0, 0.0])
 
@@ -213,7 +253,11 @@ def test_four_bar_example_is_the_mechanism_derived_here():
     assert sp.expand(example.L.xreplace(rename) - here.L) == 0
     assert [sp.expand(a.xreplace(rename) - b) for a, b in zip(example.holonomic, here.holonomic)] == [0, 0]
     q, qd = _consistent_states(1, seed=2)[0]
-    np.testing.assert_allclose(example.numeric_accelerations(PARAMS)(0.0, q, qd)[0], here.numeric_accelerations(PARAMS)(0.0, q, qd)[0], rtol=1e-12)
+    np.testing.assert_allclose(
+        example.numeric_accelerations(PARAMS)(0.0, q, qd)[0],
+        here.numeric_accelerations(PARAMS)(0.0, q, qd)[0],
+        rtol=1e-12,
+    )
 
 
 def test_numeric_handles_a_lagrangian_not_quadratic_in_the_velocities():

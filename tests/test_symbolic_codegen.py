@@ -141,7 +141,9 @@ def test_generated_code_states_the_order_of_p(language):
     else:
         ns: dict = {}
         exec(src, ns)
-        M, g, tau = (np.asarray(v, dtype=float) for v in (ns["eom_M"](q, p), ns["eom_g"](q, p), ns["eom_tau"](q, qd, qdd, p)))
+        M, g, tau = (
+            np.asarray(v, dtype=float) for v in (ns["eom_M"](q, p), ns["eom_g"](q, p), ns["eom_tau"](q, qd, qdd, p))
+        )
     np.testing.assert_allclose(M, numeric.mass_matrix(q), rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(g, numeric.gravity_torque(q), rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(tau, numeric.inverse_dynamics(q, qd, qdd), rtol=1e-10, atol=1e-12)

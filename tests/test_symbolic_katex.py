@@ -58,7 +58,11 @@ def test_markdown_and_fragment_render_in_katex(planar):
     assert len(md_blocks) > 20 and len(rows) > 30
     titles = [r for r in rows if r.startswith(r"&\text{")]
     assert len(titles) == len(planar.steps) + 1
-    _render_all(md_blocks + ["\\begin{aligned}" + r + "\\end{aligned}" for r in titles] + [planar.to_latex().replace("align*", "aligned")])
+    _render_all(
+        md_blocks
+        + ["\\begin{aligned}" + r + "\\end{aligned}" for r in titles]
+        + [planar.to_latex().replace("align*", "aligned")]
+    )
 
 
 def test_mechanism_markdown_renders_in_katex():
@@ -73,7 +77,11 @@ def test_tutorial_markdown_uses_the_books_notation_and_renders():
     joined = "\n".join(blocks)
     for raw in (r"\text{J", r"\^{}", "thetadot", "dL/d", "J^-1"):
         assert raw not in joined, raw
-    assert "J^{-1} = " in joined and r"\frac{\partial L}{\partial \dot{\theta}_{1}}" in joined and r"\dot{\theta}_{1}" in joined
+    assert (
+        "J^{-1} = " in joined
+        and r"\frac{\partial L}{\partial \dot{\theta}_{1}}" in joined
+        and r"\dot{\theta}_{1}" in joined
+    )
     _render_all(blocks)
 
 

@@ -26,7 +26,12 @@ def _zero(M) -> bool:
     return sp.Matrix(M).applyfunc(lambda e: sp.simplify(sp.expand_trig(e))) == sp.zeros(*sp.Matrix(M).shape)
 
 
-def _compare_numeric(robot, trials=3, seed=1, refs=(("world", None), ("world", (0.1, -0.2, 0.3)), ("local", (0.1, -0.2, 0.3)), ("spatial", None))):
+def _compare_numeric(
+    robot,
+    trials=3,
+    seed=1,
+    refs=(("world", None), ("world", (0.1, -0.2, 0.3)), ("local", (0.1, -0.2, 0.3)), ("spatial", None)),
+):
     q = ks.joint_symbols(robot)
     rng = np.random.default_rng(seed)
     states = [robot.random_configuration(rng) for _ in range(trials)]
@@ -36,7 +41,9 @@ def _compare_numeric(robot, trials=3, seed=1, refs=(("world", None), ("world", (
     for ref, point in refs:
         fJ = sp.lambdify(q, ks.jacobian(robot, reference=ref, point=point), "numpy")
         for x in states:
-            assert np.allclose(np.array(fJ(*x), dtype=float), robot.jacobian(x, reference=ref, point=point), rtol=0, atol=1e-10), (robot.name, ref, point)
+            assert np.allclose(
+                np.array(fJ(*x), dtype=float), robot.jacobian(x, reference=ref, point=point), rtol=0, atol=1e-10
+            ), (robot.name, ref, point)
 
 
 @pytest.mark.parametrize("name", kd.robots.names())
@@ -227,8 +234,13 @@ def test_bad_arguments():
 def _cli(*args):
     # the kinedyn under test (the working tree's or the installed wheel's), not necessarily ROOT/python
     package_parent = str(Path(kd.__file__).resolve().parents[1])
-    return subprocess.run([sys.executable, "-m", "kinedyn", *args], capture_output=True, text=True, cwd=ROOT,
-                          env={"PYTHONPATH": package_parent, "PATH": "/usr/bin:/bin"})
+    return subprocess.run(
+        [sys.executable, "-m", "kinedyn", *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={"PYTHONPATH": package_parent, "PATH": "/usr/bin:/bin"},
+    )
 
 
 def test_cli_fk_and_jacobian_symbolic():

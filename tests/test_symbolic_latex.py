@@ -30,15 +30,22 @@ PDFLATEX = shutil.which("pdflatex")
 needs_tex = pytest.mark.skipif(PDFLATEX is None, reason="pdflatex is not installed (CI installs texlive-latex-base)")
 OVERFULL_PT = 1.0
 
-FRAGMENT_DOCUMENT = "\\documentclass{article}\n\\usepackage[a4paper,margin=2cm]{geometry}\n\\usepackage{amsmath}\n" \
-                    "\\allowdisplaybreaks\n\\begin{document}\n%s\n\\end{document}\n"
+FRAGMENT_DOCUMENT = (
+    "\\documentclass{article}\n\\usepackage[a4paper,margin=2cm]{geometry}\n\\usepackage{amsmath}\n"
+    "\\allowdisplaybreaks\n\\begin{document}\n%s\n\\end{document}\n"
+)
 
 
 def compile_tex(tmp_path: Path, name: str, tex: str) -> str:
     """pdflatex the document; returns the log after asserting a PDF, no error and no overfull line."""
     (tmp_path / f"{name}.tex").write_text(tex)
-    run = subprocess.run([PDFLATEX, "-halt-on-error", "-interaction=nonstopmode", f"{name}.tex"], cwd=tmp_path,
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [PDFLATEX, "-halt-on-error", "-interaction=nonstopmode", f"{name}.tex"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     log = (tmp_path / f"{name}.log").read_text(errors="replace")
     errors = [line for line in log.splitlines() if line.startswith("!")]
     assert run.returncode == 0 and not errors, f"pdflatex failed on {name}: {errors or run.stdout[-2000:]}"
@@ -53,15 +60,29 @@ def _symbolic_builtins():
 
 
 ROBOT_CASES = [(n, False) for n in kd.robots.CATALOGUE] + [(n, True) for n in _symbolic_builtins()]
-MECHANISMS = ["remotely_driven_arm", "five_bar", "sphere_particle", "falling_particle", "simple_variational", "geared_link",
-              "remotely_driven_arm_from_robot", "five_bar_from_chains", "four_bar_linkage"]
+MECHANISMS = [
+    "remotely_driven_arm",
+    "five_bar",
+    "sphere_particle",
+    "falling_particle",
+    "simple_variational",
+    "geared_link",
+    "remotely_driven_arm_from_robot",
+    "five_bar_from_chains",
+    "four_bar_linkage",
+]
 
 
 def test_every_builtin_and_mechanism_is_listed():
     """The parametrisations below cover kinedyn's built-in list and every LagrangianSystem example."""
     assert {n for n, _ in ROBOT_CASES} == set(kd.robots.CATALOGUE)
-    makers = {n for n, f in inspect.getmembers(examples, inspect.isfunction)
-              if f.__module__ == examples.__name__ and not n.startswith("_") and n not in ("geared_link_robot", "five_bar_chains")}  # a Robot; two Robots
+    makers = {
+        n
+        for n, f in inspect.getmembers(examples, inspect.isfunction)
+        if f.__module__ == examples.__name__
+        and not n.startswith("_")
+        and n not in ("geared_link_robot", "five_bar_chains")
+    }  # a Robot; two Robots
     assert makers == set(MECHANISMS)
 
 
@@ -72,7 +93,9 @@ def test_derive_latex_document_compiles(tmp_path, capsys, name, symbolic):
     argv = ["derive", name, "--format", "latex", "-o", str(out)] + (["--symbolic"] if symbolic else [])
     assert main(argv) == 0
     tex = out.read_text()
-    assert tex.startswith("\\documentclass") and "\\usepackage{amsmath" in tex and tex.rstrip().endswith("\\end{document}")
+    assert (
+        tex.startswith("\\documentclass") and "\\usepackage{amsmath" in tex and tex.rstrip().endswith("\\end{document}")
+    )
     compile_tex(tmp_path, "eom", tex)
 
 
@@ -99,7 +122,9 @@ def test_prose_is_escaped_for_text_mode():
     "Missing $ inserted". Every special character is escaped; the math words become inline math."""
     s = latex_text("Joint torques tau_k = d/dt dL/dqd_k - dL/dq_k; 50% & #1 ~ {x} \\ planar_2r")
     outside = re.sub(r"\$[^$]*\$", "", s)
-    assert not re.search(r"(?<!\\)[_^%&#~{}]", outside.replace("\\textasciitilde{}", "").replace("\\textbackslash{}", "")), s
+    assert not re.search(
+        r"(?<!\\)[_^%&#~{}]", outside.replace("\\textasciitilde{}", "").replace("\\textbackslash{}", "")
+    ), s
     assert r"\tau_{k}" in s and r"\dot{q}_{k}" in s
     assert latex_text("K = qd^T D(q) qd / 2") == r"$K = \dot{q}^{T} D\left(q\right) \dot{q}$ / 2"
 

@@ -10,7 +10,13 @@ import sympy as sp
 
 import kinedyn as kd
 from kinedyn.symbolic import examples as ex
-from kinedyn.symbolic.mechanisms import change_coordinates, closed_chain, closed_chain_system, decoupling_condition, loop_closure
+from kinedyn.symbolic.mechanisms import (
+    change_coordinates,
+    closed_chain,
+    closed_chain_system,
+    decoupling_condition,
+    loop_closure,
+)
 
 RNG = np.random.default_rng(41)
 
@@ -43,11 +49,15 @@ def test_remotely_driven_arm_from_robot_equals_the_hand_written_bodies():
         assert sp.Poly(e, pd1, pd2).coeff_monomial(pd1 * pd2) == 0
 
 
-@pytest.mark.parametrize("arm, A", [
-    ("planar_2r", [[1, 0], [-1, 1]]),
-    ("planar_3r", [[1, 0, 0], [-1, 1, 0], [2, -1, 1]]),
-    ("planar_3r", [[0, 1, 0], [1, 0, 1], [1, 1, -1]]),
-], ids=["remote-drive", "triangular", "mixing"])
+@pytest.mark.parametrize(
+    "arm, A",
+    [
+        ("planar_2r", [[1, 0], [-1, 1]]),
+        ("planar_3r", [[1, 0, 0], [-1, 1, 0], [2, -1, 1]]),
+        ("planar_3r", [[0, 1, 0], [1, 0, 1], [1, 1, -1]]),
+    ],
+    ids=["remote-drive", "triangular", "mixing"],
+)
 def test_change_of_coordinates_against_the_numeric_core(arm, A):
     """tau_p(p, pd, pdd) == A^T tau_q(A p, A pd, A pdd) and C_p == A^T C_q A, D_p == A^T D_q A with
     tau_q, C_q, D_q from the numeric core (RNEA, Coriolis matrix, CRBA)."""
@@ -111,7 +121,7 @@ def _tree_projection(chains, values, q_red):
     theta = np.array([q1, q2 - q1, q2, q1 - q2])  # (q1, phi4, q2, phi3) on the parallelogram branch
 
     def closure(th):
-        return (a.pose(th[:2])[:2, 3] - b.pose(th[2:])[:2, 3])
+        return a.pose(th[:2])[:2, 3] - b.pose(th[2:])[:2, 3]
 
     assert np.abs(closure(theta)).max() < 1e-12
     h = 1e-6
@@ -145,9 +155,13 @@ def test_five_bar_decoupling_condition_solved():
     m3, m4, l1, l2, lc3, lc4 = sp.symbols("m3 m4 l1 l2 lc3 lc4", positive=True)
     conditions, solution = decoupling_condition(reduced, solve_for="m3")
     assert len(conditions) == 1
-    assert sp.expand((conditions[0].lhs - conditions[0].rhs) ** 2 - (m3 * l2 * lc3 - m4 * l1 * lc4) ** 2) == 0  # m3 l2 lc3 = m4 l1 lc4
+    assert (
+        sp.expand((conditions[0].lhs - conditions[0].rhs) ** 2 - (m3 * l2 * lc3 - m4 * l1 * lc4) ** 2) == 0
+    )  # m3 l2 lc3 = m4 l1 lc4
     assert sp.simplify(solution[m3] - m4 * l1 * lc4 / (l2 * lc3)) == 0
-    assert decoupling_condition(reduced, solve_for="m3", constant=True)[1] == solution  # the diagonal is constant anyway
+    assert (
+        decoupling_condition(reduced, solve_for="m3", constant=True)[1] == solution
+    )  # the diagonal is constant anyway
     decoupled = reduced.subs({m3: solution[m3]})
     assert decoupled.M[0, 1].simplify() == 0 and not decoupled.M.free_symbols & set(reduced.q)
     assert decoupled.C.applyfunc(sp.simplify) == sp.zeros(2, 2)

@@ -56,7 +56,9 @@ def arm(multiplier="-1.5", offset="0.2"):
 
 def mixed():
     robot = kd.Robot.from_urdf(MIXED)
-    drive = lambda joint: dataclasses.replace(joint, gear_ratio=2.0, rotor_inertia=0.01) if joint.kind != "fixed" else joint
+    drive = lambda joint: (
+        dataclasses.replace(joint, gear_ratio=2.0, rotor_inertia=0.01) if joint.kind != "fixed" else joint
+    )
     return robot.replace(links=[dataclasses.replace(link, joint=drive(link.joint)) for link in robot.links])
 
 
@@ -128,7 +130,9 @@ def test_lagrange_newton_euler_and_cse_routes_agree(make):
 def test_newton_euler_steps_show_the_mapping_of_joint_forces_to_the_coordinates():
     steps = arm().equations_of_motion(method="newton_euler").steps
     last = steps[-1]
-    assert "G^T" in last.title and "j3 = -1.5 j2 + 0.2" in last.text and "finger_right = 1 finger_left + 0.01" in last.text
+    assert (
+        "G^T" in last.title and "j3 = -1.5 j2 + 0.2" in last.text and "finger_right = 1 finger_left + 0.01" in last.text
+    )
     assert len(last.equations) == 3
 
 
@@ -157,7 +161,9 @@ def test_symbolic_pose_and_jacobians_of_follower_moved_frames_equal_the_numeric_
         for reference in ("world", "local", "spatial"):
             J = number(kd.symbolic.jacobian(robot, frame, reference=reference, simplify=False), at)
             assert J.shape == (6, 3)
-            np.testing.assert_allclose(J, robot.jacobian(q, frame=frame, reference=reference), atol=1e-12, err_msg=f"{frame} {reference}")
+            np.testing.assert_allclose(
+                J, robot.jacobian(q, frame=frame, reference=reference), atol=1e-12, err_msg=f"{frame} {reference}"
+            )
 
 
 def test_panda_closed_form_with_its_mimic_finger():
@@ -175,7 +181,11 @@ def test_panda_closed_form_with_its_mimic_finger():
     rng = np.random.default_rng(5)
     q, qd = rng.uniform(-1, 1, 8) * [1, 1, 1, 1, 1, 1, 1, 0.04], rng.uniform(-1, 1, 8)
     at = dict(zip(q_symbols, q)) | dict(zip(qd_symbols, qd))
-    for name, reference in (("M", robot.mass_matrix(q)), ("C", robot.coriolis_matrix(q, qd)), ("g", robot.gravity_torque(q))):
+    for name, reference in (
+        ("M", robot.mass_matrix(q)),
+        ("C", robot.coriolis_matrix(q, qd)),
+        ("g", robot.gravity_torque(q)),
+    ):
         block = np.array([float(x) for x in evaluate_block(cse[name], at)]).reshape(reference.shape)
         np.testing.assert_allclose(block, reference, atol=1e-10, err_msg=name)
 
@@ -187,7 +197,11 @@ def test_general_parameters_are_per_body_and_the_regressor_reproduces_tau():
     assert Y.shape[0] == 3
     from kinedyn.symbolic.robot_eom import general_parameters
 
-    numbers = {s: v for row, values in zip(general_parameters(robot), robot.inertial_parameters().reshape(-1, 10)) for s, v in zip(row, values)}
+    numbers = {
+        s: v
+        for row, values in zip(general_parameters(robot), robot.inertial_parameters().reshape(-1, 10))
+        for s, v in zip(row, values)
+    }
     for q, qd, qdd in states(robot, seed=6):
         at = values(eom, q, qd, qdd)
         tau = np.array((Y * sp.Matrix(theta)).xreplace(at).xreplace(numbers).evalf(), dtype=float).ravel()

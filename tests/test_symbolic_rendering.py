@@ -39,7 +39,10 @@ def _check_mathml(eom):
     assert len(sections[-1].findall(f"{M}math")) == 4  # D, C, g, tau
     for el in root.iter():
         if el.tag.startswith(M):
-            assert "\\" not in (el.text or "") and "{" not in (el.text or ""), (el.tag, el.text)  # no raw LaTeX anywhere
+            assert "\\" not in (el.text or "") and "{" not in (el.text or ""), (
+                el.tag,
+                el.text,
+            )  # no raw LaTeX anywhere
     return root
 
 
@@ -70,14 +73,18 @@ def test_plain_text_names_are_readable(planar):
         assert any(line.startswith(f"dL/dqdot{k} = ") for line in lines)
         assert any(line.startswith(f"d/dt dL/dqdot{k} = ") for line in lines)
         assert any(line.startswith(f"dL/dq{k} = ") for line in lines)
-        assert any(line.startswith(f"J_vc{k} = ") for line in lines) and any(line.startswith(f"J_w{k} = ") for line in lines)
+        assert any(line.startswith(f"J_vc{k} = ") for line in lines) and any(
+            line.startswith(f"J_w{k} = ") for line in lines
+        )
     assert "dotq" not in text and "ddt" not in text and "mathcal" not in text
     assert any(line.startswith("C(q, qd) = ") for line in lines) and any(line.startswith("tau = ") for line in lines)
     md = planar.to_markdown()
     assert md.count("$$") % 2 == 0
     # a long equation is an aligned block ("lhs &= ...", continued on "&\\quad ..." lines)
     assert re.search(r"\\frac\{d\}\{dt\}\\frac\{\\partial \\mathcal\{L\}\}\{\\partial \\dot\{q\}_\{1\}\} &?= ", md)
-    assert re.search(r"\\frac\{\\partial \\mathcal\{L\}\}\{\\partial q_\{2\}\} &?= ", md) and re.search(r"C_\{\d+\}\(q, \\dot\{q\}\) &?= |C\(q, \\dot\{q\}\) &?= ", md)
+    assert re.search(r"\\frac\{\\partial \\mathcal\{L\}\}\{\\partial q_\{2\}\} &?= ", md) and re.search(
+        r"C_\{\d+\}\(q, \\dot\{q\}\) &?= |C\(q, \\dot\{q\}\) &?= ", md
+    )
 
 
 def _expand(eom, value):
@@ -125,14 +132,21 @@ def test_newton_euler_centre_of_mass_acceleration_is_the_textbook_one(planar_ne)
     t = sp.Symbol("t")
     a1, a2 = sp.Function("a1")(t), sp.Function("a2")(t)
     rc2 = sp.Matrix([l1 * sp.cos(a1) + lc2 * sp.cos(a1 + a2), l1 * sp.sin(a1) + lc2 * sp.sin(a1 + a2), 0])
-    acc = rc2.diff(t, 2).subs({a1.diff(t, 2): qdd1, a2.diff(t, 2): qdd2}).subs({a1.diff(t): qd1, a2.diff(t): qd2}).subs({a1: q1, a2: q2})
+    acc = (
+        rc2.diff(t, 2)
+        .subs({a1.diff(t, 2): qdd1, a2.diff(t, 2): qdd2})
+        .subs({a1.diff(t): qd1, a2.diff(t): qd2})
+        .subs({a1: q1, a2: q2})
+    )
     expected = acc + sp.Matrix([0, g, 0])  # minus gravity (0, -g, 0)
     vdc = {lhs.text: v for s in eom.steps for lhs, v in s.equations}["vdc2"]
     R = sp.Matrix([[sp.cos(q1 + q2), -sp.sin(q1 + q2), 0], [sp.sin(q1 + q2), sp.cos(q1 + q2), 0], [0, 0, 1]])
     got = R * vdc.applyfunc(lambda e: _expand(eom, e))
     rng = np.random.default_rng(5)
     values = dict(zip([q1, q2, qd1, qd2, qdd1, qdd2, l1, lc2, g], rng.uniform(0.3, 1.5, 9)))
-    np.testing.assert_allclose(np.array(got.xreplace(values), float), np.array(expected.xreplace(values), float), rtol=1e-12)
+    np.testing.assert_allclose(
+        np.array(got.xreplace(values), float), np.array(expected.xreplace(values), float), rtol=1e-12
+    )
 
 
 def test_derive_newton_euler_markdown_shows_the_steps(capsys):

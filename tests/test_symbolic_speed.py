@@ -13,14 +13,13 @@ import re
 import numpy as np
 import pytest
 import sympy as sp
+from reference import PANDA, erd
 
 import kinedyn as kd
 from kinedyn.cli import main
 from kinedyn.symbolic.cse import closed_form, evaluate_block
 from kinedyn.symbolic.lagrange import state_symbols
 from kinedyn.symbolic.robot_eom import general_parameters
-
-from reference import PANDA, erd
 
 
 def _general_values(robot, syms):
@@ -73,7 +72,9 @@ def test_cse_form_equals_the_expanded_equations_symbolically_for_a_small_arm():
     rng = np.random.default_rng(3)
     state = list(cse.q) + list(cse.qd)
     for _ in range(2):
-        vals = {s: float(v) for s, v in zip(state + cse.parameters, rng.uniform(0.3, 1.5, len(state) + len(cse.parameters)))}
+        vals = {
+            s: float(v) for s, v in zip(state + cse.parameters, rng.uniform(0.3, 1.5, len(state) + len(cse.parameters)))
+        }
         for key in ("M", "C", "g"):
             got = np.array(evaluate_block(cf[key], vals), dtype=float)
             want = np.array(getattr(expanded, key).xreplace(vals), dtype=float).ravel()
@@ -86,7 +87,11 @@ def _evaluate_printed(lines, values):
     env = {str(k): v for k, v in values.items()}
     for line in lines:
         lhs, rhs = line.split(" = ", 1)
-        env[lhs.strip()] = float(sp.sympify(rhs, locals={k: sp.Symbol(k) for k in _names(rhs)}).subs({sp.Symbol(k): v for k, v in env.items() if k in rhs}))
+        env[lhs.strip()] = float(
+            sp.sympify(rhs, locals={k: sp.Symbol(k) for k in _names(rhs)}).subs(
+                {sp.Symbol(k): v for k, v in env.items() if k in rhs}
+            )
+        )
     return env
 
 
@@ -102,12 +107,12 @@ def test_derive_text_of_the_puma_with_general_inertias_evaluates_to_the_numeric_
     assert main(["derive", "puma560", "--general", "--method", "newton_euler", "-o", str(out)]) == 0
     text = out.read_text()
     start = text.index("Step", text.index("Inertia matrix M(q)") - 40)
-    block = text[start:text.index("D(q) = ")]
+    block = text[start : text.index("D(q) = ")]
     lines = [ln.strip() for ln in block.splitlines() if ln.startswith("  ") and " = " in ln]
     assert any(re.match(r"x\d+ = ", ln) for ln in lines), "no CSE variables printed"
     q, qd, _ = state_symbols(robot)
     params = _general_values(robot, general_parameters(robot))
-    (qv, qdv), = _states(robot, 1, seed=5)
+    ((qv, qdv),) = _states(robot, 1, seed=5)
     env = _evaluate_printed(lines, {**params, **dict(zip(q, qv)), **dict(zip(qd, qdv))})
     Mn, Cn, gn = _numeric(robot, qv, qdv)
     n = robot.n
@@ -148,7 +153,7 @@ def test_derive_json_in_cse_form_evaluates_to_the_numeric_core(capsys):
     assert doc["form"] == "cse"
     q, qd, _ = state_symbols(robot)
     params = _general_values(robot, general_parameters(robot))
-    (qv, qdv), = _states(robot, 1, seed=11)
+    ((qv, qdv),) = _states(robot, 1, seed=11)
     base = {**params, **dict(zip(q, qv)), **dict(zip(qd, qdv))}
     Mn, Cn, gn = _numeric(robot, qv, qdv)
     for key, want in (("M", Mn), ("g", gn), ("C", Cn)):
@@ -169,8 +174,12 @@ def test_symbolic_panda_closed_form_equals_the_numeric_core():
     for qv, qdv in _states(robot, 3, seed=13):
         vals = {**dict(zip(eom.q, qv)), **dict(zip(eom.qd, qdv))}
         Mn, Cn, gn = _numeric(robot, qv, qdv)
-        np.testing.assert_allclose(np.array(evaluate_block(cf["M"], vals), dtype=float).reshape(7, 7), Mn, rtol=1e-8, atol=1e-10)
-        np.testing.assert_allclose(np.array(evaluate_block(cf["C"], vals), dtype=float).reshape(7, 7), Cn, rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose(
+            np.array(evaluate_block(cf["M"], vals), dtype=float).reshape(7, 7), Mn, rtol=1e-8, atol=1e-10
+        )
+        np.testing.assert_allclose(
+            np.array(evaluate_block(cf["C"], vals), dtype=float).reshape(7, 7), Cn, rtol=1e-8, atol=1e-10
+        )
         np.testing.assert_allclose(np.array(evaluate_block(cf["g"], vals), dtype=float), gn, rtol=1e-8, atol=1e-9)
     # and the compiled code built from the same blocks
     f = eom.compile(what=("M", "g"), backend="numpy")

@@ -23,7 +23,9 @@ def _same(a, b, symbols, trials=5):
     fa, fb = sp.lambdify(symbols, a, "numpy"), sp.lambdify(symbols, b, "numpy")
     for _ in range(trials):
         x = RNG.uniform(0.3, 1.5, len(symbols))
-        np.testing.assert_allclose(np.asarray(fa(*x), dtype=float), np.asarray(fb(*x), dtype=float), rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(
+            np.asarray(fa(*x), dtype=float), np.asarray(fb(*x), dtype=float), rtol=1e-9, atol=1e-12
+        )
 
 
 def _raw_multipliers(s):
@@ -47,8 +49,13 @@ def test_sphere_multiplier_is_the_textbook_one():
 def test_knife_edge_multiplier_loses_its_denominator():
     (x, y, th), (xd, yd, thd) = coordinates("x y th")
     m, J = sp.symbols("m J", positive=True)
-    s = LagrangianSystem([x, y, th], K=m * (xd**2 + yd**2) / 2 + J * thd**2 / 2, P=0, qd=[xd, yd, thd],
-                         pfaffian=sp.Matrix([[sp.sin(th), -sp.cos(th), 0]]))
+    s = LagrangianSystem(
+        [x, y, th],
+        K=m * (xd**2 + yd**2) / 2 + J * thd**2 / 2,
+        P=0,
+        qd=[xd, yd, thd],
+        pfaffian=sp.Matrix([[sp.sin(th), -sp.cos(th), 0]]),
+    )
     lam = s.multipliers()
     assert sp.fraction(sp.together(lam[0]))[1] == 1, lam  # no sin^2/m + cos^2/m denominator
     assert _ops(lam) <= 12

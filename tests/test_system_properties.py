@@ -14,25 +14,43 @@ from kinedyn.symbolic import LagrangianSystem, coordinates
 from kinedyn.symbolic import examples as ex
 from kinedyn.symbolic.mechanisms import closed_chain_system, loop_closure
 
-EXACT = ["M symmetric (exact)", "dM/dt - 2C skew-symmetric (exact)", "dM/dt == C + C^T (exact)", "C qd + g == Euler-Lagrange bias (exact)"]
+EXACT = [
+    "M symmetric (exact)",
+    "dM/dt - 2C skew-symmetric (exact)",
+    "dM/dt == C + C^T (exact)",
+    "C qd + g == Euler-Lagrange bias (exact)",
+]
 CONSTRAINED = ["constraint forces do no work", "motion stays on the constraint manifold"]
 
 
 def _values(system, seed=0):
     rng = np.random.default_rng(seed)
     state = {c.name for c in system.q + system.qd} | {system.t.name}
-    names = sorted({s.name for e in [system.L, *system.B, *system.A, *system.holonomic] for s in sp.sympify(e).free_symbols} - state)
+    names = sorted(
+        {s.name for e in [system.L, *system.B, *system.A, *system.holonomic] for s in sp.sympify(e).free_symbols}
+        - state
+    )
     return {k: float(rng.uniform(0.5, 2.0)) for k in names}
 
 
 def _five_bar_trees():
-    return closed_chain_system(ex.five_bar_chains(), loop_closure(*ex.five_bar_chains()), name="five-bar (trees + closure)")
+    return closed_chain_system(
+        ex.five_bar_chains(), loop_closure(*ex.five_bar_chains()), name="five-bar (trees + closure)"
+    )
 
 
-@pytest.mark.parametrize("factory, constrained", [
-    (ex.remotely_driven_arm, False), (ex.five_bar, False), (ex.geared_link, False), (ex.falling_particle, False),
-    (ex.sphere_particle, True), (_five_bar_trees, True),
-], ids=["remote", "five_bar", "geared_damped", "falling", "sphere", "five_bar_trees"])
+@pytest.mark.parametrize(
+    "factory, constrained",
+    [
+        (ex.remotely_driven_arm, False),
+        (ex.five_bar, False),
+        (ex.geared_link, False),
+        (ex.falling_particle, False),
+        (ex.sphere_particle, True),
+        (_five_bar_trees, True),
+    ],
+    ids=["remote", "five_bar", "geared_damped", "falling", "sphere", "five_bar_trees"],
+)
 def test_properties_hold_and_are_proven_exactly(factory, constrained):
     system = factory()
     report = kd.analysis.check_system_properties(system, _values(system))
@@ -53,7 +71,9 @@ def test_non_natural_lagrangian_gets_only_the_checks_that_apply():
     defined by Christoffel symbols, so only the symmetry of M is proven; the energy balance holds."""
     (x, y), (xd, yd) = coordinates("x y")
     b = sp.Symbol("b", positive=True)
-    system = LagrangianSystem([x, y], L=(xd**2 + yd**2) / 2 + b * (x * yd - y * xd) / 2, qd=[xd, yd], name="charge in a field")
+    system = LagrangianSystem(
+        [x, y], L=(xd**2 + yd**2) / 2 + b * (x * yd - y * xd) / 2, qd=[xd, yd], name="charge in a field"
+    )
     report = system.check_properties({"b": 1.5})
     assert report.passed, str(report)
     names = [c.name for c in report.checks]
@@ -64,7 +84,9 @@ def test_non_natural_lagrangian_gets_only_the_checks_that_apply():
 def _with(eom, C):
     from kinedyn.symbolic.eom import EquationsOfMotion
 
-    return EquationsOfMotion(eom.q, eom.qd, eom.qdd, eom.M, C, eom.g, K=eom.K, P=eom.P, friction=eom.friction, extra=eom.extra)
+    return EquationsOfMotion(
+        eom.q, eom.qd, eom.qdd, eom.M, C, eom.g, K=eom.K, P=eom.P, friction=eom.friction, extra=eom.extra
+    )
 
 
 def test_exact_checks_catch_a_wrong_coriolis_matrix(monkeypatch):

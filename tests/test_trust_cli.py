@@ -121,7 +121,9 @@ def _mutations():
         "truncated.urdf": urdf_text[: len(urdf_text) // 2],
         "missing_parent.urdf": urdf_text.replace('<parent link="link1"/>', '<parent link="nowhere"/>'),
         "non_numeric.urdf": urdf_text.replace('xyz="2.0 0 0"', 'xyz="two 0 0"'),
-        "short_axis.urdf": urdf_text.replace('<axis xyz="0 0 1"/></joint>\n  <joint name="q2"', '<axis xyz="0 1"/></joint>\n  <joint name="q2"'),
+        "short_axis.urdf": urdf_text.replace(
+            '<axis xyz="0 0 1"/></joint>\n  <joint name="q2"', '<axis xyz="0 1"/></joint>\n  <joint name="q2"'
+        ),
         "unknown_joint_type.urdf": urdf_text.replace('type="continuous"', 'type="spinning"', 1),
         "non_numeric_mass.urdf": urdf_text.replace('<mass value="1.0"/>', '<mass value="heavy"/>', 1),
         "not_xml.urdf": "hello, robot",
@@ -186,7 +188,32 @@ def test_randomly_damaged_files_never_give_a_traceback(capsys, tmp_path, source,
     text = (EXAMPLES / source).read_text()
     a = data.draw(st.integers(0, len(text)))
     b = data.draw(st.integers(a, min(len(text), a + 40)))
-    insert = data.draw(st.sampled_from(["", "[", "{", "]", "}", ":", "- ", "\n", "\"", "'", "=", "<", ">", "/>", "1e999", "-", "nan", "&", "x", "\t"]))
+    insert = data.draw(
+        st.sampled_from(
+            [
+                "",
+                "[",
+                "{",
+                "]",
+                "}",
+                ":",
+                "- ",
+                "\n",
+                '"',
+                "'",
+                "=",
+                "<",
+                ">",
+                "/>",
+                "1e999",
+                "-",
+                "nan",
+                "&",
+                "x",
+                "\t",
+            ]
+        )
+    )
     damaged = text[:a] + insert + text[b:]
     path = tmp_path / f"damaged{Path(source).suffix}"
     path.write_text(damaged)
@@ -220,7 +247,9 @@ def test_every_file_option_is_checked():
     for name, p in sub.choices.items():
         for a in p._actions:
             text = f"{a.help or ''} {a.metavar or ''}".lower()
-            if (a.option_strings or a.dest == "output") and ("write" in text or a.dest in ("output", "plot", "animate", "csv", "npz")):
+            if (a.option_strings or a.dest == "output") and (
+                "write" in text or a.dest in ("output", "plot", "animate", "csv", "npz")
+            ):
                 writers.add((name, a.option_strings[-1] if a.option_strings else a.metavar))
     assert writers == set(output_options())
     assert ("report", "--output") in writers and ("derive", "--output") in writers and ("simulate", "--csv") in writers
@@ -269,7 +298,11 @@ def test_output_without_permission_as_the_system_says(capsys, tmp_path, monkeypa
     locked.mkdir()
     (locked / "old.txt").write_text("x")
     real_access = os.access
-    monkeypatch.setattr(cli.os, "access", lambda p, mode: False if Path(p).parent == locked or Path(p) == locked else real_access(p, mode))
+    monkeypatch.setattr(
+        cli.os,
+        "access",
+        lambda p, mode: False if Path(p).parent == locked or Path(p) == locked else real_access(p, mode),
+    )
     code, _, err = run(capsys, "derive", "planar_2r", "-o", locked / "eom.txt")
     assert_one_line_error(code, err, "-o/--output", "no permission to create a file in")
     code, _, err = run(capsys, "derive", "planar_2r", "-o", locked / "old.txt")
@@ -358,9 +391,11 @@ def test_library_messages_use_the_flags(capsys, tmp_path):
     assert "method='numeric'" not in line and "4x4" not in line
     # an arm whose joint limits exclude every closed-form solution
     arm = tmp_path / "limited.yaml"
-    arm.write_text("name: limited\nconvention: standard\ngravity: [0, -9.81, 0]\njoints:\n"
-                   "  - {name: q1, a: 1.0, mass: 1, limits: {lower: 2.0, upper: 2.5}}\n"
-                   "  - {name: q2, a: 1.0, mass: 1, limits: {lower: 2.0, upper: 2.5}}\n")
+    arm.write_text(
+        "name: limited\nconvention: standard\ngravity: [0, -9.81, 0]\njoints:\n"
+        "  - {name: q1, a: 1.0, mass: 1, limits: {lower: 2.0, upper: 2.5}}\n"
+        "  - {name: q2, a: 1.0, mass: 1, limits: {lower: 2.0, upper: 2.5}}\n"
+    )
     code, out, err = run(capsys, "ik", arm, "--xyz", "1", "1", "0")
     assert code == cli.EXIT_NO, err
     assert "--ignore-limits" in out and "respect_limits" not in out
@@ -395,7 +430,9 @@ def test_symbolic_file_on_a_numeric_command_says_how_to_give_values(capsys, tmp_
 
 def test_set_gives_a_symbolic_file_its_numbers(capsys):
     """With every value given the file is the tutorial arm: the same numbers as the built-in."""
-    code, out, err = run(capsys, "dynamics", SYMBOLIC, "--q", "0.3", "-0.7", "--qd", "1", "2", *set_args(PLANAR_2R), "--json")
+    code, out, err = run(
+        capsys, "dynamics", SYMBOLIC, "--q", "0.3", "-0.7", "--qd", "1", "2", *set_args(PLANAR_2R), "--json"
+    )
     assert code == 0, err
     doc = json.loads(out)
     ref = kd.robots.planar_2r()
@@ -429,7 +466,11 @@ def test_set_on_built_ins_and_bad_set_values(capsys):
         (["fk", "planar_2r", "--set", "l1"], "argument --set: expected NAME=VALUE", "l1"),
         (["fk", "planar_2r", "--set", "l1=abc"], "argument --set: l1: the value must be a number", "abc"),
         (["fk", "planar_2r", "--set", "l1=inf"], "argument --set: l1: the value must be a number", "inf"),
-        (["fk", "planar_2r", "--set", "l1=exec(chr(49))"], "argument --set: l1: the value must be a number", "'exec' is not a known function"),
+        (
+            ["fk", "planar_2r", "--set", "l1=exec(chr(49))"],
+            "argument --set: l1: the value must be a number",
+            "'exec' is not a known function",
+        ),
         (["fk", "planar_2r", "--set", "l1=9**9**9"], "argument --set: l1: the value must be a number", "exponent"),
         (["fk", "planar_2r", "--set", "=1"], "argument --set: expected NAME=VALUE", "=1"),
         (["fk", "planar_2r", "--set", "l1=1", "--set", "l1=2"], "--set l1 is given twice", ""),
@@ -453,12 +494,20 @@ class FakePanic(BaseException):
     [
         (ValueError("bad thing"), 1, ["kinedyn fk: error: bad thing"]),
         (KeyError("unknown frame 'x'"), 1, ["kinedyn fk: error: unknown frame 'x'"]),
-        (FileNotFoundError(2, "No such file or directory", "/x/y"), 1, ["kinedyn fk: error: '/x/y': No such file or directory"]),
+        (
+            FileNotFoundError(2, "No such file or directory", "/x/y"),
+            1,
+            ["kinedyn fk: error: '/x/y': No such file or directory"],
+        ),
         (PermissionError(13, "Permission denied", "out.html"), 1, ["'out.html': Permission denied"]),
         (RuntimeError("needs ffmpeg on the PATH"), 1, ["error: needs ffmpeg"]),
         (MemoryError(), 1, ["kinedyn fk: error: out of memory"]),
         (MemoryError("Unable to allocate 149. GiB"), 1, ["out of memory: Unable to allocate 149. GiB"]),
-        (TypeError("float() argument"), 70, ["kinedyn fk: internal error: TypeError: float() argument", "bug", "--debug"]),
+        (
+            TypeError("float() argument"),
+            70,
+            ["kinedyn fk: internal error: TypeError: float() argument", "bug", "--debug"],
+        ),
         (AttributeError("'x' has no attribute 'y'"), 70, ["internal error: AttributeError", "--debug"]),
         (RecursionError("maximum recursion depth exceeded"), 70, ["internal error: RecursionError", "--debug"]),
         (OverflowError("int too large"), 70, ["internal error: OverflowError", "--debug"]),
@@ -509,18 +558,33 @@ def test_warnings_are_one_line(capsys, monkeypatch):
     import warnings
 
     def warns(args):
-        warnings.warn("inertia of link 'antenna' is not positive semi-definite\n(eigenvalues -3.5e-08)", UserWarning)
+        warnings.warn(
+            "inertia of link 'antenna' is not positive semi-definite\n(eigenvalues -3.5e-08)", UserWarning, stacklevel=1
+        )
         return 0
 
     monkeypatch.setattr(cli, "cmd_fk", warns)
     code, _, err = run(capsys, "fk", "planar_2r")
-    assert code == 0 and err.strip() == "kinedyn fk: warning: inertia of link 'antenna' is not positive semi-definite (eigenvalues -3.5e-08)"
+    assert (
+        code == 0
+        and err.strip()
+        == "kinedyn fk: warning: inertia of link 'antenna' is not positive semi-definite (eigenvalues -3.5e-08)"
+    )
 
 
 # ------------------------------------------------------------------ the real command, in a subprocess
 def kinedyn(*argv, timeout=120, **kw):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]))
-    return subprocess.run([sys.executable, "-m", "kinedyn", *map(str, argv)], capture_output=True, text=True, env=env, timeout=timeout, **kw)
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])
+    )
+    return subprocess.run(
+        [sys.executable, "-m", "kinedyn", *map(str, argv)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=timeout,
+        **kw,
+    )
 
 
 def test_subprocess_bad_file_bad_output_and_debug(tmp_path, bad_files):
@@ -529,18 +593,44 @@ def test_subprocess_bad_file_bad_output_and_debug(tmp_path, bad_files):
     assert str(bad_files["truncated.yaml"]) in done.stderr
     done = kinedyn("report", "planar_2r", "-o", "/proc/self/report.html")
     assert done.returncode == 1 and done.stderr.strip() == (
-        "kinedyn report: error: -o/--output: cannot write '/proc/self/report.html': it is in /proc, the kernel's virtual files, not a place for output")
+        "kinedyn report: error: -o/--output: cannot write '/proc/self/report.html': it is in /proc, the kernel's virtual files, not a place for output"
+    )
     done = kinedyn("fk", SYMBOLIC, "--debug")
-    assert done.returncode == 1 and "Traceback" in done.stderr and done.stderr.strip().splitlines()[-1].startswith("kinedyn fk: error:")
+    assert (
+        done.returncode == 1
+        and "Traceback" in done.stderr
+        and done.stderr.strip().splitlines()[-1].startswith("kinedyn fk: error:")
+    )
     done = kinedyn("fk", "planar_2r", "--q", "1")
     assert done.returncode == 1 and done.stderr.count("\n") == 1 and "--q needs 2 values" in done.stderr
 
 
 def test_subprocess_ctrl_c_exits_130_without_a_traceback(tmp_path):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]),
-               PYTHONFAULTHANDLER="1")
-    proc = subprocess.Popen([sys.executable, "-m", "kinedyn", "simulate", "planar_2r", "--t", "1e6", "--dt", "0.5", "--method", "rk45", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join([str(Path(kd.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]),
+        PYTHONFAULTHANDLER="1",
+    )
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "kinedyn",
+            "simulate",
+            "planar_2r",
+            "--t",
+            "1e6",
+            "--dt",
+            "0.5",
+            "--method",
+            "rk45",
+            "--json",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     time.sleep(4.0)
     assert proc.poll() is None, proc.communicate()
     proc.send_signal(signal.SIGINT)
@@ -583,6 +673,7 @@ def test_names_that_look_like_rich_markup_are_printed_as_they_are(capsys, tmp_pa
 
 def test_output_into_a_closed_pipe_is_quiet(capsys, monkeypatch):
     """`kinedyn derive ... | head`: the reader leaves early; status 0 and nothing on stderr."""
+
     def closed(args):
         raise BrokenPipeError(32, "Broken pipe")
 
@@ -593,8 +684,21 @@ def test_output_into_a_closed_pipe_is_quiet(capsys, monkeypatch):
 
 def test_set_reads_arithmetic_on_numbers(capsys):
     """--set values go through kinedyn's expression parser: arithmetic on numbers, never eval."""
-    _, by_expression, _ = main_json(capsys, "fk", "planar_2r", "--set", "l1=sqrt(2)/2", "--set", "l2=pi/4", "--q", "0", "0")
-    _, by_number, _ = main_json(capsys, "fk", "planar_2r", "--set", f"l1={2 ** 0.5 / 2!r}", "--set", f"l2={3.141592653589793 / 4!r}", "--q", "0", "0")
+    _, by_expression, _ = main_json(
+        capsys, "fk", "planar_2r", "--set", "l1=sqrt(2)/2", "--set", "l2=pi/4", "--q", "0", "0"
+    )
+    _, by_number, _ = main_json(
+        capsys,
+        "fk",
+        "planar_2r",
+        "--set",
+        f"l1={2**0.5 / 2!r}",
+        "--set",
+        f"l2={3.141592653589793 / 4!r}",
+        "--q",
+        "0",
+        "0",
+    )
     assert by_expression == by_number
 
 

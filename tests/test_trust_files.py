@@ -46,9 +46,14 @@ def _load_in_child(path, seconds: float = 20.0, memory_gib: float = 2.0) -> tupl
         """
     )
     # the kinedyn this test imported (the working tree or an installed wheel), not necessarily ROOT/python
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(kd.__file__)), os.environ.get("PYTHONPATH", "")]))
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(kd.__file__)), os.environ.get("PYTHONPATH", "")]),
+    )
     try:
-        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=seconds + 15, env=env)
+        run = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, timeout=seconds + 15, env=env
+        )
     except subprocess.TimeoutExpired:
         return "timeout", seconds
     if run.returncode != 0:
@@ -145,10 +150,18 @@ BAD = {
     "nan as a name": ("joints:\n  - {a: 1, coulomb: nan}\n", "joints row 1.coulomb", 2),
     "inf as text": ("joints:\n  - {a: 1, gear_ratio: 'inf'}\n", "joints row 1.gear_ratio", 2),
     "overflowing literal": ("joints:\n  - {a: '1e400'}\n", "joints row 1.a", 2),
-    "parent is a list": ("links:\n  - {name: a, joint: {type: revolute}}\n  - {name: b,\n     parent: [1, 2], joint: {type: revolute}}\n", "links row 2 ('b').parent", 4),
+    "parent is a list": (
+        "links:\n  - {name: a, joint: {type: revolute}}\n  - {name: b,\n     parent: [1, 2], joint: {type: revolute}}\n",
+        "links row 2 ('b').parent",
+        4,
+    ),
     "name is a mapping": ("links:\n  - {name: {x: 1}, joint: {type: revolute}}\n", "links row 1.name", 2),
     "frames not a list": ("frames: 3\njoints: [{a: 1}]\n", "frames", 1),
-    "frame placed beyond any robot": ("frames:\n  - {name: camera, origin: {xyz: [1.0e+150, 0, 0]}}\njoints: [{a: 1}]\n", "frames[0]", 2),
+    "frame placed beyond any robot": (
+        "frames:\n  - {name: camera, origin: {xyz: [1.0e+150, 0, 0]}}\njoints: [{a: 1}]\n",
+        "frames[0]",
+        2,
+    ),
     "duplicate key": ("joints:\n  - {a: 1}\njoints:\n  - {a: 2}\n", "appears twice", 3),
     "duplicate key in a row": ("joints:\n  - {a: 1, a: 2}\n", "appears twice", 2),
     "unknown function": ("joints:\n  - {a: 'gamma(3)'}\n", "joints row 1.a", 2),
@@ -163,7 +176,9 @@ def test_a_bad_value_is_a_value_error_naming_file_line_and_field(tmp_path, case)
     with pytest.raises(ValueError) as info:
         kd.load(path)
     message = str(info.value)
-    assert message.startswith(f"{path}, line {line}:") or message.startswith(f"{path}: invalid YAML at line {line},"), message
+    assert message.startswith(f"{path}, line {line}:") or message.startswith(f"{path}: invalid YAML at line {line},"), (
+        message
+    )
     assert field in message, message
     assert message.count(str(path)) == 1, message
 
@@ -209,7 +224,10 @@ def _leaf():
 def _tree(children):
     """(text, the SymPy object built directly) pairs: the parser must build the same object."""
     binary = st.tuples(children, st.sampled_from(["+", "-", "*"]), children).map(
-        lambda t: (f"({t[0][0]}) {t[1]} ({t[2][0]})", {"+": sp.Add, "-": lambda a, b: a - b, "*": sp.Mul}[t[1]](t[0][1], t[2][1]))
+        lambda t: (
+            f"({t[0][0]}) {t[1]} ({t[2][0]})",
+            {"+": sp.Add, "-": lambda a, b: a - b, "*": sp.Mul}[t[1]](t[0][1], t[2][1]),
+        )
     )
     power = st.tuples(children, st.integers(-3, 3)).map(lambda t: (f"({t[0][0]})**{t[1]}", t[0][1] ** t[1]))
     function = st.tuples(st.sampled_from(["sin", "cos", "sqrt", "exp", "atan"]), children).map(
@@ -225,7 +243,9 @@ def test_the_parser_builds_the_expression_the_text_writes(pair):
     try:
         got = parse_expression(text)
     except ValueError as e:  # only for values that are not finite reals, or too large
-        assert any(w in str(e) for w in ("not a real", "not a finite", "division by zero", "larger than", "too large")), e
+        assert any(
+            w in str(e) for w in ("not a real", "not a finite", "division by zero", "larger than", "too large")
+        ), e
         return
     if isinstance(got, float):
         assert not expected.free_symbols
@@ -242,7 +262,11 @@ def test_the_parser_builds_the_expression_the_text_writes(pair):
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.sampled_from(list("0123456789.+-*/()e ,_abcxyzsinqrtpo") + ["**", "exp(", "9**9", "__", "nan"]), max_size=40).map("".join))
+@given(
+    st.lists(
+        st.sampled_from(list("0123456789.+-*/()e ,_abcxyzsinqrtpo") + ["**", "exp(", "9**9", "__", "nan"]), max_size=40
+    ).map("".join)
+)
 def test_any_text_is_a_value_or_a_value_error(text):
     try:
         value = parse_expression(text)
@@ -275,10 +299,13 @@ def test_values_given_as_text_to_subs_are_parsed_not_evaluated(tmp_path):
     assert not numeric.symbols
 
 
-@pytest.mark.parametrize("text", [
-    "joints:\n  - {a: 1, mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.1}}\n",
-    "links:\n  - {name: link1, joint: {type: revolute}, inertial: {mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.2}}}\n",
-])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "joints:\n  - {a: 1, mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.1}}\n",
+        "links:\n  - {name: link1, joint: {type: revolute}, inertial: {mass: 1, inertia: {ixx: 1, iyy: 1, izz: -0.2}}}\n",
+    ],
+)
 def test_the_inertia_policy_applies_to_robot_files(tmp_path, text):
     path = _write(tmp_path, "arm.yaml", text)
     with pytest.raises(ValueError, match=r"arm\.yaml: link 'link1': inertia tensor is not positive semi-definite"):
@@ -287,6 +314,7 @@ def test_the_inertia_policy_applies_to_robot_files(tmp_path, text):
         kept = kd.load(path)
     with pytest.warns(kd.PhysicalConsistencyWarning, match="repaired"):
         repaired = kd.load(path, inertia="repair")
+
     def smallest_moment(robot):
         return min(np.linalg.eigvalsh(np.array(robot.tree.bodies[0].inertia.inertia, dtype=float)))
 
@@ -315,5 +343,8 @@ def test_a_toml_integer_beyond_pythons_digit_limit_names_the_file(tmp_path):
 @pytest.mark.parametrize("value", ["2001-12-14", "!!timestamp 2001-12-14nan", "!!binary aGVsbG8=", "!!set {a: null}"])
 def test_yaml_types_a_robot_file_has_no_use_for_are_refused_with_their_line(tmp_path, value):
     path = _write(tmp_path, "arm.yaml", f"name: arm\njoints:\n  - {{a: 1, d: {value}}}\n")
-    with pytest.raises(ValueError, match=r"arm\.yaml: invalid YAML at line 3, column \d+: the YAML type \w+ .*has no meaning in a robot file"):
+    with pytest.raises(
+        ValueError,
+        match=r"arm\.yaml: invalid YAML at line 3, column \d+: the YAML type \w+ .*has no meaning in a robot file",
+    ):
         kd.load(path)

@@ -15,10 +15,11 @@ import pytest
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
+from reference import PANDA, erd  # noqa: E402
+
 import kinedyn as kd  # noqa: E402
 from kinedyn.cli import main  # noqa: E402
 from kinedyn.simulate import PD, ComputedTorque, PDGravity, Quintic, SimulationError, SimulationTruncatedWarning  # noqa: E402
-from reference import PANDA, erd  # noqa: E402
 
 TALOS = ("talos_data", "robots", "talos_full_v2.urdf")
 PANDA_GOAL = np.array([0.3, -0.5, 0.4, -1.5, 0.3, 1.2, 0.2, 0.01, 0.01])
@@ -88,7 +89,11 @@ def test_controller_jacobians_match_finite_differences(puma, kind):
     rng = np.random.default_rng(3)
     kp, kd_ = rng.uniform(50, 150, 6), rng.uniform(5, 20, 6)
     goal = rng.uniform(-1, 1, 6)
-    ctl = {"pd": PD(kp, kd_, goal), "pdg": PDGravity(puma, kp, kd_, goal), "ct": ComputedTorque(puma, kp, kd_, Quintic(np.zeros(6), goal, 1.0))}[kind]
+    ctl = {
+        "pd": PD(kp, kd_, goal),
+        "pdg": PDGravity(puma, kp, kd_, goal),
+        "ct": ComputedTorque(puma, kp, kd_, Quintic(np.zeros(6), goal, 1.0)),
+    }[kind]
     t, q, qd = 0.3, rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6)
     dq, dqd = ctl.jacobian(t, q, qd)
     h = 1e-6
@@ -117,13 +122,26 @@ def test_a_falling_arm_stays_inside_its_limits(panda, method):
     free = kd.simulate(panda, 2.0, x0, method=method, dt=1e-4 if method != "implicit" else 1e-3, record_every=10)
     outside = (free.q < lo - 1e-9) | (free.q > hi + 1e-9)
     assert outside.any(), "the premise: without limits the free fall passes through them"
-    held = kd.simulate(panda, 2.0, x0, method=method, dt=1e-4 if method != "implicit" else 1e-3, record_every=10, joint_limits=True)
+    held = kd.simulate(
+        panda, 2.0, x0, method=method, dt=1e-4 if method != "implicit" else 1e-3, record_every=10, joint_limits=True
+    )
     assert np.all(held.q >= lo - 1e-12) and np.all(held.q <= hi + 1e-12)
     # the joints that hit a stop rest on it
     on_stop = np.isclose(held.q[-1], lo) | np.isclose(held.q[-1], hi)
     assert on_stop.any()
     # without the option nothing changed: the same numbers as the option's default
-    assert np.array_equal(free.q, kd.simulate(panda, 2.0, x0, method=method, dt=1e-4 if method != "implicit" else 1e-3, record_every=10, joint_limits=False).q)
+    assert np.array_equal(
+        free.q,
+        kd.simulate(
+            panda,
+            2.0,
+            x0,
+            method=method,
+            dt=1e-4 if method != "implicit" else 1e-3,
+            record_every=10,
+            joint_limits=False,
+        ).q,
+    )
 
 
 def test_joint_limits_errors(puma):
@@ -134,14 +152,24 @@ def test_joint_limits_errors(puma):
 def test_joint_limits_on_the_python_loop(panda):
     lo, hi = panda.lower_limits, panda.upper_limits
     x0 = np.r_[np.clip(np.zeros(panda.n), lo, hi), np.zeros(panda.n)]
-    held = kd.simulate(panda, 1.0, x0, method="implicit", f_ext=np.zeros((panda.n, 6)), joint_limits=True, record_every=10)
+    held = kd.simulate(
+        panda, 1.0, x0, method="implicit", f_ext=np.zeros((panda.n, 6)), joint_limits=True, record_every=10
+    )
     assert not held.info["native"]
     assert np.all(held.q >= lo - 1e-12) and np.all(held.q <= hi + 1e-12)
 
 
 # ------------------------------------------------------------------ budgets
-@pytest.mark.parametrize("how", [dict(), dict(method="implicit"), dict(method="rk45"), dict(f_ext=np.zeros((6, 6))),
-                                 dict(controller=lambda t, q, qd: np.zeros(6))])
+@pytest.mark.parametrize(
+    "how",
+    [
+        dict(),
+        dict(method="implicit"),
+        dict(method="rk45"),
+        dict(f_ext=np.zeros((6, 6))),
+        dict(controller=lambda t, q, qd: np.zeros(6)),
+    ],
+)
 def test_a_time_budget_cuts_a_run_short_and_says_so(puma, how):
     x0 = np.r_[0.1, 0.5, -0.3, 0.2, 0.4, 0.1, np.zeros(6)]
     start = time.perf_counter()
@@ -177,7 +205,9 @@ def test_the_report_on_talos_is_bounded_and_says_when_it_cut_the_simulation(tmp_
     page = (tmp_path / "talos.html").read_text()
     assert "up to 3 joints" in page  # the symbolic equations are skipped, with a note
     # a budget too small for the run: the page and the terminal say that it was cut short
-    code, text, err = run(capsys, "report", path, "-o", str(tmp_path / "cut.html"), "--t", "1000", "--time-budget", "0.5")
+    code, text, err = run(
+        capsys, "report", path, "-o", str(tmp_path / "cut.html"), "--t", "1000", "--time-budget", "0.5"
+    )
     assert code == 0, err
     page = (tmp_path / "cut.html").read_text()
     assert "id='simulation-cut-short'" in page and "The simulation was cut short" in page
@@ -188,8 +218,22 @@ def test_the_report_on_talos_is_bounded_and_says_when_it_cut_the_simulation(tmp_
 def test_cli_per_joint_gains_and_limits(capsys):
     # PD without gravity compensation settles where Kp e = g(q): each joint's own gain shows
     goal, kp = np.array([0.3, -0.5, 0.4, 0, 0, 0]), np.array([400, 300, 300, 50, 50, 50])
-    code, text, err = run(capsys, "simulate", "puma560", "--t", "6", "--controller", "pd", "--goal", *map(str, goal),
-                          "--kp", *map(str, kp), "--kd", "40", "--json")
+    code, text, err = run(
+        capsys,
+        "simulate",
+        "puma560",
+        "--t",
+        "6",
+        "--controller",
+        "pd",
+        "--goal",
+        *map(str, goal),
+        "--kp",
+        *map(str, kp),
+        "--kd",
+        "40",
+        "--json",
+    )
     assert code == 0, err
     d = json.loads(text)  # nothing else on stdout: no progress bar
     q = np.array(d["q_final"])
@@ -197,11 +241,17 @@ def test_cli_per_joint_gains_and_limits(capsys):
     assert np.abs(d["qd_final"]).max() < 1e-4
     code, _, err = run(capsys, "simulate", "puma560", "--kp", "1", "2")
     assert code == 1 and "--kp takes one gain for every joint or one per joint (6" in err
-    code, _, err = run(capsys, "simulate", "puma560", "--method", "rk4", "--controller", "pd", "--kp", "1e7", "--t", "0.1")
-    assert code == 1 and "blew up" in err and "reduce --dt, use --method implicit" in err and "error.trajectory" not in err
+    code, _, err = run(
+        capsys, "simulate", "puma560", "--method", "rk4", "--controller", "pd", "--kp", "1e7", "--t", "0.1"
+    )
+    assert (
+        code == 1 and "blew up" in err and "reduce --dt, use --method implicit" in err and "error.trajectory" not in err
+    )
     code, _, err = run(capsys, "simulate", "puma560", "--joint-limits", "--method", "rk45")
     assert code == 1 and "--joint-limits needs a fixed-step --method" in err
-    code, text, err = run(capsys, "simulate", "puma560", "--t", "2", "--q", "0", "1.2", "0", "0", "0", "0", "--joint-limits", "--json")
+    code, text, err = run(
+        capsys, "simulate", "puma560", "--t", "2", "--q", "0", "1.2", "0", "0", "0", "0", "--joint-limits", "--json"
+    )
     assert code == 0, err
     robot = kd.robots.puma560()
     q = np.array(json.loads(text)["q_final"])
@@ -239,7 +289,14 @@ def test_stiff_scipy_methods_get_the_analytical_jacobian(panda):
     ctl.jacobian = lambda t, q, qd: calls.append(t) or inner(t, q, qd)
     traj = kd.simulate(panda, 2.0, np.zeros(2 * panda.n), controller=ctl, method="bdf", dt=1e-2, rtol=1e-8, atol=1e-10)
     assert calls, "the controller's Jacobian was not used"
-    implicit = kd.simulate(panda, 2.0, np.zeros(2 * panda.n), controller=PDGravity(panda, 100.0, 20.0, PANDA_GOAL), dt=1e-4, record_every=100)
+    implicit = kd.simulate(
+        panda,
+        2.0,
+        np.zeros(2 * panda.n),
+        controller=PDGravity(panda, 100.0, 20.0, PANDA_GOAL),
+        dt=1e-4,
+        record_every=100,
+    )
     np.testing.assert_allclose(traj.q, implicit.q, atol=2e-3)
 
 
@@ -289,5 +346,7 @@ def test_derive_runs_under_a_spinner_on_a_terminal(monkeypatch, capsys):
     assert main(["derive", "planar_2r", "--format", "text"]) == 0
     assert main(["derive", "planar_2r", "--json"]) == 0
     capsys.readouterr()
-    assert labels == [("deriving the equations of motion of 'planar_2r' (lagrange)", None),
-                      ("deriving the equations of motion of 'planar_2r' (lagrange)", False)]
+    assert labels == [
+        ("deriving the equations of motion of 'planar_2r' (lagrange)", None),
+        ("deriving the equations of motion of 'planar_2r' (lagrange)", False),
+    ]

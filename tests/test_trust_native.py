@@ -30,7 +30,9 @@ from hypothesis import strategies as st
 import kinedyn as kd
 from kinedyn import _core
 
-PACKAGE_PARENT = Path(kd.__file__).resolve().parents[1]  # the kinedyn under test: the working tree's or an installed wheel's
+PACKAGE_PARENT = (
+    Path(kd.__file__).resolve().parents[1]
+)  # the kinedyn under test: the working tree's or an installed wheel's
 
 
 def _run_script(code: str, timeout: float = 120) -> subprocess.CompletedProcess:
@@ -40,7 +42,14 @@ def _run_script(code: str, timeout: float = 120) -> subprocess.CompletedProcess:
     import signal
 
     env = dict(os.environ, PYTHONPATH=str(PACKAGE_PARENT), RUST_BACKTRACE="0")
-    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        start_new_session=True,
+    )
     try:
         out, err = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -131,7 +140,16 @@ def test_batches_under_an_address_space_limit_raise_memory_error():
     assert "PanicException" not in result.stdout + result.stderr
     lines = result.stdout.splitlines()
     assert lines[-1] == "alive"
-    for name in ("mass_matrix", "christoffel", "regressor", "inverse_dynamics_derivatives", "forward_kinematics", "jacobian", "simulate", "inverse_kinematics"):
+    for name in (
+        "mass_matrix",
+        "christoffel",
+        "regressor",
+        "inverse_dynamics_derivatives",
+        "forward_kinematics",
+        "jacobian",
+        "simulate",
+        "inverse_kinematics",
+    ):
         assert f"{name} MemoryError" in result.stdout, result.stdout
 
 
@@ -190,7 +208,9 @@ def test_a_robot_goes_to_a_spawn_pool_worker(ur5):
     np.testing.assert_array_equal(tau, ur5.inverse_dynamics(q, q, q))
 
 
-@pytest.mark.parametrize("clone", [lambda r: pickle.loads(pickle.dumps(r)), copy.deepcopy, copy.copy], ids=["pickle", "deepcopy", "copy"])
+@pytest.mark.parametrize(
+    "clone", [lambda r: pickle.loads(pickle.dumps(r)), copy.deepcopy, copy.copy], ids=["pickle", "deepcopy", "copy"]
+)
 def test_robot_round_trips_after_native_use(puma, clone):
     q = puma.random_configuration(rng=3, size=5)
     M = puma.mass_matrix(q)
@@ -209,7 +229,9 @@ def test_a_symbolic_robot_pickles():
     robot = kd.Robot.from_dh([(0, 0, l1, 0), (0, 0, l2, 0)])
     back = pickle.loads(pickle.dumps(robot))
     assert back.symbols == robot.symbols
-    np.testing.assert_allclose(back.subs({"l1": 1.0, "l2": 2.0}).pose([0.3, 0.4]), robot.subs({"l1": 1.0, "l2": 2.0}).pose([0.3, 0.4]))
+    np.testing.assert_allclose(
+        back.subs({"l1": 1.0, "l2": 2.0}).pose([0.3, 0.4]), robot.subs({"l1": 1.0, "l2": 2.0}).pose([0.3, 0.4])
+    )
 
 
 def test_results_pickle(puma):
@@ -245,17 +267,22 @@ def test_finite_inputs_with_overflowing_results_raise(puma):
         puma.bias_torque(np.zeros((10, 6)), qd)
     with pytest.raises(kd.NonFiniteResultError, match="tool_velocity"):
         kd.kinematics.tool_velocity(puma, q, np.full(6, 1e308))
-    viscous = kd.Robot.from_dh([{"theta": 0, "d": 0, "a": 1, "alpha": 0, "viscous": 10.0, "inertia": kd.Inertia.rod(1.0, 1.0)}])
+    viscous = kd.Robot.from_dh(
+        [{"theta": 0, "d": 0, "a": 1, "alpha": 0, "viscous": 10.0, "inertia": kd.Inertia.rod(1.0, 1.0)}]
+    )
     with pytest.raises(kd.NonFiniteResultError, match="friction_torque"):
         viscous.friction_torque([1.7e308])
 
 
 def _two_link(first, second):
     """planar 2R (links of length 1, no gravity) with the given link inertias."""
-    return kd.Robot.from_dh([
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": first},
-        {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": second},
-    ], gravity=(0, 0, 0))
+    return kd.Robot.from_dh(
+        [
+            {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": first},
+            {"theta": 0, "d": 0, "a": 1, "alpha": 0, "inertia": second},
+        ],
+        gravity=(0, 0, 0),
+    )
 
 
 def test_bodies_of_very_different_sizes_invert_exactly():
@@ -334,7 +361,19 @@ def test_dls_with_zero_damping_at_a_singularity_is_the_minimum_norm_answer(puma)
         np.testing.assert_allclose(batch[k], Jk.T @ np.linalg.solve(Jk @ Jk.T + 0.05**2 * np.eye(6), v), atol=1e-9)
 
 
-@pytest.mark.parametrize("name, value", [("max_iterations", 2**64), ("max_iterations", -1), ("max_iterations", 2.5), ("restarts", 2**40), ("seed", -3), ("seed", 2**64), ("tolerance", float("nan")), ("tolerance", 1j)])
+@pytest.mark.parametrize(
+    "name, value",
+    [
+        ("max_iterations", 2**64),
+        ("max_iterations", -1),
+        ("max_iterations", 2.5),
+        ("restarts", 2**40),
+        ("seed", -3),
+        ("seed", 2**64),
+        ("tolerance", float("nan")),
+        ("tolerance", 1j),
+    ],
+)
 def test_ik_settings_are_checked_by_name(puma, name, value):
     with pytest.raises(ValueError, match=name):
         puma.inverse_kinematics(puma.pose(np.full(6, 0.3)), method="numeric", **{name: value})
@@ -348,10 +387,18 @@ def test_one_f_ext_for_a_batch_of_states(puma, ur5):
         batch = robot.inverse_dynamics(q, qd, qdd, f_ext=f)
         one_by_one = np.stack([robot.inverse_dynamics(q[k], qd[k], qdd[k], f_ext=f) for k in range(4)])
         np.testing.assert_allclose(batch, one_by_one, atol=1e-12)
-        np.testing.assert_allclose(robot.forward_dynamics(q, qd, qdd, f_ext=f), np.stack([robot.forward_dynamics(q[k], qd[k], qdd[k], f_ext=f) for k in range(4)]), atol=1e-10)
+        np.testing.assert_allclose(
+            robot.forward_dynamics(q, qd, qdd, f_ext=f),
+            np.stack([robot.forward_dynamics(q[k], qd[k], qdd[k], f_ext=f) for k in range(4)]),
+            atol=1e-10,
+        )
         dq = robot.inverse_dynamics_derivatives(q, qd, qdd, f_ext=f)[0]
-        np.testing.assert_allclose(dq, np.stack([robot.inverse_dynamics_derivatives(q[k], qd[k], qdd[k], f_ext=f)[0] for k in range(4)]), atol=1e-10)
-        with pytest.raises(ValueError, match=r"f_ext must have shape \(%d, 6\)" % robot.n):
+        np.testing.assert_allclose(
+            dq,
+            np.stack([robot.inverse_dynamics_derivatives(q[k], qd[k], qdd[k], f_ext=f)[0] for k in range(4)]),
+            atol=1e-10,
+        )
+        with pytest.raises(ValueError, match=rf"f_ext must have shape \({robot.n}, 6\)"):
             robot.inverse_dynamics(q, qd, qdd, f_ext=np.zeros((robot.n, 5)))
 
 
@@ -403,10 +450,16 @@ _ARGS = {  # method: the per-state shapes of its array arguments
 _FUNCTIONS = {  # kinedyn.kinematics / ik functions: (callable(robot, *arrays), shapes)
     "tool_velocity": (lambda r, q, v: kd.kinematics.tool_velocity(r, q, v), [(_N,), (_N,)]),
     "joint_torques": (lambda r, q, w: kd.kinematics.joint_torques(r, q, w), [(_N,), (6,)]),
-    "joint_velocities_dls": (lambda r, q, v: kd.kinematics.joint_velocities(r, q, v, method="dls", damping=0.0), [(_N,), (6,)]),
+    "joint_velocities_dls": (
+        lambda r, q, v: kd.kinematics.joint_velocities(r, q, v, method="dls", damping=0.0),
+        [(_N,), (6,)],
+    ),
     "joint_velocities_pinv": (lambda r, q, v: kd.kinematics.joint_velocities(r, q, v, method="pinv"), [(_N,), (6,)]),
     "manipulability": (lambda r, q: kd.kinematics.manipulability(r, q), [(_N,)]),
-    "inverse_kinematics": (lambda r, t, q0: r.inverse_kinematics(t, q0=q0, method="numeric", restarts=1, max_iterations=5), [(3,), (_N,)]),
+    "inverse_kinematics": (
+        lambda r, t, q0: r.inverse_kinematics(t, q0=q0, method="numeric", restarts=1, max_iterations=5),
+        [(3,), (_N,)],
+    ),
     "inverse_dynamics_f_ext": (lambda r, q, f: r.inverse_dynamics(q, q, q, f_ext=f), [(_N,), (_N, 6)]),
 }
 
@@ -485,7 +538,9 @@ def fuzz_case(robot, data, name):
 FUZZ_NAMES = sorted(_ARGS) + sorted(_FUNCTIONS)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
+)
 @given(data=st.data(), name=st.sampled_from(FUZZ_NAMES))
 def test_bad_arrays_give_clean_errors_or_finite_results(puma, data, name):
     outcome = fuzz_case(puma, data, name)
@@ -502,11 +557,15 @@ def test_a_factorisation_that_overflows_is_a_non_finite_result_error(name):
     if name == "panda":  # finite M of 1e306 (the fingers at 1e154 m) beside a finger's 1.5e-2
         from reference import PANDA, erd
 
-        robot = kd.Robot.from_urdf(erd(*PANDA), mimic="independent")  # the native factorisation (test_mimic.py: reduced)
+        robot = kd.Robot.from_urdf(
+            erd(*PANDA), mimic="independent"
+        )  # the native factorisation (test_mimic.py: reduced)
     else:
         robot = kd.robots.get(name)
     q = np.full(robot.n, 1e154)  # finite, but prismatic offsets of 1e154 m square to more than float64 holds
-    calls = [lambda: robot.forward_dynamics(q, np.zeros(robot.n), np.zeros(robot.n))]  # the ABA's spatial inertias overflow
+    calls = [
+        lambda: robot.forward_dynamics(q, np.zeros(robot.n), np.zeros(robot.n))
+    ]  # the ABA's spatial inertias overflow
     if name != "cartesian_2p":  # M overflows, or is too large to factor (the Cartesian arm's M does not depend on q)
         calls.append(lambda: robot.mass_matrix_inverse(q))
     for call in calls:

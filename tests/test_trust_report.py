@@ -21,7 +21,6 @@ from hypothesis import strategies as st
 html5lib = pytest.importorskip("html5lib")
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
-import kinedyn as kd  # noqa: E402
 from kinedyn.cli import _jsonable  # noqa: E402
 from kinedyn.description.files import robot_from_mapping  # noqa: E402
 from kinedyn.report.html import _asset, _model_for_view, build_report, collect, script_json  # noqa: E402
@@ -29,15 +28,61 @@ from kinedyn.report.html import _asset, _model_for_view, build_report, collect, 
 XHTML = "{http://www.w3.org/1999/xhtml}"
 
 # pieces that each break a naive embedding in one way or another
-HOSTILE = ["<!--<script>", "</script>", "<script>", "<!--", "-->", "]]>", "<![CDATA[", "</", "<", ">", "&", "&amp;", "&lt;",
-           "\"", "'", "`", "\\", "\\u003c", "\u2028", "\u2029", "\u00e9", "\u03c9", "\U0001f916", "{{", "}}", "${x}", "</title>",
-           "<style>", "</style>", "<textarea>", "<plaintext>", "<!DOCTYPE", "<?xml", "\x00", "\t"]
+HOSTILE = [
+    "<!--<script>",
+    "</script>",
+    "<script>",
+    "<!--",
+    "-->",
+    "]]>",
+    "<![CDATA[",
+    "</",
+    "<",
+    ">",
+    "&",
+    "&amp;",
+    "&lt;",
+    '"',
+    "'",
+    "`",
+    "\\",
+    "\\u003c",
+    "\u2028",
+    "\u2029",
+    "\u00e9",
+    "\u03c9",
+    "\U0001f916",
+    "{{",
+    "}}",
+    "${x}",
+    "</title>",
+    "<style>",
+    "</style>",
+    "<textarea>",
+    "<plaintext>",
+    "<!DOCTYPE",
+    "<?xml",
+    "\x00",
+    "\t",
+]
 # text an HTML document can show as itself: no controls (NUL becomes U+FFFD, CR becomes LF) and no
 # leading/trailing white space, which a table cell's text keeps but names do not need
 printable = st.characters(blacklist_categories=("Cs", "Cc"))
-shown_name = st.lists(st.one_of(st.sampled_from([h for h in HOSTILE if h not in ("\x00", "\t")]), st.text(printable, max_size=6)),
-                      min_size=1, max_size=6).map("".join).map(str.strip).filter(bool)
-any_name = st.lists(st.one_of(st.sampled_from(HOSTILE), st.text(max_size=6)), min_size=1, max_size=6).map("".join).filter(str.strip)
+shown_name = (
+    st.lists(
+        st.one_of(st.sampled_from([h for h in HOSTILE if h not in ("\x00", "\t")]), st.text(printable, max_size=6)),
+        min_size=1,
+        max_size=6,
+    )
+    .map("".join)
+    .map(str.strip)
+    .filter(bool)
+)
+any_name = (
+    st.lists(st.one_of(st.sampled_from(HOSTILE), st.text(max_size=6)), min_size=1, max_size=6)
+    .map("".join)
+    .filter(str.strip)
+)
 
 
 def parse(page: str):
@@ -55,7 +100,9 @@ def text_of(el) -> str:
 # ------------------------------------------------------------------ the embedding function alone
 json_values = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False, allow_infinity=False) | any_name | st.text(),
-    lambda children: st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=8) | any_name, children, max_size=4),
+    lambda children: (
+        st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=8) | any_name, children, max_size=4)
+    ),
     max_leaves=12,
 )
 
@@ -78,7 +125,9 @@ def test_script_json_survives_an_html5_parser(obj):
     assert len(after) == 1 and after[0].text == "after"
 
 
-@pytest.mark.parametrize("name", ["<!--<script>", "</script><p id=after>", "<!--<script></script>", "x]]>&amp;</SCRIPT >"])
+@pytest.mark.parametrize(
+    "name", ["<!--<script>", "</script><p id=after>", "<!--<script></script>", "x]]>&amp;</SCRIPT >"]
+)
 def test_script_json_known_breakers(name):
     page = f'<!DOCTYPE html><html><body><script type="application/json">{script_json({"name": name})}</script><p id="after">a</p></body></html>'
     doc = parse(page)
@@ -92,21 +141,35 @@ def hostile_robot(robot_name, link1, link2, tool, joint1, joint2, base="base", f
     """A two-link arm (a tree description: every name is free text) with the given names and one
     extra frame."""
     inertia = {"ixx": 0.01, "iyy": 0.3, "izz": 0.3}
-    return robot_from_mapping({
-        "name": robot_name,
-        "source": robot_name,
-        "gravity": [0, 0, -9.81],
-        "base": base,
-        "tool": tool,
-        "links": [
-            {"name": link1, "parent": base, "joint": {"name": joint1, "type": "revolute", "axis": [0, 1, 0]},
-             "inertial": {"mass": 1.0, "com": [0.5, 0, 0], "inertia": inertia}},
-            {"name": link2, "parent": link1, "joint": {"name": joint2, "type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [1, 0, 0]}},
-             "inertial": {"mass": 1.0, "com": [0.5, 0, 0], "inertia": inertia}},
-            {"name": tool, "parent": link2, "joint": {"name": f"{tool} fixed", "type": "fixed", "origin": {"xyz": [1, 0, 0]}}},
-        ],
-        "frames": [{"name": frame, "link": link1, "origin": {"xyz": [0.5, 0, 0.1]}}],
-    })
+    return robot_from_mapping(
+        {
+            "name": robot_name,
+            "source": robot_name,
+            "gravity": [0, 0, -9.81],
+            "base": base,
+            "tool": tool,
+            "links": [
+                {
+                    "name": link1,
+                    "parent": base,
+                    "joint": {"name": joint1, "type": "revolute", "axis": [0, 1, 0]},
+                    "inertial": {"mass": 1.0, "com": [0.5, 0, 0], "inertia": inertia},
+                },
+                {
+                    "name": link2,
+                    "parent": link1,
+                    "joint": {"name": joint2, "type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [1, 0, 0]}},
+                    "inertial": {"mass": 1.0, "com": [0.5, 0, 0], "inertia": inertia},
+                },
+                {
+                    "name": tool,
+                    "parent": link2,
+                    "joint": {"name": f"{tool} fixed", "type": "fixed", "origin": {"xyz": [1, 0, 0]}},
+                },
+            ],
+            "frames": [{"name": frame, "link": link1, "origin": {"xyz": [0.5, 0, 0.1]}}],
+        }
+    )
 
 
 def check_report(robot, shown: bool):
@@ -138,7 +201,9 @@ def check_report(robot, shown: bool):
         assert text_of(h1) == robot.name
         assert text_of(next(doc.iter(f"{XHTML}title"))) == f"kinedyn report: {robot.name}"
         tables = {t.get("class"): t for t in doc.iter(f"{XHTML}table")}
-        first_cells = lambda cls: [text_of(tr.find(f"{XHTML}td")) for tr in tables[cls].iter(f"{XHTML}tr") if tr.find(f"{XHTML}td") is not None]
+        first_cells = lambda cls: [
+            text_of(tr.find(f"{XHTML}td")) for tr in tables[cls].iter(f"{XHTML}tr") if tr.find(f"{XHTML}td") is not None
+        ]
         assert first_cells("joints") == robot.joint_names
         assert first_cells("bodies") == [b.name for b in robot.tree.bodies]
         assert first_cells("mass-matrix") == robot.joint_names
@@ -157,7 +222,11 @@ def test_report_with_hostile_names_parses_back(names):
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-@given(names=st.lists(any_name, min_size=7, max_size=7, unique=True).filter(lambda v: "base" not in v and len({n.strip() for n in v}) == 7))
+@given(
+    names=st.lists(any_name, min_size=7, max_size=7, unique=True).filter(
+        lambda v: "base" not in v and len({n.strip() for n in v}) == 7
+    )
+)
 def test_report_json_survives_any_name(names):
     """Control characters and white space too: the JSON blocks (what the viewer reads) still parse
     back equal, whatever the HTML text shows of such characters."""
@@ -174,7 +243,15 @@ THE_BREAKER = "<!--<script>"
 
 def test_the_reported_breaker(tmp_path):
     """The example of the issue: a link named '<!--<script>' (and the other names as bad)."""
-    robot = hostile_robot(THE_BREAKER + " robot", THE_BREAKER, "</script><b>2", "tool]]>&", "q1 <!--", "q2 \u2028 </SCRIPT", frame="<script>x")
+    robot = hostile_robot(
+        THE_BREAKER + " robot",
+        THE_BREAKER,
+        "</script><b>2",
+        "tool]]>&",
+        "q1 <!--",
+        "q2 \u2028 </SCRIPT",
+        frame="<script>x",
+    )
     check_report(robot, shown=True)
 
 
@@ -206,7 +283,10 @@ def test_report_with_a_hostile_name_in_chromium(browser, tmp_path):
     page.wait_for_function("window.kinedyn && window.kinedyn.ready()")
     page.evaluate("window.kinedyn.ready()")
     assert errors == [] and dialogs == []
-    assert page.evaluate("document.getElementById('kinedyn-data') !== null && document.querySelectorAll('script').length") == 4
+    assert (
+        page.evaluate("document.getElementById('kinedyn-data') !== null && document.querySelectorAll('script').length")
+        == 4
+    )
     assert nonblank(page.locator("#kinedyn-view").screenshot()) > 0.01
     for q in ([0.1, 0.2], [2.0, -1.0]):
         T = np.array(page.evaluate("(q) => window.kinedyn.fk(q).frames['tool & <b>']", q)).reshape(4, 4)

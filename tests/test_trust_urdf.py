@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from reference import erd
 
 import kinedyn as kd
-from kinedyn import Frame, Inertia, Joint, Link
+from kinedyn import Inertia, Joint, Link
 from kinedyn.description import inertia as inertia_module
 from kinedyn.description.urdf import MAX_DEPTH, robot_from_urdf
-from reference import erd
 
 BODY = '<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
 
@@ -28,12 +28,16 @@ def chain_urdf(moving: int, fixed_after: int = 0, wide: int = 0) -> str:
     links, joints, parent = ['<link name="base"/>'], [], "base"
     for i in range(moving):
         links.append(f'<link name="m{i}">{BODY}</link>')
-        joints.append(f'<joint name="jm{i}" type="revolute"><parent link="{parent}"/><child link="m{i}"/>'
-                      f'<origin xyz="0 0 0.1" rpy="0 0.1 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>')
+        joints.append(
+            f'<joint name="jm{i}" type="revolute"><parent link="{parent}"/><child link="m{i}"/>'
+            f'<origin xyz="0 0 0.1" rpy="0 0.1 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>'
+        )
         parent = f"m{i}"
     for i in range(fixed_after):
         links.append(f'<link name="f{i}">{BODY}</link>')
-        joints.append(f'<joint name="jf{i}" type="fixed"><parent link="{parent}"/><child link="f{i}"/><origin xyz="0 0 0.1"/></joint>')
+        joints.append(
+            f'<joint name="jf{i}" type="fixed"><parent link="{parent}"/><child link="f{i}"/><origin xyz="0 0 0.1"/></joint>'
+        )
         parent = f"f{i}"
     for i in range(wide):
         links.append(f'<link name="w{i}">{BODY}</link>')
@@ -87,8 +91,10 @@ def random_trees(draw):
         any_moving |= moving
         links.append(f'<link name="l{i}"/>')
         kind = "revolute" if moving else "fixed"
-        joints.append(f'<joint name="j{i}" type="{kind}"><parent link="{parent}"/><child link="l{i}"/>'
-                      f'<limit lower="-1" upper="1"/></joint>')
+        joints.append(
+            f'<joint name="j{i}" type="{kind}"><parent link="{parent}"/><child link="l{i}"/>'
+            f'<limit lower="-1" upper="1"/></joint>'
+        )
         names.append(f"l{i}")
     return "<robot name='t'>" + "".join(links + joints) + "</robot>"
 
@@ -100,10 +106,15 @@ def test_default_tool_is_the_end_of_the_longest_chain(xml):
     assert robot.tool == _reference_default_tool(list(robot.links), robot.base)
 
 
-@pytest.mark.parametrize("name, tool", [("ur_description/urdf/ur5_robot.urdf", "tool0"),  # REP 199's name
-                                        ("panda_description/urdf/panda.urdf", "panda_hand_tcp"),  # not a finger (issue 13 §5)
-                                        ("talos_data/robots/talos_full_v2.urdf", "wrist_right_ft_tool_link"),  # not a sole
-                                        ("romeo_description/urdf/romeo.urdf", "RThumb3Link")])  # no tool name: longest chain
+@pytest.mark.parametrize(
+    "name, tool",
+    [
+        ("ur_description/urdf/ur5_robot.urdf", "tool0"),  # REP 199's name
+        ("panda_description/urdf/panda.urdf", "panda_hand_tcp"),  # not a finger (issue 13 §5)
+        ("talos_data/robots/talos_full_v2.urdf", "wrist_right_ft_tool_link"),  # not a sole
+        ("romeo_description/urdf/romeo.urdf", "RThumb3Link"),
+    ],
+)  # no tool name: longest chain
 def test_default_tool_of_real_robots(name, tool):
     robot = robot_from_urdf(erd(*name.split("/")))
     assert robot.tool == tool
@@ -126,8 +137,14 @@ BILLION_LAUGHS = """<?xml version="1.0"?>
     "xml, message",
     [
         (BILLION_LAUGHS, r"<URDF string>:2: a DOCTYPE with declarations"),
-        ('<?xml version="1.0"?>\n<!DOCTYPE robot SYSTEM "file:///etc/passwd">\n<robot name="&x;"/>', r":2: a DOCTYPE .* external DTD"),
-        ("<robot>" + "<a>" * (MAX_DEPTH + 5) + "</a>" * (MAX_DEPTH + 5) + "</robot>", rf"<URDF string>:1: elements nested deeper than {MAX_DEPTH}"),
+        (
+            '<?xml version="1.0"?>\n<!DOCTYPE robot SYSTEM "file:///etc/passwd">\n<robot name="&x;"/>',
+            r":2: a DOCTYPE .* external DTD",
+        ),
+        (
+            "<robot>" + "<a>" * (MAX_DEPTH + 5) + "</a>" * (MAX_DEPTH + 5) + "</robot>",
+            rf"<URDF string>:1: elements nested deeper than {MAX_DEPTH}",
+        ),
         ("<robot name='&undefined;'/>", r"malformed XML at line 1, column \d+: undefined entity"),
     ],
 )
@@ -154,8 +171,10 @@ def test_plain_doctype_and_namespaces_are_accepted():
 
 def test_file_encoding_declaration_is_honoured(tmp_path):
     path = tmp_path / "latin.urdf"
-    xml = ('<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="r\xe9"><link name="base"/><link name="a"/>'
-           '<joint name="j" type="revolute"><parent link="base"/><child link="a"/><limit lower="-1" upper="1"/></joint></robot>')
+    xml = (
+        '<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="r\xe9"><link name="base"/><link name="a"/>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="a"/><limit lower="-1" upper="1"/></joint></robot>'
+    )
     path.write_bytes(xml.encode("latin-1"))
     assert robot_from_urdf(path).name == "r\xe9"
 
@@ -176,25 +195,75 @@ BAD_FILES = {
     # name: (joint inner xml, link inner xml, expected line, expected text)
     "origin_nan": ('<origin xyz="nan 0 0"/>', "", 4, r"joint 'j' origin xyz must be 3 finite numbers"),
     "origin_inf_rpy": ('<origin rpy="0 inf 0"/>', "", 4, r"joint 'j' origin rpy must be 3 finite numbers"),
-    "origin_1e200": ('<origin xyz="1e200 0 0"/>', "", 4, r"joint 'j' origin xyz has 1e\+200, larger in magnitude than 1e\+100"),
+    "origin_1e200": (
+        '<origin xyz="1e200 0 0"/>',
+        "",
+        4,
+        r"joint 'j' origin xyz has 1e\+200, larger in magnitude than 1e\+100",
+    ),
     "origin_two_numbers": ('<origin xyz="0 0"/>', "", 4, r"joint 'j' origin xyz must be 3 numbers, got 2"),
     "axis_nan": ('<axis xyz="0 0 nan"/>', "", 4, r"joint 'j' axis must be 3 finite numbers"),
     "axis_zero": ('<axis xyz="0 0 0"/>', "", 4, r"joint 'j': axis .* zero"),
     "axis_words": ('<axis xyz="x y z"/>', "", 4, r"joint 'j' axis must be 3 numbers, got 'x y z'"),
-    "limit_nan": ('<limit lower="nan" upper="1"/>', "", 4, r"joint 'j' <limit> attribute 'lower' must be 1 finite numbers"),
-    "limit_huge_integer": (f'<limit lower="-1" upper="{BIG}"/>', "", 4, r"joint 'j' <limit> attribute 'upper' must be 1 finite"),
+    "limit_nan": (
+        '<limit lower="nan" upper="1"/>',
+        "",
+        4,
+        r"joint 'j' <limit> attribute 'lower' must be 1 finite numbers",
+    ),
+    "limit_huge_integer": (
+        f'<limit lower="-1" upper="{BIG}"/>',
+        "",
+        4,
+        r"joint 'j' <limit> attribute 'upper' must be 1 finite",
+    ),
     "limit_inverted": ('<limit lower="1" upper="-1"/>', "", 4, r"joint 'j': lower limit 1.0 exceeds upper limit -1.0"),
-    "limit_velocity_negative": ('<limit lower="-1" upper="1" velocity="-2"/>', "", 4, r"joint 'j': velocity_limit is negative"),
+    "limit_velocity_negative": (
+        '<limit lower="-1" upper="1" velocity="-2"/>',
+        "",
+        4,
+        r"joint 'j': velocity_limit is negative",
+    ),
     "damping_nan": ('<dynamics damping="nan"/>', "", 4, r"joint 'j' <dynamics> attribute 'damping' must be 1 finite"),
     "friction_1e200": ('<dynamics friction="1e200"/>', "", 4, r"joint 'j' <dynamics> attribute 'friction' has 1e\+200"),
     "damping_negative": ('<dynamics damping="-1"/>', "", 4, r"joint 'j': viscous must be >= 0"),
-    "mass_huge_integer": ("", f'<inertial><mass value="{BIG}"/></inertial>', 3, r"link 'a' <inertial> <mass> attribute 'value' must be 1 finite"),
-    "mass_1e200": ("", '<inertial><mass value="1e200"/></inertial>', 3, r"link 'a' <inertial> <mass> attribute 'value' has 1e\+200"),
-    "mass_missing_value": ("", "<inertial><mass/></inertial>", 3, r"link 'a' <inertial> <mass> has no 'value' attribute"),
+    "mass_huge_integer": (
+        "",
+        f'<inertial><mass value="{BIG}"/></inertial>',
+        3,
+        r"link 'a' <inertial> <mass> attribute 'value' must be 1 finite",
+    ),
+    "mass_1e200": (
+        "",
+        '<inertial><mass value="1e200"/></inertial>',
+        3,
+        r"link 'a' <inertial> <mass> attribute 'value' has 1e\+200",
+    ),
+    "mass_missing_value": (
+        "",
+        "<inertial><mass/></inertial>",
+        3,
+        r"link 'a' <inertial> <mass> has no 'value' attribute",
+    ),
     "mass_negative": ("", '<inertial><mass value="-1"/></inertial>', 3, r"link 'a' <inertial>: mass is negative"),
-    "inertia_nan": ("", '<inertial><mass value="1"/><inertia ixx="nan"/></inertial>', 3, r"link 'a' <inertial> <inertia> attribute 'ixx' must be 1 finite"),
-    "inertia_1e200": ("", '<inertial><mass value="1"/><inertia ixx="1e200" iyy="1" izz="1"/></inertial>', 3, r"attribute 'ixx' has 1e\+200"),
-    "inertial_origin_inf": ("", '<inertial><origin xyz="0 0 -inf"/><mass value="1"/></inertial>', 3, r"link 'a' <inertial> origin xyz must be 3 finite"),
+    "inertia_nan": (
+        "",
+        '<inertial><mass value="1"/><inertia ixx="nan"/></inertial>',
+        3,
+        r"link 'a' <inertial> <inertia> attribute 'ixx' must be 1 finite",
+    ),
+    "inertia_1e200": (
+        "",
+        '<inertial><mass value="1"/><inertia ixx="1e200" iyy="1" izz="1"/></inertial>',
+        3,
+        r"attribute 'ixx' has 1e\+200",
+    ),
+    "inertial_origin_inf": (
+        "",
+        '<inertial><origin xyz="0 0 -inf"/><mass value="1"/></inertial>',
+        3,
+        r"link 'a' <inertial> origin xyz must be 3 finite",
+    ),
 }
 
 
@@ -215,17 +284,37 @@ def test_bad_value_names_file_line_and_field_once(tmp_path, case):
 @pytest.mark.parametrize(
     "xml, line, text",
     [
-        ("<robot name='r'>\n<link name='a'/>\n<link name='a'/>\n</robot>", 3, r"link 'a' is defined twice \(first at line 2\)"),
-        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='ball'><parent link='a'/><child link='b'/></joint>\n</robot>",
-         4, r"joint 'j' has type 'ball', which is not supported"),
-        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='revolute'><child link='b'/></joint>\n</robot>",
-         4, r"joint 'j' has no <parent link=...>"),
+        (
+            "<robot name='r'>\n<link name='a'/>\n<link name='a'/>\n</robot>",
+            3,
+            r"link 'a' is defined twice \(first at line 2\)",
+        ),
+        (
+            "<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='ball'><parent link='a'/><child link='b'/></joint>\n</robot>",
+            4,
+            r"joint 'j' has type 'ball', which is not supported",
+        ),
+        (
+            "<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j' type='revolute'><child link='b'/></joint>\n</robot>",
+            4,
+            r"joint 'j' has no <parent link=...>",
+        ),
         ("<robot name='r'>\n<link/>\n</robot>", 2, r"a <link> has no name"),
-        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j'><parent link='a'/><child link='b'/></joint>\n</robot>",
-         4, r"joint 'j' has no type attribute"),
-        ("<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint type='fixed'><parent link='a'/><child link='b'/></joint>\n</robot>", 4, r"a <joint> has no name"),
-        ("<robot name='r'>\n<link name='a'/><link name='b'/>\n<joint name='j' type='revolute'><parent link='a'/><child link='b'/><limit lower='2'/></joint>\n</robot>",
-         3, r"joint 'j': lower limit 2.0 exceeds upper limit 0.0"),  # URDF's upper defaults to 0
+        (
+            "<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint name='j'><parent link='a'/><child link='b'/></joint>\n</robot>",
+            4,
+            r"joint 'j' has no type attribute",
+        ),
+        (
+            "<robot name='r'>\n<link name='a'/>\n<link name='b'/>\n<joint type='fixed'><parent link='a'/><child link='b'/></joint>\n</robot>",
+            4,
+            r"a <joint> has no name",
+        ),
+        (
+            "<robot name='r'>\n<link name='a'/><link name='b'/>\n<joint name='j' type='revolute'><parent link='a'/><child link='b'/><limit lower='2'/></joint>\n</robot>",
+            3,
+            r"joint 'j': lower limit 2.0 exceeds upper limit 0.0",
+        ),  # URDF's upper defaults to 0
     ],
 )
 def test_structural_errors_name_the_line(xml, line, text):
@@ -239,17 +328,24 @@ def test_structural_errors_name_the_line(xml, line, text):
 def test_a_cycle_of_thousands_of_links_is_reported_in_linear_time():
     n = 5000
     links = "".join(f'<link name="l{i}"/>' for i in range(n))
-    joints = "".join(f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{(i + 1) % n}"/></joint>' for i in range(n))
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{(i + 1) % n}"/></joint>'
+        for i in range(n)
+    )
     start = time.perf_counter()
-    with pytest.raises(ValueError, match=r"no root link: its joints form a cycle \(l1 <- l0 <- l4999 <- .* 4991 more .* <- l1\)"):
+    with pytest.raises(
+        ValueError, match=r"no root link: its joints form a cycle \(l1 <- l0 <- l4999 <- .* 4991 more .* <- l1\)"
+    ):
         robot_from_urdf(f"<robot name='c'>{links}{joints}</robot>")
     assert time.perf_counter() - start < 5.0
 
 
 def test_robot_level_errors_get_the_file_once(tmp_path):
     path = tmp_path / "still.urdf"
-    path.write_text("<robot name='still'><link name='a'/><link name='b'/>"
-                    "<joint name='j' type='fixed'><parent link='a'/><child link='b'/></joint></robot>")
+    path.write_text(
+        "<robot name='still'><link name='a'/><link name='b'/>"
+        "<joint name='j' type='fixed'><parent link='a'/><child link='b'/></joint></robot>"
+    )
     with pytest.raises(ValueError) as info:
         kd.load(path)
     assert str(info.value) == f"{path}: robot 'still' has no moving joint"
@@ -293,12 +389,17 @@ def test_joint_values_are_checked_with_the_field_named(kwargs, message):
         (lambda: Inertia(10**400), r"mass is too large"),
         (lambda: Inertia(1e200), r"mass is 1e\+200"),
         (lambda: Inertia(1.0, (0, 1e200, 0)), r"centre of mass\[1\] is 1e\+200"),
-        (lambda: Inertia(1.0, (0, 0, 0), [[1, 0, 0], [0, float("nan"), 0], [0, 0, 1]]), r"inertia tensor\[1\]\[1\] is not finite"),
+        (
+            lambda: Inertia(1.0, (0, 0, 0), [[1, 0, 0], [0, float("nan"), 0], [0, 0, 1]]),
+            r"inertia tensor\[1\]\[1\] is not finite",
+        ),
         (lambda: Inertia(1.0, (0, 0, 0), np.eye(3) * 1e200), r"inertia tensor\[0\]\[0\] is 1e\+200"),
         (lambda: Inertia(1.0, (0, 0, 0), np.eye(3) + 1j), r"inertia tensor\[0\]\[0\] must be a real number"),
         (lambda: Inertia(1.0, (0, 0, 0), np.eye(2)), r"inertia tensor must be 3x3"),
-        (lambda: Link("a", None, Joint("j"), np.diag([1, 1, 1, 1.0]) + np.pad([[0, 0, 0, 1e200]], ((0, 3), (0, 0)))),
-         r"placement of link 'a' has a translation larger in magnitude than 1e\+100"),
+        (
+            lambda: Link("a", None, Joint("j"), np.diag([1, 1, 1, 1.0]) + np.pad([[0, 0, 0, 1e200]], ((0, 3), (0, 0)))),
+            r"placement of link 'a' has a translation larger in magnitude than 1e\+100",
+        ),
         (lambda: Link("a", None, "revolute"), r"link 'a': joint must be a Joint"),
         (lambda: Link("a", None, Joint("j"), np.eye(4) * (1 + 0j)), r"placement of link 'a' must be real, got complex"),
         (lambda: kd.Robot.from_dh([(0, 0, 1j, 0)]), r"DH row 1: a must be a real number"),
@@ -356,8 +457,10 @@ def test_tiago_loads_with_a_warning_naming_the_link_and_eigenvalues():
     robot, caught = _warnings_of(lambda: kd.load(path))
     messages = [str(w.message) for w in caught]
     assert robot.n == 48 and len(messages) == 2, messages
-    assert messages[0].startswith(f"{path}:175: link 'base_antenna_left_link': inertia tensor is not positive semi-definite "
-                                  "(eigenvalues -3.53486e-08, 3.50085e-08, 9.08701e-08)")
+    assert messages[0].startswith(
+        f"{path}:175: link 'base_antenna_left_link': inertia tensor is not positive semi-definite "
+        "(eigenvalues -3.53486e-08, 3.50085e-08, 9.08701e-08)"
+    )
     assert "base_antenna_right_link" in messages[1]
     assert set(robot.nonphysical) == {"base_antenna_left_link", "base_antenna_right_link"}
     assert issubclass(kd.PhysicalConsistencyWarning, Warning)
@@ -368,13 +471,18 @@ def test_romeo_loads_with_warnings_naming_its_links():
     robot, caught = _warnings_of(lambda: kd.Robot.from_urdf(path))
     named = {re.match(rf"{re.escape(path)}:\d+: link '(\w+)': ", str(w.message)).group(1) for w in caught}
     assert {"body", "LHipPitch_link", "RHipPitch_link"} <= named == set(robot.nonphysical)
-    assert all("not positive semi-definite (eigenvalues" in str(w.message) or "triangle inequality" in str(w.message) for w in caught)
+    assert all(
+        "not positive semi-definite (eigenvalues" in str(w.message) or "triangle inequality" in str(w.message)
+        for w in caught
+    )
 
 
 @pytest.mark.parametrize("where", [TIAGO, ROMEO])
 def test_strict_raises_naming_file_line_and_link(where):
     path = erd(*where)
-    with pytest.raises(ValueError, match=rf"^{re.escape(path)}:\d+: link '\w+': inertia tensor is not positive semi-definite"):
+    with pytest.raises(
+        ValueError, match=rf"^{re.escape(path)}:\d+: link '\w+': inertia tensor is not positive semi-definite"
+    ):
         kd.Robot.from_urdf(path, inertia="strict")
 
 
@@ -412,7 +520,7 @@ def test_warned_robots_agree_with_pinocchio(where):
         out = pin.neutral(model)
         for j, x in zip(ids, q):
             joint = model.joints[j]
-            out[joint.idx_q:joint.idx_q + joint.nq] = [math.cos(x), math.sin(x)] if joint.nq == 2 else [x]
+            out[joint.idx_q : joint.idx_q + joint.nq] = [math.cos(x), math.sin(x)] if joint.nq == 2 else [x]
         return out
 
     def pin_v(v):
@@ -435,10 +543,14 @@ def test_the_three_routes_share_the_policy(tmp_path):
     """URDF, Python construction and the Robot keyword: same judgement, same messages."""
     bad = Inertia(1.0, (0, 0, 0), np.diag([-0.1, 1.0, 1.0]))
     link = Link("a", None, Joint("j", axis=(1, 0, 0)), inertia=bad)
-    with pytest.raises(ValueError, match=r"^link 'a': inertia tensor is not positive semi-definite \(eigenvalues -0.1, 1, 1\)"):
+    with pytest.raises(
+        ValueError, match=r"^link 'a': inertia tensor is not positive semi-definite \(eigenvalues -0.1, 1, 1\)"
+    ):
         kd.Robot([link], inertia="strict")
     robot, caught = _warnings_of(lambda: kd.Robot([link]))
-    assert len(caught) == 1 and str(caught[0].message).startswith("link 'a': inertia tensor is not positive semi-definite")
+    assert len(caught) == 1 and str(caught[0].message).startswith(
+        "link 'a': inertia tensor is not positive semi-definite"
+    )
     repaired, caught = _warnings_of(lambda: kd.Robot([link], inertia="repair"))
     assert len(caught) == 1 and repaired.links[0].inertia.consistency().ok
     assert repaired.replace(name="copy").links[0].inertia == repaired.links[0].inertia  # the policy is kept
@@ -450,7 +562,10 @@ def test_forward_dynamics_names_the_nonphysical_link():
         warnings.simplefilter("ignore", kd.PhysicalConsistencyWarning)
         robot = kd.Robot([Link("a", None, Joint("j", axis=(1, 0, 0)), inertia=bad)])
     for call in (lambda: robot.forward_dynamics([0.0], [0.0], [1.0]), lambda: robot.mass_matrix_inverse([0.0])):
-        with pytest.raises(RuntimeError, match=r"joint 0 \('j'.*(negative inertia about the axis|negative pivot, so M is indefinite).*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'"):
+        with pytest.raises(
+            RuntimeError,
+            match=r"joint 0 \('j'.*(negative inertia about the axis|negative pivot, so M is indefinite).*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'",
+        ):
             call()
     # repaired: second moments (1.05, -0.05, -0.05) clipped to (1.05, 0, 0): principal moments (0, 1.05, 1.05)
     with pytest.warns(kd.PhysicalConsistencyWarning, match="repaired"):
@@ -515,9 +630,31 @@ def test_projection_of_tiago_antenna():
 
 
 # ------------------------------------------------ mutated real URDFs: a robot or one clean ValueError
-TOKENS = ["nan", "inf", "-inf", "1e200", "1" * 400, "-1", "0", "x", "", "1 2", "1e-320", "&amp;", "<", '"',
-          "revolute", "fixed", "floating", "panda_link0", "\u00e9", "<link name='z'/>", "</robot>",
-          "<!DOCTYPE r [<!ENTITY a 'b'>]>", "<a>" * 200]
+TOKENS = [
+    "nan",
+    "inf",
+    "-inf",
+    "1e200",
+    "1" * 400,
+    "-1",
+    "0",
+    "x",
+    "",
+    "1 2",
+    "1e-320",
+    "&amp;",
+    "<",
+    '"',
+    "revolute",
+    "fixed",
+    "floating",
+    "panda_link0",
+    "\u00e9",
+    "<link name='z'/>",
+    "</robot>",
+    "<!DOCTYPE r [<!ENTITY a 'b'>]>",
+    "<a>" * 200,
+]
 
 
 @settings(max_examples=150, deadline=None)
@@ -531,14 +668,14 @@ def test_mutated_panda_loads_or_fails_with_one_clean_value_error(data):
             q = text.find('"', pos)
             q2 = text.find('"', q + 1)
             if q >= 0 and q2 >= 0:
-                text = text[:q + 1] + data.draw(st.sampled_from(TOKENS)) + text[q2:]
+                text = text[: q + 1] + data.draw(st.sampled_from(TOKENS)) + text[q2:]
         elif op == "insert":
             text = text[:pos] + data.draw(st.sampled_from(TOKENS)) + text[pos:]
         elif op == "delete":
-            text = text[:pos] + text[pos + data.draw(st.integers(1, 200)):]
+            text = text[:pos] + text[pos + data.draw(st.integers(1, 200)) :]
         else:
             start = data.draw(st.integers(0, len(text) - 1))
-            text = text[:pos] + text[start:start + data.draw(st.integers(1, 300))] + text[pos:]
+            text = text[:pos] + text[start : start + data.draw(st.integers(1, 300))] + text[pos:]
     began = time.perf_counter()
     try:
         with warnings.catch_warnings():
@@ -561,5 +698,8 @@ def test_a_simulation_stopped_by_a_nonphysical_body_names_it(method):
         robot = kd.Robot([Link("a", None, Joint("j", axis=(1, 0, 0)), inertia=bad)])
     from kinedyn.simulate.core import SimulationError
 
-    with pytest.raises(SimulationError, match=r"stopped at t = 0 s.*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'"):
+    with pytest.raises(
+        SimulationError,
+        match=r"stopped at t = 0 s.*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'",
+    ):
         kd.simulate(robot, 0.1, np.zeros(2), method=method)

@@ -99,7 +99,12 @@ def rod_arm_tau(th, thd, thdd, l1, l2, m1, m2, g):
     d22 = m2 * lc2**2 + I2
     h = -m2 * l1 * lc2 * s2
     C = np.array([[h * thd[1], h * (thd[0] + thd[1])], [-h * thd[0], 0.0]])
-    phi = np.array([(m1 * lc1 + m2 * l1) * g * math.cos(th[0]) + m2 * lc2 * g * math.cos(th[0] + th[1]), m2 * lc2 * g * math.cos(th[0] + th[1])])
+    phi = np.array(
+        [
+            (m1 * lc1 + m2 * l1) * g * math.cos(th[0]) + m2 * lc2 * g * math.cos(th[0] + th[1]),
+            m2 * lc2 * g * math.cos(th[0] + th[1]),
+        ]
+    )
     return np.array([[d11, d12], [d12, d22]]) @ thdd + C @ thd + phi
 
 
@@ -109,7 +114,19 @@ def test_q3_equations_of_motion_equal_spong(doc):
     for _ in range(4):
         th, thd, thdd = rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 2)
         l1, l2, m1, m2 = rng.uniform(0.5, 3, 4)
-        values = dict(th1=th[0], th2=th[1], thd1=thd[0], thd2=thd[1], thdd1=thdd[0], thdd2=thdd[1], l1=l1, l2=l2, m1=m1, m2=m2, g=9.81)
+        values = dict(
+            th1=th[0],
+            th2=th[1],
+            thd1=thd[0],
+            thd2=thd[1],
+            thdd1=thdd[0],
+            thdd2=thdd[1],
+            l1=l1,
+            l2=l2,
+            m1=m1,
+            m2=m2,
+            g=9.81,
+        )
         expected = rod_arm_tau(th, thd, thdd, l1, l2, m1, m2, 9.81)
         assert evaluate(res["tau1"], **values) == pytest.approx(expected[0], rel=1e-10)
         assert evaluate(res["tau2"], **values) == pytest.approx(expected[1], rel=1e-10)
@@ -142,7 +159,13 @@ def test_challenge_four_solutions_reach_the_target(doc):
     t = sols[0]
     c1, s1 = math.cos(t[0]), math.sin(t[0])
     r, z = L2 * math.cos(t[1]) + L3 * math.cos(t[1] + t[2]), L2 * math.sin(t[1]) + L3 * math.sin(t[1] + t[2])
-    Jv = np.array([[-s1 * r, -c1 * z, -L3 * c1 * math.sin(t[1] + t[2])], [c1 * r, -s1 * z, -L3 * s1 * math.sin(t[1] + t[2])], [0, r, L3 * math.cos(t[1] + t[2])]])
+    Jv = np.array(
+        [
+            [-s1 * r, -c1 * z, -L3 * c1 * math.sin(t[1] + t[2])],
+            [c1 * r, -s1 * z, -L3 * s1 * math.sin(t[1] + t[2])],
+            [0, r, L3 * math.cos(t[1] + t[2])],
+        ]
+    )
     np.testing.assert_allclose(np.array(res["jacobians"][0])[:3], Jv, atol=1e-12)
     np.testing.assert_allclose(np.array(res["jacobians"][0])[3:], [[0, s1, s1], [0, -c1, -c1], [1, 0, 0]], atol=1e-12)
     assert res["symbolic_vs_numeric_max_difference"] < 1e-12
@@ -214,4 +237,8 @@ def test_challenge_branch_labels_are_geometric(doc):
         q = rng.uniform(-math.pi, math.pi, 3)
         p = robot.pose(q)[:3, 3]
         for t in tutorial.elbow_ik(*p, L1, L2, L3):
-            assert tutorial.elbow_branch_name(robot, t) == _branch_by_hand(t, p, L1, L2) == _symbolic_name(t, p, L1, L2, L3)
+            assert (
+                tutorial.elbow_branch_name(robot, t)
+                == _branch_by_hand(t, p, L1, L2)
+                == _symbolic_name(t, p, L1, L2, L3)
+            )

@@ -8,11 +8,10 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
+from reference import PANDA, UR5, all_frame_poses, erd, frame_pose, joint_motion, pose, random_q, rpy
 
 import kinedyn as kd
 from kinedyn.description.urdf import robot_from_urdf
-from reference import PANDA, UR5, all_frame_poses, erd, frame_pose, joint_motion, pose, random_q, rpy
-
 
 # A small tree: base -> a (revolute) -> b (prismatic) -> tip (fixed); a -> side (continuous)
 TREE = """<?xml version="1.0"?>
@@ -155,7 +154,9 @@ def test_ur5_urdf_matches_raw_chain():
 
 def test_panda_nine_joints_lock_fingers():
     path = erd(*PANDA)
-    robot = robot_from_urdf(path, mimic="independent")  # the second finger a coordinate of its own (tests/test_mimic.py reduces it)
+    robot = robot_from_urdf(
+        path, mimic="independent"
+    )  # the second finger a coordinate of its own (tests/test_mimic.py reduces it)
     assert robot.n == 9
     assert robot.joint_names[:7] == [f"panda_joint{i}" for i in range(1, 8)]
     arm = robot.lock_joints({"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0})
@@ -194,7 +195,7 @@ def test_panda_inertias_agree_with_pinocchio():
     assert ours == pytest.approx(theirs)
     assert ours == pytest.approx(sum(masses.values()) - masses["panda_link0"])
     # body by body: mass, com and the 10 parameters in the joint frame
-    for i, body in enumerate(robot.tree.bodies):
+    for _i, body in enumerate(robot.tree.bodies):
         Y = model.inertias[model.getJointId(body.joint.name)]
         assert body.inertia.mass == pytest.approx(Y.mass)
         np.testing.assert_allclose(body.inertia.com, Y.lever, atol=1e-12)
@@ -257,7 +258,9 @@ def test_missing_child_link():
 
 
 def test_two_roots():
-    xml = _one_joint('<joint name="j" type="revolute"><parent link="base"/><child link="a"/></joint>', ("base", "a", "other"))
+    xml = _one_joint(
+        '<joint name="j" type="revolute"><parent link="base"/><child link="a"/></joint>', ("base", "a", "other")
+    )
     with pytest.raises(ValueError, match=r"several root links \['base', 'other'\]"):
         robot_from_urdf(xml)
 
@@ -292,7 +295,9 @@ def test_link_with_two_parents():
 
 
 def test_bad_numbers_and_inertia():
-    bad_origin = _one_joint('<joint name="j" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 x 0"/></joint>')
+    bad_origin = _one_joint(
+        '<joint name="j" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 x 0"/></joint>'
+    )
     with pytest.raises(ValueError, match=r"joint 'j' origin xyz must be 3 numbers"):
         robot_from_urdf(bad_origin)
     negative = TREE.replace('<mass value="1.5"/>', '<mass value="-1.5"/>')
@@ -307,11 +312,19 @@ def _gripper_urdf(tool_link: str, extra: str = "") -> str:  # extra: more XML in
     """A 2-joint arm whose hand carries a fixed `tool_link` and two sliding fingers (the longer chains)."""
     body = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
     links = ["base", "l1", "l2", tool_link, "finger_a", "finger_b"]
-    joints = [("j1", "revolute", "base", "l1"), ("j2", "revolute", "l1", "l2"), ("jt", "fixed", "l2", tool_link),
-              ("fa", "prismatic", "l2", "finger_a"), ("fb", "prismatic", "l2", "finger_b")]
+    joints = [
+        ("j1", "revolute", "base", "l1"),
+        ("j2", "revolute", "l1", "l2"),
+        ("jt", "fixed", "l2", tool_link),
+        ("fa", "prismatic", "l2", "finger_a"),
+        ("fb", "prismatic", "l2", "finger_b"),
+    ]
     xml = "".join(f'<link name="{n}">{body}</link>' for n in links) + extra
-    xml += "".join(f'<joint name="{j}" type="{k}"><parent link="{p}"/><child link="{c}"/><origin xyz="0 0 0.1"/>'
-                   f'<axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>' for j, k, p, c in joints)
+    xml += "".join(
+        f'<joint name="{j}" type="{k}"><parent link="{p}"/><child link="{c}"/><origin xyz="0 0 0.1"/>'
+        f'<axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>'
+        for j, k, p, c in joints
+    )
     return f'<robot name="gripper">{xml}</robot>'
 
 
@@ -325,7 +338,9 @@ def test_default_tool_prefers_a_named_tool_over_a_finger(tool_link):
 def test_default_tool_without_a_tool_name_is_the_end_of_the_longest_chain():
     assert robot_from_urdf(_gripper_urdf("wrist_plate")).tool == "finger_b"  # two chains of 3: the later one
     # a better-ranked name wins over a worse-ranked one (a *_tcp over a *_hand), wherever it is in the file
-    hand = '<link name="panda_hand"/><joint name="jh" type="fixed"><parent link="l2"/><child link="panda_hand"/></joint>'
+    hand = (
+        '<link name="panda_hand"/><joint name="jh" type="fixed"><parent link="l2"/><child link="panda_hand"/></joint>'
+    )
     assert robot_from_urdf(_gripper_urdf("panda_hand_tcp", hand)).tool == "panda_hand_tcp"
     assert robot_from_urdf(_gripper_urdf("wrist_plate", hand)).tool == "panda_hand"
 

@@ -9,19 +9,18 @@ import io
 import os
 import socket
 import time
-import warnings
 
 import numpy as np
 import pytest
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
+from reference import PANDA, UR5, erd  # noqa: E402
+
 import kinedyn as kd  # noqa: E402
 from kinedyn.description.geometry import Box, Cylinder, Mesh, MeshNotFound, Sphere, resolve_mesh  # noqa: E402
 from kinedyn.report.html import default_configuration  # noqa: E402
 from kinedyn.visual import MissingMeshWarning, robot_scene  # noqa: E402
-
-from reference import PANDA, UR5, erd  # noqa: E402
 
 trimesh = pytest.importorskip("trimesh", reason="the viz extra is not installed")
 
@@ -83,16 +82,21 @@ def test_urdf_visuals_materials_origins_and_collisions(mesh_folder):
     assert robot_scene(robot, "collision").drawn == 1
 
 
-@pytest.mark.parametrize("xml, message", [
-    ('<box size="0.1 -1 0.1"/>', "<box> needs size with 3 positive numbers"),
-    ('<cylinder radius="0.1"/>', "has no 'length' attribute"),
-    ('<mesh/>', "<mesh> needs a filename"),
-    ('<mesh filename="a.stl" scale="1 0 1"/>', "scale may not hold 0"),
-    ('<cone/>', "holds none of"),
-])
+@pytest.mark.parametrize(
+    "xml, message",
+    [
+        ('<box size="0.1 -1 0.1"/>', "<box> needs size with 3 positive numbers"),
+        ('<cylinder radius="0.1"/>', "has no 'length' attribute"),
+        ("<mesh/>", "<mesh> needs a filename"),
+        ('<mesh filename="a.stl" scale="1 0 1"/>', "scale may not hold 0"),
+        ("<cone/>", "holds none of"),
+    ],
+)
 def test_bad_visuals_name_file_line_and_link(xml, message):
-    text = f'<robot name="r">\n<link name="a"/>\n<link name="b"><visual><geometry>{xml}</geometry></visual></link>\n' \
-           '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="-1" upper="1"/></joint></robot>'
+    text = (
+        f'<robot name="r">\n<link name="a"/>\n<link name="b"><visual><geometry>{xml}</geometry></visual></link>\n'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="-1" upper="1"/></joint></robot>'
+    )
     with pytest.raises(ValueError, match=message) as e:
         kd.Robot.from_urdf(text)
     assert "<URDF string>:3" in str(e.value) and "link 'b'" in str(e.value)
@@ -107,7 +111,9 @@ def test_mesh_paths_resolve_in_order_and_stay_inside(mesh_folder, monkeypatch):
     elsewhere.mkdir(parents=True)
     (elsewhere / "cube.stl").write_bytes(cube.read_bytes())
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(mesh_folder / "ros"))
-    assert resolve_mesh("package://pkg/meshes/cube.stl", base).resolve() == (elsewhere / "cube.stl").resolve()  # ROS_PACKAGE_PATH first
+    assert (
+        resolve_mesh("package://pkg/meshes/cube.stl", base).resolve() == (elsewhere / "cube.stl").resolve()
+    )  # ROS_PACKAGE_PATH first
     # relative: the URDF's folder, then its parents
     assert resolve_mesh("meshes/cube.stl", base).resolve() == cube
     # a package path may not climb out of its package; a file that is not a mesh is never read
@@ -169,7 +175,9 @@ def test_robots_without_meshes_get_solid_links():
     assert any(abs(s[0] - 0.4318) < 1e-3 and s[1] < 0.1 for s in spans), spans
     # link 3 (d3 = 0.15005, a3 = 0.0203): one cylinder along d (z of frame 2: y of link 3's frame),
     # then one along a (x of link 3's frame), not a slanted bar between the joints
-    spans = [np.ptp(p.part.vertices, axis=0) for p in robot_scene(puma).parts if p.frame == "link3" and p.part.rgba[0] < 0.9]
+    spans = [
+        np.ptp(p.part.vertices, axis=0) for p in robot_scene(puma).parts if p.frame == "link3" and p.part.rgba[0] < 0.9
+    ]
     assert any(abs(s[1] - 0.15005) < 1e-3 for s in spans) and any(abs(s[0] - 0.0203) < 1e-3 for s in spans), spans
 
 
@@ -352,7 +360,12 @@ def test_view_command(capsys):
     pytest.importorskip("viser", reason="the viz extra is not installed")
     from kinedyn.cli import main
 
-    assert main(["view", "puma560", "--q", "0", "30", "0", "0", "0", "0", "--deg", "--no-wait", "--port", str(free_port())]) == 0
+    assert (
+        main(
+            ["view", "puma560", "--q", "0", "30", "0", "0", "0", "0", "--deg", "--no-wait", "--port", str(free_port())]
+        )
+        == 0
+    )
     assert "http://localhost:" in capsys.readouterr().out
 
 
@@ -370,8 +383,13 @@ def test_html_animations_are_offline(tmp_path, browser):
     page = path.read_text()
     assert 'id="kinedyn-model"' in page and page.count('"vertices"') == len(model_block(page)["meshes"])
     assert model_block(page)["shapes_drawn"] == len(robot.visuals)
-    pendulum = MechanicalSystem(1, lambda q: np.eye(1), lambda q, qd: np.array([9.81 * np.sin(q[0])]),
-                                points=lambda q: np.array([[0.0, 0.0], [np.sin(q[0]), -np.cos(q[0])]]), name="pendulum")
+    pendulum = MechanicalSystem(
+        1,
+        lambda q: np.eye(1),
+        lambda q, qd: np.array([9.81 * np.sin(q[0])]),
+        points=lambda q: np.array([[0.0, 0.0], [np.sin(q[0]), -np.cos(q[0])]]),
+        name="pendulum",
+    )
     swing = kd.simulate.simulate(pendulum, (0.0, 0.2), np.array([0.5, 0.0]), dt=1e-2)
     other = swing.animate(tmp_path / "pendulum.html", fps=10).read_text()
     assert "font-awesome" not in other and "<link" not in other and "\u25b6" in other
@@ -413,7 +431,10 @@ visuals:
     again = kd.load(tmp_path / "again.yaml")
     assert len(again.visuals) == 3 and robot_scene(again).drawn == 3
     text = (tmp_path / "arm.yaml").read_text()
-    for bad, message in [("box: [0.5, 0.08, 0.08]", "visuals\\[0\\].*exactly one of"), ("link: link2", "names links \\['nope'\\]")]:
+    for bad, message in [
+        ("box: [0.5, 0.08, 0.08]", "visuals\\[0\\].*exactly one of"),
+        ("link: link2", "names links \\['nope'\\]"),
+    ]:
         (tmp_path / "bad.yaml").write_text(text.replace(bad, bad + ", sphere: 1" if "box" in bad else "link: nope"))
         with pytest.raises(ValueError, match=message):
             kd.load(tmp_path / "bad.yaml")

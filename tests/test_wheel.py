@@ -95,7 +95,9 @@ def _see_host_packages(env_dir: Path) -> None:
     folders = [f for f in dict.fromkeys(folders) if Path(f).is_dir()]
     purelib = subprocess.run(
         [str(env_dir / "bin" / "python"), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-        check=True, capture_output=True, text=True,
+        check=True,
+        capture_output=True,
+        text=True,
     ).stdout.strip()
     lines = [f"import site; site.addsitedir({f!r})" for f in folders]
     (Path(purelib) / "_kinedyn_test_host_packages.pth").write_text("\n".join(lines) + "\n")
@@ -118,10 +120,28 @@ def venv(tmp_path_factory):
     path = os.pathsep.join([str(bin_dir), "/usr/bin", "/bin"])
     for tool in ("cargo", "rustc", "maturin"):
         assert shutil.which(tool, path=path) is None, f"{tool} is on the test PATH {path}"
-    env = {"PATH": path, "HOME": str(home), "LANG": "C.UTF-8", "MPLBACKEND": "Agg", "PIP_DISABLE_PIP_VERSION_CHECK": "1"}
+    env = {
+        "PATH": path,
+        "HOME": str(home),
+        "LANG": "C.UTF-8",
+        "MPLBACKEND": "Agg",
+        "PIP_DISABLE_PIP_VERSION_CHECK": "1",
+    }
     subprocess.run(
-        [str(bin_dir / "python"), "-m", "pip", "install", "--quiet", "--no-index", "--no-deps", "--ignore-installed", str(wheel)],
-        check=True, cwd=home, env=env,
+        [
+            str(bin_dir / "python"),
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-index",
+            "--no-deps",
+            "--ignore-installed",
+            str(wheel),
+        ],
+        check=True,
+        cwd=home,
+        env=env,
     )
     return env_dir, env, home
 

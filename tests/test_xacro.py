@@ -61,9 +61,12 @@ def arm_urdf(length: float, prefix: str, meshes: Path) -> str:
     <limit lower="{-np.pi / 2}" upper="{np.pi / 2}" effort="10" velocity="2"/>
   </joint>"""
 
-    return (f'<robot name="xarm"><link name="{prefix}base"/>'
-            + segment("upper", "base", "0 0 1", f'<origin xyz="0 0 0.1" rpy="0 0 {np.radians(30)}"/>')
-            + segment("lower", "upper", "0 1 0", f'<origin xyz="{length} 0 0"/>') + "</robot>")
+    return (
+        f'<robot name="xarm"><link name="{prefix}base"/>'
+        + segment("upper", "base", "0 0 1", f'<origin xyz="0 0 0.1" rpy="0 0 {np.radians(30)}"/>')
+        + segment("lower", "upper", "0 1 0", f'<origin xyz="{length} 0 0"/>')
+        + "</robot>"
+    )
 
 
 @pytest.fixture
@@ -80,7 +83,9 @@ def package(tmp_path):
 def assert_same_robot(a, b, seed: int = 0):
     assert a.joint_names == b.joint_names and a.frame_names == b.frame_names
     assert [j.kind for j in a.joints] == [j.kind for j in b.joints]
-    np.testing.assert_allclose([(*j.axis, j.lower, j.upper) for j in a.joints], [(*j.axis, j.lower, j.upper) for j in b.joints], atol=1e-12)
+    np.testing.assert_allclose(
+        [(*j.axis, j.lower, j.upper) for j in a.joints], [(*j.axis, j.lower, j.upper) for j in b.joints], atol=1e-12
+    )
     rng = np.random.default_rng(seed)
     for _ in range(3):
         q, qd = rng.uniform(-1, 1, a.n), rng.normal(size=a.n)
@@ -93,7 +98,9 @@ def assert_same_robot(a, b, seed: int = 0):
 def test_xacro_with_args_macros_and_find_is_the_urdf_written_out(package, args):
     share, path = package
     robot = kd.Robot.from_urdf(path, xacro_args=args, trust_xacro=True, package_dirs=[share])
-    expected = kd.Robot.from_urdf(arm_urdf(float(args.get("length", 0.5)), args.get("prefix", ""), share / "arm_description" / "meshes"))
+    expected = kd.Robot.from_urdf(
+        arm_urdf(float(args.get("length", 0.5)), args.get("prefix", ""), share / "arm_description" / "meshes")
+    )
     assert robot.joint_names == [args.get("prefix", "") + n for n in ("upper_joint", "lower_joint")]
     assert_same_robot(robot, expected)
     # $(find arm_description) found the package in package_dirs; the file names the source
@@ -106,14 +113,18 @@ def test_xacro_with_args_macros_and_find_is_the_urdf_written_out(package, args):
 def test_find_without_the_package_is_a_clear_error(package, monkeypatch):
     _, path = package
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
-    with pytest.raises(ValueError, match=r"arm\.urdf\.xacro: xacro could not expand the file: .*package 'arm_description' not found"):
+    with pytest.raises(
+        ValueError, match=r"arm\.urdf\.xacro: xacro could not expand the file: .*package 'arm_description' not found"
+    ):
         kd.Robot.from_urdf(path, trust_xacro=True)
 
 
 def test_errors_in_the_expanded_urdf_name_the_xacro_file(tmp_path):
     path = tmp_path / "bad.urdf.xacro"
-    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n<link name="a"/>\n'
-                    '<joint name="j" type="revolute"><parent link="a"/><child link="missing"/></joint></robot>')
+    path.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n<link name="a"/>\n'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="missing"/></joint></robot>'
+    )
     with pytest.raises(ValueError, match=r"bad\.urdf\.xacro:\d+: joint 'j' names child link 'missing'"):
         kd.load(path, trust_xacro=True)
     with pytest.raises(ValueError, match=r"xacro argument name 'a b' is not a name"):
@@ -136,7 +147,9 @@ def test_a_xacro_file_is_refused_without_trust_and_its_code_does_not_run(tmp_pat
     path = tmp_path / "evil.urdf.xacro"
     path.write_text(EVIL_XACRO.replace("MARKER", str(marker)))
     for load in (lambda: kd.Robot.from_urdf(path), lambda: kd.load(path), lambda: kd.load(path, trust_xacro="yes")):
-        with pytest.raises(ValueError, match=r"evil\.urdf\.xacro: expanding xacro runs the file's Python expressions.*trust_xacro=True"):
+        with pytest.raises(
+            ValueError, match=r"evil\.urdf\.xacro: expanding xacro runs the file's Python expressions.*trust_xacro=True"
+        ):
             load()
     assert not marker.exists()
 
@@ -154,8 +167,13 @@ def test_the_refusal_is_needed_a_trusted_xacro_file_runs_code(tmp_path):
 def test_the_cli_refuses_xacro_without_trust_and_passes_xacro_args(package):
     share, path = package
     env = {**os.environ, "PYTHONPATH": str(Path(kd.__file__).parents[1]), "ROS_PACKAGE_PATH": str(share)}
-    run = lambda *extra: subprocess.run([sys.executable, "-m", "kinedyn", "info", str(path), "--json", *extra],
-                                        capture_output=True, text=True, env=env, timeout=120)
+    run = lambda *extra: subprocess.run(
+        [sys.executable, "-m", "kinedyn", "info", str(path), "--json", *extra],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     refused = run()
     assert refused.returncode == 1 and "--trust-xacro" in refused.stderr and "can run any code" in refused.stderr
     done = run("--trust-xacro", "--xacro-arg", "prefix:=right_", "--xacro-arg", "length:=0.7")

@@ -47,7 +47,11 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
 
     urdf = name.removesuffix("_fixed")
     # every joint its own coordinate, as Pinocchio builds the file (mimic="independent")
-    robot = without_friction(kd.Robot.from_urdf(str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name, mimic="independent"))
+    robot = without_friction(
+        kd.Robot.from_urdf(
+            str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name, mimic="independent"
+        )
+    )
     if np.any(np.asarray(robot.armature) != 0):
         raise SystemExit(f"{name}: the harnesses leave rotor inertia (armature) out; this robot has some")
     bodies = robot.tree.bodies
@@ -55,13 +59,26 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
     for body in bodies:
         j = body.joint
         if j.kind not in KINDS:
-            raise SystemExit(f"{name}: joint '{j.name}' of kind {j.kind}: the harnesses build free, revolute and prismatic joints only")
+            raise SystemExit(
+                f"{name}: joint '{j.name}' of kind {j.kind}: the harnesses build free, revolute and prismatic joints only"
+            )
         T = np.asarray(body.placement, dtype=float)
         inertia = body.inertia
-        lines.append(" ".join([
-            "body", str(body.parent), KINDS[j.kind], fmt(j.axis), fmt(T[:3, :3]), fmt(T[:3, 3]),
-            fmt([inertia.mass]), fmt(np.asarray(inertia.com, dtype=float)), fmt(np.asarray(inertia.inertia, dtype=float)),
-        ]))
+        lines.append(
+            " ".join(
+                [
+                    "body",
+                    str(body.parent),
+                    KINDS[j.kind],
+                    fmt(j.axis),
+                    fmt(T[:3, :3]),
+                    fmt(T[:3, 3]),
+                    fmt([inertia.mass]),
+                    fmt(np.asarray(inertia.com, dtype=float)),
+                    fmt(np.asarray(inertia.inertia, dtype=float)),
+                ]
+            )
+        )
     q, v, a = random_state(robot, np.random.default_rng(seed))
     lines += [f"q {fmt(q)}", f"v {fmt(v)}", f"a {fmt(a)}", f"expect_rnea {fmt(robot.inverse_dynamics(q, v, a))}"]
     path.write_text("\n".join(lines) + "\n")

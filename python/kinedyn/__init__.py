@@ -4,17 +4,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ._core import NonFiniteResultError
-from ._core import simd  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
+from . import robots
+from ._core import (
+    NonFiniteResultError,
+    simd,  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
+)
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 from .scale import sweep  # configuration-space sweeps into Zarr on a dask scheduler (docs/scale.md)
-from . import robots
+
 if TYPE_CHECKING:
     # what type checkers and IDEs see: kd.simulate is the function and still holds the package's
     # names (kd.simulate.PD); the lazily loaded submodules are the modules themselves
-    from . import analysis, configuration, dynamics, ik, kinematics, symbolic, testing
+    from . import analysis, configuration, dynamics, ik, kinematics, symbolic, testing  # noqa: F401
     from ._typing import PathLike
     from .simulate._callable import simulate
 else:
@@ -46,6 +49,21 @@ def load(path: PathLike, **kwargs) -> Robot:
 
 
 __all__ = [
-    "Robot", "Inertia", "Joint", "Link", "Frame", "DHRow", "load", "robots", "LagrangianSystem", "simulate",
-    "Trajectory", "sweep", "PhysicalConsistencyWarning", "NonFiniteResultError", "simd", "__version__", *_SUBMODULES,
+    "Robot",
+    "Inertia",
+    "Joint",
+    "Link",
+    "Frame",
+    "DHRow",
+    "load",
+    "robots",
+    "LagrangianSystem",
+    "simulate",
+    "Trajectory",
+    "sweep",
+    "PhysicalConsistencyWarning",
+    "NonFiniteResultError",
+    "simd",
+    "__version__",
+    *_SUBMODULES,
 ]

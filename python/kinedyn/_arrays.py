@@ -33,7 +33,11 @@ def real_array(x, name: str) -> np.ndarray:
     except OverflowError:  # a Python integer beyond float64 (and int64)
         raise ValueError(f"{name} holds an integer too large for float64") from None
     if a.dtype.kind not in _REAL_KINDS:
-        what = "complex numbers (the imaginary part would be lost)" if a.dtype.kind == "c" else f"an array of dtype {a.dtype}"
+        what = (
+            "complex numbers (the imaginary part would be lost)"
+            if a.dtype.kind == "c"
+            else f"an array of dtype {a.dtype}"
+        )
         raise TypeError(f"{name} must be real numbers, got {what}")
     try:
         return np.ascontiguousarray(a, dtype=np.float64)
@@ -49,7 +53,11 @@ def finite_result(x, what: str, batch_axes: int = 0):
     a = np.asarray(x)
     if a.dtype.kind in "fc" and not np.isfinite(a).all():
         bad = np.argwhere(~np.isfinite(a))[0]
-        at = f" at state {tuple(int(i) for i in bad[:batch_axes]) if batch_axes > 1 else int(bad[0])} of the batch" if batch_axes and a.ndim >= batch_axes else ""
+        at = (
+            f" at state {tuple(int(i) for i in bad[:batch_axes]) if batch_axes > 1 else int(bad[0])} of the batch"
+            if batch_axes and a.ndim >= batch_axes
+            else ""
+        )
         element = f"{what}[{', '.join(str(int(i)) for i in bad[batch_axes:])}]" if a.ndim > batch_axes else what
         raise NonFiniteResultError(
             f"{element} is {a[tuple(bad)]}{at}, although every input is finite: the computation overflowed float64; "
@@ -66,7 +74,9 @@ def whole_number(value, name: str, low: int = 0, high: int = 2**31 - 1) -> int:
     try:
         v = operator.index(value)
     except TypeError:
-        raise ValueError(f"{name} must be a whole number in [{low}, {high}], got {value!r} ({type(value).__name__})") from None
+        raise ValueError(
+            f"{name} must be a whole number in [{low}, {high}], got {value!r} ({type(value).__name__})"
+        ) from None
     if not low <= v <= high:
         raise ValueError(f"{name} must be a whole number in [{low}, {high}], got {v}")
     return v

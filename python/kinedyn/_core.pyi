@@ -10,7 +10,8 @@ Batches run in a thread pool rebuilt in a forked child, so they work after ``for
 ``reference``: 0 = "world" (LOCAL_WORLD_ALIGNED), 1 = "local", 2 = "spatial" (WORLD).
 """
 
-from typing import Any, Callable, Optional, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,8 +34,9 @@ class Model:
         gravity: F64,  # (3,) in base coordinates
         frame_body: I64,  # (nf,) body of each named frame, -1 = base
         frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
-        coulomb_negative: Optional[F64] = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
-        blocks: Optional[I64] = None,  # (n,) 0 a 1-DOF joint; 1/2/3 head of a free-flyer/spherical/planar joint; -1 its further bodies
+        coulomb_negative: F64 | None = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
+        blocks: I64
+        | None = None,  # (n,) 0 a 1-DOF joint; 1/2/3 head of a free-flyer/spherical/planar joint; -1 its further bodies
     ) -> None: ...
     @property
     def n(self) -> int: ...  # bodies = degrees of freedom (nv)
@@ -44,26 +46,40 @@ class Model:
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
-    def jacobian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6, n) | (N, 6, n)
-    def jacobian_hessian(self, q: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (n, 6, n) | (N, n, 6, n), H[i, r, j] = dJ[r, j]/dq_i
-    def frame_velocity(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
-    def jdot_qd(self, q: F64, qd: F64, frame: int, reference: int, point: Optional[F64] = None) -> F64: ...  # (6,) | (N, 6)
+    def jacobian(self, q: F64, frame: int, reference: int, point: F64 | None = None) -> F64: ...  # (6, n) | (N, 6, n)
+    def jacobian_hessian(
+        self, q: F64, frame: int, reference: int, point: F64 | None = None
+    ) -> F64: ...  # (n, 6, n) | (N, n, 6, n), H[i, r, j] = dJ[r, j]/dq_i
+    def frame_velocity(
+        self, q: F64, qd: F64, frame: int, reference: int, point: F64 | None = None
+    ) -> F64: ...  # (6,) | (N, 6)
+    def jdot_qd(
+        self, q: F64, qd: F64, frame: int, reference: int, point: F64 | None = None
+    ) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----
     # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the body origin.
     # A singular mass matrix (forward_dynamics, mass_matrix_inverse) raises RuntimeError naming the joint.
-    def inverse_dynamics(self, q: F64, qd: F64, qdd: F64, f_ext: Optional[F64] = None, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
-    def mass_matrix(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
-    def mass_matrix_inverse(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
-    def forward_dynamics(self, q: F64, qd: F64, tau: F64, f_ext: Optional[F64] = None, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
-    def coriolis_matrix(self, q: F64, qd: F64, out: Optional[F64] = None) -> F64: ...  # (n, n) | (N, n, n)
+    def inverse_dynamics(
+        self, q: F64, qd: F64, qdd: F64, f_ext: F64 | None = None, out: F64 | None = None
+    ) -> F64: ...  # (n,) | (N, n)
+    def mass_matrix(self, q: F64, out: F64 | None = None) -> F64: ...  # (n, n) | (N, n, n)
+    def mass_matrix_inverse(self, q: F64, out: F64 | None = None) -> F64: ...  # (n, n) | (N, n, n)
+    def forward_dynamics(
+        self, q: F64, qd: F64, tau: F64, f_ext: F64 | None = None, out: F64 | None = None
+    ) -> F64: ...  # (n,) | (N, n)
+    def coriolis_matrix(self, q: F64, qd: F64, out: F64 | None = None) -> F64: ...  # (n, n) | (N, n, n)
     def christoffel(self, q: F64) -> F64: ...  # (n, n, n) | (N, n, n, n), c[i, j, k]
-    def gravity_torque(self, q: F64, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n)
-    def bias_torque(self, q: F64, qd: F64, out: Optional[F64] = None) -> F64: ...  # (n,) | (N, n), C qd + g
+    def gravity_torque(self, q: F64, out: F64 | None = None) -> F64: ...  # (n,) | (N, n)
+    def bias_torque(self, q: F64, qd: F64, out: F64 | None = None) -> F64: ...  # (n,) | (N, n), C qd + g
     def kinetic_energy(self, q: F64, qd: F64) -> F64: ...  # () | (N,)
     def potential_energy(self, q: F64) -> F64: ...  # () | (N,)
-    def inverse_dynamics_derivatives(self, q: F64, qd: F64, qdd: F64, f_ext: Optional[F64] = None) -> tuple[F64, F64, F64]: ...
+    def inverse_dynamics_derivatives(
+        self, q: F64, qd: F64, qdd: F64, f_ext: F64 | None = None
+    ) -> tuple[F64, F64, F64]: ...
     # (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA
-    def forward_dynamics_derivatives(self, q: F64, qd: F64, tau: F64, f_ext: Optional[F64] = None) -> tuple[F64, F64, F64]: ...
+    def forward_dynamics_derivatives(
+        self, q: F64, qd: F64, tau: F64, f_ext: F64 | None = None
+    ) -> tuple[F64, F64, F64]: ...
     # (dqdd/dq, dqdd/dqd, M^-1), each (n, n) | (N, n, n): derivatives of the ABA
     def regressor(self, q: F64, qd: F64, qdd: F64) -> F64: ...  # (n, 10 n) | (N, n, 10 n)
     def center_of_mass(self, q: F64) -> F64: ...  # (3,) | (N, 3)
@@ -74,7 +90,6 @@ class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""
 
 def simd() -> tuple[str, int]: ...  # (kind, states per block) of batches: "avx512" | "avx2" | "portable" | "off"
-
 def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
     """TEST-ONLY: panics inside a guarded binding (on a batch worker thread if ``in_worker``), to
     check that a panic reaches Python as a RuntimeError."""
@@ -101,22 +116,28 @@ def solve_ik(
     seed: int = 0,
     first_index: int = 0,  # index of targets[0] in the whole batch (each target's random restarts follow from seed and its index)
     # reduced mimic coordinates: (q_source (nq_full,), q_multiplier, q_offset, v_source (nv_full,), v_multiplier, q_keep (nq,), nv)
-    reduction: Optional[tuple[list[int], list[float], list[float], list[int], list[float], list[int], int]] = None,
-) -> tuple[Any, Any, Any, Any, Any]: ...  # (q, success, position_error, orientation_error, iterations), leading N for a batch
+    reduction: tuple[list[int], list[float], list[float], list[int], list[float], list[int], int] | None = None,
+) -> tuple[
+    Any, Any, Any, Any, Any
+]: ...  # (q, success, position_error, orientation_error, iterations), leading N for a batch
 
 class AnalyticIk:
     """A closed-form solver detected from a model's geometry (None from ``detect`` when there is none)."""
     @staticmethod
-    def detect(model: Model, frame: int, lower: F64, upper: F64) -> Optional[AnalyticIk]: ...
+    def detect(model: Model, frame: int, lower: F64, upper: F64) -> AnalyticIk | None: ...
     @property
     def structure(self) -> str: ...  # e.g. "spherical_wrist"
     @property
-    def arm(self) -> Optional[str]: ...  # the arm of a spherical-wrist chain
+    def arm(self) -> str | None: ...  # the arm of a spherical-wrist chain
     @property
     def solves_position(self) -> bool: ...  # whether (3,) position targets have a closed form
-    def solve(self, target: F64, reference: F64, respect_limits: bool = True, tolerance: float = 1e-09) -> tuple[F64, F64, F64, int, bool]: ...
+    def solve(
+        self, target: F64, reference: F64, respect_limits: bool = True, tolerance: float = 1e-09
+    ) -> tuple[F64, F64, F64, int, bool]: ...
     # (solutions (m, n) nearest reference first, position errors (m,), orientation errors (m,), found before the limit filter, singular)
-    def solve_nearest(self, targets: F64, references: F64, respect_limits: bool = True, tolerance: float = 1e-09) -> tuple[F64, NDArray[np.bool_], F64, F64]: ...
+    def solve_nearest(
+        self, targets: F64, references: F64, respect_limits: bool = True, tolerance: float = 1e-09
+    ) -> tuple[F64, NDArray[np.bool_], F64, F64]: ...
     # (q (N, n), success (N,), position errors (N,), orientation errors (N,)); q is NaN where no solution exists
 
 # ---- fixed-step integration (crates/kinedyn-py/src/simulate.rs) ----
@@ -130,13 +151,13 @@ def integrate_fixed(
     t0: float,
     dt: float,
     steps: int,
-    tau: Optional[F64] = None,  # None, (S, n) or (N, S, n)
+    tau: F64 | None = None,  # None, (S, n) or (N, S, n)
     linear: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
-    lower: Optional[F64] = None,  # (n,) joint position limits: inelastic stops when given
-    upper: Optional[F64] = None,
-) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
+    lower: F64 | None = None,  # (n,) joint position limits: inelastic stops when given
+    upper: F64 | None = None,
+) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
 def integrate_callback(
     model: Model,
     method_name: str,
@@ -149,7 +170,8 @@ def integrate_callback(
     hold: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
-    jacobian: Optional[Callable[[int, float, F64, F64], Any]] = None,  # (step, t, q, qd) -> (dtau/dq, dtau/dqd) (n, n) each, or None
-    lower: Optional[F64] = None,
-    upper: Optional[F64] = None,
-) -> tuple[F64, F64, F64, F64, I64, list[Optional[dict[str, Any]]]]: ...
+    jacobian: Callable[[int, float, F64, F64], Any]
+    | None = None,  # (step, t, q, qd) -> (dtau/dq, dtau/dqd) (n, n) each, or None
+    lower: F64 | None = None,
+    upper: F64 | None = None,
+) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...

@@ -21,7 +21,8 @@ import os
 import pickle
 import sys
 import threading
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, TypeVar
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -33,7 +34,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 __all__ = ["batched", "is_dask_array", "process_cache_info"]
 
 
-def _dask_array_type() -> Optional[type]:
+def _dask_array_type() -> type | None:
     """``dask.array.Array`` if dask.array was imported by someone, else None (never imports it)."""
     module = sys.modules.get("dask.array")
     return getattr(module, "Array", None) if module is not None else None
@@ -46,12 +47,12 @@ def is_dask_array(x: Any) -> bool:
 
 
 # ------------------------------------------------------------------ the per-process robot cache
-_CACHE: dict[str, "Robot"] = {}
+_CACHE: dict[str, Robot] = {}
 _CACHE_LOCK = threading.Lock()
 _UNPICKLED: dict[str, int] = {}  # digest -> how many times this process unpickled the description
 
 
-def _robot_from_cache(digest: str, payload: bytes) -> "_RobotByContent":
+def _robot_from_cache(digest: str, payload: bytes) -> _RobotByContent:
     """Unpickling side of :class:`_RobotByContent`: the robot of this process for ``digest``."""
     with _CACHE_LOCK:
         robot = _CACHE.get(digest)
@@ -79,11 +80,11 @@ class _RobotByContent:
 
     __slots__ = ("robot", "digest", "payload")
 
-    def __init__(self, robot: "Robot", digest: str, payload: bytes):
+    def __init__(self, robot: Robot, digest: str, payload: bytes):
         self.robot, self.digest, self.payload = robot, digest, payload
 
     @classmethod
-    def of(cls, robot: "Robot") -> "_RobotByContent":
+    def of(cls, robot: Robot) -> _RobotByContent:
         payload = pickle.dumps(robot, protocol=pickle.HIGHEST_PROTOCOL)
         return cls(robot, hashlib.sha256(payload).hexdigest(), payload)
 
@@ -118,7 +119,9 @@ def batched(*state_args: str) -> Callable[[F], F]:
     def decorate(method: F) -> F:
         signature = inspect.signature(method)
         parameters = list(signature.parameters.values())
-        if any(p.kind is not p.POSITIONAL_OR_KEYWORD for p in parameters) or not set(state_args) <= set(signature.parameters):
+        if any(p.kind is not p.POSITIONAL_OR_KEYWORD for p in parameters) or not set(state_args) <= set(
+            signature.parameters
+        ):
             raise TypeError(f"batched: {method.__name__} must take plain parameters including {state_args}")
         defaults = {f"_default_{p.name}": p.default for p in parameters if p.default is not p.empty}
         header = ", ".join(p.name if p.default is p.empty else f"{p.name}=_default_{p.name}" for p in parameters)
@@ -130,8 +133,16 @@ def batched(*state_args: str) -> Callable[[F], F]:
             f"        return _lazy_call(_method, _signature, _state_args, {parameters[0].name}, ({names}{',' if len(parameters) == 2 else ''}), {{}})\n"
             f"    return _method({parameters[0].name}, {names})\n"
         )
-        namespace = {"_DASK_ARRAY": _DASK_ARRAY, "_MODULES": _MODULES, "_any_dask": _any_dask, "_lazy_call": _lazy_call,
-                     "_method": method, "_signature": signature, "_state_args": state_args, **defaults}
+        namespace = {
+            "_DASK_ARRAY": _DASK_ARRAY,
+            "_MODULES": _MODULES,
+            "_any_dask": _any_dask,
+            "_lazy_call": _lazy_call,
+            "_method": method,
+            "_signature": signature,
+            "_state_args": state_args,
+            **defaults,
+        }
         exec(compile(source, f"<kinedyn._dask.batched {method.__name__}>", "exec"), namespace)
         wrapper = functools.wraps(method)(namespace[method.__name__])
         wrapper.__kinedyn_batched__ = state_args  # type: ignore[attr-defined]
@@ -155,7 +166,7 @@ def _check_chunks(name: str, x) -> None:
             )
 
 
-def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], robot: "Robot", args, kwargs):
+def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], robot: Robot, args, kwargs):
     import dask.array as da
 
     bound = signature.bind(robot, *args, **kwargs)
@@ -169,7 +180,9 @@ def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], 
     lazy = {name: arguments[name] for name in arguments if is_dask_array(arguments[name])}
     wrong = sorted(set(lazy) - set(state_args))
     if wrong:
-        raise TypeError(f"{method.__name__}: {', '.join(wrong)} cannot be a dask array (only {', '.join(state_args)} can)")
+        raise TypeError(
+            f"{method.__name__}: {', '.join(wrong)} cannot be a dask array (only {', '.join(state_args)} can)"
+        )
     for name, x in lazy.items():
         _check_chunks(name, x)
     names = list(lazy)
@@ -182,13 +195,19 @@ def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], 
     # the states' chunks are those of the first dask input; the others follow, and the per-state
     # axes are one chunk each
     arrays = [lazy[names[0]].astype(np.float64)] + [
-        lazy[name].astype(np.float64).rechunk({0: first.chunks[0], **{a: -1 for a in range(1, lazy[name].ndim)}}) for name in names[1:]
+        lazy[name].astype(np.float64).rechunk({0: first.chunks[0], **{a: -1 for a in range(1, lazy[name].ndim)}})
+        for name in names[1:]
     ]
     # NumPy batch arguments (N, ...) become dask arrays with the same chunks; others travel as they are
     fixed = {k: v for k, v in arguments.items() if k not in lazy}
     for name in state_args:
         v = fixed.get(name)
-        if v is not None and np.ndim(v) >= 2 and np.shape(v)[0] == first.shape[0] and not (name == "f_ext" and np.ndim(v) == 2):
+        if (
+            v is not None
+            and np.ndim(v) >= 2
+            and np.shape(v)[0] == first.shape[0]
+            and not (name == "f_ext" and np.ndim(v) == 2)
+        ):
             arrays.append(da.from_array(np.asarray(v, dtype=np.float64), chunks=(first.chunks[0],) + np.shape(v)[1:]))
             names.append(name)
             del fixed[name]
@@ -217,13 +236,21 @@ def _lazy_call(method, signature: inspect.Signature, state_args: Sequence[str], 
         sizes = [int(np.prod(s)) for s in shapes]
         out_axes = next(letters)
         new_axes = {out_axes: sum(sizes)}
-    out = da.blockwise(block, states + out_axes, *pairs, new_axes=new_axes, concatenate=True, dtype=np.float64,
-                       align_arrays=False, name=f"kinedyn-{method.__name__}-{carrier.digest[:8]}-" + da.core.tokenize(*arrays, fixed))
+    out = da.blockwise(
+        block,
+        states + out_axes,
+        *pairs,
+        new_axes=new_axes,
+        concatenate=True,
+        dtype=np.float64,
+        align_arrays=False,
+        name=f"kinedyn-{method.__name__}-{carrier.digest[:8]}-" + da.core.tokenize(*arrays, fixed),
+    )
     if len(results) == 1:
         return out
     parts, start = [], 0
     for size, shape in zip(sizes, shapes):
-        parts.append(out[:, start:start + size].reshape((out.shape[0],) + tuple(shape)))
+        parts.append(out[:, start : start + size].reshape((out.shape[0],) + tuple(shape)))
         start += size
     return tuple(parts)
 
@@ -239,7 +266,7 @@ def _block(carrier: _RobotByContent, method_name: str, names: tuple, fixed: dict
 
 
 # ------------------------------------------------------------------ batch inverse kinematics
-def lazy_inverse_kinematics(robot: "Robot", target, q0, mask, method: str, respect_limits: bool, options: dict):
+def lazy_inverse_kinematics(robot: Robot, target, q0, mask, method: str, respect_limits: bool, options: dict):
     """``robot.inverse_kinematics`` of a dask batch of targets, (N, 4, 4) poses or (N, 3) positions:
     an ``IKBatchResult`` whose ``q`` (N, n), ``success``, ``position_error``, ``orientation_error``
     and ``iterations`` (N,) are lazy dask arrays chunked as the targets. ``q0`` may be one (n,) start
@@ -252,7 +279,9 @@ def lazy_inverse_kinematics(robot: "Robot", target, q0, mask, method: str, respe
 
     _check_chunks("target", target)
     if target.shape[1:] not in ((4, 4), (3,)):
-        raise ValueError(f"target must be a batch of 4x4 poses (N, 4, 4) or positions (N, 3), got a dask array of shape {target.shape}")
+        raise ValueError(
+            f"target must be a batch of 4x4 poses (N, 4, 4) or positions (N, 3), got a dask array of shape {target.shape}"
+        )
     target = target.astype(np.float64)
     arrays, names = [target], ["target"]
     n = robot.nq  # a configuration's size (7 for a free-flyer)
@@ -260,29 +289,56 @@ def lazy_inverse_kinematics(robot: "Robot", target, q0, mask, method: str, respe
         q0 = q0 if is_dask_array(q0) else da.from_array(np.asarray(q0, dtype=np.float64), chunks=(target.chunks[0], -1))
         _check_chunks("q0", q0)
         if q0.shape != (target.shape[0], n):
-            raise ValueError(f"q0 must be one start (nq,) = ({n},) or one per target ({target.shape[0]}, {n}), got {q0.shape}")
+            raise ValueError(
+                f"q0 must be one start (nq,) = ({n},) or one per target ({target.shape[0]}, {n}), got {q0.shape}"
+            )
         arrays.append(q0.astype(np.float64).rechunk({0: target.chunks[0], 1: -1}))
         names.append("q0")
         q0 = None
     # the solver's name, from a probe at the neutral pose (the numbers are not used)
     neutral = robot.pose(robot.neutral()[None], options.get("frame"))
-    probe = robot.inverse_kinematics(neutral if target.ndim == 3 else neutral[:, :3, 3], q0, mask, method, respect_limits, **options)
+    probe = robot.inverse_kinematics(
+        neutral if target.ndim == 3 else neutral[:, :3, 3], q0, mask, method, respect_limits, **options
+    )
     fixed = {"q0": q0, "mask": mask, "method": method, "respect_limits": respect_limits, **options}
     carrier = _RobotByContent.of(robot)
     block = functools.partial(_ik_block, carrier, tuple(names), fixed)
     pairs: list[Any] = [target, "s" + "ab"[: target.ndim - 1]]
     if len(arrays) > 1:
         pairs += [arrays[1], "sc"]
-    packed = da.blockwise(block, "sz", *pairs, new_axes={"z": n + 4}, concatenate=True, dtype=np.float64, align_arrays=False,
-                          name="kinedyn-inverse_kinematics-" + carrier.digest[:8] + "-" + da.core.tokenize(*arrays, fixed))
-    return IKBatchResult(q=packed[:, :n], success=packed[:, n] > 0.5, position_error=packed[:, n + 1],
-                         orientation_error=packed[:, n + 2], iterations=packed[:, n + 3].astype(np.int64), solver=probe.solver)
+    packed = da.blockwise(
+        block,
+        "sz",
+        *pairs,
+        new_axes={"z": n + 4},
+        concatenate=True,
+        dtype=np.float64,
+        align_arrays=False,
+        name="kinedyn-inverse_kinematics-" + carrier.digest[:8] + "-" + da.core.tokenize(*arrays, fixed),
+    )
+    return IKBatchResult(
+        q=packed[:, :n],
+        success=packed[:, n] > 0.5,
+        position_error=packed[:, n + 1],
+        orientation_error=packed[:, n + 2],
+        iterations=packed[:, n + 3].astype(np.int64),
+        solver=probe.solver,
+    )
 
 
 def _ik_block(carrier: _RobotByContent, names: tuple, fixed: dict, *blocks):
     arguments = dict(fixed, **dict(zip(names, blocks)))
     solve = type(carrier.robot).inverse_kinematics
-    result = solve(carrier.robot, arguments.pop("target"), arguments.pop("q0"), arguments.pop("mask"), arguments.pop("method"),
-                   arguments.pop("respect_limits"), **arguments)
+    result = solve(
+        carrier.robot,
+        arguments.pop("target"),
+        arguments.pop("q0"),
+        arguments.pop("mask"),
+        arguments.pop("method"),
+        arguments.pop("respect_limits"),
+        **arguments,
+    )
     columns = [result.success, result.position_error, result.orientation_error, result.iterations]
-    return np.concatenate([np.asarray(result.q, dtype=np.float64)] + [np.asarray(c, dtype=np.float64)[:, None] for c in columns], axis=1)
+    return np.concatenate(
+        [np.asarray(result.q, dtype=np.float64)] + [np.asarray(c, dtype=np.float64)[:, None] for c in columns], axis=1
+    )

@@ -7,7 +7,8 @@ Poses are 4x4 homogeneous transforms ``a_from_b`` (a point in b's coordinates ->
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -163,7 +164,7 @@ def to_float_array(value, shape=None, what: str = "value") -> np.ndarray:
     """Convert numbers / numeric SymPy matrices to a float array; explain when symbols remain."""
     if is_symbolic(value):
         free = set()
-        for e in (value if isinstance(value, sp.MatrixBase) else np.asarray(value, dtype=object).flat):
+        for e in value if isinstance(value, sp.MatrixBase) else np.asarray(value, dtype=object).flat:
             if isinstance(e, sp.Basic):
                 free |= e.free_symbols
         raise ValueError(
@@ -185,4 +186,7 @@ def by_name(mapping, symbols) -> dict:
     symbols. A value given as text is read by kinedyn's expression parser (SymPy's ``subs`` would
     hand it to ``eval``)."""
     named = {s.name: s for s in symbols if isinstance(s, sp.Symbol)}
-    return {(named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): (as_value(v) if isinstance(v, str) else v) for k, v in dict(mapping).items()}
+    return {
+        (named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): (as_value(v) if isinstance(v, str) else v)
+        for k, v in dict(mapping).items()
+    }

@@ -28,8 +28,6 @@ a coordinate) and has the same methods and signatures, in the reduced coordinate
 
 from __future__ import annotations
 
-from typing import Optional
-
 import numpy as np
 
 from ._arrays import finite_result, real_array
@@ -66,11 +64,13 @@ class ReducedModel:
         if name.startswith("__") or name in ("native", "map", "robot", "G"):
             raise AttributeError(name)
         if callable(getattr(self.native, name, None)):
-            raise NotImplementedError(f"robot '{self.robot}': '{name}' is not mapped to reduced mimic coordinates yet "
-                                      "(kinedyn/_mimic.py); load the robot with mimic='independent'")
+            raise NotImplementedError(
+                f"robot '{self.robot}': '{name}' is not mapped to reduced mimic coordinates yet "
+                "(kinedyn/_mimic.py); load the robot with mimic='independent'"
+            )
         raise AttributeError(f"'ReducedModel' object has no attribute '{name}'")
 
-    def _arg(self, x, name: str, size: int, batch: Optional[int] = None) -> np.ndarray:
+    def _arg(self, x, name: str, size: int, batch: int | None = None) -> np.ndarray:
         a = x if type(x) is np.ndarray and x.dtype == np.float64 else real_array(x, name)
         if a.shape[-1:] != (size,) or a.ndim > 2 or a.ndim < 1:
             raise ValueError(f"{name} must have shape ({size},) or a batch (N, {size}), got {a.shape}")
@@ -78,7 +78,9 @@ class ReducedModel:
             bad = np.flatnonzero(~np.isfinite(a.reshape(-1)))
             raise ValueError(f"{name} contains a non-finite value (NaN or inf) at index {bad[0] % size}")
         if batch is not None and a.ndim != batch:
-            raise ValueError(f"{name} has shape {a.shape} but q has {'a batch' if batch == 2 else 'one state'} (shape {'(N, n)' if batch == 2 else '(n,)'})")
+            raise ValueError(
+                f"{name} has shape {a.shape} but q has {'a batch' if batch == 2 else 'one state'} (shape {'(N, n)' if batch == 2 else '(n,)'})"
+            )
         return a
 
     def _q(self, q) -> tuple:
@@ -86,7 +88,9 @@ class ReducedModel:
         with np.errstate(over="ignore", invalid="ignore"):
             full = self.map.expand_q(q)
         if not np.isfinite(full).all():
-            raise ValueError(f"q is too large: a mimic follower's coordinate multiplier * q_leader + offset overflows float64 (robot '{self.robot}')")
+            raise ValueError(
+                f"q is too large: a mimic follower's coordinate multiplier * q_leader + offset overflows float64 (robot '{self.robot}')"
+            )
         return q, full
 
     def _v(self, v, name: str, q: np.ndarray) -> np.ndarray:
@@ -96,7 +100,7 @@ class ReducedModel:
         return self.map.expand_v(v)
 
     @staticmethod
-    def _out(result: np.ndarray, out: Optional[np.ndarray]) -> np.ndarray:
+    def _out(result: np.ndarray, out: np.ndarray | None) -> np.ndarray:
         if out is None:
             return result
         if not isinstance(out, np.ndarray) or out.dtype != np.float64:
@@ -152,11 +156,14 @@ class ReducedModel:
             if np.abs(M).max() > 1e150:  # its factorisation squares the entries
                 from ._core import NonFiniteResultError
 
-                raise NonFiniteResultError(f"robot '{self.robot}': the reduced mass matrix G^T M G has entries of "
-                                           f"{np.abs(M).max():.3g}, too large for float64 to factor") from None
+                raise NonFiniteResultError(
+                    f"robot '{self.robot}': the reduced mass matrix G^T M G has entries of "
+                    f"{np.abs(M).max():.3g}, too large for float64 to factor"
+                ) from None
             raise RuntimeError(
                 "the reduced mass matrix G^T M G is singular or not positive definite "
-                "(a massless leader with massless followers and no rotor inertia?)") from None
+                "(a massless leader with massless followers and no rotor inertia?)"
+            ) from None
 
     def mass_matrix_inverse(self, q, out=None):
         L = self._cholesky(self.mass_matrix(q))

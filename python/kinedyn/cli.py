@@ -22,14 +22,28 @@ import os
 import re
 import sys
 import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, Optional, Sequence
+from typing import Any
 
 import numpy as np
 
-__all__ = ["main", "load_robot", "parse_q", "emit", "console", "check_output_path", "OutputPath", "ROBOT_FILE_EXTENSIONS",
-           "EXIT_OK", "EXIT_ERROR", "EXIT_NO", "EXIT_INTERNAL", "EXIT_INTERRUPTED"]
+__all__ = [
+    "main",
+    "load_robot",
+    "parse_q",
+    "emit",
+    "console",
+    "check_output_path",
+    "OutputPath",
+    "ROBOT_FILE_EXTENSIONS",
+    "EXIT_OK",
+    "EXIT_ERROR",
+    "EXIT_NO",
+    "EXIT_INTERNAL",
+    "EXIT_INTERRUPTED",
+]
 
 EXIT_OK = 0
 EXIT_ERROR = 1  # the user's mistake: bad argument, bad robot file, unwritable output
@@ -49,20 +63,20 @@ class _Invocation:
     it needs a numeric robot (every command but ``derive`` and ``info``)."""
 
     command: str
-    values: Dict[str, float] = field(default_factory=dict)
+    values: dict[str, float] = field(default_factory=dict)
     numeric: bool = True
-    xacro_args: Dict[str, str] = field(default_factory=dict)  # --xacro-arg NAME:=VALUE
+    xacro_args: dict[str, str] = field(default_factory=dict)  # --xacro-arg NAME:=VALUE
     trust_xacro: bool = False  # --trust-xacro: expanding xacro runs the file's Python expressions
     floating_base: bool = False  # --floating-base: a URDF's root link on a free-flyer
 
 
-_INVOCATION: contextvars.ContextVar[Optional[_Invocation]] = contextvars.ContextVar("kinedyn_cli_invocation", default=None)
+_INVOCATION: contextvars.ContextVar[_Invocation | None] = contextvars.ContextVar("kinedyn_cli_invocation", default=None)
 
 # commands that show a robot with symbolic parameters as it is (the others need numbers)
 SYMBOLIC_COMMANDS = {"derive", "info"}
 
 
-def load_robot(spec: str, *, values: Optional[Dict[str, float]] = None, numeric: Optional[bool] = None):
+def load_robot(spec: str, *, values: dict[str, float] | None = None, numeric: bool | None = None):
     """A built-in robot by name, or a robot file by path, with parameter ``values`` substituted
     (``--set name=value``: a built-in's keyword parameters, or a robot file's symbols). ``numeric``:
     refuse a robot that still has symbolic parameters, naming them and the ``--set`` that gives them.
@@ -76,7 +90,9 @@ def load_robot(spec: str, *, values: Optional[Dict[str, float]] = None, numeric:
         numeric = run.numeric if run is not None else False
     if spec in robots.CATALOGUE:
         if run is not None and run.floating_base:
-            raise ValueError(f"--floating-base applies to URDF (and xacro) files; '{spec}' is a built-in robot with a fixed base")
+            raise ValueError(
+                f"--floating-base applies to URDF (and xacro) files; '{spec}' is a built-in robot with a fixed base"
+            )
         robot = _builtin(spec, values)
     else:
         robot = _substitute(_robot_file(spec), values, spec)
@@ -104,19 +120,23 @@ def _robot_file(spec: str):
     if path.is_dir():
         raise ValueError(f"robot file '{spec}' is a folder")
     run = _INVOCATION.get()
-    options: Dict[str, Any] = {}
+    options: dict[str, Any] = {}
     if ext == ".xacro" and run is not None:
         options = {"xacro_args": run.xacro_args, "trust_xacro": run.trust_xacro}
     if run is not None and run.floating_base:
         if ext not in (".urdf", ".xacro"):
-            raise ValueError(f"--floating-base applies to URDF (and xacro) files, not '{spec}' (a robot file or MJCF says its own joints)")
+            raise ValueError(
+                f"--floating-base applies to URDF (and xacro) files, not '{spec}' (a robot file or MJCF says its own joints)"
+            )
         options["floating_base"] = True
     try:
         try:
             return load(path, **options)
         except ValueError as e:
             if ext == ".xacro" and "trust_xacro=True" in str(e):
-                raise ValueError(str(e).replace("pass trust_xacro=True (command line: --trust-xacro)", "add --trust-xacro")) from None
+                raise ValueError(
+                    str(e).replace("pass trust_xacro=True (command line: --trust-xacro)", "add --trust-xacro")
+                ) from None
             raise
     except ValueError as e:  # the loader's own message; make sure it says which file
         if spec in str(e) or str(path) in str(e):
@@ -125,11 +145,11 @@ def _robot_file(spec: str):
     except (OSError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as e:  # a loader should raise only ValueError: say which file it was reading
-        setattr(e, "kinedyn_context", f"while loading robot file '{spec}'")  # read by the error handler
+        e.kinedyn_context = f"while loading robot file '{spec}'"  # read by the error handler
         raise
 
 
-def _builtin(name: str, values: Dict[str, float]):
+def _builtin(name: str, values: dict[str, float]):
     """A built-in with ``values`` for its numeric keyword parameters (``planar_2r --set l1=2``)."""
     import inspect
 
@@ -139,7 +159,9 @@ def _builtin(name: str, values: Dict[str, float]):
         return robots.get(name)
     params = inspect.signature(robots.CATALOGUE[name]).parameters
 
-    def is_number(v: inspect.Parameter) -> bool:  # a number, or None standing for a computed number (planar_2r's lc1 = l1/2)
+    def is_number(
+        v: inspect.Parameter,
+    ) -> bool:  # a number, or None standing for a computed number (planar_2r's lc1 = l1/2)
         if v.default is None:
             return v.annotation in (inspect.Parameter.empty, "float", "Optional[float]", float)
         return isinstance(v.default, (int, float)) and not isinstance(v.default, bool)
@@ -147,24 +169,28 @@ def _builtin(name: str, values: Dict[str, float]):
     numeric = [p for p, v in params.items() if is_number(v)]
     unknown = [k for k in values if k not in numeric]
     if unknown:
-        raise ValueError(f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})")
+        raise ValueError(
+            f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})"
+        )
     return robots.get(name, **values)
 
 
-def set_values() -> Dict[str, float]:
+def set_values() -> dict[str, float]:
     """The running command's ``--set`` values (empty outside :func:`main`)."""
     run = _INVOCATION.get()
     return dict(run.values) if run is not None else {}
 
 
-def _substitute(robot, values: Dict[str, float], spec: str):
+def _substitute(robot, values: dict[str, float], spec: str):
     """The file's robot with its symbols replaced by ``values`` (names checked first)."""
     if not values:
         return robot
     known = sorted(str(s) for s in robot.symbols)
     unknown = [k for k in values if k not in known]
     if unknown:
-        has = f"its parameters: {', '.join(known)}" if known else "it has no symbolic parameters: every value is a number"
+        has = (
+            f"its parameters: {', '.join(known)}" if known else "it has no symbolic parameters: every value is a number"
+        )
         raise ValueError(f"--set {unknown[0]}: robot '{spec}' has no parameter '{unknown[0]}' ({has})")
     return robot.subs(values)
 
@@ -197,8 +223,8 @@ def _parse_xacro_arg(text: str):
     return name.strip(), value
 
 
-def _set_values(pairs) -> Dict[str, float]:
-    values: Dict[str, float] = {}
+def _set_values(pairs) -> dict[str, float]:
+    values: dict[str, float] = {}
     for name, value in pairs or []:
         if name in values:
             raise ValueError(f"--set {name} is given twice")
@@ -251,8 +277,12 @@ def _check_outputs(args) -> None:
     if parser is None:
         return
     robot = getattr(args, "robot", None)
-    robot_file = Path(robot).resolve() if robot and Path(robot).suffix.lower() in ROBOT_FILE_EXTENSIONS and Path(robot).exists() else None
-    seen: Dict[Path, str] = {}
+    robot_file = (
+        Path(robot).resolve()
+        if robot and Path(robot).suffix.lower() in ROBOT_FILE_EXTENSIONS and Path(robot).exists()
+        else None
+    )
+    seen: dict[Path, str] = {}
     for action in parser._actions:
         if not isinstance(action, OutputPath):
             continue
@@ -293,7 +323,7 @@ positive_int = _number_type(int, lambda v: v >= 1, "must be a whole number >= 1"
 nonnegative_int = _number_type(int, lambda v: v >= 0, "must be a whole number >= 0")
 
 
-def in_cli_terms(text: str, phrases: Optional[Dict[str, str]]) -> str:
+def in_cli_terms(text: str, phrases: dict[str, str] | None) -> str:
     """``text`` (a library message) with the Python argument names in ``phrases`` replaced by the
     command line flags that set them (``respect_limits=False`` -> ``--ignore-limits``)."""
     for python, flag in (phrases or {}).items():
@@ -301,7 +331,9 @@ def in_cli_terms(text: str, phrases: Optional[Dict[str, str]]) -> str:
     return text
 
 
-def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, flag: str = "--q", rates: Optional[bool] = None) -> np.ndarray:
+def parse_q(
+    values: Sequence[float] | None, robot, degrees: bool = False, flag: str = "--q", rates: bool | None = None
+) -> np.ndarray:
     """Joint values (``--q``, ``--q0``, ``--goal``: a configuration of ``robot.nq`` numbers, the
     neutral one when omitted) or rates, accelerations, torques (the other flags, or ``rates=True``:
     ``robot.nv`` numbers, zeros when omitted); degrees convert revolute joints only. ``flag`` names
@@ -318,12 +350,18 @@ def parse_q(values: Optional[Sequence[float]], robot, degrees: bool = False, fla
         owners.extend([None] * k if j.is_multi_dof else [j])
     if q.shape != (size,):
         what = "rates" if rates else "coordinates"
-        extra = f" {what}: nq = {robot.nq} with its multi-DOF joints" if robot.has_multi_dof_joints and not rates else ""
-        raise ValueError(f"{flag} needs {size} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}{extra}), got {q.size}")
+        extra = (
+            f" {what}: nq = {robot.nq} with its multi-DOF joints" if robot.has_multi_dof_joints and not rates else ""
+        )
+        raise ValueError(
+            f"{flag} needs {size} values for robot '{robot.name}' (joints {', '.join(robot.joint_names)}{extra}), got {q.size}"
+        )
     bad = np.flatnonzero(~np.isfinite(q))
     if bad.size:
         owner = owners[bad[0]]
-        raise ValueError(f"{flag}: value {bad[0] + 1} ({owner.name if owner is not None else 'a multi-DOF joint'}) is {q[bad[0]]}, not a finite number")
+        raise ValueError(
+            f"{flag}: value {bad[0] + 1} ({owner.name if owner is not None else 'a multi-DOF joint'}) is {q[bad[0]]}, not a finite number"
+        )
     if degrees:
         q = np.array([math.radians(v) if j is not None and j.kind == "revolute" else v for v, j in zip(q, owners)])
     return q
@@ -392,7 +430,9 @@ def _fmt(v) -> str:
 
 
 def _robot_arg(p):
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
+    p.add_argument(
+        "robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
 
 
@@ -464,13 +504,22 @@ def cmd_info(args) -> int:
             }
         )
     bodies = [
-        {"link": b.name, "mass": _value(b.inertia.mass), "com": [_value(c) for c in b.inertia.com],
-         "inertia_about_com": [[_value(x) for x in row] for row in np.asarray(b.inertia.inertia, dtype=object).tolist()]}
+        {
+            "link": b.name,
+            "mass": _value(b.inertia.mass),
+            "com": [_value(c) for c in b.inertia.com],
+            "inertia_about_com": [
+                [_value(x) for x in row] for row in np.asarray(b.inertia.inertia, dtype=object).tolist()
+            ],
+        }
         for b in robot.tree.bodies
     ]
     dh = None
     if robot.dh is not None:
-        dh = [{"theta": _value(r.theta), "d": _value(r.d), "a": _value(r.a), "alpha": _value(r.alpha), "type": r.kind} for r in robot.dh]
+        dh = [
+            {"theta": _value(r.theta), "d": _value(r.d), "a": _value(r.a), "alpha": _value(r.alpha), "type": r.kind}
+            for r in robot.dh
+        ]
     payload = {
         "name": robot.name,
         "n": robot.n,
@@ -490,7 +539,9 @@ def cmd_info(args) -> int:
         from rich.table import Table
 
         c = console()
-        c.print(f"[bold]{esc(robot.name)}[/bold]: {robot.n} joints, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2")
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold]: {robot.n} joints, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2"
+        )
         if robot.source:
             c.print(f"source: {esc(robot.source)}")
         t = Table(title="joints", title_justify="left")
@@ -499,8 +550,14 @@ def cmd_info(args) -> int:
         for i, j in enumerate(joints, 1):
             unit = "rad" if j["type"] == "revolute" else "m"
             t.add_row(
-                str(i), esc(j["name"]), j["type"], esc(f"{j['parent']} -> {j['link']}"), esc(" ".join(_fmt(a) for a in j["axis"])), esc(_fmt(j["offset"])),
-                f"[{_fmt(j['lower'])}, {_fmt(j['upper'])}] {unit}", f"{_fmt(j['velocity_limit'])} / {_fmt(j['effort_limit'])}",
+                str(i),
+                esc(j["name"]),
+                j["type"],
+                esc(f"{j['parent']} -> {j['link']}"),
+                esc(" ".join(_fmt(a) for a in j["axis"])),
+                esc(_fmt(j["offset"])),
+                f"[{_fmt(j['lower'])}, {_fmt(j['upper'])}] {unit}",
+                f"{_fmt(j['velocity_limit'])} / {_fmt(j['effort_limit'])}",
             )
         c.print(t)
         if dh is not None:
@@ -513,7 +570,11 @@ def cmd_info(args) -> int:
                     str(i),
                     esc(f"q{i} + {_fmt(r['theta'])}" if var == "q" else _fmt(r["theta"])),
                     esc(f"q{i} + {_fmt(r['d'])}" if var == "d" else _fmt(r["d"])),
-                    esc(_fmt(r["a"])), f"{_fmt(math.degrees(r['alpha']))} deg" if isinstance(r["alpha"], float) else esc(f"{r['alpha']} rad"), r["type"],
+                    esc(_fmt(r["a"])),
+                    f"{_fmt(math.degrees(r['alpha']))} deg"
+                    if isinstance(r["alpha"], float)
+                    else esc(f"{r['alpha']} rad"),
+                    r["type"],
                 )
             c.print(t)
         t = Table(title="mass properties (body frames = joint frames)", title_justify="left")
@@ -521,11 +582,18 @@ def cmd_info(args) -> int:
             t.add_column(col)
         for b in bodies:
             I = b["inertia_about_com"]
-            t.add_row(esc(b["link"]), esc(_fmt(b["mass"])), esc(" ".join(_fmt(x) for x in b["com"])), esc(" ".join(_fmt(I[k][k]) for k in range(3))))
+            t.add_row(
+                esc(b["link"]),
+                esc(_fmt(b["mass"])),
+                esc(" ".join(_fmt(x) for x in b["com"])),
+                esc(" ".join(_fmt(I[k][k]) for k in range(3))),
+            )
         c.print(t)
         c.print(f"total moving mass: {esc(_fmt(payload['total_mass']))} kg")
         if payload["symbols"]:
-            c.print(f"symbolic parameters: {', '.join(payload['symbols'])} (numeric commands take their values: --set NAME=VALUE)")
+            c.print(
+                f"symbolic parameters: {', '.join(payload['symbols'])} (numeric commands take their values: --set NAME=VALUE)"
+            )
 
     emit(args, payload, render)
     return 0
@@ -572,8 +640,13 @@ def cmd_symbolic_kinematics(args, what: str) -> int:
     fmt = "json" if args.json else args.format
     title = f"{'pose' if what == 'fk' else 'geometric Jacobian (rows [v; w], ' + args.reference + ')'} of '{frame}' of {robot.name} in q = ({', '.join(map(str, q))})"
     if fmt == "json":
-        payload = {"robot": robot.name, "frame": frame, "q": [str(s) for s in q],
-                   "parameters": sorted(str(s) for s in robot.symbols), ("pose" if what == "fk" else "jacobian"): [[str(e) for e in row] for row in M.tolist()]}
+        payload = {
+            "robot": robot.name,
+            "frame": frame,
+            "q": [str(s) for s in q],
+            "parameters": sorted(str(s) for s in robot.symbols),
+            ("pose" if what == "fk" else "jacobian"): [[str(e) for e in row] for row in M.tolist()],
+        }
         if what == "jacobian":
             payload["reference"] = args.reference
         print(json.dumps(payload, indent=2))
@@ -589,9 +662,20 @@ def cmd_symbolic_kinematics(args, what: str) -> int:
 
 
 def _symbolic_args(p) -> None:
-    p.add_argument("--symbolic", action="store_true", help="the result as formulas in the joint symbols (kinedyn.symbolic), with the robot's parameter symbols")
-    p.add_argument("--format", default="text", choices=["text", "latex", "markdown", "json"], help="with --symbolic: output format (default text)")
-    p.add_argument("--abbreviate", action="store_true", help="with --symbolic: cos(q1 + q2) shown as c12, sin(q2) as s2")
+    p.add_argument(
+        "--symbolic",
+        action="store_true",
+        help="the result as formulas in the joint symbols (kinedyn.symbolic), with the robot's parameter symbols",
+    )
+    p.add_argument(
+        "--format",
+        default="text",
+        choices=["text", "latex", "markdown", "json"],
+        help="with --symbolic: output format (default text)",
+    )
+    p.add_argument(
+        "--abbreviate", action="store_true", help="with --symbolic: cos(q1 + q2) shown as c12, sin(q2) as s2"
+    )
 
 
 def cmd_fk(args) -> int:
@@ -601,7 +685,11 @@ def cmd_fk(args) -> int:
     q = parse_q(args.q, robot, args.deg)
     frames = robot.frame_names if args.all else [args.frame or robot.tool]
     poses = robot.frame_poses(q, frames)
-    payload = {"robot": robot.name, "q": q, "frames": {f: {"pose": T, "position": T[:3, 3], "rpy": _rpy(T[:3, :3])} for f, T in zip(frames, poses)}}
+    payload = {
+        "robot": robot.name,
+        "q": q,
+        "frames": {f: {"pose": T, "position": T[:3, 3], "rpy": _rpy(T[:3, :3])} for f, T in zip(frames, poses)},
+    }
 
     def render():
         c = console()
@@ -609,7 +697,9 @@ def cmd_fk(args) -> int:
         for f, T in zip(frames, poses):
             c.print(matrix_table(f"pose of '{f}' in '{robot.base}'", T, ["", "", "", ""], ["", "", "", ""]))
             rpy = _rpy(T[:3, :3])
-            c.print(f"  position {np.array2string(T[:3, 3], precision=6)} m, rpy {np.array2string(np.degrees(rpy), precision=4)} deg")
+            c.print(
+                f"  position {np.array2string(T[:3, 3], precision=6)} m, rpy {np.array2string(np.degrees(rpy), precision=4)} deg"
+            )
 
     emit(args, payload, render)
     return 0
@@ -645,7 +735,11 @@ def _analysis_rows(robot, rows, explicit: bool, frame, reference):
     """(rows, basis) on which ``jacobian`` measures rank and manipulability: the --task rows when given;
     otherwise all six for n >= 6, or the rows an arm with fewer joints spans (``spanned_rows``)."""
     if explicit:
-        return rows, "the --task rows" + (f"; {len(rows)} rows > {robot.n} joints, so J J^T is singular by construction" if len(rows) > robot.n else "")
+        return rows, "the --task rows" + (
+            f"; {len(rows)} rows > {robot.n} joints, so J J^T is singular by construction"
+            if len(rows) > robot.n
+            else ""
+        )
     if len(rows) <= robot.n:
         return rows, "all six rows"
     chosen = spanned_rows(robot, frame, reference)
@@ -691,7 +785,9 @@ def cmd_jacobian(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}; frame '{esc(payload['frame'])}', reference '{args.reference}'")
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}; frame '{esc(payload['frame'])}', reference '{args.reference}'"
+        )
         c.print(matrix_table("Jacobian", J, names, robot.joint_names))
         c.print(f"rank, singular values and manipulability over rows {', '.join(w_rows)} ({basis})")
         c.print(f"singular values: {np.array2string(report.singular_values, precision=6)}")
@@ -731,13 +827,26 @@ def cmd_dynamics(args) -> int:
     def render():
         c = console()
         names = robot.joint_names
-        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}")
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}"
+        )
         c.print(matrix_table("M(q), mass matrix", M, names, names))
         c.print(matrix_table("C(q, qd), Coriolis matrix (Christoffel symbols)", C, names, names))
-        c.print(matrix_table("g(q), gravity torque and tau = M qdd + C qd + g + friction", np.column_stack([g, payload["tau"]]), names, ["g", "tau"]))
-        c.print(f"kinetic energy {payload['kinetic_energy']:.6g} J, potential energy {payload['potential_energy']:.6g} J")
+        c.print(
+            matrix_table(
+                "g(q), gravity torque and tau = M qdd + C qd + g + friction",
+                np.column_stack([g, payload["tau"]]),
+                names,
+                ["g", "tau"],
+            )
+        )
+        c.print(
+            f"kinetic energy {payload['kinetic_energy']:.6g} J, potential energy {payload['potential_energy']:.6g} J"
+        )
         if args.tau is not None:
-            c.print(f"forward dynamics: tau = {np.array2string(payload['applied_tau'], precision=6)} gives qdd = {np.array2string(payload['forward_dynamics_qdd'], precision=6)}")
+            c.print(
+                f"forward dynamics: tau = {np.array2string(payload['applied_tau'], precision=6)} gives qdd = {np.array2string(payload['forward_dynamics_qdd'], precision=6)}"
+            )
         if args.derivatives:
             c.print(matrix_table("dtau/dq", payload["dtau_dq"], names, names))
             c.print(matrix_table("dtau/dqd", payload["dtau_dqd"], names, names))
@@ -779,15 +888,37 @@ def _common_options(p: argparse.ArgumentParser, global_: bool = False) -> None:
     default = False if global_ else argparse.SUPPRESS
     p.add_argument("--debug", action="store_true", default=default, help="on an error, show the Python traceback")
     if global_ or any(a.dest == "robot" for a in p._actions):
-        p.add_argument("--set", dest="set_global" if global_ else "set", action="append", type=_parse_set, default=None if global_ else argparse.SUPPRESS,
-                       metavar="NAME=VALUE", help="give a robot parameter a value (repeatable): a symbol of a robot file, or a keyword of a built-in (e.g. --set l1=0.5)")
+        p.add_argument(
+            "--set",
+            dest="set_global" if global_ else "set",
+            action="append",
+            type=_parse_set,
+            default=None if global_ else argparse.SUPPRESS,
+            metavar="NAME=VALUE",
+            help="give a robot parameter a value (repeatable): a symbol of a robot file, or a keyword of a built-in (e.g. --set l1=0.5)",
+        )
     if not global_ and any(a.dest == "robot" for a in p._actions):
-        p.add_argument("--xacro-arg", dest="xacro_args", action="append", type=_parse_xacro_arg, default=argparse.SUPPRESS, metavar="NAME:=VALUE",
-                       help="an argument of a .xacro robot file (repeatable)")
-        p.add_argument("--trust-xacro", action="store_true", default=argparse.SUPPRESS,
-                       help="expand a .xacro robot file: xacro runs Python expressions from the file, so only for files you trust")
-        p.add_argument("--floating-base", action="store_true", default=argparse.SUPPRESS,
-                       help="a URDF's root link moves freely on a free-flyer joint 'root_joint' (q: position, quaternion x y z w, joints)")
+        p.add_argument(
+            "--xacro-arg",
+            dest="xacro_args",
+            action="append",
+            type=_parse_xacro_arg,
+            default=argparse.SUPPRESS,
+            metavar="NAME:=VALUE",
+            help="an argument of a .xacro robot file (repeatable)",
+        )
+        p.add_argument(
+            "--trust-xacro",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help="expand a .xacro robot file: xacro runs Python expressions from the file, so only for files you trust",
+        )
+        p.add_argument(
+            "--floating-base",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help="a URDF's root link moves freely on a free-flyer joint 'root_joint' (q: position, quaternion x y z w, joints)",
+        )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -819,32 +950,58 @@ def build_parser() -> argparse.ArgumentParser:
     _state_args(p)
     p.add_argument("--frame", help="frame name (default: the tool)")
     p.add_argument("--reference", default="world", choices=["world", "local", "spatial"])
-    p.add_argument("--task", default=None, help="rows: full, position, orientation, planar, planar_pose (default full; the manipulability "
-                   "of an arm with fewer than six joints then uses the rows it spans, e.g. vx vy vz for elbow_3r)")
+    p.add_argument(
+        "--task",
+        default=None,
+        help="rows: full, position, orientation, planar, planar_pose (default full; the manipulability "
+        "of an arm with fewer than six joints then uses the rows it spans, e.g. vx vy vz for elbow_3r)",
+    )
     _symbolic_args(p)
     p.set_defaults(func=cmd_jacobian)
 
-    p = sub.add_parser("dynamics", help="M, C, g and tau at a state (Rust core); forward dynamics with --tau; derivatives")
+    p = sub.add_parser(
+        "dynamics", help="M, C, g and tau at a state (Rust core); forward dynamics with --tau; derivatives"
+    )
     _robot_arg(p)
     _state_args(p, with_qd=True)
     p.add_argument("--qdd", nargs="+", type=float, metavar="QDD", help="joint accelerations for tau (default zeros)")
-    p.add_argument("--tau", nargs="+", type=float, metavar="TAU", help="joint torques/forces: also print the forward dynamics qdd")
+    p.add_argument(
+        "--tau", nargs="+", type=float, metavar="TAU", help="joint torques/forces: also print the forward dynamics qdd"
+    )
     p.add_argument("--derivatives", action="store_true", help="also print dtau/dq and dtau/dqd (analytical)")
     p.set_defaults(func=cmd_dynamics)
 
-    p = sub.add_parser("convert", help="write a robot as URDF, MJCF, a robot file or a DH table, and check the result",
-                       description="Write ROBOT (a built-in or any robot file kinedyn reads) to OUT in the format of OUT's extension "
-                                   "(.urdf, .xml/.mjcf, .yaml/.yml, .toml) or --to; then read OUT back and compare frame poses, M and "
-                                   "inverse dynamics with ROBOT at random states (docs/model-files.md, 'Converting robots').")
+    p = sub.add_parser(
+        "convert",
+        help="write a robot as URDF, MJCF, a robot file or a DH table, and check the result",
+        description="Write ROBOT (a built-in or any robot file kinedyn reads) to OUT in the format of OUT's extension "
+        "(.urdf, .xml/.mjcf, .yaml/.yml, .toml) or --to; then read OUT back and compare frame poses, M and "
+        "inverse dynamics with ROBOT at random states (docs/model-files.md, 'Converting robots').",
+    )
     p.add_argument("robot", help="built-in name or robot file")
     p.add_argument("output", metavar="OUT", action=OutputPath, help="the file to write")
-    p.add_argument("--to", choices=["dh", "urdf", "mjcf", "yaml", "toml"], help="output format (default: from OUT's extension); "
-                   "dh: the DH table of a serial chain, written as a .yaml/.toml robot file")
-    p.add_argument("--convention", choices=["standard", "modified"], default="standard", help="DH convention for --to dh")
-    p.add_argument("--inertia", choices=["warn", "repair", "strict"], default=None,
-                   help="inertia policy for tensors no rigid body has (repair: project them onto physical ones, as MJCF needs)")
-    p.add_argument("--lock", action="append", default=[], metavar="JOINT",
-                   help="fix a joint at 0 before converting (repeatable; e.g. a gripper's fingers, for --to dh)")
+    p.add_argument(
+        "--to",
+        choices=["dh", "urdf", "mjcf", "yaml", "toml"],
+        help="output format (default: from OUT's extension); "
+        "dh: the DH table of a serial chain, written as a .yaml/.toml robot file",
+    )
+    p.add_argument(
+        "--convention", choices=["standard", "modified"], default="standard", help="DH convention for --to dh"
+    )
+    p.add_argument(
+        "--inertia",
+        choices=["warn", "repair", "strict"],
+        default=None,
+        help="inertia policy for tensors no rigid body has (repair: project them onto physical ones, as MJCF needs)",
+    )
+    p.add_argument(
+        "--lock",
+        action="append",
+        default=[],
+        metavar="JOINT",
+        help="fix a joint at 0 before converting (repeatable; e.g. a gripper's fingers, for --to dh)",
+    )
     p.add_argument("--states", type=int, default=5, help="random states of the check (default 5)")
     p.add_argument("--no-check", action="store_true", help="skip the check (reading the result back)")
     p.set_defaults(func=cmd_convert)
@@ -867,11 +1024,18 @@ def cmd_convert(args) -> int:
         robot = robot.lock_joints(args.lock)
     if args.states < 1:
         raise ValueError(f"--states must be at least 1, got {args.states}")
-    result = convert(robot, args.output, args.to, convention=args.convention, check=not args.no_check, states=args.states)
+    result = convert(
+        robot, args.output, args.to, convention=args.convention, check=not args.no_check, states=args.states
+    )
     print(result.summary())
     if result.checked and not result.max_error < CONVERT_TOLERANCE:
-        print(_one_line(f"kinedyn convert: error: the written file differs from {args.robot} by {result.max_error:.3g} "
-                        f"(more than {CONVERT_TOLERANCE:g}); this is a bug in kinedyn's writer, please report it"), file=sys.stderr)
+        print(
+            _one_line(
+                f"kinedyn convert: error: the written file differs from {args.robot} by {result.max_error:.3g} "
+                f"(more than {CONVERT_TOLERANCE:g}); this is a bug in kinedyn's writer, please report it"
+            ),
+            file=sys.stderr,
+        )
         return EXIT_ERROR
     return EXIT_OK
 
@@ -902,7 +1066,7 @@ _USER_ERRORS = (ValueError, KeyError, OSError, RuntimeError)
 _BUGS = (RecursionError,)
 
 
-def _report(command: str, e: BaseException, debug: bool, phrases: Optional[Dict[str, str]]) -> int:
+def _report(command: str, e: BaseException, debug: bool, phrases: dict[str, str] | None) -> int:
     """Print ``e`` as one line (and its traceback with --debug); return the exit status."""
     import traceback
 
@@ -911,14 +1075,24 @@ def _report(command: str, e: BaseException, debug: bool, phrases: Optional[Dict[
     head = f"kinedyn {command}" if command else "kinedyn"
     if isinstance(e, MemoryError):
         detail = _message(e) if str(e) else "the work needs more memory than this machine has"
-        print(_one_line(f"{head}: error: out of memory: {detail} (ask for less: fewer samples or states, a larger step, a shorter time)"), file=sys.stderr)
+        print(
+            _one_line(
+                f"{head}: error: out of memory: {detail} (ask for less: fewer samples or states, a larger step, a shorter time)"
+            ),
+            file=sys.stderr,
+        )
         return EXIT_ERROR
     if isinstance(e, _USER_ERRORS) and not isinstance(e, _BUGS):
         print(_one_line(f"{head}: error: {in_cli_terms(_message(e), phrases)}"), file=sys.stderr)
         return EXIT_ERROR
     context = getattr(e, "kinedyn_context", None)
-    print(_one_line(f"{head}: internal error{' ' + context if context else ''}: {type(e).__name__}: {_message(e)}. "
-                    f"This is a bug in kinedyn: rerun with --debug to see the traceback, and please report it"), file=sys.stderr)
+    print(
+        _one_line(
+            f"{head}: internal error{' ' + context if context else ''}: {type(e).__name__}: {_message(e)}. "
+            f"This is a bug in kinedyn: rerun with --debug to see the traceback, and please report it"
+        ),
+        file=sys.stderr,
+    )
     return EXIT_INTERNAL
 
 
@@ -931,7 +1105,7 @@ def _warning_line(command: str):
     return show
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit status (see the
     module docstring). Never lets an exception out, but SystemExit from --help and --version."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -950,9 +1124,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         command = args.command
         debug = bool(args.debug)
         phrases = getattr(args, "_flag_phrases", None)
-        run = _Invocation(command, _set_values((args.set_global or []) + (getattr(args, "set", None) or [])), command not in SYMBOLIC_COMMANDS,
-                          dict(getattr(args, "xacro_args", None) or []), bool(getattr(args, "trust_xacro", False)),
-                          bool(getattr(args, "floating_base", False)))
+        run = _Invocation(
+            command,
+            _set_values((args.set_global or []) + (getattr(args, "set", None) or [])),
+            command not in SYMBOLIC_COMMANDS,
+            dict(getattr(args, "xacro_args", None) or []),
+            bool(getattr(args, "trust_xacro", False)),
+            bool(getattr(args, "floating_base", False)),
+        )
         token = _INVOCATION.set(run)
         try:
             with warnings.catch_warnings():
@@ -963,7 +1142,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         finally:
             _INVOCATION.reset(token)
     except BrokenPipeError:  # e.g. `kinedyn derive | head`: the reader left, nothing to report
-        with contextlib.suppress(Exception):  # the interpreter's flush at exit must not fail again (Python docs, signal: SIGPIPE)
+        with contextlib.suppress(
+            Exception
+        ):  # the interpreter's flush at exit must not fail again (Python docs, signal: SIGPIPE)
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK
     except KeyboardInterrupt:

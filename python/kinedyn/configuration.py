@@ -29,8 +29,9 @@ from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Optional, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,9 +42,23 @@ if TYPE_CHECKING:
     from .robot import Robot
 
 __all__ = [
-    "ConfigurationSpace", "UNIT_TOLERANCE", "space", "neutral", "integrate", "difference", "interpolate",
-    "random_configuration", "normalize", "check_configuration", "integrate_jacobians", "difference_jacobians",
-    "quaternion_multiply", "quaternion_rotate", "quaternion_to_matrix", "exp3", "log3",
+    "ConfigurationSpace",
+    "UNIT_TOLERANCE",
+    "space",
+    "neutral",
+    "integrate",
+    "difference",
+    "interpolate",
+    "random_configuration",
+    "normalize",
+    "check_configuration",
+    "integrate_jacobians",
+    "difference_jacobians",
+    "quaternion_multiply",
+    "quaternion_rotate",
+    "quaternion_to_matrix",
+    "exp3",
+    "log3",
 ]
 
 #: How far from 1 the norm of a quaternion or of a planar joint's (cos θ, sin θ) may be before
@@ -55,7 +70,8 @@ UNIT_TOLERANCE = 1e-6
 _SERIES_BELOW = 1e-2
 
 _Q_NAMES = {
-    "revolute": ("angle",), "prismatic": ("displacement",),
+    "revolute": ("angle",),
+    "prismatic": ("displacement",),
     "spherical": ("qx", "qy", "qz", "qw"),
     "floating": ("x", "y", "z", "qx", "qy", "qz", "qw"),
     "planar": ("x", "y", "cos theta", "sin theta"),
@@ -64,9 +80,14 @@ _Q_NAMES = {
 
 # ----------------------------------------------------------------------------- SO(3) by quaternions
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    return np.stack(
+        [
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ],
+        axis=-1,
+    )
 
 
 def quaternion_multiply(a: ArrayLike, b: ArrayLike) -> np.ndarray:
@@ -91,11 +112,14 @@ def quaternion_to_matrix(quat: ArrayLike) -> np.ndarray:
     """The rotation matrix (..., 3, 3) of unit quaternions (..., 4) in (x, y, z, w) order."""
     quat = np.asarray(quat, dtype=float)
     x, y, z, w = (quat[..., i] for i in range(4))
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
-    ], axis=-2)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=-2,
+    )
 
 
 def _norm(x: np.ndarray) -> np.ndarray:
@@ -164,7 +188,6 @@ def _se3_left_jacobian_inverse_times(omega: np.ndarray, theta: np.ndarray, p: np
     return p - 0.5 * wxp + c[..., None] * _cross(omega, wxp)
 
 
-
 # ------------------------------------------------------------- Jacobians of integrate, difference
 # Perturbations act on the right, as velocities do: q ⊕ δ. With the group's adjoint Ad and its right
 # Jacobian Jr(τ) (Exp(τ + δ) ≈ Exp(τ) Exp(Jr(τ) δ)), and Jl(τ) = Jr(-τ) = Σ ad_τᵏ/(k+1)!:
@@ -176,9 +199,14 @@ def _se3_left_jacobian_inverse_times(omega: np.ndarray, theta: np.ndarray, p: np
 # Q(ρ, ω) = D Jl_SO(3)(ω)[ρ], the derivative of SO(3)'s Jl = I + a W + b W² along ρ (W = ω×).
 def _skew(w: np.ndarray) -> np.ndarray:
     z = np.zeros(w.shape[:-1])
-    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
-                     np.stack([w[..., 2], z, -w[..., 0]], -1),
-                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
+    return np.stack(
+        [
+            np.stack([z, -w[..., 2], w[..., 1]], -1),
+            np.stack([w[..., 2], z, -w[..., 0]], -1),
+            np.stack([-w[..., 1], w[..., 0], z], -1),
+        ],
+        -2,
+    )
 
 
 # coefficients of the series of a'(θ)/θ and b'(θ)/θ in θ², highest power first (for np.polyval)
@@ -253,17 +281,17 @@ def _se2_left_jacobian(tau: np.ndarray) -> tuple:
     so Jl = [[V(θ), h(θ J)(-J ρ)], [0, 1]] with h(x) = (eˣ - 1 - x)/x²: the top right is
     (θ - sin θ)/θ² ρ - (1 - cos θ)/θ² J ρ."""
     theta = tau[..., 2]
-    a = np.sinc(theta / np.pi)                                  # sin θ/θ
-    half = 0.5 * np.sinc(theta / (2 * np.pi)) ** 2              # (1 - cos θ)/θ²
-    b = half * theta                                            # (1 - cos θ)/θ
-    d = theta * _theta_minus_sin_over_cube(np.abs(theta))       # (θ - sin θ)/θ²
+    a = np.sinc(theta / np.pi)  # sin θ/θ
+    half = 0.5 * np.sinc(theta / (2 * np.pi)) ** 2  # (1 - cos θ)/θ²
+    b = half * theta  # (1 - cos θ)/θ
+    d = theta * _theta_minus_sin_over_cube(np.abs(theta))  # (θ - sin θ)/θ²
     rx, ry = tau[..., 0], tau[..., 1]
-    corner = np.stack([d * rx + half * ry, d * ry - half * rx], axis=-1)   # J ρ = (-ρy, ρx)
+    corner = np.stack([d * rx + half * ry, d * ry - half * rx], axis=-1)  # J ρ = (-ρy, ρx)
     out = np.zeros(tau.shape[:-1] + (3, 3))
     out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = a, -b, b, a
     out[..., :2, 2] = corner
     out[..., 2, 2] = 1.0
-    alpha = np.cos(theta / 2) / np.sinc(theta / (2 * np.pi))   # V⁻¹ = [[α, θ/2], [-θ/2, α]]
+    alpha = np.cos(theta / 2) / np.sinc(theta / (2 * np.pi))  # V⁻¹ = [[α, θ/2], [-θ/2, α]]
     inv = np.zeros_like(out)
     inv[..., 0, 0], inv[..., 0, 1], inv[..., 1, 0], inv[..., 1, 1] = alpha, theta / 2, -theta / 2, alpha
     inv[..., :2, 2] = -np.einsum("...ij,...j->...i", inv[..., :2, :2], corner)
@@ -357,7 +385,9 @@ class _Block:
 
 
 def _indices(blocks, kind: str, size: int, attr: str) -> np.ndarray:
-    return np.array([[getattr(b, attr) + k for k in range(size)] for b in blocks if b.joint.kind == kind], dtype=np.intp).reshape(-1, size)
+    return np.array(
+        [[getattr(b, attr) + k for k in range(size)] for b in blocks if b.joint.kind == kind], dtype=np.intp
+    ).reshape(-1, size)
 
 
 class ConfigurationSpace:
@@ -393,7 +423,7 @@ class ConfigurationSpace:
                 self._unit_parts.append((b, np.arange(b.iq + 2, b.iq + 4), "(cos theta, sin theta) pair"))
 
     @classmethod
-    def of(cls, robot: "Robot") -> "ConfigurationSpace":
+    def of(cls, robot: Robot) -> ConfigurationSpace:
         """The configuration space of ``robot`` (built once per robot and remembered)."""
         found = _SPACES.get(robot)
         if found is None:
@@ -425,7 +455,9 @@ class ConfigurationSpace:
         a = self._array(q, self.nq, name, "nq: a free-flyer takes 7, a spherical or planar joint 4")
         if not np.all(np.isfinite(a)):
             bad = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
-            raise ValueError(f"{name}{list(bad)} ({self._describe(bad[-1])}) is {a[bad]}: a configuration must be finite{self._at(bad[:-1])}")
+            raise ValueError(
+                f"{name}{list(bad)} ({self._describe(bad[-1])}) is {a[bad]}: a configuration must be finite{self._at(bad[:-1])}"
+            )
         for block, columns, what in self._unit_parts:
             norm = _norm(a[..., columns])
             off = np.abs(norm - 1.0) > UNIT_TOLERANCE
@@ -436,9 +468,10 @@ class ConfigurationSpace:
                 names = ", ".join(_Q_NAMES[joint.kind][i - block.iq] for i in columns)
                 raise ValueError(
                     f"{name}[{columns[0]}:{columns[-1] + 1}] of {joint.kind} joint '{joint.name}' is the {what} "
-                    f"({names}) = {tuple(float(x) for x in values)} of norm {float(np.sqrt(np.sum(values ** 2))):.9g}, not 1 to within "
+                    f"({names}) = {tuple(float(x) for x in values)} of norm {float(np.sqrt(np.sum(values**2))):.9g}, not 1 to within "
                     f"{UNIT_TOLERANCE:g}{self._at(state)}: normalise it (robot.normalize(q) divides each by its norm"
-                    + ("; q and -q are the same rotation" if what == "quaternion" else "") + ")"
+                    + ("; q and -q are the same rotation" if what == "quaternion" else "")
+                    + ")"
                 )
         return a
 
@@ -481,7 +514,11 @@ class ConfigurationSpace:
         out = np.array(q, dtype=float)
         # 1-DOF joints: q + v dt
         out[..., self._scalar_q] = q[..., self._scalar_q] + vdt[..., self._scalar_v]
-        step: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {"floating": _integrate_floating, "spherical": _integrate_rotation, "planar": _integrate_planar}
+        step: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
+            "floating": _integrate_floating,
+            "spherical": _integrate_rotation,
+            "planar": _integrate_planar,
+        }
         for kind, (qi, vi) in self._kinds.items():
             out[..., qi] = step[kind](q[..., qi], vdt[..., vi])
         return out
@@ -565,12 +602,14 @@ class ConfigurationSpace:
         for block, columns, what in self._unit_parts:
             norm = _norm(out[..., columns])
             if not np.all(norm > 1e-12) or not np.all(np.isfinite(norm)):
-                raise ValueError(f"q[{columns[0]}:{columns[-1] + 1}] of joint '{block.joint.name}': a {what} of norm "
-                                 f"{np.min(norm) if np.all(np.isfinite(norm)) else 'nan/inf'} cannot be normalised")
+                raise ValueError(
+                    f"q[{columns[0]}:{columns[-1] + 1}] of joint '{block.joint.name}': a {what} of norm "
+                    f"{np.min(norm) if np.all(np.isfinite(norm)) else 'nan/inf'} cannot be normalised"
+                )
             out[..., columns] = out[..., columns] / norm[..., None]
         return out
 
-    def random(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
+    def random(self, rng: SeedLike = None, size: int | None = None) -> np.ndarray:
         """Random configurations: 1-DOF joints uniform within their limits (an infinite side replaced
         by ±π for revolute, ±1 for prismatic joints); quaternions uniform over rotations (Shoemake
         1992); free-flyer and planar positions uniform in the joint's limits when finite, else in
@@ -590,13 +629,13 @@ class ConfigurationSpace:
             if kind in ("floating", "planar"):
                 k = 3 if kind == "floating" else 2
                 lo, hi = _sampling_range([b.joint], position=True)
-                out[..., b.iq:b.iq + k] = rng.uniform(lo[0], hi[0], size=lead + (k,))
+                out[..., b.iq : b.iq + k] = rng.uniform(lo[0], hi[0], size=lead + (k,))
                 if kind == "planar":
                     theta = rng.uniform(-np.pi, np.pi, size=lead)
                     out[..., b.iq + 2], out[..., b.iq + 3] = np.cos(theta), np.sin(theta)
             if kind in ("floating", "spherical"):
                 start = b.iq + (3 if kind == "floating" else 0)
-                out[..., start:start + 4] = _uniform_quaternions(rng, lead)
+                out[..., start : start + 4] = _uniform_quaternions(rng, lead)
         return out
 
 
@@ -623,57 +662,57 @@ def _uniform_quaternions(rng: np.random.Generator, lead: tuple) -> np.ndarray:
     return np.stack([a * np.sin(t2), a * np.cos(t2), b * np.sin(t3), b * np.cos(t3)], axis=-1)
 
 
-_SPACES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_SPACES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 # ---------------------------------------------------------------------- functions of a robot
-def space(robot: "Robot") -> ConfigurationSpace:
+def space(robot: Robot) -> ConfigurationSpace:
     """The :class:`ConfigurationSpace` of ``robot``'s moving joints, in body order."""
     return ConfigurationSpace.of(robot)
 
 
-def neutral(robot: "Robot") -> np.ndarray:
+def neutral(robot: Robot) -> np.ndarray:
     """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
     return space(robot).neutral()
 
 
-def integrate(robot: "Robot", q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
+def integrate(robot: Robot, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
     """q ⊕ v dt: (nq,) or a batch (N, nq) (see the module docstring for each joint kind)."""
     return space(robot).integrate(q, v, dt)
 
 
-def difference(robot: "Robot", q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
+def difference(robot: Robot, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
     """v (nv,) or (N, nv) with integrate(q0, v) = q1, the short way round for rotations."""
     return space(robot).difference(q0, q1)
 
 
-def interpolate(robot: "Robot", q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
+def interpolate(robot: Robot, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
     """q0 ⊕ t · difference(q0, q1): the geodesic between two configurations."""
     return space(robot).interpolate(q0, q1, t)
 
 
-def random_configuration(robot: "Robot", rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
+def random_configuration(robot: Robot, rng: SeedLike = None, size: int | None = None) -> np.ndarray:
     """Random configurations (nq,) or (size, nq): see :meth:`ConfigurationSpace.random`."""
     return space(robot).random(rng, size)
 
 
-def normalize(robot: "Robot", q: ArrayLike) -> np.ndarray:
+def normalize(robot: Robot, q: ArrayLike) -> np.ndarray:
     """``q`` with its quaternions and planar (cos, sin) pairs made unit."""
     return space(robot).normalize(q)
 
 
-def check_configuration(robot: "Robot", q: ArrayLike) -> np.ndarray:
+def check_configuration(robot: Robot, q: ArrayLike) -> np.ndarray:
     """``q`` as a float array if it is a configuration of ``robot``, else a ValueError naming the joint
     and block: the length is not nq, a number is NaN or infinite, or a quaternion or planar
     (cos θ, sin θ) pair has a norm further than :data:`UNIT_TOLERANCE` (1e-6) from 1."""
     return space(robot).check(q)
 
 
-def integrate_jacobians(robot: "Robot", q: ArrayLike, v: ArrayLike, dt: float = 1.0) -> tuple:
+def integrate_jacobians(robot: Robot, q: ArrayLike, v: ArrayLike, dt: float = 1.0) -> tuple:
     """(∂(q ⊕ v dt)/∂q, ∂(q ⊕ v dt)/∂v): see :meth:`ConfigurationSpace.integrate_jacobians`."""
     return space(robot).integrate_jacobians(q, v, dt)
 
 
-def difference_jacobians(robot: "Robot", q0: ArrayLike, q1: ArrayLike) -> tuple:
+def difference_jacobians(robot: Robot, q0: ArrayLike, q1: ArrayLike) -> tuple:
     """(∂ difference/∂q0, ∂ difference/∂q1): see :meth:`ConfigurationSpace.difference_jacobians`."""
     return space(robot).difference_jacobians(q0, q1)

@@ -19,12 +19,26 @@ from __future__ import annotations
 
 import html
 import math
-from typing import Iterable, List, Optional, Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-__all__ = ["robot_html", "robot_markdown", "stick_figure_svg", "eom_html", "eom_latex", "eom_markdown", "step_html", "step_latex",
-           "step_markdown", "ik_html", "ik_markdown", "trajectory_html", "properties_html", "identification_html"]
+__all__ = [
+    "robot_html",
+    "robot_markdown",
+    "stick_figure_svg",
+    "eom_html",
+    "eom_latex",
+    "eom_markdown",
+    "step_html",
+    "step_latex",
+    "step_markdown",
+    "ik_html",
+    "ik_markdown",
+    "trajectory_html",
+    "properties_html",
+    "identification_html",
+]
 
 _BOX = "font-family: system-ui, sans-serif; font-size: 13px; max-width: 100%; overflow-x: auto"
 _MONO = "font-family: ui-monospace, 'DejaVu Sans Mono', monospace; text-align: right"
@@ -43,14 +57,24 @@ def _num(v, digits: int = 6) -> str:
     return f"{x:.{digits}g}"
 
 
-def _table(headers: Sequence[str], rows: Iterable[Sequence], numeric_from: int = 1, cls: str = "", numeric_to: Optional[int] = None) -> str:
+def _table(
+    headers: Sequence[str],
+    rows: Iterable[Sequence],
+    numeric_from: int = 1,
+    cls: str = "",
+    numeric_to: int | None = None,
+) -> str:
     """An HTML table; columns ``numeric_from`` up to (not including) ``numeric_to`` hold numbers."""
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
     body = []
     for row in rows:
         stop = len(row) if numeric_to is None else numeric_to
-        cells = [f'<td style="{_MONO}">{html.escape(str(c))}</td>' if numeric_from <= k < stop else f"<td>{html.escape(str(c))}</td>"
-                 for k, c in enumerate(row)]
+        cells = [
+            f'<td style="{_MONO}">{html.escape(str(c))}</td>'
+            if numeric_from <= k < stop
+            else f"<td>{html.escape(str(c))}</td>"
+            for k, c in enumerate(row)
+        ]
         body.append("<tr>" + "".join(cells) + "</tr>")
     return f'<table class="{cls}"><thead><tr>{head}</tr></thead><tbody>{"".join(body)}</tbody></table>'
 
@@ -67,7 +91,7 @@ def _box(cls: str, content: str) -> str:
 
 
 # ------------------------------------------------------------------ Robot
-def _joint_rows(robot) -> List[list]:
+def _joint_rows(robot) -> list[list]:
     rows = []
     for j in robot.joints:
         unit = "rad" if j.kind == "revolute" else "m"
@@ -88,7 +112,7 @@ def _gravity(robot) -> str:
     return "(" + ", ".join(_num(g) for g in robot.gravity) + ") m/s²"
 
 
-def stick_figure_svg(robot, q=None, size: int = 220) -> Optional[str]:
+def stick_figure_svg(robot, q=None, size: int = 220) -> str | None:
     """The robot at ``q`` (default: the report's generic configuration) as a small inline SVG drawing: a line
     from each link frame to its parent's and to each extra frame, seen from the front-right and above
     the base (up = against gravity), the tool frame in red. None for a robot whose geometry is symbolic."""
@@ -103,7 +127,9 @@ def stick_figure_svg(robot, q=None, size: int = 220) -> Optional[str]:
         return None
     names = robot.frame_names
     at = {name: poses[k, :3, 3] for k, name in enumerate(names)}
-    edges = [(link.parent or robot.base, link.name) for link in robot.links] + [(f.link or robot.base, f.name) for f in robot.frames]
+    edges = [(link.parent or robot.base, link.name) for link in robot.links] + [
+        (f.link or robot.base, f.name) for f in robot.frames
+    ]
     edges = [(a, b) for a, b in edges if a in at and b in at]
     g = np.asarray(robot.gravity, dtype=float)
     up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
@@ -126,23 +152,33 @@ def stick_figure_svg(robot, q=None, size: int = 220) -> Optional[str]:
         u = np.array([p @ right, p @ screen_up]) - centre
         return size / 2 + scale * u[0], size / 2 - scale * u[1]
 
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}" role="img" '
-           f'aria-label="{html.escape(robot.name)} at q" style="background:#fafaf7;border:1px solid #ddd">']
+    out = [
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}" role="img" '
+        f'aria-label="{html.escape(robot.name)} at q" style="background:#fafaf7;border:1px solid #ddd">'
+    ]
     for a, b in edges:
         (x1, y1), (x2, y2) = xy(at[a]), xy(at[b])
-        out.append(f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" stroke="#5f6b73" stroke-width="3" stroke-linecap="round"/>')
+        out.append(
+            f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" stroke="#5f6b73" stroke-width="3" stroke-linecap="round"/>'
+        )
     for name, p in at.items():
         x, y = xy(p)
-        colour, r = ("#d62728", 4.5) if name == robot.tool else (("#243238", 3.5) if name == robot.base else ("#ff7f0e", 2.5))
-        out.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r}" fill="{colour}"><title>{html.escape(name)}</title></circle>')
+        colour, r = (
+            ("#d62728", 4.5) if name == robot.tool else (("#243238", 3.5) if name == robot.base else ("#ff7f0e", 2.5))
+        )
+        out.append(
+            f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r}" fill="{colour}"><title>{html.escape(name)}</title></circle>'
+        )
     out.append("</svg>")
     return "".join(out)
 
 
 def robot_html(robot) -> str:
     """A robot in a notebook: a summary line, its joint table and a stick figure beside it."""
-    summary = (f"<b>{html.escape(robot.name)}</b>: {robot.n} joints, total moving mass {html.escape(_total_mass(robot))}, "
-               f"gravity {html.escape(_gravity(robot))}, tool frame <code>{html.escape(robot.tool)}</code>")
+    summary = (
+        f"<b>{html.escape(robot.name)}</b>: {robot.n} joints, total moving mass {html.escape(_total_mass(robot))}, "
+        f"gravity {html.escape(_gravity(robot))}, tool frame <code>{html.escape(robot.tool)}</code>"
+    )
     if robot.source:
         summary += f"<br><small>{html.escape(str(robot.source))}</small>"
     table = _table(["joint", "type", "axis", "limits"], _joint_rows(robot), numeric_from=2, cls="kinedyn-joints")
@@ -150,13 +186,18 @@ def robot_html(robot) -> str:
         table = f'<div style="max-height: 24em; overflow-y: auto">{table}</div>'
     picture = stick_figure_svg(robot)
     figure = f'<div style="flex: 0 0 auto">{picture}</div>' if picture else ""
-    return _box("kinedyn-robot", f"<p>{summary}</p><div style='display: flex; gap: 16px; align-items: flex-start; flex-wrap: wrap'>"
-                f"<div style='flex: 1 1 auto; min-width: 0; overflow-x: auto'>{table}</div>{figure}</div>")
+    return _box(
+        "kinedyn-robot",
+        f"<p>{summary}</p><div style='display: flex; gap: 16px; align-items: flex-start; flex-wrap: wrap'>"
+        f"<div style='flex: 1 1 auto; min-width: 0; overflow-x: auto'>{table}</div>{figure}</div>",
+    )
 
 
 def robot_markdown(robot) -> str:
-    return (f"**{robot.name}**: {robot.n} joints, total moving mass {_total_mass(robot)}, gravity {_gravity(robot)}, "
-            f"tool frame `{robot.tool}`\n\n" + _md_table(["joint", "type", "axis", "limits"], _joint_rows(robot)))
+    return (
+        f"**{robot.name}**: {robot.n} joints, total moving mass {_total_mass(robot)}, gravity {_gravity(robot)}, "
+        f"tool frame `{robot.tool}`\n\n" + _md_table(["joint", "type", "axis", "limits"], _joint_rows(robot))
+    )
 
 
 # ------------------------------------------------------------------ equations of motion
@@ -166,8 +207,10 @@ def _eq_box(math_element: str) -> str:
 
 def eom_html(eom) -> str:
     """The result M, C, g, tau typeset (MathML), and every step of the derivation under a fold."""
-    head = (f"<p><b>Equations of motion{' of ' + html.escape(eom.name) if eom.name else ''}</b> ({html.escape(str(eom.method))}): "
-            "M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</p>")
+    head = (
+        f"<p><b>Equations of motion{' of ' + html.escape(eom.name) if eom.name else ''}</b> ({html.escape(str(eom.method))}): "
+        "M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</p>"
+    )
     result = "".join(_eq_box(eom.equation_mathml(lhs, value)) for lhs, value in eom._final_equations())
     steps = eom.steps
     folded = ""
@@ -190,7 +233,7 @@ def _step_owner(step):
     return getattr(step, "_eom", None)
 
 
-def step_html(step, number: Optional[int] = None) -> str:
+def step_html(step, number: int | None = None) -> str:
     owner = _step_owner(step)
     if owner is not None:
         equation = owner.equation_mathml
@@ -226,8 +269,10 @@ def step_markdown(step) -> str:
 def _ik_rows(result) -> tuple:
     n = result.solutions.shape[1] if result.solutions.ndim == 2 else 0
     headers = ["#", *[f"q{k + 1}" for k in range(n)], "|dp| [m]", "|dR| [rad]"]
-    rows = [[str(i + 1), *(_num(v) for v in q), _num(result.position_error[i], 3), _num(result.orientation_error[i], 3)]
-            for i, q in enumerate(result.solutions)]
+    rows = [
+        [str(i + 1), *(_num(v) for v in q), _num(result.position_error[i], 3), _num(result.orientation_error[i], 3)]
+        for i, q in enumerate(result.solutions)
+    ]
     return headers, rows
 
 
@@ -240,7 +285,9 @@ def _ik_summary(result) -> str:
         extra.append("on a singularity")
     if result.message and not result.success:
         extra.append(result.message)
-    return f"{len(result.solutions)} solution(s), {verdict}; solver {result.solver}" + ("; " + "; ".join(extra) if extra else "")
+    return f"{len(result.solutions)} solution(s), {verdict}; solver {result.solver}" + (
+        "; " + "; ".join(extra) if extra else ""
+    )
 
 
 def ik_html(result) -> str:
@@ -262,22 +309,42 @@ def trajectory_html(traj) -> str:
     q = traj.q[0] if traj.batch is not None else traj.q
     names = traj.names
     batch = f", batch of {traj.batch} (the first is plotted)" if traj.batch is not None else ""
-    head = (f"<p><b>Trajectory</b> of {html.escape(str(getattr(traj.system, 'name', '?')))}: {len(traj)} samples, "
-            f"t = {_num(traj.t[0])} … {_num(traj.t[-1])} s, method {html.escape(str(traj.method))}{html.escape(batch)}</p>")
+    head = (
+        f"<p><b>Trajectory</b> of {html.escape(str(getattr(traj.system, 'name', '?')))}: {len(traj)} samples, "
+        f"t = {_num(traj.t[0])} … {_num(traj.t[-1])} s, method {html.escape(str(traj.method))}{html.escape(batch)}</p>"
+    )
     if len(traj) < 2:
         return _box("kinedyn-trajectory", head)
     every = max(1, math.ceil(len(traj) / 400))  # at most ~400 points a line: a light notebook
-    keep = np.r_[np.arange(0, len(traj), every), len(traj) - 1] if (len(traj) - 1) % every else np.arange(0, len(traj), every)
-    plot = svg_plot(traj.t[keep], [(nm, q[keep, k]) for k, nm in enumerate(names)], "joint positions", "t [s]", "q [rad or m]")
+    keep = (
+        np.r_[np.arange(0, len(traj), every), len(traj) - 1]
+        if (len(traj) - 1) % every
+        else np.arange(0, len(traj), every)
+    )
+    plot = svg_plot(
+        traj.t[keep], [(nm, q[keep, k]) for k, nm in enumerate(names)], "joint positions", "t [s]", "q [rad or m]"
+    )
     return _box("kinedyn-trajectory", head + plot)
 
 
 # ------------------------------------------------------------------ analysis
 def properties_html(report) -> str:
-    rows = [[c.name, _num(c.residual, 3), _num(c.tolerance, 3), "holds" if c.passed else "FAILS", c.detail] for c in report.checks]
+    rows = [
+        [c.name, _num(c.residual, 3), _num(c.tolerance, 3), "holds" if c.passed else "FAILS", c.detail]
+        for c in report.checks
+    ]
     verdict = "all hold" if report.passed else "some FAIL"
-    return _box("kinedyn-properties", f"<p><b>Properties of {html.escape(report.robot)}</b> over {report.samples} sampled states: {verdict}</p>"
-                + _table(["property", "residual", "tolerance", "", "measured"], rows, numeric_from=1, numeric_to=3, cls="kinedyn-properties"))
+    return _box(
+        "kinedyn-properties",
+        f"<p><b>Properties of {html.escape(report.robot)}</b> over {report.samples} sampled states: {verdict}</p>"
+        + _table(
+            ["property", "residual", "tolerance", "", "measured"],
+            rows,
+            numeric_from=1,
+            numeric_to=3,
+            cls="kinedyn-properties",
+        ),
+    )
 
 
 def identification_html(ident) -> str:
@@ -292,6 +359,8 @@ def identification_html(ident) -> str:
             row += [_num(true[k]), _num(ident.estimates[k] - true[k], 3)]
         rows.append(row)
     kind = "weighted" if ident.weighted else "ordinary"
-    head = (f"<p><b>Identification</b>: {len(ident.names)} base parameters by {kind} least squares, cond(W) = {_num(ident.condition_number, 4)}; "
-            f"residual RMS per joint ({', '.join(_num(r, 3) for r in np.atleast_1d(ident.residual_rms))})</p>")
+    head = (
+        f"<p><b>Identification</b>: {len(ident.names)} base parameters by {kind} least squares, cond(W) = {_num(ident.condition_number, 4)}; "
+        f"residual RMS per joint ({', '.join(_num(r, 3) for r in np.atleast_1d(ident.residual_rms))})</p>"
+    )
     return _box("kinedyn-identification", head + _table(headers, rows, cls="kinedyn-identification"))

@@ -21,9 +21,8 @@ frame presents to forces along the task rows, ``Lambda = (J M^-1 J^T)^-1``
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Optional
-
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -31,7 +30,13 @@ if TYPE_CHECKING:
     from ._typing import ArrayLike, SeedLike
     from .robot import Robot
 
-__all__ = ["BaseParameters", "base_parameters", "linearize", "operational_space_inertia", "dynamically_consistent_inverse"]
+__all__ = [
+    "BaseParameters",
+    "base_parameters",
+    "linearize",
+    "operational_space_inertia",
+    "dynamically_consistent_inverse",
+]
 
 
 @dataclass(frozen=True)
@@ -101,10 +106,14 @@ def base_parameters(robot: Robot, samples: int = 200, rng: SeedLike = 0, tol: fl
     grouping = grouping[order]
     indices = independent[order]
     names = tuple(f"{robot.body_names[k // 10]}.{PARAMETER_NAMES[k % 10]}" for k in indices)
-    return BaseParameters(indices=indices, grouping=grouping, values=grouping @ robot.inertial_parameters(), names=names)
+    return BaseParameters(
+        indices=indices, grouping=grouping, values=grouping @ robot.inertial_parameters(), names=names
+    )
 
 
-def linearize(robot: Robot, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray]:
+def linearize(
+    robot: Robot, q: ArrayLike, qd: ArrayLike | None = None, tau: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """``(A, B)`` of ``d/dt [dq; dqd] = A [dq; dqd] + B dtau``: the equations of motion
     ``qdd = FD(q, qd, tau)`` linearised about ``(q, qd, tau)`` with the analytical derivatives
     (:meth:`kinedyn.Robot.forward_dynamics_derivatives`)::
@@ -174,7 +183,15 @@ def _lambda(A: np.ndarray, method: str, tol: float) -> np.ndarray:
     return (V * inv_w[..., None, :]) @ np.swapaxes(V, -1, -2)
 
 
-def operational_space_inertia(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task="full", reference: str = "world", method: str = "inverse", tol: float = 1e-9) -> np.ndarray:
+def operational_space_inertia(
+    robot: Robot,
+    q: ArrayLike,
+    frame: str | None = None,
+    task="full",
+    reference: str = "world",
+    method: str = "inverse",
+    tol: float = 1e-9,
+) -> np.ndarray:
     """Khatib's operational-space (task-space) inertia ``Lambda(q) = (J M^-1 J^T)^-1`` of ``frame``
     (default the tool) on the task rows (``task`` as in :mod:`kinedyn.kinematics`, Jacobian in
     ``reference``): (m, m), or (N, m, m) for a batch. The tool then obeys ``Lambda a + mu + p = F``.
@@ -194,7 +211,15 @@ def operational_space_inertia(robot: Robot, q: ArrayLike, frame: Optional[str] =
     return (L + np.swapaxes(L, -1, -2)) / 2
 
 
-def dynamically_consistent_inverse(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task="full", reference: str = "world", method: str = "inverse", tol: float = 1e-9) -> np.ndarray:
+def dynamically_consistent_inverse(
+    robot: Robot,
+    q: ArrayLike,
+    frame: str | None = None,
+    task="full",
+    reference: str = "world",
+    method: str = "inverse",
+    tol: float = 1e-9,
+) -> np.ndarray:
     """Khatib's dynamically consistent generalised inverse ``J_bar = M^-1 J^T Lambda`` (n, m), or
     (N, n, m) for a batch, with ``Lambda`` from :func:`operational_space_inertia` (same arguments).
 

@@ -12,8 +12,9 @@ manipulability (:func:`manipulability_jacobian`, RTB's ``jacobm``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional, Sequence, TYPE_CHECKING, Union
+from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
@@ -56,14 +57,18 @@ def task_rows(task: Task) -> list:
         try:
             return list(_TASKS[task])
         except KeyError:
-            raise ValueError(f"unknown task '{task}' (use one of {list(_TASKS)} or a list of row indices 0..5)") from None
+            raise ValueError(
+                f"unknown task '{task}' (use one of {list(_TASKS)} or a list of row indices 0..5)"
+            ) from None
     rows = [int(r) for r in task]
     if not rows or any(r < 0 or r > 5 for r in rows) or len(set(rows)) != len(rows):
         raise ValueError(f"task rows must be distinct indices in 0..5, got {list(task)}")
     return rows
 
 
-def task_jacobian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def task_jacobian(
+    robot: Robot, q: ArrayLike, frame: str | None = None, task: Task = "full", reference: str = "world"
+) -> np.ndarray:
     """The selected rows of the frame Jacobian: (m, n), or (N, m, n) for a batch of q."""
     return robot.jacobian(q, frame, reference)[..., task_rows(task), :]
 
@@ -85,7 +90,9 @@ def _mul(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (A @ v[..., None])[..., 0]
 
 
-def tool_velocity(robot: Robot, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def tool_velocity(
+    robot: Robot, q: ArrayLike, qd: ArrayLike, frame: str | None = None, task: Task = "full", reference: str = "world"
+) -> np.ndarray:
     """Tool twist (selected rows) ``J(q) qd``; (N, m) for a batch of q and/or qd."""
     J = task_jacobian(robot, q, frame, task, reference)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -93,7 +100,14 @@ def tool_velocity(robot: Robot, q: ArrayLike, qd: ArrayLike, frame: Optional[str
     return finite_result(v, "tool_velocity: v", v.ndim - 1)
 
 
-def joint_torques(robot: Robot, q: ArrayLike, wrench: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def joint_torques(
+    robot: Robot,
+    q: ArrayLike,
+    wrench: ArrayLike,
+    frame: str | None = None,
+    task: Task = "full",
+    reference: str = "world",
+) -> np.ndarray:
     """Static joint torques balancing a tool wrench: ``tau = J^T F`` (Spong §4.10); (N, n) for a batch.
 
     ``wrench`` has one entry per task row (e.g. (Fx, Fy) with ``task="planar"``; [force; moment]
@@ -110,7 +124,7 @@ def joint_velocities(
     robot,
     q,
     velocity,
-    frame: Optional[str] = None,
+    frame: str | None = None,
     task: Task = "full",
     method: str = "pinv",
     damping: float = 1e-2,
@@ -131,18 +145,24 @@ def joint_velocities(
     v = _vector(velocity, J.shape[-2], "velocity", J)
     if method == "inverse":
         if J.shape[-2] != J.shape[-1]:
-            raise ValueError(f"method='inverse' needs a square Jacobian; the task gives {J.shape[-2]}x{J.shape[-1]} (use 'pinv' or 'dls')")
+            raise ValueError(
+                f"method='inverse' needs a square Jacobian; the task gives {J.shape[-2]}x{J.shape[-1]} (use 'pinv' or 'dls')"
+            )
         qs = np.asarray(q, dtype=float).reshape(-1, robot.n)
         for k, Jk in enumerate(J.reshape(-1, *J.shape[-2:])):
             report = _report(Jk, task_rows(task), robot.n, 1e-9)
             if report.singular:
                 where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
-                raise ValueError(f"the Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}: {report.summary()}")
+                raise ValueError(
+                    f"the Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}: {report.summary()}"
+                )
         with np.errstate(over="ignore", invalid="ignore"):
             qd = np.linalg.solve(J, v[..., None])[..., 0]
         return finite_result(qd, "joint_velocities: qd", qd.ndim - 1)
     damping = 0.0 if method == "pinv" else damping
-    if isinstance(damping, (complex, np.complexfloating)) or not (np.isreal(damping) and damping >= 0 and np.isfinite(damping)):
+    if isinstance(damping, (complex, np.complexfloating)) or not (
+        np.isreal(damping) and damping >= 0 and np.isfinite(damping)
+    ):
         raise ValueError(f"damping must be a finite number >= 0, got {damping!r}")
     U, s, Vt = np.linalg.svd(J, full_matrices=False)
     lam2 = float(damping) ** 2
@@ -157,12 +177,16 @@ def joint_velocities(
     return finite_result(qd, "joint_velocities: qd", qd.ndim - 1)
 
 
-def singular_values(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def singular_values(
+    robot: Robot, q: ArrayLike, frame: str | None = None, task: Task = "full", reference: str = "world"
+) -> np.ndarray:
     """Singular values of the task Jacobian, descending; (N, k) for a batch."""
     return np.linalg.svd(task_jacobian(robot, q, frame, task, reference), compute_uv=False)
 
 
-def manipulability(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> Union[float, np.ndarray]:
+def manipulability(
+    robot: Robot, q: ArrayLike, frame: str | None = None, task: Task = "full", reference: str = "world"
+) -> Union[float, np.ndarray]:
     """Yoshikawa's measure ``w = sqrt(det(J J^T))`` = the product of the singular values."""
     s = singular_values(robot, q, frame, task, reference)
     m = len(task_rows(task))
@@ -171,14 +195,16 @@ def manipulability(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task
     return np.prod(s, axis=-1)
 
 
-def jacobian_hessian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world") -> np.ndarray:
+def jacobian_hessian(
+    robot: Robot, q: ArrayLike, frame: str | None = None, task: Task = "full", reference: str = "world"
+) -> np.ndarray:
     """``dJ/dq`` of the task rows of the Jacobian: (n, m, n), or (N, n, m, n) for a batch, with
     ``H[i, :, j] = dJ[:, j]/dq_i`` (:meth:`kinedyn.Robot.jacobian_hessian`; Robotics Toolbox's
     ``(n, 6, n)`` layout, so ``reference="world"`` with ``task="full"`` is RTB's ``hessian0``)."""
     return robot.jacobian_hessian(q, frame, reference)[..., task_rows(task), :]
 
 
-def hessian_in_frame_axes(robot: Robot, q: ArrayLike, frame: Optional[str] = None) -> np.ndarray:
+def hessian_in_frame_axes(robot: Robot, q: ArrayLike, frame: str | None = None) -> np.ndarray:
     """Robotics Toolbox's ``hessiane``: the world Hessian ``dJ_world/dq`` (RTB's ``hessian0``) with
     its linear and angular rows expressed in the frame's own axes, ``diag(R^T, R^T) H0[i]``;
     (n, 6, n) or (N, n, 6, n).
@@ -198,7 +224,14 @@ def hessian_in_frame_axes(robot: Robot, q: ArrayLike, frame: Optional[str] = Non
     return out
 
 
-def manipulability_jacobian(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> np.ndarray:
+def manipulability_jacobian(
+    robot: Robot,
+    q: ArrayLike,
+    frame: str | None = None,
+    task: Task = "full",
+    reference: str = "world",
+    tol: float = 1e-9,
+) -> np.ndarray:
     """Gradient ``dw/dq`` of Yoshikawa's manipulability ``w = sqrt(det(J J^T))`` on the task rows
     (the rows :func:`manipulability` uses): (n,), or (N, n) for a batch. Robotics Toolbox's
     ``jacobm`` (which returns it as an (n, 1) column).
@@ -269,7 +302,14 @@ class SingularityReport:
         return f"rank {self.rank} < {min(self.rows, self.n_joints)}: the tool cannot move along {dirs}"
 
 
-def singularity_report(robot: Robot, q: ArrayLike, frame: Optional[str] = None, task: Task = "full", reference: str = "world", tol: float = 1e-9) -> SingularityReport:
+def singularity_report(
+    robot: Robot,
+    q: ArrayLike,
+    frame: str | None = None,
+    task: Task = "full",
+    reference: str = "world",
+    tol: float = 1e-9,
+) -> SingularityReport:
     """Rank, singular values and the lost task directions of the Jacobian at one configuration.
 
     A singular value below ``tol * max(1, sigma_max)`` counts as zero."""

@@ -10,7 +10,8 @@ from __future__ import annotations
 import contextlib
 import sys
 import time
-from typing import TYPE_CHECKING, Iterator, Optional
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
@@ -20,7 +21,7 @@ __all__ = ["Steps", "Delayed", "busy", "wanted"]
 SHOW_AFTER = 1.0  # seconds: work that runs longer shows a bar (so runs over ~2 s show progress)
 
 
-def wanted(progress: Optional[bool]) -> bool:
+def wanted(progress: bool | None) -> bool:
     """``progress`` as given, or (None) whether stderr is a terminal."""
     if progress is None:
         return bool(getattr(sys.stderr, "isatty", lambda: False)())
@@ -31,19 +32,25 @@ class Steps:
     """``with Steps("report", total=5, progress=None) as p: p.step("simulation"); ...``: a bar of
     ``total`` named steps on stderr; does nothing when progress is off."""
 
-    def __init__(self, label: str, total: int, progress: Optional[bool] = None):
+    def __init__(self, label: str, total: int, progress: bool | None = None):
         self.label = label
         self.total = max(int(total), 1)
-        self.bar: Optional[Progress] = None
-        self.task: Optional[TaskID] = None
+        self.bar: Progress | None = None
+        self.task: TaskID | None = None
         if wanted(progress):
             from rich.console import Console
+            from rich.markup import escape
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-            from rich.markup import escape
-
-            self.bar = Progress(TextColumn(f"{escape(label)}:"), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                                console=Console(file=sys.stderr), transient=True)
+            self.bar = Progress(
+                TextColumn(f"{escape(label)}:"),
+                TextColumn("{task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                console=Console(file=sys.stderr),
+                transient=True,
+            )
             self.task = self.bar.add_task("", total=self.total)
             self.bar.start()
 
@@ -63,7 +70,7 @@ class Steps:
             self.bar.stop()
             self.bar = None
 
-    def __enter__(self) -> "Steps":
+    def __enter__(self) -> Steps:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -75,10 +82,17 @@ class Delayed:
     (at once for ``delay=0``); ``text`` formats the amount (rich's ``{task.completed}``,
     ``{task.total}``). Does nothing when ``enabled`` is false."""
 
-    def __init__(self, enabled: bool, total: float, label: str, text: str = "{task.completed:.0f} / {task.total:.0f}", delay: float = 0.0):
+    def __init__(
+        self,
+        enabled: bool,
+        total: float,
+        label: str,
+        text: str = "{task.completed:.0f} / {task.total:.0f}",
+        delay: float = 0.0,
+    ):
         self.enabled, self.total, self.label, self.text, self.delay = enabled, total, label, text, delay
-        self.bar: Optional[Progress] = None
-        self.task: Optional[TaskID] = None
+        self.bar: Progress | None = None
+        self.task: TaskID | None = None
         self.start = time.perf_counter()
         self.last = 0.0
         if enabled and delay <= 0:
@@ -86,12 +100,17 @@ class Delayed:
 
     def _show(self) -> None:
         from rich.console import Console
+        from rich.markup import escape
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-        from rich.markup import escape
-
-        bar = Progress(TextColumn(escape(self.label)), BarColumn(), TextColumn(self.text), TimeRemainingColumn(),
-                       console=Console(file=sys.stderr), transient=True)
+        bar = Progress(
+            TextColumn(escape(self.label)),
+            BarColumn(),
+            TextColumn(self.text),
+            TimeRemainingColumn(),
+            console=Console(file=sys.stderr),
+            transient=True,
+        )
         self.bar, self.task = bar, bar.add_task(self.label, total=self.total)
         bar.start()
 
@@ -115,7 +134,7 @@ class Delayed:
 
 
 @contextlib.contextmanager
-def busy(label: str, progress: Optional[bool] = None) -> Iterator[None]:
+def busy(label: str, progress: bool | None = None) -> Iterator[None]:
     """A spinner with ``label`` and the elapsed time on stderr while the block runs (for work that
     cannot report its own progress, such as a SymPy derivation); nothing when progress is off."""
     if not wanted(progress):

@@ -10,8 +10,9 @@ from __future__ import annotations
 import math
 import os
 import sys
+from collections.abc import Mapping, Sequence
 from functools import cached_property
-from typing import TYPE_CHECKING, Mapping, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Union
 
 import numpy as np
 import sympy as sp
@@ -19,10 +20,10 @@ import sympy as sp
 from ._arrays import finite_result, real_array
 from ._dask import batched, is_dask_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
+from .description.checks import vector
 from .description.dh import DHRow, links_from_dh
 from .description.geometry import Visual
 from .description.joint import Joint
-from .description.checks import vector
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
 from .description.mimic import mimic_map as _mimic_map
 
@@ -42,6 +43,7 @@ def _load_ik():
 
     _IK_SOLVE = inverse_kinematics
     return _IK_SOLVE
+
 
 _DASK_ARRAYS = ("dask.array",)  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
 
@@ -77,11 +79,15 @@ def _locked_block(joint, block) -> np.ndarray:
     checked): what :meth:`Robot.lock_joints` folds into the placement."""
     b = real_array(block, f"value of joint '{joint.name}'").ravel()
     if b.shape != (joint.nq,) or not np.all(np.isfinite(b)):
-        raise ValueError(f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}")
+        raise ValueError(
+            f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}"
+        )
     T = np.eye(4)
     unit = b[-4:] if joint.kind != "planar" else b[2:]
     if abs(np.linalg.norm(unit) - 1.0) > 1e-6:
-        raise ValueError(f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit")
+        raise ValueError(
+            f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit"
+        )
     if joint.kind == "planar":
         e1, e2 = _planar_basis(to_float_array(joint.axis, (3,), "axis"))
         n = np.cross(e1, e2)
@@ -112,6 +118,8 @@ def _joint_columns(joint) -> list:
         e1, e2 = _planar_basis(axis)
         return [(1, e1), (1, e2), (0, np.cross(e1, e2))]
     return [(0 if joint.kind == "revolute" else 1, axis)]
+
+
 _F64 = np.dtype(np.float64)
 
 
@@ -129,10 +137,10 @@ class Robot:
         *,
         gravity=(0.0, 0.0, -9.81),
         base: str = "base",
-        tool: Optional[str] = None,
+        tool: str | None = None,
         name: str = "robot",
-        dh: Optional[Sequence[DHRow]] = None,
-        dh_convention: Optional[str] = None,
+        dh: Sequence[DHRow] | None = None,
+        dh_convention: str | None = None,
         source: str = "",
         inertia: str = "warn",
         visuals: Sequence[Visual] = (),
@@ -182,7 +190,7 @@ class Robot:
         name: str = "dh_robot",
         source: str = "",
         inertia: str = "warn",
-    ) -> "Robot":
+    ) -> Robot:
         """A serial arm from a DH table (see :mod:`kinedyn.description.dh` for the conventions).
 
         ``rows``: DHRow objects, mappings with keys theta/d/a/alpha/kind/inertia/limits..., or tuples
@@ -193,14 +201,35 @@ class Robot:
         links, dh_rows = links_from_dh(rows, convention)
         if base_pose is not None:
             first = links[0]
-            links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
+            links[0] = Link(
+                first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia
+            )
         frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
-        return cls(links, frames, gravity=gravity, name=name, dh=dh_rows, dh_convention=convention, source=source, inertia=inertia)
+        return cls(
+            links,
+            frames,
+            gravity=gravity,
+            name=name,
+            dh=dh_rows,
+            dh_convention=convention,
+            source=source,
+            inertia=inertia,
+        )
 
     @classmethod
-    def from_urdf(cls, path_or_string: Union[PathLike, bytes], *, gravity: ArrayLike = (0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn",
-                  floating_base: bool = False, xacro_args: Optional[Mapping[str, object]] = None, trust_xacro: bool = False,
-                  package_dirs: Sequence[PathLike] = (), mimic: str = "reduce") -> "Robot":
+    def from_urdf(
+        cls,
+        path_or_string: Union[PathLike, bytes],
+        *,
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+        tool: str | None = None,
+        inertia: str = "warn",
+        floating_base: bool = False,
+        xacro_args: Mapping[str, object] | None = None,
+        trust_xacro: bool = False,
+        package_dirs: Sequence[PathLike] = (),
+        mimic: str = "reduce",
+    ) -> Robot:
         """A robot from a URDF file path or an XML string (see :mod:`kinedyn.description.urdf`).
         ``inertia``: what to do with an inertia no rigid body can have: ``"warn"`` (load it, with a
         ``PhysicalConsistencyWarning``), ``"repair"`` (project it onto the nearest consistent one)
@@ -219,14 +248,30 @@ class Robot:
 
         if is_xacro(path_or_string):
             text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
-            return robot_from_urdf(text, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base,
-                                   source_path=os.fsdecode(path_or_string), mimic=mimic)
+            return robot_from_urdf(
+                text,
+                gravity=gravity,
+                tool=tool,
+                inertia=inertia,
+                floating_base=floating_base,
+                source_path=os.fsdecode(path_or_string),
+                mimic=mimic,
+            )
         if xacro_args:
             raise ValueError("xacro_args are for a .xacro file")
-        return robot_from_urdf(path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic)
+        return robot_from_urdf(
+            path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic
+        )
 
     @classmethod
-    def from_mjcf(cls, path_or_string: Union[PathLike, bytes], *, gravity: Optional[ArrayLike] = None, tool: Optional[str] = None, inertia: str = "warn") -> "Robot":
+    def from_mjcf(
+        cls,
+        path_or_string: Union[PathLike, bytes],
+        *,
+        gravity: ArrayLike | None = None,
+        tool: str | None = None,
+        inertia: str = "warn",
+    ) -> Robot:
         """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
         and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
         ``tool`` and ``inertia`` as :meth:`from_urdf`."""
@@ -234,7 +279,7 @@ class Robot:
 
         return robot_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
 
-    def replace(self, **changes) -> "Robot":
+    def replace(self, **changes) -> Robot:
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
         kwargs = dict(
             links=self.links,
@@ -254,7 +299,7 @@ class Robot:
         kwargs.update(changes)
         return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
 
-    def lock_joints(self, joints, at=None) -> "Robot":
+    def lock_joints(self, joints, at=None) -> Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
 
         ``joints``: a mapping ``{joint: value}``, or a sequence (list, tuple, set, array) of joints
@@ -269,7 +314,9 @@ class Robot:
         n_joints = len(names)
         starts = np.cumsum([0] + [j.nq for j in self.joints])
         if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
-            raise TypeError(f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}")
+            raise TypeError(
+                f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}"
+            )
         if isinstance(joints, Mapping):
             items = list(joints.items())
         else:
@@ -278,7 +325,9 @@ class Robot:
                 raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
             items = [(j, None) for j in joints]
         followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
-        unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
+        unknown = sorted(
+            str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers
+        )
         if unknown:
             raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
         values: dict = {}
@@ -296,7 +345,7 @@ class Robot:
             else:
                 raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
             if self.joints[i].is_multi_dof:
-                block = q_at[starts[i]:starts[i + 1]] if value is None else value
+                block = q_at[starts[i] : starts[i + 1]] if value is None else value
                 values[names[i]] = _locked_block(self.joints[i], block)
                 continue
             if value is None:
@@ -304,7 +353,9 @@ class Robot:
             try:
                 v = float(value)
             except (TypeError, ValueError):
-                raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}") from None
+                raise ValueError(
+                    f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}"
+                ) from None
             if not math.isfinite(v):
                 raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
             values[names[i]] = v
@@ -317,7 +368,9 @@ class Robot:
             j = link.joint
             if j.name in values and j.is_multi_dof:
                 fixed = Joint(j.name, "fixed")
-                link = Link(link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia)
+                link = Link(
+                    link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia
+                )
             elif j.name in values and j.is_moving:
                 x = values[j.name] + j.offset
                 motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
@@ -395,7 +448,8 @@ class Robot:
             follower, relation = next(iter(self._mimic.relations.items()))
             raise ValueError(
                 f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
-                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)")
+                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)"
+            )
 
     @property
     def body_names(self) -> list:
@@ -531,7 +585,7 @@ class Robot:
                 add(f.placement)
         return free
 
-    def subs(self, mapping: Mapping) -> "Robot":
+    def subs(self, mapping: Mapping) -> Robot:
         """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);
         keys are symbols or their names."""
         mapping = by_name(mapping, self.symbols)
@@ -548,8 +602,19 @@ class Robot:
         for link in self.links:
             j = link.joint
             joint = Joint(
-                j.name, j.kind, tuple(f(a) for a in j.axis), f(j.offset), j.lower, j.upper, j.velocity_limit,
-                j.effort_limit, f(j.gear_ratio), f(j.rotor_inertia), f(j.viscous), f(j.coulomb), f(j.coulomb_negative),
+                j.name,
+                j.kind,
+                tuple(f(a) for a in j.axis),
+                f(j.offset),
+                j.lower,
+                j.upper,
+                j.velocity_limit,
+                j.effort_limit,
+                f(j.gear_ratio),
+                f(j.rotor_inertia),
+                f(j.viscous),
+                f(j.coulomb),
+                f(j.coulomb_negative),
                 mimic=j.mimic,
             )
             try:
@@ -561,9 +626,24 @@ class Robot:
         dh = None
         if self.dh is not None:
             dh = [
-                DHRow(f(r.theta), f(r.d), f(r.a), f(r.alpha), r.kind, r.name, r.inertia.subs(mapping), r.lower, r.upper,
-                      r.velocity_limit, r.effort_limit, f(r.gear_ratio), f(r.rotor_inertia), f(r.viscous), f(r.coulomb),
-                      f(r.coulomb_negative))
+                DHRow(
+                    f(r.theta),
+                    f(r.d),
+                    f(r.a),
+                    f(r.alpha),
+                    r.kind,
+                    r.name,
+                    r.inertia.subs(mapping),
+                    r.lower,
+                    r.upper,
+                    r.velocity_limit,
+                    r.effort_limit,
+                    f(r.gear_ratio),
+                    f(r.rotor_inertia),
+                    f(r.viscous),
+                    f(r.coulomb),
+                    f(r.coulomb_negative),
+                )
                 for r in self.dh
             ]
         return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
@@ -574,7 +654,9 @@ class Robot:
 
         save(self, path)
 
-    def to_urdf(self, path: Optional[PathLike] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
+    def to_urdf(
+        self, path: PathLike | None = None, *, geometry: bool = True, floating_base_as_root: bool = True
+    ) -> str:
         """The robot as URDF text, written to ``path`` when given (joint offsets folded into the joint
         origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
         robots"). ``geometry``: cylinders along the links of a robot without visuals;
@@ -583,7 +665,7 @@ class Robot:
 
         return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
-    def to_mjcf(self, path: Optional[PathLike] = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
+    def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
         """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
         :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
         from .description.export import to_mjcf
@@ -593,7 +675,9 @@ class Robot:
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
-        return np.concatenate([to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies])
+        return np.concatenate(
+            [to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies]
+        )
 
     @cached_property
     def _frame_ids(self) -> dict:
@@ -605,7 +689,7 @@ class Robot:
         except KeyError:
             raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
 
-    def show(self, q: Optional[ArrayLike] = None, *, block: Optional[bool] = None, **kwargs):
+    def show(self, q: ArrayLike | None = None, *, block: bool | None = None, **kwargs):
         """Open a live 3-D view of the robot at ``q`` in the browser (a viser server on localhost; its
         URL is printed): meshes, frames, a slider per joint. Returns the :class:`kinedyn.visual.viewer.Viewer`;
         ``block``: wait until Ctrl-C (default: from a script yes, in Jupyter no). ``kwargs``: host,
@@ -668,11 +752,20 @@ class Robot:
                 axis.append(a)
             blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
             inertia[last[b]] = link_inertia[b]
+
         # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
         def per_dof(value):
-            return np.array([x for body in bodies for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])])
+            return np.array(
+                [
+                    x
+                    for body in bodies
+                    for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])
+                ]
+            )
 
-        armature, viscous, coulomb = (per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb"))
+        armature, viscous, coulomb = (
+            per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb")
+        )
         gravity = to_float_array(self.gravity, (3,), "gravity")
         frames = self.tree.frames
         frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
@@ -680,10 +773,22 @@ class Robot:
         # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
         coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
         asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        native = _core.Model(np.array(parent, dtype=np.int64), np.array(kind, dtype=np.int64), np.array(axis, dtype=float).reshape(-1, 3),
-                             np.array(offset), np.array(placement).reshape(-1, 4, 4), inertia, armature, viscous, coulomb, gravity,
-                             frame_body, frame_placement, coulomb_negative=asymmetric,
-                             blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None)
+        native = _core.Model(
+            np.array(parent, dtype=np.int64),
+            np.array(kind, dtype=np.int64),
+            np.array(axis, dtype=float).reshape(-1, 3),
+            np.array(offset),
+            np.array(placement).reshape(-1, 4, 4),
+            inertia,
+            armature,
+            viscous,
+            coulomb,
+            gravity,
+            frame_body,
+            frame_placement,
+            coulomb_negative=asymmetric,
+            blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None,
+        )
         if self._mimic is None:
             return native
         from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
@@ -712,7 +817,7 @@ class Robot:
         except KeyError:
             raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'") from None
 
-    def _point(self, point) -> Optional[np.ndarray]:
+    def _point(self, point) -> np.ndarray | None:
         if point is None:
             return None
         p = real_array(point, "point")
@@ -727,14 +832,14 @@ class Robot:
         return self._model.frame_poses(self._state(q), self._link_frame_ids)
 
     @batched("q")
-    def frame_poses(self, q: ArrayLike, frames: Optional[Sequence[str]] = None) -> np.ndarray:
+    def frame_poses(self, q: ArrayLike, frames: Sequence[str] | None = None) -> np.ndarray:
         """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
         names = self.frame_names if frames is None else list(frames)
         ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
         return self._model.frame_poses(self._state(q), ids)
 
     @batched("q")
-    def pose(self, q: ArrayLike, frame: Optional[str] = None) -> np.ndarray:
+    def pose(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
         out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
         return out[0] if out.ndim == 3 else out[:, 0]
@@ -751,7 +856,9 @@ class Robot:
         return ids
 
     @batched("q")
-    def jacobian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+    def jacobian(
+        self, q: ArrayLike, frame: str | None = None, reference: str = "world", point: ArrayLike | None = None
+    ) -> np.ndarray:
         """Geometric Jacobian (6, n), rows [linear; angular] (see docs/conventions.md).
 
         ``reference="world"``: velocity of the frame origin (or of ``point``, given in the frame's
@@ -765,7 +872,9 @@ class Robot:
         return self._model.jacobian(self._state(q), fid, ref, point)
 
     @batched("q")
-    def jacobian_hessian(self, q: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+    def jacobian_hessian(
+        self, q: ArrayLike, frame: str | None = None, reference: str = "world", point: ArrayLike | None = None
+    ) -> np.ndarray:
         """Kinematic Hessian ``dJ/dq`` of :meth:`jacobian` (same frame, reference and point):
         (n, 6, n), or (N, n, 6, n) for a batch, with ``H[i, :, j] = dJ[:, j]/dq_i`` (Robotics
         Toolbox's layout: ``H[i]`` is the derivative of the whole Jacobian along joint i).
@@ -780,23 +889,65 @@ class Robot:
         return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
 
     @batched("q", "qd")
-    def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+    def frame_velocity(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        frame: str | None = None,
+        reference: str = "world",
+        point: ArrayLike | None = None,
+    ) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
-        return self._model.frame_velocity(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+        return self._model.frame_velocity(
+            self._state(q),
+            self._state(qd, "qd"),
+            self.frame_index(frame or self.tool),
+            self._reference(reference),
+            self._point(point),
+        )
 
     @batched("q", "qd")
-    def jacobian_dot_qd(self, q: ArrayLike, qd: ArrayLike, frame: Optional[str] = None, reference: str = "world", point: Optional[ArrayLike] = None) -> np.ndarray:
+    def jacobian_dot_qd(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        frame: str | None = None,
+        reference: str = "world",
+        point: ArrayLike | None = None,
+    ) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
-        return self._model.jdot_qd(self._state(q), self._state(qd, "qd"), self.frame_index(frame or self.tool), self._reference(reference), self._point(point))
+        return self._model.jdot_qd(
+            self._state(q),
+            self._state(qd, "qd"),
+            self.frame_index(frame or self.tool),
+            self._reference(reference),
+            self._point(point),
+        )
 
-    def inverse_kinematics(self, target: ArrayLike, q0: Optional[ArrayLike] = None, mask: Optional[ArrayLike] = None, method: str = "auto", respect_limits: bool = True, **kwargs):  # IKResult, or IKBatchResult for a batch of targets
+    def inverse_kinematics(
+        self,
+        target: ArrayLike,
+        q0: ArrayLike | None = None,
+        mask: ArrayLike | None = None,
+        method: str = "auto",
+        respect_limits: bool = True,
+        **kwargs,
+    ):  # IKResult, or IKBatchResult for a batch of targets
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
         if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             from ._dask import lazy_inverse_kinematics
 
-            return lazy_inverse_kinematics(self, target if is_dask_array(target) else _dask_targets(target, q0), q0, mask, method, respect_limits, kwargs)
+            return lazy_inverse_kinematics(
+                self,
+                target if is_dask_array(target) else _dask_targets(target, q0),
+                q0,
+                mask,
+                method,
+                respect_limits,
+                kwargs,
+            )
         if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
             from ._mimic import inverse_kinematics
 
@@ -809,7 +960,7 @@ class Robot:
     # friction = viscous qd + coulomb sign(qd) (direction-dependent levels: friction_torque), M including
     # the reflected rotor inertia r^2 J_m.
     @cached_property
-    def _link_origin_in_body(self) -> Optional[np.ndarray]:
+    def _link_origin_in_body(self) -> np.ndarray | None:
         """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
         frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
         u = np.zeros((len(self.tree.bodies), 3))
@@ -830,7 +981,9 @@ class Robot:
             f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
         if self._multi_dof:
             if f.shape[-2:] != (links, 6):
-                raise ValueError(f"f_ext must have shape ({links}, 6): one wrench per moving link {self.body_names}, got {f.shape}")
+                raise ValueError(
+                    f"f_ext must have shape ({links}, 6): one wrench per moving link {self.body_names}, got {f.shape}"
+                )
             u = self._link_origin_in_body
             if u is not None and f.ndim == np.ndim(q) + 1:
                 R = self.forward_kinematics(q)[..., :3, :3]
@@ -884,19 +1037,26 @@ class Robot:
         for i in range(joint + 1, len(self.tree.bodies)):  # parent[i] < i
             if parents[i] in subtree:
                 subtree.add(i)
-        bad = [f"link '{f.name}' ({self.nonphysical[f.name].describe()})" for f in self.tree.frames
-               if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive]
+        bad = [
+            f"link '{f.name}' ({self.nonphysical[f.name].describe()})"
+            for f in self.tree.frames
+            if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive
+        ]
         if not bad:
             return ""
-        return (f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
-                f"{', '.join(bad)}; load the robot with inertia='repair'")
+        return (
+            f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
+            f"{', '.join(bad)}; load the robot with inertia='repair'"
+        )
 
     @staticmethod
     def _scalar(x):
         return float(x) if np.ndim(x) == 0 else x
 
     @batched("q", "qd", "qdd", "f_ext")
-    def inverse_dynamics(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def inverse_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: ArrayLike | None = None, out: np.ndarray | None = None
+    ) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
         ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
@@ -909,14 +1069,14 @@ class Robot:
         return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext), out)
 
     @batched("q")
-    def mass_matrix(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def mass_matrix(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric.
         ``out``: a float64 array of the result's shape to write into instead of allocating one (as
         NumPy's ``out=``; also on the other per-step methods, for control loops)."""
         return self._model.mass_matrix(q, out)
 
     @batched("q")
-    def mass_matrix_inverse(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def mass_matrix_inverse(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
             return self._model.mass_matrix_inverse(q, out)
@@ -924,7 +1084,9 @@ class Robot:
             raise self._singular(e) from None
 
     @batched("q", "qd", "tau", "f_ext")
-    def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def forward_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: ArrayLike | None = None, out: np.ndarray | None = None
+    ) -> np.ndarray:
         """qdd solving M qdd = tau - C qd - g - friction + sum_i J_i^T f_ext_i (articulated-body
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
@@ -937,7 +1099,9 @@ class Robot:
             raise self._singular(e) from None
 
     @batched("q", "qd", "qdd", "f_ext")
-    def inverse_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def inverse_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: ArrayLike | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dtau/dq, dtau/dqd, dtau/dqdd = M)`` of :meth:`inverse_dynamics`, each (n, n) (or
         (N, n, n)), entry ``[i, j] = d tau_i / d x_j``: analytical and exact, O(n^2), from one pass
         in world coordinates (Pinocchio's ``computeRNEADerivatives``; the derivation is in the
@@ -952,7 +1116,9 @@ class Robot:
         return (dq if shift is None else dq + shift), dqd, M
 
     @batched("q", "qd", "tau", "f_ext")
-    def forward_dynamics_derivatives(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: Optional[ArrayLike] = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def forward_dynamics_derivatives(
+        self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: ArrayLike | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1)`` of :meth:`forward_dynamics`, each (n, n) (or
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
         (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
@@ -966,7 +1132,7 @@ class Robot:
         shift = self._moment_shift_derivative(q, f_ext)
         return (dq if shift is None else dq - Minv @ shift), dqd, Minv
 
-    def _moment_shift_derivative(self, q: ArrayLike, f_ext) -> Optional[np.ndarray]:
+    def _moment_shift_derivative(self, q: ArrayLike, f_ext) -> np.ndarray | None:
         """The part of dtau/dq the core does not see: :meth:`_f_ext` moves each moment to the body
         origin with ``d_i(q) x f_i``, and ``d_i = R_i u_i`` turns with the joints supporting body i,
         ``dd_i/dq_j = w_j x d_i`` (``w_j``: joint j's world axis, column j of body i's angular
@@ -984,7 +1150,7 @@ class Robot:
         return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
 
     @batched("q", "qd")
-    def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         return self._model.coriolis_matrix(q, qd, out)
 
@@ -995,12 +1161,12 @@ class Robot:
         return self._model.christoffel(q)
 
     @batched("q")
-    def gravity_torque(self, q: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def gravity_torque(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """g(q) = dP/dq."""
         return self._model.gravity_torque(q, out)
 
     @batched("q", "qd")
-    def bias_torque(self, q: ArrayLike, qd: ArrayLike, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def bias_torque(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
         return self._model.bias_torque(q, qd, out)
 
@@ -1075,7 +1241,7 @@ class Robot:
 
         return neutral(self)
 
-    def random_configuration(self, rng: SeedLike = None, size: Optional[int] = None) -> np.ndarray:
+    def random_configuration(self, rng: SeedLike = None, size: int | None = None) -> np.ndarray:
         """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
         uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
         from .configuration import random_configuration

@@ -11,7 +11,8 @@ its place in the store as soon as it is done: no process ever holds more than a 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Sequence, Union
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 
@@ -24,11 +25,22 @@ __all__ = ["sweep", "configurations"]
 Quantity = Union[str, Callable[["Robot", np.ndarray], np.ndarray]]
 
 # Robot methods of q alone that a sweep evaluates by name
-_OF_Q = ("forward_kinematics", "frame_poses", "pose", "jacobian", "jacobian_hessian", "mass_matrix", "mass_matrix_inverse",
-         "christoffel", "gravity_torque", "potential_energy", "center_of_mass")
+_OF_Q = (
+    "forward_kinematics",
+    "frame_poses",
+    "pose",
+    "jacobian",
+    "jacobian_hessian",
+    "mass_matrix",
+    "mass_matrix_inverse",
+    "christoffel",
+    "gravity_torque",
+    "potential_energy",
+    "center_of_mass",
+)
 
 
-def _bounds(robot: "Robot") -> tuple[np.ndarray, np.ndarray]:
+def _bounds(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """The box a sweep covers: the joint limits, [-pi, pi] (revolute) or [-1, 1] (prismatic) where
     a side is infinite (as Robot.random_configuration)."""
     lo, hi = robot.lower_limits.copy(), robot.upper_limits.copy()
@@ -53,8 +65,14 @@ def _grid_block(index: np.ndarray, axes: tuple) -> np.ndarray:
     return np.stack([a[d] for a, d in zip(axes, digits)], axis=1)
 
 
-def configurations(robot: "Robot", *, samples: Optional[int] = None, grid: Union[int, Sequence[int], None] = None,
-                   chunk: int = 100_000, seed: int = 0):
+def configurations(
+    robot: Robot,
+    *,
+    samples: int | None = None,
+    grid: Union[int, Sequence[int], None] = None,
+    chunk: int = 100_000,
+    seed: int = 0,
+):
     """The configurations of a sweep as a lazy (N, n) dask array chunked by ``chunk`` states:
     ``samples`` uniform random configurations in the joint limits (chunk k drawn from
     ``numpy.random.default_rng([seed, k])``), or a ``grid`` of points per joint (one number, or one
@@ -71,41 +89,74 @@ def configurations(robot: "Robot", *, samples: Optional[int] = None, grid: Union
         if not (isinstance(samples, (int, np.integer)) and samples >= 1):
             raise ValueError(f"samples must be a whole number of configurations >= 1, got {samples!r}")
         index = da.arange(int(samples), chunks=int(chunk), dtype=np.int64)
-        return index.map_blocks(_random_block, lo, hi, int(seed), int(chunk), new_axis=1, chunks=(index.chunks[0], (n,)),
-                                dtype=np.float64, meta=np.empty((0, 0)))
+        return index.map_blocks(
+            _random_block,
+            lo,
+            hi,
+            int(seed),
+            int(chunk),
+            new_axis=1,
+            chunks=(index.chunks[0], (n,)),
+            dtype=np.float64,
+            meta=np.empty((0, 0)),
+        )
     points: list = [grid] * n if isinstance(grid, (int, np.integer)) else list(grid or ())
     if len(points) != n or not all(isinstance(p, (int, np.integer)) and p >= 1 for p in points):
         raise ValueError(f"grid must be a number of points >= 1 per joint (one number, or {n} of them), got {grid!r}")
-    axes = tuple(np.linspace(lo[i], hi[i], int(p)) if p > 1 else np.array([(lo[i] + hi[i]) / 2]) for i, p in enumerate(points))
+    axes = tuple(
+        np.linspace(lo[i], hi[i], int(p)) if p > 1 else np.array([(lo[i] + hi[i]) / 2]) for i, p in enumerate(points)
+    )
     total = int(np.prod([int(p) for p in points], dtype=object))
     index = da.arange(total, chunks=int(chunk), dtype=np.int64)
-    return index.map_blocks(_grid_block, axes, new_axis=1, chunks=(index.chunks[0], (n,)), dtype=np.float64, meta=np.empty((0, 0)))
+    return index.map_blocks(
+        _grid_block, axes, new_axis=1, chunks=(index.chunks[0], (n,)), dtype=np.float64, meta=np.empty((0, 0))
+    )
 
 
-def _evaluate(robot: "Robot", q, name: str, quantity: Quantity):
-    import dask.array as da
+def _evaluate(robot: Robot, q, name: str, quantity: Quantity):
 
     if isinstance(quantity, str):
         if quantity not in _OF_Q:
-            raise ValueError(f"sweep quantity '{quantity}' is not a Robot method of q alone; one of {list(_OF_Q)}, "
-                             "or a function f(robot, q) of a NumPy (m, n) block returning (m, ...)")
+            raise ValueError(
+                f"sweep quantity '{quantity}' is not a Robot method of q alone; one of {list(_OF_Q)}, "
+                "or a function f(robot, q) of a NumPy (m, n) block returning (m, ...)"
+            )
         return getattr(robot, quantity)(q)
     # a function of a NumPy block of configurations: its per-state shape from one state
     probe = np.asarray(quantity(robot, robot.neutral()[None]))
     if probe.ndim < 1 or probe.shape[0] != 1:
-        raise ValueError(f"sweep quantity '{name}' must return one row per configuration, (m, ...); for 1 state it gave shape {probe.shape}")
+        raise ValueError(
+            f"sweep quantity '{name}' must return one row per configuration, (m, ...); for 1 state it gave shape {probe.shape}"
+        )
     trailing = probe.shape[1:]
-    return q.map_blocks(_apply, robot, quantity, drop_axis=1, new_axis=list(range(1, 1 + len(trailing))),
-                        chunks=(q.chunks[0],) + tuple((s,) for s in trailing), dtype=np.float64, meta=np.empty((0,) * probe.ndim))
+    return q.map_blocks(
+        _apply,
+        robot,
+        quantity,
+        drop_axis=1,
+        new_axis=list(range(1, 1 + len(trailing))),
+        chunks=(q.chunks[0],) + tuple((s,) for s in trailing),
+        dtype=np.float64,
+        meta=np.empty((0,) * probe.ndim),
+    )
 
 
-def _apply(block: np.ndarray, robot: "Robot", function) -> np.ndarray:
+def _apply(block: np.ndarray, robot: Robot, function) -> np.ndarray:
     return np.asarray(function(robot, block), dtype=np.float64)
 
 
-def sweep(robot: "Robot", store: Union["PathLike", Any], quantities: Union[Sequence[Quantity], Mapping[str, Quantity]] = ("mass_matrix",), *,
-          samples: Optional[int] = None, grid: Union[int, Sequence[int], None] = None, chunk: int = 100_000, seed: int = 0,
-          progress: Union[bool, None, Callable[[int, int], Any]] = None, overwrite: bool = False):
+def sweep(
+    robot: Robot,
+    store: Union[PathLike, Any],
+    quantities: Union[Sequence[Quantity], Mapping[str, Quantity]] = ("mass_matrix",),
+    *,
+    samples: int | None = None,
+    grid: Union[int, Sequence[int], None] = None,
+    chunk: int = 100_000,
+    seed: int = 0,
+    progress: Union[bool, None, Callable[[int, int], Any]] = None,
+    overwrite: bool = False,
+):
     """Evaluate ``quantities`` over a random sample or a grid of configurations, writing each chunk
     of states to the Zarr ``store`` (a path or a Zarr store) as it is computed, on the active dask
     scheduler (threads by default; a ``distributed.Client`` when one exists).
@@ -122,8 +173,13 @@ def sweep(robot: "Robot", store: Union["PathLike", Any], quantities: Union[Seque
     import dask.array as da
     import zarr
 
-    named: dict[str, Quantity] = dict(quantities) if isinstance(quantities, Mapping) else {
-        (q if isinstance(q, str) else getattr(q, "__name__", f"quantity{i}")): q for i, q in enumerate(quantities)}
+    named: dict[str, Quantity] = (
+        dict(quantities)
+        if isinstance(quantities, Mapping)
+        else {
+            (q if isinstance(q, str) else getattr(q, "__name__", f"quantity{i}")): q for i, q in enumerate(quantities)
+        }
+    )
     if "q" in named:
         raise ValueError("'q' is the name of the configurations' array in the store: name the quantity otherwise")
     q = configurations(robot, samples=samples, grid=grid, chunk=chunk, seed=seed)
@@ -135,20 +191,37 @@ def sweep(robot: "Robot", store: Union["PathLike", Any], quantities: Union[Seque
     if not overwrite and isinstance(store, (str, os.PathLike)) and os.path.exists(store):
         raise FileExistsError(f"sweep: {os.fspath(store)} exists; pass overwrite=True to replace it")
     group = zarr.open_group(store, mode="w" if overwrite else "w-")
-    group.attrs.update({
-        "kinedyn": "sweep", "robot": robot.name, "joint_names": list(robot.joint_names),
-        "sampling": "random" if samples is not None else "grid", "seed": int(seed), "chunk": int(chunk),
-        "grid": None if grid is None else ([int(grid)] * robot.n if isinstance(grid, (int, np.integer)) else [int(g) for g in grid]),
-        "lower": _bounds(robot)[0].tolist(), "upper": _bounds(robot)[1].tolist(),
-    })
+    group.attrs.update(
+        {
+            "kinedyn": "sweep",
+            "robot": robot.name,
+            "joint_names": list(robot.joint_names),
+            "sampling": "random" if samples is not None else "grid",
+            "seed": int(seed),
+            "chunk": int(chunk),
+            "grid": None
+            if grid is None
+            else ([int(grid)] * robot.n if isinstance(grid, (int, np.integer)) else [int(g) for g in grid]),
+            "lower": _bounds(robot)[0].tolist(),
+            "upper": _bounds(robot)[1].tolist(),
+        }
+    )
     targets = {}
     for name, x in arrays.items():
         targets[name] = group.create_array(name, shape=x.shape, chunks=(chunk,) + x.shape[1:], dtype=x.dtype)
     # one write task per chunk of states, all arrays of the chunk together
     total = q.shape[0]
     flat = [arrays[k].reshape(total, -1) for k in arrays]
-    writes = da.map_blocks(_write_chunk, *flat, targets=[targets[k] for k in arrays], shapes=[arrays[k].shape[1:] for k in arrays],
-                           drop_axis=1, chunks=((1,) * len(q.chunks[0]),), dtype=np.int64, meta=np.empty((0,), dtype=np.int64))
+    writes = da.map_blocks(
+        _write_chunk,
+        *flat,
+        targets=[targets[k] for k in arrays],
+        shapes=[arrays[k].shape[1:] for k in arrays],
+        drop_axis=1,
+        chunks=((1,) * len(q.chunks[0]),),
+        dtype=np.int64,
+        meta=np.empty((0,), dtype=np.int64),
+    )
     report = _progress(progress, total)
     chunks = writes.to_delayed().ravel()
     done = 0
@@ -163,7 +236,7 @@ def sweep(robot: "Robot", store: Union["PathLike", Any], quantities: Union[Seque
         else:
             step = _parallelism()  # a few chunks per worker thread at a time, so the bar moves
             for start in range(0, len(chunks), step):
-                done += sum(int(c[0]) for c in dask.compute(*chunks[start:start + step]))
+                done += sum(int(c[0]) for c in dask.compute(*chunks[start : start + step]))
                 report(done, total)
     finally:
         getattr(report, "close", lambda: None)()

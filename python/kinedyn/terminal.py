@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import copy
 import re
-from typing import List
 
 __all__ = ["console", "fit_table", "NUMBER"]
 
 #: A cell that is one number as kinedyn prints them (``-1.5``, `` 2.44929e-21``, ``inf``, ``nan``,
 #: ``3.1 m``, ``28.6°``).
-NUMBER = re.compile(r"\s*[-+]?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?\s*(°|m|rad|%)?\s*|\s*[-+]?(inf|nan|∞)\s*", re.IGNORECASE)
+NUMBER = re.compile(
+    r"\s*[-+]?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?\s*(°|m|rad|%)?\s*|\s*[-+]?(inf|nan|∞)\s*", re.IGNORECASE
+)
 
 
 def _plain(cell) -> str:
@@ -32,14 +33,13 @@ def _plain(cell) -> str:
     return ""  # another renderable: not a number
 
 
-def fit_table(table, width: int, console) -> List:
+def fit_table(table, width: int, console) -> list:
     """``table`` (a rich Table) as a list of tables no wider than ``width`` columns of ``console``:
     numeric columns (every cell a :data:`NUMBER`) do not wrap, other columns fold rather than cut;
     if the table is still too wide, its columns go into several tables, each keeping the first column
     (the row labels) and titled with the columns it shows."""
-    from rich.measure import Measurement
-
     from rich.cells import cell_len
+    from rich.measure import Measurement
 
     for k, column in enumerate(table.columns):
         cells = [_plain(c) for c in column._cells]
@@ -65,7 +65,7 @@ def fit_table(table, width: int, console) -> List:
         t.columns = [copy.copy(c) for c in [key, *columns]]
         return t
 
-    groups: List[list] = [[]]
+    groups: list[list] = [[]]
     for column in rest:
         if groups[-1] and too_wide(part(groups[-1] + [column])):
             groups.append([])

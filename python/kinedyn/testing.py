@@ -9,7 +9,6 @@ report and a user can all ask "does the engine agree with itself on this robot?"
 from __future__ import annotations
 
 import math
-from typing import Optional
 
 import numpy as np
 
@@ -22,7 +21,7 @@ from .robot import Robot
 __all__ = ["random_robot", "random_inertia", "check_identities", "example_robot_data_dir"]
 
 
-def example_robot_data_dir() -> Optional[str]:
+def example_robot_data_dir() -> str | None:
     """The ``robots/`` folder of an installed example-robot-data (its wheel ships the URDFs and meshes
     under ``site-packages/cmeel.prefix/share/example-robot-data/robots``), or None."""
     import os
@@ -56,8 +55,17 @@ def random_inertia(rng) -> Inertia:
     return Inertia(m, tuple(rng.uniform(-0.3, 0.3, 3)), R @ principal @ R.T)
 
 
-def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: float = 0.25, fixed: int = 1, friction: bool = True,
-                 floating: bool = False, spherical: float = 0.0, planar: float = 0.0) -> Robot:
+def random_robot(
+    seed: int = 0,
+    n: int = 6,
+    branching: bool = False,
+    prismatic: float = 0.25,
+    fixed: int = 1,
+    friction: bool = True,
+    floating: bool = False,
+    spherical: float = 0.0,
+    planar: float = 0.0,
+) -> Robot:
     """A random robot of ``n`` moving joints (plus ``fixed`` fixed links with inertia, merged at
     compile time). ``branching=True`` gives a tree (each link's parent is any earlier link).
     ``floating=True``: the first joint is a free-flyer; ``spherical`` / ``planar``: the chance that
@@ -70,7 +78,11 @@ def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: 
         parent = None if i == 0 else (names[int(rng.integers(0, i))] if branching else names[-1])
         # (drawn only when asked for, so that the robots of a seed stay those of earlier versions)
         draw = rng.uniform() if spherical or planar else 1.0
-        multi = "floating" if floating and i == 0 else ("spherical" if draw < spherical else "planar" if draw < spherical + planar else None)
+        multi = (
+            "floating"
+            if floating and i == 0
+            else ("spherical" if draw < spherical else "planar" if draw < spherical + planar else None)
+        )
         if moving and multi is not None and i > 0 or (moving and multi == "floating"):
             joint = Joint(f"j{i + 1}", multi, (0.0, 0.0, 1.0))
         elif moving:
@@ -95,7 +107,7 @@ def random_robot(seed: int = 0, n: int = 6, branching: bool = False, prismatic: 
     return Robot(links, [tool], gravity=(0.0, 0.0, -9.81), name=f"random_{'tree' if branching else 'chain'}_{seed}")
 
 
-def check_identities(robot: Robot, states: int = 5, seed: Optional[int] = 0, h: float = 1e-6) -> dict:
+def check_identities(robot: Robot, states: int = 5, seed: int | None = 0, h: float = 1e-6) -> dict:
     """Largest residual of each identity over ``states`` random states, as {name: residual}.
 
     Each residual is an absolute difference scaled by max(1, |reference|) of the quantities
@@ -137,6 +149,12 @@ def check_identities(robot: Robot, states: int = 5, seed: Optional[int] = 0, h: 
         record("dM/dt == C + C^T (finite differences)", Mdot, C + C.T)
         S = Mdot - 2 * C
         record("dM/dt - 2C skew (finite differences)", S, -S.T)
-        dP = np.array([(robot.potential_energy(robot.integrate(q, e, h)) - robot.potential_energy(robot.integrate(q, e, -h))) / (2 * h) for e in np.eye(n)])
+        dP = np.array(
+            [
+                (robot.potential_energy(robot.integrate(q, e, h)) - robot.potential_energy(robot.integrate(q, e, -h)))
+                / (2 * h)
+                for e in np.eye(n)
+            ]
+        )
         record("g == dP/dq (finite differences)", g, dP)
     return worst

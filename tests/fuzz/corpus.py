@@ -103,20 +103,34 @@ def _read(path: str) -> str:
         return f.read()
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def seeds(kind: str) -> tuple:
     """The seed texts of one kind ("urdf", "yaml" or "toml"), in a fixed order."""
     if kind == "urdf":
-        out = [Seed("examples/robots/planar_2r.urdf", "urdf", _read(os.path.join(ROOT, "examples", "robots", "planar_2r.urdf")))]
+        out = [
+            Seed(
+                "examples/robots/planar_2r.urdf",
+                "urdf",
+                _read(os.path.join(ROOT, "examples", "robots", "planar_2r.urdf")),
+            )
+        ]
         erd = erd_robots_dir()
         if erd is not None:
-            out += [Seed(f"example-robot-data/{p}", "urdf", _read(os.path.join(erd, p))) for p in ERD_URDFS if os.path.exists(os.path.join(erd, p))]
+            out += [
+                Seed(f"example-robot-data/{p}", "urdf", _read(os.path.join(erd, p)))
+                for p in ERD_URDFS
+                if os.path.exists(os.path.join(erd, p))
+            ]
         return tuple(out)
     if kind not in ("yaml", "toml"):
         raise ValueError(f"unknown seed kind {kind!r}")
     ext = {"yaml": (".yaml", ".yml"), "toml": (".toml",)}[kind]
     folder = os.path.join(ROOT, "examples", "robots")
-    out = [Seed(f"examples/robots/{f}", kind, _read(os.path.join(folder, f))) for f in sorted(os.listdir(folder)) if f.endswith(ext)]
+    out = [
+        Seed(f"examples/robots/{f}", kind, _read(os.path.join(folder, f)))
+        for f in sorted(os.listdir(folder))
+        if f.endswith(ext)
+    ]
     for name, text in (("full_dh", FULL_DH_YAML), ("full_tree", FULL_TREE_YAML)):
         if kind == "toml":
             import tomli_w
@@ -127,7 +141,7 @@ def seeds(kind: str) -> tuple:
     return tuple(out) + _saved(kind)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _saved(kind: str) -> tuple:
     """``Robot.save`` of every built-in robot (DH flavour) and of two URDF robots (tree flavour)."""
     import kinedyn as kd
@@ -138,7 +152,12 @@ def _saved(kind: str) -> tuple:
         if erd is not None and os.path.exists(os.path.join(erd, p)):
             robots.append((f"example-robot-data/{p}", kd.Robot.from_urdf(os.path.join(erd, p))))
     if not robots[-1][0].startswith("example"):  # no example-robot-data: the project's own URDF
-        robots.append(("examples/robots/planar_2r.urdf", kd.Robot.from_urdf(os.path.join(ROOT, "examples", "robots", "planar_2r.urdf"))))
+        robots.append(
+            (
+                "examples/robots/planar_2r.urdf",
+                kd.Robot.from_urdf(os.path.join(ROOT, "examples", "robots", "planar_2r.urdf")),
+            )
+        )
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, robot in robots:

@@ -21,14 +21,13 @@ import tempfile
 import threading
 import time
 from collections import Counter
-from typing import Optional
 
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import seed as hypothesis_seed
 
 from . import strategies
 from .strategies import KINDS, MARKER_ENV, Case
-from .worker import CLASSES, CODE_EXEC, CRASH, DEFECTS, HANG, MEMORY, read_frame, write_frame
+from .worker import CODE_EXEC, CRASH, DEFECTS, HANG, MEMORY, read_frame, write_frame
 
 PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # share of each kind in --kind all
@@ -50,8 +49,14 @@ def generate(kind: str, count: int, seed: int = 0, issue: bool = True) -> list:
         return out
     out: list = []
 
-    @settings(max_examples=count, database=None, phases=[Phase.generate], deadline=None,
-              suppress_health_check=list(HealthCheck), print_blob=False)
+    @settings(
+        max_examples=count,
+        database=None,
+        phases=[Phase.generate],
+        deadline=None,
+        suppress_health_check=list(HealthCheck),
+        print_blob=False,
+    )
     @hypothesis_seed(seed)
     @given(strategies.cases(kind))
     def collect(case):
@@ -76,7 +81,7 @@ class Worker:
         self.start_timeout = start_timeout
         self.folder = tempfile.mkdtemp(prefix="kd-fuzz-")
         self.marker = os.path.join(self.folder, "canary-marker")
-        self.proc: Optional[subprocess.Popen] = None
+        self.proc: subprocess.Popen | None = None
         self.starts = 0
 
     def _start(self) -> None:
@@ -90,8 +95,15 @@ class Worker:
         env.pop(strategies.CANARY_ENV, None)
         self.err_path = os.path.join(self.folder, "stderr")
         self.err = open(self.err_path, "wb")
-        self.proc = subprocess.Popen([sys.executable, "-m", "fuzz.worker"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=self.err, cwd=self.folder, env=env, start_new_session=True)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "fuzz.worker"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.err,
+            cwd=self.folder,
+            env=env,
+            start_new_session=True,
+        )
         self.starts += 1
         ready = self._answer(self.start_timeout)
         if not isinstance(ready, dict) or "ready" not in ready:
@@ -151,9 +163,16 @@ class Worker:
             code = self.proc.wait()
             tail = self._stderr_tail()
             self.stop()
-            how = f"killed by signal {-code} ({signal.Signals(-code).name})" if code < 0 else f"exited with status {code}"
+            how = (
+                f"killed by signal {-code} ({signal.Signals(-code).name})" if code < 0 else f"exited with status {code}"
+            )
             outcome = MEMORY if "memory allocation of" in tail or "MemoryError" in tail else CRASH
-            result = {"index": case.index, "outcome": outcome, "detail": f"the worker {how}: {tail[-600:]}", "seconds": seconds}
+            result = {
+                "index": case.index,
+                "outcome": outcome,
+                "detail": f"the worker {how}: {tail[-600:]}",
+                "seconds": seconds,
+            }
         if os.path.exists(self.marker):  # the canary ran before the worker hung or died
             os.remove(self.marker)
             result["detail"] = f"the canary ran (was: {result['outcome']}: {result['detail']})"
@@ -165,7 +184,7 @@ def run(cases: list, jobs: int = 1, timeout: float = 10.0, memory: int = 2 << 30
     """Results (dicts with outcome, detail, seconds), in the order of ``cases``."""
     results: list = [None] * len(cases)
     todo: queue.Queue = queue.Queue()
-    for i, case in enumerate(cases):
+    for i, _case in enumerate(cases):
         todo.put(i)
     done = Counter()
     lock = threading.Lock()
@@ -299,7 +318,7 @@ def shrink(case: Case, outcome: str, timeout: float, memory: int, budget: int = 
         while chunk >= 1 and tries < budget:
             i, removed = 0, False
             while i < len(parts) and tries < budget:
-                trial = parts[:i] + parts[i + chunk:]
+                trial = parts[:i] + parts[i + chunk :]
                 if trial and same(sep.join(trial)):
                     parts, removed = trial, True
                 else:

@@ -26,8 +26,8 @@ import functools
 import math
 import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
-from typing import Any, Optional
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import tomli_w
@@ -50,7 +50,7 @@ class Case:
     seed: str  # the seed file or the robot
     ops: tuple  # readable description of each mutation
     data: Any = None
-    call: Optional[tuple] = None
+    call: tuple | None = None
     index: int = -1  # position in the generated list (set by the runner)
     valid: bool = False  # the input is valid as documented: any error is a defect (valid input rejected)
 
@@ -66,8 +66,10 @@ def _canary(function: str = "exec") -> str:
     if function == "exec":
         code = f"import os;os.environ['{CANARY_ENV}']='1';open(os.environ['{MARKER_ENV}'],'w').write('pwned')"
     else:
-        code = (f"(__import__('os').environ.__setitem__('{CANARY_ENV}','1'),"
-                f"open(__import__('os').environ['{MARKER_ENV}'],'w').write('pwned'))")
+        code = (
+            f"(__import__('os').environ.__setitem__('{CANARY_ENV}','1'),"
+            f"open(__import__('os').environ['{MARKER_ENV}'],'w').write('pwned'))"
+        )
     return f"{function}(" + "+".join(f"chr({ord(c)})" for c in code) + ")"
 
 
@@ -76,33 +78,167 @@ CANARY = _canary("exec")
 # ============================================================================ hostile values
 DEEP = 5000
 HOSTILE_NUMBER_TEXT = (
-    "nan", "NaN", ".nan", "inf", "-inf", ".inf", "-.inf", "Infinity", "1e200", "-1e200", "1e308", "1e309", "-1e309",
-    "1e300", "1e154", "-1e154", "1e-320", "5e-324", "0", "-0.0", "-1", "-1e-9", "4" * 400, "-" + "9" * 400,
-    "1e99999", "1e", "0x1F", "1_000", "", " ", "1 2", "1,5", "--1", "+-1", "1e200 1e200 1e200", "nan nan nan",
-    "0 0 0 0", "1" * 20 + ".5",
+    "nan",
+    "NaN",
+    ".nan",
+    "inf",
+    "-inf",
+    ".inf",
+    "-.inf",
+    "Infinity",
+    "1e200",
+    "-1e200",
+    "1e308",
+    "1e309",
+    "-1e309",
+    "1e300",
+    "1e154",
+    "-1e154",
+    "1e-320",
+    "5e-324",
+    "0",
+    "-0.0",
+    "-1",
+    "-1e-9",
+    "4" * 400,
+    "-" + "9" * 400,
+    "1e99999",
+    "1e",
+    "0x1F",
+    "1_000",
+    "",
+    " ",
+    "1 2",
+    "1,5",
+    "--1",
+    "+-1",
+    "1e200 1e200 1e200",
+    "nan nan nan",
+    "0 0 0 0",
+    "1" * 20 + ".5",
 )
 HOSTILE_EXPRESSIONS = (
-    "9**9**9", "factorial(10**7)", "__import__('os')", "x.y", "sqrt(-1)", "(" * DEEP + "1" + ")" * DEEP,
-    "-" * DEEP + "1", "1/0", "zoo", "oo", "-oo", "nan", "E**1000", "10**400", "2**-100000", "exp(10**6)",
-    "Integer(10)**(10**8)", "l1**l2**l3**l4**l5", CANARY, _canary("eval"), "lambda: 1", "[1]*10**9", "'a'*10**10",
-    "x" * 100_000, "a+" * 20_000 + "a", "Symbol('x')", "sin", "pi", "I", "E", "S", "Q", "N", "True", "None",
-    "1e200*1e200", "(-1)**0.5", "0**-1", "log(0)", "gamma(10**10)", "x if y else z", "a;b", "`x`", "{}", "[]",
-    "10**10**10", "2**(2**(2**(2**9)))", "binomial(10**9, 10**8)", "primepi(10**12)", "Float('1e100000')",
-    "m1*l1**2/12", "l1 - lc1", "-g", "1" * 5000,
+    "9**9**9",
+    "factorial(10**7)",
+    "__import__('os')",
+    "x.y",
+    "sqrt(-1)",
+    "(" * DEEP + "1" + ")" * DEEP,
+    "-" * DEEP + "1",
+    "1/0",
+    "zoo",
+    "oo",
+    "-oo",
+    "nan",
+    "E**1000",
+    "10**400",
+    "2**-100000",
+    "exp(10**6)",
+    "Integer(10)**(10**8)",
+    "l1**l2**l3**l4**l5",
+    CANARY,
+    _canary("eval"),
+    "lambda: 1",
+    "[1]*10**9",
+    "'a'*10**10",
+    "x" * 100_000,
+    "a+" * 20_000 + "a",
+    "Symbol('x')",
+    "sin",
+    "pi",
+    "I",
+    "E",
+    "S",
+    "Q",
+    "N",
+    "True",
+    "None",
+    "1e200*1e200",
+    "(-1)**0.5",
+    "0**-1",
+    "log(0)",
+    "gamma(10**10)",
+    "x if y else z",
+    "a;b",
+    "`x`",
+    "{}",
+    "[]",
+    "10**10**10",
+    "2**(2**(2**(2**9)))",
+    "binomial(10**9, 10**8)",
+    "primepi(10**12)",
+    "Float('1e100000')",
+    "m1*l1**2/12",
+    "l1 - lc1",
+    "-g",
+    "1" * 5000,
 )
 HOSTILE_NAMES = (
-    "", " ", "a" * 10_000, "<!--<script>", "</script><script>alert(1)</script>", "名前", "base_link", "world",
-    "tool", "a b", "a/b", "..", "a\tb", "{{x}}", "${HOME}", "%s%n",
+    "",
+    " ",
+    "a" * 10_000,
+    "<!--<script>",
+    "</script><script>alert(1)</script>",
+    "名前",
+    "base_link",
+    "world",
+    "tool",
+    "a b",
+    "a/b",
+    "..",
+    "a\tb",
+    "{{x}}",
+    "${HOME}",
+    "%s%n",
 )
 HOSTILE_JOINT_TYPES = (
-    "spherical", "floating", "planar", "screw", "REVOLUTE", "Revolute", "", "revolute ", "prismatic", "continuous",
-    "fixed", "revolute_x", "ball", "free",
+    "spherical",
+    "floating",
+    "planar",
+    "screw",
+    "REVOLUTE",
+    "Revolute",
+    "",
+    "revolute ",
+    "prismatic",
+    "continuous",
+    "fixed",
+    "revolute_x",
+    "ball",
+    "free",
 )
 # values of the wrong type or range, for a parsed YAML/TOML value
 HOSTILE_VALUES = (
-    float("nan"), float("inf"), -float("inf"), 1e200, -1e200, 1e300, 1e154, 5e-324, 10**400, -(10**400), 2**64, -1,
-    0, -0.0, True, None, [], {}, [1, 2], [[1, 2], [3]], {"a": 1}, "", "nan", [float("nan")] * 3, [1e200] * 3,
-    [0.0] * 2, [0.0] * 4, ["x", "y", "z"], {"xyz": [0, 0, 0]}, [[0.0] * 3] * 3,
+    float("nan"),
+    float("inf"),
+    -float("inf"),
+    1e200,
+    -1e200,
+    1e300,
+    1e154,
+    5e-324,
+    10**400,
+    -(10**400),
+    2**64,
+    -1,
+    0,
+    -0.0,
+    True,
+    None,
+    [],
+    {},
+    [1, 2],
+    [[1, 2], [3]],
+    {"a": 1},
+    "",
+    "nan",
+    [float("nan")] * 3,
+    [1e200] * 3,
+    [0.0] * 2,
+    [0.0] * 4,
+    ["x", "y", "z"],
+    {"xyz": [0, 0, 0]},
+    [[0.0] * 3] * 3,
 )
 XML_ENTITY_BOMB = (
     '<?xml version="1.0"?>\n<!DOCTYPE robot [\n <!ENTITY a "aaaaaaaaaa">\n'
@@ -141,7 +277,7 @@ def op_replace_number(draw, data, kind):
     new = draw(st.sampled_from(HOSTILE_NUMBER_TEXT))
     if kind != "urdf" and draw(st.booleans()):
         new = f"'{new}'" if kind == "yaml" else f'"{new}"'
-    return text[: m.start()] + new + text[m.end():], f"number '{m.group()}' at offset {m.start()} -> {_short(new)}"
+    return text[: m.start()] + new + text[m.end() :], f"number '{m.group()}' at offset {m.start()} -> {_short(new)}"
 
 
 def op_replace_quoted(draw, data, kind):
@@ -160,7 +296,7 @@ def op_replace_quoted(draw, data, kind):
     else:  # a double-quoted YAML or TOML string (TOML literal strings cannot hold a quote)
         quote = '"'
         body = new.replace("\\", "\\\\").replace('"', '\\"')
-    text = text[: m.start()] + quote + body + quote + text[m.end():]
+    text = text[: m.start()] + quote + body + quote + text[m.end() :]
     return text, f"string {_short(m.group())} at offset {m.start()} -> {_short(new)}"
 
 
@@ -173,7 +309,9 @@ def op_yaml_scalar(draw, data, kind):
     m = matches[_pick(draw, len(matches), "scalar")]
     new = draw(st.sampled_from(HOSTILE_EXPRESSIONS))
     new_text = "'" + new.replace("'", "''") + "'"
-    return text[: m.start(2)] + new_text + text[m.end(2):], f"scalar {_short(m.group(2))} after {_short(m.group(1).strip())} -> {_short(new)}"
+    return text[: m.start(2)] + new_text + text[
+        m.end(2) :
+    ], f"scalar {_short(m.group(2))} after {_short(m.group(1).strip())} -> {_short(new)}"
 
 
 def op_truncate(draw, data, kind):
@@ -195,10 +333,10 @@ def op_bytes(draw, data, kind):
         return raw[:at] + blob + raw[at:], f"inserted bytes {blob!r} at {at}"
     if how == "flip":
         bit = draw(st.integers(0, 7))
-        return raw[:at] + bytes([raw[at] ^ (1 << bit)]) + raw[at + 1:], f"flipped bit {bit} of byte {at}"
+        return raw[:at] + bytes([raw[at] ^ (1 << bit)]) + raw[at + 1 :], f"flipped bit {bit} of byte {at}"
     if how == "delete":
         k = draw(st.integers(1, 16))
-        return raw[:at] + raw[at + k:], f"deleted {k} bytes at {at}"
+        return raw[:at] + raw[at + k :], f"deleted {k} bytes at {at}"
     if how == "nul":
         return raw[:at] + b"\x00" + raw[at:], f"inserted NUL at {at}"
     if how == "invalid-utf8":
@@ -220,14 +358,14 @@ def op_lines(draw, data, kind):
     how = draw(st.sampled_from(("delete", "duplicate", "swap", "repeat")))
     if how == "delete":
         k = draw(st.integers(1, 5))
-        del lines[i: i + k]
+        del lines[i : i + k]
         return "\n".join(lines), f"deleted lines {i + 1}-{i + k}"
     if how == "duplicate":
         lines.insert(i, lines[i])
         return "\n".join(lines), f"duplicated line {i + 1}: {_short(lines[i].strip())}"
     if how == "repeat":
         k = draw(st.sampled_from((2, 10, 1000)))
-        lines[i: i + 1] = [lines[i]] * k
+        lines[i : i + 1] = [lines[i]] * k
         return "\n".join(lines), f"line {i + 1} repeated {k} times: {_short(lines[i].strip())}"
     j = _pick(draw, len(lines), "other line")
     lines[i], lines[j] = lines[j], lines[i]
@@ -253,9 +391,26 @@ def op_urdf_tree(draw, data, kind):
     elements = [(parent, child) for parent in root.iter() for child in parent]
     joints = root.findall("joint")
     links = [l.get("name") for l in root.findall("link") if l.get("name")]
-    how = draw(st.sampled_from(("delete", "duplicate", "attribute", "drop-attribute", "joint-type", "cycle", "self-parent",
-                                "dangling", "fixed-chain", "deep-nesting", "entity-bomb", "empty-robot", "swap-limits",
-                                "add-dynamics")))
+    how = draw(
+        st.sampled_from(
+            (
+                "delete",
+                "duplicate",
+                "attribute",
+                "drop-attribute",
+                "joint-type",
+                "cycle",
+                "self-parent",
+                "dangling",
+                "fixed-chain",
+                "deep-nesting",
+                "entity-bomb",
+                "empty-robot",
+                "swap-limits",
+                "add-dynamics",
+            )
+        )
+    )
     if how in ("delete", "duplicate", "attribute", "drop-attribute") and elements:
         parent, child = elements[_pick(draw, len(elements), "element")]
         where = f"<{child.tag} {_short(str(child.attrib), 60)}>"
@@ -332,7 +487,9 @@ def op_urdf_tree(draw, data, kind):
         body = re.sub(r'(<link name=")([^"]*)(")', r"\1&i;\3", body, count=1)
         return XML_ENTITY_BOMB + body, "XML entity bomb (10**9 characters) as the first link's name"
     if how == "empty-robot":
-        return draw(st.sampled_from(('<robot name="r"/>', "<robot/>", "<notrobot/>", "", "<robot>", "<?xml version='1.0'?>"))), "replaced by a tiny document"
+        return draw(
+            st.sampled_from(('<robot name="r"/>', "<robot/>", "<notrobot/>", "", "<robot>", "<?xml version='1.0'?>"))
+        ), "replaced by a tiny document"
     return data, None
 
 
@@ -346,9 +503,13 @@ def _load(data, kind):
         return None
 
 
-def _dump(obj, kind) -> Optional[str]:
+def _dump(obj, kind) -> str | None:
     try:
-        return tomli_w.dumps(obj) if kind == "toml" else yaml.safe_dump(obj, sort_keys=False, default_flow_style=None, width=120)
+        return (
+            tomli_w.dumps(obj)
+            if kind == "toml"
+            else yaml.safe_dump(obj, sort_keys=False, default_flow_style=None, width=120)
+        )
     except Exception:
         return None
 
@@ -370,7 +531,13 @@ def _joint_rows(obj) -> list:
     """The joint mappings of a parsed robot file (DH rows or the links' joints), whatever an earlier
     mutation did to its structure."""
     joints, links = obj.get("joints"), obj.get("links")
-    rows = joints if isinstance(joints, list) else [l.get("joint") for l in links if isinstance(l, dict)] if isinstance(links, list) else []
+    rows = (
+        joints
+        if isinstance(joints, list)
+        else [l.get("joint") for l in links if isinstance(l, dict)]
+        if isinstance(links, list)
+        else []
+    )
     return [r for r in rows if isinstance(r, dict)]
 
 
@@ -385,7 +552,11 @@ def op_mapping(draw, data, kind):
         slots = _slots(obj)
     except RecursionError:  # a deeply nested value from an earlier mutation
         return data, None
-    how = draw(st.sampled_from(("value", "expression", "delete", "duplicate", "joint-type", "cycle", "name", "add-field", "swap-limits")))
+    how = draw(
+        st.sampled_from(
+            ("value", "expression", "delete", "duplicate", "joint-type", "cycle", "name", "add-field", "swap-limits")
+        )
+    )
     desc = None
     if how in ("value", "expression", "delete", "duplicate") and slots:
         container, key, path = slots[_pick(draw, len(slots), "slot")]
@@ -431,7 +602,11 @@ def op_mapping(draw, data, kind):
             row["limits"] = {"lower": 1.0, "upper": -1.0}
             desc = f"joint '{row.get('name')}' limits lower 1 > upper -1"
         else:
-            key = draw(st.sampled_from(("gear_ratio", "rotor_inertia", "viscous", "coulomb", "offset", "limits", "origin", "axis")))
+            key = draw(
+                st.sampled_from(
+                    ("gear_ratio", "rotor_inertia", "viscous", "coulomb", "offset", "limits", "origin", "axis")
+                )
+            )
             new = draw(st.sampled_from(HOSTILE_VALUES + HOSTILE_EXPRESSIONS[:12]))
             row[key] = copy.deepcopy(new)
             desc = f"joint '{row.get('name')}' {key} = {_short(repr(new))}"
@@ -457,20 +632,40 @@ def op_yaml_special(draw, data, kind):
         return data, None
     if how == "alias-bomb":
         levels = draw(st.sampled_from((3, 6, 9, 10)))
-        return text[: m.start()] + "name: " + yaml_alias_bomb(levels) + text[m.end():], f"name: a YAML alias bomb of 9**{levels} leaves"
+        return text[: m.start()] + "name: " + yaml_alias_bomb(levels) + text[
+            m.end() :
+        ], f"name: a YAML alias bomb of 9**{levels} leaves"
     if how == "deep-list":
         depth = draw(st.sampled_from((100, 1000, DEEP)))
-        return text[: m.start()] + "name: " + "[" * depth + "]" * depth + text[m.end():], f"name: a list nested {depth} deep"
+        return text[: m.start()] + "name: " + "[" * depth + "]" * depth + text[
+            m.end() :
+        ], f"name: a list nested {depth} deep"
     if how == "deep-map":
         depth = draw(st.sampled_from((100, 1000, DEEP)))
-        return text[: m.start()] + "name: " + "{a: " * depth + "1" + "}" * depth + text[m.end():], f"name: a mapping nested {depth} deep"
+        return text[: m.start()] + "name: " + "{a: " * depth + "1" + "}" * depth + text[
+            m.end() :
+        ], f"name: a mapping nested {depth} deep"
     if how == "duplicate-key":
-        key = draw(st.sampled_from(("name: other", "gravity: [0, 0, 9.81]", "convention: modified", "units: {angle: deg}")))
+        key = draw(
+            st.sampled_from(("name: other", "gravity: [0, 0, 9.81]", "convention: modified", "units: {angle: deg}"))
+        )
         return text + "\n" + key + "\n", f"duplicate top-level key '{key}'"
     if how == "tag":
-        tag = draw(st.sampled_from(("!!python/object/apply:os.system ['true']", "!!binary aGVsbG8=", "!!timestamp 2001-12-14",
-                                    "!!set {a, b}", "!!float nan", "!!int 0x" + "f" * 400, "!!str 1", "!custom x")))
-        return text[: m.start()] + "name: " + tag + text[m.end():], f"name: {tag}"
+        tag = draw(
+            st.sampled_from(
+                (
+                    "!!python/object/apply:os.system ['true']",
+                    "!!binary aGVsbG8=",
+                    "!!timestamp 2001-12-14",
+                    "!!set {a, b}",
+                    "!!float nan",
+                    "!!int 0x" + "f" * 400,
+                    "!!str 1",
+                    "!custom x",
+                )
+            )
+        )
+        return text[: m.start()] + "name: " + tag + text[m.end() :], f"name: {tag}"
     if how == "merge":
         return text + "\nbase_defaults: &d {mass: 1}\n", "unknown top-level key with an anchor"
     return "&top " + text.replace("gravity:", "gravity: *top\nold_gravity:", 1), "the document aliases itself"
@@ -479,18 +674,22 @@ def op_yaml_special(draw, data, kind):
 def op_toml_special(draw, data, kind):
     text = _as_text(data)
     how = draw(st.sampled_from(("deep-array", "deep-table", "duplicate-key", "huge-int")))
-    m = re.search(r'(?m)^name = .*$', text)
+    m = re.search(r"(?m)^name = .*$", text)
     if m is None:
         return data, None
     if how == "deep-array":
         depth = draw(st.sampled_from((100, 1000, DEEP)))
-        return text[: m.start()] + "name = " + "[" * depth + "]" * depth + text[m.end():], f"name = an array nested {depth} deep"
+        return text[: m.start()] + "name = " + "[" * depth + "]" * depth + text[
+            m.end() :
+        ], f"name = an array nested {depth} deep"
     if how == "deep-table":
         depth = draw(st.sampled_from((100, 1000, DEEP)))
-        return text[: m.start()] + "name = " + "{a = " * depth + "1" + "}" * depth + text[m.end():], f"name = an inline table nested {depth} deep"
+        return text[: m.start()] + "name = " + "{a = " * depth + "1" + "}" * depth + text[
+            m.end() :
+        ], f"name = an inline table nested {depth} deep"
     if how == "duplicate-key":
-        return text[: m.end()] + "\n" + text[m.start(): m.end()] + text[m.end():], "duplicate key 'name'"
-    return text[: m.start()] + "name = " + "9" * 5000 + text[m.end():], "name = a 5000-digit integer"
+        return text[: m.end()] + "\n" + text[m.start() : m.end()] + text[m.end() :], "duplicate key 'name'"
+    return text[: m.start()] + "name = " + "9" * 5000 + text[m.end() :], "name = a 5000-digit integer"
 
 
 TEXT_OPS = (op_replace_number, op_replace_quoted, op_truncate, op_bytes, op_lines)
@@ -503,7 +702,7 @@ OPS = {
 
 def _short(s: str, n: int = 50) -> str:
     s = str(s)
-    return repr(s) if len(s) <= n else repr(s[: n // 2]) + f"...({len(s)} chars)..." + repr(s[-n // 4:])
+    return repr(s) if len(s) <= n else repr(s[: n // 2]) + f"...({len(s)} chars)..." + repr(s[-n // 4 :])
 
 
 @st.composite
@@ -531,11 +730,18 @@ def file_cases(draw, kind: str) -> Case:
 
 # ============================================================================ numeric calls
 # robot specs: "builtin:<name>" or "erd:<path under example-robot-data/robots>"
-ARRAY_ROBOTS = ("builtin:planar_2r", "builtin:puma560", "builtin:stanford", "builtin:ur5", "builtin:cartesian_2p",
-                "erd:panda_description/urdf/panda.urdf", "erd:solo_description/robots/solo.urdf")
+ARRAY_ROBOTS = (
+    "builtin:planar_2r",
+    "builtin:puma560",
+    "builtin:stanford",
+    "builtin:ur5",
+    "builtin:cartesian_2p",
+    "erd:panda_description/urdf/panda.urdf",
+    "erd:solo_description/robots/solo.urdf",
+)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def make_robot(spec: str):
     import os
 
@@ -550,7 +756,7 @@ def make_robot(spec: str):
     return kd.Robot.from_urdf(os.path.join(root, name))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def robot_facts(spec: str):
     robot = make_robot(spec)
     if robot is None:
@@ -593,7 +799,16 @@ KEYWORD_VALUES = {
     "frame": lambda tool, bodies: (tool, bodies[0], bodies[-1], "", "no_such_frame", 5, None, b"tool"),
     "reference": lambda *_: ("world", "local", "spatial", "WORLD", "", None, 3),
     "point": lambda *_: (None, [0.1, 0.0, 0.0], [float("nan"), 0, 0], [1e300, 0, 0], [0.0, 0.0], "x", np.zeros((2, 3))),
-    "mask": lambda *_: (None, (1, 1, 1, 0, 0, 0), (1, 1, 1, 1, 1, 1), (0,) * 6, (1, 1, 1), (float("nan"),) * 6, (-1,) * 6, "xyz"),
+    "mask": lambda *_: (
+        None,
+        (1, 1, 1, 0, 0, 0),
+        (1, 1, 1, 1, 1, 1),
+        (0,) * 6,
+        (1, 1, 1),
+        (float("nan"),) * 6,
+        (-1,) * 6,
+        "xyz",
+    ),
     "method_ik": lambda *_: ("auto", "analytic", "numeric", "lm", "", None),
     "tolerance": lambda *_: (1e-9, 0.0, -1.0, float("nan"), float("inf"), 1e-300, 1.0, "1e-9"),
     "max_iterations": lambda *_: (50, 0, -1, 2**63, 2**64, 1.5, "10", None, True),
@@ -608,7 +823,10 @@ KEYWORD_VALUES = {
 def _mutated_array(draw, rng, shape, scale: float, label: str):
     """A float64 array of ``shape`` (valid) or a mutation of it; returns (value, description)."""
     base = rng.uniform(-scale, scale, size=shape)
-    how = draw(st.sampled_from(("huge", "huge-one", "nonfinite", "shape", "dtype", "layout", "python", "scalar", "zero")), label=label)
+    how = draw(
+        st.sampled_from(("huge", "huge-one", "nonfinite", "shape", "dtype", "layout", "python", "scalar", "zero")),
+        label=label,
+    )
     if how == "zero":
         return np.zeros(shape), "zeros"
     if how in ("huge", "huge-one"):
@@ -626,10 +844,43 @@ def _mutated_array(draw, rng, shape, scale: float, label: str):
         return flat.reshape(shape), f"one element {v}"
     if how == "shape":
         n = shape[-1] if shape else 1
-        new = draw(st.sampled_from(((n + 1,), (max(n - 1, 0),), (0,), (), (n, 1), (1, n), (0, n), (2, n, 1), (3, n + 1), (2, 2, n), (n * 2,))))
+        new = draw(
+            st.sampled_from(
+                (
+                    (n + 1,),
+                    (max(n - 1, 0),),
+                    (0,),
+                    (),
+                    (n, 1),
+                    (1, n),
+                    (0, n),
+                    (2, n, 1),
+                    (3, n + 1),
+                    (2, 2, n),
+                    (n * 2,),
+                )
+            )
+        )
         return rng.uniform(-scale, scale, size=new), f"shape {new}"
     if how == "dtype":
-        dt = draw(st.sampled_from(("int64", "int32", "bool", "float32", "float16", "complex-imag", "complex-real", "object", "object-str", "str", "uint8", "longdouble")))
+        dt = draw(
+            st.sampled_from(
+                (
+                    "int64",
+                    "int32",
+                    "bool",
+                    "float32",
+                    "float16",
+                    "complex-imag",
+                    "complex-real",
+                    "object",
+                    "object-str",
+                    "str",
+                    "uint8",
+                    "longdouble",
+                )
+            )
+        )
         if dt == "complex-imag":
             return base + 1j, "complex with imaginary part 1"
         if dt == "complex-real":
@@ -684,7 +935,11 @@ def array_cases(draw) -> Case:
     valid = draw(st.integers(0, 4), label="valid call") == 0  # one call in five is valid as documented
     batch = draw(st.sampled_from((None, None, 1, 3) if valid else (None, None, 1, 3, 0)), label="batch")
     state_shape = (n,) if batch is None else (batch, n)
-    mutate = set() if valid else set(draw(st.lists(st.sampled_from(roles), min_size=1, max_size=2, unique=True), label="mutated"))
+    mutate = (
+        set()
+        if valid
+        else set(draw(st.lists(st.sampled_from(roles), min_size=1, max_size=2, unique=True), label="mutated"))
+    )
     args, kwargs, ops = [], {}, [f"batch {batch}" if batch is not None else "single state"]
     for role in roles:
         optional = role.startswith("*")
@@ -695,7 +950,9 @@ def array_cases(draw) -> Case:
         if name in ("q", "qd", "qdd", "tau", "q0"):
             shape = (n,) if name == "q0" else state_shape
             scale = {"q": math.pi, "qd": 3.0, "qdd": 5.0, "tau": 20.0, "q0": 1.0}[name]
-            value, desc = _mutated_array(draw, rng, shape, scale, name) if bad else (rng.uniform(-scale, scale, shape), "valid")
+            value, desc = (
+                _mutated_array(draw, rng, shape, scale, name) if bad else (rng.uniform(-scale, scale, shape), "valid")
+            )
         elif name == "f_ext":
             shape = (n, 6) if batch is None else (batch, n, 6)
             if bad and batch is not None and draw(st.booleans()):
@@ -706,7 +963,11 @@ def array_cases(draw) -> Case:
             else:
                 value, desc = draw(st.sampled_from(((None, "None"), (rng.uniform(-10, 10, shape), "valid"))))
         elif name == "out":
-            out_shape = {"inverse_dynamics": state_shape, "forward_dynamics": state_shape, "mass_matrix": state_shape + (n,)}[method]
+            out_shape = {
+                "inverse_dynamics": state_shape,
+                "forward_dynamics": state_shape,
+                "mass_matrix": state_shape + (n,),
+            }[method]
             value, desc = _mutated_array(draw, rng, out_shape, 1.0, name) if bad else (np.zeros(out_shape), "valid")
         elif name == "target":
             R, _ = np.linalg.qr(rng.normal(size=(3, 3)))
@@ -721,15 +982,36 @@ def array_cases(draw) -> Case:
                 value, desc = draw(st.sampled_from(((T, "pose"), (T[..., :3, 3].copy(), "position"))))
         elif name == "values":
             joint = make_robot(spec).joint_names[0]
-            choices = ({joint: 0.1}, [joint], (joint,), {"no_such_joint": 0.0}, {joint: float("nan")}, {joint: "x"}, {joint: 1e300},
-                       {joint: 1j}, {joint: [0.1, 0.2]}, joint, {})
+            choices = (
+                {joint: 0.1},
+                [joint],
+                (joint,),
+                {"no_such_joint": 0.0},
+                {joint: float("nan")},
+                {joint: "x"},
+                {joint: 1e300},
+                {joint: 1j},
+                {joint: [0.1, 0.2]},
+                joint,
+                {},
+            )
             value = draw(st.sampled_from(choices[1:])) if bad else choices[0]
             desc = _short(repr(value))
         elif name in ("t_span", "x0"):
             if name == "x0":
-                value, desc = _mutated_array(draw, rng, (2 * n,), 1.0, name) if bad else (rng.uniform(-1, 1, 2 * n), "valid")
+                value, desc = (
+                    _mutated_array(draw, rng, (2 * n,), 1.0, name) if bad else (rng.uniform(-1, 1, 2 * n), "valid")
+                )
             else:
-                value = draw(st.sampled_from(((0.0, 0.02), 0.02, (0.0, 1e300), (0.0, float("nan")), (1.0, 0.0), (0.0,), "1", (0.0, 1.0)))) if bad else (0.0, 0.02)
+                value = (
+                    draw(
+                        st.sampled_from(
+                            ((0.0, 0.02), 0.02, (0.0, 1e300), (0.0, float("nan")), (1.0, 0.0), (0.0,), "1", (0.0, 1.0))
+                        )
+                    )
+                    if bad
+                    else (0.0, 0.02)
+                )
                 desc = repr(value)
         else:
             key = {"method": "method_ik" if method == "inverse_kinematics" else "method_sim"}.get(name, name)
@@ -779,31 +1061,67 @@ def issue_cases() -> list:
     add("toml", "§1 d = the chr-built exec canary", elbow.replace("d = 3.0", f'd = "{CANARY}"', 1))
     add("yaml", "§2 a: '9**9**9'", a("'9**9**9'"))
     add("yaml", "§2 a: 'factorial(10**7)'", a("'factorial(10**7)'"))
-    add("yaml", "§2 a YAML alias bomb in name:", two_link.replace("name: tutorial_two_link", "name: " + yaml_alias_bomb(9), 1))
-    add("yaml", "§2 name: a list nested 5,000 deep", two_link.replace("name: tutorial_two_link", "name: " + "[" * DEEP + "]" * DEEP, 1))
-    add("toml", "§2 name = an array nested 5,000 deep", elbow.replace('name = "elbow_arm"', "name = " + "[" * DEEP + "]" * DEEP, 1))
+    add(
+        "yaml",
+        "§2 a YAML alias bomb in name:",
+        two_link.replace("name: tutorial_two_link", "name: " + yaml_alias_bomb(9), 1),
+    )
+    add(
+        "yaml",
+        "§2 name: a list nested 5,000 deep",
+        two_link.replace("name: tutorial_two_link", "name: " + "[" * DEEP + "]" * DEEP, 1),
+    )
+    add(
+        "toml",
+        "§2 name = an array nested 5,000 deep",
+        elbow.replace('name = "elbow_arm"', "name = " + "[" * DEEP + "]" * DEEP, 1),
+    )
     add("yaml", "§2 a: 5,000 nested parentheses", a("'" + "(" * DEEP + "1" + ")" * DEEP + "'"))
-    links = "".join(f'<link name="fz{i}"/><joint name="fzj{i}" type="fixed"><parent link="{"link2" if i == 0 else f"fz{i - 1}"}"/>'
-                    f'<child link="fz{i}"/></joint>' for i in range(2000))
+    links = "".join(
+        f'<link name="fz{i}"/><joint name="fzj{i}" type="fixed"><parent link="{"link2" if i == 0 else f"fz{i - 1}"}"/>'
+        f'<child link="fz{i}"/></joint>'
+        for i in range(2000)
+    )
     add("urdf", "§2 2,000 fixed links after the last moving joint", planar.replace("</robot>", links + "</robot>"))
     add("yaml", "§3 a: a 400-digit integer", a("4" * 400))
     add("yaml", "§3 gear_ratio: 1e200", two_link.replace("mass: 1.0,", "gear_ratio: 1e200, mass: 1.0,", 1))
     add("yaml", "§3 a: 'x.y'", a("'x.y'"))
     add("yaml", "§3 a: 'sqrt(-1)'", a("'sqrt(-1)'"))
     add("yaml", "§3 parent: [1, 2]", tree.replace("parent: pan", "parent: [1, 2]", 1))
-    add("yaml", "§3 gravity: [.nan, -9.81, 0]", two_link.replace("gravity: [0, -9.81, 0]", "gravity: [.nan, -9.81, 0]", 1))
+    add(
+        "yaml",
+        "§3 gravity: [.nan, -9.81, 0]",
+        two_link.replace("gravity: [0, -9.81, 0]", "gravity: [.nan, -9.81, 0]", 1),
+    )
     add("yaml", "§3 offset: .nan", tree.replace("offset: 0.1", "offset: .nan", 1))
     add("yaml", "§3 viscous: .inf", tree.replace("viscous: 0.01", "viscous: .inf", 1))
     add("yaml", "§3 coulomb: .nan", tree.replace("coulomb: 0.02", "coulomb: .nan", 1))
     add("yaml", "§3 gear_ratio: .nan", tree.replace("gear_ratio: 100", "gear_ratio: .nan", 1))
-    add("yaml", "§3 origin xyz: [1e200, 0, 0] (of the second link)", tree.replace("xyz: [0, 0, 0.05]", "xyz: [1e200, 0, 0]", 1))
+    add(
+        "yaml",
+        "§3 origin xyz: [1e200, 0, 0] (of the second link)",
+        tree.replace("xyz: [0, 0, 0.05]", "xyz: [1e200, 0, 0]", 1),
+    )
     add("yaml", "§3 a duplicate key", two_link + "\nname: again\n")
-    add("urdf", "§3 an inertial origin of NaN (the URDF prefix repeated)", planar.replace('<origin xyz="', '<origin xyz="nan ', 1))
+    add(
+        "urdf",
+        "§3 an inertial origin of NaN (the URDF prefix repeated)",
+        planar.replace('<origin xyz="', '<origin xyz="nan ', 1),
+    )
     erd = corpus.erd_robots_dir()
     for path in ("tiago_description/robots/tiago_no_hand.urdf", "romeo_description/urdf/romeo.urdf"):
         if erd is not None and os.path.exists(os.path.join(erd, path)):  # loaded by Pinocchio: must load here
-            add("urdf", f"§4 example-robot-data/{path} as it is", open(os.path.join(erd, path), encoding="utf-8").read(), valid=True)
-    add("yaml", "§11 limits lower > upper", tree.replace("limits: {lower: -3.0, upper: 3.0,", "limits: {lower: 3.0, upper: -3.0,", 1))
+            add(
+                "urdf",
+                f"§4 example-robot-data/{path} as it is",
+                open(os.path.join(erd, path), encoding="utf-8").read(),
+                valid=True,
+            )
+    add(
+        "yaml",
+        "§11 limits lower > upper",
+        tree.replace("limits: {lower: -3.0, upper: 3.0,", "limits: {lower: 3.0, upper: -3.0,", 1),
+    )
     add("yaml", "unknown joint type 'spherical'", tree.replace("type: continuous", "type: spherical", 1))
 
     n = 6
@@ -811,15 +1129,43 @@ def issue_cases() -> list:
     q = rng.uniform(-1, 1, n)
     T = np.eye(4)
     T[:3, 3] = (0.3, 0.1, 0.2)
-    add("arrays", "§8 inverse_dynamics(q, 1e154 * ones, 0)", call=("builtin:puma560", "inverse_dynamics", (q, 1e154 * np.ones(n), np.zeros(n)), {}))
-    add("arrays", "§8 kinetic_energy(q, 1e200 * ones)", call=("builtin:puma560", "kinetic_energy", (q, 1e200 * np.ones(n)), {}))
-    add("arrays", "§8 mass_matrix_inverse at q = 1e154", call=("builtin:stanford", "mass_matrix_inverse", (np.full(n, 1e154),), {}))
+    add(
+        "arrays",
+        "§8 inverse_dynamics(q, 1e154 * ones, 0)",
+        call=("builtin:puma560", "inverse_dynamics", (q, 1e154 * np.ones(n), np.zeros(n)), {}),
+    )
+    add(
+        "arrays",
+        "§8 kinetic_energy(q, 1e200 * ones)",
+        call=("builtin:puma560", "kinetic_energy", (q, 1e200 * np.ones(n)), {}),
+    )
+    add(
+        "arrays",
+        "§8 mass_matrix_inverse at q = 1e154",
+        call=("builtin:stanford", "mass_matrix_inverse", (np.full(n, 1e154),), {}),
+    )
     add("arrays", "§11 complex q", call=("builtin:puma560", "forward_kinematics", (q + 1j,), {}))
-    add("arrays", "§11 inverse_kinematics(max_iterations=2**64)", call=("builtin:puma560", "inverse_kinematics", (T,), {"method": "numeric", "max_iterations": 2**64}))
-    add("arrays", "§11 a batch of states with one f_ext on a DH robot",
-        call=("builtin:puma560", "inverse_dynamics", (rng.uniform(-1, 1, (3, n)), np.zeros((3, n)), np.zeros((3, n))), {"f_ext": rng.uniform(-1, 1, (n, 6))}))
+    add(
+        "arrays",
+        "§11 inverse_kinematics(max_iterations=2**64)",
+        call=("builtin:puma560", "inverse_kinematics", (T,), {"method": "numeric", "max_iterations": 2**64}),
+    )
+    add(
+        "arrays",
+        "§11 a batch of states with one f_ext on a DH robot",
+        call=(
+            "builtin:puma560",
+            "inverse_dynamics",
+            (rng.uniform(-1, 1, (3, n)), np.zeros((3, n)), np.zeros((3, n))),
+            {"f_ext": rng.uniform(-1, 1, (n, 6))},
+        ),
+    )
     # (a clear ValueError/TypeError would be right here too; today's TypeError is not clear, which the
     # classes cannot tell: this one is for the figures, the regression test is the fixer's)
     add("arrays", "§11 lock_joints with a list", call=("builtin:puma560", "lock_joints", (["q1"],), {}))
-    add("arrays", "§6 simulate(puma560, (0, 1), x0, dt=1e-12)", call=("builtin:puma560", "simulate", ((0.0, 1.0), np.zeros(2 * n)), {"dt": 1e-12}))
+    add(
+        "arrays",
+        "§6 simulate(puma560, (0, 1), x0, dt=1e-12)",
+        call=("builtin:puma560", "simulate", ((0.0, 1.0), np.zeros(2 * n)), {"dt": 1e-12}),
+    )
     return out

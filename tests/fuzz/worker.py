@@ -38,11 +38,27 @@ CODE_EXEC = "code_exec"  # the canary ran: a file's expression executed Python
 NO_FILENAME = "no_filename"  # a loader's ValueError that does not name the file
 REPEATED_NAME = "repeated_name"  # a loader's message that repeats the file name (a doubled prefix)
 DEFERRED = "deferred"  # a file that loaded but failed at its first numeric call (the error belongs at load)
-BAD_INPUT_ACCEPTED = "bad_input_accepted"  # complex (non-zero imaginary part) or NaN/inf input, or duplicate YAML keys, accepted
+BAD_INPUT_ACCEPTED = (
+    "bad_input_accepted"  # complex (non-zero imaginary part) or NaN/inf input, or duplicate YAML keys, accepted
+)
 VALID_REJECTED = "valid_rejected"  # an input valid as documented (an unmutated seed, a valid call) raised an error
 
-CLASSES = (CLEAN, SUCCESS, PANIC, CRASH, HANG, MEMORY, NONFINITE, BAD_EXCEPTION, CODE_EXEC, NO_FILENAME, REPEATED_NAME,
-           DEFERRED, BAD_INPUT_ACCEPTED, VALID_REJECTED)
+CLASSES = (
+    CLEAN,
+    SUCCESS,
+    PANIC,
+    CRASH,
+    HANG,
+    MEMORY,
+    NONFINITE,
+    BAD_EXCEPTION,
+    CODE_EXEC,
+    NO_FILENAME,
+    REPEATED_NAME,
+    DEFERRED,
+    BAD_INPUT_ACCEPTED,
+    VALID_REJECTED,
+)
 DEFECTS = CLASSES[2:]
 FILE_NAME = "fuzzcase"  # basename (without extension) of the file each file case is written to
 
@@ -113,9 +129,13 @@ def _probe(robot):
         return DEFERRED, f"loaded with lower > upper limits for joints {inverted}"
     q = robot.neutral()
     z = np.zeros(robot.n)
-    calls = (("forward_kinematics", lambda: robot.forward_kinematics(q)), ("mass_matrix", lambda: robot.mass_matrix(q)),
-             ("inverse_dynamics", lambda: robot.inverse_dynamics(q, z, z)), ("gravity_torque", lambda: robot.gravity_torque(q)),
-             ("random_configuration", lambda: robot.random_configuration(0)))
+    calls = (
+        ("forward_kinematics", lambda: robot.forward_kinematics(q)),
+        ("mass_matrix", lambda: robot.mass_matrix(q)),
+        ("inverse_dynamics", lambda: robot.inverse_dynamics(q, z, z)),
+        ("gravity_torque", lambda: robot.gravity_torque(q)),
+        ("random_configuration", lambda: robot.random_configuration(0)),
+    )
     for name, call in calls:
         try:
             out = call()
@@ -227,7 +247,11 @@ def run_selftest(case: Case):
     if what == "hang":
         time.sleep(3600)
     if what == "memory":
-        return run_file(Case(kind="yaml", seed="selftest", ops=(), data="name: x\n"), os.getcwd()) if bytearray(8 << 30) else None
+        return (
+            run_file(Case(kind="yaml", seed="selftest", ops=(), data="name: x\n"), os.getcwd())
+            if bytearray(8 << 30)
+            else None
+        )
     if what == "clean":
         return run_file(Case(kind="yaml", seed="selftest", ops=(), data="name: [1, 2]\n"), os.getcwd())
     raise ValueError(f"unknown self-test {what!r}")
@@ -298,9 +322,10 @@ def main() -> None:
     os.dup2(2, 1)  # prints of the library go to stderr, never into the protocol
     faulthandler.enable()  # a crash leaves its Python traceback in the stderr file
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-    import kinedyn  # noqa: F401  (imported before the limit: the import is not what is tested)
     import sympy  # noqa: F401
     import yaml  # noqa: F401
+
+    import kinedyn  # noqa: F401  (imported before the limit: the import is not what is tested)
 
     memory = int(os.environ.get("KD_FUZZ_MEMORY", str(2 << 30)))
     if memory > 0:

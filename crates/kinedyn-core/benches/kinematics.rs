@@ -13,7 +13,9 @@ fn bench(c: &mut Criterion) {
         let q = Rng::new(3).vector(model.n, -3.0, 3.0);
         let mut j = vec![0.0; 6 * model.n];
         let tool = 0;
-        c.bench_function(&format!("{name}/forward_kinematics"), |b| b.iter(|| forward_kinematics(&model, &mut data, black_box(&q))));
+        c.bench_function(&format!("{name}/forward_kinematics"), |b| {
+            b.iter(|| forward_kinematics(&model, &mut data, black_box(&q)))
+        });
         c.bench_function(&format!("{name}/tool_jacobian_world"), |b| {
             b.iter(|| frame_jacobian(&model, &mut data, black_box(&q), tool, Reference::World, None, &mut j))
         });

@@ -56,7 +56,10 @@ fn min_ns_ab(mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64) {
 }
 
 fn main() {
-    let filter = std::env::args().skip(1).find(|a| !a.starts_with("--")).unwrap_or_default();
+    let filter = std::env::args()
+        .skip(1)
+        .find(|a| !a.starts_with("--"))
+        .unwrap_or_default();
     for (name, model) in models::all() {
         let n = model.n;
         let mut data = Data::new(&model);
@@ -69,18 +72,67 @@ fn main() {
                 println!("{key:28} {:8.1}", min_ns(|| f(&mut *d)));
             }
         };
-        run("rnea", &mut |d| _ = black_box(alg::rnea(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None)[0]));
+        run("rnea", &mut |d| {
+            _ = black_box(alg::rnea(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None)[0])
+        });
         run("crba", &mut |d| _ = black_box(alg::crba(&model, d, black_box(&q))[0]));
-        run("aba", &mut |d| _ = black_box(alg::aba(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None).unwrap()[0]));
-        run("coriolis_matrix", &mut |d| _ = black_box(alg::coriolis_matrix(&model, d, black_box(&q), black_box(&qd))[0]));
-        run("gravity_torque", &mut |d| _ = black_box(alg::gravity_torque(&model, d, black_box(&q))[0]));
-        run("mass_matrix_inverse", &mut |d| _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0]));
+        run("aba", &mut |d| {
+            _ = black_box(alg::aba(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None).unwrap()[0])
+        });
+        run("coriolis_matrix", &mut |d| {
+            _ = black_box(alg::coriolis_matrix(&model, d, black_box(&q), black_box(&qd))[0])
+        });
+        run("gravity_torque", &mut |d| {
+            _ = black_box(alg::gravity_torque(&model, d, black_box(&q))[0])
+        });
+        run("mass_matrix_inverse", &mut |d| {
+            _ = black_box(alg::mass_matrix_inverse(&model, d, black_box(&q)).unwrap()[0])
+        });
         let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-        run("rnea_derivatives", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), None, &mut d1, &mut d2, None));
+        run("rnea_derivatives", &mut |d| {
+            alg::rnea_derivatives(
+                &model,
+                d,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                None,
+                &mut d1,
+                &mut d2,
+                None,
+            )
+        });
         let fx: Vec<f64> = (0..6 * n).map(|k| 0.1 * k as f64 - 1.0).collect();
-        run("rnea_derivatives_f_ext", &mut |d| alg::rnea_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&qdd), Some(&fx), &mut d1, &mut d2, None));
-        run("aba_derivatives", &mut |d| alg::aba_derivatives(&model, d, black_box(&q), black_box(&qd), black_box(&tau), None, &mut d1, &mut d2, &mut d3).unwrap());
-        run("forward_kinematics", &mut |d| alg::forward_kinematics(&model, d, black_box(&q)));
+        run("rnea_derivatives_f_ext", &mut |d| {
+            alg::rnea_derivatives(
+                &model,
+                d,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                Some(&fx),
+                &mut d1,
+                &mut d2,
+                None,
+            )
+        });
+        run("aba_derivatives", &mut |d| {
+            alg::aba_derivatives(
+                &model,
+                d,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&tau),
+                None,
+                &mut d1,
+                &mut d2,
+                &mut d3,
+            )
+            .unwrap()
+        });
+        run("forward_kinematics", &mut |d| {
+            alg::forward_kinematics(&model, d, black_box(&q))
+        });
         bench_batches(name, &model, &filter);
         if filter == "flops" {
             print_flops(name, &model);
@@ -98,14 +150,42 @@ fn bench_batches(name: &str, model: &kinedyn_core::Model, filter: &str) {
     use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
     const STATES: usize = 1024;
     let mut rng = kinedyn_core::testing::Rng::new(17);
-    let q: Vec<f64> = (0..STATES).flat_map(|_| kinedyn_core::testing::random_configuration(model, &mut rng)).collect();
-    let (qd, qdd) = (rng.vector(STATES * model.n, -2.0, 2.0), rng.vector(STATES * model.n, -2.0, 2.0));
+    let q: Vec<f64> = (0..STATES)
+        .flat_map(|_| kinedyn_core::testing::random_configuration(model, &mut rng))
+        .collect();
+    let (qd, qdd) = (
+        rng.vector(STATES * model.n, -2.0, 2.0),
+        rng.vector(STATES * model.n, -2.0, 2.0),
+    );
     let mut scratch = Scratch::new(model);
     let mut tau = vec![0.0; STATES * model.n];
-    let x3 = [Input { values: &q, width: model.nq }, Input { values: &qd, width: model.n }, Input { values: &qdd, width: model.n }];
+    let x3 = [
+        Input {
+            values: &q,
+            width: model.nq,
+        },
+        Input {
+            values: &qd,
+            width: model.n,
+        },
+        Input {
+            values: &qdd,
+            width: model.n,
+        },
+    ];
     batch::run(model, &mut scratch, &kernels::InverseDynamics, &x3, &mut tau, Simd::Off).unwrap();
-    let aba_in = [x3[0], x3[1], Input { values: &tau, width: model.n }];
-    for simd in [Simd::Off, Simd::Portable, Simd::Avx2, Simd::Avx512].into_iter().filter(|s| s.is_supported()) {
+    let aba_in = [
+        x3[0],
+        x3[1],
+        Input {
+            values: &tau,
+            width: model.n,
+        },
+    ];
+    for simd in [Simd::Off, Simd::Portable, Simd::Avx2, Simd::Avx512]
+        .into_iter()
+        .filter(|s| s.is_supported())
+    {
         let mut time = |alg: &str, kernel: &dyn Fn(&mut Scratch)| {
             let key = format!("{name}/{alg}_batch_{}", simd.name());
             if key.contains(filter) {
@@ -136,9 +216,15 @@ fn bench_tree(tree: &models::TreeFile, filter: &str) {
     let tau = alg::rnea(model, &mut data, q, v, a, None).to_vec();
     print_check(&format!("{name}/check_rnea"), &tau);
     let m = alg::crba(model, &mut data, q).to_vec();
-    let upper: Vec<f64> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).map(|(i, j)| m[i * n + j]).collect();
+    let upper: Vec<f64> = (0..n)
+        .flat_map(|i| (i..n).map(move |j| (i, j)))
+        .map(|(i, j)| m[i * n + j])
+        .collect();
     print_check(&format!("{name}/check_crba"), &upper);
-    print_check(&format!("{name}/check_aba"), alg::aba(model, &mut data, q, v, &tau, None).unwrap());
+    print_check(
+        &format!("{name}/check_aba"),
+        alg::aba(model, &mut data, q, v, &tau, None).unwrap(),
+    );
     let d = &mut data;
     let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {
         let key = format!("{name}/{alg}");
@@ -146,9 +232,13 @@ fn bench_tree(tree: &models::TreeFile, filter: &str) {
             println!("{key:28} {:8.1}", min_ns(|| f(&mut *d)));
         }
     };
-    run("rnea", &mut |d| _ = black_box(alg::rnea(model, d, black_box(q), black_box(v), black_box(a), None)[0]));
+    run("rnea", &mut |d| {
+        _ = black_box(alg::rnea(model, d, black_box(q), black_box(v), black_box(a), None)[0])
+    });
     run("crba", &mut |d| _ = black_box(alg::crba(model, d, black_box(q))[0]));
-    run("aba", &mut |d| _ = black_box(alg::aba(model, d, black_box(q), black_box(v), black_box(&tau), None).unwrap()[0]));
+    run("aba", &mut |d| {
+        _ = black_box(alg::aba(model, d, black_box(q), black_box(v), black_box(&tau), None).unwrap()[0])
+    });
     free_flyer_crba_share(model, d, tree, filter);
 }
 
@@ -162,7 +252,14 @@ fn free_flyer_crba_share(model: &kinedyn_core::Model, data: &mut Data, tree: &mo
     use kinedyn_core::algorithms::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
     use kinedyn_core::model::{Block, Coordinates};
     use kinedyn_core::spatial::{Force, Inertia, Vec3};
-    if !matches!(model.coordinates.first(), Some(Coordinates::Head { block: Block::FreeFlyer, .. })) || model.parent[0].is_some() {
+    if !matches!(
+        model.coordinates.first(),
+        Some(Coordinates::Head {
+            block: Block::FreeFlyer,
+            ..
+        })
+    ) || model.parent[0].is_some()
+    {
         return;
     }
     let key = format!("{}/crba_free_flyer_members", tree.name);
@@ -174,7 +271,9 @@ fn free_flyer_crba_share(model: &kinedyn_core::Model, data: &mut Data, tree: &mo
     let (sin, cos) = (data.sin.clone(), data.cos.clone());
     let ic: Vec<Inertia> = model.inertia.clone();
     let mut to_parent = vec![Inertia::zero(); n];
-    let mut f: Vec<Force> = (0..n).map(|k| Force::new(Vec3::new(k as f64, 1.0, -2.0), Vec3::new(0.5, k as f64, 3.0))).collect();
+    let mut f: Vec<Force> = (0..n)
+        .map(|k| Force::new(Vec3::new(k as f64, 1.0, -2.0), Vec3::new(0.5, k as f64, 3.0)))
+        .collect();
     let ns = min_ns(|| {
         for i in (2..=5).rev() {
             let x = parent_from_body_trig(model, black_box(q), &sin, &cos, i);
@@ -309,7 +408,10 @@ fn print_flops(name: &str, model: &kinedyn_core::Model) {
     let mut rng = kinedyn_core::testing::Rng::new(3);
     let lift = |v: Vec<f64>| v.into_iter().map(Counted).collect::<Vec<_>>();
     let q = lift(kinedyn_core::testing::random_configuration(model, &mut rng));
-    let (qd, qdd) = (lift(rng.vector(model.n, -1.0, 1.0)), lift(rng.vector(model.n, -1.0, 1.0)));
+    let (qd, qdd) = (
+        lift(rng.vector(model.n, -1.0, 1.0)),
+        lift(rng.vector(model.n, -1.0, 1.0)),
+    );
     let mut data = Data::<Counted>::new(model);
     let d = &mut data;
     for (alg, (ops, trig)) in [

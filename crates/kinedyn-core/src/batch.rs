@@ -15,9 +15,9 @@
 use crate::data::Data;
 use crate::error::Error;
 use crate::model::Model;
-use crate::scalar::{as_f64s, as_f64s_mut, Lanes, Real};
 #[cfg(target_arch = "x86_64")]
 use crate::scalar::x86::{F64x4, F64x8};
+use crate::scalar::{as_f64s, as_f64s_mut, Lanes, Real};
 use std::sync::OnceLock;
 
 /// An algorithm as a batch runs it: `run` reads one state's inputs (`x[k]`, one slice per input)
@@ -89,7 +89,9 @@ impl Simd {
     pub fn is_supported(self) -> bool {
         match self {
             #[cfg(target_arch = "x86_64")]
-            Simd::Avx512 => std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512dq"),
+            Simd::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512dq")
+            }
             #[cfg(target_arch = "x86_64")]
             Simd::Avx2 => std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
             #[cfg(not(target_arch = "x86_64"))]
@@ -99,7 +101,10 @@ impl Simd {
     }
 
     fn best_supported() -> Simd {
-        [Simd::Avx512, Simd::Avx2].into_iter().find(|s| s.is_supported()).unwrap_or(Simd::Portable)
+        [Simd::Avx512, Simd::Avx2]
+            .into_iter()
+            .find(|s| s.is_supported())
+            .unwrap_or(Simd::Portable)
     }
 }
 
@@ -153,10 +158,24 @@ pub struct StateError {
 
 /// `kernel` on every state of `inputs` (each holding the same number of states), results to `out`
 /// (`kernel.output_len(model)` numbers per state), computed the `simd` way.
-pub fn run<K: Kernel>(model: &Model, scratch: &mut Scratch, kernel: &K, inputs: &[Input], out: &mut [f64], simd: Simd) -> Result<(), StateError> {
+pub fn run<K: Kernel>(
+    model: &Model,
+    scratch: &mut Scratch,
+    kernel: &K,
+    inputs: &[Input],
+    out: &mut [f64],
+    simd: Simd,
+) -> Result<(), StateError> {
     let width = kernel.output_len(model);
-    let states = if width > 0 { out.len() / width } else { inputs.first().map_or(0, |x| x.values.len() / x.width.max(1)) };
-    assert!(inputs.iter().all(|x| x.values.len() == states * x.width) && out.len() == states * width, "batch::run: inputs and output disagree on the number of states");
+    let states = if width > 0 {
+        out.len() / width
+    } else {
+        inputs.first().map_or(0, |x| x.values.len() / x.width.max(1))
+    };
+    assert!(
+        inputs.iter().all(|x| x.values.len() == states * x.width) && out.len() == states * width,
+        "batch::run: inputs and output disagree on the number of states"
+    );
     match simd {
         Simd::Off => one_by_one(model, &mut scratch.data, kernel, inputs, out, 0, states),
         #[cfg(target_arch = "x86_64")]
@@ -165,25 +184,51 @@ pub fn run<K: Kernel>(model: &Model, scratch: &mut Scratch, kernel: &K, inputs: 
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above
         Simd::Avx2 if simd.is_supported() => unsafe { blocks_avx2(model, scratch, kernel, inputs, out, states) },
-        _ => blocks(model, split(model, &mut scratch.portable), &mut scratch.data, kernel, inputs, out, states),
+        _ => blocks(
+            model,
+            split(model, &mut scratch.portable),
+            &mut scratch.data,
+            kernel,
+            inputs,
+            out,
+            states,
+        ),
     }
 }
 
 /// The scratch's block of lane type L (made on first use).
 fn split<'s, L: Real>(model: &Model, slot: &'s mut Option<Block<L>>) -> &'s mut Block<L> {
-    slot.get_or_insert_with(|| Block { data: Data::new(model), inputs: Vec::new(), out: Vec::new() })
+    slot.get_or_insert_with(|| Block {
+        data: Data::new(model),
+        inputs: Vec::new(),
+        out: Vec::new(),
+    })
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx2,fma")]
-fn blocks_avx512<K: Kernel>(model: &Model, scratch: &mut Scratch, kernel: &K, inputs: &[Input], out: &mut [f64], states: usize) -> Result<(), StateError> {
+fn blocks_avx512<K: Kernel>(
+    model: &Model,
+    scratch: &mut Scratch,
+    kernel: &K,
+    inputs: &[Input],
+    out: &mut [f64],
+    states: usize,
+) -> Result<(), StateError> {
     let block = split(model, &mut scratch.avx512);
     blocks(model, block, &mut scratch.data, kernel, inputs, out, states)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn blocks_avx2<K: Kernel>(model: &Model, scratch: &mut Scratch, kernel: &K, inputs: &[Input], out: &mut [f64], states: usize) -> Result<(), StateError> {
+fn blocks_avx2<K: Kernel>(
+    model: &Model,
+    scratch: &mut Scratch,
+    kernel: &K,
+    inputs: &[Input],
+    out: &mut [f64],
+    states: usize,
+) -> Result<(), StateError> {
     let block = split(model, &mut scratch.avx2);
     blocks(model, block, &mut scratch.data, kernel, inputs, out, states)
 }
@@ -191,7 +236,15 @@ fn blocks_avx2<K: Kernel>(model: &Model, scratch: &mut Scratch, kernel: &K, inpu
 /// The states in blocks of N: transpose in, run, transpose out. Inlined into each instance above,
 /// so that the whole algorithm is compiled for that instance's instruction set.
 #[inline(always)]
-fn blocks<K: Kernel, L: Real>(model: &Model, block: &mut Block<L>, data: &mut Data, kernel: &K, inputs: &[Input], out: &mut [f64], states: usize) -> Result<(), StateError> {
+fn blocks<K: Kernel, L: Real>(
+    model: &Model,
+    block: &mut Block<L>,
+    data: &mut Data,
+    kernel: &K,
+    inputs: &[Input],
+    out: &mut [f64],
+    states: usize,
+) -> Result<(), StateError> {
     let (width, lanes) = (kernel.output_len(model), L::LANES);
     block.inputs.resize_with(inputs.len(), Vec::new);
     for (buf, x) in block.inputs.iter_mut().zip(inputs) {
@@ -212,7 +265,10 @@ fn blocks<K: Kernel, L: Real>(model: &Model, block: &mut Block<L>, data: &mut Da
             }
         }
         let x: [&[L]; 4] = std::array::from_fn(|k| block.inputs.get(k).map_or(&[][..], |b| &b[..]));
-        if kernel.run(model, &mut block.data, &x[..inputs.len()], &mut block.out).is_err() {
+        if kernel
+            .run(model, &mut block.data, &x[..inputs.len()], &mut block.out)
+            .is_err()
+        {
             return one_by_one(model, data, kernel, inputs, out, first, first + count);
         }
         let soa = as_f64s(&block.out);
@@ -227,12 +283,29 @@ fn blocks<K: Kernel, L: Real>(model: &Model, block: &mut Block<L>, data: &mut Da
 }
 
 /// States `a..b` one at a time with the single-call code (stops at the first error).
-fn one_by_one<K: Kernel>(model: &Model, data: &mut Data, kernel: &K, inputs: &[Input], out: &mut [f64], a: usize, b: usize) -> Result<(), StateError> {
+fn one_by_one<K: Kernel>(
+    model: &Model,
+    data: &mut Data,
+    kernel: &K,
+    inputs: &[Input],
+    out: &mut [f64],
+    a: usize,
+    b: usize,
+) -> Result<(), StateError> {
     let width = kernel.output_len(model);
     for state in a..b {
-        let x: [&[f64]; 4] = std::array::from_fn(|k| inputs.get(k).map_or(&[][..], |x| &x.values[state * x.width..(state + 1) * x.width]));
+        let x: [&[f64]; 4] = std::array::from_fn(|k| {
+            inputs
+                .get(k)
+                .map_or(&[][..], |x| &x.values[state * x.width..(state + 1) * x.width])
+        });
         kernel
-            .run(model, data, &x[..inputs.len()], &mut out[state * width..(state + 1) * width])
+            .run(
+                model,
+                data,
+                &x[..inputs.len()],
+                &mut out[state * width..(state + 1) * width],
+            )
             .map_err(|error| StateError { state, error })?;
     }
     Ok(())
@@ -340,10 +413,22 @@ pub mod kernels {
                 let (r, t) = (&pose.rot, &pose.trans);
                 let (zero, one) = (T::zero(), T::one());
                 slot.copy_from_slice(&[
-                    r[(0, 0)], r[(0, 1)], r[(0, 2)], t.x,
-                    r[(1, 0)], r[(1, 1)], r[(1, 2)], t.y,
-                    r[(2, 0)], r[(2, 1)], r[(2, 2)], t.z,
-                    zero, zero, zero, one,
+                    r[(0, 0)],
+                    r[(0, 1)],
+                    r[(0, 2)],
+                    t.x,
+                    r[(1, 0)],
+                    r[(1, 1)],
+                    r[(1, 2)],
+                    t.y,
+                    r[(2, 0)],
+                    r[(2, 1)],
+                    r[(2, 2)],
+                    t.z,
+                    zero,
+                    zero,
+                    zero,
+                    one,
                 ]);
             }
             Ok(())
@@ -423,14 +508,21 @@ mod tests {
             ("floating", random_floating_model(4, 5, false)),
             ("floating tree", random_floating_model(5, 6, true)),
             // direction-dependent Coulomb levels (the lanes' compare-and-blend friction)
-            ("asymmetric friction", random_model(6, 4, false).with_coulomb_negative(vec![0.05, 0.7, 0.2, 0.4]).unwrap()),
+            (
+                "asymmetric friction",
+                random_model(6, 4, false)
+                    .with_coulomb_negative(vec![0.05, 0.7, 0.2, 0.4])
+                    .unwrap(),
+            ),
         ]
     }
 
     /// `states` random states of `model`: q (nq each), two n-vectors and external wrenches (6 n).
     fn states(model: &Model, states: usize, seed: u64) -> [Vec<f64>; 4] {
         let mut rng = Rng::new(seed);
-        let q: Vec<f64> = (0..states).flat_map(|_| random_configuration(model, &mut rng)).collect();
+        let q: Vec<f64> = (0..states)
+            .flat_map(|_| random_configuration(model, &mut rng))
+            .collect();
         let [a, b] = std::array::from_fn(|_| rng.vector(states * model.n, -2.0, 2.0));
         [q, a, b, rng.vector(states * 6 * model.n, -5.0, 5.0)]
     }
@@ -439,12 +531,20 @@ mod tests {
     /// magnitude of the state's result), on chains, trees and floating bases, for batch sizes that
     /// are not multiples of the lane count (padded blocks) and a batch of one.
     fn lanes_equal_single_calls<K: Kernel>(kernel: K, inputs: usize) {
-        let kinds: Vec<Simd> = [Simd::Portable, Simd::Avx2, Simd::Avx512].into_iter().filter(|s| s.is_supported()).collect();
+        let kinds: Vec<Simd> = [Simd::Portable, Simd::Avx2, Simd::Avx512]
+            .into_iter()
+            .filter(|s| s.is_supported())
+            .collect();
         for (name, model) in models() {
             for count in [1usize, 5, 13] {
                 let values = states(&model, count, 7 + count as u64);
                 let widths = [model.nq, model.n, model.n, 6 * model.n];
-                let x: Vec<Input> = (0..inputs).map(|k| Input { values: &values[k], width: widths[k] }).collect();
+                let x: Vec<Input> = (0..inputs)
+                    .map(|k| Input {
+                        values: &values[k],
+                        width: widths[k],
+                    })
+                    .collect();
                 let width = kernel.output_len(&model);
                 let mut expected = vec![f64::NAN; count * width];
                 let mut scratch = Scratch::new(&model);
@@ -456,7 +556,10 @@ mod tests {
                         let (e, g) = (&expected[s * width..(s + 1) * width], &got[s * width..(s + 1) * width]);
                         let scale = e.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
                         for (a, b) in e.iter().zip(g) {
-                            assert!((a - b).abs() <= 1e-13 * scale, "{name}, {simd:?}, batch of {count}, state {s}: {a} vs {b}");
+                            assert!(
+                                (a - b).abs() <= 1e-13 * scale,
+                                "{name}, {simd:?}, batch of {count}, state {s}: {a} vs {b}"
+                            );
                         }
                     }
                 }
@@ -523,8 +626,22 @@ mod tests {
         lanes_equal_single_calls(FramePoses { frames: &[0] }, 1);
         let point = Some(crate::spatial::Vec3::new(0.1, -0.2, 0.3));
         for reference in [alg::Reference::World, alg::Reference::Local, alg::Reference::Spatial] {
-            lanes_equal_single_calls(Jacobian { frame: 0, reference, point }, 1);
-            lanes_equal_single_calls(Jacobian { frame: 0, reference, point: None }, 1);
+            lanes_equal_single_calls(
+                Jacobian {
+                    frame: 0,
+                    reference,
+                    point,
+                },
+                1,
+            );
+            lanes_equal_single_calls(
+                Jacobian {
+                    frame: 0,
+                    reference,
+                    point: None,
+                },
+                1,
+            );
         }
     }
 
@@ -537,12 +654,20 @@ mod tests {
         model.armature[massless] = 0.0;
         let [q, qd, _, _] = states(&model, 6, 1);
         let tau = qd.clone();
-        let x = [Input { values: &q, width: 4 }, Input { values: &qd, width: 4 }, Input { values: &tau, width: 4 }];
+        let x = [
+            Input { values: &q, width: 4 },
+            Input { values: &qd, width: 4 },
+            Input { values: &tau, width: 4 },
+        ];
         for simd in [Simd::Off, Simd::Portable] {
             let mut out = vec![0.0; 6 * 4];
             let err = run(&model, &mut Scratch::new(&model), &ForwardDynamics, &x, &mut out, simd).unwrap_err();
             assert_eq!(err.state, 0, "{simd:?}");
-            assert!(err.error.to_string().contains(&format!("joint {massless}")), "{}", err.error);
+            assert!(
+                err.error.to_string().contains(&format!("joint {massless}")),
+                "{}",
+                err.error
+            );
         }
     }
 }

@@ -175,7 +175,10 @@ impl Joint {
                 _ => Vec3::new(-i.h.y, i.h.x, T::zero()),
             };
             return match self.kind {
-                JointKind::Revolute => Force::new(ek_cross_h * sign, Vec3::new(i.i_o[(0, k)], i.i_o[(1, k)], i.i_o[(2, k)]) * sign),
+                JointKind::Revolute => Force::new(
+                    ek_cross_h * sign,
+                    Vec3::new(i.i_o[(0, k)], i.i_o[(1, k)], i.i_o[(2, k)]) * sign,
+                ),
                 JointKind::Prismatic => {
                     let mut lin = Vec3::zeros();
                     lin[k] = i.mass * sign;
@@ -217,24 +220,47 @@ mod tests {
                 let s = joint.subspace::<f64>();
                 assert_eq!(joint.project(&f), s.dot(&f), "{kind:?} {axis:?}");
                 let (fast, general) = (joint.inertia_times_s(&inertia), inertia.mul_motion(&s));
-                assert!((fast.lin - general.lin).norm() + (fast.ang - general.ang).norm() < 1e-15, "{kind:?} {axis:?}");
+                assert!(
+                    (fast.lin - general.lin).norm() + (fast.ang - general.ang).norm() < 1e-15,
+                    "{kind:?} {axis:?}"
+                );
             }
         }
-        assert!(Joint { kind: JointKind::Revolute, axis: Vec3::new(0.6, 0.8, 0.0) }.coordinate_axis().is_none());
+        assert!(Joint {
+            kind: JointKind::Revolute,
+            axis: Vec3::new(0.6, 0.8, 0.0)
+        }
+        .coordinate_axis()
+        .is_none());
     }
 
     /// The specialised composition equals the general `placement * jcalc(x)` for every axis case.
     #[test]
     fn compose_equals_placement_times_jcalc() {
-        let placement = Transform::new(axis_angle(&Vec3::new(0.3, -0.5, 0.8).normalize(), 0.9), Vec3::new(0.1, -0.2, 0.3));
-        let axes = [Vec3::x(), Vec3::y(), Vec3::z(), -Vec3::x(), -Vec3::y(), -Vec3::z(), Vec3::new(1.0, 2.0, -2.0) / 3.0];
+        let placement = Transform::new(
+            axis_angle(&Vec3::new(0.3, -0.5, 0.8).normalize(), 0.9),
+            Vec3::new(0.1, -0.2, 0.3),
+        );
+        let axes = [
+            Vec3::x(),
+            Vec3::y(),
+            Vec3::z(),
+            -Vec3::x(),
+            -Vec3::y(),
+            -Vec3::z(),
+            Vec3::new(1.0, 2.0, -2.0) / 3.0,
+        ];
         for axis in axes {
             for kind in [JointKind::Revolute, JointKind::Prismatic] {
                 let joint = Joint { kind, axis };
                 for x in [-2.5, 0.0, 0.7, 3.1] {
                     let expected = placement * joint.jcalc(x).0;
                     let got = joint.compose(&placement, x);
-                    assert!((got.rot - expected.rot).abs().max() < 1e-15 && (got.trans - expected.trans).abs().max() < 1e-15, "{kind:?} {axis:?} {x}");
+                    assert!(
+                        (got.rot - expected.rot).abs().max() < 1e-15
+                            && (got.trans - expected.trans).abs().max() < 1e-15,
+                        "{kind:?} {axis:?} {x}"
+                    );
                 }
             }
         }

@@ -24,9 +24,15 @@ pub fn quaternion_matrix<T: Real>(q: &[T]) -> Mat3<T> {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
     let (one, two) = (T::one(), T::splat(2.0));
     Mat3::new(
-        one - two * (y * y + z * z), two * (x * y - z * w), two * (x * z + y * w),
-        two * (x * y + z * w), one - two * (x * x + z * z), two * (y * z - x * w),
-        two * (x * z - y * w), two * (y * z + x * w), one - two * (x * x + y * y),
+        one - two * (y * y + z * z),
+        two * (x * y - z * w),
+        two * (x * z + y * w),
+        two * (x * y + z * w),
+        one - two * (x * x + z * z),
+        two * (y * z - x * w),
+        two * (x * z - y * w),
+        two * (y * z + x * w),
+        one - two * (x * x + y * y),
     )
 }
 
@@ -123,7 +129,9 @@ pub struct Model {
 
 fn finite(what: &str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(k) => Err(Error::InvalidModel(format!("{what} has a non-finite value at index {k}"))),
+        Some(k) => Err(Error::InvalidModel(format!(
+            "{what} has a non-finite value at index {k}"
+        ))),
         None => Ok(()),
     }
 }
@@ -170,7 +178,10 @@ impl Model {
         for (i, j) in joints.iter().enumerate() {
             let norm = j.axis.norm();
             if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
-                return Err(Error::InvalidModel(format!("joint {i}: axis {:?} is not a unit vector", j.axis.as_slice())));
+                return Err(Error::InvalidModel(format!(
+                    "joint {i}: axis {:?} is not a unit vector",
+                    j.axis.as_slice()
+                )));
             }
         }
         finite("offset", &offset)?;
@@ -190,7 +201,9 @@ impl Model {
         for (k, f) in frames.iter().enumerate() {
             if let Some(b) = f.body {
                 if b >= n {
-                    return Err(Error::InvalidModel(format!("frame {k} is attached to body {b}, but there are {n} bodies")));
+                    return Err(Error::InvalidModel(format!(
+                        "frame {k} is attached to body {b}, but there are {n} bodies"
+                    )));
                 }
             }
             finite(&format!("placement of frame {k}"), &f.body_from_frame.to_homogeneous())?;
@@ -213,7 +226,10 @@ impl Model {
             }
         }
         let subtrees_contiguous = (0..n).all(|i| subtree_end[i] - i == subtree_size[i]);
-        let placement_rotation = parent_from_joint.iter().map(|x| AxisRotation::classify(&x.rot)).collect();
+        let placement_rotation = parent_from_joint
+            .iter()
+            .map(|x| AxisRotation::classify(&x.rot))
+            .collect();
         Ok(Self {
             n,
             nq: n,
@@ -244,7 +260,10 @@ impl Model {
     pub fn with_coordinates(mut self, coordinates: Vec<Coordinates>) -> Result<Self> {
         let n = self.n;
         if coordinates.len() != n {
-            return Err(Error::InvalidModel(format!("coordinates has {} entries for {n} bodies", coordinates.len())));
+            return Err(Error::InvalidModel(format!(
+                "coordinates has {} entries for {n} bodies",
+                coordinates.len()
+            )));
         }
         let bad = |i: usize, why: String| Err(Error::InvalidModel(format!("body {i}: {why}")));
         let (mut nq, mut first, mut last) = (0usize, (0..n).collect::<Vec<_>>(), (0..n).collect::<Vec<_>>());
@@ -265,7 +284,10 @@ impl Model {
                     }
                     let end = i + block.nv();
                     if end > n {
-                        return bad(i, format!("a {block:?} joint needs {} bodies, only {} remain", block.nv(), n - i));
+                        return bad(
+                            i,
+                            format!("a {block:?} joint needs {} bodies, only {} remain", block.nv(), n - i),
+                        );
                     }
                     self.check_block(i, block, &coordinates)?;
                     for k in i..end {
@@ -280,14 +302,22 @@ impl Model {
         for (k, p) in self.parent.iter().enumerate() {
             if let Some(p) = *p {
                 if last[p] != p && !(k == p + 1 && first[k] == first[p]) {
-                    return bad(k, format!("its parent {p} is an inner body of a multi-DOF joint (attach to body {})", last[p]));
+                    return bad(
+                        k,
+                        format!(
+                            "its parent {p} is an inner body of a multi-DOF joint (attach to body {})",
+                            last[p]
+                        ),
+                    );
                 }
             }
         }
         for (k, f) in self.frames.iter().enumerate() {
             if let Some(b) = f.body {
                 if last[b] != b {
-                    return Err(Error::InvalidModel(format!("frame {k} is attached to inner body {b} of a multi-DOF joint")));
+                    return Err(Error::InvalidModel(format!(
+                        "frame {k} is attached to inner body {b} of a multi-DOF joint"
+                    )));
                 }
             }
         }
@@ -303,14 +333,20 @@ impl Model {
         let nv = block.nv();
         let unit = |k: usize| crate::spatial::Vec3::ith(k, 1.0);
         let expected: Vec<(crate::joint::JointKind, Vec3)> = match block {
-            Block::FreeFlyer => (0..6).map(|k| (if k < 3 { Prismatic } else { Revolute }, unit(k % 3))).collect(),
+            Block::FreeFlyer => (0..6)
+                .map(|k| (if k < 3 { Prismatic } else { Revolute }, unit(k % 3)))
+                .collect(),
             Block::Spherical => (0..3).map(|k| (Revolute, unit(k))).collect(),
             Block::Planar => {
                 let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
                 vec![(Prismatic, e1), (Prismatic, e2), (Revolute, e1.cross(&e2))]
             }
         };
-        let bad = |k: usize, why: &str| Err(Error::InvalidModel(format!("body {k} ({block:?} joint starting at body {i}): {why}")));
+        let bad = |k: usize, why: &str| {
+            Err(Error::InvalidModel(format!(
+                "body {k} ({block:?} joint starting at body {i}): {why}"
+            )))
+        };
         if block == Block::Planar && self.joints[i].axis.dot(&self.joints[i + 1].axis).abs() > 1e-12 {
             return bad(i, "the planar joint's in-plane axes are not orthogonal");
         }
@@ -350,7 +386,10 @@ impl Model {
                 let n = e1.cross(&e2);
                 let (c, s) = (qb[2], qb[3]);
                 // rotation about n by th: R = c 1 + s [n]x + (1 - c) n n^T
-                let (skew_n, nn) = (crate::spatial::splat33::<T>(&crate::spatial::skew(&n)), crate::spatial::splat33::<T>(&(n * n.transpose())));
+                let (skew_n, nn) = (
+                    crate::spatial::splat33::<T>(&crate::spatial::skew(&n)),
+                    crate::spatial::splat33::<T>(&(n * n.transpose())),
+                );
                 let rot = Mat3::identity() * c + skew_n * s + nn * (T::one() - c);
                 Transform::new(rot, splat3::<T>(&e1) * qb[0] + splat3::<T>(&e2) * qb[1])
             }
@@ -440,11 +479,18 @@ impl Model {
     /// `qd_i < 0`, `coulomb[i]` against `qd_i > 0`.
     pub fn with_coulomb_negative(mut self, levels: Vec<f64>) -> Result<Self> {
         if levels.len() != self.n {
-            return Err(Error::InvalidModel(format!("coulomb_negative has {} entries for {} bodies", levels.len(), self.n)));
+            return Err(Error::InvalidModel(format!(
+                "coulomb_negative has {} entries for {} bodies",
+                levels.len(),
+                self.n
+            )));
         }
         finite("coulomb_negative", &levels)?;
         if let Some(k) = levels.iter().position(|c| *c < 0.0) {
-            return Err(Error::InvalidModel(format!("coulomb_negative of joint {k} is {}, a level must be >= 0", levels[k])));
+            return Err(Error::InvalidModel(format!(
+                "coulomb_negative of joint {k} is {}, a level must be >= 0",
+                levels[k]
+            )));
         }
         self.coulomb_negative = Some(levels);
         Ok(self)
@@ -454,7 +500,10 @@ impl Model {
     /// `-coulomb_negative_i` for `qd < 0`, 0 at rest (`coulomb_i sign(qd)` when symmetric).
     #[inline(always)]
     pub fn coulomb_torque<T: Real>(&self, i: usize, qd: T) -> T {
-        qd.signed_level(self.coulomb[i], self.coulomb_negative.as_ref().map_or(self.coulomb[i], |c| c[i]))
+        qd.signed_level(
+            self.coulomb[i],
+            self.coulomb_negative.as_ref().map_or(self.coulomb[i], |c| c[i]),
+        )
     }
 
     /// Whether joint i has Coulomb friction in either direction.
@@ -468,7 +517,13 @@ impl Model {
 /// so(3) `a x b`; se(3) `[a_lin; a_ang]`: `(a_ang x b_lin - b_ang x a_lin, a_ang x b_ang)`; se(2)
 /// `(vx, vy, w)`: `(w_a J v_b - w_b J v_a, 0)` with `J` the quarter turn.
 fn lie_bracket(block: Block, a: &[f64], b: &[f64]) -> [f64; 6] {
-    let cross = |x: &[f64], y: &[f64]| [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+    let cross = |x: &[f64], y: &[f64]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
     match block {
         Block::Spherical => {
             let c = cross(a, b);
@@ -479,6 +534,13 @@ fn lie_bracket(block: Block, a: &[f64], b: &[f64]) -> [f64; 6] {
             let w = cross(&a[3..6], &b[3..6]);
             [p[0] - q[0], p[1] - q[1], p[2] - q[2], w[0], w[1], w[2]]
         }
-        Block::Planar => [-a[2] * b[1] + b[2] * a[1], a[2] * b[0] - b[2] * a[0], 0.0, 0.0, 0.0, 0.0],
+        Block::Planar => [
+            -a[2] * b[1] + b[2] * a[1],
+            a[2] * b[0] - b[2] * a[0],
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ],
     }
 }

@@ -190,7 +190,10 @@ impl<const N: usize> Real for Lanes<N> {
         assert!(cos.len() * N >= len);
         // SAFETY: `Lanes<N>` is `repr(transparent)` over `[f64; N]`: a slice of k of them is k N f64s
         let (x, cos) = unsafe {
-            (std::slice::from_raw_parts_mut(x.as_mut_ptr() as *mut f64, len), std::slice::from_raw_parts_mut(cos.as_mut_ptr() as *mut f64, len))
+            (
+                std::slice::from_raw_parts_mut(x.as_mut_ptr() as *mut f64, len),
+                std::slice::from_raw_parts_mut(cos.as_mut_ptr() as *mut f64, len),
+            )
         };
         crate::trig::sin_cos_in_place(x, cos);
     }
@@ -352,7 +355,10 @@ pub mod x86 {
                     assert!(cos.len() * $n >= len);
                     // SAFETY: the register type is `[f64; N]` in memory
                     let (x, cos) = unsafe {
-                        (std::slice::from_raw_parts_mut(x.as_mut_ptr() as *mut f64, len), std::slice::from_raw_parts_mut(cos.as_mut_ptr() as *mut f64, len))
+                        (
+                            std::slice::from_raw_parts_mut(x.as_mut_ptr() as *mut f64, len),
+                            std::slice::from_raw_parts_mut(cos.as_mut_ptr() as *mut f64, len),
+                        )
                     };
                     crate::trig::sin_cos_in_place(x, cos);
                 }
@@ -404,8 +410,30 @@ pub mod x86 {
         }
     }
 
-    lane_type!(F64x4, __m256d, 4, _mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd, _mm256_div_pd, _mm256_set1_pd, _mm256_xor_pd, _mm256_setzero_pd);
-    lane_type!(F64x8, __m512d, 8, _mm512_add_pd, _mm512_sub_pd, _mm512_mul_pd, _mm512_div_pd, _mm512_set1_pd, _mm512_xor_pd, _mm512_setzero_pd);
+    lane_type!(
+        F64x4,
+        __m256d,
+        4,
+        _mm256_add_pd,
+        _mm256_sub_pd,
+        _mm256_mul_pd,
+        _mm256_div_pd,
+        _mm256_set1_pd,
+        _mm256_xor_pd,
+        _mm256_setzero_pd
+    );
+    lane_type!(
+        F64x8,
+        __m512d,
+        8,
+        _mm512_add_pd,
+        _mm512_sub_pd,
+        _mm512_mul_pd,
+        _mm512_div_pd,
+        _mm512_set1_pd,
+        _mm512_xor_pd,
+        _mm512_setzero_pd
+    );
 }
 
 /// The numbers of a slice of lane values, lane after lane of each value (`v[i]` lane k at `i N + k`).

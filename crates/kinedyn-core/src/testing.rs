@@ -14,7 +14,11 @@ pub fn random_inertia(rng: &mut Rng) -> Inertia {
     // principal moments from a random box: always a real body
     let (a, b, c) = (rng.uniform(0.05, 0.5), rng.uniform(0.05, 0.5), rng.uniform(0.05, 0.5));
     let k = mass / 12.0;
-    let principal = Mat3::from_diagonal(&Vec3::new(k * (b * b + c * c), k * (a * a + c * c), k * (a * a + b * b)));
+    let principal = Mat3::from_diagonal(&Vec3::new(
+        k * (b * b + c * c),
+        k * (a * a + c * c),
+        k * (a * a + b * b),
+    ));
     let r = rng.rotation();
     let i_c = r * principal * r.transpose();
     // about the body origin: I_o = I_c - m [c]x [c]x
@@ -39,8 +43,15 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
             (_, false) => Some(i - 1),
             (_, true) => Some((rng.next_u64() % i as u64) as usize),
         });
-        let kind = if rng.uniform(0.0, 1.0) < 0.25 { JointKind::Prismatic } else { JointKind::Revolute };
-        joints.push(Joint { kind, axis: random_axis(&mut rng) });
+        let kind = if rng.uniform(0.0, 1.0) < 0.25 {
+            JointKind::Prismatic
+        } else {
+            JointKind::Revolute
+        };
+        joints.push(Joint {
+            kind,
+            axis: random_axis(&mut rng),
+        });
         let rotation = match rng.next_u64() % 4 {
             0 => Mat3::identity(),
             1 => axis_angle(&random_axis(&mut rng), rng.uniform(-3.0, 3.0)),
@@ -54,11 +65,28 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
     let viscous = rng.vector(n, 0.0, 0.5);
     let coulomb = rng.vector(n, 0.0, 0.3);
     let frames = (0..n)
-        .map(|b| Frame { body: Some(b), body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)) })
-        .chain(std::iter::once(Frame { body: None, body_from_frame: Transform::identity() }))
+        .map(|b| Frame {
+            body: Some(b),
+            body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)),
+        })
+        .chain(std::iter::once(Frame {
+            body: None,
+            body_from_frame: Transform::identity(),
+        }))
         .collect();
-    Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(0.0, 0.0, -9.81), frames)
-        .expect("random models are valid by construction")
+    Model::new(
+        parent,
+        joints,
+        offset,
+        placements,
+        inertias,
+        armature,
+        viscous,
+        coulomb,
+        Vec3::new(0.0, 0.0, -9.81),
+        frames,
+    )
+    .expect("random models are valid by construction")
 }
 
 /// A random unit vector, or (half of the time) a signed coordinate axis.
@@ -86,12 +114,32 @@ pub fn dh_model(rows: &[(f64, f64, f64)], seed: u64) -> Model {
         placements.push(previous * Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d)));
         previous = tx_rx(a, alpha);
     }
-    let joints = vec![Joint { kind: JointKind::Revolute, axis: Vec3::z() }; n];
+    let joints = vec![
+        Joint {
+            kind: JointKind::Revolute,
+            axis: Vec3::z()
+        };
+        n
+    ];
     let parent = (0..n).map(|i| i.checked_sub(1)).collect();
     let inertias = (0..n).map(|_| random_inertia(&mut rng)).collect();
-    let tool = Frame { body: Some(n - 1), body_from_frame: previous };
-    Model::new(parent, joints, vec![0.0; n], placements, inertias, vec![0.0; n], vec![0.0; n], vec![0.0; n], Vec3::new(0.0, 0.0, -9.81), vec![tool])
-        .expect("a DH arm is a valid model")
+    let tool = Frame {
+        body: Some(n - 1),
+        body_from_frame: previous,
+    };
+    Model::new(
+        parent,
+        joints,
+        vec![0.0; n],
+        placements,
+        inertias,
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        Vec3::new(0.0, 0.0, -9.81),
+        vec![tool],
+    )
+    .expect("a DH arm is a valid model")
 }
 
 /// Universal Robots' published UR5 DH rows `(d, a, alpha)`.
@@ -115,10 +163,31 @@ pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
     // (parent, joint, placement, inertia, coordinates) per body
     let mut bodies: Vec<(Option<usize>, Joint, Transform, Inertia, Coordinates)> = Vec::new();
     for k in 0..6usize {
-        let kind = if k < 3 { JointKind::Prismatic } else { JointKind::Revolute };
-        let inertia = if k == 5 { random_inertia(&mut rng) } else { Inertia::zero() };
-        let c = if k == 0 { Coordinates::Head { block: Block::FreeFlyer, at: 0 } } else { Coordinates::Member };
-        bodies.push((k.checked_sub(1), Joint { kind, axis: unit(k) }, Transform::identity(), inertia, c));
+        let kind = if k < 3 {
+            JointKind::Prismatic
+        } else {
+            JointKind::Revolute
+        };
+        let inertia = if k == 5 {
+            random_inertia(&mut rng)
+        } else {
+            Inertia::zero()
+        };
+        let c = if k == 0 {
+            Coordinates::Head {
+                block: Block::FreeFlyer,
+                at: 0,
+            }
+        } else {
+            Coordinates::Member
+        };
+        bodies.push((
+            k.checked_sub(1),
+            Joint { kind, axis: unit(k) },
+            Transform::identity(),
+            inertia,
+            c,
+        ));
     }
     // tail body i -> its (last) body here; tail body 1 (if any) becomes a spherical joint
     let mut index = vec![0usize; n];
@@ -129,14 +198,36 @@ pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
             for k in 0..3 {
                 let inertia = if k == 2 { tail.inertia[i] } else { Inertia::zero() };
                 let (parent, x, c) = match k {
-                    0 => (p, tail.parent_from_joint[i], Coordinates::Head { block: Block::Spherical, at }),
+                    0 => (
+                        p,
+                        tail.parent_from_joint[i],
+                        Coordinates::Head {
+                            block: Block::Spherical,
+                            at,
+                        },
+                    ),
                     _ => (bodies.len() - 1, Transform::identity(), Coordinates::Member),
                 };
-                bodies.push((Some(parent), Joint { kind: JointKind::Revolute, axis: unit(k) }, x, inertia, c));
+                bodies.push((
+                    Some(parent),
+                    Joint {
+                        kind: JointKind::Revolute,
+                        axis: unit(k),
+                    },
+                    x,
+                    inertia,
+                    c,
+                ));
             }
             at += 4;
         } else {
-            bodies.push((Some(p), tail.joints[i], tail.parent_from_joint[i], tail.inertia[i], Coordinates::Scalar { at }));
+            bodies.push((
+                Some(p),
+                tail.joints[i],
+                tail.parent_from_joint[i],
+                tail.inertia[i],
+                Coordinates::Scalar { at },
+            ));
             at += 1;
         }
         index[i] = bodies.len() - 1;
@@ -150,7 +241,12 @@ pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
         }
         out
     };
-    let frames = (0..n).map(|b| Frame { body: Some(index[b]), body_from_frame: tail.frames[b].body_from_frame }).collect();
+    let frames = (0..n)
+        .map(|b| Frame {
+            body: Some(index[b]),
+            body_from_frame: tail.frames[b].body_from_frame,
+        })
+        .collect();
     Model::new(
         bodies.iter().map(|b| b.0).collect(),
         bodies.iter().map(|b| b.1).collect(),
@@ -216,7 +312,10 @@ impl Dual {
     }
     /// `x` with `eps = 1` at index `k` and 0 elsewhere (the direction e_k).
     pub fn seeded(x: &[f64], k: Option<usize>) -> Vec<Dual> {
-        x.iter().enumerate().map(|(i, &v)| Dual::new(v, if Some(i) == k { 1.0 } else { 0.0 })).collect()
+        x.iter()
+            .enumerate()
+            .map(|(i, &v)| Dual::new(v, if Some(i) == k { 1.0 } else { 0.0 }))
+            .collect()
     }
 }
 

@@ -103,7 +103,9 @@ mod tests {
     fn within_two_ulps_of_the_standard_library() {
         let mut state = 0x1234_5678_9abc_def0u64;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut worst: f64 = 0.0;
@@ -115,10 +117,21 @@ mod tests {
             let (s, c) = sin_cos(x);
             let (s0, c0) = x.sin_cos();
             // near a zero of sin or cos compare absolutely (the reduction is accurate to ~1e-30)
-            let es = if s0.abs() < 1e-12 { (s - s0).abs() / f64::EPSILON } else { ulps(s, s0) };
-            let ec = if c0.abs() < 1e-12 { (c - c0).abs() / f64::EPSILON } else { ulps(c, c0) };
+            let es = if s0.abs() < 1e-12 {
+                (s - s0).abs() / f64::EPSILON
+            } else {
+                ulps(s, s0)
+            };
+            let ec = if c0.abs() < 1e-12 {
+                (c - c0).abs() / f64::EPSILON
+            } else {
+                ulps(c, c0)
+            };
             worst = worst.max(es).max(ec);
-            assert!(es <= 2.0 && ec <= 2.0, "x = {x:e}: sin {s:e} vs {s0:e} ({es} ulp), cos {c:e} vs {c0:e} ({ec} ulp)");
+            assert!(
+                es <= 2.0 && ec <= 2.0,
+                "x = {x:e}: sin {s:e} vs {s0:e} ({es} ulp), cos {c:e} vs {c0:e} ({ec} ulp)"
+            );
         }
         assert!(worst > 0.0, "the test should see some rounding differences");
     }
@@ -126,12 +139,18 @@ mod tests {
     /// The slice form gives the scalar form's numbers, in range and with a fallback element.
     #[test]
     fn in_place_equals_scalar() {
-        for xs in [vec![0.3f64, -2.0, 7.5, 1e4, -3.1, 0.0, 2.2], vec![0.3, 2e5, -1.0, f64::NAN]] {
+        for xs in [
+            vec![0.3f64, -2.0, 7.5, 1e4, -3.1, 0.0, 2.2],
+            vec![0.3, 2e5, -1.0, f64::NAN],
+        ] {
             let (mut s, mut c) = (xs.clone(), vec![0.0; xs.len()]);
             sin_cos_in_place(&mut s, &mut c);
             for (k, &x) in xs.iter().enumerate() {
                 let (s0, c0) = sin_cos(x);
-                assert!(s[k].to_bits() == s0.to_bits() && c[k].to_bits() == c0.to_bits() || x.is_nan() && s[k].is_nan(), "{x}");
+                assert!(
+                    s[k].to_bits() == s0.to_bits() && c[k].to_bits() == c0.to_bits() || x.is_nan() && s[k].is_nan(),
+                    "{x}"
+                );
             }
         }
     }

@@ -9,7 +9,11 @@ use rand::{Rng, SeedableRng};
 
 fn unit(rng: &mut StdRng) -> Vec3 {
     loop {
-        let v = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         if v.norm() > 0.2 {
             return v.normalize();
         }
@@ -27,7 +31,11 @@ fn random_inertia(rng: &mut StdRng, massless: bool) -> Inertia {
         return Inertia::zero();
     }
     let m = rng.random_range(0.2..3.0);
-    let c = Vec3::new(rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3));
+    let c = Vec3::new(
+        rng.random_range(-0.3..0.3),
+        rng.random_range(-0.3..0.3),
+        rng.random_range(-0.3..0.3),
+    );
     let (a, b): (f64, f64) = (rng.random_range(0.01..0.2), rng.random_range(0.01..0.2));
     let d = rng.random_range((a - b).abs() + 0.005..a + b);
     let r = rotation(rng);
@@ -41,30 +49,76 @@ fn random_inertia(rng: &mut StdRng, massless: bool) -> Inertia {
 fn random_model(seed: u64, n: usize, tree: bool, drives: bool, massless: bool) -> Model {
     let mut rng = StdRng::seed_from_u64(seed);
     let parent: Vec<Option<usize>> = (0..n)
-        .map(|i| if i == 0 { None } else if tree { if rng.random_range(0..4) == 0 { None } else { Some(rng.random_range(0..i)) } } else { Some(i - 1) })
+        .map(|i| {
+            if i == 0 {
+                None
+            } else if tree {
+                if rng.random_range(0..4) == 0 {
+                    None
+                } else {
+                    Some(rng.random_range(0..i))
+                }
+            } else {
+                Some(i - 1)
+            }
+        })
         .collect();
     let joints = (0..n)
-        .map(|_| Joint { kind: if rng.random_range(0..4) == 0 { JointKind::Prismatic } else { JointKind::Revolute }, axis: unit(&mut rng) })
+        .map(|_| Joint {
+            kind: if rng.random_range(0..4) == 0 {
+                JointKind::Prismatic
+            } else {
+                JointKind::Revolute
+            },
+            axis: unit(&mut rng),
+        })
         .collect();
     let offset = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
     let placement = (0..n)
-        .map(|_| Transform::new(rotation(&mut rng), Vec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5))))
+        .map(|_| {
+            Transform::new(
+                rotation(&mut rng),
+                Vec3::new(
+                    rng.random_range(-0.5..0.5),
+                    rng.random_range(-0.5..0.5),
+                    rng.random_range(-0.5..0.5),
+                ),
+            )
+        })
         .collect();
     let inertia = (0..n).map(|_| random_inertia(&mut rng, massless)).collect();
-    let mut coef = |on: bool| -> Vec<f64> { (0..n).map(|_| if on { rng.random_range(0.0..0.5) } else { 0.0 }).collect() };
+    let mut coef = |on: bool| -> Vec<f64> {
+        (0..n)
+            .map(|_| if on { rng.random_range(0.0..0.5) } else { 0.0 })
+            .collect()
+    };
     let armature = coef(drives);
     let viscous = coef(drives);
     let coulomb = coef(drives);
     let gravity = Vec3::new(0.3, -0.5, -9.81);
-    let frames = (0..n).map(|i| Frame { body: Some(i), body_from_frame: Transform::identity() }).collect();
-    Model::new(parent, joints, offset, placement, inertia, armature, viscous, coulomb, gravity, frames).unwrap()
+    let frames = (0..n)
+        .map(|i| Frame {
+            body: Some(i),
+            body_from_frame: Transform::identity(),
+        })
+        .collect();
+    Model::new(
+        parent, joints, offset, placement, inertia, armature, viscous, coulomb, gravity, frames,
+    )
+    .unwrap()
 }
 
 fn models() -> Vec<(String, Model)> {
     let mut out = Vec::new();
     for (seed, n) in [(1u64, 1usize), (2, 2), (3, 5), (4, 7), (5, 12)] {
-        out.push((format!("chain n={n} seed={seed}"), random_model(seed, n, false, true, false)));
-        out.push((format!("tree n={n} seed={seed}"), random_model(100 + seed, n, true, true, false)));
+        out.push((
+            format!("chain n={n} seed={seed}"),
+            random_model(seed, n, false, true, false),
+        ));
+        out.push((
+            format!("tree n={n} seed={seed}"),
+            random_model(100 + seed, n, true, true, false),
+        ));
     }
     out
 }
@@ -82,18 +136,42 @@ fn assert_close(what: &str, got: &[f64], want: &[f64], tol: f64) {
     assert_eq!(got.len(), want.len(), "{what}: lengths differ");
     let scale = want.iter().fold(1.0f64, |s, v| s.max(v.abs()));
     for (k, (g, w)) in got.iter().zip(want).enumerate() {
-        assert!((g - w).abs() <= tol * scale, "{what}: index {k}: got {g}, want {w} (|diff| {:e}, scale {scale})", (g - w).abs());
+        assert!(
+            (g - w).abs() <= tol * scale,
+            "{what}: index {k}: got {g}, want {w} (|diff| {:e}, scale {scale})",
+            (g - w).abs()
+        );
     }
 }
 
 fn friction(model: &Model, qd: &[f64]) -> Vec<f64> {
-    (0..model.n).map(|i| model.viscous[i] * qd[i] + model.coulomb[i] * if qd[i] > 0.0 { 1.0 } else if qd[i] < 0.0 { -1.0 } else { 0.0 }).collect()
+    (0..model.n)
+        .map(|i| {
+            model.viscous[i] * qd[i]
+                + model.coulomb[i]
+                    * if qd[i] > 0.0 {
+                        1.0
+                    } else if qd[i] < 0.0 {
+                        -1.0
+                    } else {
+                        0.0
+                    }
+        })
+        .collect()
 }
 
 /// A random state (q, qd, qdd) for each model.
 fn states(model: &Model, seed: u64) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     let mut rng = StdRng::seed_from_u64(seed);
-    (0..3).map(|_| (vector(&mut rng, model.n, 3.0), vector(&mut rng, model.n, 2.0), vector(&mut rng, model.n, 2.0))).collect()
+    (0..3)
+        .map(|_| {
+            (
+                vector(&mut rng, model.n, 3.0),
+                vector(&mut rng, model.n, 2.0),
+                vector(&mut rng, model.n, 2.0),
+            )
+        })
+        .collect()
 }
 
 #[test]
@@ -105,7 +183,12 @@ fn rnea_equals_mass_matrix_times_qdd_plus_bias_plus_friction() {
             let m = alg::crba(&model, &mut data, &q).to_vec();
             let bias = alg::bias_torque(&model, &mut data, &q, &qd).to_vec();
             let fr = friction(&model, &qd);
-            let want: Vec<f64> = matvec(&m, &qdd).iter().zip(&bias).zip(&fr).map(|((a, b), c)| a + b + c).collect();
+            let want: Vec<f64> = matvec(&m, &qdd)
+                .iter()
+                .zip(&bias)
+                .zip(&fr)
+                .map(|((a, b), c)| a + b + c)
+                .collect();
             assert_close(&format!("{name}: rnea vs M qdd + bias + friction"), &tau, &want, 1e-12);
         }
     }
@@ -120,14 +203,30 @@ fn mass_matrix_columns_are_rnea_of_unit_accelerations_and_exactly_symmetric() {
             let m = alg::crba(&model, &mut data, &q).to_vec();
             for i in 0..n {
                 for j in 0..n {
-                    assert_eq!(m[i * n + j].to_bits(), m[j * n + i].to_bits(), "{name}: M not bitwise symmetric at ({i},{j})");
+                    assert_eq!(
+                        m[i * n + j].to_bits(),
+                        m[j * n + i].to_bits(),
+                        "{name}: M not bitwise symmetric at ({i},{j})"
+                    );
                 }
             }
             let zero = vec![0.0; n];
             for j in 0..n {
                 let mut e = vec![0.0; n];
                 e[j] = 1.0;
-                let col = alg::rnea_with(&model, &mut data, &q, &zero, &e, None, RneaTerms { gravity: false, drives: true }).to_vec();
+                let col = alg::rnea_with(
+                    &model,
+                    &mut data,
+                    &q,
+                    &zero,
+                    &e,
+                    None,
+                    RneaTerms {
+                        gravity: false,
+                        drives: true,
+                    },
+                )
+                .to_vec();
                 let mcol: Vec<f64> = (0..n).map(|i| m[i * n + j]).collect();
                 assert_close(&format!("{name}: M column {j}"), &mcol, &col, 1e-12);
             }
@@ -197,7 +296,8 @@ fn gravity_is_rnea_at_rest_and_the_gradient_of_potential_energy() {
                     let (mut qp, mut qm) = (q.clone(), q.clone());
                     qp[i] += h;
                     qm[i] -= h;
-                    (alg::potential_energy(&model, &mut data, &qp) - alg::potential_energy(&model, &mut data, &qm)) / (2.0 * h)
+                    (alg::potential_energy(&model, &mut data, &qp) - alg::potential_energy(&model, &mut data, &qm))
+                        / (2.0 * h)
                 })
                 .collect();
             assert_close(&format!("{name}: g vs dP/dq"), &g, &fd, 1e-7);
@@ -277,7 +377,9 @@ fn christoffel_symbols_match_finite_differences_of_m_and_build_c() {
             assert_close(&format!("{name}: christoffel vs FD"), &c3, &want, 1e-7);
             // C[k][j] = sum_i c_ijk qd_i
             let c = alg::coriolis_matrix(&model, &mut data, &q, &qd).to_vec();
-            let from3: Vec<f64> = (0..n * n).map(|kj| (0..n).map(|i| c3[i * n * n + (kj % n) * n + kj / n] * qd[i]).sum()).collect();
+            let from3: Vec<f64> = (0..n * n)
+                .map(|kj| (0..n).map(|i| c3[i * n * n + (kj % n) * n + kj / n] * qd[i]).sum())
+                .collect();
             assert_close(&format!("{name}: C from christoffel"), &c, &from3, 1e-12);
         }
     }
@@ -298,9 +400,16 @@ fn kinetic_energy_is_half_qd_m_qd_and_momentum_matches_com_velocity() {
             let h = 1e-6;
             let qp: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + h * b).collect();
             let qm: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a - h * b).collect();
-            let cd = (alg::center_of_mass(&model, &mut data, &qp).unwrap() - alg::center_of_mass(&model, &mut data, &qm).unwrap()) / (2.0 * h);
+            let cd = (alg::center_of_mass(&model, &mut data, &qp).unwrap()
+                - alg::center_of_mass(&model, &mut data, &qm).unwrap())
+                / (2.0 * h);
             let p = alg::spatial_momentum(&model, &mut data, &q, &qd);
-            assert_close(&format!("{name}: momentum"), p.lin.as_slice(), (cd * total).as_slice(), 1e-7);
+            assert_close(
+                &format!("{name}: momentum"),
+                p.lin.as_slice(),
+                (cd * total).as_slice(),
+                1e-7,
+            );
             let _ = n;
         }
     }
@@ -335,7 +444,9 @@ fn regressor_times_parameters_is_rigid_body_torque() {
         for (q, qd, qdd) in states(&model, 19) {
             let mut y = vec![0.0; n * 10 * n];
             alg::regressor(&model, &mut data, &q, &qd, &qdd, &mut y);
-            let got: Vec<f64> = (0..n).map(|i| (0..10 * n).map(|c| y[i * 10 * n + c] * pi[c]).sum()).collect();
+            let got: Vec<f64> = (0..n)
+                .map(|i| (0..10 * n).map(|c| y[i * 10 * n + c] * pi[c]).sum())
+                .collect();
             let want = alg::rnea_with(&model, &mut data, &q, &qd, &qdd, None, RneaTerms::RIGID).to_vec();
             assert_close(&format!("{name}: Y pi"), &got, &want, 1e-12);
         }
@@ -351,7 +462,11 @@ fn mass_matrix_inverse_times_mass_matrix_is_identity() {
             let minv = alg::mass_matrix_inverse(&model, &mut data, &q).unwrap().to_vec();
             for i in 0..n {
                 for j in 0..n {
-                    assert_eq!(minv[i * n + j].to_bits(), minv[j * n + i].to_bits(), "{name}: Minv not symmetric");
+                    assert_eq!(
+                        minv[i * n + j].to_bits(),
+                        minv[j * n + i].to_bits(),
+                        "{name}: Minv not symmetric"
+                    );
                 }
             }
             let m = alg::crba(&model, &mut data, &q).to_vec();
@@ -383,16 +498,33 @@ fn singular_mass_matrix_is_an_error_naming_the_joint() {
         Err(Error::SingularMassMatrix(msg)) => assert!(msg.contains("joint 3"), "{msg}"),
         other => panic!("expected a singular mass matrix error, got {other:?}"),
     }
-    assert!(matches!(alg::mass_matrix_inverse(&model, &mut data, &z), Err(Error::SingularMassMatrix(_))));
+    assert!(matches!(
+        alg::mass_matrix_inverse(&model, &mut data, &z),
+        Err(Error::SingularMassMatrix(_))
+    ));
     // a point mass on a revolute axis through it: zero inertia about the axis
-    let joints = vec![Joint { kind: JointKind::Revolute, axis: Vec3::z() }];
+    let joints = vec![Joint {
+        kind: JointKind::Revolute,
+        axis: Vec3::z(),
+    }];
     let model = Model::new(
-        vec![None], joints, vec![0.0], vec![Transform::identity()], vec![Inertia::new(2.0, Vec3::zeros(), Mat3::zeros())],
-        vec![0.0], vec![0.0], vec![0.0], Vec3::new(0.0, 0.0, -9.81), vec![],
+        vec![None],
+        joints,
+        vec![0.0],
+        vec![Transform::identity()],
+        vec![Inertia::new(2.0, Vec3::zeros(), Mat3::zeros())],
+        vec![0.0],
+        vec![0.0],
+        vec![0.0],
+        Vec3::new(0.0, 0.0, -9.81),
+        vec![],
     )
     .unwrap();
     let mut data = Data::new(&model);
-    assert!(matches!(alg::aba(&model, &mut data, &[0.3], &[0.0], &[1.0], None), Err(Error::SingularMassMatrix(_))));
+    assert!(matches!(
+        alg::aba(&model, &mut data, &[0.3], &[0.0], &[1.0], None),
+        Err(Error::SingularMassMatrix(_))
+    ));
     // with a rotor inertia the same joint is fine: qdd = tau / armature
     let mut m2 = model.clone();
     m2.armature = vec![0.5];
@@ -426,13 +558,31 @@ fn double_pendulum_matches_its_closed_form() {
     // planar 2R in the x-y plane, joints about z, gravity -y; link i: length l_i, centre of mass
     // at lc_i on its x axis, inertia izz_i about the centre of mass (Spong et al. 2006, §7.4).
     let (m1, m2, l1, lc1, lc2, i1, i2, g0) = (1.3, 0.7, 0.9, 0.4, 0.35, 0.05, 0.02, 9.81);
-    let body = |m: f64, lc: f64, izz: f64| Inertia::new(m, Vec3::new(m * lc, 0.0, 0.0), Mat3::from_diagonal(&Vec3::new(0.01, 0.01 + m * lc * lc, izz + m * lc * lc)));
-    let rz = Joint { kind: JointKind::Revolute, axis: Vec3::z() };
+    let body = |m: f64, lc: f64, izz: f64| {
+        Inertia::new(
+            m,
+            Vec3::new(m * lc, 0.0, 0.0),
+            Mat3::from_diagonal(&Vec3::new(0.01, 0.01 + m * lc * lc, izz + m * lc * lc)),
+        )
+    };
+    let rz = Joint {
+        kind: JointKind::Revolute,
+        axis: Vec3::z(),
+    };
     let model = Model::new(
-        vec![None, Some(0)], vec![rz, rz], vec![0.0, 0.0],
-        vec![Transform::identity(), Transform::new(Mat3::identity(), Vec3::new(l1, 0.0, 0.0))],
-        vec![body(m1, lc1, i1), body(m2, lc2, i2)], vec![0.0; 2], vec![0.0; 2], vec![0.0; 2],
-        Vec3::new(0.0, -g0, 0.0), vec![],
+        vec![None, Some(0)],
+        vec![rz, rz],
+        vec![0.0, 0.0],
+        vec![
+            Transform::identity(),
+            Transform::new(Mat3::identity(), Vec3::new(l1, 0.0, 0.0)),
+        ],
+        vec![body(m1, lc1, i1), body(m2, lc2, i2)],
+        vec![0.0; 2],
+        vec![0.0; 2],
+        vec![0.0; 2],
+        Vec3::new(0.0, -g0, 0.0),
+        vec![],
     )
     .unwrap();
     let mut data = Data::new(&model);
@@ -464,11 +614,25 @@ fn asymmetric_coulomb_friction_gives_each_direction_its_level() {
             let tau = alg::rnea(&asym, &mut data_a, &q, &qd, &qdd, None).to_vec();
             for i in 0..n {
                 // the symmetric model carries coulomb sign(qd); the asymmetric one differs only for qd < 0
-                let want = if qd[i] < 0.0 { base[i] + model.coulomb[i] - negative[i] } else { base[i] };
-                assert!((tau[i] - want).abs() < 1e-12 * want.abs().max(1.0), "{name}: joint {i} qd {}: tau {} want {want}", qd[i], tau[i]);
+                let want = if qd[i] < 0.0 {
+                    base[i] + model.coulomb[i] - negative[i]
+                } else {
+                    base[i]
+                };
+                assert!(
+                    (tau[i] - want).abs() < 1e-12 * want.abs().max(1.0),
+                    "{name}: joint {i} qd {}: tau {} want {want}",
+                    qd[i],
+                    tau[i]
+                );
             }
             let back = alg::aba(&asym, &mut data_a, &q, &qd, &tau, None).unwrap().to_vec();
-            assert_close(&format!("{name}: aba(rnea(qdd)) with asymmetric Coulomb"), &back, &qdd, 1e-10);
+            assert_close(
+                &format!("{name}: aba(rnea(qdd)) with asymmetric Coulomb"),
+                &back,
+                &qdd,
+                1e-10,
+            );
             for i in 0..n {
                 assert_eq!(asym.coulomb_torque(i, 0.0), 0.0);
                 assert_eq!(asym.coulomb_torque(i, 1e-300), asym.coulomb[i]);
@@ -478,9 +642,18 @@ fn asymmetric_coulomb_friction_gives_each_direction_its_level() {
     }
     let model = random_model(1, 2, false, true, false);
     let short = model.clone().with_coulomb_negative(vec![0.1]).unwrap_err();
-    assert!(format!("{short:?}").contains("coulomb_negative has 1 entries for 2 bodies"), "{short:?}");
+    assert!(
+        format!("{short:?}").contains("coulomb_negative has 1 entries for 2 bodies"),
+        "{short:?}"
+    );
     let negative = model.clone().with_coulomb_negative(vec![0.1, -0.2]).unwrap_err();
-    assert!(format!("{negative:?}").contains("coulomb_negative of joint 1 is -0.2"), "{negative:?}");
+    assert!(
+        format!("{negative:?}").contains("coulomb_negative of joint 1 is -0.2"),
+        "{negative:?}"
+    );
     let nan = model.with_coulomb_negative(vec![f64::NAN, 0.1]).unwrap_err();
-    assert!(format!("{nan:?}").contains("coulomb_negative has a non-finite value at index 0"), "{nan:?}");
+    assert!(
+        format!("{nan:?}").contains("coulomb_negative has a non-finite value at index 0"),
+        "{nan:?}"
+    );
 }

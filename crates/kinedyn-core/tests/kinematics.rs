@@ -9,7 +9,11 @@ use kinedyn_core::{Data, Model};
 const REFS: [Reference; 3] = [Reference::World, Reference::Local, Reference::Spatial];
 
 fn models() -> Vec<Model> {
-    vec![random_model(1, 7, false), random_model(2, 9, true), random_model(3, 1, false)]
+    vec![
+        random_model(1, 7, false),
+        random_model(2, 9, true),
+        random_model(3, 1, false),
+    ]
 }
 
 /// Angular velocity w (base axes) from dR/dt R^T, by central differences.
@@ -35,7 +39,10 @@ fn jacobians_match_finite_differences_of_forward_kinematics() {
                     let (mut qp, mut qm) = (q.clone(), q.clone());
                     qp[col] += h;
                     qm[col] -= h;
-                    let (tp, tm) = (frame_pose_at(&model, &mut data, &qp, frame), frame_pose_at(&model, &mut data, &qm, frame));
+                    let (tp, tm) = (
+                        frame_pose_at(&model, &mut data, &qp, frame),
+                        frame_pose_at(&model, &mut data, &qm, frame),
+                    );
                     let v = (tp.trans - tm.trans) / (2.0 * h);
                     let w = omega(&tm.rot, &tp.rot, h);
                     let (lin, ang) = match reference {
@@ -46,7 +53,11 @@ fn jacobians_match_finite_differences_of_forward_kinematics() {
                     let expected = [lin.x, lin.y, lin.z, ang.x, ang.y, ang.z];
                     for row in 0..6 {
                         let got = j[row * n + col];
-                        assert!((got - expected[row]).abs() < 1e-6, "frame {frame} {reference:?} J[{row}][{col}] = {got}, fd {}", expected[row]);
+                        assert!(
+                            (got - expected[row]).abs() < 1e-6,
+                            "frame {frame} {reference:?} J[{row}][{col}] = {got}, fd {}",
+                            expected[row]
+                        );
                     }
                 }
             }
@@ -69,7 +80,9 @@ fn twist_is_j_qd_and_drift_is_its_derivative() {
                 let jqd = |data: &mut Data, q: &[f64]| {
                     let mut j = vec![0.0; 6 * n];
                     frame_jacobian(&model, data, q, frame, reference, point.as_ref(), &mut j);
-                    (0..6).map(|r| (0..n).map(|c| j[r * n + c] * qd[c]).sum::<f64>()).collect::<Vec<f64>>()
+                    (0..6)
+                        .map(|r| (0..n).map(|c| j[r * n + c] * qd[c]).sum::<f64>())
+                        .collect::<Vec<f64>>()
                 };
                 let v = frame_velocity(&model, &mut data, &q, &qd, frame, reference, point.as_ref()).to_array();
                 let expected = jqd(&mut data, &q);
@@ -82,7 +95,11 @@ fn twist_is_j_qd_and_drift_is_its_derivative() {
                 let drift = jacobian_dot_qd(&model, &mut data, &q, &qd, frame, reference, point.as_ref()).to_array();
                 for r in 0..6 {
                     let fd = (ep[r] - em[r]) / (2.0 * h);
-                    assert!((drift[r] - fd).abs() < 1e-6 * fd.abs().max(1.0), "frame {frame} {reference:?} drift row {r}: {} vs {fd}", drift[r]);
+                    assert!(
+                        (drift[r] - fd).abs() < 1e-6 * fd.abs().max(1.0),
+                        "frame {frame} {reference:?} drift row {r}: {} vs {fd}",
+                        drift[r]
+                    );
                 }
             }
         }
@@ -102,7 +119,15 @@ fn hessian_matches_finite_differences_of_the_jacobian_and_gives_the_drift() {
             for frame in 0..model.frames.len() {
                 for reference in REFS {
                     let mut hess = vec![0.0; 6 * n * n];
-                    kinedyn_core::algorithms::frame_jacobian_hessian(&model, &mut data, &q, frame, reference, point.as_ref(), &mut hess);
+                    kinedyn_core::algorithms::frame_jacobian_hessian(
+                        &model,
+                        &mut data,
+                        &q,
+                        frame,
+                        reference,
+                        point.as_ref(),
+                        &mut hess,
+                    );
                     let (mut jp, mut jm) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
                     for i in 0..n {
                         let (mut qp, mut qm) = (q.clone(), q.clone());
@@ -113,14 +138,26 @@ fn hessian_matches_finite_differences_of_the_jacobian_and_gives_the_drift() {
                         for k in 0..6 * n {
                             let fd = (jp[k] - jm[k]) / (2.0 * h);
                             let got = hess[i * 6 * n + k];
-                            assert!((got - fd).abs() < 1e-6 * fd.abs().max(1.0), "frame {frame} {reference:?} dJ[{}][{}]/dq{i} = {got}, fd {fd}", k / n, k % n);
+                            assert!(
+                                (got - fd).abs() < 1e-6 * fd.abs().max(1.0),
+                                "frame {frame} {reference:?} dJ[{}][{}]/dq{i} = {got}, fd {fd}",
+                                k / n,
+                                k % n
+                            );
                         }
                     }
                     // sum_i H[i] qd_i qd = dJ/dt qd, the acceleration drift of the same reference
-                    let drift = jacobian_dot_qd(&model, &mut data, &q, &qd, frame, reference, point.as_ref()).to_array();
+                    let drift =
+                        jacobian_dot_qd(&model, &mut data, &q, &qd, frame, reference, point.as_ref()).to_array();
                     for r in 0..6 {
-                        let hqq: f64 = (0..n).map(|i| (0..n).map(|j| hess[(i * 6 + r) * n + j] * qd[i] * qd[j]).sum::<f64>()).sum();
-                        assert!((hqq - drift[r]).abs() < 1e-9 * drift[r].abs().max(1.0), "frame {frame} {reference:?} drift row {r}: H qd qd = {hqq}, {}", drift[r]);
+                        let hqq: f64 = (0..n)
+                            .map(|i| (0..n).map(|j| hess[(i * 6 + r) * n + j] * qd[i] * qd[j]).sum::<f64>())
+                            .sum();
+                        assert!(
+                            (hqq - drift[r]).abs() < 1e-9 * drift[r].abs().max(1.0),
+                            "frame {frame} {reference:?} drift row {r}: H qd qd = {hqq}, {}",
+                            drift[r]
+                        );
                     }
                 }
             }

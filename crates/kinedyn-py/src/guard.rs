@@ -70,7 +70,10 @@ pub fn _debug_panic(py: Python<'_>, message: &str, in_worker: bool) -> PyResult<
 pub fn shape_text(shape: &[usize]) -> String {
     match shape {
         [one] => format!("({one},)"),
-        _ => format!("({})", shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
+        _ => format!(
+            "({})",
+            shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")
+        ),
     }
 }
 
@@ -95,7 +98,11 @@ pub fn check_size(what: &str, count: usize, shape: &[usize]) -> PyResult<()> {
     let elements = shape.iter().map(|&d| d as u128).product::<u128>();
     let bytes = elements * 8 * count as u128;
     if bytes > isize::MAX as u128 {
-        let arrays = if count == 1 { "an array".to_string() } else { format!("{count} arrays") };
+        let arrays = if count == 1 {
+            "an array".to_string()
+        } else {
+            format!("{count} arrays")
+        };
         return Err(PyMemoryError::new_err(format!(
             "{what}: the result needs {arrays} of shape {} (float64), {} in all, more than any allocation can hold",
             shape_text(shape),
@@ -119,7 +126,12 @@ fn out_of_memory(py: Python<'_>, what: &str, shape: &[usize], detail: Option<PyE
 /// A fresh C-ordered array (float64 for results; the size check counts 8 bytes per element, an
 /// upper bound for bool and int64 too), uninitialised (`zeroed = false`) or zeros; MemoryError naming
 /// `what` and the size when it cannot be had (rust-numpy's `PyArray::new` / `zeros` panic then).
-fn allocate<'py, T: Element>(py: Python<'py>, what: &str, shape: &[usize], zeroed: bool) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+fn allocate<'py, T: Element>(
+    py: Python<'py>,
+    what: &str,
+    shape: &[usize],
+    zeroed: bool,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     check_size(what, 1, shape)?;
     let mut dims: Vec<npy_intp> = shape.iter().map(|&d| d as npy_intp).collect();
     // SAFETY: the NumPy C API with a valid descriptor (its reference is stolen by the call) and
@@ -240,7 +252,10 @@ fn non_finite_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
     NON_FINITE
         .get_or_try_init(py, || {
             let builtins = py.import("builtins")?;
-            let bases = PyTuple::new(py, [builtins.getattr("FloatingPointError")?, builtins.getattr("ValueError")?])?;
+            let bases = PyTuple::new(
+                py,
+                [builtins.getattr("FloatingPointError")?, builtins.getattr("ValueError")?],
+            )?;
             let namespace = PyDict::new(py);
             namespace.set_item("__module__", "kinedyn")?;
             namespace.set_item(
@@ -248,7 +263,9 @@ fn non_finite_type(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
                 "Finite inputs gave a non-finite result (NaN or inf): the numbers overflowed float64. \
                  A FloatingPointError and a ValueError (the inputs are outside what the model can represent).",
             )?;
-            let ty = py.get_type::<PyType>().call1(("NonFiniteResultError", bases, namespace))?;
+            let ty = py
+                .get_type::<PyType>()
+                .call1(("NonFiniteResultError", bases, namespace))?;
             Ok::<_, PyErr>(ty.cast_into::<PyType>()?.unbind())
         })
         .map(|t| t.bind(py))

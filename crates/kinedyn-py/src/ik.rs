@@ -19,15 +19,22 @@ use crate::PyModel;
 fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResult<Transform> {
     let at = index.map(|k| format!(" (target {k})")).unwrap_or_default();
     if let Some(k) = values.iter().position(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!("target contains a non-finite value (NaN or inf) at flat index {k}{at}")));
+        return Err(PyValueError::new_err(format!(
+            "target contains a non-finite value (NaN or inf) at flat index {k}{at}"
+        )));
     }
     if position {
-        return Ok(Transform::new(Mat3::identity(), Vec3::new(values[0], values[1], values[2])));
+        return Ok(Transform::new(
+            Mat3::identity(),
+            Vec3::new(values[0], values[1], values[2]),
+        ));
     }
     let t = Transform::from_homogeneous(values);
     let bottom = &values[12..16];
     if bottom[0].abs() > 1e-9 || bottom[1].abs() > 1e-9 || bottom[2].abs() > 1e-9 || (bottom[3] - 1.0).abs() > 1e-9 {
-        return Err(PyValueError::new_err(format!("target is not an SE(3) matrix: its last row is {bottom:?}, not [0, 0, 0, 1]{at}")));
+        return Err(PyValueError::new_err(format!(
+            "target is not an SE(3) matrix: its last row is {bottom:?}, not [0, 0, 0, 1]{at}"
+        )));
     }
     let off = (t.rot.transpose() * t.rot - Mat3::identity()).abs().max();
     if off > 1e-6 || t.rot.determinant() < 0.0 {
@@ -77,7 +84,10 @@ fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transfo
 
 fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Vec<f64>> {
     if a.shape() != [len] {
-        return Err(PyValueError::new_err(format!("{name} must have shape ({len},), got {:?}", a.shape())));
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({len},), got {:?}",
+            a.shape()
+        )));
     }
     numbers(a)
 }
@@ -85,7 +95,10 @@ fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Ve
 fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
     for i in 0..lower.len() {
         if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
-            return Err(PyValueError::new_err(format!("joint {i}: limits [{}, {}] are not an interval", lower[i], upper[i])));
+            return Err(PyValueError::new_err(format!(
+                "joint {i}: limits [{}, {}] are not an interval",
+                lower[i], upper[i]
+            )));
         }
     }
     Ok(())
@@ -96,14 +109,30 @@ fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
 type ReductionArgs = (Vec<i64>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<f64>, Vec<i64>, usize);
 
 fn reduction(model: &Model, args: Option<ReductionArgs>) -> PyResult<Option<ik::Reduction>> {
-    let Some((q_source, q_multiplier, q_offset, v_source, v_multiplier, q_keep, nv)) = args else { return Ok(None) };
+    let Some((q_source, q_multiplier, q_offset, v_source, v_multiplier, q_keep, nv)) = args else {
+        return Ok(None);
+    };
     let index = |x: i64| usize::try_from(x).unwrap_or(usize::MAX);
-    if q_multiplier.len() != q_source.len() || q_offset.len() != q_source.len() || v_multiplier.len() != v_source.len() {
-        return Err(PyValueError::new_err("reduction: q_source, q_multiplier and q_offset (and v_source, v_multiplier) must have one length"));
+    if q_multiplier.len() != q_source.len() || q_offset.len() != q_source.len() || v_multiplier.len() != v_source.len()
+    {
+        return Err(PyValueError::new_err(
+            "reduction: q_source, q_multiplier and q_offset (and v_source, v_multiplier) must have one length",
+        ));
     }
-    let q = q_source.iter().zip(&q_multiplier).zip(&q_offset).map(|((k, m), b)| (index(*k), *m, *b)).collect();
-    let v = v_source.iter().zip(&v_multiplier).map(|(k, m)| (index(*k), *m)).collect();
-    ik::Reduction::new(model, q, v, q_keep.into_iter().map(index).collect(), nv).map(Some).map_err(PyValueError::new_err)
+    let q = q_source
+        .iter()
+        .zip(&q_multiplier)
+        .zip(&q_offset)
+        .map(|((k, m), b)| (index(*k), *m, *b))
+        .collect();
+    let v = v_source
+        .iter()
+        .zip(&v_multiplier)
+        .map(|(k, m)| (index(*k), *m))
+        .collect();
+    ik::Reduction::new(model, q, v, q_keep.into_iter().map(index).collect(), nv)
+        .map(Some)
+        .map_err(PyValueError::new_err)
 }
 
 /// Levenberg-Marquardt inverse kinematics of `frame` for one target or a batch, on the
@@ -137,97 +166,157 @@ pub fn solve_ik<'py>(
     reduction: Option<ReductionArgs>,
 ) -> PyResult<Bound<'py, PyAny>> {
     guarded("solve_ik", || {
-    let m: &Model = &model.model;
-    let reduced = self::reduction(m, reduction)?;
-    let reduced = reduced.as_ref();
-    // configurations have n entries (nq), steps nv
-    let (n, _) = ik::solver_sizes(m, reduced);
-    let frame = model.frame(frame)?;
-    let (targets, batch, position) = gather_targets(&targets)?;
-    let count = targets.len();
-    let lower = vector("lower", &lower, n)?;
-    let upper = vector("upper", &upper, n)?;
-    check_limits(&lower, &upper)?;
-    let w = vector("weights", &weights, 6)?;
-    if w.iter().any(|x| !x.is_finite() || *x < 0.0) || w.iter().all(|x| *x == 0.0) {
-        return Err(PyValueError::new_err(format!("weights must be 6 finite values >= 0, not all zero; got {w:?}")));
-    }
-    let mut weights: [f64; 6] = [w[0], w[1], w[2], w[3], w[4], w[5]];
-    if position {
-        weights[3..].fill(0.0);
-    }
-    let q0_shape = q0.shape().to_vec();
-    let q0s: Vec<f64> = numbers(&q0)?;
-    let per_target = match (q0_shape.as_slice(), batch) {
-        ([k], _) if *k == n => false,
-        ([b, k], Some(nb)) if *k == n && *b == nb => true,
-        _ => return Err(PyValueError::new_err(format!("q0 must have shape ({n},) or ({count}, {n}), got {q0_shape:?}"))),
-    };
-    if q0s.iter().any(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err("q0 contains a non-finite value"));
-    }
-    for (k, start) in q0s.chunks(n.max(1)).enumerate() {
-        ik::check_start(m, reduced, start, &lower, &upper).map_err(|e| PyValueError::new_err(if per_target { format!("{e} (start {k})") } else { e }))?;
-    }
-    let settings = Settings { weights, max_iterations, restarts, position_tolerance, orientation_tolerance, lambda_min, max_step };
-    let solve_one = |data: &mut Data, k: usize| {
-        let start = if per_target { &q0s[k * n..(k + 1) * n] } else { &q0s[..] };
-        // a seed per target, from its index in the whole batch (`first_index` + k when the caller
-        // sends the batch in chunks): results do not depend on how the batch is split
-        let index = first_index.wrapping_add(k as u64);
-        ik::numeric_ik_reduced(m, reduced, data, frame, &targets[k], start, &lower, &upper, &settings, seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(index))
-    };
-    // the results, allocated fallibly before the work (MemoryError, not an abort), each target
-    // writing its own row
-    let q = guard::empty::<f64>(py, "solve_ik", &[count, n])?;
-    let success = guard::zeros::<bool>(py, "solve_ik", &[count])?; // (zeros: no invalid bools)
-    let [pe, oe] = [guard::empty::<f64>(py, "solve_ik", &[count])?, guard::empty::<f64>(py, "solve_ik", &[count])?];
-    let it = guard::empty::<i64>(py, "solve_ik", &[count])?;
-    // SAFETY: fresh arrays, referenced by nothing else until returned
-    let (q_out, s_out, pe_out, oe_out, it_out) = unsafe { (q.as_slice_mut()?, success.as_slice_mut()?, pe.as_slice_mut()?, oe.as_slice_mut()?, it.as_slice_mut()?) };
-    let write = |data: &mut Data, k: usize, qk: &mut [f64], s: &mut bool, p: &mut f64, o: &mut f64, i: &mut i64| {
-        let out = solve_one(data, k);
-        qk.copy_from_slice(&out.q);
-        (*s, *p, *o, *i) = (out.success, out.position_error, out.orientation_error, out.iterations as i64);
-    };
-    py.detach(|| {
-        let rows = q_out.chunks_mut(n).zip(s_out.iter_mut()).zip(pe_out.iter_mut()).zip(oe_out.iter_mut()).zip(it_out.iter_mut());
-        if count <= 4 {
-            // the model's cached Data, unless another thread holds it (then a fresh one: a lock
-            // held by a thread of the parent at a fork would otherwise never be released)
-            let mut fresh;
-            let mut cached = model.data.try_lock();
-            let data: &mut Data = match cached.as_deref_mut() {
-                Ok(d) => d,
-                Err(_) => {
-                    fresh = Data::new(m);
-                    &mut fresh
-                }
-            };
-            for (k, ((((qk, s), p), o), i)) in rows.enumerate() {
-                write(data, k, qk, s, p, o, i);
-            }
-            Ok(())
-        } else {
-            guard::install(|| {
-                q_out.par_chunks_mut(n).zip(s_out.par_iter_mut()).zip(pe_out.par_iter_mut()).zip(oe_out.par_iter_mut()).zip(it_out.par_iter_mut()).enumerate().for_each_init(
-                    || Data::new(m),
-                    |data, (k, ((((qk, s), p), o), i))| write(data, k, qk, s, p, o, i),
-                )
-            })
+        let m: &Model = &model.model;
+        let reduced = self::reduction(m, reduction)?;
+        let reduced = reduced.as_ref();
+        // configurations have n entries (nq), steps nv
+        let (n, _) = ik::solver_sizes(m, reduced);
+        let frame = model.frame(frame)?;
+        let (targets, batch, position) = gather_targets(&targets)?;
+        let count = targets.len();
+        let lower = vector("lower", &lower, n)?;
+        let upper = vector("upper", &upper, n)?;
+        check_limits(&lower, &upper)?;
+        let w = vector("weights", &weights, 6)?;
+        if w.iter().any(|x| !x.is_finite() || *x < 0.0) || w.iter().all(|x| *x == 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "weights must be 6 finite values >= 0, not all zero; got {w:?}"
+            )));
         }
-    })?;
-    let result = match batch {
-        Some(_) => (q.into_any(), success.into_any(), pe.into_any(), oe.into_any(), it.into_any()),
-        None => (
-            q.reshape([n])?.into_any(),
-            s_out[0].into_pyobject(py)?.to_owned().into_any(),
-            pe_out[0].into_pyobject(py)?.into_any(),
-            oe_out[0].into_pyobject(py)?.into_any(),
-            it_out[0].into_pyobject(py)?.into_any(),
-        ),
-    };
-    Ok(result.into_pyobject(py)?.into_any())
+        let mut weights: [f64; 6] = [w[0], w[1], w[2], w[3], w[4], w[5]];
+        if position {
+            weights[3..].fill(0.0);
+        }
+        let q0_shape = q0.shape().to_vec();
+        let q0s: Vec<f64> = numbers(&q0)?;
+        let per_target = match (q0_shape.as_slice(), batch) {
+            ([k], _) if *k == n => false,
+            ([b, k], Some(nb)) if *k == n && *b == nb => true,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "q0 must have shape ({n},) or ({count}, {n}), got {q0_shape:?}"
+                )))
+            }
+        };
+        if q0s.iter().any(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err("q0 contains a non-finite value"));
+        }
+        for (k, start) in q0s.chunks(n.max(1)).enumerate() {
+            ik::check_start(m, reduced, start, &lower, &upper)
+                .map_err(|e| PyValueError::new_err(if per_target { format!("{e} (start {k})") } else { e }))?;
+        }
+        let settings = Settings {
+            weights,
+            max_iterations,
+            restarts,
+            position_tolerance,
+            orientation_tolerance,
+            lambda_min,
+            max_step,
+        };
+        let solve_one = |data: &mut Data, k: usize| {
+            let start = if per_target { &q0s[k * n..(k + 1) * n] } else { &q0s[..] };
+            // a seed per target, from its index in the whole batch (`first_index` + k when the caller
+            // sends the batch in chunks): results do not depend on how the batch is split
+            let index = first_index.wrapping_add(k as u64);
+            ik::numeric_ik_reduced(
+                m,
+                reduced,
+                data,
+                frame,
+                &targets[k],
+                start,
+                &lower,
+                &upper,
+                &settings,
+                seed.wrapping_mul(0x2545_F491_4F6C_DD1D).wrapping_add(index),
+            )
+        };
+        // the results, allocated fallibly before the work (MemoryError, not an abort), each target
+        // writing its own row
+        let q = guard::empty::<f64>(py, "solve_ik", &[count, n])?;
+        let success = guard::zeros::<bool>(py, "solve_ik", &[count])?; // (zeros: no invalid bools)
+        let [pe, oe] = [
+            guard::empty::<f64>(py, "solve_ik", &[count])?,
+            guard::empty::<f64>(py, "solve_ik", &[count])?,
+        ];
+        let it = guard::empty::<i64>(py, "solve_ik", &[count])?;
+        // SAFETY: fresh arrays, referenced by nothing else until returned
+        let (q_out, s_out, pe_out, oe_out, it_out) = unsafe {
+            (
+                q.as_slice_mut()?,
+                success.as_slice_mut()?,
+                pe.as_slice_mut()?,
+                oe.as_slice_mut()?,
+                it.as_slice_mut()?,
+            )
+        };
+        let write = |data: &mut Data, k: usize, qk: &mut [f64], s: &mut bool, p: &mut f64, o: &mut f64, i: &mut i64| {
+            let out = solve_one(data, k);
+            qk.copy_from_slice(&out.q);
+            (*s, *p, *o, *i) = (
+                out.success,
+                out.position_error,
+                out.orientation_error,
+                out.iterations as i64,
+            );
+        };
+        py.detach(|| {
+            let rows = q_out
+                .chunks_mut(n)
+                .zip(s_out.iter_mut())
+                .zip(pe_out.iter_mut())
+                .zip(oe_out.iter_mut())
+                .zip(it_out.iter_mut());
+            if count <= 4 {
+                // the model's cached Data, unless another thread holds it (then a fresh one: a lock
+                // held by a thread of the parent at a fork would otherwise never be released)
+                let mut fresh;
+                let mut cached = model.data.try_lock();
+                let data: &mut Data = match cached.as_deref_mut() {
+                    Ok(d) => d,
+                    Err(_) => {
+                        fresh = Data::new(m);
+                        &mut fresh
+                    }
+                };
+                for (k, ((((qk, s), p), o), i)) in rows.enumerate() {
+                    write(data, k, qk, s, p, o, i);
+                }
+                Ok(())
+            } else {
+                guard::install(|| {
+                    q_out
+                        .par_chunks_mut(n)
+                        .zip(s_out.par_iter_mut())
+                        .zip(pe_out.par_iter_mut())
+                        .zip(oe_out.par_iter_mut())
+                        .zip(it_out.par_iter_mut())
+                        .enumerate()
+                        .for_each_init(
+                            || Data::new(m),
+                            |data, (k, ((((qk, s), p), o), i))| write(data, k, qk, s, p, o, i),
+                        )
+                })
+            }
+        })?;
+        let result = match batch {
+            Some(_) => (
+                q.into_any(),
+                success.into_any(),
+                pe.into_any(),
+                oe.into_any(),
+                it.into_any(),
+            ),
+            None => (
+                q.reshape([n])?.into_any(),
+                s_out[0].into_pyobject(py)?.to_owned().into_any(),
+                pe_out[0].into_pyobject(py)?.into_any(),
+                oe_out[0].into_pyobject(py)?.into_any(),
+                it_out[0].into_pyobject(py)?.into_any(),
+            ),
+        };
+        Ok(result.into_pyobject(py)?.into_any())
     })
 }
 
@@ -246,18 +335,30 @@ pub struct PyAnalyticIk {
 impl PyAnalyticIk {
     /// The solver of `frame`'s chain, or None if its geometry has no closed form here.
     #[staticmethod]
-    fn detect(model: &PyModel, frame: i64, lower: Bound<'_, PyArrayDyn<f64>>, upper: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Option<Self>> {
+    fn detect(
+        model: &PyModel,
+        frame: i64,
+        lower: Bound<'_, PyArrayDyn<f64>>,
+        upper: Bound<'_, PyArrayDyn<f64>>,
+    ) -> PyResult<Option<Self>> {
         guarded("AnalyticIk.detect", || {
-        let frame = model.frame(frame)?;
-        if !model.model.plain {
-            return Ok(None); // a multi-DOF joint is no screw: no closed form here
-        }
-        let m = model.model.clone();
-        let lower = vector("lower", &lower, m.n)?;
-        let upper = vector("upper", &upper, m.n)?;
-        check_limits(&lower, &upper)?;
-        let mut data = Data::new(&m);
-        Ok(ik::detect_analytic(&m, &mut data, frame).map(|solver| Self { solver, model: m, data: Mutex::new(data), frame, lower, upper }))
+            let frame = model.frame(frame)?;
+            if !model.model.plain {
+                return Ok(None); // a multi-DOF joint is no screw: no closed form here
+            }
+            let m = model.model.clone();
+            let lower = vector("lower", &lower, m.n)?;
+            let upper = vector("upper", &upper, m.n)?;
+            check_limits(&lower, &upper)?;
+            let mut data = Data::new(&m);
+            Ok(ik::detect_analytic(&m, &mut data, frame).map(|solver| Self {
+                solver,
+                model: m,
+                data: Mutex::new(data),
+                frame,
+                lower,
+                upper,
+            }))
         })
     }
 
@@ -291,27 +392,47 @@ impl PyAnalyticIk {
         reference: Bound<'py, PyArrayDyn<f64>>,
         respect_limits: bool,
         tolerance: f64,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, usize, bool)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        usize,
+        bool,
+    )> {
         guarded("AnalyticIk.solve", || {
-        let n = self.model.n;
-        let (targets, batch, position) = gather_targets(&target)?;
-        if batch.is_some() {
-            return Err(PyValueError::new_err("AnalyticIk.solve takes one target; use solve_nearest for a batch"));
-        }
-        let reference = vector("reference", &reference, n)?;
-        let out = {
-            let mut data = self.data.lock().unwrap_or_else(|e| e.into_inner());
-            ik::analytic_solutions(&self.model, &mut data, &self.solver, self.frame, &targets[0], position, &reference, &self.lower, &self.upper, respect_limits, tolerance)
-        };
-        let m = out.solutions.len();
-        let flat: Vec<f64> = out.solutions.concat();
-        Ok((
-            PyArray1::from_vec(py, flat).reshape([m, n])?,
-            PyArray1::from_vec(py, out.position_error),
-            PyArray1::from_vec(py, out.orientation_error),
-            out.found,
-            out.singular,
-        ))
+            let n = self.model.n;
+            let (targets, batch, position) = gather_targets(&target)?;
+            if batch.is_some() {
+                return Err(PyValueError::new_err(
+                    "AnalyticIk.solve takes one target; use solve_nearest for a batch",
+                ));
+            }
+            let reference = vector("reference", &reference, n)?;
+            let out = {
+                let mut data = self.data.lock().unwrap_or_else(|e| e.into_inner());
+                ik::analytic_solutions(
+                    &self.model,
+                    &mut data,
+                    &self.solver,
+                    self.frame,
+                    &targets[0],
+                    position,
+                    &reference,
+                    &self.lower,
+                    &self.upper,
+                    respect_limits,
+                    tolerance,
+                )
+            };
+            let m = out.solutions.len();
+            let flat: Vec<f64> = out.solutions.concat();
+            Ok((
+                PyArray1::from_vec(py, flat).reshape([m, n])?,
+                PyArray1::from_vec(py, out.position_error),
+                PyArray1::from_vec(py, out.orientation_error),
+                out.found,
+                out.singular,
+            ))
         })
     }
 
@@ -326,44 +447,85 @@ impl PyAnalyticIk {
         references: Bound<'py, PyArrayDyn<f64>>,
         respect_limits: bool,
         tolerance: f64,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
         guarded("AnalyticIk.solve_nearest", || {
-        let n = self.model.n;
-        let (targets, _, position) = gather_targets(&targets)?;
-        let count = targets.len();
-        let refs: Vec<f64> = numbers(&references)?;
-        if references.shape() != [count, n] {
-            return Err(PyValueError::new_err(format!("references must have shape ({count}, {n}), got {:?}", references.shape())));
-        }
-        // the results, allocated fallibly before the work, each target writing its own row
-        const WHAT: &str = "AnalyticIk.solve_nearest";
-        let q = guard::empty::<f64>(py, WHAT, &[count, n])?;
-        let success = guard::zeros::<bool>(py, WHAT, &[count])?;
-        let [pe, oe] = [guard::empty::<f64>(py, WHAT, &[count])?, guard::empty::<f64>(py, WHAT, &[count])?];
-        // SAFETY: fresh arrays, referenced by nothing else until returned
-        let (q_out, s_out, pe_out, oe_out) = unsafe { (q.as_slice_mut()?, success.as_slice_mut()?, pe.as_slice_mut()?, oe.as_slice_mut()?) };
-        py.detach(|| {
-            guard::install(|| {
-                q_out.par_chunks_mut(n).zip(s_out.par_iter_mut()).zip(pe_out.par_iter_mut()).zip(oe_out.par_iter_mut()).enumerate().for_each_init(
-                    || Data::new(&self.model),
-                    |data, (k, (((qk, s), p), o))| {
-                        let r = &refs[k * n..(k + 1) * n];
-                        let out = ik::analytic_solutions(&self.model, data, &self.solver, self.frame, &targets[k], position, r, &self.lower, &self.upper, respect_limits, tolerance);
-                        match out.solutions.first() {
-                            Some(best) => {
-                                qk.copy_from_slice(best);
-                                (*s, *p, *o) = (true, out.position_error[0], out.orientation_error[0]);
-                            }
-                            None => {
-                                qk.fill(f64::NAN);
-                                (*s, *p, *o) = (false, f64::NAN, f64::NAN);
-                            }
-                        }
-                    },
+            let n = self.model.n;
+            let (targets, _, position) = gather_targets(&targets)?;
+            let count = targets.len();
+            let refs: Vec<f64> = numbers(&references)?;
+            if references.shape() != [count, n] {
+                return Err(PyValueError::new_err(format!(
+                    "references must have shape ({count}, {n}), got {:?}",
+                    references.shape()
+                )));
+            }
+            // the results, allocated fallibly before the work, each target writing its own row
+            const WHAT: &str = "AnalyticIk.solve_nearest";
+            let q = guard::empty::<f64>(py, WHAT, &[count, n])?;
+            let success = guard::zeros::<bool>(py, WHAT, &[count])?;
+            let [pe, oe] = [
+                guard::empty::<f64>(py, WHAT, &[count])?,
+                guard::empty::<f64>(py, WHAT, &[count])?,
+            ];
+            // SAFETY: fresh arrays, referenced by nothing else until returned
+            let (q_out, s_out, pe_out, oe_out) = unsafe {
+                (
+                    q.as_slice_mut()?,
+                    success.as_slice_mut()?,
+                    pe.as_slice_mut()?,
+                    oe.as_slice_mut()?,
                 )
-            })
-        })?;
-        Ok((q.cast_into::<PyArray2<f64>>()?, success.cast_into::<PyArray1<bool>>()?, pe.cast_into::<PyArray1<f64>>()?, oe.cast_into::<PyArray1<f64>>()?))
+            };
+            py.detach(|| {
+                guard::install(|| {
+                    q_out
+                        .par_chunks_mut(n)
+                        .zip(s_out.par_iter_mut())
+                        .zip(pe_out.par_iter_mut())
+                        .zip(oe_out.par_iter_mut())
+                        .enumerate()
+                        .for_each_init(
+                            || Data::new(&self.model),
+                            |data, (k, (((qk, s), p), o))| {
+                                let r = &refs[k * n..(k + 1) * n];
+                                let out = ik::analytic_solutions(
+                                    &self.model,
+                                    data,
+                                    &self.solver,
+                                    self.frame,
+                                    &targets[k],
+                                    position,
+                                    r,
+                                    &self.lower,
+                                    &self.upper,
+                                    respect_limits,
+                                    tolerance,
+                                );
+                                match out.solutions.first() {
+                                    Some(best) => {
+                                        qk.copy_from_slice(best);
+                                        (*s, *p, *o) = (true, out.position_error[0], out.orientation_error[0]);
+                                    }
+                                    None => {
+                                        qk.fill(f64::NAN);
+                                        (*s, *p, *o) = (false, f64::NAN, f64::NAN);
+                                    }
+                                }
+                            },
+                        )
+                })
+            })?;
+            Ok((
+                q.cast_into::<PyArray2<f64>>()?,
+                success.cast_into::<PyArray1<bool>>()?,
+                pe.cast_into::<PyArray1<f64>>()?,
+                oe.cast_into::<PyArray1<f64>>()?,
+            ))
         })
     }
 }

@@ -17,9 +17,9 @@ use std::sync::Mutex;
 use guard::{guarded, shape_text};
 
 use kinedyn_core::algorithms::{self, Reference};
-use kinedyn_core::spatial::{Inertia, Transform, Vec3};
-use kinedyn_core::model::{Block, Coordinates};
 use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
+use kinedyn_core::model::{Block, Coordinates};
+use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Error as CoreError, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -43,7 +43,10 @@ fn optional<'a>(x: &[&'a [f64]], k: usize) -> Option<&'a [f64]> {
 fn reshape_error(name: &str, expected: &[usize], got: &[usize]) -> PyErr {
     let exp = expected.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ");
     let one = if expected.len() == 1 { "," } else { "" };
-    PyValueError::new_err(format!("{name} must have shape ({exp}{one}) or a batch (N, {exp}), got {}", shape_text(got)))
+    PyValueError::new_err(format!(
+        "{name} must have shape ({exp}{one}) or a batch (N, {exp}), got {}",
+        shape_text(got)
+    ))
 }
 
 /// A NumPy float64 array as the inputs of one call. Two kinds: `PyReadonlyArrayDyn` (rust-numpy's
@@ -87,7 +90,11 @@ impl<'a> StateArray<'a> for Bound<'_, PyArrayDyn<f64>> {
         if self.is_c_contiguous() {
             if let Ok(s) = unsafe { self.as_slice() } {
                 // a batch is copied with one memcpy (ndarray's element iterator was 4 % of a batch)
-                return Ok(if batch { Cow::Owned(guard::try_copy(&format!("copying {name}"), s)?) } else { Cow::Borrowed(s) });
+                return Ok(if batch {
+                    Cow::Owned(guard::try_copy(&format!("copying {name}"), s)?)
+                } else {
+                    Cow::Borrowed(s)
+                });
             }
         }
         Ok(Cow::Owned(collect_c_order(name, unsafe { self.as_array() }.iter())?))
@@ -104,7 +111,9 @@ fn f64_array<'py>(name: &str, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
     }
     static ASARRAY: pyo3::sync::PyOnceLock<Py<PyAny>> = pyo3::sync::PyOnceLock::new();
     let py = x.py();
-    let asarray = ASARRAY.get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?.bind(py);
+    let asarray = ASARRAY
+        .get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?
+        .bind(py);
     // an array (or what NumPy makes of a list) of what dtype?
     let array = match x.cast::<numpy::PyUntypedArray>() {
         Ok(a) => a.clone(),
@@ -113,7 +122,11 @@ fn f64_array<'py>(name: &str, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
     let dtype = array.dtype();
     let kind = dtype.kind();
     if !matches!(kind, b'f' | b'i' | b'u' | b'b' | b'O') {
-        let what = if kind == b'c' { "complex numbers (the imaginary part would be lost)".to_string() } else { format!("an array of dtype {dtype}") };
+        let what = if kind == b'c' {
+            "complex numbers (the imaginary part would be lost)".to_string()
+        } else {
+            format!("an array of dtype {dtype}")
+        };
         return Err(PyTypeError::new_err(format!("{name} must be real numbers, got {what}")));
     }
     let kwargs = [("dtype", "float64")].into_py_dict(py)?;
@@ -143,7 +156,10 @@ impl<'a> Batch<'a> {
     /// Check each input against its per-state shape; all inputs share one batch size.
     fn gather<A: StateArray<'a> + ?Sized>(inputs: &[(&str, &'a A, &[usize])]) -> PyResult<Self> {
         let mut batch: Option<Option<usize>> = None;
-        assert!(inputs.len() <= MAX_INPUTS, "a method takes at most {MAX_INPUTS} state arrays");
+        assert!(
+            inputs.len() <= MAX_INPUTS,
+            "a method takes at most {MAX_INPUTS} state arrays"
+        );
         let mut values: [Cow<'a, [f64]>; MAX_INPUTS] = Default::default();
         let mut width = [0; MAX_INPUTS];
         for (k, (name, array, shape)) in inputs.iter().enumerate() {
@@ -173,7 +189,11 @@ impl<'a> Batch<'a> {
             let w: usize = shape.iter().product();
             if let Some(k) = data.iter().position(|x| !x.is_finite()) {
                 let state = if w > 0 { k / w } else { 0 };
-                let at = if this.is_some() { format!(" in state {state}") } else { String::new() };
+                let at = if this.is_some() {
+                    format!(" in state {state}")
+                } else {
+                    String::new()
+                };
                 return Err(PyValueError::new_err(format!(
                     "{name} contains a non-finite value (NaN or inf) at index {}{at}",
                     k % w.max(1)
@@ -182,7 +202,12 @@ impl<'a> Batch<'a> {
             values[k] = data;
             width[k] = w;
         }
-        Ok(Self { batch: batch.flatten(), values, width, count: inputs.len() })
+        Ok(Self {
+            batch: batch.flatten(),
+            values,
+            width,
+            count: inputs.len(),
+        })
     }
 
     /// The inputs of state `k` (at most 4 arguments per call).
@@ -204,7 +229,14 @@ impl<'a> Batch<'a> {
     /// allocated (MemoryError) and a non-finite number in a result of finite inputs
     /// (`NonFiniteResultError`: the outputs of each chunk of states are scanned right after its
     /// kernels wrote them, while they are in cache).
-    fn run<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    fn run<'py, F>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Output,
+        out_shape: &[usize],
+        kernel: F,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
@@ -214,23 +246,57 @@ impl<'a> Batch<'a> {
     /// `run` writing into the caller's array `out` when given (NumPy's `out=`: no allocation per
     /// call), after checking that it is a writeable, C-contiguous float64 array of the result's
     /// shape that shares no memory with the inputs.
-    fn run_out<'py, F>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: F) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
+    fn run_out<'py, F>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Output,
+        out_shape: &[usize],
+        out: Option<Bound<'py, PyAny>>,
+        kernel: F,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], &mut [f64]) -> Result<(), CoreError> + Sync,
     {
         let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
-        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], None, |model, data, x, [out]| kernel(model, data, x, out))?;
+        let [array] = self.run_many::<1, _>(
+            py,
+            m,
+            (what.0, [what.1]),
+            out_shape,
+            [given],
+            None,
+            |model, data, x, [out]| kernel(model, data, x, out),
+        )?;
         Ok(array)
     }
 
     /// `run_out` for a core [`Kernel`]: a batch computes several states at once in SIMD lanes
     /// (`kinedyn_core::batch`, the lane kind chosen from the CPU), a single state with the cached
     /// `Data`.
-    fn run_kernel<'py, Kn: Kernel>(&self, py: Python<'py>, m: &PyModel, what: Output, out_shape: &[usize], out: Option<Bound<'py, PyAny>>, kernel: Kn) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn run_kernel<'py, Kn: Kernel>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Output,
+        out_shape: &[usize],
+        out: Option<Bound<'py, PyAny>>,
+        kernel: Kn,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let given = out.map(|o| self.checked_out(o, out_shape)).transpose()?;
         let simd = Simd::detected();
-        let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernel, x, out, simd);
-        let [array] = self.run_many::<1, _>(py, m, (what.0, [what.1]), out_shape, [given], Some(&lanes), |model, data, x, [out]| kernel.run(model, data, x, out))?;
+        let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| {
+            batch::run(model, scratch, &kernel, x, out, simd)
+        };
+        let [array] = self.run_many::<1, _>(
+            py,
+            m,
+            (what.0, [what.1]),
+            out_shape,
+            [given],
+            Some(&lanes),
+            |model, data, x, [out]| kernel.run(model, data, x, out),
+        )?;
         Ok(array)
     }
 
@@ -246,7 +312,11 @@ impl<'a> Batch<'a> {
         })?;
         let expected: Vec<usize> = self.batch.iter().chain(out_shape).copied().collect();
         if array.shape() != expected.as_slice() {
-            return Err(PyValueError::new_err(format!("out must have shape {}, got {}", shape_text(&expected), shape_text(array.shape()))));
+            return Err(PyValueError::new_err(format!(
+                "out must have shape {}, got {}",
+                shape_text(&expected),
+                shape_text(array.shape())
+            )));
         }
         // SAFETY: reading the flags of a live array object
         let writeable = unsafe { (*array.as_array_ptr()).flags } & numpy::npyffi::flags::NPY_ARRAY_WRITEABLE != 0;
@@ -268,7 +338,16 @@ impl<'a> Batch<'a> {
     ///
     /// `lanes`, when given (K = 1), computes a range of a batch's states at once (`run_kernel`).
     #[allow(clippy::too_many_arguments)]
-    fn run_many<'py, const K: usize, F>(&self, py: Python<'py>, m: &PyModel, what: Outputs<K>, out_shape: &[usize], given: [Option<Bound<'py, PyArrayDyn<f64>>>; K], lanes: Option<&LaneRange>, kernel: F) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
+    fn run_many<'py, const K: usize, F>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Outputs<K>,
+        out_shape: &[usize],
+        given: [Option<Bound<'py, PyArrayDyn<f64>>>; K],
+        lanes: Option<&LaneRange>,
+        kernel: F,
+    ) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; K]>
     where
         F: Fn(&Model, &mut Data, &[&[f64]], [&mut [f64]; K]) -> Result<(), CoreError> + Sync,
     {
@@ -305,7 +384,8 @@ impl<'a> Batch<'a> {
         // SAFETY (both paths): state k's outputs are the disjoint ranges [k per_state, (k + 1)
         // per_state) of the arrays, each written by exactly one kernel call (and read back by the
         // scan right after it, by the same thread).
-        let outputs = |k: usize| bases.map(|b| unsafe { std::slice::from_raw_parts_mut(b.0.add(k * per_state), per_state) });
+        let outputs =
+            |k: usize| bases.map(|b| unsafe { std::slice::from_raw_parts_mut(b.0.add(k * per_state), per_state) });
         let check = guard::CHECK_FINITE.load(Ordering::Relaxed);
         // states [a, b): the kernel on each, then one scan of the outputs they wrote (contiguous,
         // still in cache: a chunk of 64 states of M is 18 KiB for n = 6)
@@ -316,7 +396,12 @@ impl<'a> Batch<'a> {
                     let written = unsafe { std::slice::from_raw_parts(base.0.add(a * per_state), (b - a) * per_state) };
                     if any_non_finite(written) {
                         let at = written.iter().position(|v| !v.is_finite()).unwrap_or(0);
-                        return Err(Fault::NonFinite { state: a + at / per_state, output: o, index: at % per_state, value: written[at] });
+                        return Err(Fault::NonFinite {
+                            state: a + at / per_state,
+                            output: o,
+                            index: at % per_state,
+                            value: written[at],
+                        });
                     }
                 }
             }
@@ -327,18 +412,24 @@ impl<'a> Batch<'a> {
                 Some(lanes) if b - a > 1 => {
                     let inputs: [Input; MAX_INPUTS] = std::array::from_fn(|k| {
                         let w = self.width[k];
-                        Input { values: self.values[k].get(a * w..b * w).unwrap_or(&[]), width: w }
+                        Input {
+                            values: self.values[k].get(a * w..b * w).unwrap_or(&[]),
+                            width: w,
+                        }
                     });
                     if K == 1 {
                         // SAFETY: the range [a per_state, b per_state) of the one output, written by this thread only
-                        let out = unsafe { std::slice::from_raw_parts_mut(bases[0].0.add(a * per_state), (b - a) * per_state) };
+                        let out = unsafe {
+                            std::slice::from_raw_parts_mut(bases[0].0.add(a * per_state), (b - a) * per_state)
+                        };
                         lanes(&m.model, scratch, &inputs[..self.count], out).map_err(|e| Fault::Core(e.error))?;
                     } else {
                         // the kernel writes a state's K outputs one after the other: gathered in the
                         // scratch's buffer, then copied to the K arrays
                         let mut buffer = std::mem::take(&mut scratch.buffer);
                         buffer.resize((b - a) * K * per_state, 0.0);
-                        lanes(&m.model, scratch, &inputs[..self.count], &mut buffer).map_err(|e| Fault::Core(e.error))?;
+                        lanes(&m.model, scratch, &inputs[..self.count], &mut buffer)
+                            .map_err(|e| Fault::Core(e.error))?;
                         for (state, values) in (a..b).zip(buffer.chunks_exact(K * per_state.max(1))) {
                             for (out, part) in outputs(state).into_iter().zip(values.chunks_exact(per_state.max(1))) {
                                 out.copy_from_slice(part);
@@ -358,7 +449,8 @@ impl<'a> Batch<'a> {
         let result: Result<(), Fault> = match self.batch {
             None => {
                 let mut guard = m.data.lock().unwrap_or_else(|e| e.into_inner());
-                (0..1).try_for_each(|k| kernel(&m.model, &mut guard, &self.state(k), outputs(k)).map_err(Fault::from))
+                (0..1)
+                    .try_for_each(|k| kernel(&m.model, &mut guard, &self.state(k), outputs(k)).map_err(Fault::from))
                     .and_then(|()| check_range(0, 1))
             }
             Some(states) => py.detach(|| {
@@ -377,13 +469,27 @@ impl<'a> Batch<'a> {
             Ok(()) => Ok(arrays),
             Err(Fault::Core(e)) => Err(core_err(e)),
             Err(Fault::Py(e)) => Err(e),
-            Err(Fault::NonFinite { state, output, index, value }) => Err(self.non_finite(py, what.0, what.1[output], out_shape, state, index, value)),
+            Err(Fault::NonFinite {
+                state,
+                output,
+                index,
+                value,
+            }) => Err(self.non_finite(py, what.0, what.1[output], out_shape, state, index, value)),
         }
     }
 
     /// The error of a non-finite result of finite inputs (every input was checked by `gather`).
     #[allow(clippy::too_many_arguments)]
-    fn non_finite(&self, py: Python<'_>, method: &str, quantity: &str, out_shape: &[usize], state: usize, index: usize, value: f64) -> PyErr {
+    fn non_finite(
+        &self,
+        py: Python<'_>,
+        method: &str,
+        quantity: &str,
+        out_shape: &[usize],
+        state: usize,
+        index: usize,
+        value: f64,
+    ) -> PyErr {
         // the element as an index of the per-state result: tau[2], M[1, 3]
         let mut rest = index;
         let mut idx = vec![0; out_shape.len()];
@@ -391,12 +497,23 @@ impl<'a> Batch<'a> {
             *slot = rest % d.max(&1);
             rest /= d.max(&1);
         }
-        let element = if idx.is_empty() { quantity.to_string() } else { format!("{quantity}[{}]", idx.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")) };
+        let element = if idx.is_empty() {
+            quantity.to_string()
+        } else {
+            format!(
+                "{quantity}[{}]",
+                idx.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
+            )
+        };
         let at = match self.batch {
             Some(_) => format!(" at state {state} of the batch"),
             None => String::new(),
         };
-        let largest = self.state(state).iter().flat_map(|x| x.iter()).fold(0.0f64, |a, x| a.max(x.abs()));
+        let largest = self
+            .state(state)
+            .iter()
+            .flat_map(|x| x.iter())
+            .fold(0.0f64, |a, x| a.max(x.abs()));
         guard::non_finite_error(
             py,
             format!(
@@ -418,7 +535,12 @@ type Outputs<const K: usize> = (&'static str, [&'static str; K]);
 enum Fault {
     Core(CoreError),
     Py(PyErr),
-    NonFinite { state: usize, output: usize, index: usize, value: f64 },
+    NonFinite {
+        state: usize,
+        output: usize,
+        index: usize,
+        value: f64,
+    },
 }
 
 impl From<CoreError> for Fault {
@@ -448,7 +570,11 @@ fn any_non_finite(x: &[f64]) -> bool {
 }
 
 /// Three arrays returned as a Python tuple.
-type Arrays3<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+type Arrays3<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+);
 
 /// Where an output array's numbers start, shared by the threads of a batch, each writing its own
 /// states' ranges (see `Batch::run_many`).
@@ -477,7 +603,9 @@ fn reference(code: i64) -> PyResult<Reference> {
         0 => Ok(Reference::World),
         1 => Ok(Reference::Local),
         2 => Ok(Reference::Spatial),
-        _ => Err(PyValueError::new_err(format!("reference code must be 0 (world), 1 (local) or 2 (spatial), got {code}"))),
+        _ => Err(PyValueError::new_err(format!(
+            "reference code must be 0 (world), 1 (local) or 2 (spatial), got {code}"
+        ))),
     }
 }
 
@@ -504,11 +632,21 @@ impl PyModel {
                     };
                     let norm = unit.iter().map(|x| x * x).sum::<f64>().sqrt();
                     if (norm - 1.0).abs() > 1e-6 {
-                        let batch = if q.len() > model.nq { format!(" of state {k}") } else { String::new() };
+                        let batch = if q.len() > model.nq {
+                            format!(" of state {k}")
+                        } else {
+                            String::new()
+                        };
                         return Err(PyValueError::new_err(format!(
                             "q[{}..{}]{batch}, the {what} of the {block:?} joint at body {i}, has norm {norm}, not 1 \
                              (to 1e-6): normalise it (robot.normalize(q))",
-                            at + if block == Block::FreeFlyer { 3 } else if block == Block::Planar { 2 } else { 0 },
+                            at + if block == Block::FreeFlyer {
+                                3
+                            } else if block == Block::Planar {
+                                2
+                            } else {
+                                0
+                            },
                             at + block.nq()
                         )));
                     }
@@ -521,7 +659,9 @@ impl PyModel {
     fn frame(&self, frame: i64) -> PyResult<usize> {
         let nf = self.model.frames.len();
         if frame < 0 || frame as usize >= nf {
-            return Err(PyValueError::new_err(format!("frame index {frame} out of range (the model has {nf} frames)")));
+            return Err(PyValueError::new_err(format!(
+                "frame index {frame} out of range (the model has {nf} frames)"
+            )));
         }
         Ok(frame as usize)
     }
@@ -568,19 +708,31 @@ impl PyModel {
             let inertia = vec_of("inertia", &inertia, &[n, 10])?;
             let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
             if kind.len() != n {
-                return Err(PyValueError::new_err(format!("kind has {} entries for {n} bodies", kind.len())));
+                return Err(PyValueError::new_err(format!(
+                    "kind has {} entries for {n} bodies",
+                    kind.len()
+                )));
             }
             if gravity.len() != 3 {
-                return Err(PyValueError::new_err(format!("gravity must have 3 components, got {}", gravity.len())));
+                return Err(PyValueError::new_err(format!(
+                    "gravity must have 3 components, got {}",
+                    gravity.len()
+                )));
             }
             let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
                 match p {
                     -1 => Ok(None),
                     p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
-                    p => Err(PyValueError::new_err(format!("{what} {k}: body index {p} is out of range (-1..{n})"))),
+                    p => Err(PyValueError::new_err(format!(
+                        "{what} {k}: body index {p} is out of range (-1..{n})"
+                    ))),
                 }
             };
-            let parent = parent.iter().enumerate().map(|(i, &p)| body_index("parent of body", i, p)).collect::<PyResult<Vec<_>>>()?;
+            let parent = parent
+                .iter()
+                .enumerate()
+                .map(|(i, &p)| body_index("parent of body", i, p))
+                .collect::<PyResult<Vec<_>>>()?;
             let joints = kind
                 .iter()
                 .enumerate()
@@ -590,7 +742,10 @@ impl PyModel {
                         1 => JointKind::Prismatic,
                         _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
                     };
-                    Ok(Joint { kind, axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]) })
+                    Ok(Joint {
+                        kind,
+                        axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]),
+                    })
                 })
                 .collect::<PyResult<Vec<_>>>()?;
             let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
@@ -599,11 +754,25 @@ impl PyModel {
                 .iter()
                 .enumerate()
                 .map(|(k, &b)| {
-                    Ok(Frame { body: body_index("frame", k, b)?, body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]) })
+                    Ok(Frame {
+                        body: body_index("frame", k, b)?,
+                        body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]),
+                    })
                 })
                 .collect::<PyResult<Vec<_>>>()?;
-            let mut model = Model::new(parent, joints, offset, placements, inertias, armature, viscous, coulomb, Vec3::new(gravity[0], gravity[1], gravity[2]), frames)
-                .map_err(core_err)?;
+            let mut model = Model::new(
+                parent,
+                joints,
+                offset,
+                placements,
+                inertias,
+                armature,
+                viscous,
+                coulomb,
+                Vec3::new(gravity[0], gravity[1], gravity[2]),
+                frames,
+            )
+            .map_err(core_err)?;
             if let Some(levels) = coulomb_negative {
                 model = model.with_coulomb_negative(levels).map_err(core_err)?;
             }
@@ -611,16 +780,28 @@ impl PyModel {
                 // per body: 0 a 1-DOF joint, 1 / 2 / 3 the head of a free-flyer / spherical / planar
                 // joint, -1 a further member of the multi-DOF joint before it
                 if codes.len() != n {
-                    return Err(PyValueError::new_err(format!("blocks has {} entries for {n} bodies", codes.len())));
+                    return Err(PyValueError::new_err(format!(
+                        "blocks has {} entries for {n} bodies",
+                        codes.len()
+                    )));
                 }
                 let mut at = 0;
                 let mut coordinates = Vec::with_capacity(n);
                 for (i, &code) in codes.iter().enumerate() {
                     let c = match code {
                         0 => Coordinates::Scalar { at },
-                        1 => Coordinates::Head { block: Block::FreeFlyer, at },
-                        2 => Coordinates::Head { block: Block::Spherical, at },
-                        3 => Coordinates::Head { block: Block::Planar, at },
+                        1 => Coordinates::Head {
+                            block: Block::FreeFlyer,
+                            at,
+                        },
+                        2 => Coordinates::Head {
+                            block: Block::Spherical,
+                            at,
+                        },
+                        3 => Coordinates::Head {
+                            block: Block::Planar,
+                            at,
+                        },
                         -1 => Coordinates::Member,
                         _ => return Err(PyValueError::new_err(format!("body {i}: unknown block code {code}"))),
                     };
@@ -655,44 +836,98 @@ impl PyModel {
     }
 
     /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
-    fn frame_poses<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frames: Bound<'py, PyArray1<i64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn frame_poses<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyArrayDyn<f64>>,
+        frames: Bound<'py, PyArray1<i64>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.frame_poses", || {
             // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
-            let ids = unsafe { frames.as_array() }.iter().map(|&f| self.frame(f)).collect::<PyResult<Vec<_>>>()?;
+            let ids = unsafe { frames.as_array() }
+                .iter()
+                .map(|&f| self.frame(f))
+                .collect::<PyResult<Vec<_>>>()?;
             let nq = self.model.nq;
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_kernel(py, self, ("frame_poses", "pose"), &[ids.len(), 4, 4], None, kernels::FramePoses { frames: &ids })
+            batch.run_kernel(
+                py,
+                self,
+                ("frame_poses", "pose"),
+                &[ids.len(), 4, 4],
+                None,
+                kernels::FramePoses { frames: &ids },
+            )
         })
     }
 
     /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
     #[pyo3(signature = (q, frame, reference, point=None))]
-    fn jacobian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyArrayDyn<f64>>,
+        frame: i64,
+        reference: i64,
+        point: Option<PyReadonlyArrayDyn<f64>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jacobian", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_kernel(py, self, ("jacobian", "J"), &[6, n], None, kernels::Jacobian { frame: f, reference: r, point: p })
+            batch.run_kernel(
+                py,
+                self,
+                ("jacobian", "J"),
+                &[6, n],
+                None,
+                kernels::Jacobian {
+                    frame: f,
+                    reference: r,
+                    point: p,
+                },
+            )
         })
     }
 
     /// Kinematic Hessian dJ/dq (n, 6, n) or (N, n, 6, n): `H[i, r, j] = dJ[r, j]/dq_i`.
     #[pyo3(signature = (q, frame, reference, point=None))]
-    fn jacobian_hessian<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn jacobian_hessian<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyArrayDyn<f64>>,
+        frame: i64,
+        reference: i64,
+        point: Option<PyReadonlyArrayDyn<f64>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jacobian_hessian", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("jacobian_hessian", "dJ/dq"), &[n, 6, n], |model, data, x, out| {
-                algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
-                Ok(())
-            })
+            batch.run(
+                py,
+                self,
+                ("jacobian_hessian", "dJ/dq"),
+                &[n, 6, n],
+                |model, data, x, out| {
+                    algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
+                    Ok(())
+                },
+            )
         })
     }
 
     /// Twist J qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
-    fn frame_velocity<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn frame_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyArrayDyn<f64>>,
+        qd: Bound<'py, PyArrayDyn<f64>>,
+        frame: i64,
+        reference: i64,
+        point: Option<PyReadonlyArrayDyn<f64>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.frame_velocity", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
             let (n, nq) = (self.n(), self.model.nq);
@@ -706,7 +941,15 @@ impl PyModel {
 
     /// Acceleration drift dJ/dt qd (6,) or (N, 6).
     #[pyo3(signature = (q, qd, frame, reference, point=None))]
-    fn jdot_qd<'py>(&self, py: Python<'py>, q: Bound<'py, PyArrayDyn<f64>>, qd: Bound<'py, PyArrayDyn<f64>>, frame: i64, reference: i64, point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn jdot_qd<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyArrayDyn<f64>>,
+        qd: Bound<'py, PyArrayDyn<f64>>,
+        frame: i64,
+        reference: i64,
+        point: Option<PyReadonlyArrayDyn<f64>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.jdot_qd", || {
             let (f, r, p) = (self.frame(frame)?, self::reference(reference)?, Self::point(point)?);
             let (n, nq) = (self.n(), self.model.nq);
@@ -722,7 +965,15 @@ impl PyModel {
 
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
     #[pyo3(signature = (q, qd, qdd, f_ext=None, out=None))]
-    fn inverse_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        qdd: Bound<'py, PyAny>,
+        f_ext: Option<Bound<'py, PyAny>>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.inverse_dynamics", || {
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
             let q = f64_array("q", &q)?;
@@ -731,16 +982,33 @@ impl PyModel {
             let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                Some(f) => Batch::gather(&[
+                    ("q", &q, &[nq]),
+                    ("qd", &qd, &s1),
+                    ("qdd", &qdd, &s1),
+                    ("f_ext", f, &s6),
+                ])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
-            batch.run_kernel(py, self, ("inverse_dynamics", "tau"), &[n], out, kernels::InverseDynamics)
+            batch.run_kernel(
+                py,
+                self,
+                ("inverse_dynamics", "tau"),
+                &[n],
+                out,
+                kernels::InverseDynamics,
+            )
         })
     }
 
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
     #[pyo3(signature = (q, out=None))]
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.mass_matrix", || {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
@@ -751,18 +1019,38 @@ impl PyModel {
 
     /// M^-1 (n, n) | (N, n, n).
     #[pyo3(signature = (q, out=None))]
-    fn mass_matrix_inverse<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn mass_matrix_inverse<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.mass_matrix_inverse", || {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run_kernel(py, self, ("mass_matrix_inverse", "M^-1"), &[n, n], out, kernels::MassMatrixInverse)
+            batch.run_kernel(
+                py,
+                self,
+                ("mass_matrix_inverse", "M^-1"),
+                &[n, n],
+                out,
+                kernels::MassMatrixInverse,
+            )
         })
     }
 
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
     #[pyo3(signature = (q, qd, tau, f_ext=None, out=None))]
-    fn forward_dynamics<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        tau: Bound<'py, PyAny>,
+        f_ext: Option<Bound<'py, PyAny>>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.forward_dynamics", || {
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
             let q = f64_array("q", &q)?;
@@ -771,59 +1059,121 @@ impl PyModel {
             let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                Some(f) => Batch::gather(&[
+                    ("q", &q, &[nq]),
+                    ("qd", &qd, &s1),
+                    ("tau", &tau, &s1),
+                    ("f_ext", f, &s6),
+                ])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
-            batch.run_kernel(py, self, ("forward_dynamics", "qdd"), &[n], out, kernels::ForwardDynamics)
+            batch.run_kernel(
+                py,
+                self,
+                ("forward_dynamics", "qdd"),
+                &[n],
+                out,
+                kernels::ForwardDynamics,
+            )
         })
     }
 
     /// (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA.
     #[pyo3(signature = (q, qd, qdd, f_ext=None))]
-    fn inverse_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
+    fn inverse_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        qdd: Bound<'py, PyAny>,
+        f_ext: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Arrays3<'py>> {
         guarded("Model.inverse_dynamics_derivatives", || {
             let (q, qd, qdd) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("qdd", &qdd)?);
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
             let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1), ("f_ext", f, &s6)])?,
+                Some(f) => Batch::gather(&[
+                    ("q", &q, &[nq]),
+                    ("qd", &qd, &s1),
+                    ("qdd", &qdd, &s1),
+                    ("f_ext", f, &s6),
+                ])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("qdd", &qdd, &s1)])?,
             };
             let simd = Simd::detected();
-            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernels::InverseDynamicsDerivatives, x, out, simd);
-            let [dq, dqd, m] = batch.run_many::<3, _>(py, self, ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]), &[n, n], [None, None, None], Some(&lanes), |model, data, x, [dq, dqd, m]| {
-                algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
-                Ok(())
-            })?;
+            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| {
+                batch::run(model, scratch, &kernels::InverseDynamicsDerivatives, x, out, simd)
+            };
+            let [dq, dqd, m] = batch.run_many::<3, _>(
+                py,
+                self,
+                ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]),
+                &[n, n],
+                [None, None, None],
+                Some(&lanes),
+                |model, data, x, [dq, dqd, m]| {
+                    algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
+                    Ok(())
+                },
+            )?;
             Ok((dq, dqd, m))
         })
     }
 
     /// (dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1), each (n, n) | (N, n, n): derivatives of the ABA.
     #[pyo3(signature = (q, qd, tau, f_ext=None))]
-    fn forward_dynamics_derivatives<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, tau: Bound<'py, PyAny>, f_ext: Option<Bound<'py, PyAny>>) -> PyResult<Arrays3<'py>> {
+    fn forward_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        tau: Bound<'py, PyAny>,
+        f_ext: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Arrays3<'py>> {
         guarded("Model.forward_dynamics_derivatives", || {
             let (q, qd, tau) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("tau", &tau)?);
             let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
             let (n, nq) = (self.n(), self.model.nq);
             let (s1, s6) = ([n], [n, 6]);
             let batch = match f_ext.as_ref() {
-                Some(f) => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1), ("f_ext", f, &s6)])?,
+                Some(f) => Batch::gather(&[
+                    ("q", &q, &[nq]),
+                    ("qd", &qd, &s1),
+                    ("tau", &tau, &s1),
+                    ("f_ext", f, &s6),
+                ])?,
                 None => Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &s1), ("tau", &tau, &s1)])?,
             };
             let simd = Simd::detected();
-            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| batch::run(model, scratch, &kernels::ForwardDynamicsDerivatives, x, out, simd);
-            let [dq, dqd, dtau] = batch.run_many::<3, _>(py, self, ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]), &[n, n], [None, None, None], Some(&lanes), |model, data, x, [dq, dqd, dtau]| {
-                algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
-            })?;
+            let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| {
+                batch::run(model, scratch, &kernels::ForwardDynamicsDerivatives, x, out, simd)
+            };
+            let [dq, dqd, dtau] = batch.run_many::<3, _>(
+                py,
+                self,
+                ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]),
+                &[n, n],
+                [None, None, None],
+                Some(&lanes),
+                |model, data, x, [dq, dqd, dtau]| {
+                    algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
+                },
+            )?;
             Ok((dq, dqd, dtau))
         })
     }
 
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
     #[pyo3(signature = (q, qd, out=None))]
-    fn coriolis_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn coriolis_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.coriolis_matrix", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
@@ -845,7 +1195,12 @@ impl PyModel {
 
     /// g (n,) | (N, n).
     #[pyo3(signature = (q, out=None))]
-    fn gravity_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn gravity_torque<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.gravity_torque", || {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
@@ -856,7 +1211,13 @@ impl PyModel {
 
     /// C qd + g (n,) | (N, n), without friction.
     #[pyo3(signature = (q, qd, out=None))]
-    fn bias_torque<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, out: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn bias_torque<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.bias_torque", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
@@ -867,7 +1228,12 @@ impl PyModel {
     }
 
     /// K () | (N,).
-    fn kinetic_energy<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn kinetic_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.kinetic_energy", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
@@ -888,7 +1254,13 @@ impl PyModel {
     }
 
     /// Y (n, 10 n) | (N, n, 10 n).
-    fn regressor<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>, qdd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+        qdd: Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.regressor", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;
@@ -913,20 +1285,35 @@ impl PyModel {
     }
 
     /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
-    fn centroidal_momentum_matrix<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn centroidal_momentum_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.centroidal_momentum_matrix", || {
             let q = f64_array("q", &q)?;
             let (n, nq) = (self.n(), self.model.nq);
             let batch = Batch::gather(&[("q", &q, &[nq])])?;
-            batch.run(py, self, ("centroidal_momentum_matrix", "A_G"), &[6, n], |model, data, x, out| {
-                algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
-                Ok(())
-            })
+            batch.run(
+                py,
+                self,
+                ("centroidal_momentum_matrix", "A_G"),
+                &[6, n],
+                |model, data, x, out| {
+                    algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
+                    Ok(())
+                },
+            )
         })
     }
 
     /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
-    fn momentum<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, qd: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    fn momentum<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guarded("Model.momentum", || {
             let q = f64_array("q", &q)?;
             let qd = f64_array("qd", &qd)?;

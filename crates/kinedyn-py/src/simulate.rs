@@ -8,7 +8,9 @@
 
 use std::cell::RefCell;
 
-use kinedyn_core::algorithms::integrate::{self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn};
+use kinedyn_core::algorithms::integrate::{
+    self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn,
+};
 use kinedyn_core::Data;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -25,25 +27,43 @@ fn method(name: &str) -> PyResult<Method> {
         "semi_implicit" | "semi_implicit_euler" | "symplectic_euler" => Ok(Method::SemiImplicitEuler),
         "euler" => Ok(Method::Euler),
         "implicit" | "implicit_euler" => Ok(Method::Implicit),
-        _ => Err(PyValueError::new_err(format!("unknown fixed-step method '{name}' (rk4, semi_implicit, euler, implicit)"))),
+        _ => Err(PyValueError::new_err(format!(
+            "unknown fixed-step method '{name}' (rk4, semi_implicit, euler, implicit)"
+        ))),
     }
 }
 
 /// Joint limits from `lower`, `upper` ((n,) each, or both None): checked, flattened.
-fn limits(n: usize, lower: Option<&PyReadonlyArrayDyn<f64>>, upper: Option<&PyReadonlyArrayDyn<f64>>) -> PyResult<Option<(Vec<f64>, Vec<f64>)>> {
+fn limits(
+    n: usize,
+    lower: Option<&PyReadonlyArrayDyn<f64>>,
+    upper: Option<&PyReadonlyArrayDyn<f64>>,
+) -> PyResult<Option<(Vec<f64>, Vec<f64>)>> {
     match (lower, upper) {
         (None, None) => Ok(None),
         (Some(lo), Some(hi)) => {
-            let (lo, hi): (Vec<f64>, Vec<f64>) = (lo.as_array().iter().copied().collect(), hi.as_array().iter().copied().collect());
+            let (lo, hi): (Vec<f64>, Vec<f64>) = (
+                lo.as_array().iter().copied().collect(),
+                hi.as_array().iter().copied().collect(),
+            );
             if lo.len() != n || hi.len() != n {
-                return Err(PyValueError::new_err(format!("lower and upper limits need {n} values each, got {} and {}", lo.len(), hi.len())));
+                return Err(PyValueError::new_err(format!(
+                    "lower and upper limits need {n} values each, got {} and {}",
+                    lo.len(),
+                    hi.len()
+                )));
             }
             if let Some(j) = (0..n).find(|&j| lo[j].is_nan() || hi[j].is_nan() || lo[j] > hi[j]) {
-                return Err(PyValueError::new_err(format!("joint {j} has limits [{}, {}]: lower must not exceed upper", lo[j], hi[j])));
+                return Err(PyValueError::new_err(format!(
+                    "joint {j} has limits [{}, {}]: lower must not exceed upper",
+                    lo[j], hi[j]
+                )));
             }
             Ok(Some((lo, hi)))
         }
-        _ => Err(PyValueError::new_err("give both lower and upper joint limits, or neither")),
+        _ => Err(PyValueError::new_err(
+            "give both lower and upper joint limits, or neither",
+        )),
     }
 }
 
@@ -52,7 +72,9 @@ fn flat(name: &str, a: &PyReadonlyArrayDyn<f64>) -> PyResult<Vec<f64>> {
     let mut v = guard::try_vec(&format!("simulate: copying {name}"), view.len())?;
     v.extend(view.iter().copied());
     if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!("{name} contains a non-finite value (NaN or inf) at flat index {k}")));
+        return Err(PyValueError::new_err(format!(
+            "{name} contains a non-finite value (NaN or inf) at flat index {k}"
+        )));
     }
     Ok(v)
 }
@@ -77,7 +99,13 @@ fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict
 
 /// Fresh output arrays `(batch?, samples, n)` x 4 (q, qd, qdd, tau), their total size checked
 /// first: a MemoryError naming the bytes when they cannot be had (e.g. a tiny dt over a long span).
-fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize, nq: usize) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; 4]> {
+fn outputs<'py>(
+    py: Python<'py>,
+    batch: Option<usize>,
+    samples: usize,
+    n: usize,
+    nq: usize,
+) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; 4]> {
     let shape_of = |w: usize| -> Vec<usize> {
         match batch {
             Some(b) => vec![b, samples, w],
@@ -87,10 +115,19 @@ fn outputs<'py>(py: Python<'py>, batch: Option<usize>, samples: usize, n: usize,
     let (shape, shape_q) = (shape_of(n), shape_of(nq));
     const WHAT: &str = "simulate (the recorded q, qd, qdd and tau)";
     guard::check_size(WHAT, 4, &shape_of(n.max(nq)))?;
-    Ok([guard::zeros(py, WHAT, &shape_q)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?, guard::zeros(py, WHAT, &shape)?])
+    Ok([
+        guard::zeros(py, WHAT, &shape_q)?,
+        guard::zeros(py, WHAT, &shape)?,
+        guard::zeros(py, WHAT, &shape)?,
+        guard::zeros(py, WHAT, &shape)?,
+    ])
 }
 
-fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcomes: &[Outcome]) -> PyResult<Bound<'py, PyTuple>> {
+fn result<'py>(
+    py: Python<'py>,
+    arrays: [Bound<'py, PyArrayDyn<f64>>; 4],
+    outcomes: &[Outcome],
+) -> PyResult<Bound<'py, PyTuple>> {
     let steps = PyArray1::from_iter(py, outcomes.iter().map(|o| o.steps as i64));
     let failures = PyList::empty(py);
     for o in outcomes {
@@ -100,21 +137,43 @@ fn result<'py>(py: Python<'py>, arrays: [Bound<'py, PyArrayDyn<f64>>; 4], outcom
         }
     }
     let [q, qd, qdd, tau] = arrays;
-    PyTuple::new(py, [q.into_any(), qd.into_any(), qdd.into_any(), tau.into_any(), steps.into_any(), failures.into_any()])
+    PyTuple::new(
+        py,
+        [
+            q.into_any(),
+            qd.into_any(),
+            qdd.into_any(),
+            tau.into_any(),
+            steps.into_any(),
+            failures.into_any(),
+        ],
+    )
 }
 
 /// Check `q0` ((nq,) or (N, nq)) and `qd0` ((n,) or (N, n), the same batch), and the unit blocks of
 /// q0's multi-DOF joints: (batch, q0, qd0 flattened).
-fn initial_states(m: &PyModel, q0: &PyReadonlyArrayDyn<f64>, qd0: &PyReadonlyArrayDyn<f64>) -> PyResult<(Option<usize>, Vec<f64>, Vec<f64>)> {
+fn initial_states(
+    m: &PyModel,
+    q0: &PyReadonlyArrayDyn<f64>,
+    qd0: &PyReadonlyArrayDyn<f64>,
+) -> PyResult<(Option<usize>, Vec<f64>, Vec<f64>)> {
     let (n, nq) = (m.model.n, m.model.nq);
     let batch = match q0.shape() {
         [w] if *w == nq => None,
         [b, w] if *w == nq => Some(*b),
-        s => return Err(PyValueError::new_err(format!("q0 must have shape ({nq},) or a batch (N, {nq}), got {s:?}"))),
+        s => {
+            return Err(PyValueError::new_err(format!(
+                "q0 must have shape ({nq},) or a batch (N, {nq}), got {s:?}"
+            )))
+        }
     };
     let expected: Vec<usize> = batch.into_iter().chain([n]).collect();
     if qd0.shape() != expected.as_slice() {
-        return Err(PyValueError::new_err(format!("qd0 has shape {:?}, q0 has shape {:?}: qd0 must have shape {expected:?}", qd0.shape(), q0.shape())));
+        return Err(PyValueError::new_err(format!(
+            "qd0 has shape {:?}, q0 has shape {:?}: qd0 must have shape {expected:?}",
+            qd0.shape(),
+            q0.shape()
+        )));
     }
     let q0 = flat("q0", q0)?;
     m.check_configurations(&q0)?;
@@ -145,81 +204,117 @@ pub fn integrate_fixed<'py>(
     upper: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_fixed", || {
-    let m = model.get();
-    let (n, nq) = (m.model.n, m.model.nq);
-    let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
-    let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
-    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold: false, max_speed, limits };
-    if !(dt > 0.0 && dt.is_finite()) {
-        return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
-    }
-    if record_every == 0 {
-        return Err(PyValueError::new_err("record_every must be at least 1"));
-    }
-    let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
-    let count = batch.unwrap_or(1);
-    // torque samples: (rows per trajectory, shared?)
-    let (tau, rows, shared) = match tau.as_ref() {
-        None => (Vec::new(), 0, true),
-        Some(a) => {
-            let (rows, shared) = match a.shape() {
-                [s, w] if *w == n => (*s, true),
-                [b, s, w] if *w == n && Some(*b) == batch => (*s, false),
-                s => {
-                    return Err(PyValueError::new_err(format!(
-                        "tau must have shape (S, {n}) or, for a batch of {count}, ({count}, S, {n}); got {s:?}"
-                    )))
-                }
-            };
-            let need = if linear { steps + 1 } else { steps };
-            if rows != 1 && rows < need {
-                return Err(PyValueError::new_err(format!(
-                    "tau has {rows} samples; {steps} steps need {need} ({}), or 1 for a constant",
-                    if linear { "one per sample time, interpolated" } else { "one per step, held" }
-                )));
-            }
-            (flat("tau", a)?, rows, shared)
-        }
-    };
-    let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n, nq)?;
-    // SAFETY: the arrays were created above; nothing else refers to them yet.
-    let mut views = Vec::with_capacity(4);
-    for a in arrays.iter() {
-        views.push(unsafe { a.as_slice_mut()? });
-    }
-    let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
-    let (per, per_q) = (samples * n, samples * nq);
-    let model_ref = &m.model;
-    let run_one = |i: usize, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64], t: &mut [f64]| -> Result<Outcome, kinedyn_core::Error> {
-        let values = if rows == 0 {
-            &tau[..0]
-        } else if shared {
-            &tau[..]
-        } else {
-            &tau[i * rows * n..(i + 1) * rows * n]
+        let m = model.get();
+        let (n, nq) = (m.model.n, m.model.nq);
+        let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
+        let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
+        let settings = Settings {
+            method: method(method_name)?,
+            dt,
+            steps,
+            t0,
+            record_every,
+            hold: false,
+            max_speed,
+            limits,
         };
-        let mut source = Sampled { values, n, t0, dt, linear };
-        let mut data = Data::new(model_ref);
-        integrate::integrate(model_ref, &mut data, &settings, &q0[i * nq..(i + 1) * nq], &qd0[i * n..(i + 1) * n], &mut source, Record { q, qd, qdd, tau: t })
-    };
-    let outcomes: Vec<Outcome> = py
-        .detach(|| {
-            if count == 1 {
-                return Ok(run_one(0, oq, oqd, oqdd, otau).map(|o| vec![o]));
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "dt must be a positive finite step in seconds, got {dt}"
+            )));
+        }
+        if record_every == 0 {
+            return Err(PyValueError::new_err("record_every must be at least 1"));
+        }
+        let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
+        let count = batch.unwrap_or(1);
+        // torque samples: (rows per trajectory, shared?)
+        let (tau, rows, shared) = match tau.as_ref() {
+            None => (Vec::new(), 0, true),
+            Some(a) => {
+                let (rows, shared) = match a.shape() {
+                    [s, w] if *w == n => (*s, true),
+                    [b, s, w] if *w == n && Some(*b) == batch => (*s, false),
+                    s => {
+                        return Err(PyValueError::new_err(format!(
+                            "tau must have shape (S, {n}) or, for a batch of {count}, ({count}, S, {n}); got {s:?}"
+                        )))
+                    }
+                };
+                let need = if linear { steps + 1 } else { steps };
+                if rows != 1 && rows < need {
+                    return Err(PyValueError::new_err(format!(
+                        "tau has {rows} samples; {steps} steps need {need} ({}), or 1 for a constant",
+                        if linear {
+                            "one per sample time, interpolated"
+                        } else {
+                            "one per step, held"
+                        }
+                    )));
+                }
+                (flat("tau", a)?, rows, shared)
             }
-            guard::install(|| {
-                oq.par_chunks_mut(per_q)
-                    .zip(oqd.par_chunks_mut(per))
-                    .zip(oqdd.par_chunks_mut(per))
-                    .zip(otau.par_chunks_mut(per))
-                    .enumerate()
-                    .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-        })?
-        .map_err(core_err)?;
-    result(py, arrays, &outcomes)
+        };
+        let samples = settings.samples();
+        let arrays = outputs(py, batch, samples, n, nq)?;
+        // SAFETY: the arrays were created above; nothing else refers to them yet.
+        let mut views = Vec::with_capacity(4);
+        for a in arrays.iter() {
+            views.push(unsafe { a.as_slice_mut()? });
+        }
+        let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views
+            .try_into()
+            .map_err(|_| PyValueError::new_err("internal: output views"))?;
+        let (per, per_q) = (samples * n, samples * nq);
+        let model_ref = &m.model;
+        let run_one = |i: usize,
+                       q: &mut [f64],
+                       qd: &mut [f64],
+                       qdd: &mut [f64],
+                       t: &mut [f64]|
+         -> Result<Outcome, kinedyn_core::Error> {
+            let values = if rows == 0 {
+                &tau[..0]
+            } else if shared {
+                &tau[..]
+            } else {
+                &tau[i * rows * n..(i + 1) * rows * n]
+            };
+            let mut source = Sampled {
+                values,
+                n,
+                t0,
+                dt,
+                linear,
+            };
+            let mut data = Data::new(model_ref);
+            integrate::integrate(
+                model_ref,
+                &mut data,
+                &settings,
+                &q0[i * nq..(i + 1) * nq],
+                &qd0[i * n..(i + 1) * n],
+                &mut source,
+                Record { q, qd, qdd, tau: t },
+            )
+        };
+        let outcomes: Vec<Outcome> = py
+            .detach(|| {
+                if count == 1 {
+                    return Ok(run_one(0, oq, oqd, oqdd, otau).map(|o| vec![o]));
+                }
+                guard::install(|| {
+                    oq.par_chunks_mut(per_q)
+                        .zip(oqd.par_chunks_mut(per))
+                        .zip(oqdd.par_chunks_mut(per))
+                        .zip(otau.par_chunks_mut(per))
+                        .enumerate()
+                        .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+            })?
+            .map_err(core_err)?;
+        result(py, arrays, &outcomes)
     })
 }
 
@@ -238,7 +333,15 @@ where
     fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<(), String> {
         (self.torque)(step, t, q, qd, out)
     }
-    fn jacobian(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], dq: &mut [f64], dqd: &mut [f64]) -> Result<bool, String> {
+    fn jacobian(
+        &mut self,
+        step: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        dq: &mut [f64],
+        dqd: &mut [f64],
+    ) -> Result<bool, String> {
         (self.jacobian)(step, t, q, qd, dq, dqd)
     }
 }
@@ -247,7 +350,10 @@ where
 fn matrix_into(value: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut [f64]) -> PyResult<()> {
     let a: PyReadonlyArrayDyn<f64> = value.extract()?;
     if a.shape() != [n, n] {
-        return Err(PyValueError::new_err(format!("{what} must have shape ({n}, {n}), got {:?}", a.shape())));
+        return Err(PyValueError::new_err(format!(
+            "{what} must have shape ({n}, {n}), got {:?}",
+            a.shape()
+        )));
     }
     out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
     Ok(())
@@ -279,88 +385,120 @@ pub fn integrate_callback<'py>(
     upper: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_callback", || {
-    let m = model.get();
-    let (n, nq) = (m.model.n, m.model.nq);
-    let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
-    let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
-    let settings = Settings { method: method(method_name)?, dt, steps, t0, record_every, hold, max_speed, limits };
-    if !(dt > 0.0 && dt.is_finite()) {
-        return Err(PyValueError::new_err(format!("dt must be a positive finite step in seconds, got {dt}")));
-    }
-    if record_every == 0 {
-        return Err(PyValueError::new_err("record_every must be at least 1"));
-    }
-    let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
-    let count = batch.unwrap_or(1);
-    let samples = settings.samples();
-    let arrays = outputs(py, batch, samples, n, nq)?;
-    let mut views = Vec::with_capacity(4);
-    for a in arrays.iter() {
-        views.push(unsafe { a.as_slice_mut()? });
-    }
-    let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views.try_into().map_err(|_| PyValueError::new_err("internal: output views"))?;
-    let (per, per_q) = (samples * n, samples * nq);
-    let error: RefCell<Option<PyErr>> = RefCell::new(None);
-    let torque = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
-        let mut call = || -> PyResult<()> {
-            let qa = PyArray1::from_slice(py, q);
-            let qda = PyArray1::from_slice(py, qd);
-            let value = callback.call1((k, t, qa, qda))?;
-            let got = match value.extract::<PyReadonlyArrayDyn<f64>>() {
-                Ok(a) if a.ndim() == 1 && a.len() == n => {
-                    out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
-                    return Ok(());
-                }
-                Ok(a) => a.shape().to_vec(),
-                Err(_) => {
-                    let v: Vec<f64> = value.extract()?;
-                    if v.len() == n {
-                        out.copy_from_slice(&v);
+        let m = model.get();
+        let (n, nq) = (m.model.n, m.model.nq);
+        let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
+        let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
+        let settings = Settings {
+            method: method(method_name)?,
+            dt,
+            steps,
+            t0,
+            record_every,
+            hold,
+            max_speed,
+            limits,
+        };
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "dt must be a positive finite step in seconds, got {dt}"
+            )));
+        }
+        if record_every == 0 {
+            return Err(PyValueError::new_err("record_every must be at least 1"));
+        }
+        let (batch, q0, qd0) = initial_states(m, &q0, &qd0)?;
+        let count = batch.unwrap_or(1);
+        let samples = settings.samples();
+        let arrays = outputs(py, batch, samples, n, nq)?;
+        let mut views = Vec::with_capacity(4);
+        for a in arrays.iter() {
+            views.push(unsafe { a.as_slice_mut()? });
+        }
+        let [oq, oqd, oqdd, otau]: [&mut [f64]; 4] = views
+            .try_into()
+            .map_err(|_| PyValueError::new_err("internal: output views"))?;
+        let (per, per_q) = (samples * n, samples * nq);
+        let error: RefCell<Option<PyErr>> = RefCell::new(None);
+        let torque = |k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<(), String> {
+            let mut call = || -> PyResult<()> {
+                let qa = PyArray1::from_slice(py, q);
+                let qda = PyArray1::from_slice(py, qd);
+                let value = callback.call1((k, t, qa, qda))?;
+                let got = match value.extract::<PyReadonlyArrayDyn<f64>>() {
+                    Ok(a) if a.ndim() == 1 && a.len() == n => {
+                        out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
                         return Ok(());
                     }
-                    vec![v.len()]
-                }
+                    Ok(a) => a.shape().to_vec(),
+                    Err(_) => {
+                        let v: Vec<f64> = value.extract()?;
+                        if v.len() == n {
+                            out.copy_from_slice(&v);
+                            return Ok(());
+                        }
+                        vec![v.len()]
+                    }
+                };
+                Err(PyValueError::new_err(format!(
+                    "the controller returned torques of shape {got:?} at t = {t}; the robot has {n} joints"
+                )))
             };
-            Err(PyValueError::new_err(format!("the controller returned torques of shape {got:?} at t = {t}; the robot has {n} joints")))
+            call().map_err(|e| {
+                let message = e.to_string();
+                *error.borrow_mut() = Some(e);
+                message
+            })
         };
-        call().map_err(|e| {
-            let message = e.to_string();
-            *error.borrow_mut() = Some(e);
-            message
-        })
-    };
-    let derivatives = |k: usize, t: f64, q: &[f64], qd: &[f64], dq: &mut [f64], dqd: &mut [f64]| -> Result<bool, String> {
-        let Some(f) = jacobian.as_ref() else { return Ok(false) };
-        let mut call = || -> PyResult<bool> {
-            let value = f.call1((k, t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)))?;
-            if value.is_none() {
-                return Ok(false);
-            }
-            let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) = value.extract()?;
-            matrix_into(&a, n, "dtau/dq", dq)?;
-            matrix_into(&b, n, "dtau/dqd", dqd)?;
-            Ok(true)
+        let derivatives =
+            |k: usize, t: f64, q: &[f64], qd: &[f64], dq: &mut [f64], dqd: &mut [f64]| -> Result<bool, String> {
+                let Some(f) = jacobian.as_ref() else { return Ok(false) };
+                let mut call = || -> PyResult<bool> {
+                    let value = f.call1((k, t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)))?;
+                    if value.is_none() {
+                        return Ok(false);
+                    }
+                    let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) = value.extract()?;
+                    matrix_into(&a, n, "dtau/dq", dq)?;
+                    matrix_into(&b, n, "dtau/dqd", dqd)?;
+                    Ok(true)
+                };
+                call().map_err(|e| {
+                    let message = e.to_string();
+                    *error.borrow_mut() = Some(e);
+                    message
+                })
+            };
+        let mut source = CallbackSource {
+            torque,
+            jacobian: derivatives,
         };
-        call().map_err(|e| {
-            let message = e.to_string();
-            *error.borrow_mut() = Some(e);
-            message
-        })
-    };
-    let mut source = CallbackSource { torque, jacobian: derivatives };
-    let mut outcomes = Vec::with_capacity(count);
-    let mut data = Data::new(&m.model);
-    for i in 0..count {
-        let r = i * per..(i + 1) * per;
-        let out = Record { q: &mut oq[i * per_q..(i + 1) * per_q], qd: &mut oqd[r.clone()], qdd: &mut oqdd[r.clone()], tau: &mut otau[r] };
-        let outcome = integrate::integrate(&m.model, &mut data, &settings, &q0[i * nq..(i + 1) * nq], &qd0[i * n..(i + 1) * n], &mut source, out)
+        let mut outcomes = Vec::with_capacity(count);
+        let mut data = Data::new(&m.model);
+        for i in 0..count {
+            let r = i * per..(i + 1) * per;
+            let out = Record {
+                q: &mut oq[i * per_q..(i + 1) * per_q],
+                qd: &mut oqd[r.clone()],
+                qdd: &mut oqdd[r.clone()],
+                tau: &mut otau[r],
+            };
+            let outcome = integrate::integrate(
+                &m.model,
+                &mut data,
+                &settings,
+                &q0[i * nq..(i + 1) * nq],
+                &qd0[i * n..(i + 1) * n],
+                &mut source,
+                out,
+            )
             .map_err(core_err)?;
-        if let Some(e) = error.borrow_mut().take() {
-            return Err(e);
+            if let Some(e) = error.borrow_mut().take() {
+                return Err(e);
+            }
+            outcomes.push(outcome);
         }
-        outcomes.push(outcome);
-    }
-    result(py, arrays, &outcomes)
+        result(py, arrays, &outcomes)
     })
 }
 

@@ -4,10 +4,28 @@ excitation data (:func:`identify`). See docs/analysis.md."""
 
 from .excitation import excitation_condition, optimize_excitation, write_trajectory_csv
 from .friction import FrictionModel
-from .identification import (Identification, Measurements, RotorEstimate, Validation, base_parameters_with_rotors, excitation, geared_joints, identify,
-                             pseudo_inertia, simulate_measurements, with_inertial_parameters)
+from .identification import (
+    Identification,
+    Measurements,
+    RotorEstimate,
+    Validation,
+    base_parameters_with_rotors,
+    excitation,
+    geared_joints,
+    identify,
+    pseudo_inertia,
+    simulate_measurements,
+    with_inertial_parameters,
+)
 from .logs import Log, LogError, load_log
-from .properties import Check, InertiaBounds, PropertiesReport, check_properties, global_inertia_bounds, prove_properties
+from .properties import (
+    Check,
+    InertiaBounds,
+    PropertiesReport,
+    check_properties,
+    global_inertia_bounds,
+    prove_properties,
+)
 from .system_properties import check_system_properties
 
 __all__ = [

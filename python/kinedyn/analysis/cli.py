@@ -3,14 +3,12 @@ identification from a robot's log, ``--data``, or from a simulated excitation)."
 
 from __future__ import annotations
 
-import numpy as np
-
 __all__ = ["add_analysis_commands", "cmd_check", "cmd_identify"]
 
 
 def cmd_check(args) -> int:
-    from ..cli import console, emit, esc, load_robot
     from .. import robots
+    from ..cli import console, emit, esc, load_robot
     from .properties import check_properties
 
     robot = load_robot(args.robot or robots.DEFAULT)
@@ -20,7 +18,8 @@ def cmd_check(args) -> int:
             f"kinedyn check --prove handles revolute and prismatic joints only; robot '{robot.name}' has the {joint.kind} joint "
             f"'{joint.name}': the symbolic engine writes it in ZYX Euler angles, whose D(q) is singular at pitch = ±pi/2, so no inertia "
             f"bounds exist in them, and a floating base's derivation is large. Run 'kinedyn check' without --prove (the numeric "
-            f"checks handle multi-DOF joints), or call robot.equations_of_motion().check_properties() in Python for the identities")
+            f"checks handle multi-DOF joints), or call robot.equations_of_motion().check_properties() in Python for the identities"
+        )
     report = check_properties(robot, samples=args.samples, seed=args.seed, T=args.t)
     if getattr(args, "prove", False):
         from dataclasses import replace
@@ -34,7 +33,10 @@ def cmd_check(args) -> int:
         from rich.table import Table
 
         c = console()
-        t = Table(title=f"properties of {esc(robot.name)} ({args.samples} sampled states, {args.t:g} s trajectory)", title_justify="left")
+        t = Table(
+            title=f"properties of {esc(robot.name)} ({args.samples} sampled states, {args.t:g} s trajectory)",
+            title_justify="left",
+        )
         for col in ("", "property", "how", "residual", "tolerance", "measured"):
             t.add_column(col)
         for chk in report.checks:
@@ -47,8 +49,8 @@ def cmd_check(args) -> int:
 
 
 def cmd_identify(args) -> int:
-    from ..cli import console, emit, esc, load_robot
     from .. import robots
+    from ..cli import console, emit, esc, load_robot
     from .identification import excitation, identify, simulate_measurements
 
     robot = load_robot(args.robot or robots.DEFAULT)
@@ -57,7 +59,9 @@ def cmd_identify(args) -> int:
     if args.data:
         return _identify_from_log(robot, args)
     ref = excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
-    data = simulate_measurements(robot, ref, T=args.periods * args.period, rate=args.rate, noise=args.noise, seed=args.seed)
+    data = simulate_measurements(
+        robot, ref, T=args.periods * args.period, rate=args.rate, noise=args.noise, seed=args.seed
+    )
     result = identify(robot, data, weighted=args.weighted)
     payload = dict(robot=robot.name, samples=len(data.t), noise=args.noise, **result.to_dict())
     if args.output:
@@ -67,9 +71,11 @@ def cmd_identify(args) -> int:
         from rich.table import Table
 
         c = console()
-        c.print(f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters from {len(data.t)} samples "
-                f"({args.periods:g} periods of a {args.harmonics}-harmonic Fourier excitation, noise {args.noise:g}); "
-                f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares")
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters from {len(data.t)} samples "
+            f"({args.periods:g} periods of a {args.harmonics}-harmonic Fourier excitation, noise {args.noise:g}); "
+            f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+        )
         t = Table(title_justify="left")
         for col in ("parameter", "estimate", "std", "true", "error", "error / std"):
             t.add_column(col, justify="right")
@@ -77,8 +83,14 @@ def cmd_identify(args) -> int:
         assert true is not None  # identify() on a known robot always has the true values
         for k, nm in enumerate(result.names):
             e = result.estimates[k] - true[k]
-            t.add_row(esc(nm), f"{result.estimates[k]:.8g}", f"{result.std[k]:.2g}", f"{true[k]:.8g}", f"{e:.2g}",
-                      f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-")
+            t.add_row(
+                esc(nm),
+                f"{result.estimates[k]:.8g}",
+                f"{result.std[k]:.2g}",
+                f"{true[k]:.8g}",
+                f"{e:.2g}",
+                f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-",
+            )
         c.print(t)
         if result.dropped:
             c.print(f"not excited (zero regressor columns on the data): {esc(', '.join(result.dropped))}")
@@ -96,14 +108,25 @@ def _write_excitation(robot, args) -> int:
     ref = optimize_excitation(robot, period=args.period, harmonics=args.harmonics, seed=args.seed)
     write_trajectory_csv(ref, args.excite, rate=args.rate)
     cond = excitation_condition(robot, ref)
-    random_cond = excitation_condition(robot, excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed))
-    payload = dict(robot=robot.name, trajectory=str(args.excite), period=args.period, harmonics=args.harmonics, rate=args.rate,
-                   condition_number=cond, random_condition_number=random_cond)
+    random_cond = excitation_condition(
+        robot, excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
+    )
+    payload = dict(
+        robot=robot.name,
+        trajectory=str(args.excite),
+        period=args.period,
+        harmonics=args.harmonics,
+        rate=args.rate,
+        condition_number=cond,
+        random_condition_number=random_cond,
+    )
 
     def render():
-        console().print(f"[bold]{esc(robot.name)}[/bold]: excitation of {args.harmonics} harmonics, period {args.period:g} s, "
-                        f"at rest at both ends, written to {esc(str(args.excite))} at {args.rate:g} Hz; "
-                        f"cond(Y_base) {cond:.4g} (a random Fourier excitation of the same band: {random_cond:.4g})")
+        console().print(
+            f"[bold]{esc(robot.name)}[/bold]: excitation of {args.harmonics} harmonics, period {args.period:g} s, "
+            f"at rest at both ends, written to {esc(str(args.excite))} at {args.rate:g} Hz; "
+            f"cond(Y_base) {cond:.4g} (a random Fourier excitation of the same band: {random_cond:.4g})"
+        )
 
     emit(args, payload, render)
     return 0
@@ -117,7 +140,9 @@ def _identify_from_log(robot, args) -> int:
 
     options = dict(cutoff=args.cutoff, decimate=args.decimate)
     log = load_log(args.data, n=robot.n, **options)
-    result = identify(robot, log, weighted=args.weighted, friction=args.friction, consistent=args.consistent, smoothing=args.smoothing)
+    result = identify(
+        robot, log, weighted=args.weighted, friction=args.friction, consistent=args.consistent, smoothing=args.smoothing
+    )
     payload = dict(robot=robot.name, data=str(args.data), cutoff_hz=log.cutoff, rate_hz=log.rate, **result.to_dict())
     check = None
     if args.validate:
@@ -134,10 +159,12 @@ def _identify_from_log(robot, args) -> int:
         from rich.table import Table
 
         c = console()
-        c.print(f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters and {len(result.friction_names)} friction coefficients "
-                f"from {len(log)} samples of {esc(str(args.data))} (cut-off {log.cutoff or 0:.3g} Hz, {log.rate:.4g} Hz after decimation); "
-                f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
-                + (", physically consistent (SDP)" if result.consistent else ""))
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters and {len(result.friction_names)} friction coefficients "
+            f"from {len(log)} samples of {esc(str(args.data))} (cut-off {log.cutoff or 0:.3g} Hz, {log.rate:.4g} Hz after decimation); "
+            f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+            + (", physically consistent (SDP)" if result.consistent else "")
+        )
         t = Table(title_justify="left")
         for col in ("parameter", "estimate", "std", "std %"):
             t.add_column(col, justify="right")
@@ -148,8 +175,10 @@ def _identify_from_log(robot, args) -> int:
         c.print(t)
         grouped = [r for r in result.rotors if r.armature is None]
         if grouped:
-            c.print("armatures r² J_m grouped with link parameters (not identifiable on their own): "
-                    + "; ".join(f"{esc(r.joint)} into {esc(', '.join(r.grouped_into))}" for r in grouped))
+            c.print(
+                "armatures r² J_m grouped with link parameters (not identifiable on their own): "
+                + "; ".join(f"{esc(r.joint)} into {esc(', '.join(r.grouped_into))}" for r in grouped)
+            )
         if args.output:
             c.print(f"report written to {esc(str(args.output))}")
         if check is not None:
@@ -167,18 +196,30 @@ def _identify_from_log(robot, args) -> int:
 def add_analysis_commands(subparsers) -> None:
     from ..cli import OutputPath, _robot_arg, nonnegative_float, nonnegative_int, positive_float, positive_int
 
-    p = subparsers.add_parser("check", help="properties of the equations of motion, each with its residual (Spong §9.5)")
+    p = subparsers.add_parser(
+        "check", help="properties of the equations of motion, each with its residual (Spong §9.5)"
+    )
     _robot_arg(p)
     p.add_argument("--samples", type=positive_int, default=200, help="random states (default 200)")
-    p.add_argument("--t", type=positive_float, default=2.0, help="length of the passivity trajectory in seconds (default 2)")
+    p.add_argument(
+        "--t", type=positive_float, default=2.0, help="length of the passivity trajectory in seconds (default 2)"
+    )
     p.add_argument("--seed", type=nonnegative_int, default=0)
-    p.add_argument("--prove", action="store_true",
-                   help="also prove the identities on the symbolic model (exact simplification) and search its inertia bounds")
+    p.add_argument(
+        "--prove",
+        action="store_true",
+        help="also prove the identities on the symbolic model (exact simplification) and search its inertia bounds",
+    )
     p.set_defaults(func=cmd_check)
 
-    p = subparsers.add_parser("identify", help="identify base inertial parameters and friction from a log (--data) or a simulated Fourier excitation")
+    p = subparsers.add_parser(
+        "identify",
+        help="identify base inertial parameters and friction from a log (--data) or a simulated Fourier excitation",
+    )
     _robot_arg(p)
-    p.add_argument("--noise", type=nonnegative_float, default=0.0, help="torque noise standard deviation, N m (default 0)")
+    p.add_argument(
+        "--noise", type=nonnegative_float, default=0.0, help="torque noise standard deviation, N m (default 0)"
+    )
     p.add_argument("--harmonics", type=positive_int, default=5)
     p.add_argument("--period", type=positive_float, default=10.0, help="period of the excitation, s (default 10)")
     p.add_argument("--periods", type=positive_float, default=2.0, help="measured periods (default 2)")
@@ -186,16 +227,51 @@ def add_analysis_commands(subparsers) -> None:
     p.add_argument("--rate", type=positive_float, default=100.0, help="sample rate, Hz (default 100)")
     p.add_argument("--weighted", action="store_true", help="weighted least squares (per-joint noise levels)")
     p.add_argument("--seed", type=nonnegative_int, default=0)
-    p.add_argument("--data", metavar="LOG", help="identify from a log (CSV or NPZ: t, q1..qn, tau1..taun) instead of a simulated excitation")
-    p.add_argument("--friction", default="viscous+coulomb", help="friction terms estimated with --data: viscous, coulomb, offset joined by '+', or none / known (default viscous+coulomb)")
-    p.add_argument("--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s")
-    p.add_argument("--consistent", action="store_true", help="physically consistent parameters (pseudo-inertias positive definite; an SDP through cvxpy)")
-    p.add_argument("--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model")
-    p.add_argument("--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)")
-    p.add_argument("--decimate", type=positive_int, default=None, help="keep every k-th sample after filtering (default: rate / (5 cut-off))")
-    p.add_argument("--excite", metavar="CSV", action=OutputPath,
-                   help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop")
-    p.add_argument("--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)")
-    p.add_argument("-o", "--output", metavar="HTML", action=OutputPath, default=None,
-                   help="write a self-contained HTML identification report (parameters, friction, rotor inertia, torque and residual plots)")
+    p.add_argument(
+        "--data",
+        metavar="LOG",
+        help="identify from a log (CSV or NPZ: t, q1..qn, tau1..taun) instead of a simulated excitation",
+    )
+    p.add_argument(
+        "--friction",
+        default="viscous+coulomb",
+        help="friction terms estimated with --data: viscous, coulomb, offset joined by '+', or none / known (default viscous+coulomb)",
+    )
+    p.add_argument(
+        "--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s"
+    )
+    p.add_argument(
+        "--consistent",
+        action="store_true",
+        help="physically consistent parameters (pseudo-inertias positive definite; an SDP through cvxpy)",
+    )
+    p.add_argument(
+        "--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model"
+    )
+    p.add_argument(
+        "--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)"
+    )
+    p.add_argument(
+        "--decimate",
+        type=positive_int,
+        default=None,
+        help="keep every k-th sample after filtering (default: rate / (5 cut-off))",
+    )
+    p.add_argument(
+        "--excite",
+        metavar="CSV",
+        action=OutputPath,
+        help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop",
+    )
+    p.add_argument(
+        "--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)"
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="HTML",
+        action=OutputPath,
+        default=None,
+        help="write a self-contained HTML identification report (parameters, friction, rotor inertia, torque and residual plots)",
+    )
     p.set_defaults(func=cmd_identify)

@@ -19,7 +19,7 @@ the period, subject to the position, velocity and acceleration limits at the sam
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -55,7 +55,7 @@ def optimize_excitation(
     robot: Robot,
     period: float = 10.0,
     harmonics: int = 5,
-    limits: Optional[dict] = None,
+    limits: dict | None = None,
     samples: int = 100,
     seed: int = 0,
     maxiter: int = 200,
@@ -100,7 +100,9 @@ def optimize_excitation(
 
     def objective(x):
         q, qd, qdd = motion(x)
-        W = robot.regressor(np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(qdd))[..., base.indices]
+        W = robot.regressor(np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(qdd))[
+            ..., base.indices
+        ]
         W = W.reshape(-1, base.count)
         # cond(W)^2 = cond(W^T W): the eigenvalues of the small Gram matrix cost a fraction of an SVD of
         # the tall W (which also ran 30x slower than this under a multi-threaded BLAS on a busy
@@ -113,16 +115,30 @@ def optimize_excitation(
 
     def margins(x):
         q, qd, qdd = motion(x)
-        return np.concatenate([(half - np.abs(q - q0)).ravel() / half.max(), (qd_max - np.abs(qd)).ravel() / qd_max.max(),
-                               (qdd_max - np.abs(qdd)).ravel() / qdd_max.max()])
+        return np.concatenate(
+            [
+                (half - np.abs(q - q0)).ravel() / half.max(),
+                (qd_max - np.abs(qd)).ravel() / qd_max.max(),
+                (qdd_max - np.abs(qdd)).ravel() / qdd_max.max(),
+            ]
+        )
 
     rng = np.random.default_rng(seed)
     x0 = rng.normal(size=2 * n * (L - 1))
     q, qd, qdd = motion(x0)
-    shrink = min(float((half / np.maximum(np.abs(q - q0).max(axis=0), 1e-12)).min()), float((qd_max / np.maximum(np.abs(qd).max(axis=0), 1e-12)).min()),
-                 float((qdd_max / np.maximum(np.abs(qdd).max(axis=0), 1e-12)).min()))
+    shrink = min(
+        float((half / np.maximum(np.abs(q - q0).max(axis=0), 1e-12)).min()),
+        float((qd_max / np.maximum(np.abs(qd).max(axis=0), 1e-12)).min()),
+        float((qdd_max / np.maximum(np.abs(qdd).max(axis=0), 1e-12)).min()),
+    )
     x0 = 0.9 * shrink * x0
-    result = minimize(objective, x0, method="SLSQP", constraints=[dict(type="ineq", fun=margins)], options=dict(maxiter=maxiter, ftol=1e-6))
+    result = minimize(
+        objective,
+        x0,
+        method="SLSQP",
+        constraints=[dict(type="ineq", fun=margins)],
+        options=dict(maxiter=maxiter, ftol=1e-6),
+    )
     x = result.x if np.all(margins(result.x) >= -1e-6) and objective(result.x) < objective(x0) else x0
     a, b = _from_free(x, n, L)
     return Fourier(a, b, wf, q0)
@@ -137,4 +153,6 @@ def write_trajectory_csv(reference, path, rate: float = 1000.0, periods: float =
     q, qd, qdd = reference(t)
     n = q.shape[1]
     header = ",".join(["t"] + [f"{p}{j + 1}" for p in ("q", "qd", "qdd") for j in range(n)])
-    np.savetxt(os.fspath(path), np.column_stack([t, q, qd, qdd]), delimiter=",", header=header, comments="", fmt="%.10g")
+    np.savetxt(
+        os.fspath(path), np.column_stack([t, q, qd, qdd]), delimiter=",", header=header, comments="", fmt="%.10g"
+    )

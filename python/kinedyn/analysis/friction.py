@@ -13,7 +13,6 @@ matches real friction at slow reversals better than a jump does).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
 
@@ -28,7 +27,7 @@ class FrictionModel:
 
     terms: tuple = ()
     known: bool = False
-    smoothing: Optional[float] = None
+    smoothing: float | None = None
 
     def names(self, n: int) -> tuple:
         """Parameter names, joint by joint: ``joint1.viscous``, ``joint1.coulomb``, ..."""
@@ -37,7 +36,7 @@ class FrictionModel:
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.sign(qd) if self.smoothing is None else np.tanh(qd / self.smoothing)
 
-    def regressor(self, qd: np.ndarray, sign: Optional[np.ndarray] = None) -> np.ndarray:
+    def regressor(self, qd: np.ndarray, sign: np.ndarray | None = None) -> np.ndarray:
         """(S, n, n k) for qd (S, n): column block j holds joint j's terms (zero in other rows).
         ``sign``: a filtered sign(qd) to use for the Coulomb term (ignored with smoothing)."""
         qd = np.asarray(qd, dtype=float)
@@ -61,7 +60,7 @@ class FrictionModel:
         return (self.regressor(batch) @ np.asarray(coefficients, dtype=float)).reshape(qd.shape)
 
 
-def parse_friction(spec, smoothing: Optional[float] = None) -> FrictionModel:
+def parse_friction(spec, smoothing: float | None = None) -> FrictionModel:
     """``"viscous+coulomb"``, ``"viscous+coulomb+offset"``, ``"none"`` (no friction), ``"known"``
     (the robot's own friction model, subtracted), or a sequence of term names."""
     if isinstance(spec, FrictionModel):

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,8 +44,19 @@ if TYPE_CHECKING:
     from ..dynamics import BaseParameters
     from ..robot import Robot
 
-__all__ = ["Measurements", "Identification", "Validation", "RotorEstimate", "pseudo_inertia", "excitation", "simulate_measurements", "identify",
-           "with_inertial_parameters", "base_parameters_with_rotors", "geared_joints"]
+__all__ = [
+    "Measurements",
+    "Identification",
+    "Validation",
+    "RotorEstimate",
+    "pseudo_inertia",
+    "excitation",
+    "simulate_measurements",
+    "identify",
+    "with_inertial_parameters",
+    "base_parameters_with_rotors",
+    "geared_joints",
+]
 
 
 @dataclass
@@ -69,7 +80,7 @@ class Identification:
     estimates: np.ndarray
     std: np.ndarray
     covariance: np.ndarray
-    true_values: Optional[np.ndarray]
+    true_values: np.ndarray | None
     condition_number: float
     residual_rms: np.ndarray  # per joint
     weighted: bool
@@ -78,24 +89,24 @@ class Identification:
     #: base parameters left out because their regressor columns vanish on the data (round-off level)
     dropped: tuple = ()
     #: which rows of ``base`` the estimates are for (None: all of them)
-    used: Optional[np.ndarray] = field(default=None, repr=False)
+    used: np.ndarray | None = field(default=None, repr=False)
     #: the friction model (``known``: the nominal robot's friction, subtracted, not estimated)
     friction: FrictionModel = field(default_factory=lambda: FrictionModel((), known=True))
     friction_names: tuple = ()
     friction_estimates: np.ndarray = field(default_factory=lambda: np.zeros(0))
     friction_std: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: per-joint torque noise standard deviation estimated from the least-squares residuals
-    noise: Optional[np.ndarray] = None
+    noise: np.ndarray | None = None
     #: physically consistent estimate (``consistent=True``): all 10 n standard parameters
-    standard: Optional[np.ndarray] = field(default=None, repr=False)
+    standard: np.ndarray | None = field(default=None, repr=False)
     samples: int = 0
     #: joints whose armature r^2 J_m is estimated (their columns follow the 10 n link columns of the
     #: augmented parameter vector that ``base`` is over); the other joints' rotor inertia is known
     rotor_joints: tuple = ()
     #: consistent estimate: the armature of each of ``rotor_joints`` (>= 0)
-    standard_armature: Optional[np.ndarray] = field(default=None, repr=False)
+    standard_armature: np.ndarray | None = field(default=None, repr=False)
     #: consistent estimate: the unconstrained (ordinary or weighted least-squares) fit of the same data
-    unconstrained: Optional["Identification"] = field(default=None, repr=False)
+    unconstrained: Identification | None = field(default=None, repr=False)
     #: the samples fitted (a Log or Measurements), for plots and reports
     data: Any = field(default=None, repr=False)
 
@@ -114,15 +125,17 @@ class Identification:
         return np.arange(len(self.base.indices)) if self.used is None else self.used
 
     @property
-    def errors(self) -> Optional[np.ndarray]:
+    def errors(self) -> np.ndarray | None:
         """estimates - true values (if the true values are known)."""
         return None if self.true_values is None else self.estimates - self.true_values
 
     @property
-    def relative_errors(self) -> Optional[np.ndarray]:
+    def relative_errors(self) -> np.ndarray | None:
         if self.true_values is None:
             return None
-        return np.abs(self.estimates - self.true_values) / np.maximum(np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max()))
+        return np.abs(self.estimates - self.true_values) / np.maximum(
+            np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max())
+        )
 
     def predict_torque(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Torques of the identified model, (n,) or (S, n): rigid body (base regressor times the
@@ -167,7 +180,9 @@ class Identification:
             nominal = float(self.nominal.armature[j])
             if own in names:
                 i = names.index(own)
-                value = float(self.standard_armature[k]) if self.standard_armature is not None else float(self.estimates[i])
+                value = (
+                    float(self.standard_armature[k]) if self.standard_armature is not None else float(self.estimates[i])
+                )
                 out.append(RotorEstimate(joint.name, float(joint.gear_ratio), nominal, value, float(self.std[i])))
             else:
                 grouped = tuple(names[i] for i in np.flatnonzero(np.abs(G[:, 10 * n + k]) > 0))
@@ -206,10 +221,10 @@ class Identification:
             x0 = np.concatenate([self.nominal.inertial_parameters(), self.nominal.armature[rotor]])
             # a grouped armature keeps its nominal value: the links' parameters take up the group
             free = np.ones(x0.size, dtype=bool)
-            free[10 * n:] = [r.armature is not None for r in self.rotors]
+            free[10 * n :] = [r.armature is not None for r in self.rotors]
             x = x0.copy()
             x[free] += np.linalg.pinv(G[:, free]) @ (self.estimates - G @ x0)
-            pi, armature = x[: 10 * n], x[10 * n:]
+            pi, armature = x[: 10 * n], x[10 * n :]
         robot = with_inertial_parameters(self.nominal, pi)
         if rotor:
             robot = _with_armatures(robot, dict(zip(rotor, armature)))
@@ -217,7 +232,7 @@ class Identification:
             return robot
         return _with_friction(robot, self.friction, self.friction_estimates)
 
-    def validate(self, log, **load_options) -> "Validation":
+    def validate(self, log, **load_options) -> Validation:
         """Torque prediction on another log (a :class:`Log`, or anything :func:`load_log` reads,
         processed with ``load_options``): RMS error and R^2 per joint."""
         from .logs import load_log
@@ -255,13 +270,23 @@ class Identification:
 
     def to_dict(self) -> dict:
         d = dict(
-            names=list(self.names), estimates=self.estimates, std=self.std, condition_number=self.condition_number,
-            residual_rms=self.residual_rms, weighted=self.weighted, dropped=list(self.dropped),
+            names=list(self.names),
+            estimates=self.estimates,
+            std=self.std,
+            condition_number=self.condition_number,
+            residual_rms=self.residual_rms,
+            weighted=self.weighted,
+            dropped=list(self.dropped),
         )
         if not self.friction.known:
-            d.update(relative_std_percent=self.relative_std, friction_names=list(self.friction_names),
-                     friction_estimates=self.friction_estimates, friction_std=self.friction_std, consistent=self.consistent,
-                     samples=self.samples)
+            d.update(
+                relative_std_percent=self.relative_std,
+                friction_names=list(self.friction_names),
+                friction_estimates=self.friction_estimates,
+                friction_std=self.friction_std,
+                consistent=self.consistent,
+                samples=self.samples,
+            )
             if self.noise is not None:
                 d.update(noise=self.noise)
             if self.standard is not None:
@@ -270,8 +295,12 @@ class Identification:
                 d.update(rotors=[r.to_dict() for r in self.rotors])
         if self.true_values is not None:
             errors = self.estimates - self.true_values
-            d.update(true_values=self.true_values, errors=errors, max_abs_error=float(np.abs(errors).max()),
-                     max_error_in_std=float(np.abs(errors / self.std).max()) if np.all(self.std > 0) else None)
+            d.update(
+                true_values=self.true_values,
+                errors=errors,
+                max_abs_error=float(np.abs(errors).max()),
+                max_error_in_std=float(np.abs(errors / self.std).max()) if np.all(self.std > 0) else None,
+            )
         return d
 
     def _repr_html_(self) -> str:  # notebooks: estimates, std and errors as a table (kinedyn.display)
@@ -280,7 +309,9 @@ class Identification:
         return identification_html(self)
 
     def __str__(self) -> str:
-        lines = [f"{len(self.names)} base parameters, cond(W) = {self.condition_number:.4g}, {'weighted' if self.weighted else 'ordinary'} least squares"]
+        lines = [
+            f"{len(self.names)} base parameters, cond(W) = {self.condition_number:.4g}, {'weighted' if self.weighted else 'ordinary'} least squares"
+        ]
         for k, nm in enumerate(self.names):
             s = f"  {nm:<22} {self.estimates[k]: .8g} +- {self.std[k]:.2g}"
             if self.true_values is not None:
@@ -340,7 +371,9 @@ class Validation:
         return fig
 
 
-def excitation(robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0: Optional[ArrayLike] = None, seed: int = 0) -> Fourier:
+def excitation(
+    robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0: ArrayLike | None = None, seed: int = 0
+) -> Fourier:
     """A random Fourier excitation for ``robot`` (Swevers et al. 1997): ``harmonics`` harmonics of
     the base frequency 2 pi / period, each joint's excursion ``amplitude`` about ``q0`` (default: the
     middle of finite joint limits, else 0)."""
@@ -353,7 +386,9 @@ def excitation(robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude
     return Fourier.random(robot.n, harmonics=harmonics, wf=2 * np.pi / period, amplitude=amplitude, q0=q0, seed=seed)
 
 
-def simulate_measurements(robot: Robot, reference, T: Optional[float] = None, rate: float = 100.0, noise=0.0, seed: int = 0) -> Measurements:
+def simulate_measurements(
+    robot: Robot, reference, T: float | None = None, rate: float = 100.0, noise=0.0, seed: int = 0
+) -> Measurements:
     """Sample ``reference`` at ``rate`` Hz over ``T`` seconds (default: two periods of a Fourier
     reference) and measure torques by inverse dynamics (one native batch call) plus Gaussian noise of
     standard deviation ``noise`` (scalar or per joint, N m / N)."""
@@ -380,11 +415,11 @@ def identify(
     *,
     friction=None,
     consistent: bool = False,
-    rotor: Optional[bool] = None,
-    smoothing: Optional[float] = None,
+    rotor: bool | None = None,
+    smoothing: float | None = None,
     regularization: float = 1e-4,
     margin: float = 1e-8,
-    solver: Optional[str] = None,
+    solver: str | None = None,
     **load_options,
 ) -> Identification:
     """Least-squares estimates of ``robot``'s base parameters (and friction) from ``data``.
@@ -417,9 +452,11 @@ def identify(
     if base is None:
         base = base_parameters_with_rotors(robot, rotor_joints)
     elif rotor_joints and base.grouping.shape[1] != 10 * n + len(rotor_joints):
-        raise ValueError(f"base: {base.grouping.shape[1]} parameters, but the link parameters and the armatures of the geared joints "
-                         f"{[robot.joints[j].name for j in rotor_joints]} are {10 * n + len(rotor_joints)} (see base_parameters_with_rotors, or rotor=False)")
-    true_values: Optional[np.ndarray] = None
+        raise ValueError(
+            f"base: {base.grouping.shape[1]} parameters, but the link parameters and the armatures of the geared joints "
+            f"{[robot.joints[j].name for j in rotor_joints]} are {10 * n + len(rotor_joints)} (see base_parameters_with_rotors, or rotor=False)"
+        )
+    true_values: np.ndarray | None = None
     if simulated:
         model = parse_friction("known" if friction is None else friction, smoothing)
         true_values = np.asarray(base.values, dtype=float)
@@ -439,7 +476,9 @@ def identify(
         y = y - robot.friction_torque(qd)
     nb, nf = base.count, F.shape[2]
     if S * n <= nb + nf:
-        raise ValueError(f"{S} samples x {n} joints = {S * n} equations cannot determine {nb} base parameters and {nf} friction coefficients")
+        raise ValueError(
+            f"{S} samples x {n} joints = {S * n} equations cannot determine {nb} base parameters and {nf} friction coefficients"
+        )
     W = np.concatenate([Yfull[..., base.indices], F], axis=2).reshape(S * n, nb + nf)
     yv = y.reshape(S * n)
     # a column that is round-off noise on the data carries no information: leave it out
@@ -447,7 +486,9 @@ def identify(
     keep = norms > 1e-9 * norms.max()
     if not keep[nb:].all():
         idle = [nm for nm, k in zip(model.names(n), keep[nb:]) if not k]
-        raise ValueError(f"friction terms {idle} have no excitation in the data (a joint that never moves?): use friction='none' or move the joint")
+        raise ValueError(
+            f"friction terms {idle} have no excitation in the data (a joint that never moves?): use friction='none' or move the joint"
+        )
     used = keep[:nb]
     dropped = tuple(nm for nm, u in zip(base.names, used) if not u)
     W = W[:, keep]
@@ -477,21 +518,45 @@ def identify(
 
     def result(est, r, **extra) -> Identification:
         return Identification(
-            names=tuple(nm for nm, u in zip(base.names, used) if u), estimates=est[:kb], std=std[:kb], covariance=cov[:kb, :kb],
-            true_values=None if true_values is None else true_values[used], condition_number=cond, residual_rms=np.sqrt((r**2).mean(axis=0)),
-            weighted=weighted, base=base, nominal=robot, dropped=dropped, used=used,
-            friction=model, friction_names=model.names(n), friction_estimates=est[kb:], friction_std=std[kb:], noise=sig,
-            samples=S, rotor_joints=rotor_joints, data=data, **extra,
+            names=tuple(nm for nm, u in zip(base.names, used) if u),
+            estimates=est[:kb],
+            std=std[:kb],
+            covariance=cov[:kb, :kb],
+            true_values=None if true_values is None else true_values[used],
+            condition_number=cond,
+            residual_rms=np.sqrt((r**2).mean(axis=0)),
+            weighted=weighted,
+            base=base,
+            nominal=robot,
+            dropped=dropped,
+            used=used,
+            friction=model,
+            friction_names=model.names(n),
+            friction_estimates=est[kb:],
+            friction_std=std[kb:],
+            noise=sig,
+            samples=S,
+            rotor_joints=rotor_joints,
+            data=data,
+            **extra,
         )
 
     free = result(est, r)
     if not consistent:
         return free
     full = np.concatenate([Yfull.reshape(S * n, 10 * n + nr), F.reshape(S * n, nf)], axis=1)
-    standard, armature, fric = _consistent_fit(robot, full * w[:, None], yv * w, nf, rotor_joints, regularization, margin, solver)
+    standard, armature, fric = _consistent_fit(
+        robot, full * w[:, None], yv * w, nf, rotor_joints, regularization, margin, solver
+    )
     x = np.concatenate([standard, armature])
     r = (yv - full @ np.concatenate([x, fric])).reshape(S, n)
-    return result(np.concatenate([base.grouping[used] @ x, fric]), r, standard=standard, standard_armature=armature if nr else None, unconstrained=free)
+    return result(
+        np.concatenate([base.grouping[used] @ x, fric]),
+        r,
+        standard=standard,
+        standard_armature=armature if nr else None,
+        unconstrained=free,
+    )
 
 
 def pseudo_inertia(parameters: ArrayLike) -> np.ndarray:
@@ -514,7 +579,16 @@ def _pseudo_inertia_basis() -> np.ndarray:
     return np.array([pseudo_inertia(e) for e in np.eye(10)])
 
 
-def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, rotor_joints: tuple, regularization: float, margin: float, solver: Optional[str]):
+def _consistent_fit(
+    robot: Robot,
+    A: np.ndarray,
+    b: np.ndarray,
+    nf: int,
+    rotor_joints: tuple,
+    regularization: float,
+    margin: float,
+    solver: str | None,
+):
     """min |A [pi; a; f] - b|^2 + lam |[pi; a] - [pi0; a0]|^2 subject to J_k(pi) >= margin I for
     every body and the armatures a >= 0: a semidefinite program (cvxpy; Clarabel, else SCS). The data
     term enters through the R factor of A = QR, so the program's size does not grow with the number
@@ -522,7 +596,9 @@ def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, rotor_j
     try:
         import cvxpy as cp
     except ImportError:  # pragma: no cover - depends on the installation
-        raise ImportError("consistent identification needs cvxpy with Clarabel or SCS: pip install 'kinedyn[identify]'") from None
+        raise ImportError(
+            "consistent identification needs cvxpy with Clarabel or SCS: pip install 'kinedyn[identify]'"
+        ) from None
     n = robot.n
     nr = len(rotor_joints)
     m = 10 * n + nr  # inertial unknowns: link parameters, then armatures
@@ -548,7 +624,7 @@ def _consistent_fit(robot: Robot, A: np.ndarray, b: np.ndarray, nf: int, rotor_j
     solvers = [solver] if solver else [s for s in ("CLARABEL", "SCS") if s in cp.installed_solvers()]
     if not solvers:
         raise ImportError("consistent identification needs the Clarabel or SCS solver for cvxpy")
-    last: Optional[Exception] = None
+    last: Exception | None = None
     for name in solvers:
         try:
             problem.solve(solver=name)
@@ -575,8 +651,12 @@ def _with_friction(robot: Robot, model: FrictionModel, coefficients: np.ndarray)
         i = index.get(link.joint.name) if link.joint.is_moving else None
         if i is not None:
             c = dict(zip(model.terms, coefficients[i * k : (i + 1) * k]))
-            joint = dc_replace(link.joint, viscous=float(c.get("viscous", link.joint.viscous)),
-                               coulomb=float(abs(c.get("coulomb", link.joint.coulomb))), coulomb_negative=None)
+            joint = dc_replace(
+                link.joint,
+                viscous=float(c.get("viscous", link.joint.viscous)),
+                coulomb=float(abs(c.get("coulomb", link.joint.coulomb))),
+                coulomb_negative=None,
+            )
             link = Link(link.name, link.parent, joint, link.placement, link.post, link.inertia)
         links.append(link)
     with warnings.catch_warnings():
@@ -632,7 +712,9 @@ def with_inertial_parameters(robot: Robot, pi: ArrayLike) -> Robot:
             inv[:3, 3] = -post[:3, :3].T @ post[:3, 3]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                link = Link(link.name, link.parent, link.joint, link.placement, link.post, body_inertia.transformed(inv))
+                link = Link(
+                    link.name, link.parent, link.joint, link.placement, link.post, body_inertia.transformed(inv)
+                )
         elif link.name in moving_descendant:
             link = Link(link.name, link.parent, link.joint, link.placement, link.post, Inertia())
         links.append(link)
@@ -665,7 +747,9 @@ def rotor_regressor(qdd: ArrayLike, joints: tuple, n: int) -> np.ndarray:
     return out
 
 
-def base_parameters_with_rotors(robot: Robot, joints: tuple, samples: int = 200, rng=0, tol: float = 1e-9, dependence: float = 1e-7) -> BaseParameters:
+def base_parameters_with_rotors(
+    robot: Robot, joints: tuple, samples: int = 200, rng=0, tol: float = 1e-9, dependence: float = 1e-7
+) -> BaseParameters:
     """Base parameters of the link parameters and the armatures of ``joints`` together.
 
     The parameter vector is ``[pi (10 n); a (len(joints))]`` and the regressor ``[Y, R]`` with R of
@@ -718,17 +802,24 @@ class RotorEstimate:
     joint: str
     gear_ratio: float
     nominal: float
-    armature: Optional[float]
-    std: Optional[float]
+    armature: float | None
+    std: float | None
     grouped_into: tuple = ()
 
     @property
-    def rotor_inertia(self) -> Optional[float]:
+    def rotor_inertia(self) -> float | None:
         return None if self.armature is None else self.armature / self.gear_ratio**2
 
     def to_dict(self) -> dict:
-        return dict(joint=self.joint, gear_ratio=self.gear_ratio, nominal_armature=self.nominal, armature=self.armature, std=self.std,
-                    rotor_inertia=self.rotor_inertia, grouped_into=list(self.grouped_into))
+        return dict(
+            joint=self.joint,
+            gear_ratio=self.gear_ratio,
+            nominal_armature=self.nominal,
+            armature=self.armature,
+            std=self.std,
+            rotor_inertia=self.rotor_inertia,
+            grouped_into=list(self.grouped_into),
+        )
 
 
 def _with_armatures(robot: Robot, armatures: dict) -> Robot:
@@ -745,8 +836,17 @@ def _with_armatures(robot: Robot, armatures: dict) -> Robot:
         if a is not None:
             r = float(link.joint.gear_ratio)
             if a < 0:
-                raise ValueError(f"joint '{link.joint.name}': the identified armature r^2 J_m = {a:.4g} is negative (not physical; try consistent=True)")
-            link = Link(link.name, link.parent, dc_replace(link.joint, rotor_inertia=a / r**2), link.placement, link.post, link.inertia)
+                raise ValueError(
+                    f"joint '{link.joint.name}': the identified armature r^2 J_m = {a:.4g} is negative (not physical; try consistent=True)"
+                )
+            link = Link(
+                link.name,
+                link.parent,
+                dc_replace(link.joint, rotor_inertia=a / r**2),
+                link.placement,
+                link.post,
+                link.inertia,
+            )
         links.append(link)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

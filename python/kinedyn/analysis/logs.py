@@ -33,8 +33,9 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -57,12 +58,12 @@ class Log:
     #: sample rate after decimation, Hz
     rate: float
     #: low-pass cut-off in Hz (None: the log came with velocities and accelerations, not filtered)
-    cutoff: Optional[float] = None
+    cutoff: float | None = None
     decimation: int = 1
     source: str = "<data>"
     #: sign(qd) passed through the same low-pass filter as the torques (None when not filtered): the
     #: Coulomb column of the friction regressor, so that it sees the filter the torque's Coulomb part saw
-    filtered_sign: Optional[np.ndarray] = None
+    filtered_sign: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -168,13 +169,13 @@ def _lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarra
 def load_log(
     source: Any,
     *,
-    n: Optional[int] = None,
-    torque_constants: Optional[Any] = None,
-    gear_ratios: Optional[Any] = None,
-    cutoff: Optional[float] = None,
+    n: int | None = None,
+    torque_constants: Any | None = None,
+    gear_ratios: Any | None = None,
+    cutoff: float | None = None,
     order: int = 4,
-    decimate: Optional[int] = None,
-    trim: Optional[float] = None,
+    decimate: int | None = None,
+    trim: float | None = None,
 ) -> Log:
     """Read and prepare a log (CSV with a header line, NPZ, a pandas DataFrame or a dict of columns).
 
@@ -201,7 +202,7 @@ def load_log(
             raise LogError(f"{name}: column '{k}' has {np.asarray(v).shape} values, 't' has {S}")
     t = cols["t"]
 
-    def block(prefix: str, what: str, required: bool = True) -> Optional[np.ndarray]:
+    def block(prefix: str, what: str, required: bool = True) -> np.ndarray | None:
         present = [f"{prefix}{j}" for j in range(1, n + 1) if f"{prefix}{j}" in cols]
         if not present:
             if required:
@@ -218,9 +219,13 @@ def load_log(
     if tau is None:
         cur = block("i", "motor currents", required=False)
         if cur is None:
-            raise LogError(f"{name}: missing columns 'tau1'..'tau{n}' (joint torques, N m) or 'i1'..'i{n}' (motor currents, A)")
+            raise LogError(
+                f"{name}: missing columns 'tau1'..'tau{n}' (joint torques, N m) or 'i1'..'i{n}' (motor currents, A)"
+            )
         if torque_constants is None or gear_ratios is None:
-            raise LogError(f"{name}: the log has motor currents i1..i{n}: give torque_constants and gear_ratios to turn them into torques")
+            raise LogError(
+                f"{name}: the log has motor currents i1..i{n}: give torque_constants and gear_ratios to turn them into torques"
+            )
         kt = np.broadcast_to(np.asarray(torque_constants, dtype=float), (n,))
         r = np.broadcast_to(np.asarray(gear_ratios, dtype=float), (n,))
         if not (np.all(np.isfinite(kt)) and np.all(np.isfinite(r))):
@@ -235,7 +240,9 @@ def load_log(
         if bad.any():
             row, j = (int(x) for x in np.argwhere(bad)[0])
             col = label if label == "t" else f"{label}{j + 1}"
-            raise LogError(f"{name}: column '{col}' has a non-finite value (NaN or inf) at sample {row} (t index), data row {row + 1}")
+            raise LogError(
+                f"{name}: column '{col}' has a non-finite value (NaN or inf) at sample {row} (t index), data row {row + 1}"
+            )
     if S < 10:
         raise LogError(f"{name}: {S} samples are too few to identify anything")
     dt = np.diff(t)
@@ -244,7 +251,9 @@ def load_log(
         raise LogError(f"{name}: time is not increasing at sample {k + 1} (t = {t[k]:g} then {t[k + 1]:g})")
     rate = float(1.0 / np.median(dt))
     if np.max(np.abs(dt * rate - 1.0)) > 0.05:
-        raise LogError(f"{name}: the sampling is not uniform (steps from {dt.min():g} to {dt.max():g} s); resample the log first")
+        raise LogError(
+            f"{name}: the sampling is not uniform (steps from {dt.min():g} to {dt.max():g} s); resample the log first"
+        )
     if qd is not None and qdd is not None and cutoff is None:
         k = 1 if decimate is None else int(decimate)
         return Log(t[::k], q[::k], qd[::k], qdd[::k], tau[::k], rate / k, None, k, name)

@@ -27,15 +27,24 @@ and random states find no counterexample, and "failed" with the state that shows
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["Check", "PropertiesReport", "InertiaBounds", "check_properties", "global_inertia_bounds", "mass_matrix_rate", "prove_properties"]
+__all__ = [
+    "Check",
+    "PropertiesReport",
+    "InertiaBounds",
+    "check_properties",
+    "global_inertia_bounds",
+    "mass_matrix_rate",
+    "prove_properties",
+]
 
 
 #: how a check was decided: exact simplification, numbers at random states, a global optimisation, a
@@ -70,8 +79,16 @@ class Check:
         return self.status == "proved"
 
     def to_dict(self) -> dict:
-        return dict(name=self.name, passed=self.passed, status=self.status, residual=self.residual, tolerance=self.tolerance, detail=self.detail,
-                    source=self.source, **{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.data.items()})
+        return dict(
+            name=self.name,
+            passed=self.passed,
+            status=self.status,
+            residual=self.residual,
+            tolerance=self.tolerance,
+            detail=self.detail,
+            source=self.source,
+            **{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.data.items()},
+        )
 
 
 @dataclass
@@ -91,7 +108,9 @@ class PropertiesReport:
         raise KeyError(f"no check named '{name}' (checks: {[c.name for c in self.checks]})")
 
     def to_dict(self) -> dict:
-        return dict(robot=self.robot, samples=self.samples, passed=self.passed, checks=[c.to_dict() for c in self.checks])
+        return dict(
+            robot=self.robot, samples=self.samples, passed=self.passed, checks=[c.to_dict() for c in self.checks]
+        )
 
     def _repr_html_(self) -> str:  # notebooks: the checks as a table (kinedyn.display)
         from ..display import properties_html
@@ -128,13 +147,17 @@ class InertiaBounds:
     space: str = ""
 
     def describe(self) -> str:
-        box = self.space or ", ".join(("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic))
+        box = self.space or ", ".join(
+            ("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic)
+        )
         if self.starts == 0 and self.space:  # nothing to search (M constant)
             return f"lambda_min = {self.lambda_min:.8g}, lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)} ({self.space})"
-        return (f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
-                f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
-                f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
-                f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box})")
+        return (
+            f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
+            f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
+            f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
+            f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box})"
+        )
 
 
 def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
@@ -143,9 +166,17 @@ def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
     return q
 
 
-def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_matrix_gradient: Callable[[np.ndarray], np.ndarray],
-                          lower, upper, periodic=None, samples: int = 256, starts: int = 12, seed: int = 0,
-                          wrap: Optional[Callable[[np.ndarray], np.ndarray]] = None) -> InertiaBounds:
+def global_inertia_bounds(
+    mass_matrix: Callable[[np.ndarray], np.ndarray],
+    mass_matrix_gradient: Callable[[np.ndarray], np.ndarray],
+    lower,
+    upper,
+    periodic=None,
+    samples: int = 256,
+    starts: int = 12,
+    seed: int = 0,
+    wrap: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> InertiaBounds:
     """The least and greatest eigenvalue of M(q) over the box ``lower <= q <= upper`` (coordinates
     marked ``periodic`` are searched without bounds, M being 2 pi-periodic in them, and reported in
     [-pi, pi)), by a multistart local optimisation: ``samples`` uniform random configurations, then
@@ -163,8 +194,16 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
     upper = np.asarray(upper, dtype=float)
     nq = len(lower)
     periodic = np.zeros(nq, dtype=bool) if periodic is None else np.asarray(periodic, dtype=bool)
-    if upper.shape != lower.shape or periodic.shape != lower.shape or np.any(~np.isfinite(lower)) or np.any(~np.isfinite(upper)) or np.any(upper < lower):
-        raise ValueError(f"the search box must be finite with lower <= upper, one entry per coordinate: lower {lower}, upper {upper}")
+    if (
+        upper.shape != lower.shape
+        or periodic.shape != lower.shape
+        or np.any(~np.isfinite(lower))
+        or np.any(~np.isfinite(upper))
+        or np.any(upper < lower)
+    ):
+        raise ValueError(
+            f"the search box must be finite with lower <= upper, one entry per coordinate: lower {lower}, upper {upper}"
+        )
     if samples < 1 or starts < 0:
         raise ValueError(f"samples must be >= 1 and starts >= 0, got {samples} and {starts}")
     rng = np.random.default_rng(seed)
@@ -179,12 +218,20 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
             v = V[:, column]
             dM = np.asarray(mass_matrix_gradient(q), dtype=float)
             return sign * w[column], sign * np.einsum("i,kij,j->k", v, dM, v)
+
         values = sign * (lo_s if column == 0 else hi_s)
         order = np.argsort(values)
         picks = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
         best_q, best = Q[order[0]].copy(), values[order[0]]
         for k in dict.fromkeys(int(i) for i in picks):
-            res = minimize(f, Q[k], jac=True, method="TNC", bounds=bounds, options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12))
+            res = minimize(
+                f,
+                Q[k],
+                jac=True,
+                method="TNC",
+                bounds=bounds,
+                options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12),
+            )
             x = np.array(res.x, dtype=float)
             x[~periodic] = np.clip(x[~periodic], lower[~periodic], upper[~periodic])
             x = _wrap(x, periodic) if wrap is None else wrap(x)
@@ -195,7 +242,19 @@ def global_inertia_bounds(mass_matrix: Callable[[np.ndarray], np.ndarray], mass_
 
     lmin, qmin = extreme(1.0, 0)
     lmax, qmax = extreme(-1.0, -1)
-    return InertiaBounds(float(lmin), qmin, float(lmax), qmax, float(lo_s.min()), float(hi_s.max()), samples, starts, lower, upper, periodic)
+    return InertiaBounds(
+        float(lmin),
+        qmin,
+        float(lmax),
+        qmax,
+        float(lo_s.min()),
+        float(hi_s.max()),
+        samples,
+        starts,
+        lower,
+        upper,
+        periodic,
+    )
 
 
 def _joint_box(joint) -> tuple:
@@ -292,16 +351,16 @@ class _ManifoldChart:
 
         x = np.asarray(x, dtype=float)
         q = np.broadcast_to(self.neutral, x.shape[:-1] + (self.nq,)).copy()
-        for j, iq, iv, ix in self.blocks:
+        for j, iq, _iv, ix in self.blocks:
             if ix is None:
                 continue
             if j.kind == "floating":
-                q[..., iq:iq + 3] = x[..., ix:ix + 3]
-                q[..., iq + 3:iq + 7] = exp3(x[..., ix + 3:ix + 6])
+                q[..., iq : iq + 3] = x[..., ix : ix + 3]
+                q[..., iq + 3 : iq + 7] = exp3(x[..., ix + 3 : ix + 6])
             elif j.kind == "spherical":
-                q[..., iq:iq + 4] = exp3(x[..., ix:ix + 3])
+                q[..., iq : iq + 4] = exp3(x[..., ix : ix + 3])
             elif j.kind == "planar":
-                q[..., iq:iq + 2] = x[..., ix:ix + 2]
+                q[..., iq : iq + 2] = x[..., ix : ix + 2]
                 q[..., iq + 2], q[..., iq + 3] = np.cos(x[..., ix + 2]), np.sin(x[..., ix + 2])
             else:
                 q[..., iq] = x[..., ix]
@@ -313,17 +372,17 @@ class _ManifoldChart:
 
         x = np.asarray(x, dtype=float)
         T = np.zeros((self.nv, self.nx))
-        for j, iq, iv, ix in self.blocks:
+        for j, _iq, iv, ix in self.blocks:
             if ix is None:
                 continue
             if j.kind == "floating":  # ⊕ [rho; 0] moves the position by R rho; ⊕ [0; w] turns R to R Exp(w)
-                T[iv:iv + 3, ix:ix + 3] = quaternion_to_matrix(exp3(x[ix + 3:ix + 6])).T
-                T[iv + 3:iv + 6, ix + 3:ix + 6] = _right_jacobian_so3(x[ix + 3:ix + 6])
+                T[iv : iv + 3, ix : ix + 3] = quaternion_to_matrix(exp3(x[ix + 3 : ix + 6])).T
+                T[iv + 3 : iv + 6, ix + 3 : ix + 6] = _right_jacobian_so3(x[ix + 3 : ix + 6])
             elif j.kind == "spherical":
-                T[iv:iv + 3, ix:ix + 3] = _right_jacobian_so3(x[ix:ix + 3])
+                T[iv : iv + 3, ix : ix + 3] = _right_jacobian_so3(x[ix : ix + 3])
             elif j.kind == "planar":  # in SE(2): ⊕ (rho, 0) moves the position by R(theta) rho
                 c, s_ = np.cos(x[ix + 2]), np.sin(x[ix + 2])
-                T[iv:iv + 2, ix:ix + 2] = np.array([[c, s_], [-s_, c]])
+                T[iv : iv + 2, ix : ix + 2] = np.array([[c, s_], [-s_, c]])
                 T[iv + 2, ix + 2] = 1.0
             else:
                 T[iv, ix] = 1.0
@@ -332,13 +391,13 @@ class _ManifoldChart:
     def wrap(self, x) -> np.ndarray:
         """The reported representative of x: angles in [-pi, pi), rotation vectors with |r| <= pi."""
         x = np.array(x, dtype=float)
-        for j, iq, iv, ix in self.blocks:
+        for j, _iq, _iv, ix in self.blocks:
             if ix is None:
                 continue
             if j.kind == "floating":
-                x[ix + 3:ix + 6] = _shortest_rotation_vector(x[ix + 3:ix + 6])
+                x[ix + 3 : ix + 6] = _shortest_rotation_vector(x[ix + 3 : ix + 6])
             elif j.kind == "spherical":
-                x[ix:ix + 3] = _shortest_rotation_vector(x[ix:ix + 3])
+                x[ix : ix + 3] = _shortest_rotation_vector(x[ix : ix + 3])
             elif j.kind == "planar":
                 x[ix + 2] = (x[ix + 2] + np.pi) % (2 * np.pi) - np.pi
             elif self.periodic[ix]:
@@ -347,13 +406,17 @@ class _ManifoldChart:
 
     def describe(self) -> str:
         parts = []
-        for j, iq, iv, ix in self.blocks:
+        for j, _iq, _iv, ix in self.blocks:
             if ix is None:
-                parts.append(f"{j.name}: held at its identity (M does not depend on a {j.kind} joint on the fixed base)")
+                parts.append(
+                    f"{j.name}: held at its identity (M does not depend on a {j.kind} joint on the fixed base)"
+                )
             elif j.kind in ("floating", "planar"):
                 k = 3 if j.kind == "floating" else 2
-                parts.append(f"{j.name}: position in [{self.lower[ix]:.3g}, {self.upper[ix]:.3g}]^{k}, "
-                             + ("every rotation" if j.kind == "floating" else "every angle"))
+                parts.append(
+                    f"{j.name}: position in [{self.lower[ix]:.3g}, {self.upper[ix]:.3g}]^{k}, "
+                    + ("every rotation" if j.kind == "floating" else "every angle")
+                )
             elif j.kind == "spherical":
                 parts.append(f"{j.name}: every rotation")
             elif self.periodic[ix]:
@@ -362,8 +425,10 @@ class _ManifoldChart:
                 parts.append(f"{j.name}: [{self.lower[ix]:.3g}, {self.upper[ix]:.3g}]")
         if self.nx == 0:
             return "; ".join(parts)
-        return ("; ".join(parts) + " (searched in coordinates of the manifold: positions, rotation vectors, angles; "
-                "the configurations above are q, quaternions (x, y, z, w))")
+        return (
+            "; ".join(parts) + " (searched in coordinates of the manifold: positions, rotation vectors, angles; "
+            "the configurations above are q, quaternions (x, y, z, w))"
+        )
 
 
 def _inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> InertiaBounds:
@@ -378,19 +443,42 @@ def _inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> Inert
 
     if not robot.has_multi_dof_joints:
         box_lo, box_hi, periodic = _configuration_box(robot)
-        return global_inertia_bounds(robot.mass_matrix, tangent_dM, box_lo, box_hi, periodic, samples=samples, starts=starts, seed=seed)
+        return global_inertia_bounds(
+            robot.mass_matrix, tangent_dM, box_lo, box_hi, periodic, samples=samples, starts=starts, seed=seed
+        )
     chart = _ManifoldChart(robot)
     if chart.nx == 0:  # a floating body alone (a drone): M is one constant matrix
         q0 = chart.neutral
         eig = np.linalg.eigvalsh(robot.mass_matrix(q0))
-        return InertiaBounds(float(eig[0]), q0, float(eig[-1]), q0, float(eig[0]), float(eig[-1]), 1, 0, chart.lower, chart.upper, chart.periodic,
-                             space=chart.describe() + ": M is constant, its extreme eigenvalues are the bounds")
+        return InertiaBounds(
+            float(eig[0]),
+            q0,
+            float(eig[-1]),
+            q0,
+            float(eig[0]),
+            float(eig[-1]),
+            1,
+            0,
+            chart.lower,
+            chart.upper,
+            chart.periodic,
+            space=chart.describe() + ": M is constant, its extreme eigenvalues are the bounds",
+        )
 
     def dM_dx(x):
         return np.einsum("jk,jab->kab", chart.tangent(x), tangent_dM(chart.configuration(x)))
 
-    b = global_inertia_bounds(lambda x: robot.mass_matrix(chart.configuration(x)), dM_dx, chart.lower, chart.upper, chart.periodic,
-                              samples=samples, starts=starts, seed=seed, wrap=chart.wrap)
+    b = global_inertia_bounds(
+        lambda x: robot.mass_matrix(chart.configuration(x)),
+        dM_dx,
+        chart.lower,
+        chart.upper,
+        chart.periodic,
+        samples=samples,
+        starts=starts,
+        seed=seed,
+        wrap=chart.wrap,
+    )
     b.q_lambda_min = chart.configuration(b.q_lambda_min)
     b.q_lambda_max = chart.configuration(b.q_lambda_max)
     b.space = chart.describe()
@@ -436,7 +524,9 @@ def mass_matrix_rate(robot: Robot, q, qd, h: float = 1e-6) -> np.ndarray:
     return (robot.mass_matrix(robot.integrate(q, qd, h)) - robot.mass_matrix(robot.integrate(q, qd, -h))) / (2 * h)
 
 
-def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6) -> PropertiesReport:
+def check_properties(
+    robot: Robot, samples: int = 200, seed: int = 0, T: float = 2.0, dt: float = 1e-3, h: float = 1e-6
+) -> PropertiesReport:
     """Measure every property on ``samples`` random states (seeded) and one simulated trajectory of
     ``T`` seconds (RK4, step ``dt``, PD + gravity compensation towards a random set point, gains
     ``Kp = wn^2 m_i``, ``Kd = 2 wn m_i`` with wn = 5 rad/s and m_i the least M_ii over the goal and 64
@@ -456,21 +546,42 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     sym = float(np.abs(M - np.swapaxes(M, 1, 2)).max() / scale)
     eig = np.linalg.eigvalsh(M)
     lo = eig[:, 0]
-    checks.append(Check(
-        "M symmetric positive definite", bool(sym <= 1e-12 and lo.min() > 0), sym, 1e-12,
-        f"max |M - M^T| / max |M| = {sym:.2g}; smallest eigenvalue {lo.min():.6g} > 0", "Spong eq. 9.42",
-        dict(min_eigenvalue=float(lo.min())), status="sampled",
-    ))
+    checks.append(
+        Check(
+            "M symmetric positive definite",
+            bool(sym <= 1e-12 and lo.min() > 0),
+            sym,
+            1e-12,
+            f"max |M - M^T| / max |M| = {sym:.2g}; smallest eigenvalue {lo.min():.6g} > 0",
+            "Spong eq. 9.42",
+            dict(min_eigenvalue=float(lo.min())),
+            status="sampled",
+        )
+    )
     # inertia bounds: a global search over the configurations (on the manifold with multi-DOF joints)
     b = _inertia_bounds(robot, samples=max(samples, 64), starts=8, seed=seed)
-    checks.append(Check(
-        "inertia bounds lambda_min I <= M(q) <= lambda_max I", bool(b.lambda_min > 0), float(max(0.0, -b.lambda_min)), 0.0,
-        b.describe() + f"; condition number <= {b.lambda_max / b.lambda_min:.4g}" if b.lambda_min > 0 else b.describe(),
-        "Spong eqs. 9.119-9.120",
-        dict(lambda_min=b.lambda_min, lambda_max=b.lambda_max, q_lambda_min=b.q_lambda_min, q_lambda_max=b.q_lambda_max,
-             sampled_min=b.sampled_min, sampled_max=b.sampled_max, condition_number=float(b.lambda_max / b.lambda_min) if b.lambda_min > 0 else float("inf")),
-        status="searched",
-    ))
+    checks.append(
+        Check(
+            "inertia bounds lambda_min I <= M(q) <= lambda_max I",
+            bool(b.lambda_min > 0),
+            float(max(0.0, -b.lambda_min)),
+            0.0,
+            b.describe() + f"; condition number <= {b.lambda_max / b.lambda_min:.4g}"
+            if b.lambda_min > 0
+            else b.describe(),
+            "Spong eqs. 9.119-9.120",
+            dict(
+                lambda_min=b.lambda_min,
+                lambda_max=b.lambda_max,
+                q_lambda_min=b.q_lambda_min,
+                q_lambda_max=b.q_lambda_max,
+                sampled_min=b.sampled_min,
+                sampled_max=b.sampled_max,
+                condition_number=float(b.lambda_max / b.lambda_min) if b.lambda_min > 0 else float("inf"),
+            ),
+            status="searched",
+        )
+    )
 
     # dM/dt - 2C skew, dM/dt == C + C^T (central differences along qd, on the manifold: q ⊕ t qd)
     C = robot.coriolis_matrix(Q, QD)
@@ -480,24 +591,46 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     skew = float(np.abs(N + np.swapaxes(N, 1, 2)).max() / ref)
     cct = float(np.abs(Mdot - C - np.swapaxes(C, 1, 2)).max() / ref)
     tol_fd = 1e-6
-    checks.append(Check(
-        "dM/dt - 2C skew-symmetric", bool(skew <= tol_fd), skew, tol_fd,
-        f"max |N + N^T| / max(1, |dM/dt|) with N = dM/dt - 2C, dM/dt by central differences (h = {h:g})"
-        + (" along q ⊕ t qd (robot.integrate: quaternions turned by Exp, not added to)" if robot.has_multi_dof_joints else ""), "Spong Prop. 9.1, eq. 9.109",
-        status="sampled",
-    ))
-    checks.append(Check(
-        "dM/dt == C + C^T", bool(cct <= tol_fd), cct, tol_fd, "max |dM/dt - C - C^T| / max(1, |dM/dt|)", "Spong eq. 9.110",
-    ))
+    checks.append(
+        Check(
+            "dM/dt - 2C skew-symmetric",
+            bool(skew <= tol_fd),
+            skew,
+            tol_fd,
+            f"max |N + N^T| / max(1, |dM/dt|) with N = dM/dt - 2C, dM/dt by central differences (h = {h:g})"
+            + (
+                " along q ⊕ t qd (robot.integrate: quaternions turned by Exp, not added to)"
+                if robot.has_multi_dof_joints
+                else ""
+            ),
+            "Spong Prop. 9.1, eq. 9.109",
+            status="sampled",
+        )
+    )
+    checks.append(
+        Check(
+            "dM/dt == C + C^T",
+            bool(cct <= tol_fd),
+            cct,
+            tol_fd,
+            "max |dM/dt - C - C^T| / max(1, |dM/dt|)",
+            "Spong eq. 9.110",
+        )
+    )
     # neither identity sees a transposed C; the velocity product does
     cqd = np.einsum("skj,sj->sk", C, QD)
     h_minus_g = robot.bias_torque(Q, QD) - robot.gravity_torque(Q)
     cq = float(np.abs(cqd - h_minus_g).max() / max(1.0, float(np.abs(h_minus_g).max())))
-    checks.append(Check(
-        "C(q, qd) qd == Coriolis/centrifugal torque", bool(cq <= 1e-10), cq, 1e-10,
-        "max |C qd - (rnea(q, qd, 0) - g)| / max(1, |.|): C is the Christoffel matrix of these dynamics (a transposed C passes the two identities above)",
-        "Spong eqs. 9.58-9.62",
-    ))
+    checks.append(
+        Check(
+            "C(q, qd) qd == Coriolis/centrifugal torque",
+            bool(cq <= 1e-10),
+            cq,
+            1e-10,
+            "max |C qd - (rnea(q, qd, 0) - g)| / max(1, |.|): C is the Christoffel matrix of these dynamics (a transposed C passes the two identities above)",
+            "Spong eqs. 9.58-9.62",
+        )
+    )
 
     # linearity in the parameters
     tau = robot.inverse_dynamics(Q, QD, QDD)
@@ -505,16 +638,24 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     pi = robot.inertial_parameters()
     rigid = tau - robot.armature * QDD - robot.friction_torque(QD)
     lin = float(np.abs(np.einsum("skp,p->sk", Y, pi) - rigid).max() / max(1.0, float(np.abs(rigid).max())))
-    checks.append(Check(
-        "linearity in the parameters Y pi == tau", bool(lin <= 1e-10), lin, 1e-10,
-        f"max |Y pi - tau_rigid| / max(1, |tau|) over {samples} states; Y is {n} x {10 * n}", "Spong §9.5.3, eq. 9.121",
-    ))
+    checks.append(
+        Check(
+            "linearity in the parameters Y pi == tau",
+            bool(lin <= 1e-10),
+            lin,
+            1e-10,
+            f"max |Y pi - tau_rigid| / max(1, |tau|) over {samples} states; Y is {n} x {10 * n}",
+            "Spong §9.5.3, eq. 9.121",
+        )
+    )
 
     # passivity / energy balance along a simulated trajectory, from a stream of its own: the
     # trajectory depends on the seed only, not on how many samples were drawn above
     rng_trajectory = np.random.default_rng([seed, 1])
     goal = robot.random_configuration(rng_trajectory)
-    x0 = np.concatenate([robot.random_configuration(rng_trajectory), rng_trajectory.uniform(-1.0, 1.0, n)])  # q (nq), qd (nv)
+    x0 = np.concatenate(
+        [robot.random_configuration(rng_trajectory), rng_trajectory.uniform(-1.0, 1.0, n)]
+    )  # q (nq), qd (nv)
     # gains from the smallest inertia each joint shows (at the goal and 64 seeded configurations): each
     # joint's loop at most a critically damped 5 rad/s one, so a configuration where an axis carries
     # little inertia (elbow_3r upright) does not make the loop too stiff for RK4 at dt
@@ -530,26 +671,43 @@ def check_properties(robot: Robot, samples: int = 200, seed: int = 0, T: float =
     step = dt
     for refinement in range(3):
         try:
-            if robot.has_multi_dof_joints:  # PD on the 1-DOF joints only (q and qd do not line up); RK4 as the detail says
-                traj = simulate(robot, T, x0, controller=_joint_pd_gravity(robot, wn**2 * d, 2 * wn * d, goal), dt=step, method="rk4")
+            if (
+                robot.has_multi_dof_joints
+            ):  # PD on the 1-DOF joints only (q and qd do not line up); RK4 as the detail says
+                traj = simulate(
+                    robot,
+                    T,
+                    x0,
+                    controller=_joint_pd_gravity(robot, wn**2 * d, 2 * wn * d, goal),
+                    dt=step,
+                    method="rk4",
+                )
             else:
                 traj = simulate(robot, T, x0, controller=PDGravity(robot, wn**2 * d, 2 * wn * d, goal), dt=step)
         except (SimulationError, RuntimeError, np.linalg.LinAlgError) as e:
-            checks.append(Check(name, False, float("inf"), 0.0, f"the simulation failed: {e}", "Spong eqs. 9.113-9.117"))
+            checks.append(
+                Check(name, False, float("inf"), 0.0, f"the simulation failed: {e}", "Spong eqs. 9.113-9.117")
+            )
             return PropertiesReport(robot.name, samples, checks)
         bal = traj.energy_balance()
         if bal["relative"] <= tol_p or refinement == 2:
             break
         step /= 2
     dt = step
-    checks.append(Check(
-        name, bool(bal["relative"] <= tol_p), bal["relative"], tol_p,
-        f"{T:g} s of RK4 at dt = {dt:g} s under PD + gravity compensation: work {bal['work'][-1]:.6g} J, dH {bal['dH'][-1]:.6g} J, "
-        f"friction {bal['dissipated'][-1]:.6g} J" + ("; Coulomb friction's sign switches limit the quadrature" if coulomb else ""),
-        "Spong eqs. 9.113-9.117",
-        dict(work=float(bal["work"][-1]), dH=float(bal["dH"][-1]), dissipated=float(bal["dissipated"][-1])),
-        status="simulated",
-    ))
+    checks.append(
+        Check(
+            name,
+            bool(bal["relative"] <= tol_p),
+            bal["relative"],
+            tol_p,
+            f"{T:g} s of RK4 at dt = {dt:g} s under PD + gravity compensation: work {bal['work'][-1]:.6g} J, dH {bal['dH'][-1]:.6g} J, "
+            f"friction {bal['dissipated'][-1]:.6g} J"
+            + ("; Coulomb friction's sign switches limit the quadrature" if coulomb else ""),
+            "Spong eqs. 9.113-9.117",
+            dict(work=float(bal["work"][-1]), dH=float(bal["dH"][-1]), dissipated=float(bal["dissipated"][-1])),
+            status="simulated",
+        )
+    )
     return PropertiesReport(robot.name, samples, checks)
 
 
@@ -579,8 +737,10 @@ def _trig_normal_form(expr, coordinates):
     num, _ = sp.fraction(sp.together(e))
     num = sp.expand(num)
     for s_k, c_k in pyth:
-        num = num.replace(lambda x, s_k=s_k: x.is_Pow and x.base == s_k and x.exp.is_Integer and x.exp >= 2,
-                          lambda x, s_k=s_k, c_k=c_k: s_k ** (int(x.exp) % 2) * (1 - c_k**2) ** (int(x.exp) // 2))
+        num = num.replace(
+            lambda x, s_k=s_k: x.is_Pow and x.base == s_k and x.exp.is_Integer and x.exp >= 2,
+            lambda x, s_k=s_k, c_k=c_k: s_k ** (int(x.exp) % 2) * (1 - c_k**2) ** (int(x.exp) // 2),
+        )
     return sp.expand(num)
 
 
@@ -607,7 +767,9 @@ def _decide_zero(entries, coordinates, variables, rng, tries: int = 12):
     return "sampled", worst, None
 
 
-def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: int = 12, seed: int = 0) -> PropertiesReport:
+def prove_properties(
+    eom, params=None, limits=None, samples: int = 256, starts: int = 12, seed: int = 0
+) -> PropertiesReport:
     """The properties of Spong §9.5 for a symbolic :class:`kinedyn.symbolic.EquationsOfMotion`
     (``eom.check_properties()``), each decided exactly where it can be:
 
@@ -639,21 +801,47 @@ def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: 
 
     def decided(name, entries, source, what):
         status, residual, witness = _decide_zero(entries, q, variables, rng)
-        how = {"proved": "reduces to 0 exactly (sin/cos of sums expanded, reduced modulo sin^2 + cos^2 = 1)",
-               "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)"
-                          + ("; the model holds floating-point numbers (e.g. cos of a DH twist of pi/2 rounded), whose rounding "
-                             "leaves a residue exact cancellation cannot remove: exact (rational or symbolic) parameters can be proved" if floating else ""),
-               "failed": f"not zero: |{what}| = {residual:.3g} at {witness}"}[status]
-        checks.append(Check(name, status != "failed", residual, 0.0 if status == "proved" else 1e-9, f"{what}: {how}", source,
-                            dict(witness=witness) if witness else {}, status=status))
+        how = {
+            "proved": "reduces to 0 exactly (sin/cos of sums expanded, reduced modulo sin^2 + cos^2 = 1)",
+            "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)"
+            + (
+                "; the model holds floating-point numbers (e.g. cos of a DH twist of pi/2 rounded), whose rounding "
+                "leaves a residue exact cancellation cannot remove: exact (rational or symbolic) parameters can be proved"
+                if floating
+                else ""
+            ),
+            "failed": f"not zero: |{what}| = {residual:.3g} at {witness}",
+        }[status]
+        checks.append(
+            Check(
+                name,
+                status != "failed",
+                residual,
+                0.0 if status == "proved" else 1e-9,
+                f"{what}: {how}",
+                source,
+                dict(witness=witness) if witness else {},
+                status=status,
+            )
+        )
 
     decided("D symmetric", [D[i, j] - D[j, i] for i in range(n) for j in range(i + 1, n)], "Spong eq. 9.50", "D - D^T")
     Ddot = sp.zeros(n, n)
     for qi, vi in zip(q, qd):
         Ddot += D.diff(qi) * vi
     N = Ddot - 2 * C
-    decided("dD/dt - 2C skew-symmetric", [N[i, j] + N[j, i] for i in range(n) for j in range(i, n)], "Spong Prop. 9.1, eqs. 9.109-9.111", "N + N^T")
-    decided("dD/dt == C + C^T", [Ddot[i, j] - C[i, j] - C[j, i] for i in range(n) for j in range(i, n)], "Spong eq. 9.110", "dD/dt - C - C^T")
+    decided(
+        "dD/dt - 2C skew-symmetric",
+        [N[i, j] + N[j, i] for i in range(n) for j in range(i, n)],
+        "Spong Prop. 9.1, eqs. 9.109-9.111",
+        "N + N^T",
+    )
+    decided(
+        "dD/dt == C + C^T",
+        [Ddot[i, j] - C[i, j] - C[j, i] for i in range(n) for j in range(i, n)],
+        "Spong eq. 9.110",
+        "dD/dt - C - C^T",
+    )
     P = eom.P
     if P is not None:
         L = eom.K - P
@@ -663,25 +851,52 @@ def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: 
             ddt = sum(sp.diff(p_k, a) * b for a, b in zip(q + qd, qd + list(eom.qdd)))
             lhs.append(ddt - sp.diff(L, q[k]))
         rigid = D * eom.qdd + C * sp.Matrix(qd) + g
-        decided("D qdd + C qd + g == d/dt dL/dqd - dL/dq", [rigid[k] - lhs[k] for k in range(n)], "Spong eqs. 9.52-9.61",
-                "D qdd + C qd + g - (d/dt dL/dqd - dL/dq)")
+        decided(
+            "D qdd + C qd + g == d/dt dL/dqd - dL/dq",
+            [rigid[k] - lhs[k] for k in range(n)],
+            "Spong eqs. 9.52-9.61",
+            "D qdd + C qd + g - (d/dt dL/dqd - dL/dq)",
+        )
     else:
-        checks.append(Check("D qdd + C qd + g == d/dt dL/dqd - dL/dq", True, 0.0, 0.0, "no potential energy P in this model (not a natural system)",
-                            "Spong eqs. 9.52-9.61", status="skipped"))
+        checks.append(
+            Check(
+                "D qdd + C qd + g == d/dt dL/dqd - dL/dq",
+                True,
+                0.0,
+                0.0,
+                "no potential energy P in this model (not a natural system)",
+                "Spong eqs. 9.52-9.61",
+                status="skipped",
+            )
+        )
 
     # inertia bounds by a global search
     name = "inertia bounds lambda_min I <= D(q) <= lambda_max I"
     Dn = D.xreplace(by_name(params, eom.parameters)) if params else D
     free = sorted(Dn.free_symbols - set(q), key=str)
     if free:
-        checks.append(Check(name, True, 0.0, 0.0, f"D has free parameters {', '.join(map(str, free))}: give their values in params= to search the bounds",
-                            "Spong eqs. 9.119-9.120", status="skipped"))
+        checks.append(
+            Check(
+                name,
+                True,
+                0.0,
+                0.0,
+                f"D has free parameters {', '.join(map(str, free))}: give their values in params= to search the bounds",
+                "Spong eqs. 9.119-9.120",
+                status="skipped",
+            )
+        )
         return PropertiesReport(eom.name or "equations of motion", samples, checks)
     limits = by_name(limits, q) if limits else {}
     # 2 pi-periodic: only inside sines and cosines, with integer multiples (a mimic follower's cos(3 q/2) is not)
     angles = [sp.expand(f.args[0]) for f in Dn.atoms(sp.sin, sp.cos)]
-    periodic = np.array([not Dn.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1)).has(c)
-                         and all(a.coeff(c).is_integer for a in angles) for c in q])
+    periodic = np.array(
+        [
+            not Dn.replace(lambda x: isinstance(x, (sp.sin, sp.cos)), lambda x: sp.Integer(1)).has(c)
+            and all(a.coeff(c).is_integer for a in angles)
+            for c in q
+        ]
+    )
     lower = np.array([-np.pi if p else float(limits.get(c, (-1.0, 1.0))[0]) for c, p in zip(q, periodic)])
     upper = np.array([np.pi if p else float(limits.get(c, (-1.0, 1.0))[1]) for c, p in zip(q, periodic)])
     f_D = sp.lambdify([q], Dn, "numpy")
@@ -693,9 +908,33 @@ def prove_properties(eom, params=None, limits=None, samples: int = 256, starts: 
             return np.array([np.asarray(f_D(row), dtype=float) for row in x])
         return np.asarray(f_D(x), dtype=float)
 
-    b = global_inertia_bounds(mass_matrix, lambda x: np.asarray(f_dD(np.asarray(x, dtype=float)), dtype=float), lower, upper, periodic,
-                              samples=samples, starts=starts, seed=seed)
-    checks.append(Check(name, bool(b.lambda_min > 0), float(max(0.0, -b.lambda_min)), 0.0, b.describe(), "Spong eqs. 9.119-9.120",
-                        dict(lambda_min=b.lambda_min, lambda_max=b.lambda_max, q_lambda_min=b.q_lambda_min, q_lambda_max=b.q_lambda_max,
-                             sampled_min=b.sampled_min, sampled_max=b.sampled_max), status="searched"))
+    b = global_inertia_bounds(
+        mass_matrix,
+        lambda x: np.asarray(f_dD(np.asarray(x, dtype=float)), dtype=float),
+        lower,
+        upper,
+        periodic,
+        samples=samples,
+        starts=starts,
+        seed=seed,
+    )
+    checks.append(
+        Check(
+            name,
+            bool(b.lambda_min > 0),
+            float(max(0.0, -b.lambda_min)),
+            0.0,
+            b.describe(),
+            "Spong eqs. 9.119-9.120",
+            dict(
+                lambda_min=b.lambda_min,
+                lambda_max=b.lambda_max,
+                q_lambda_min=b.q_lambda_min,
+                q_lambda_max=b.q_lambda_max,
+                sampled_min=b.sampled_min,
+                sampled_max=b.sampled_max,
+            ),
+            status="searched",
+        )
+    )
     return PropertiesReport(eom.name or "equations of motion", samples, checks)

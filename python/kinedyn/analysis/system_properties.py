@@ -28,7 +28,8 @@ the motion stays on the manifold (|g_c(q)| and |A qd| along the trajectory).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable, Optional
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
@@ -60,27 +61,59 @@ def _exact_checks(system, eom) -> list:
     checks = []
     M = eom.M
     asym = _nonzero([M[i, j] - M[j, i] for i in range(n) for j in range(i + 1, n)], simp)
-    checks.append(Check("M symmetric (exact)", not asym, float(len(asym)), 0.0,
-                        "M = d2L/dqd2; every M_ij - M_ji simplified to 0" if not asym else f"M_ij - M_ji not zero: {asym[:2]}", "Spong eq. 9.42"))
+    checks.append(
+        Check(
+            "M symmetric (exact)",
+            not asym,
+            float(len(asym)),
+            0.0,
+            "M = d2L/dqd2; every M_ij - M_ji simplified to 0" if not asym else f"M_ij - M_ji not zero: {asym[:2]}",
+            "Spong eq. 9.42",
+        )
+    )
     if not eom.extra.get("natural", True):
         return checks
     qd = list(eom.qd)
     Mdot = sp.Matrix(n, n, lambda i, j: sum(sp.diff(M[i, j], c) * v for c, v in zip(eom.q, qd)))
     N = Mdot - 2 * eom.C
     skew = _nonzero([N[i, j] + N[j, i] for i in range(n) for j in range(i, n)], simp)
-    checks.append(Check("dM/dt - 2C skew-symmetric (exact)", not skew, float(len(skew)), 0.0,
-                        "N = dM/dt - 2C, every N_ij + N_ji simplified to 0" if not skew else f"N + N^T not zero: {skew[:2]}",
-                        "Spong Prop. 9.1, eq. 9.109"))
+    checks.append(
+        Check(
+            "dM/dt - 2C skew-symmetric (exact)",
+            not skew,
+            float(len(skew)),
+            0.0,
+            "N = dM/dt - 2C, every N_ij + N_ji simplified to 0" if not skew else f"N + N^T not zero: {skew[:2]}",
+            "Spong Prop. 9.1, eq. 9.109",
+        )
+    )
     cct = _nonzero(list(Mdot - eom.C - eom.C.T), simp)
-    checks.append(Check("dM/dt == C + C^T (exact)", not cct, float(len(cct)), 0.0,
-                        "every entry of dM/dt - C - C^T simplified to 0" if not cct else f"not zero: {cct[:2]}", "Spong eq. 9.110"))
+    checks.append(
+        Check(
+            "dM/dt == C + C^T (exact)",
+            not cct,
+            float(len(cct)),
+            0.0,
+            "every entry of dM/dt - C - C^T simplified to 0" if not cct else f"not zero: {cct[:2]}",
+            "Spong eq. 9.110",
+        )
+    )
     bias = eom.extra.get("bias")
     if bias is None:
         bias = sp.Matrix([e.subs({a: 0 for a in system.qdd}) for e in system.euler_lagrange()])
     cq = _nonzero(list(eom.C * eom.qd + eom.g - bias), simp)
-    checks.append(Check("C qd + g == Euler-Lagrange bias (exact)", not cq, float(len(cq)), 0.0,
-                        "C qd + g - (d/dt dL/dqd - dL/dq)|qdd=0 simplified to 0 (a transposed C fails here)" if not cq else f"not zero: {cq[:2]}",
-                        "Spong eqs. 9.58-9.62"))
+    checks.append(
+        Check(
+            "C qd + g == Euler-Lagrange bias (exact)",
+            not cq,
+            float(len(cq)),
+            0.0,
+            "C qd + g - (d/dt dL/dqd - dL/dq)|qdd=0 simplified to 0 (a transposed C fails here)"
+            if not cq
+            else f"not zero: {cq[:2]}",
+            "Spong eqs. 9.58-9.62",
+        )
+    )
     return checks
 
 
@@ -100,8 +133,15 @@ def _on_manifold(q, qd, A_fn, phi_fn, k_h):
     return q, qd
 
 
-def check_system_properties(system: "LagrangianSystem", params: Optional[dict] = None, samples: int = 50, seed: int = 0, T: float = 2.0,
-                            exact_only: bool = False, tolerance: float = 1e-6) -> PropertiesReport:
+def check_system_properties(
+    system: LagrangianSystem,
+    params: dict | None = None,
+    samples: int = 50,
+    seed: int = 0,
+    T: float = 2.0,
+    exact_only: bool = False,
+    tolerance: float = 1e-6,
+) -> PropertiesReport:
     """Prove and measure the properties of a Lagrangian system (see the module docstring).
 
     ``params``: parameter values by name (needed for the numeric checks unless ``exact_only``);
@@ -119,7 +159,9 @@ def check_system_properties(system: "LagrangianSystem", params: Optional[dict] =
     exprs = [system.L, *system.B, *system.A, *system.holonomic]
     missing = sorted({str(s) for e in exprs for s in sp.sympify(e).free_symbols - state if str(s) not in values})
     if missing:
-        raise ValueError(f"check_system_properties: give values for the parameters {missing} (params={{'name': value}}), or exact_only=True")
+        raise ValueError(
+            f"check_system_properties: give values for the parameters {missing} (params={{'name': value}}), or exact_only=True"
+        )
     sub = lambda e: sp.sympify(e).xreplace({s: values[str(s)] for s in sp.sympify(e).free_symbols if str(s) in values})
     n = system.n
     q_sym, qd_sym = list(system.q), list(system.qd)
@@ -131,9 +173,17 @@ def check_system_properties(system: "LagrangianSystem", params: Optional[dict] =
     QD = rng.normal(size=(samples, n))
     eig = np.array([np.linalg.eigvalsh(np.asarray(M_fn(q, v), dtype=float).reshape(n, n))[0] for q, v in zip(Q, QD)])
     worst = int(np.argmin(eig))
-    checks.append(Check("M positive definite (sampled)", bool(eig.min() > 0), float(max(0.0, -eig.min())), 0.0,
-                        f"smallest eigenvalue {eig.min():.6g} over {samples} random states (at q = {np.array2string(Q[worst], precision=3)})",
-                        "Spong eq. 9.42", dict(min_eigenvalue=float(eig.min()))))
+    checks.append(
+        Check(
+            "M positive definite (sampled)",
+            bool(eig.min() > 0),
+            float(max(0.0, -eig.min())),
+            0.0,
+            f"smallest eigenvalue {eig.min():.6g} over {samples} random states (at q = {np.array2string(Q[worst], precision=3)})",
+            "Spong eq. 9.42",
+            dict(min_eigenvalue=float(eig.min())),
+        )
+    )
 
     # passivity along a trajectory under smooth random forces
     t = system.t
@@ -153,7 +203,7 @@ def check_system_properties(system: "LagrangianSystem", params: Optional[dict] =
         q0, qd0 = _on_manifold(q0, qd0, A_fn, phi_fn, k_h)
 
     def rhs(time, y):
-        q, qd = y[:n], y[n:2 * n]
+        q, qd = y[:n], y[n : 2 * n]
         qdd, lam = accelerations(time, q, qd)
         work = float(qd @ np.asarray(u_fn(time), dtype=float))
         dissipated = float(qd @ np.asarray(B_fn(q, qd), dtype=float).reshape(n))
@@ -164,29 +214,59 @@ def check_system_properties(system: "LagrangianSystem", params: Optional[dict] =
     try:
         sol = solve_ivp(rhs, (0.0, T), np.concatenate([q0, qd0, [0.0, 0.0, 0.0]]), rtol=1e-10, atol=1e-12)
     except ValueError as err:  # a singular configuration met along the way
-        checks.append(Check(name, False, float("inf"), tolerance, f"the simulation failed: {err}", "Spong eqs. 9.113-9.117"))
+        checks.append(
+            Check(name, False, float("inf"), tolerance, f"the simulation failed: {err}", "Spong eqs. 9.113-9.117")
+        )
         return PropertiesReport(system.name or "Lagrangian system", samples, checks)
     if not sol.success:
-        checks.append(Check(name, False, float("inf"), tolerance, f"the simulation failed: {sol.message}", "Spong eqs. 9.113-9.117"))
+        checks.append(
+            Check(
+                name, False, float("inf"), tolerance, f"the simulation failed: {sol.message}", "Spong eqs. 9.113-9.117"
+            )
+        )
         return PropertiesReport(system.name or "Lagrangian system", samples, checks)
     yT = sol.y[:, -1]
-    H0, HT = float(H_fn(q0, qd0)), float(H_fn(yT[:n], yT[n:2 * n]))
-    work, dissipated, constraint_work = yT[2 * n:]
+    H0, HT = float(H_fn(q0, qd0)), float(H_fn(yT[:n], yT[n : 2 * n]))
+    work, dissipated, constraint_work = yT[2 * n :]
     scale = max(1.0, abs(work), abs(H0), abs(HT), abs(dissipated))
     residual = abs(work - (HT - H0) - dissipated) / scale
-    checks.append(Check(name, bool(residual <= tolerance), float(residual), tolerance,
-                        f"{T:g} s under u = a sin(w t + phi): work {work:.6g}, dH {HT - H0:.6g}, dissipated {dissipated:.6g} (solve_ivp, rtol 1e-10)",
-                        "Spong eqs. 9.113-9.117", dict(work=float(work), dH=HT - H0, dissipated=float(dissipated))))
+    checks.append(
+        Check(
+            name,
+            bool(residual <= tolerance),
+            float(residual),
+            tolerance,
+            f"{T:g} s under u = a sin(w t + phi): work {work:.6g}, dH {HT - H0:.6g}, dissipated {dissipated:.6g} (solve_ivp, rtol 1e-10)",
+            "Spong eqs. 9.113-9.117",
+            dict(work=float(work), dH=HT - H0, dissipated=float(dissipated)),
+        )
+    )
     if k:
         cw = abs(constraint_work) / scale
-        checks.append(Check("constraint forces do no work: int qd . A^T lambda dt == 0", bool(cw <= tolerance), float(cw), tolerance,
-                            f"|int qd . A^T lambda dt| = {abs(constraint_work):.3g} (A qd = 0 along the motion)", "LaValle §13.4.3 (d'Alembert)"))
+        checks.append(
+            Check(
+                "constraint forces do no work: int qd . A^T lambda dt == 0",
+                bool(cw <= tolerance),
+                float(cw),
+                tolerance,
+                f"|int qd . A^T lambda dt| = {abs(constraint_work):.3g} (A qd = 0 along the motion)",
+                "LaValle §13.4.3 (d'Alembert)",
+            )
+        )
         drift = 0.0
         for y in sol.y.T:
-            q, qd = y[:n], y[n:2 * n]
+            q, qd = y[:n], y[n : 2 * n]
             drift = max(drift, float(np.abs(np.atleast_2d(A_fn(q)) @ qd).max()))
             if k_h:
                 drift = max(drift, float(np.abs(np.atleast_1d(phi_fn(q))).max()))
-        checks.append(Check("motion stays on the constraint manifold", bool(drift <= tolerance), drift, tolerance,
-                            "max over the trajectory of |g_c(q)| and |A(q) qd| (no Baumgarte stabilisation)", "LaValle eqs. 13.170-13.171"))
+        checks.append(
+            Check(
+                "motion stays on the constraint manifold",
+                bool(drift <= tolerance),
+                drift,
+                tolerance,
+                "max over the trajectory of |g_c(q)| and |A(q) qd| (no Baumgarte stabilisation)",
+                "LaValle eqs. 13.170-13.171",
+            )
+        )
     return PropertiesReport(system.name or "Lagrangian system", samples, checks)

@@ -8,13 +8,16 @@ ValueError naming the file and line. The work is linear in the size of the text.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Callable, Union
+from collections.abc import Callable
+from typing import Union
 from xml.parsers import expat
 
 __all__ = ["parse_bounded"]
 
 
-def parse_bounded(data: Union[str, bytes], label: str, kind: str, max_depth: int, record: Callable[[ET.Element, int], None]) -> ET.Element:
+def parse_bounded(
+    data: Union[str, bytes], label: str, kind: str, max_depth: int, record: Callable[[ET.Element, int], None]
+) -> ET.Element:
     """The root element of ``data`` (bytes: expat honours the encoding declaration). ``label`` names
     the source in errors, ``kind`` the format ("a URDF", "an MJCF model"); ``record(element, line)``
     is called for every element as it starts (the callers keep the lines for their messages)."""
@@ -42,7 +45,9 @@ def parse_bounded(data: Union[str, bytes], label: str, kind: str, max_depth: int
             )
 
     def entity(name, *args):
-        raise ValueError(f"{label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in {kind}")
+        raise ValueError(
+            f"{label}:{parser.CurrentLineNumber}: the entity declaration '{name}' is not accepted in {kind}"
+        )
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
@@ -52,7 +57,9 @@ def parse_bounded(data: Union[str, bytes], label: str, kind: str, max_depth: int
     try:
         parser.Parse(data, True)
     except expat.ExpatError as e:
-        raise ValueError(f"{label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}") from None
+        raise ValueError(
+            f"{label}: malformed XML at line {e.lineno}, column {e.offset + 1}: {expat.ErrorString(e.code)}"
+        ) from None
     except LookupError as e:  # an XML declaration naming an encoding Python does not know
         raise ValueError(f"{label}: the XML declaration names an unknown encoding ({e})") from None
     return builder.close()

@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, List, Optional
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,16 +30,20 @@ FORMATS = ("urdf", "mjcf", "yaml", "toml", "dh")
 _BY_EXTENSION = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".yaml": "yaml", ".yml": "yaml", ".toml": "toml"}
 
 
-def format_of(path: "PathLike", to: Optional[str] = None) -> str:
+def format_of(path: PathLike, to: str | None = None) -> str:
     """The output format: ``to`` if given, else by the file's extension (ValueError if neither says)."""
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if to is not None:
         if to not in FORMATS:
             raise ValueError(f"unknown output format '{to}' (formats: {', '.join(FORMATS)})")
         if to == "dh" and ext not in (".yaml", ".yml", ".toml"):
-            raise ValueError(f"a DH table is written as a robot file: '{os.fspath(path)}' must end in .yaml, .yml or .toml")
+            raise ValueError(
+                f"a DH table is written as a robot file: '{os.fspath(path)}' must end in .yaml, .yml or .toml"
+            )
         if to in ("yaml", "toml") and ext not in (".yaml", ".yml", ".toml"):
-            raise ValueError(f"a {to} robot file must end in .{to}{' or .yml' if to == 'yaml' else ''}, not '{ext or '(no extension)'}'")
+            raise ValueError(
+                f"a {to} robot file must end in .{to}{' or .yml' if to == 'yaml' else ''}, not '{ext or '(no extension)'}'"
+            )
         return to
     if ext not in _BY_EXTENSION:
         raise ValueError(
@@ -62,15 +66,17 @@ class Conversion:
     max_frame_error: float = 0.0  # largest entry of a 4x4 pose difference, over the compared frames
     max_mass_matrix_error: float = 0.0
     max_torque_error: float = 0.0
-    frames_compared: List[str] = field(default_factory=list)
-    notes: List[str] = field(default_factory=list)  # what the format could not hold, what the check skipped
+    frames_compared: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # what the format could not hold, what the check skipped
 
     @property
     def max_error(self) -> float:
         return max(self.max_frame_error, self.max_mass_matrix_error, self.max_torque_error)
 
     def summary(self) -> str:
-        lines = [f"wrote {self.path} ({self.format}, {self.joints} joints){f' from robot {self.robot!r}' if self.robot else ''}"]
+        lines = [
+            f"wrote {self.path} ({self.format}, {self.joints} joints){f' from robot {self.robot!r}' if self.robot else ''}"
+        ]
         if self.checked:
             lines.append(
                 f"checked by reading it back: {len(self.frames_compared)} frames, M and inverse dynamics at {self.states} random states: "
@@ -81,7 +87,7 @@ class Conversion:
         return "\n".join(lines)
 
 
-def _random_states(robot: "Robot", states: int, seed: int):
+def _random_states(robot: Robot, states: int, seed: int):
     rng = np.random.default_rng(seed)
     lo = np.where(np.isfinite(robot.lower_limits), robot.lower_limits, -np.pi)
     hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
@@ -89,20 +95,30 @@ def _random_states(robot: "Robot", states: int, seed: int):
         yield rng.uniform(lo, hi), rng.uniform(-1, 1, robot.n), rng.uniform(-1, 1, robot.n)
 
 
-def convert(robot: "Robot", path: "PathLike", to: Optional[str] = None, *, convention: str = "standard", check: bool = True,
-            states: int = 5, seed: int = 0) -> Conversion:
+def convert(
+    robot: Robot,
+    path: PathLike,
+    to: str | None = None,
+    *,
+    convention: str = "standard",
+    check: bool = True,
+    states: int = 5,
+    seed: int = 0,
+) -> Conversion:
     """Write ``robot`` to ``path`` in format ``to`` (default: by extension; see the module docstring)
     and, with ``check``, read it back and compare (:func:`check_conversion`). ``convention``: of the
     DH table for ``to="dh"``."""
     fmt = format_of(path, to)
     path = os.fspath(path)
-    notes: List[str] = []
+    notes: list[str] = []
     source = robot
     if fmt == "urdf":
         robot.to_urdf(path)
         if np.any(robot.armature) and not robot.is_symbolic:
-            notes.append("URDF has no rotor inertia: gear ratios and rotor inertias are in Drake's <transmission> extension, "
-                         "which kinedyn's URDF reader does not read (the check adds r^2 J_m back)")
+            notes.append(
+                "URDF has no rotor inertia: gear ratios and rotor inertias are in Drake's <transmission> extension, "
+                "which kinedyn's URDF reader does not read (the check adds r^2 J_m back)"
+            )
         if not robot.is_symbolic and not np.allclose(np.asarray(robot.gravity, dtype=float), (0.0, 0.0, -9.81)):
             notes.append(f"URDF holds no gravity: give gravity={list(map(float, robot.gravity))} when loading it")
     elif fmt == "mjcf":
@@ -115,7 +131,9 @@ def convert(robot: "Robot", path: "PathLike", to: Optional[str] = None, *, conve
         dh_names = {f"link{i + 1}" for i in range(robot.n)} | {"tool"}
         clashing = [n for n in found.source_frames if n in dh_names]
         if clashing:
-            notes.append(f"in the DH file, {', '.join(clashing)} are the DH table's own frames (the source's frames of those names are not kept)")
+            notes.append(
+                f"in the DH file, {', '.join(clashing)} are the DH table's own frames (the source's frames of those names are not kept)"
+            )
     else:
         robot.save(path)
     result = Conversion(path, "DH " + convention if fmt == "dh" else fmt, source.n, source.name, notes=notes)
@@ -128,7 +146,9 @@ def convert(robot: "Robot", path: "PathLike", to: Optional[str] = None, *, conve
     return result
 
 
-def check_conversion(source: "Robot", path: str, fmt: str, result: Conversion, *, states: int = 5, seed: int = 0) -> Conversion:
+def check_conversion(
+    source: Robot, path: str, fmt: str, result: Conversion, *, states: int = 5, seed: int = 0
+) -> Conversion:
     """Read ``path`` back and fill ``result`` with the largest differences from ``source``."""
     if fmt == "mjcf":
         return _check_with_mujoco(source, path, result, states, seed)
@@ -139,7 +159,9 @@ def check_conversion(source: "Robot", path: str, fmt: str, result: Conversion, *
         warnings.simplefilter("ignore", PhysicalConsistencyWarning)  # the source's own inertias, warned about already
         back = load(path, gravity=source.gravity) if fmt == "urdf" else load(path)
     if back.joint_names != source.joint_names:
-        raise ValueError(f"the written file reads back with joints {back.joint_names}, not the source's {source.joint_names}")
+        raise ValueError(
+            f"the written file reads back with joints {back.joint_names}, not the source's {source.joint_names}"
+        )
     armature = np.diag(source.armature) if fmt == "urdf" else 0.0
     frames = [n for n in source.frame_names if n in back.frame_names and n != source.base]
     if fmt == "dh":  # DH link frames are the DH table's own, not the source's frames of the same name
@@ -150,10 +172,13 @@ def check_conversion(source: "Robot", path: str, fmt: str, result: Conversion, *
         if frames:
             e_fk = max(e_fk, float(np.abs(source.frame_poses(q, frames) - back.frame_poses(q, frames)).max()))
         result.max_frame_error = max(result.max_frame_error, e_fk)
-        result.max_mass_matrix_error = max(result.max_mass_matrix_error, float(np.abs(source.mass_matrix(q) - back.mass_matrix(q) - armature).max()))
+        result.max_mass_matrix_error = max(
+            result.max_mass_matrix_error, float(np.abs(source.mass_matrix(q) - back.mass_matrix(q) - armature).max())
+        )
         tau_extra = source.armature * qdd if fmt == "urdf" else 0.0
         result.max_torque_error = max(
-            result.max_torque_error, float(np.abs(source.inverse_dynamics(q, qd, qdd) - back.inverse_dynamics(q, qd, qdd) - tau_extra).max())
+            result.max_torque_error,
+            float(np.abs(source.inverse_dynamics(q, qd, qdd) - back.inverse_dynamics(q, qd, qdd) - tau_extra).max()),
         )
     if fmt == "dh":
         result.frames_compared = ["tool (the source's tool)"] + frames
@@ -161,7 +186,7 @@ def check_conversion(source: "Robot", path: str, fmt: str, result: Conversion, *
     return result
 
 
-def _check_with_mujoco(source: "Robot", path: str, result: Conversion, states: int, seed: int) -> Conversion:
+def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int, seed: int) -> Conversion:
     import importlib
 
     try:  # (through importlib: MuJoCo ships no type stubs, and the type checker need not know it)
@@ -172,7 +197,9 @@ def _check_with_mujoco(source: "Robot", path: str, result: Conversion, states: i
     model = mujoco.MjModel.from_xml_path(path)
     data = mujoco.MjData(model)
     if model.nv != source.n or model.nq != source.nq:
-        raise ValueError(f"MuJoCo reads the written file with nq={model.nq}, nv={model.nv}; the source has nq={source.nq}, nv={source.n}")
+        raise ValueError(
+            f"MuJoCo reads the written file with nq={model.nq}, nv={model.nv}; the source has nq={source.nq}, nv={source.n}"
+        )
     names = [l.name for l in source.links] + [f.name for f in source.frames]
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
     result.frames_compared = names
@@ -182,11 +209,16 @@ def _check_with_mujoco(source: "Robot", path: str, result: Conversion, states: i
         mujoco.mj_forward(model, data)
         mujoco.mj_fullM(model, data, M)
         poses = source.frame_poses(q, names)
-        e_fk = max(float(np.abs(data.xpos[ids] - poses[:, :3, 3]).max()), float(np.abs(data.xmat[ids].reshape(-1, 3, 3) - poses[:, :3, :3]).max()))
+        e_fk = max(
+            float(np.abs(data.xpos[ids] - poses[:, :3, 3]).max()),
+            float(np.abs(data.xmat[ids].reshape(-1, 3, 3) - poses[:, :3, :3]).max()),
+        )
         result.max_frame_error = max(result.max_frame_error, e_fk)
         result.max_mass_matrix_error = max(result.max_mass_matrix_error, float(np.abs(M - source.mass_matrix(q)).max()))
         bias = source.coriolis_matrix(q, qd) @ qd + source.gravity_torque(q)
         result.max_torque_error = max(result.max_torque_error, float(np.abs(data.qfrc_bias - bias).max()))
-    result.notes.append("read back by MuJoCo: M = mj_fullM, and qfrc_bias against C qd + g (MuJoCo keeps friction out of the bias)")
+    result.notes.append(
+        "read back by MuJoCo: M = mj_fullM, and qfrc_bias against C qd + g (MuJoCo keeps friction out of the bias)"
+    )
     result.checked, result.states = True, states
     return result

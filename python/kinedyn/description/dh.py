@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
-from typing import Any, Optional
+from typing import Any
 
 import sympy as sp
 
@@ -33,7 +33,7 @@ class DHRow:
     a: Any = 0.0
     alpha: Any = 0.0
     kind: str = "revolute"
-    name: Optional[str] = None
+    name: str | None = None
     inertia: Inertia = field(default_factory=Inertia)
     lower: float = -math.inf
     upper: float = math.inf
@@ -49,12 +49,14 @@ class DHRow:
         # coulomb=(positive, negative) is stored as the two fields, as Joint stores it
         if isinstance(self.coulomb, (tuple, list)):
             if len(self.coulomb) != 2 or self.coulomb_negative is not None:
-                raise ValueError(f"DH row '{self.name}': coulomb must be one level or a pair (positive, negative), given once; got {self.coulomb!r}")
+                raise ValueError(
+                    f"DH row '{self.name}': coulomb must be one level or a pair (positive, negative), given once; got {self.coulomb!r}"
+                )
             object.__setattr__(self, "coulomb_negative", self.coulomb[1])
             object.__setattr__(self, "coulomb", self.coulomb[0])
 
     @classmethod
-    def from_mapping(cls, row: dict, index: int) -> "DHRow":
+    def from_mapping(cls, row: dict, index: int) -> DHRow:
         known = {f.name for f in fields(cls)}
         row = dict(row)
         if "type" in row:
@@ -119,12 +121,16 @@ def links_from_dh(rows, convention: str = "standard"):
         if convention == "standard":
             # Rz(theta) Tz(d) | Tx(a) Rx(alpha): the joint moves first, the rest is fixed to link i
             placement = translation(0, 0, 0) if revolute else rot_z(r.theta)
-            post = matmul(translation(0, 0, r.d), translation(r.a, 0, 0), rot_x(r.alpha)) if revolute else matmul(
-                translation(r.a, 0, 0), rot_x(r.alpha)
+            post = (
+                matmul(translation(0, 0, r.d), translation(r.a, 0, 0), rot_x(r.alpha))
+                if revolute
+                else matmul(translation(r.a, 0, 0), rot_x(r.alpha))
             )
         else:
             # Rx(alpha_{i-1}) Tx(a_{i-1}) | Rz(theta_i) Tz(d_i): fixed part first, then the joint
-            placement = matmul(rot_x(r.alpha), translation(r.a, 0, 0), translation(0, 0, r.d) if revolute else rot_z(r.theta))
+            placement = matmul(
+                rot_x(r.alpha), translation(r.a, 0, 0), translation(0, 0, r.d) if revolute else rot_z(r.theta)
+            )
             post = translation(0, 0, 0)
         name = f"link{i}"
         links.append(Link(name, parent, joint, placement, post, r.inertia))
@@ -214,11 +220,15 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
     if convention not in ("standard", "modified"):
         raise ValueError(f"DH convention must be 'standard' or 'modified', got '{convention}'")
     if robot.is_symbolic:
-        raise ValueError(f"dh_from_robot: robot '{robot.name}' has symbolic parameters {sorted(map(str, robot.symbols))}: substitute numbers first (robot.subs)")
+        raise ValueError(
+            f"dh_from_robot: robot '{robot.name}' has symbolic parameters {sorted(map(str, robot.symbols))}: substitute numbers first (robot.subs)"
+        )
     bodies = robot.tree.bodies
     for i, b in enumerate(bodies):
         if b.joint.kind not in ("revolute", "prismatic"):
-            raise ValueError(f"dh_from_robot: joint '{b.joint.name}' is {b.joint.kind}; a DH row holds one revolute or prismatic joint")
+            raise ValueError(
+                f"dh_from_robot: joint '{b.joint.name}' is {b.joint.kind}; a DH row holds one revolute or prismatic joint"
+            )
         if b.parent != i - 1:
             other = next(c.joint.name for c in bodies if c.parent == b.parent)
             where = f"link '{bodies[b.parent].name}'" if b.parent >= 0 else f"the base '{robot.base}'"
@@ -276,7 +286,10 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
                 normal = _common_normal(p[i], u[i], p[i + 1], u[i + 1], eps)
                 if normal is None:
                     foot_next = p[i + 1] + ((start - p[i + 1]) @ u[i + 1]) * u[i + 1]
-                    origin, x = start, _perpendicular(foot_next - start, u[i], frame_of[i][:3, 0] if i else world_body[0][:3, 0])
+                    origin, x = (
+                        start,
+                        _perpendicular(foot_next - start, u[i], frame_of[i][:3, 0] if i else world_body[0][:3, 0]),
+                    )
                 else:
                     origin, _, x = normal
             else:  # last frame: on the last axis at the foot of the tool origin, x toward the tool
@@ -304,14 +317,40 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
         j = b.joint
         # link i's inertia moves from its body frame into DH frame i (both fixed to link i)
         inertia = b.inertia.transformed(np.asarray(pose_inverse(F1), dtype=float) @ world_body[i - 1])
-        rows.append(DHRow(theta + 0.0, d + 0.0, a + 0.0, alpha + 0.0, j.kind, j.name, inertia, j.lower, j.upper, j.velocity_limit,
-                          j.effort_limit, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb, j.coulomb_negative))
+        rows.append(
+            DHRow(
+                theta + 0.0,
+                d + 0.0,
+                a + 0.0,
+                alpha + 0.0,
+                j.kind,
+                j.name,
+                inertia,
+                j.lower,
+                j.upper,
+                j.velocity_limit,
+                j.effort_limit,
+                j.gear_ratio,
+                j.rotor_inertia,
+                j.viscous,
+                j.coulomb,
+                j.coulomb_negative,
+            )
+        )
     from ..robot import Robot
 
     base_pose = frames[0]
     tool = np.asarray(pose_inverse(frames[n]), dtype=float) @ world_tool
-    dh_robot = Robot.from_dh(rows, convention, gravity=robot.gravity, base_pose=base_pose, tool=tool, name=robot.name,
-                             source=robot.source, inertia=robot.inertia_policy if robot.inertia_policy != "strict" else "strict")
+    dh_robot = Robot.from_dh(
+        rows,
+        convention,
+        gravity=robot.gravity,
+        base_pose=base_pose,
+        tool=tool,
+        name=robot.name,
+        source=robot.source,
+        inertia=robot.inertia_policy if robot.inertia_policy != "strict" else "strict",
+    )
     taken = set(dh_robot.frame_names)
     extra, source_frames = [], {}
     for f in robot.tree.frames[1:]:

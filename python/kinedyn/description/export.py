@@ -27,11 +27,11 @@ import math
 import os
 import warnings
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._math import matmul, pose_inverse, rot_axis, translation
+from .._math import pose_inverse, rot_axis, translation
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 
 if TYPE_CHECKING:
@@ -63,7 +63,7 @@ def _fs(values) -> str:
     return " ".join(_f(v) for v in values)
 
 
-def rpy_from_matrix(R) -> Tuple[float, float, float]:
+def rpy_from_matrix(R) -> tuple[float, float, float]:
     """URDF's (roll, pitch, yaw) with R = Rz(yaw) Ry(pitch) Rx(roll), exact to rounding everywhere,
     gimbal lock (pitch = ±90°) and its neighbourhood included.
 
@@ -74,7 +74,9 @@ def rpy_from_matrix(R) -> Tuple[float, float, float]:
     R = np.asarray(R, dtype=float)
     cos_pitch = math.hypot(R[0, 0], R[1, 0])
     pitch = math.atan2(-R[2, 0], cos_pitch)
-    yaw = math.atan2(R[1, 0], R[0, 0])  # the direction of (R00, R10) = cos(pitch) (cos yaw, sin yaw): exact even when tiny
+    yaw = math.atan2(
+        R[1, 0], R[0, 0]
+    )  # the direction of (R00, R10) = cos(pitch) (cos yaw, sin yaw): exact even when tiny
     cy, sy, cp, sp_ = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
     Rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
     Ry = np.array([[cp, 0.0, sp_], [0.0, 1.0, 0.0], [-sp_, 0.0, cp]])
@@ -83,7 +85,7 @@ def rpy_from_matrix(R) -> Tuple[float, float, float]:
     return (roll + 0.0, pitch + 0.0, yaw + 0.0)
 
 
-def quaternion_from_matrix(R) -> Tuple[float, float, float, float]:
+def quaternion_from_matrix(R) -> tuple[float, float, float, float]:
     """Unit quaternion (w, x, y, z) (MuJoCo's order) of a rotation matrix, w >= 0 (Shepperd's method:
     the largest of 4w², 4x², 4y², 4z² is the pivot, so no division by a small number)."""
     R = np.asarray(R, dtype=float)
@@ -108,7 +110,7 @@ def quaternion_from_matrix(R) -> Tuple[float, float, float, float]:
 
 
 # ---------------------------------------------------------------------------------------- checks
-def _require_numeric(robot: "Robot", what: str) -> None:
+def _require_numeric(robot: Robot, what: str) -> None:
     if robot.is_symbolic:
         names = sorted(map(str, robot.symbols))
         raise ValueError(
@@ -162,7 +164,7 @@ def _mesh_file(shape: Mesh) -> str:
 
 
 # ---------------------------------------------------------------------------------------- geometry
-def default_visuals(robot: "Robot", radius: Optional[float] = None) -> List[Visual]:
+def default_visuals(robot: Robot, radius: float | None = None) -> list[Visual]:
     """Solid links for a robot without geometry (a DH robot): a cylinder along each joint axis at
     the joint, and cylinders along each link's offsets — from the joint along its own axis, then
     across (a standard DH link's ``d`` then ``a``), and from the link frame across, then along the
@@ -170,15 +172,15 @@ def default_visuals(robot: "Robot", radius: Optional[float] = None) -> List[Visu
     ``radius``: of the link cylinders (default: 4% of the robot's reach, at least 1 cm); joint
     cylinders are 1.5 times as thick and 6 radii long. All shapes are attached to link frames."""
     _require_numeric(robot, "default visuals")
-    pieces: List[Tuple[str, np.ndarray, np.ndarray]] = []  # (frame, p0, p1) in the frame's coordinates
-    joints: List[Tuple[str, np.ndarray, np.ndarray]] = []  # (frame, point, axis)
-    children: Dict[str, list] = {}
+    pieces: list[tuple[str, np.ndarray, np.ndarray]] = []  # (frame, p0, p1) in the frame's coordinates
+    joints: list[tuple[str, np.ndarray, np.ndarray]] = []  # (frame, point, axis)
+    children: dict[str, list] = {}
     for link in robot.links:
         children.setdefault(link.parent or robot.base, []).append((_np(link.placement), link.joint))
     for extra in robot.frames:
         children.setdefault(extra.link or robot.base, []).append((_np(extra.placement), None))
 
-    def polyline(frame: str, start: np.ndarray, end: np.ndarray, axis: Optional[np.ndarray], axis_first: bool) -> None:
+    def polyline(frame: str, start: np.ndarray, end: np.ndarray, axis: np.ndarray | None, axis_first: bool) -> None:
         d = end - start
         if axis is not None and np.linalg.norm(d) > 1e-12:
             along = float(d @ axis) * axis
@@ -201,12 +203,16 @@ def default_visuals(robot: "Robot", radius: Optional[float] = None) -> List[Visu
     for owner, items in children.items():
         for placement, joint in items:
             end = placement[:3, 3]
-            axis = placement[:3, :3] @ np.array([float(a) for a in joint.axis]) if joint is not None and joint.is_moving else None
+            axis = (
+                placement[:3, :3] @ np.array([float(a) for a in joint.axis])
+                if joint is not None and joint.is_moving
+                else None
+            )
             polyline(owner, np.zeros(3), end, axis, False)
     lengths = [float(np.linalg.norm(b - a)) for _, a, b in pieces]
     reach = sum(lengths) if lengths else 0.5
     r = radius if radius is not None else max(0.04 * reach, 0.01)
-    out: List[Visual] = []
+    out: list[Visual] = []
     grey, blue = (0.72, 0.74, 0.76, 1.0), (0.25, 0.45, 0.8, 1.0)
     for frame, a, b in pieces:
         out.append(Visual(frame, Cylinder(r, float(np.linalg.norm(b - a))), _segment_pose(a, b), grey))
@@ -228,21 +234,21 @@ def _segment_pose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return T
 
 
-def _visuals_for_writing(robot: "Robot", geometry: bool) -> Tuple[list, list]:
+def _visuals_for_writing(robot: Robot, geometry: bool) -> tuple[list, list]:
     visuals, collisions = list(robot.visuals), list(robot.collisions)
     if geometry and not visuals:
         visuals = default_visuals(robot)
     return visuals, collisions
 
 
-def _default_inertias(robot: "Robot") -> "Robot":
+def _default_inertias(robot: Robot) -> Robot:
     """The robot with the documented default inertia for every moving link whose subtree has no
     mass at all (a DH table without inertial data): 1 kg spread along the link's cylinders,
     approximated as a solid cylinder of the link's length and 4% of it in radius."""
     from .inertia import Inertia
     from .link import Link
 
-    carried: Dict[str, float] = {}
+    carried: dict[str, float] = {}
     for link in reversed(robot.links):
         carried[link.name] = carried.get(link.name, 0.0) + float(link.inertia.mass)
         parent = link.parent or robot.base
@@ -294,10 +300,19 @@ def _urdf_inertial(parent: ET.Element, inertia) -> None:
     if any(com):
         ET.SubElement(el, "origin", xyz=_fs(com), rpy="0 0 0")
     ET.SubElement(el, "mass", value=_f(m))
-    ET.SubElement(el, "inertia", ixx=_f(I[0, 0]), ixy=_f(I[0, 1]), ixz=_f(I[0, 2]), iyy=_f(I[1, 1]), iyz=_f(I[1, 2]), izz=_f(I[2, 2]))
+    ET.SubElement(
+        el,
+        "inertia",
+        ixx=_f(I[0, 0]),
+        ixy=_f(I[0, 1]),
+        ixz=_f(I[0, 2]),
+        iyy=_f(I[1, 1]),
+        iyz=_f(I[1, 2]),
+        izz=_f(I[2, 2]),
+    )
 
 
-def floating_trunk(robot: "Robot"):
+def floating_trunk(robot: Robot):
     """The link a free-flyer carries when it is the robot's only link on the base, with identity
     placement and post and nothing else on the base (the shape ``from_urdf(path, floating_base=True)``
     gives a URDF's root), else None."""
@@ -307,12 +322,16 @@ def floating_trunk(robot: "Robot"):
     link = on_base[0]
     if not (_is_identity(_np(link.placement)) and _is_identity(_np(link.post))):
         return None
-    if any(f.link is None for f in robot.frames) or any(v.frame == robot.base for v in (*robot.visuals, *robot.collisions)):
+    if any(f.link is None for f in robot.frames) or any(
+        v.frame == robot.base for v in (*robot.visuals, *robot.collisions)
+    ):
         return None
     return link
 
 
-def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool = True, floating_base_as_root: bool = True) -> str:
+def to_urdf(
+    robot: Robot, path: PathLike | None = None, *, geometry: bool = True, floating_base_as_root: bool = True
+) -> str:
     """The robot as URDF text (written to ``path`` when given).
 
     Every link becomes a ``<link>`` (a link with a ``post`` transform becomes two, see the module
@@ -342,9 +361,9 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
     if any(float(l.joint.armature) != 0 for l in robot.links if l.joint.is_moving):
         root.set("xmlns:drake", DRAKE_NAMESPACE)
     taken = {robot.base} | {l.name for l in robot.links} | {f.name for f in robot.frames}
-    link_elements: Dict[str, ET.Element] = {}
+    link_elements: dict[str, ET.Element] = {}
     # where each named frame's geometry goes: (URDF link, pose of the named frame in that link)
-    geometry_home: Dict[str, Tuple[str, np.ndarray]] = {}
+    geometry_home: dict[str, tuple[str, np.ndarray]] = {}
     trunk = floating_trunk(robot) if floating_base_as_root else None
     links = list(robot.links)
     if trunk is None:
@@ -355,8 +374,8 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         link_elements[trunk.name] = ET.SubElement(root, "link", name=trunk.name)
         _urdf_inertial(link_elements[trunk.name], trunk.inertia)
         geometry_home[trunk.name] = (trunk.name, np.eye(4))
-    joints: List[ET.Element] = []
-    transmissions: List[ET.Element] = []
+    joints: list[ET.Element] = []
+    transmissions: list[ET.Element] = []
     joint_names = {l.joint.name for l in robot.links}
 
     def add_link(name: str) -> ET.Element:
@@ -395,7 +414,7 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         if kind in ("revolute", "continuous", "prismatic", "planar"):
             ET.SubElement(el, "axis", xyz=_fs(float(a) for a in j.axis))
         if kind in ("revolute", "continuous", "prismatic"):
-            limit: Dict[str, str] = {}
+            limit: dict[str, str] = {}
             if kind != "continuous":
                 limit["lower"] = _f(j.lower) if math.isfinite(j.lower) else _f(-1e9)
                 limit["upper"] = _f(j.upper) if math.isfinite(j.upper) else _f(1e9)
@@ -408,11 +427,15 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
             if viscous or coulomb:
                 ET.SubElement(el, "dynamics", damping=_f(viscous), friction=_f(coulomb))
             if j.mimic is not None:  # q = multiplier * q_leader + offset (docs/model-files.md, "Mimic joints")
-                ET.SubElement(el, "mimic", joint=j.mimic.leader, multiplier=_f(j.mimic.multiplier), offset=_f(j.mimic.offset))
+                ET.SubElement(
+                    el, "mimic", joint=j.mimic.leader, multiplier=_f(j.mimic.multiplier), offset=_f(j.mimic.offset)
+                )
             if float(j.armature) != 0:
                 tr = ET.Element("transmission", name=_unique(f"{j.name}_transmission", set(joint_names)))
                 ET.SubElement(tr, "type").text = "transmission_interface/SimpleTransmission"
-                ET.SubElement(ET.SubElement(tr, "joint", name=j.name), "hardwareInterface").text = "hardware_interface/EffortJointInterface"
+                ET.SubElement(
+                    ET.SubElement(tr, "joint", name=j.name), "hardwareInterface"
+                ).text = "hardware_interface/EffortJointInterface"
                 actuator = ET.SubElement(tr, "actuator", name=f"{j.name}_motor")
                 ET.SubElement(actuator, "mechanicalReduction").text = _f(j.gear_ratio)
                 ET.SubElement(actuator, "drake:gear_ratio", value=_f(j.gear_ratio))
@@ -424,13 +447,21 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         geometry_home[link.name] = (link.name, np.eye(4))
     for frame in robot.frames:
         add_link(frame.name)
-        add_joint(_unique(f"{frame.name}_joint", joint_names | taken), "fixed", frame.link or robot.base, frame.name, _np(frame.placement))
+        add_joint(
+            _unique(f"{frame.name}_joint", joint_names | taken),
+            "fixed",
+            frame.link or robot.base,
+            frame.name,
+            _np(frame.placement),
+        )
         geometry_home[frame.name] = (frame.name, np.eye(4))
 
     for tag, items in (("visual", visuals), ("collision", collisions)):
         for k, v in enumerate(items):
             if v.frame not in geometry_home:
-                raise ValueError(f"to_urdf: a {tag} is attached to '{v.frame}', which is no link or frame of robot '{robot.name}'")
+                raise ValueError(
+                    f"to_urdf: a {tag} is attached to '{v.frame}', which is no link or frame of robot '{robot.name}'"
+                )
             home, pose = geometry_home[v.frame]
             el = ET.SubElement(link_elements[home], tag)
             _origin(el, pose @ _np(v.origin))
@@ -446,7 +477,12 @@ def to_urdf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
     for el in joints + transmissions:
         root.append(el)
     ET.indent(root)
-    text = '<?xml version="1.0"?>\n' + f"<!-- written by kinedyn from robot '{robot.name}' -->\n" + ET.tostring(root, encoding="unicode") + "\n"
+    text = (
+        '<?xml version="1.0"?>\n'
+        + f"<!-- written by kinedyn from robot '{robot.name}' -->\n"
+        + ET.tostring(root, encoding="unicode")
+        + "\n"
+    )
     if path is not None:
         with open(os.fspath(path), "w", encoding="utf-8") as f:
             f.write(text)
@@ -461,7 +497,7 @@ def _mj_pose(el: ET.Element, T: np.ndarray) -> None:
         el.set("quat", _fs(quaternion_from_matrix(T[:3, :3])))
 
 
-def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
+def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
     """The robot as MuJoCo XML (MJCF) text (written to ``path`` when given).
 
     Nested ``<body>`` elements, one per link and extra frame, each at its link frame; joints:
@@ -486,7 +522,7 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
     ET.SubElement(root, "option", gravity=_fs(float(g) for g in robot.gravity))
     asset = ET.Element("asset")
     world = ET.SubElement(root, "worldbody")
-    bodies: Dict[str, ET.Element] = {robot.base: world}
+    bodies: dict[str, ET.Element] = {robot.base: world}
     names: set = set()
     for link in robot.links:
         j = link.joint
@@ -528,13 +564,20 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         if coulomb:
             drive["frictionloss"] = _f(coulomb)
         if j.kind in ("revolute", "prismatic"):
-            el = ET.SubElement(body, "joint", {"name": j.name, "type": "hinge" if j.kind == "revolute" else "slide", "axis": _fs(axis), **drive})
+            el = ET.SubElement(
+                body,
+                "joint",
+                {"name": j.name, "type": "hinge" if j.kind == "revolute" else "slide", "axis": _fs(axis), **drive},
+            )
             if np.any(anchor) and j.kind == "revolute":
                 el.set("pos", _fs(anchor))
             if math.isfinite(j.lower) and math.isfinite(j.upper):
                 el.set("range", _fs((j.lower, j.upper)))
             elif math.isfinite(j.lower) or math.isfinite(j.upper):
-                warnings.warn(f"MJCF limits a joint on both sides or none: joint '{j.name}' has limits [{j.lower}, {j.upper}]; writing none", stacklevel=2)
+                warnings.warn(
+                    f"MJCF limits a joint on both sides or none: joint '{j.name}' has limits [{j.lower}, {j.upper}]; writing none",
+                    stacklevel=2,
+                )
         elif j.kind == "floating":
             if link.parent is not None or not _is_identity(post) or not _is_identity(_np(link.placement)):
                 raise ValueError(
@@ -548,8 +591,10 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
                 el.set("pos", _fs(anchor))
         else:  # planar
             if not np.allclose(axis, (0.0, 0.0, 1.0)) or not _is_identity(post):
-                raise ValueError(f"to_mjcf: planar joint '{j.name}': MJCF has no planar joint; kinedyn writes one about z "
-                                 "(two slides and a hinge) only for an axis (0, 0, 1) and no post transform")
+                raise ValueError(
+                    f"to_mjcf: planar joint '{j.name}': MJCF has no planar joint; kinedyn writes one about z "
+                    "(two slides and a hinge) only for an axis (0, 0, 1) and no post transform"
+                )
             for suffix, kind, ax in (("x", "slide", "1 0 0"), ("y", "slide", "0 1 0"), ("theta", "hinge", "0 0 1")):
                 ET.SubElement(body, "joint", {"name": f"{j.name}_{suffix}", "type": kind, "axis": ax, **drive})
     for frame in robot.frames:
@@ -557,9 +602,11 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
         bodies[frame.name] = body
         _mj_pose(body, _np(frame.placement))
     for group, items in ((1, visuals), (3, collisions)):
-        for k, v in enumerate(items):
+        for _k, v in enumerate(items):
             if v.frame not in bodies:
-                raise ValueError(f"to_mjcf: a visual is attached to '{v.frame}', which is no link or frame of robot '{robot.name}'")
+                raise ValueError(
+                    f"to_mjcf: a visual is attached to '{v.frame}', which is no link or frame of robot '{robot.name}'"
+                )
             shape = v.shape
             geom = ET.Element("geom", contype="0", conaffinity="0", group=str(group))
             if isinstance(shape, Box):
@@ -574,7 +621,10 @@ def to_mjcf(robot: "Robot", path: Optional["PathLike"] = None, *, geometry: bool
             else:
                 file = _mesh_file(shape)
                 if os.path.splitext(file)[1].lower() not in (".stl", ".obj"):
-                    warnings.warn(f"MuJoCo reads STL and OBJ meshes, not '{file}' (on '{v.frame}'): left out of the MJCF", stacklevel=2)
+                    warnings.warn(
+                        f"MuJoCo reads STL and OBJ meshes, not '{file}' (on '{v.frame}'): left out of the MJCF",
+                        stacklevel=2,
+                    )
                     continue
                 if file.startswith("package://"):
                     from .geometry import resolve_mesh

@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import ast
 import math
-from typing import Mapping, Optional, Union
+from collections.abc import Mapping
+from typing import Union
 
 import sympy as sp
 
@@ -28,10 +29,20 @@ __all__ = ["FUNCTIONS", "CONSTANTS", "parse_expression", "parse_number", "MAX_LE
 
 # the functions a file may call: name -> (SymPy function, number of arguments)
 FUNCTIONS: dict = {
-    "sin": (sp.sin, 1), "cos": (sp.cos, 1), "tan": (sp.tan, 1),
-    "asin": (sp.asin, 1), "acos": (sp.acos, 1), "atan": (sp.atan, 1), "atan2": (sp.atan2, 2),
-    "sinh": (sp.sinh, 1), "cosh": (sp.cosh, 1), "tanh": (sp.tanh, 1),
-    "sqrt": (sp.sqrt, 1), "exp": (sp.exp, 1), "log": (sp.log, 1), "abs": (sp.Abs, 1),
+    "sin": (sp.sin, 1),
+    "cos": (sp.cos, 1),
+    "tan": (sp.tan, 1),
+    "asin": (sp.asin, 1),
+    "acos": (sp.acos, 1),
+    "atan": (sp.atan, 1),
+    "atan2": (sp.atan2, 2),
+    "sinh": (sp.sinh, 1),
+    "cosh": (sp.cosh, 1),
+    "tanh": (sp.tanh, 1),
+    "sqrt": (sp.sqrt, 1),
+    "exp": (sp.exp, 1),
+    "log": (sp.log, 1),
+    "abs": (sp.Abs, 1),
 }
 CONSTANTS: dict = {"pi": sp.pi}
 
@@ -53,7 +64,7 @@ class _Refused(ValueError):
 
 def parse_expression(
     text: str,
-    symbols: Optional[Mapping[str, sp.Basic]] = None,
+    symbols: Mapping[str, sp.Basic] | None = None,
     *,
     allow_symbols: bool = True,
 ) -> Union[float, sp.Expr]:
@@ -120,7 +131,9 @@ class _Walker:
             return _bounded(_binary(node.op, left, right))
         if isinstance(node, ast.Call):
             return self.call(node, depth)
-        raise _Refused(f"{_describe(node)} is not allowed (only numbers, names, + - * / **, parentheses and {', '.join(FUNCTIONS)})")
+        raise _Refused(
+            f"{_describe(node)} is not allowed (only numbers, names, + - * / **, parentheses and {', '.join(FUNCTIONS)})"
+        )
 
     def name(self, name: str) -> sp.Basic:
         if name in self.symbols:
@@ -134,7 +147,9 @@ class _Walker:
         if not self.allow_symbols:
             raise _Refused(f"'{name}' is a name, but a number is needed here")
         if len(name) > MAX_NAME or name.startswith("_") or not name.isascii():
-            raise _Refused(f"'{name[:MAX_NAME]}' is not a valid name (ASCII letters, digits and _, not starting with _, at most {MAX_NAME} characters)")
+            raise _Refused(
+                f"'{name[:MAX_NAME]}' is not a valid name (ASCII letters, digits and _, not starting with _, at most {MAX_NAME} characters)"
+            )
         return sp.Symbol(name)
 
     def call(self, node: ast.Call, depth: int) -> sp.Basic:
@@ -216,9 +231,19 @@ def _finish(e: sp.Basic) -> Union[float, sp.Expr]:
 
 
 def _describe(node: ast.AST) -> str:
-    kinds = {ast.Attribute: "attribute access (a.b)", ast.Subscript: "indexing (a[b])", ast.Lambda: "lambda",
-             ast.Compare: "a comparison", ast.BoolOp: "and/or", ast.IfExp: "if/else", ast.List: "a list",
-             ast.Tuple: "a tuple", ast.Dict: "a dict", ast.Set: "a set", ast.JoinedStr: "an f-string"}
+    kinds = {
+        ast.Attribute: "attribute access (a.b)",
+        ast.Subscript: "indexing (a[b])",
+        ast.Lambda: "lambda",
+        ast.Compare: "a comparison",
+        ast.BoolOp: "and/or",
+        ast.IfExp: "if/else",
+        ast.List: "a list",
+        ast.Tuple: "a tuple",
+        ast.Dict: "a dict",
+        ast.Set: "a set",
+        ast.JoinedStr: "an f-string",
+    }
     for kind, words in kinds.items():
         if isinstance(node, kind):
             return words

@@ -18,7 +18,7 @@ import os
 import re
 import reprlib
 import sys
-from typing import TYPE_CHECKING, Any, NoReturn, Optional
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 import sympy as sp
@@ -30,7 +30,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
     import tomli as tomllib
 import yaml
 
-from .._math import as_value, is_symbolic, matmul, pose_inverse, rpy_to_matrix, translation
+from .._math import is_symbolic, matmul, pose_inverse, rpy_to_matrix, translation
 from .dh import DHRow, links_from_dh
 from .expressions import parse_expression
 from .inertia import Inertia
@@ -46,10 +46,36 @@ __all__ = ["load", "save", "robot_from_mapping", "robot_to_mapping"]
 _TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals"}
 _TOP_DH = _TOP_COMMON | {"convention", "base_pose", "tool", "tool_frame", "joints"}
 _TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
-_ROW_KEYS = {"theta", "d", "a", "alpha", "type", "name", "limits", "mass", "com", "inertia",
-             "gear_ratio", "rotor_inertia", "viscous", "coulomb"}
+_ROW_KEYS = {
+    "theta",
+    "d",
+    "a",
+    "alpha",
+    "type",
+    "name",
+    "limits",
+    "mass",
+    "com",
+    "inertia",
+    "gear_ratio",
+    "rotor_inertia",
+    "viscous",
+    "coulomb",
+}
 _LINK_KEYS = {"name", "parent", "joint", "inertial", "post"}
-_JOINT_KEYS = {"name", "type", "axis", "origin", "offset", "limits", "gear_ratio", "rotor_inertia", "viscous", "coulomb", "mimic"}
+_JOINT_KEYS = {
+    "name",
+    "type",
+    "axis",
+    "origin",
+    "offset",
+    "limits",
+    "gear_ratio",
+    "rotor_inertia",
+    "viscous",
+    "coulomb",
+    "mimic",
+}
 _MIMIC_KEYS = {"joint", "multiplier", "offset"}  # URDF's <mimic> attributes (docs/model-files.md#mimic-joints)
 _INERTIAL_KEYS = {"mass", "com", "inertia"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
@@ -91,7 +117,9 @@ def load(path: PathLike, inertia: str = "warn", **kwargs) -> Robot:
 
         return robot_from_mjcf(path, inertia=inertia, **kwargs)
     if ext not in (".yaml", ".yml", ".toml"):
-        raise ValueError(f"{path}: unknown robot file extension '{ext}' (expected .urdf, .xacro, .xml (MJCF), .yaml, .yml or .toml)")
+        raise ValueError(
+            f"{path}: unknown robot file extension '{ext}' (expected .urdf, .xacro, .xml (MJCF), .yaml, .yml or .toml)"
+        )
     text = _read_text(path)
     data = _parse_toml(text, path) if ext == ".toml" else _parse_yaml(text, path)
     robot = robot_from_mapping(data, where=path, inertia=inertia)
@@ -181,7 +209,9 @@ class _BoundedLoader(yaml.SafeLoader):
     def _count(self, nodes: int, mark):
         self._expanded += nodes
         if self._expanded > MAX_NODES:
-            self._refuse(f"the document expands to more than {MAX_NODES} values (aliases counted as what they repeat)", mark)
+            self._refuse(
+                f"the document expands to more than {MAX_NODES} values (aliases counted as what they repeat)", mark
+            )
 
     def construct_line_mapping(self, node):
         data = _LineDict()
@@ -194,10 +224,15 @@ class _BoundedLoader(yaml.SafeLoader):
             try:
                 repeated = key in data.lines
             except TypeError:
-                raise yaml.constructor.ConstructorError(None, None, "a mapping key must be a plain value", key_node.start_mark) from None
+                raise yaml.constructor.ConstructorError(
+                    None, None, "a mapping key must be a plain value", key_node.start_mark
+                ) from None
             if repeated:
                 raise yaml.constructor.ConstructorError(
-                    None, None, f"the key {_REPR.repr(key)} appears twice in one mapping (first on line {data.lines[key]})", key_node.start_mark
+                    None,
+                    None,
+                    f"the key {_REPR.repr(key)} appears twice in one mapping (first on line {data.lines[key]})",
+                    key_node.start_mark,
                 )
             data.lines[key] = key_node.start_mark.line + 1
         data.update(self.construct_mapping(node, deep=True))
@@ -211,8 +246,12 @@ class _BoundedLoader(yaml.SafeLoader):
 
 def _refuse_tag(loader, node):
     raise yaml.constructor.ConstructorError(
-        None, None, f"the YAML type {node.tag.rsplit(':', 1)[-1]} ({_REPR.repr(node.value) if isinstance(node.value, str) else '...'}) "
-        "has no meaning in a robot file (numbers, text, lists and mappings only)", node.start_mark)
+        None,
+        None,
+        f"the YAML type {node.tag.rsplit(':', 1)[-1]} ({_REPR.repr(node.value) if isinstance(node.value, str) else '...'}) "
+        "has no meaning in a robot file (numbers, text, lists and mappings only)",
+        node.start_mark,
+    )
 
 
 # a robot file holds numbers, text, lists and mappings: YAML's other types (dates, which PyYAML's
@@ -235,7 +274,9 @@ def _parse_yaml(text: str, where: str):
     except yaml.reader.ReaderError as e:  # a character YAML does not allow (NUL, other control characters)
         line_no = text.count("\n", 0, e.position) + 1
         shown = chr(e.character) if isinstance(e.character, int) else e.character
-        raise ValueError(f"{where}: invalid YAML at line {line_no}: the character {shown!r} is not allowed in YAML") from None
+        raise ValueError(
+            f"{where}: invalid YAML at line {line_no}: the character {shown!r} is not allowed in YAML"
+        ) from None
     except yaml.YAMLError as e:
         raise ValueError(f"{where}: invalid YAML: {e}") from None
     finally:
@@ -301,7 +342,7 @@ class _Reader:
         at = f", line {line}" if line else ""
         raise ValueError(f"{self.where}{at}: {ctx}: {message}")
 
-    def line_of(self, ctx: str) -> Optional[int]:
+    def line_of(self, ctx: str) -> int | None:
         """The line of field ``ctx`` or of the nearest field that holds it."""
         while ctx:
             if ctx in self.lines:
@@ -357,7 +398,10 @@ class _Reader:
             self.fail(ctx, f"expected a number or an expression, got {raw!r}")
         if isinstance(raw, int):
             if raw.bit_length() > 1000:
-                self.fail(ctx, f"the integer has about {int(raw.bit_length() * math.log10(2))} digits, too large for a robot's parameter")
+                self.fail(
+                    ctx,
+                    f"the integer has about {int(raw.bit_length() * math.log10(2))} digits, too large for a robot's parameter",
+                )
             raw = float(raw)
         if isinstance(raw, float):
             if math.isnan(raw) or (math.isinf(raw) and not infinite):
@@ -434,11 +478,17 @@ class _Reader:
                 return out
             # [positive, negative]: direction-dependent Coulomb levels (magnitudes)
             if len(c) != 2:
-                self.fail(f"{ctx}.coulomb", f"expected one level or a list [positive, negative] of two levels, got {len(c)} values")
+                self.fail(
+                    f"{ctx}.coulomb",
+                    f"expected one level or a list [positive, negative] of two levels, got {len(c)} values",
+                )
             levels = tuple(self.value(v, f"{ctx}.coulomb[{i}]") for i, v in enumerate(c))
             for i, v in enumerate(levels):
                 if not isinstance(v, sp.Basic) and v < 0:
-                    self.fail(f"{ctx}.coulomb[{i}]", f"a Coulomb level is a magnitude >= 0, got {v} (Corke's Tc = [Tc+, Tc-] with Tc- < 0 is written [Tc+, -Tc-])")
+                    self.fail(
+                        f"{ctx}.coulomb[{i}]",
+                        f"a Coulomb level is a magnitude >= 0, got {v} (Corke's Tc = [Tc+, Tc-] with Tc- < 0 is written [Tc+, -Tc-])",
+                    )
             out["coulomb"] = levels
         return out
 
@@ -501,7 +551,9 @@ def _visuals(r: _Reader, raw, where: str) -> list:
 
     base_dir = os.path.dirname(os.path.abspath(where)) if not where.startswith("<") else None
     out = []
-    for i, v in enumerate(r.items(raw, "visuals", "{link, mesh | box | cylinder | sphere, ...}", lambda i: f"visuals[{i}]")):
+    for i, v in enumerate(
+        r.items(raw, "visuals", "{link, mesh | box | cylinder | sphere, ...}", lambda i: f"visuals[{i}]")
+    ):
         ctx = f"visuals[{i}]"
         v = r.check_keys(v, _VISUAL_KEYS, ctx)
         if "link" not in v:
@@ -523,7 +575,10 @@ def _visuals(r: _Reader, raw, where: str) -> list:
             shape = Box(size)  # type: ignore[arg-type]
         elif kind == "cylinder":
             c = r.check_keys(v["cylinder"], {"radius", "length"}, f"{ctx}.cylinder")
-            radius, length = r.number(c.get("radius", 0), f"{ctx}.cylinder.radius"), r.number(c.get("length", 0), f"{ctx}.cylinder.length")
+            radius, length = (
+                r.number(c.get("radius", 0), f"{ctx}.cylinder.radius"),
+                r.number(c.get("length", 0), f"{ctx}.cylinder.length"),
+            )
             if radius <= 0 or length <= 0:
                 r.fail(f"{ctx}.cylinder", "needs a positive radius and length")
             shape = Cylinder(radius, length)
@@ -538,7 +593,11 @@ def _visuals(r: _Reader, raw, where: str) -> list:
             if any(not 0 <= x <= 1 for x in rgba):
                 r.fail(f"{ctx}.color", "needs 4 numbers between 0 and 1 (r, g, b, alpha)")
         origin = r.pose(v["origin"], f"{ctx}.origin") if "origin" in v else np.eye(4)
-        out.append(Visual(r.text(v["link"], f"{ctx}.link"), shape, np.asarray(origin, dtype=float), rgba, None, f"{where} {ctx}"))  # type: ignore[arg-type]
+        out.append(
+            Visual(
+                r.text(v["link"], f"{ctx}.link"), shape, np.asarray(origin, dtype=float), rgba, None, f"{where} {ctx}"
+            )
+        )  # type: ignore[arg-type]
     return out
 
 
@@ -649,7 +708,11 @@ def _visual_mapping(v) -> dict:
     out: dict = {"link": v.frame}
     s = v.shape
     if isinstance(s, Mesh):
-        out["mesh"] = s.filename if s.base_dir is None or "://" in s.filename or os.path.isabs(s.filename) else os.path.join(s.base_dir, s.filename)
+        out["mesh"] = (
+            s.filename
+            if s.base_dir is None or "://" in s.filename or os.path.isabs(s.filename)
+            else os.path.join(s.base_dir, s.filename)
+        )
         out["scale"] = [float(x) for x in s.scale]
     elif isinstance(s, Box):
         out["box"] = [float(x) for x in s.size]
@@ -713,7 +776,8 @@ def _dh_base_pose(robot: Robot):
     for k, (mine, theirs) in enumerate(zip(robot.links, links)):
         placement = matmul(base_pose, theirs.placement) if k == 0 else theirs.placement
         same = (
-            (mine.name, mine.parent, mine.joint, mine.inertia) == (theirs.name, theirs.parent, theirs.joint, theirs.inertia)
+            (mine.name, mine.parent, mine.joint, mine.inertia)
+            == (theirs.name, theirs.parent, theirs.joint, theirs.inertia)
             and _same_pose(mine.placement, placement)
             and _same_pose(mine.post, theirs.post)
         )
@@ -724,7 +788,12 @@ def _dh_base_pose(robot: Robot):
 
 def _limits_mapping(joint) -> dict:
     out = {}
-    for key, field in (("lower", "lower"), ("upper", "upper"), ("velocity", "velocity_limit"), ("effort", "effort_limit")):
+    for key, field in (
+        ("lower", "lower"),
+        ("upper", "upper"),
+        ("velocity", "velocity_limit"),
+        ("effort", "effort_limit"),
+    ):
         v = getattr(joint, field)
         if math.isfinite(v):
             out[key] = float(v)
@@ -772,7 +841,7 @@ def _dh_mapping(robot: Robot, base_pose) -> dict:
         out["tool_frame"] = robot.tool
     assert robot.dh is not None  # robot_to_mapping writes a DH table only for a robot that has one
     rows = []
-    for k, (row, link) in enumerate(zip(robot.dh, robot.links)):
+    for _k, (row, link) in enumerate(zip(robot.dh, robot.links)):
         entry: dict = {"name": link.joint.name, "type": row.kind}
         entry.update({key: _dump(getattr(row, key)) for key in ("theta", "d", "a", "alpha")})
         limits = _limits_mapping(link.joint)

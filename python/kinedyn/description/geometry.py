@@ -26,13 +26,25 @@ from __future__ import annotations
 
 import os
 import site
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterator, List, Optional, Sequence, Tuple, Union
+from typing import Union
 
 import numpy as np
 
-__all__ = ["Box", "Cylinder", "Sphere", "Mesh", "Shape", "Visual", "MESH_EXTENSIONS", "MeshNotFound", "resolve_mesh", "mesh_search_folders"]
+__all__ = [
+    "Box",
+    "Cylinder",
+    "Sphere",
+    "Mesh",
+    "Shape",
+    "Visual",
+    "MESH_EXTENSIONS",
+    "MeshNotFound",
+    "resolve_mesh",
+    "mesh_search_folders",
+]
 
 MESH_EXTENSIONS = (".stl", ".obj", ".dae")
 DEFAULT_RGBA = (0.72, 0.74, 0.76, 1.0)  # a light grey, for shapes whose file gives no colour
@@ -40,7 +52,7 @@ DEFAULT_RGBA = (0.72, 0.74, 0.76, 1.0)  # a light grey, for shapes whose file gi
 
 @dataclass(frozen=True)
 class Box:
-    size: Tuple[float, float, float]  # full side lengths along x, y, z [m]
+    size: tuple[float, float, float]  # full side lengths along x, y, z [m]
 
 
 @dataclass(frozen=True)
@@ -57,8 +69,8 @@ class Sphere:
 @dataclass(frozen=True)
 class Mesh:
     filename: str  # as written in the robot file (package://..., relative or absolute)
-    scale: Tuple[float, float, float] = (1.0, 1.0, 1.0)
-    base_dir: Optional[str] = None  # the folder of the robot file that named it (relative paths start here)
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    base_dir: str | None = None  # the folder of the robot file that named it (relative paths start here)
 
 
 Shape = Union[Box, Cylinder, Sphere, Mesh]
@@ -71,8 +83,8 @@ class Visual:
     frame: str
     shape: Shape
     origin: np.ndarray = field(default_factory=lambda: np.eye(4))
-    rgba: Optional[Tuple[float, float, float, float]] = None  # None: the mesh file's colours (or a grey)
-    material: Optional[str] = None  # the material's name in the robot file, if any
+    rgba: tuple[float, float, float, float] | None = None  # None: the mesh file's colours (or a grey)
+    material: str | None = None  # the material's name in the robot file, if any
     where: str = ""  # "file:line" of the element that described it (for messages)
 
     def describe(self) -> str:
@@ -87,7 +99,7 @@ class MeshNotFound(FileNotFoundError):
 
 
 # ------------------------------------------------------------------------------ resolution
-def _site_folders() -> List[str]:
+def _site_folders() -> list[str]:
     folders = []
     try:
         folders += site.getsitepackages()
@@ -108,14 +120,14 @@ def _site_folders() -> List[str]:
     return out
 
 
-def _ancestors(base_dir: Optional[str]) -> List[Path]:
+def _ancestors(base_dir: str | None) -> list[Path]:
     if not base_dir:
         return []
     start = Path(base_dir).resolve()
     return [start, *start.parents]
 
 
-def mesh_search_folders(package: str, base_dir: Optional[str] = None) -> Iterator[Path]:
+def mesh_search_folders(package: str, base_dir: str | None = None) -> Iterator[Path]:
     """Where ``package://package/...`` is looked for, in order (see the module docstring)."""
     for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
         if entry:
@@ -138,19 +150,21 @@ def _is_mesh_file(path: Path) -> bool:
     return path.resolve().suffix.lower() in MESH_EXTENSIONS  # a symbolic link must point at a mesh file too
 
 
-def resolve_mesh(filename: str, base_dir: Optional[str] = None) -> Path:
+def resolve_mesh(filename: str, base_dir: str | None = None) -> Path:
     """The mesh file ``filename`` names (see the module docstring for the order of the search).
     Raises :class:`MeshNotFound` listing where it looked, ValueError for a name that is not a mesh
     file or a package path with ``..``."""
     name = filename.strip()
     if Path(name.split("?")[0]).suffix.lower() not in MESH_EXTENSIONS:
         raise ValueError(f"mesh '{filename}': not a mesh file name (kinedyn reads {', '.join(MESH_EXTENSIONS)})")
-    tried: List[Path] = []
+    tried: list[Path] = []
     if name.startswith("package://"):
-        package, _, rest = name[len("package://"):].partition("/")
+        package, _, rest = name[len("package://") :].partition("/")
         parts = Path(rest).parts
         if not package or not rest or ".." in parts or Path(rest).is_absolute() or ".." == package:
-            raise ValueError(f"mesh '{filename}': a package path is package://PACKAGE/path inside the package, without '..'")
+            raise ValueError(
+                f"mesh '{filename}': a package path is package://PACKAGE/path inside the package, without '..'"
+            )
         for folder in mesh_search_folders(package, base_dir):
             candidate = folder / rest
             tried.append(candidate)
@@ -158,7 +172,7 @@ def resolve_mesh(filename: str, base_dir: Optional[str] = None) -> Path:
                 return candidate
     else:
         if name.startswith("file://"):
-            name = name[len("file://"):]
+            name = name[len("file://") :]
         path = Path(os.path.expanduser(name))
         if path.is_absolute():
             tried.append(path)
@@ -171,10 +185,12 @@ def resolve_mesh(filename: str, base_dir: Optional[str] = None) -> Path:
                 if _is_mesh_file(candidate):
                     return candidate
     shown = ", ".join(str(p) for p in tried[:6]) + (f" and {len(tried) - 6} more places" if len(tried) > 6 else "")
-    raise MeshNotFound(f"mesh '{filename}' was not found (looked in {shown or 'no folder'}; set ROS_PACKAGE_PATH to the folder holding its package)")
+    raise MeshNotFound(
+        f"mesh '{filename}' was not found (looked in {shown or 'no folder'}; set ROS_PACKAGE_PATH to the folder holding its package)"
+    )
 
 
-def visuals_of_frames(visuals: Sequence[Visual], frames: Sequence[str]) -> List[Visual]:
+def visuals_of_frames(visuals: Sequence[Visual], frames: Sequence[str]) -> list[Visual]:
     """The visuals attached to known frames (those of links removed from the robot are dropped)."""
     known = set(frames)
     return [v for v in visuals if v.frame in known]

@@ -14,8 +14,9 @@ Values may be floats or SymPy expressions.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Optional, Sequence
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -90,7 +91,9 @@ class Inertia:
 
     mass: Any = 0.0
     com: Any = (0.0, 0.0, 0.0)  # any 3-vector on input; a tuple once constructed
-    inertia: Any = field(default=((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))  # 3x3 array-like; nested tuples once constructed
+    inertia: Any = field(
+        default=((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    )  # 3x3 array-like; nested tuples once constructed
     _symbolic: bool = field(default=False, init=False, repr=False, compare=False)  # set by __post_init__
 
     def __post_init__(self):
@@ -123,7 +126,7 @@ class Inertia:
         if np.abs(I - I.T).max() > 1e-12 * max(1.0, np.abs(I).max()):
             raise ValueError(f"inertia tensor{where} is not symmetric:\n{I}")
 
-    def consistency(self) -> Optional[Consistency]:
+    def consistency(self) -> Consistency | None:
         """The principal moments and whether a rigid body can have them (None when symbolic)."""
         if self.is_symbolic:
             return None
@@ -135,7 +138,7 @@ class Inertia:
         triangle = bool(planar or eig[0] + eig[1] >= eig[2] - max(tol, 1e-9 * eig[2]))
         return Consistency(tuple(float(e) for e in eig), positive, triangle)
 
-    def nearest_consistent(self) -> "Inertia":
+    def nearest_consistent(self) -> Inertia:
         """The nearest physically consistent inertia (same mass and centre of mass), or ``self``
         when it is consistent already.
 
@@ -159,16 +162,16 @@ class Inertia:
 
     # ---- named constructors -------------------------------------------------------------------
     @classmethod
-    def from_urdf(cls, mass, ixx, ixy, ixz, iyy, iyz, izz, com=(0.0, 0.0, 0.0)) -> "Inertia":
+    def from_urdf(cls, mass, ixx, ixy, ixz, iyy, iyz, izz, com=(0.0, 0.0, 0.0)) -> Inertia:
         """URDF's ``<inertia ixx ixy ixz iyy iyz izz>`` (tensor entries about the centre of mass)."""
         return cls(mass, com, ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz)))
 
     @classmethod
-    def point_mass(cls, mass, com=(0.0, 0.0, 0.0)) -> "Inertia":
+    def point_mass(cls, mass, com=(0.0, 0.0, 0.0)) -> Inertia:
         return cls(mass, com)
 
     @classmethod
-    def rod(cls, mass, length, axis: str = "x", com=None) -> "Inertia":
+    def rod(cls, mass, length, axis: str = "x", com=None) -> Inertia:
         """Thin uniform rod of ``length`` along ``axis``; centre of mass at mid-length from the origin
         unless ``com`` is given. Inertia m L^2 / 12 about the two axes across the rod."""
         i = "xyz".index(axis)
@@ -181,14 +184,14 @@ class Inertia:
         return cls(mass, tuple(com), ((diag[0], 0, 0), (0, diag[1], 0), (0, 0, diag[2])))
 
     @classmethod
-    def box(cls, mass, size: Sequence, com=(0.0, 0.0, 0.0)) -> "Inertia":
+    def box(cls, mass, size: Sequence, com=(0.0, 0.0, 0.0)) -> Inertia:
         """Solid uniform box with edge lengths (sx, sy, sz)."""
         sx, sy, sz = size
         k = mass / 12
         return cls(mass, com, ((k * (sy**2 + sz**2), 0, 0), (0, k * (sx**2 + sz**2), 0), (0, 0, k * (sx**2 + sy**2))))
 
     @classmethod
-    def cylinder(cls, mass, radius, length, axis: str = "z", com=(0.0, 0.0, 0.0)) -> "Inertia":
+    def cylinder(cls, mass, radius, length, axis: str = "z", com=(0.0, 0.0, 0.0)) -> Inertia:
         """Solid uniform cylinder with its symmetry axis along ``axis``."""
         i = "xyz".index(axis)
         across = mass * (3 * radius**2 + length**2) / 12
@@ -197,12 +200,12 @@ class Inertia:
         return cls(mass, com, ((diag[0], 0, 0), (0, diag[1], 0), (0, 0, diag[2])))
 
     @classmethod
-    def sphere(cls, mass, radius, com=(0.0, 0.0, 0.0)) -> "Inertia":
+    def sphere(cls, mass, radius, com=(0.0, 0.0, 0.0)) -> Inertia:
         I = 2 * mass * radius**2 / 5
         return cls(mass, com, ((I, 0, 0), (0, I, 0), (0, 0, I)))
 
     @classmethod
-    def from_parameters(cls, pi: Sequence) -> "Inertia":
+    def from_parameters(cls, pi: Sequence) -> Inertia:
         """Inverse of :meth:`parameters` (requires m != 0 to recover the centre of mass)."""
         m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = pi
         if not is_symbolic(m) and float(m) == 0.0:
@@ -222,8 +225,7 @@ class Inertia:
         S = skew(self.com)
         m = self.mass
         return tuple(
-            tuple(self.inertia[r][k] - m * sum(S[r][j] * S[j][k] for j in range(3)) for k in range(3))
-            for r in range(3)
+            tuple(self.inertia[r][k] - m * sum(S[r][j] * S[j][k] for j in range(3)) for k in range(3)) for r in range(3)
         )
 
     def parameters(self) -> list:
@@ -233,7 +235,7 @@ class Inertia:
         Io = self.inertia_about_origin()
         return [m, *h, Io[0][0], Io[0][1], Io[1][1], Io[0][2], Io[1][2], Io[2][2]]
 
-    def transformed(self, a_from_b) -> "Inertia":
+    def transformed(self, a_from_b) -> Inertia:
         """This inertia (given in frame b) expressed in frame a, for a pose ``a_from_b``."""
         symbolic = is_symbolic(a_from_b) or self.is_symbolic
         if symbolic:
@@ -248,7 +250,7 @@ class Inertia:
         Ic = R @ np.array(self.inertia, dtype=float) @ R.T
         return Inertia(self.mass, tuple(c), 0.5 * (Ic + Ic.T))
 
-    def __add__(self, other: "Inertia") -> "Inertia":
+    def __add__(self, other: Inertia) -> Inertia:
         """Inertia of two bodies rigidly joined (both expressed in the same frame)."""
         if not isinstance(other, Inertia):
             return NotImplemented
@@ -257,11 +259,15 @@ class Inertia:
         if not symbolic and float(m) == 0.0:
             # massless bodies may still have rotational inertia (a rotor, Corke's PUMA link 1): the
             # tensors about the common origin add; with no mass the centre of mass is moot (origin)
-            Io = np.array(self.inertia_about_origin(), dtype=float) + np.array(other.inertia_about_origin(), dtype=float)
+            Io = np.array(self.inertia_about_origin(), dtype=float) + np.array(
+                other.inertia_about_origin(), dtype=float
+            )
             return Inertia(0.0, (0.0, 0.0, 0.0), 0.5 * (Io + Io.T))
         c = tuple((self.mass * a + other.mass * b) / m for a, b in zip(self.com, other.com))
         # sum about the common origin, then shift back to the new centre of mass
-        Io = [[a + b for a, b in zip(ra, rb)] for ra, rb in zip(self.inertia_about_origin(), other.inertia_about_origin())]
+        Io = [
+            [a + b for a, b in zip(ra, rb)] for ra, rb in zip(self.inertia_about_origin(), other.inertia_about_origin())
+        ]
         S = skew(c)
         Ic = [[Io[r][k] + m * sum(S[r][j] * S[j][k] for j in range(3)) for k in range(3)] for r in range(3)]
         if symbolic:
@@ -272,7 +278,7 @@ class Inertia:
             Ic = 0.5 * (I + I.T)
         return Inertia(m, c, Ic)
 
-    def subs(self, mapping) -> "Inertia":
+    def subs(self, mapping) -> Inertia:
         f = lambda e: e.subs(mapping) if isinstance(e, sp.Basic) else e
         return Inertia(f(self.mass), tuple(f(c) for c in self.com), tuple(tuple(f(e) for e in r) for r in self.inertia))
 
@@ -313,9 +319,17 @@ def judge(inertia: Inertia, policy: str, what: str) -> Inertia:
             _WARNED.add(key)
         return repaired
     if key not in _WARNED:
-        hint = "" if policy == "strict" or check.positive else (
-            "; forward dynamics, M^-1 and simulation may fail (inertia='repair' projects it onto a consistent one)")
-        warnings.warn(f"{what}: {check.describe()}: no rigid body has this inertia, kept as given{hint}",
-                      PhysicalConsistencyWarning, stacklevel=3)
+        hint = (
+            ""
+            if policy == "strict" or check.positive
+            else (
+                "; forward dynamics, M^-1 and simulation may fail (inertia='repair' projects it onto a consistent one)"
+            )
+        )
+        warnings.warn(
+            f"{what}: {check.describe()}: no rigid body has this inertia, kept as given{hint}",
+            PhysicalConsistencyWarning,
+            stacklevel=3,
+        )
         _WARNED.add(key)
     return inertia

@@ -22,8 +22,9 @@ follower's coordinate or keeps it independent is the Robot's choice (``Robot(...
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping, Optional
+from typing import Any
 
 from .._math import is_symbolic
 from .checks import number, real, vector
@@ -37,7 +38,14 @@ JOINT_KINDS = ("revolute", "prismatic", "fixed", "floating", "spherical", "plana
 #: spherical: q = (qx, qy, qz, qw), v = angular velocity in the child's frame;
 #: planar: q = (x, y, cos theta, sin theta) in the plane normal to ``axis``, v = (vx, vy, omega) in the
 #: child's frame.
-JOINT_SIZES = {"revolute": (1, 1), "prismatic": (1, 1), "fixed": (0, 0), "floating": (7, 6), "spherical": (4, 3), "planar": (4, 3)}
+JOINT_SIZES = {
+    "revolute": (1, 1),
+    "prismatic": (1, 1),
+    "fixed": (0, 0),
+    "floating": (7, 6),
+    "spherical": (4, 3),
+    "planar": (4, 3),
+}
 MULTI_DOF_KINDS = ("floating", "spherical", "planar")
 
 
@@ -61,7 +69,7 @@ class Mimic:
         object.__setattr__(self, "offset", real(self.offset, f"{what}: offset"))
 
     @classmethod
-    def of(cls, value) -> "Mimic":
+    def of(cls, value) -> Mimic:
         """A Mimic from a Mimic, a mapping ``{leader (or joint), multiplier, offset}`` or a tuple
         ``(leader[, multiplier[, offset]])``."""
         if isinstance(value, Mimic):
@@ -71,13 +79,17 @@ class Mimic:
         if isinstance(value, Mapping):
             unknown = sorted(set(value) - {"leader", "joint", "multiplier", "offset"})
             if unknown or ("leader" in value) == ("joint" in value):
-                raise ValueError(f"mimic must be a mapping with 'leader' (or 'joint'), optional 'multiplier' and 'offset'; got keys {sorted(value)}")
+                raise ValueError(
+                    f"mimic must be a mapping with 'leader' (or 'joint'), optional 'multiplier' and 'offset'; got keys {sorted(value)}"
+                )
             return cls(value.get("leader", value.get("joint")), value.get("multiplier", 1.0), value.get("offset", 0.0))
         if isinstance(value, (tuple, list)) and 1 <= len(value) <= 3:
             return cls(*value)
-        raise ValueError(f"mimic must be a Mimic, a leader name, a mapping or a tuple (leader, multiplier, offset), got {value!r}")
+        raise ValueError(
+            f"mimic must be a Mimic, a leader name, a mapping or a tuple (leader, multiplier, offset), got {value!r}"
+        )
 
-    def then(self, outer: "Mimic") -> "Mimic":
+    def then(self, outer: Mimic) -> Mimic:
         """The relation of a follower of a follower: ``outer`` follows the joint this relation
         describes, which follows ``self.leader``; the result follows ``self.leader`` directly."""
         return Mimic(self.leader, outer.multiplier * self.multiplier, outer.multiplier * self.offset + outer.offset)
@@ -100,7 +112,7 @@ class Joint:
     #: Coulomb level for qd < 0 (magnitude); None = the same as ``coulomb`` (symmetric friction)
     coulomb_negative: Any = None
     #: this joint follows another (URDF <mimic>): q = multiplier * q_leader + offset; None = independent
-    mimic: Optional[Mimic] = None
+    mimic: Mimic | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
@@ -122,9 +134,13 @@ class Joint:
         # coulomb=(positive, negative): the two levels of direction-dependent Coulomb friction
         if isinstance(self.coulomb, (tuple, list)):
             if len(self.coulomb) != 2:
-                raise ValueError(f"{what}: coulomb must be one level or a pair (positive, negative) of levels, got {list(self.coulomb)!r}")
+                raise ValueError(
+                    f"{what}: coulomb must be one level or a pair (positive, negative) of levels, got {list(self.coulomb)!r}"
+                )
             if self.coulomb_negative is not None:
-                raise ValueError(f"{what}: give the negative-direction Coulomb level once, as coulomb=(positive, negative) or coulomb_negative=...")
+                raise ValueError(
+                    f"{what}: give the negative-direction Coulomb level once, as coulomb=(positive, negative) or coulomb_negative=..."
+                )
             positive, negative = self.coulomb
             object.__setattr__(self, "coulomb", positive)
             object.__setattr__(self, "coulomb_negative", negative)
@@ -142,8 +158,9 @@ class Joint:
             if v is not None and not is_symbolic(v) and v < 0:
                 hint = ""
                 if name == "coulomb_negative":
-                    hint = (" (a level, not a signed torque: Corke's Tc = [Tc+, Tc-] with Tc- < 0 is "
-                            "coulomb=(Tc+, -Tc-))")
+                    hint = (
+                        " (a level, not a signed torque: Corke's Tc = [Tc+, Tc-] with Tc- < 0 is coulomb=(Tc+, -Tc-))"
+                    )
                 raise ValueError(f"{what}: {name} must be >= 0, got {v}{hint}")
         if self.is_multi_dof:
             # a multi-DOF joint has one scalar of each per degree of freedom in no file format kinedyn
@@ -156,7 +173,9 @@ class Joint:
         if self.mimic is not None:
             mimic = Mimic.of(self.mimic)
             if self.kind not in ("revolute", "prismatic"):
-                raise ValueError(f"{what}: only a revolute or prismatic joint can mimic another; this one is {self.kind}")
+                raise ValueError(
+                    f"{what}: only a revolute or prismatic joint can mimic another; this one is {self.kind}"
+                )
             if mimic.leader == self.name:
                 raise ValueError(f"{what}: a joint cannot mimic itself")
             object.__setattr__(self, "mimic", mimic)

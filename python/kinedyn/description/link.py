@@ -20,7 +20,7 @@ order, so ``parent[i] < i``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -38,7 +38,11 @@ def _pose(value, what: str):
         T = sp.Matrix(value)
     else:
         raw = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value)
-        if raw.dtype.kind == "c" or raw.dtype == object and any(isinstance(v, complex) or getattr(v, "is_real", True) is False for v in raw.flat):
+        if (
+            raw.dtype.kind == "c"
+            or raw.dtype == object
+            and any(isinstance(v, complex) or getattr(v, "is_real", True) is False for v in raw.flat)
+        ):
             raise ValueError(f"{what} must be real, got complex values")
         try:
             T = raw.astype(float)
@@ -60,7 +64,7 @@ def _pose(value, what: str):
 @dataclass(frozen=True)
 class Link:
     name: str
-    parent: Optional[str]
+    parent: str | None
     joint: Joint
     placement: Any = field(default_factory=identity)
     post: Any = field(default_factory=identity)
@@ -85,7 +89,7 @@ class Frame:
     """An extra named frame fixed to a link (``link=None`` means the base), e.g. a tool frame."""
 
     name: str
-    link: Optional[str]
+    link: str | None
     placement: Any = field(default_factory=identity)
 
     def __post_init__(self):

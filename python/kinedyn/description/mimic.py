@@ -19,12 +19,10 @@ of followers is an error. How the dynamics reduce with G: :mod:`kinedyn._mimic`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional, Sequence
 
 import numpy as np
-
-from .joint import Mimic
 
 __all__ = ["MimicMap", "mimic_map", "MIMIC_MODES"]
 
@@ -85,7 +83,7 @@ def _sizes(joints) -> tuple:
     return iq, iv, q0, v0
 
 
-def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robot: str = "robot") -> Optional[MimicMap]:
+def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robot: str = "robot") -> MimicMap | None:
     """The coordinate maps of a robot whose moving joints (in body order) are ``joints``;
     ``all_joints`` includes the fixed ones (for the error naming a fixed leader). None when no
     joint follows another or ``mode == "independent"`` (mimic relations are then ignored, without
@@ -107,8 +105,10 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
         if m.leader not in index:
             if m.leader in kinds:
                 raise ValueError(f"{what}, which is {kinds[m.leader]}: a leader must be a revolute or prismatic joint")
-            raise ValueError(f"{what}, which the robot does not have (joints: {list(index)}); "
-                             "load it with mimic='independent' to keep the follower as an independent joint")
+            raise ValueError(
+                f"{what}, which the robot does not have (joints: {list(index)}); "
+                "load it with mimic='independent' to keep the follower as an independent joint"
+            )
         leader = joints[index[m.leader]]
         if leader.kind not in ("revolute", "prismatic"):
             raise ValueError(f"{what}, which is {leader.kind}: a leader must be a revolute or prismatic joint")
@@ -132,7 +132,7 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
     q_keep = np.concatenate([np.arange(iq[i], iq[i] + joints[i].nq) for i in independent]).astype(np.int64)
     G = np.zeros((nv_full, nv))
     for i in independent:
-        G[iv[i]:iv[i] + joints[i].nv, reduced_v[i]:reduced_v[i] + joints[i].nv] = np.eye(joints[i].nv)
+        G[iv[i] : iv[i] + joints[i].nv, reduced_v[i] : reduced_v[i] + joints[i].nv] = np.eye(joints[i].nv)
     q_lead, mult, off = [], [], []
     for f in followers:
         relation = relations[joints[f].name]
@@ -147,11 +147,22 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
     Gq_T[q_lead, q_follow] = mult
     b[q_follow] = off
     return MimicMap(
-        relations=relations, independent=independent, followers=followers, nq_full=nq_full, nv_full=nv_full, nq=nq, nv=nv,
-        q_keep=q_keep, q_follow=q_follow, q_lead=np.array(q_lead, dtype=np.int64),
-        multiplier=np.array(mult), offset=np.array(off), G=G, Gq_T=Gq_T, b=b,
+        relations=relations,
+        independent=independent,
+        followers=followers,
+        nq_full=nq_full,
+        nv_full=nv_full,
+        nq=nq,
+        nv=nv,
+        q_keep=q_keep,
+        q_follow=q_follow,
+        q_lead=np.array(q_lead, dtype=np.int64),
+        multiplier=np.array(mult),
+        offset=np.array(off),
+        G=G,
+        Gq_T=Gq_T,
+        b=b,
     )
-
 
 
 def reduced_coefficient(robot, name: str) -> np.ndarray:
@@ -195,11 +206,13 @@ def lock_followers(relations: dict, values: dict, given: dict) -> dict:
     value, else at ``multiplier * value + offset``. A follower named without its leader is an error
     (it moves with its leader: lock the leader, or load the robot with mimic="independent")."""
     values = dict(values)
-    for follower, value in given.items():
+    for follower in given:
         leader = relations[follower].leader
         if leader not in values:
-            raise ValueError(f"lock_joints: joint '{follower}' follows joint '{leader}' (mimic); lock '{leader}' too "
-                             "(its followers are locked with it), or load the robot with mimic='independent'")
+            raise ValueError(
+                f"lock_joints: joint '{follower}' follows joint '{leader}' (mimic); lock '{leader}' too "
+                "(its followers are locked with it), or load the robot with mimic='independent'"
+            )
     for follower, relation in relations.items():
         if relation.leader in values:
             value = given.get(follower)
@@ -208,7 +221,9 @@ def lock_followers(relations: dict, values: dict, given: dict) -> dict:
             try:
                 v = float(value)
             except (TypeError, ValueError):
-                raise ValueError(f"lock_joints: the value of joint '{follower}' must be a number, got {value!r}") from None
+                raise ValueError(
+                    f"lock_joints: the value of joint '{follower}' must be a number, got {value!r}"
+                ) from None
             if not np.isfinite(v):
                 raise ValueError(f"lock_joints: the value of joint '{follower}' must be finite, got {v}")
             values[follower] = v

@@ -53,12 +53,11 @@ import math
 import os
 import types
 import warnings
-from typing import Optional
 
 import numpy as np
 
-from .checks import LARGEST
 from .bounded_xml import parse_bounded
+from .checks import LARGEST
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
@@ -82,7 +81,7 @@ _REFUSED = ("replicate", "attach", "composite", "flexcomp")
 
 
 # ============================================================================== entry point
-def robot_from_mjcf(path_or_string, *, tool: Optional[str] = None, inertia: str = "warn", gravity=None):
+def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "warn", gravity=None):
     """A :class:`kinedyn.Robot` from an MJCF file path or an XML string (see the module docstring).
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path (an XML string
@@ -113,8 +112,18 @@ def robot_from_mjcf(path_or_string, *, tool: Optional[str] = None, inertia: str 
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(links, frames, gravity=gravity, base="world", tool=tool, name=name, source=source,
-                          inertia=inertia, visuals=visuals, collisions=collisions)
+            robot = Robot(
+                links,
+                frames,
+                gravity=gravity,
+                base="world",
+                tool=tool,
+                name=name,
+                source=source,
+                inertia=inertia,
+                visuals=visuals,
+                collisions=collisions,
+            )
     except ValueError as e:
         raise ValueError(f"{src.label}: {e}") from None
     for w in caught:
@@ -128,7 +137,7 @@ def _caller_level() -> int:
     import sys
 
     package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame: Optional[types.FrameType] = sys._getframe(2)
+    frame: types.FrameType | None = sys._getframe(2)
     level = 2
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
         frame, level = frame.f_back, level + 1
@@ -139,7 +148,7 @@ def _caller_level() -> int:
 class _Sources:
     """Where each element came from: (file label, line), for messages; the model's folder."""
 
-    def __init__(self, label: str, base_dir: Optional[str]):
+    def __init__(self, label: str, base_dir: str | None):
         self.label = label
         self.base_dir = base_dir
         self.where: dict = {}  # id(element) -> (label, line)
@@ -164,7 +173,9 @@ def _parse_model(path_or_string):
         src = _Sources("<MJCF string>", None)
         data = text.encode("utf-8")
         if len(data) > MAX_FILE_BYTES:
-            raise ValueError(f"{src.label}: the XML is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model")
+            raise ValueError(
+                f"{src.label}: the XML is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model"
+            )
         src.total_bytes += len(data)
         root = _parse_xml(data, src.label, src)
     else:
@@ -183,7 +194,9 @@ def _read(path: str, src: _Sources, element=None) -> bytes:
         raise ValueError(f"{where}cannot read MJCF file '{path}' ({e.strerror or e})") from None
     src.total_bytes += len(data)
     if len(data) > MAX_FILE_BYTES or src.total_bytes > MAX_FILE_BYTES:
-        raise ValueError(f"{path}: the model (with its includes) is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model")
+        raise ValueError(
+            f"{path}: the model (with its includes) is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model"
+        )
     return data
 
 
@@ -196,7 +209,7 @@ def _parse_xml(data: bytes, label: str, src: _Sources):
     return parse_bounded(data, label, "an MJCF model", MAX_DEPTH, record)
 
 
-def _expand_includes(element, src: _Sources, folder: Optional[str], depth: int) -> None:
+def _expand_includes(element, src: _Sources, folder: str | None, depth: int) -> None:
     """Replace every ``<include file>`` below ``element`` by the children of the included ``<mujoco>``."""
     k = 0
     while k < len(element):
@@ -209,7 +222,9 @@ def _expand_includes(element, src: _Sources, folder: Optional[str], depth: int) 
         if not name:
             raise src.error(child, "has no 'file' attribute")
         if folder is None or src.base_dir is None:
-            raise src.error(child, f"file='{name}': a model given as an XML string cannot include files (load it from its file)")
+            raise src.error(
+                child, f"file='{name}': a model given as an XML string cannot include files (load it from its file)"
+            )
         if depth >= MAX_INCLUDE_DEPTH:
             raise src.error(child, f"file='{name}': includes nested deeper than {MAX_INCLUDE_DEPTH} levels")
         src.includes += 1
@@ -218,18 +233,24 @@ def _expand_includes(element, src: _Sources, folder: Optional[str], depth: int) 
         path = os.path.realpath(os.path.join(folder, name))
         top = os.path.realpath(src.base_dir)
         if os.path.commonpath([path, top]) != top:
-            raise src.error(child, f"file='{name}' is outside the model's folder {top} (an included file must lie inside it)")
+            raise src.error(
+                child, f"file='{name}' is outside the model's folder {top} (an included file must lie inside it)"
+            )
         label = os.path.relpath(path) if not os.path.isabs(src.label) else path
         included = _parse_xml(_read(path, src, child), label, src)
         if included.tag != "mujoco":
-            raise src.error(child, f"file='{name}': the included file's root element is <{included.tag}>, expected <mujoco>")
+            raise src.error(
+                child, f"file='{name}': the included file's root element is <{included.tag}>, expected <mujoco>"
+            )
         _expand_includes(included, src, os.path.dirname(path), depth + 1)
-        element[k:k + 1] = list(included)
+        element[k : k + 1] = list(included)
         k += len(included)
 
 
 # ============================================================================== numbers, poses
-def _numbers(element, attribute: str, src: _Sources, n: Optional[int] = None, text: Optional[str] = None, at_most: Optional[int] = None) -> tuple:
+def _numbers(
+    element, attribute: str, src: _Sources, n: int | None = None, text: str | None = None, at_most: int | None = None
+) -> tuple:
     text = element.get(attribute) if text is None else text
     assert text is not None
     try:
@@ -239,10 +260,15 @@ def _numbers(element, attribute: str, src: _Sources, n: Optional[int] = None, te
     if n is not None and len(values) != n:
         raise src.error(element, f"attribute '{attribute}' must be {n} numbers, got {len(values)}: '{_short(text)}'")
     if at_most is not None and not 1 <= len(values) <= at_most:
-        raise src.error(element, f"attribute '{attribute}' must be 1 to {at_most} numbers, got {len(values)}: '{_short(text)}'")
+        raise src.error(
+            element, f"attribute '{attribute}' must be 1 to {at_most} numbers, got {len(values)}: '{_short(text)}'"
+        )
     for v in values:
         if not math.isfinite(v) or abs(v) > LARGEST:
-            raise src.error(element, f"attribute '{attribute}' must hold finite numbers of magnitude at most {LARGEST:g}, got '{_short(text)}'")
+            raise src.error(
+                element,
+                f"attribute '{attribute}' must hold finite numbers of magnitude at most {LARGEST:g}, got '{_short(text)}'",
+            )
     return values
 
 
@@ -252,21 +278,25 @@ def _short(text: str) -> str:
 
 def _quat_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
     """Rotation matrix of a unit quaternion (w, x, y, z)."""
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _axis_angle(axis, angle: float) -> np.ndarray:
     x, y, z = axis
     c, s, v = math.cos(angle), math.sin(angle), 1 - math.cos(angle)
-    return np.array([
-        [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
-        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
-        [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
-    ])
+    return np.array(
+        [
+            [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
+            [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
+            [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
+        ]
+    )
 
 
 def _z_to(vector: np.ndarray) -> np.ndarray:
@@ -318,17 +348,23 @@ class _Reader:
             for attribute, value in c.attrib.items():
                 if attribute == "angle":
                     if value not in ("degree", "radian"):
-                        raise self.src.error(c, f"attribute 'angle' must be 'degree' or 'radian', got '{_short(value)}'")
+                        raise self.src.error(
+                            c, f"attribute 'angle' must be 'degree' or 'radian', got '{_short(value)}'"
+                        )
                     self.degrees = value == "degree"
                 elif attribute == "eulerseq":
                     if len(value) != 3 or any(ch not in "xyzXYZ" for ch in value):
-                        raise self.src.error(c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{_short(value)}'")
+                        raise self.src.error(
+                            c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{_short(value)}'"
+                        )
                     self.eulerseq = value
                 elif attribute == "autolimits":
                     self.autolimits = self.boolean(c, attribute, value)
                 elif attribute == "inertiafromgeom":
                     if value not in ("true", "false", "auto"):
-                        raise self.src.error(c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{_short(value)}'")
+                        raise self.src.error(
+                            c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{_short(value)}'"
+                        )
                     self.inertiafromgeom = value
                 elif attribute == "inertiagrouprange":
                     lo, hi = _numbers(c, attribute, self.src, 2)
@@ -337,14 +373,16 @@ class _Reader:
                     if self.src.base_dir is not None and (attribute == "meshdir" or c.get("meshdir") is None):
                         self.meshdir = os.path.join(self.src.base_dir, value)
                 elif attribute == "coordinate" and value != "local":
-                    raise self.src.error(c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)")
+                    raise self.src.error(
+                        c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)"
+                    )
                 elif attribute in ("boundmass", "boundinertia", "settotalmass"):
                     setattr(self, attribute, _numbers(c, attribute, self.src, 1)[0])
                 elif attribute == "balanceinertia":
                     self.balanceinertia = self.boolean(c, attribute, value)
 
     @staticmethod
-    def boolean_value(value: str) -> Optional[bool]:
+    def boolean_value(value: str) -> bool | None:
         return {"true": True, "false": False}.get(value)
 
     def boolean(self, element, attribute: str, value: str) -> bool:
@@ -389,7 +427,7 @@ class _Reader:
         if element.tag == "geom" and "size" in out and "size" in element.attrib:
             # MuJoCo reads the numbers given over the default's (a sphere's size="r" keeps the rest)
             given = element.get("size").split()
-            rest = out["size"].split()[len(given):]
+            rest = out["size"].split()[len(given) :]
             out["size"] = " ".join(given + rest)
             element = {k: v for k, v in element.attrib.items() if k != "size"}
             out.update(element)
@@ -478,7 +516,10 @@ class _Reader:
             if child.tag in _UNMODELLED and len(child):
                 self.ignored.add(f"<{child.tag}> ({len(child)} elements)")
             elif child.tag in _REFUSED:
-                raise self.src.error(child, "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)")
+                raise self.src.error(
+                    child,
+                    "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)",
+                )
         worlds = list(self.root.iterfind("worldbody"))
         if not worlds:
             raise self.src.error(self.root, "has no <worldbody>")
@@ -507,9 +548,17 @@ class _Reader:
         if total <= 0:
             raise ValueError(f"{self.src.label}: <compiler settotalmass> needs bodies with mass to scale")
         k = self.settotalmass / total
-        self.links[:] = [Link(link.name, link.parent, link.joint, link.placement, link.post,
-                              Inertia(k * link.inertia.mass, link.inertia.com, k * np.array(link.inertia.inertia, dtype=float)))
-                         for link in self.links]
+        self.links[:] = [
+            Link(
+                link.name,
+                link.parent,
+                link.joint,
+                link.placement,
+                link.post,
+                Inertia(k * link.inertia.mass, link.inertia.com, k * np.array(link.inertia.inertia, dtype=float)),
+            )
+            for link in self.links
+        ]
 
     def children(self, element, link: str, link_from_here: np.ndarray, childclass: str, world: bool = False) -> list:
         """The bodies, geoms, sites and frames inside ``element`` (a body or frame), whose poses are
@@ -522,13 +571,18 @@ class _Reader:
                 self.body(child, link, link_from_here, childclass, world)
             elif tag == "frame":
                 a = child.attrib
-                geoms += self.children(child, link, link_from_here @ self.frame(child, a), a.get("childclass", childclass), world)
+                geoms += self.children(
+                    child, link, link_from_here @ self.frame(child, a), a.get("childclass", childclass), world
+                )
             elif tag == "geom":
                 geoms.append(self.geom(child, link, link_from_here, childclass))
             elif tag == "site":
                 self.site(child, link, link_from_here, childclass)
             elif tag in _REFUSED:
-                raise self.src.error(child, "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)")
+                raise self.src.error(
+                    child,
+                    "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)",
+                )
             elif tag in ("joint", "freejoint") and (world or element.tag == "frame"):
                 raise self.src.error(child, "must be inside a <body> (not the world body or a <frame>)")
         return geoms
@@ -588,14 +642,20 @@ class _Reader:
         kind = "free" if element.tag == "freejoint" else a.get("type", "hinge")
         what = f"joint '{name}'"
         if kind not in _JOINT_KINDS:
-            raise self.src.error(element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_JOINT_KINDS)}")
+            raise self.src.error(
+                element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_JOINT_KINDS)}"
+            )
         if kind == "free" and not (top_level and count == 1):
-            raise self.src.error(element, f"{what}: a free joint must be the only joint of a body whose parent is the world body")
+            raise self.src.error(
+                element, f"{what}: a free joint must be the only joint of a body whose parent is the world body"
+            )
         axis = _numbers(element, "axis", self.src, 3, text=a.get("axis", "0 0 1"))
         pos = _numbers(element, "pos", self.src, 3, text=a.get("pos", "0 0 0"))
         scalars = {}
         for attribute in ("armature", "damping", "frictionloss", "ref", "stiffness"):
-            scalars[attribute] = _numbers(element, attribute, self.src, 1, text=a[attribute])[0] if attribute in a else 0.0
+            scalars[attribute] = (
+                _numbers(element, attribute, self.src, 1, text=a[attribute])[0] if attribute in a else 0.0
+            )
         if scalars["stiffness"] != 0:
             self.ignored.add(f"the spring (stiffness) of {what}")
         angular = kind == "hinge"
@@ -607,13 +667,19 @@ class _Reader:
             options["coulomb"] = scalars["frictionloss"]
             limited = a.get("limited", "auto")
             if limited not in ("true", "false", "auto"):
-                raise self.src.error(element, f"{what}: attribute 'limited' must be true, false or auto, got '{_short(limited)}'")
+                raise self.src.error(
+                    element, f"{what}: attribute 'limited' must be true, false or auto, got '{_short(limited)}'"
+                )
             if limited == "auto" and not self.autolimits and "range" in a:
-                raise self.src.error(element, f"{what}: has a range but limited='auto' with autolimits off (MuJoCo refuses it too)")
+                raise self.src.error(
+                    element, f"{what}: has a range but limited='auto' with autolimits off (MuJoCo refuses it too)"
+                )
             if limited == "true" or (limited == "auto" and "range" in a):
                 lower, upper = _numbers(element, "range", self.src, 2, text=a.get("range", "0 0"))
                 if lower > upper:
-                    raise self.src.error(element, f"{what}: attribute 'range' has lower {lower:g} above upper {upper:g}")
+                    raise self.src.error(
+                        element, f"{what}: attribute 'range' has lower {lower:g} above upper {upper:g}"
+                    )
                 if angular:
                     lower, upper = self.angle(lower), self.angle(upper)
                 options["lower"], options["upper"] = lower, upper
@@ -643,7 +709,10 @@ class _Reader:
         pose = self.frame(element, a)
         if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
             if a.get("type", "sphere") not in ("capsule", "cylinder", "box", "ellipsoid"):
-                raise self.src.error(element, f"site '{name}': 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {a.get('type', 'sphere')}")
+                raise self.src.error(
+                    element,
+                    f"site '{name}': 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {a.get('type', 'sphere')}",
+                )
             pose = self.segment(element, a["fromto"])[0]
         self.frames.append(Frame(frame_name, None if link == "world" else link, link_from_here @ pose))
 
@@ -663,13 +732,17 @@ class _Reader:
         kind = a.get("type", "sphere")
         what = f"geom '{a['name']}'" if a.get("name") else "geom"
         if kind not in _SHAPES:
-            raise self.src.error(element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_SHAPES)}")
+            raise self.src.error(
+                element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_SHAPES)}"
+            )
         size = list(_numbers(element, "size", self.src, text=a["size"], at_most=3)) if "size" in a else []
         size += [0.0] * (3 - len(size))
         pose = self.frame(element, a)
         if "fromto" in a:
             if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
-                raise self.src.error(element, f"{what}: 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {kind}")
+                raise self.src.error(
+                    element, f"{what}: 'fromto' is for capsules, cylinders, boxes and ellipsoids, not a {kind}"
+                )
             pose, length = self.segment(element, a["fromto"])
             if kind in ("capsule", "cylinder"):
                 size[1] = length / 2
@@ -677,7 +750,10 @@ class _Reader:
                 size[1], size[2] = size[0], length / 2
         needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}.get(kind, 0)
         if any(s <= 0 for s in size[:needed]):
-            raise self.src.error(element, f"{what}: a {kind} needs {needed} positive size number{'s' if needed > 1 else ''}, got size='{a.get('size', '')}'")
+            raise self.src.error(
+                element,
+                f"{what}: a {kind} needs {needed} positive size number{'s' if needed > 1 else ''}, got size='{a.get('size', '')}'",
+            )
         group = int(_numbers(element, "group", self.src, 1, text=a.get("group", "0"))[0])
         shape = self.shape(element, kind, size, a, what)
         where = self.src.at(element)
@@ -737,7 +813,6 @@ class _Reader:
         return total
 
     def inertial(self, element, body: str) -> Inertia:
-        what = f"body '{body}' <inertial>"
         a = element.attrib
         for required in ("pos", "mass"):
             if required not in a:
@@ -749,7 +824,9 @@ class _Reader:
             raise self.src.error(element, f"of body '{body}' gives both 'diaginertia' and 'fullinertia'; keep one")
         if "fullinertia" in a:
             if any(k in a for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis")):
-                raise self.src.error(element, f"of body '{body}': 'fullinertia' takes no orientation (MuJoCo refuses it too)")
+                raise self.src.error(
+                    element, f"of body '{body}': 'fullinertia' takes no orientation (MuJoCo refuses it too)"
+                )
             ixx, iyy, izz, ixy, ixz, iyz = _numbers(element, "fullinertia", self.src, 6)
         elif "diaginertia" in a:
             ixx, iyy, izz = _numbers(element, "diaginertia", self.src, 3)
@@ -766,7 +843,10 @@ class _Reader:
         kind, (s0, s1, s2), a, element = g["kind"], g["size"], g["a"], g["element"]
         what = f"{g['what']} of body '{body}'"
         if kind == "mesh":
-            raise self.src.error(element, f"{what}: kinedyn does not compute a mesh's inertia; give body '{body}' an <inertial> (MuJoCo's compiled model shows it: model.body_inertia)")
+            raise self.src.error(
+                element,
+                f"{what}: kinedyn does not compute a mesh's inertia; give body '{body}' an <inertial> (MuJoCo's compiled model shows it: model.body_inertia)",
+            )
         if kind == "sphere":
             volume = 4 / 3 * math.pi * s0**3
             unit = (2 / 5 * s0**2,) * 3  # moments per unit mass
@@ -797,6 +877,8 @@ class _Reader:
         if mass < 0:
             raise self.src.error(element, f"{what}: its mass is negative ({mass:g})")
         if a.get("shellinertia") == "true":
-            raise self.src.error(element, f"{what}: shellinertia is not read by kinedyn; give body '{body}' an <inertial>")
+            raise self.src.error(
+                element, f"{what}: shellinertia is not read by kinedyn; give body '{body}' an <inertial>"
+            )
         body_inertia = Inertia(mass, (0.0, 0.0, 0.0), np.diag([mass * u for u in unit]))
         return body_inertia.transformed(g["pose"])

@@ -54,7 +54,10 @@ def _chain(joint: Joint) -> list:
         n = np.asarray(joint.axis, dtype=float)
         e1, e2 = _planar_basis(n)
         kinds, axes = ["prismatic", "prismatic", "revolute"], [e1, e2, np.cross(e1, e2)]
-    return [(suffix, kind, tuple(float(a) for a in axis)) for suffix, kind, axis in zip(EULER_SUFFIXES[joint.kind], kinds, axes)]
+    return [
+        (suffix, kind, tuple(float(a) for a in axis))
+        for suffix, kind, axis in zip(EULER_SUFFIXES[joint.kind], kinds, axes)
+    ]
 
 
 def euler_parametrised(robot):
@@ -87,7 +90,7 @@ def euler_to_native(robot, q_euler, qd_euler=None):
     values: list = []
     k = 0
     for joint in robot.joints:
-        block = q_euler[k:k + joint.nv]
+        block = q_euler[k : k + joint.nv]
         k += joint.nv
         if joint.kind == "planar":
             x, y, th = block
@@ -119,9 +122,9 @@ def euler_velocity_map(robot, q_euler) -> np.ndarray:
 
                 e1, e2 = _planar_basis(np.asarray(joint.axis, dtype=float))
                 basis = np.array([[*e1, 0, 0, 0], [*e2, 0, 0, 0], [0, 0, 0, *np.cross(e1, e2)]])
-                T[k:k + 3, k:k + 3] = basis @ J[:, k:k + 3]
+                T[k : k + 3, k : k + 3] = basis @ J[:, k : k + 3]
             else:
-                T[k:k + joint.nv, k:k + joint.nv] = J[rows, k:k + joint.nv]
+                T[k : k + joint.nv, k : k + joint.nv] = J[rows, k : k + joint.nv]
         k += joint.nv
     return T
 
@@ -131,5 +134,9 @@ def _quaternion_zyx(yaw: float, pitch: float, roll: float) -> tuple:
     cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
     cp, sp_ = np.cos(pitch / 2), np.sin(pitch / 2)
     cr, sr = np.cos(roll / 2), np.sin(roll / 2)
-    return (sr * cp * cy - cr * sp_ * sy, cr * sp_ * cy + sr * cp * sy, cr * cp * sy - sr * sp_ * cy, cr * cp * cy + sr * sp_ * sy)
-
+    return (
+        sr * cp * cy - cr * sp_ * sy,
+        cr * sp_ * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp_ * cy,
+        cr * cp * cy + sr * sp_ * sy,
+    )

@@ -19,7 +19,7 @@ a regular-expression match per link name.
 from __future__ import annotations
 
 import re
-from typing import Dict, Optional, Sequence
+from collections.abc import Sequence
 
 __all__ = ["TOOL_NAMES", "default_tool"]
 
@@ -33,7 +33,7 @@ TOOL_NAMES = (
 _PATTERNS = [re.compile(p, re.IGNORECASE) for p in TOOL_NAMES]
 
 
-def _rank(name: str) -> Optional[int]:
+def _rank(name: str) -> int | None:
     for rank, pattern in enumerate(_PATTERNS):
         if pattern.fullmatch(name):
             return rank
@@ -45,8 +45,8 @@ def default_tool(links: Sequence, base: str) -> str:
     ``parent`` and ``joint.is_moving``; any order, parents need not come first) rooted at ``base``."""
     parent = {link.name: link.parent for link in links}
     moving = {link.name: bool(link.joint.is_moving) for link in links}
-    depth: Dict[str, int] = {base: 0}  # moving joints between the base and the link
-    carrier: Dict[str, Optional[str]] = {base: None}  # the nearest moving link at or above the link
+    depth: dict[str, int] = {base: 0}  # moving joints between the base and the link
+    carrier: dict[str, str | None] = {base: None}  # the nearest moving link at or above the link
 
     def resolve(name: str) -> None:
         path = []

@@ -40,13 +40,12 @@ import os
 import re
 import types
 import warnings
-from typing import Optional
 
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
-from .checks import LARGEST
 from .bounded_xml import parse_bounded
+from .checks import LARGEST
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint, Mimic
@@ -63,8 +62,16 @@ FLOATING_BASE_FRAME = "universe"
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
-def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional[str] = None, inertia: str = "warn", floating_base: bool = False,
-                    source_path: Optional[str] = None, mimic: str = "reduce"):
+def robot_from_urdf(
+    path_or_string,
+    *,
+    gravity=(0.0, 0.0, -9.81),
+    tool: str | None = None,
+    inertia: str = "warn",
+    floating_base: bool = False,
+    source_path: str | None = None,
+    mimic: str = "reduce",
+):
     """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
@@ -96,9 +103,13 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     links = []
     if floating_base:
         if FLOATING_BASE_FRAME in link_elements:
-            raise ValueError(f"{src.label}: floating_base=True names the fixed frame '{FLOATING_BASE_FRAME}', "
-                             f"but the URDF has a link of that name")
-        links.append(Link(base, None, Joint(ROOT_JOINT, "floating"), np.eye(4), inertia=_inertial(link_elements[base], src)))
+            raise ValueError(
+                f"{src.label}: floating_base=True names the fixed frame '{FLOATING_BASE_FRAME}', "
+                f"but the URDF has a link of that name"
+            )
+        links.append(
+            Link(base, None, Joint(ROOT_JOINT, "floating"), np.eye(4), inertia=_inertial(link_elements[base], src))
+        )
         base = FLOATING_BASE_FRAME
     for j in ordered:
         element = link_elements[j["child"]]
@@ -114,12 +125,25 @@ def robot_from_urdf(path_or_string, *, gravity=(0.0, 0.0, -9.81), tool: Optional
     visuals, collisions = _geometry(root, list(link_elements.items()), src)
     # the Robot judges the inertias (policy) and checks the tree: its errors and warnings name a
     # link or joint, to which the file and line are added here, once
-    lines = {**{n: src.line(e) for n, e in link_elements.items()}, **{j["name"]: src.line(j["element"]) for j in joints}}
+    lines = {
+        **{n: src.line(e) for n, e in link_elements.items()},
+        **{j["name"]: src.line(j["element"]) for j in joints},
+    }
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(links, gravity=gravity, base=base, tool=tool, name=name, source=source, inertia=inertia, visuals=visuals, collisions=collisions,
-                          mimic=mimic)
+            robot = Robot(
+                links,
+                gravity=gravity,
+                base=base,
+                tool=tool,
+                name=name,
+                source=source,
+                inertia=inertia,
+                visuals=visuals,
+                collisions=collisions,
+                mimic=mimic,
+            )
     except ValueError as e:
         raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None
     for w in caught:
@@ -135,14 +159,14 @@ def _caller_level() -> int:
     import sys
 
     package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame: Optional[types.FrameType] = sys._getframe(1)
+    frame: types.FrameType | None = sys._getframe(1)
     level = 1
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
         frame, level = frame.f_back, level + 1
     return level
 
 
-def _line_of(message: str, lines: dict) -> Optional[int]:
+def _line_of(message: str, lines: dict) -> int | None:
     """The line of the link or joint a description-layer message starts with ("link 'x': ...")."""
     match = re.match(r"(?:link|joint) '([^']*)'", message)
     return lines.get(match.group(1)) if match else None
@@ -156,17 +180,17 @@ class _Source:
         self.label = label
         self.lines: dict = {}  # id(element) -> line of its start tag
 
-    def line(self, element) -> Optional[int]:
+    def line(self, element) -> int | None:
         return self.lines.get(id(element))
 
-    def at(self, line: Optional[int]) -> str:
+    def at(self, line: int | None) -> str:
         return self.label if line is None else f"{self.label}:{line}"
 
     def error(self, element, message: str) -> ValueError:
         return ValueError(f"{self.at(self.line(element))}: {message}")
 
 
-def _parse(path_or_string, source_path: Optional[str] = None):
+def _parse(path_or_string, source_path: str | None = None):
     """(source, root element): the XML parsed by expat with line numbers, no entity declarations
     (billion laughs, external entities) and a bounded nesting depth."""
     text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
@@ -191,7 +215,7 @@ def _parse(path_or_string, source_path: Optional[str] = None):
     return src, parse_bounded(data, src.label, "a URDF", MAX_DEPTH, record)
 
 
-def _floats(text: Optional[str], n: int, default, what: str, element, src: _Source) -> tuple:
+def _floats(text: str | None, n: int, default, what: str, element, src: _Source) -> tuple:
     if text is None:
         return tuple(default)
     parts = text.split()
@@ -205,7 +229,9 @@ def _floats(text: Optional[str], n: int, default, what: str, element, src: _Sour
         if not math.isfinite(v):
             raise src.error(element, f"{what} must be {n} finite numbers, got '{_short(text)}'")
         if abs(v) > LARGEST:
-            raise src.error(element, f"{what} has {v:g}, larger in magnitude than {LARGEST:g}, the most a description number may be")
+            raise src.error(
+                element, f"{what} has {v:g}, larger in magnitude than {LARGEST:g}, the most a description number may be"
+            )
     return values
 
 
@@ -259,8 +285,7 @@ def _joint(element, src: _Source) -> dict:
     if kind not in _SUPPORTED:
         raise src.error(
             element,
-            f"{what} has type '{kind}', which is not supported "
-            f"(supported: {', '.join(_SUPPORTED)})",
+            f"{what} has type '{kind}', which is not supported (supported: {', '.join(_SUPPORTED)})",
         )
     ends = {}
     for end in ("parent", "child"):
@@ -285,14 +310,17 @@ def _joint(element, src: _Source) -> dict:
     return {"name": name, **ends, "placement": _origin(element, what, src), "joint": joint, "element": element}
 
 
-def _mimic(element, what: str, src: _Source) -> Optional[Mimic]:
+def _mimic(element, what: str, src: _Source) -> Mimic | None:
     """``<mimic joint multiplier offset>`` (URDF defaults: multiplier 1, offset 0), or None."""
     if element is None:
         return None
     leader = element.get("joint")
     if not leader:
         raise src.error(element, f"{what}: <mimic> has no joint attribute (the joint it follows)")
-    multiplier, offset = _float(element, "multiplier", 1.0, f"{what} <mimic>", src), _float(element, "offset", 0.0, f"{what} <mimic>", src)
+    multiplier, offset = (
+        _float(element, "multiplier", 1.0, f"{what} <mimic>", src),
+        _float(element, "offset", 0.0, f"{what} <mimic>", src),
+    )
     try:
         return Mimic(leader, multiplier, offset)
     except ValueError as e:
@@ -346,7 +374,9 @@ MAX_MESH_NAME = 4096  # characters of a mesh file name
 def _rgba(element, what: str, src: _Source) -> tuple:
     rgba = _floats(element.get("rgba"), 4, (), f"{what} <color> rgba", element, src)
     if not rgba or any(not 0.0 <= c <= 1.0 for c in rgba):
-        raise src.error(element, f"{what} <color> rgba must be 4 numbers between 0 and 1, got '{_short(element.get('rgba') or '')}'")
+        raise src.error(
+            element, f"{what} <color> rgba must be 4 numbers between 0 and 1, got '{_short(element.get('rgba') or '')}'"
+        )
     return rgba
 
 
@@ -414,7 +444,16 @@ def _geometry(root, links: list, src: _Source) -> tuple:
                         rgba = _rgba(color, f"{what} <material>", src)
                     elif material in materials:
                         rgba = materials[material]
-                out.append(Visual(link_name, shape, np.asarray(_origin(item, what, src), dtype=float), rgba, material, src.at(src.line(item))))
+                out.append(
+                    Visual(
+                        link_name,
+                        shape,
+                        np.asarray(_origin(item, what, src), dtype=float),
+                        rgba,
+                        material,
+                        src.at(src.line(item)),
+                    )
+                )
     return visuals, collisions
 
 
@@ -427,7 +466,9 @@ def _order(joints: list, link_names: list, src: _Source):
     names: dict = {}
     for j in joints:
         if j["name"] in names:
-            raise src.error(j["element"], f"joint '{j['name']}' is defined twice (first at line {src.line(names[j['name']])})")
+            raise src.error(
+                j["element"], f"joint '{j['name']}' is defined twice (first at line {src.line(names[j['name']])})"
+            )
         names[j["name"]] = j["element"]
         for end in ("parent", "child"):
             if j[end] not in known:
@@ -467,11 +508,9 @@ def _cycle(parent_joint: dict) -> str:
     while True:
         link = parent_joint[link]["parent"]
         if link in position:
-            cycle = path[position[link]:] + [link]
+            cycle = path[position[link] :] + [link]
             if len(cycle) > 12:
                 cycle = cycle[:5] + [f"... {len(cycle) - 10} more ..."] + cycle[-5:]
             return " <- ".join(cycle)
         position[link] = len(path)
         path.append(link)
-
-

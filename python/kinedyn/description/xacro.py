@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import os
 import threading
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Optional, Sequence
 
 __all__ = ["expand_xacro", "is_xacro", "XACRO_REFUSED"]
 
@@ -38,8 +38,9 @@ def is_xacro(path) -> bool:
     return isinstance(path, (str, os.PathLike)) and os.fspath(path).lower().endswith(".xacro")
 
 
-def expand_xacro(path, xacro_args: Optional[Mapping[str, object]] = None, *, trust_xacro: bool = False,
-                 package_dirs: Sequence = ()) -> str:
+def expand_xacro(
+    path, xacro_args: Mapping[str, object] | None = None, *, trust_xacro: bool = False, package_dirs: Sequence = ()
+) -> str:
     """The URDF text a xacro file expands to (see the module docstring: needs ``trust_xacro=True``).
     Every failure is a ValueError naming the file."""
     path = os.fspath(path)
@@ -55,17 +56,23 @@ def expand_xacro(path, xacro_args: Optional[Mapping[str, object]] = None, *, tru
         import xacro  # type: ignore[import-untyped]
         from xacro import substitution_args
     except ImportError:
-        raise ValueError(f"{path}: reading xacro files needs the 'xacro' package (pip install xacro, or kinedyn[ros])") from None
+        raise ValueError(
+            f"{path}: reading xacro files needs the 'xacro' package (pip install xacro, or kinedyn[ros])"
+        ) from None
     folders = [Path(d) for d in package_dirs]
 
     def find(package: str) -> str:
         from .geometry import mesh_search_folders
 
-        candidates = [c for d in folders for c in (d / package, d)] + list(mesh_search_folders(package, os.path.dirname(os.path.abspath(path))))
+        candidates = [c for d in folders for c in (d / package, d)] + list(
+            mesh_search_folders(package, os.path.dirname(os.path.abspath(path)))
+        )
         for candidate in candidates:
             if candidate.name == package and candidate.is_dir():
                 return str(candidate)
-        raise ValueError(f"$(find {package}): package '{package}' not found (give its folder's parent in package_dirs, or set ROS_PACKAGE_PATH)")
+        raise ValueError(
+            f"$(find {package}): package '{package}' not found (give its folder's parent in package_dirs, or set ROS_PACKAGE_PATH)"
+        )
 
     with _LOCK:
         saved_find, saved_eval_find = substitution_args._eval_find, substitution_args._eval_dict.get("find")

@@ -15,8 +15,13 @@ from .solve import METHODS, inverse_kinematics
 __all__ = ["add_ik_command", "run_ik", "target_from_args"]
 
 # the solver's messages name its Python arguments; on the command line they are these flags
-FLAG_PHRASES = {"respect_limits=False": "--ignore-limits", "method='numeric'": "--method numeric", "method='analytic'": "--method analytic",
-                "a 4x4 pose": "a pose (--rpy)", "q0": "--q0"}
+FLAG_PHRASES = {
+    "respect_limits=False": "--ignore-limits",
+    "method='numeric'": "--method numeric",
+    "method='analytic'": "--method analytic",
+    "a 4x4 pose": "a pose (--rpy)",
+    "q0": "--q0",
+}
 
 
 def add_ik_command(subparsers):
@@ -34,9 +39,21 @@ def add_ik_command(subparsers):
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
     from ..cli import finite_float
 
-    p.add_argument("--xyz", nargs=3, type=finite_float, required=True, metavar=("X", "Y", "Z"), help="target position of the frame origin (m)")
-    p.add_argument("--rpy", nargs=3, type=finite_float, metavar=("ROLL", "PITCH", "YAW"),
-                   help="target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) (radians; degrees with --deg); omit for a position-only target")
+    p.add_argument(
+        "--xyz",
+        nargs=3,
+        type=finite_float,
+        required=True,
+        metavar=("X", "Y", "Z"),
+        help="target position of the frame origin (m)",
+    )
+    p.add_argument(
+        "--rpy",
+        nargs=3,
+        type=finite_float,
+        metavar=("ROLL", "PITCH", "YAW"),
+        help="target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) (radians; degrees with --deg); omit for a position-only target",
+    )
     p.add_argument("--all", action="store_true", help="print every solution (default: only the one nearest q0)")
     p.add_argument("--q0", nargs="+", type=float, metavar="Q", help="reference / start joint values (default zeros)")
     p.add_argument("--deg", action="store_true", help="--rpy and --q0 in degrees; angles printed in degrees")
@@ -79,7 +96,9 @@ def run_ik(args) -> int:
         from ..cli import parse_q
 
         q0 = parse_q(args.q0, robot, args.deg, "--q0")
-    result = inverse_kinematics(robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame)
+    result = inverse_kinematics(
+        robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame
+    )
     shown = result.solutions if args.all else result.solutions[:1]
     # per q coordinate: revolute angles (--deg) and the column names (a multi-DOF joint's block:
     # q1.x, q1.y, q1.z, q1.qx, ..., q1.qw for a free-flyer that is joint q1)
@@ -108,24 +127,37 @@ def run_ik(args) -> int:
         payload["nearest_q"] = angles(result.nearest_q)
 
     def render():
-        from ..cli import console, esc, in_cli_terms
         from rich.table import Table
 
+        from ..cli import console, esc, in_cli_terms
+
         c = console()
-        what = f"position {np.array2string(target, precision=6)}" if target.shape == (3,) else \
-            f"pose at {np.array2string(target[:3, 3], precision=6)}, rpy {np.array2string(np.asarray(args.rpy), precision=6)}{' deg' if args.deg else ' rad'}"
+        what = (
+            f"position {np.array2string(target, precision=6)}"
+            if target.shape == (3,)
+            else f"pose at {np.array2string(target[:3, 3], precision=6)}, rpy {np.array2string(np.asarray(args.rpy), precision=6)}{' deg' if args.deg else ' rad'}"
+        )
         c.print(f"[bold]{esc(robot.name)}[/bold]: '{esc(payload['frame'])}' to {what}; solver {result.solver}")
         if len(shown):
             unit = "deg" if args.deg else "rad"
             c.width = max(c.width, 12 * (robot.nq + 3))  # never truncate the numbers
-            table = Table(title=f"{len(result.solutions)} solution(s) ({unit}, m), nearest q0 first" + ("" if args.all else " (--all lists every one)"), title_justify="left")
+            table = Table(
+                title=f"{len(result.solutions)} solution(s) ({unit}, m), nearest q0 first"
+                + ("" if args.all else " (--all lists every one)"),
+                title_justify="left",
+            )
             table.add_column("#", justify="right")
             for label in labels:
                 table.add_column(label, justify="right")
             table.add_column("|dp| m", justify="right")
             table.add_column("|dR| rad", justify="right")
             for k, q in enumerate(shown):
-                table.add_row(str(k + 1), *(f"{v:.4f}" for v in angles(q)), f"{result.position_error[k]:.0e}", f"{result.orientation_error[k]:.0e}")
+                table.add_row(
+                    str(k + 1),
+                    *(f"{v:.4f}" for v in angles(q)),
+                    f"{result.position_error[k]:.0e}",
+                    f"{result.orientation_error[k]:.0e}",
+                )
             c.print(table)
             if robot.joint_names != [f"q{k + 1}" for k in range(len(robot.joints))]:
                 c.print("joints: " + ", ".join(f"q{k + 1} = {esc(name)}" for k, name in enumerate(robot.joint_names)))
@@ -145,5 +177,9 @@ def _coordinate_labels(robot) -> list:
 
     labels = []
     for k, j in enumerate(robot.joints):
-        labels.extend([f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}" for part in _Q_NAMES[j.kind]] if j.is_multi_dof else [f"q{k + 1}"])
+        labels.extend(
+            [f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}" for part in _Q_NAMES[j.kind]]
+            if j.is_multi_dof
+            else [f"q{k + 1}"]
+        )
     return labels

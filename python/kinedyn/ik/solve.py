@@ -12,7 +12,7 @@ Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,6 +30,7 @@ _FULL_MASK = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 
 
 _F64 = np.dtype(np.float64)
+
 
 @dataclass(slots=True)
 class IKResult:
@@ -51,15 +52,15 @@ class IKResult:
     orientation_error: np.ndarray
     iterations: int
     solver: str
-    reachable: Optional[bool] = True
+    reachable: bool | None = True
     singular: bool = False
     found: int = 0
-    nearest: Optional[np.ndarray] = None
-    nearest_q: Optional[np.ndarray] = None
+    nearest: np.ndarray | None = None
+    nearest_q: np.ndarray | None = None
     message: str = ""
 
     @property
-    def q(self) -> Optional[np.ndarray]:
+    def q(self) -> np.ndarray | None:
         """The solution nearest q0, or None."""
         return self.solutions[0] if len(self.solutions) else None
 
@@ -135,8 +136,21 @@ class _Chain:
     """What one (robot, frame) pair needs at every call, computed once. ``n`` is the size of a
     configuration (nq; reduced coordinates for a robot with reduced mimic joints)."""
 
-    __slots__ = ("frame", "n", "lower", "upper", "free_lower", "free_upper", "start", "solver", "model", "revolute", "position_ok",
-                 "reduction", "multi_dof")
+    __slots__ = (
+        "frame",
+        "n",
+        "lower",
+        "upper",
+        "free_lower",
+        "free_upper",
+        "start",
+        "solver",
+        "model",
+        "revolute",
+        "position_ok",
+        "reduction",
+        "multi_dof",
+    )
 
     def __init__(self, robot: Robot, frame: str):
         from .. import _core
@@ -172,11 +186,18 @@ def _reduction(m) -> tuple:
     q_source = np.argmax(np.abs(Gq), axis=1) if m.nq else np.zeros(len(Gq), dtype=np.intp)
     v_source = np.argmax(np.abs(G), axis=1) if m.nv else np.zeros(len(G), dtype=np.intp)
     rows_q, rows_v = np.arange(len(Gq)), np.arange(len(G))
-    return ([int(k) for k in q_source], [float(x) for x in Gq[rows_q, q_source]], [float(x) for x in np.asarray(m.b, dtype=float)],
-            [int(k) for k in v_source], [float(x) for x in G[rows_v, v_source]], [int(k) for k in m.q_keep], int(m.nv))
+    return (
+        [int(k) for k in q_source],
+        [float(x) for x in Gq[rows_q, q_source]],
+        [float(x) for x in np.asarray(m.b, dtype=float)],
+        [int(k) for k in v_source],
+        [float(x) for x in G[rows_v, v_source]],
+        [int(k) for k in m.q_keep],
+        int(m.nv),
+    )
 
 
-def _chain(robot: Robot, frame: Optional[str]) -> _Chain:
+def _chain(robot: Robot, frame: str | None) -> _Chain:
     cache = robot.__dict__.get("_ik_chains")
     if cache is None:
         cache = robot.__dict__["_ik_chains"] = {}
@@ -187,7 +208,7 @@ def _chain(robot: Robot, frame: Optional[str]) -> _Chain:
     return chain
 
 
-def analytic_structure(robot: Robot, frame: Optional[str] = None) -> Optional[str]:
+def analytic_structure(robot: Robot, frame: str | None = None) -> str | None:
     """Name of the closed-form structure detected from the robot's geometry for ``frame``
     (``"planar_2r"``, ``"planar_3r"``, ``"arm_intersecting_shoulder"``, ``"arm_parallel_elbow"``,
     ``"spherical_wrist"``, ``"three_parallel"``), or None."""
@@ -204,27 +225,33 @@ def _target(target: ArrayLike) -> tuple:
         try:
             t = real_array(target, "target")
         except (TypeError, ValueError) as e:
-            raise ValueError(f"target must be numbers (a 4x4 pose or a 3-vector position), got {type(target).__name__}: {e}") from None
+            raise ValueError(
+                f"target must be numbers (a 4x4 pose or a 3-vector position), got {type(target).__name__}: {e}"
+            ) from None
     shape = t.shape
     if shape == (4, 4) or (len(shape) == 3 and shape[1:] == (4, 4)):
         position, batch = False, len(shape) == 3
     elif shape == (3,) or (len(shape) == 2 and shape[1] == 3):
         position, batch = True, len(shape) == 2
     else:
-        raise ValueError(f"target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape}")
+        raise ValueError(
+            f"target must be a 4x4 pose, a 3-vector position, or a batch (N, 4, 4) / (N, 3); got shape {shape}"
+        )
     # a target so far away that the solver's squared residuals would overflow float64 (NaN and inf
     # are checked natively)
     reach = np.abs(t if position else t[..., :3, 3])
     if np.isfinite(reach).all() and reach.max(initial=0.0) > MAX_REACH:
-        raise ValueError(f"target position is {reach.max():.3g} m from the base: beyond {MAX_REACH:g} m, no robot reaches it "
-                         "(and float64 cannot solve for it)")
+        raise ValueError(
+            f"target position is {reach.max():.3g} m from the base: beyond {MAX_REACH:g} m, no robot reaches it "
+            "(and float64 cannot solve for it)"
+        )
     return t, position, batch
 
 
 MAX_REACH = 1e100  # m: the description's own bound on any length
 
 
-def _mask(mask) -> Optional[tuple]:
+def _mask(mask) -> tuple | None:
     if mask is None:
         return None
     try:
@@ -238,14 +265,18 @@ def _mask(mask) -> Optional[tuple]:
     return tuple(float(v) for v in m)
 
 
-def _q0(q0, chain: _Chain, batch: Optional[int], robot: Optional[Robot] = None) -> np.ndarray:
+def _q0(q0, chain: _Chain, batch: int | None, robot: Robot | None = None) -> np.ndarray:
     if q0 is None:
         return chain.start
     q = real_array(q0, "q0")
     n = chain.n
     if q.shape != (n,) and not (batch is not None and q.shape == (batch, n)):
         want = f"({n},)" + (f" or ({batch}, {n})" if batch is not None else "")
-        what = " (nq: a configuration; a free-flyer takes 7 entries, a spherical or planar joint 4)" if chain.multi_dof else ""
+        what = (
+            " (nq: a configuration; a free-flyer takes 7 entries, a spherical or planar joint 4)"
+            if chain.multi_dof
+            else ""
+        )
         raise ValueError(f"q0 must have shape {want}{what}, got {q.shape}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q0 contains a non-finite value (NaN or inf)")
@@ -266,12 +297,12 @@ def inverse_kinematics(
     method: str = "auto",
     respect_limits: bool = True,
     *,
-    frame: Optional[str] = None,
+    frame: str | None = None,
     tolerance: float = 1e-9,
     max_iterations: int = 50,
     restarts: int = 50,
     seed: int = 0,
-    progress: Optional[bool] = None,
+    progress: bool | None = None,
 ):
     """Joint vectors that put ``frame`` (default: the tool) at ``target``.
 
@@ -289,12 +320,26 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
-    if type(max_iterations) is not int or type(restarts) is not int or type(seed) is not int or not 0 <= max_iterations <= _MAX_INT \
-            or not 0 <= restarts <= _MAX_INT or not 0 <= seed < 2**64 or type(tolerance) is not float or not 0.0 < tolerance < np.inf:
+    if (
+        type(max_iterations) is not int
+        or type(restarts) is not int
+        or type(seed) is not int
+        or not 0 <= max_iterations <= _MAX_INT
+        or not 0 <= restarts <= _MAX_INT
+        or not 0 <= seed < 2**64
+        or type(tolerance) is not float
+        or not 0.0 < tolerance < np.inf
+    ):
         max_iterations, restarts, seed, tolerance = _check_settings(tolerance, max_iterations, restarts, seed)
     chain = _chain(robot, frame)
     # fast path: one float64 target, closed form, no mask (checks of the target happen natively)
-    if mask is None and method == "auto" and type(target) is np.ndarray and target.dtype is _F64 and chain.solver is not None:
+    if (
+        mask is None
+        and method == "auto"
+        and type(target) is np.ndarray
+        and target.dtype is _F64
+        and chain.solver is not None
+    ):
         shape = target.shape
         if shape == (4, 4) or (shape == (3,) and chain.position_ok):
             q_ref = chain.start if q0 is None else _q0(q0, chain, None, robot)
@@ -319,10 +364,26 @@ def inverse_kinematics(
     nb = len(t) if batch else None
     q_start = _q0(q0, chain, nb, robot)
     if batch:
-        return _batch(robot, chain, t, q_start, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress)
+        return _batch(
+            robot,
+            chain,
+            t,
+            q_start,
+            position,
+            weights,
+            use_analytic,
+            respect_limits,
+            tolerance,
+            max_iterations,
+            restarts,
+            seed,
+            progress,
+        )
     if use_analytic:
         return _analytic(robot, chain, t, q_start, position, respect_limits, tolerance, seed)
-    return _numeric(robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed)
+    return _numeric(
+        robot, chain, t, q_start, position, weights, respect_limits, tolerance, max_iterations, restarts, seed
+    )
 
 
 _MAX_INT = 2**31 - 1
@@ -363,16 +424,43 @@ def _why_not_analytic(robot: Robot, chain: _Chain, position: bool, weights) -> s
     )
 
 
-def _analytic(robot: Robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int) -> IKResult:
+def _analytic(
+    robot: Robot, chain: _Chain, t, q_ref, position: bool, respect_limits: bool, tolerance: float, seed: int
+) -> IKResult:
     solver = chain.solver
     assert solver is not None  # callers take this route only for a chain with a closed form
     sols, pe, oe, found, singular = solver.solve(t, q_ref, respect_limits, tolerance)
     name = "analytic:" + solver.structure
     if len(sols):
-        return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else ""))
+        return IKResult(
+            sols,
+            True,
+            pe,
+            oe,
+            0,
+            name,
+            True,
+            singular,
+            found,
+            message=f"{len(sols)} solution(s)"
+            + (" (singular target: a free joint was set from q0)" if singular else ""),
+        )
     if found:
-        return IKResult(sols, False, pe, oe, 0, name, True, singular, found, message=f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)")
-    result = IKResult(sols, False, pe, oe, 0, name, False, singular, 0, message="target out of reach: no solution exists")
+        return IKResult(
+            sols,
+            False,
+            pe,
+            oe,
+            0,
+            name,
+            True,
+            singular,
+            found,
+            message=f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)",
+        )
+    result = IKResult(
+        sols, False, pe, oe, 0, name, False, singular, 0, message="target out of reach: no solution exists"
+    )
     if position:
         _nearest(robot, chain, t, q_ref, result, seed)
     else:
@@ -384,15 +472,27 @@ def _nearest(robot: Robot, chain: _Chain, p, q_ref, result: IKResult, seed: int)
     """The reachable point nearest an unreachable position (least squares by LM with restarts)."""
     from .. import _core
 
-    q, _, _, _, _ = _core.solve_ik(chain.model, chain.frame, p, q_ref, chain.lower, chain.upper, np.ones(6), 200, 8, 1e-12, 1e-12, 1e-6, 0.5, seed)
+    q, _, _, _, _ = _core.solve_ik(
+        chain.model, chain.frame, p, q_ref, chain.lower, chain.upper, np.ones(6), 200, 8, 1e-12, 1e-12, 1e-6, 0.5, seed
+    )
     result.nearest_q = q
     result.nearest = robot.pose(q, robot.frame_names[chain.frame])[:3, 3]
     d = float(np.linalg.norm(result.nearest - p))
     result.message = f"target out of reach: no solution exists; the nearest reachable point is {np.array2string(result.nearest, precision=6)} ({d:.6g} m away)"
 
 
-def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int,
-                         progress: Optional[bool] = False) -> tuple:
+def _levenberg_marquardt(
+    chain: _Chain,
+    t,
+    q0,
+    w,
+    respect_limits: bool,
+    tolerance: float,
+    max_iterations: int,
+    restarts: int,
+    seed: int,
+    progress: bool | None = False,
+) -> tuple:
     """The core's LM solver for one target or a batch: (q, converged, position error, orientation
     error, iterations), revolute angles wrapped when the limits are not kept. With progress, a batch
     goes to the core in chunks (each target's restarts follow from the seed and its index in the
@@ -403,17 +503,41 @@ def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, toleranc
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
     tol = min(tolerance, 1e-10)
 
-    def solve(first: int, stop: Optional[int]):
+    def solve(first: int, stop: int | None):
         tk = t if stop is None else t[first:stop]
         qk = q0 if (stop is None or q0.ndim == 1) else q0[first:stop]
-        return _core.solve_ik(chain.model, chain.frame, tk, qk, lower, upper, w, max_iterations, restarts, tol, tol, 1e-6, 0.5, seed, first,
-                              reduction=chain.reduction)
+        return _core.solve_ik(
+            chain.model,
+            chain.frame,
+            tk,
+            qk,
+            lower,
+            upper,
+            w,
+            max_iterations,
+            restarts,
+            tol,
+            tol,
+            1e-6,
+            0.5,
+            seed,
+            first,
+            reduction=chain.reduction,
+        )
 
-    count = len(t) if t.ndim == 3 or (t.ndim == 2 and t.shape[1] == 3) else 0  # a batch: (N, 4, 4) poses or (N, 3) points
+    count = (
+        len(t) if t.ndim == 3 or (t.ndim == 2 and t.shape[1] == 3) else 0
+    )  # a batch: (N, 4, 4) poses or (N, 3) points
     if count <= IK_CHUNK or not wanted(progress):
         q, ok, pe, oe, it = solve(0, None)
     else:
-        bar = Delayed(True, count, "inverse kinematics", "{task.completed:.0f} / {task.total:.0f} targets", SHOW_AFTER if progress is None else 0.0)
+        bar = Delayed(
+            True,
+            count,
+            "inverse kinematics",
+            "{task.completed:.0f} / {task.total:.0f} targets",
+            SHOW_AFTER if progress is None else 0.0,
+        )
         parts = []
         try:
             for first in range(0, count, IK_CHUNK):
@@ -427,16 +551,50 @@ def _levenberg_marquardt(chain: _Chain, t, q0, w, respect_limits: bool, toleranc
     return q, ok, pe, oe, it
 
 
-def _numeric(robot: Robot, chain: _Chain, t, q0, position: bool, weights, respect_limits: bool, tolerance: float, max_iterations: int, restarts: int, seed: int) -> IKResult:
+def _numeric(
+    robot: Robot,
+    chain: _Chain,
+    t,
+    q0,
+    position: bool,
+    weights,
+    respect_limits: bool,
+    tolerance: float,
+    max_iterations: int,
+    restarts: int,
+    seed: int,
+) -> IKResult:
     w = np.asarray(weights if weights is not None else _FULL_MASK)
     q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed)
     ok = bool(ok) and pe <= tolerance and oe <= tolerance
     empty = np.zeros(0)
     if ok:
         singular = _is_singular(robot, chain, q, w if not position else np.asarray(_POSITION_MASK))
-        return IKResult(q[None, :], True, np.array([pe]), np.array([oe]), int(it), "numeric:lm", True, singular, 1, message="converged" + (" at a singular configuration" if singular else ""))
-    result = IKResult(np.zeros((0, chain.n)), False, empty, empty, int(it), "numeric:lm", None, False, 0, nearest_q=q,
-                      message=f"the numeric solver did not converge after {restarts} restarts (best residual {pe:.3g} m, {oe:.3g} rad); the target may be out of reach")
+        return IKResult(
+            q[None, :],
+            True,
+            np.array([pe]),
+            np.array([oe]),
+            int(it),
+            "numeric:lm",
+            True,
+            singular,
+            1,
+            message="converged" + (" at a singular configuration" if singular else ""),
+        )
+    result = IKResult(
+        np.zeros((0, chain.n)),
+        False,
+        empty,
+        empty,
+        int(it),
+        "numeric:lm",
+        None,
+        False,
+        0,
+        nearest_q=q,
+        message=f"the numeric solver did not converge after {restarts} restarts (best residual {pe:.3g} m, {oe:.3g} rad); the target may be out of reach",
+    )
     if position:
         result.nearest = robot.pose(q, robot.frame_names[chain.frame])[:3, 3]
         result.message += f"; nearest point reached {np.array2string(result.nearest, precision=6)}"
@@ -460,7 +618,21 @@ def _is_singular(robot: Robot, chain: _Chain, q: ArrayLike, weights) -> bool:
 IK_CHUNK = 256  # targets per native call when a batch shows progress
 
 
-def _batch(robot: Robot, chain: _Chain, t, q0, position, weights, use_analytic, respect_limits, tolerance, max_iterations, restarts, seed, progress) -> IKBatchResult:
+def _batch(
+    robot: Robot,
+    chain: _Chain,
+    t,
+    q0,
+    position,
+    weights,
+    use_analytic,
+    respect_limits,
+    tolerance,
+    max_iterations,
+    restarts,
+    seed,
+    progress,
+) -> IKBatchResult:
     N = len(t)
     w = np.asarray(weights if weights is not None else _FULL_MASK)
     if use_analytic:
@@ -471,11 +643,22 @@ def _batch(robot: Robot, chain: _Chain, t, q0, position, weights, use_analytic, 
         it = np.zeros(N, dtype=np.int64)
         none = ~ok
         if none.any():  # no closed-form solution: the numeric solver's best attempt, never a NaN row (§8)
-            qn, okn, pen, oen, itn = _levenberg_marquardt(chain, np.ascontiguousarray(t[none]), np.ascontiguousarray(refs[none]), w, respect_limits,
-                                                          tolerance, max_iterations, restarts, seed)
+            qn, okn, pen, oen, itn = _levenberg_marquardt(
+                chain,
+                np.ascontiguousarray(t[none]),
+                np.ascontiguousarray(refs[none]),
+                w,
+                respect_limits,
+                tolerance,
+                max_iterations,
+                restarts,
+                seed,
+            )
             q[none], pe[none], oe[none], it[none] = qn, pen, oen, itn
             ok[none] = okn & (pen <= tolerance) & (oen <= tolerance)
         return IKBatchResult(q, ok, pe, oe, it, "analytic:" + solver.structure)
-    q, ok, pe, oe, it = _levenberg_marquardt(chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed, progress)
+    q, ok, pe, oe, it = _levenberg_marquardt(
+        chain, t, q0, w, respect_limits, tolerance, max_iterations, restarts, seed, progress
+    )
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")

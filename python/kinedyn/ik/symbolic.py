@@ -32,7 +32,6 @@ lies above the shoulder-tool line: ``theta3 < 0`` on the front branch, ``theta3 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 import sympy as sp
@@ -53,7 +52,7 @@ class ElbowSolution:
     D: sp.Expr
     branches: list  # [{"name": str, "theta1": expr, "theta2": expr, "theta3": expr}]
     steps: list = field(default_factory=list)  # [(explanation, sympy.Eq)]
-    reachable: Optional[sp.Expr] = None
+    reachable: sp.Expr | None = None
 
     @property
     def symbols(self) -> tuple:
@@ -66,7 +65,9 @@ class ElbowSolution:
         if abs(D) > 1.0 + 1e-12:
             return np.full((len(self.branches), 3), np.nan)
         # at the boundary |D| = 1 rounding can leave a tiny imaginary part: keep the real part
-        return np.array([[complex(sp.N(b[k].subs(values))).real for k in ("theta1", "theta2", "theta3")] for b in self.branches])
+        return np.array(
+            [[complex(sp.N(b[k].subs(values))).real for k in ("theta1", "theta2", "theta3")] for b in self.branches]
+        )
 
     def lambdify(self):
         """A NumPy function ``f(x, y, z, L1, L2, L3) -> (4, 3)``."""
@@ -77,7 +78,11 @@ class ElbowSolution:
         """The forward kinematics (x, y, z) of step 1 as expressions of theta1..3."""
         t1, t2, t3 = sp.symbols("theta1 theta2 theta3")
         reach = self.L2 * sp.cos(t2) + self.L3 * sp.cos(t2 + t3)
-        return (t1, t2, t3), (sp.cos(t1) * reach, sp.sin(t1) * reach, self.L1 + self.L2 * sp.sin(t2) + self.L3 * sp.sin(t2 + t3))
+        return (t1, t2, t3), (
+            sp.cos(t1) * reach,
+            sp.sin(t1) * reach,
+            self.L1 + self.L2 * sp.sin(t2) + self.L3 * sp.sin(t2 + t3),
+        )
 
     def verify(self, point=(1.0, 0.2, 0.5), lengths=(3.0, 2.0, 1.0)) -> float:
         """Largest distance between ``point`` and the forward kinematics of every branch's angles."""
@@ -91,8 +96,12 @@ class ElbowSolution:
     def to_latex(self) -> str:
         lines = [sp.latex(eq) + r"\quad\text{(" + text + ")}" for text, eq in self.steps]
         for b in self.branches:
-            lines.append(r"\text{" + b["name"] + r":}\; " + ", ".join(
-                rf"\theta_{k} = {sp.latex(b[f'theta{k}'])}" for k in (1, 2, 3)))
+            lines.append(
+                r"\text{"
+                + b["name"]
+                + r":}\; "
+                + ", ".join(rf"\theta_{k} = {sp.latex(b[f'theta{k}'])}" for k in (1, 2, 3))
+            )
         return " \\\\\n".join(lines)
 
     def __str__(self) -> str:
@@ -115,13 +124,27 @@ def symbolic_elbow_solution(L1=None, L2=None, L3=None) -> ElbowSolution:
     root = sp.sqrt(1 - D**2)
     c1, c2, c3, q1, q2, q3, rho = sp.symbols("c_1 c_2 c_3 theta1 theta2 theta3 rho", real=True)
     steps = [
-        ("forward kinematics, step 1", sp.Eq(sp.Matrix([x, y, z]), sp.Matrix([
-            sp.cos(q1) * (s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3)),
-            sp.sin(q1) * (s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3)),
-            s1 + s2 * sp.sin(q2) + s3 * sp.sin(q2 + q3)]))),
+        (
+            "forward kinematics, step 1",
+            sp.Eq(
+                sp.Matrix([x, y, z]),
+                sp.Matrix(
+                    [
+                        sp.cos(q1) * (s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3)),
+                        sp.sin(q1) * (s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3)),
+                        s1 + s2 * sp.sin(q2) + s3 * sp.sin(q2 + q3),
+                    ]
+                ),
+            ),
+        ),
         ("waist angle, step 2", sp.Eq(q1, sp.atan2(y, x))),
-        ("planar 2R in the arm's plane, step 3", sp.Eq(sp.Matrix([rho, z - s1]), sp.Matrix([
-            s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3), s2 * sp.sin(q2) + s3 * sp.sin(q2 + q3)]))),
+        (
+            "planar 2R in the arm's plane, step 3",
+            sp.Eq(
+                sp.Matrix([rho, z - s1]),
+                sp.Matrix([s2 * sp.cos(q2) + s3 * sp.cos(q2 + q3), s2 * sp.sin(q2) + s3 * sp.sin(q2 + q3)]),
+            ),
+        ),
         ("law of cosines, step 4", sp.Eq(sp.cos(q3), D)),
         ("shoulder angle, step 5", sp.Eq(q2, sp.atan2(z - s1, rho) - sp.atan2(s3 * sp.sin(q3), s2 + s3 * sp.cos(q3)))),
     ]

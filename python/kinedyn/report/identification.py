@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import html
 from pathlib import Path
-from typing import TYPE_CHECKING, List, Optional
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -36,7 +36,7 @@ PLOT_POINTS = 1500
 CHECK_STATES = 200
 
 
-def _plot_data(check: "Validation") -> dict:
+def _plot_data(check: Validation) -> dict:
     S = len(check.t)
     index = np.unique(np.linspace(0, S - 1, min(S, PLOT_POINTS)).round().astype(int))
     return {
@@ -52,11 +52,11 @@ def _plot_data(check: "Validation") -> dict:
     }
 
 
-def _min_eigenvalues(result: "Identification", q: np.ndarray) -> np.ndarray:
+def _min_eigenvalues(result: Identification, q: np.ndarray) -> np.ndarray:
     return np.linalg.eigvalsh(result.mass_matrix(q)).min(axis=-1)
 
 
-def identification_data(result: "Identification", validate=None, **load_options) -> dict:
+def identification_data(result: Identification, validate=None, **load_options) -> dict:
     """Every number of the report (JSON-friendly): the result's own (``to_dict``), the fit's and the
     validation's torques at the plotted samples, and the mass-matrix check of a consistent fit.
     ``validate``: a second log (anything :meth:`Identification.validate` takes)."""
@@ -70,8 +70,13 @@ def identification_data(result: "Identification", validate=None, **load_options)
     d["friction_known"] = bool(result.friction.known)
     d["rotors"] = [r.to_dict() for r in result.rotors]
     if data is not None:
-        d["log"] = {"source": getattr(data, "source", "<data>"), "samples": int(len(data.t)), "rate_hz": getattr(data, "rate", None),
-                    "cutoff_hz": getattr(data, "cutoff", None), "decimation": getattr(data, "decimation", None)}
+        d["log"] = {
+            "source": getattr(data, "source", "<data>"),
+            "samples": int(len(data.t)),
+            "rate_hz": getattr(data, "rate", None),
+            "cutoff_hz": getattr(data, "cutoff", None),
+            "decimation": getattr(data, "decimation", None),
+        }
         d["fit"] = _plot_data(result.validate(data))
     if validate is not None:
         d["validation"] = _plot_data(result.validate(validate, **load_options))
@@ -81,41 +86,60 @@ def identification_data(result: "Identification", validate=None, **load_options)
         check = {"states": int(len(states)), "consistent_min_eigenvalue": float(_min_eigenvalues(result, states).min())}
         if result.unconstrained is not None:
             eig = _min_eigenvalues(result.unconstrained, states)
-            check.update(unconstrained_min_eigenvalue=float(eig.min()), unconstrained_indefinite_states=int(np.sum(eig <= 0)))
+            check.update(
+                unconstrained_min_eigenvalue=float(eig.min()), unconstrained_indefinite_states=int(np.sum(eig <= 0))
+            )
         d["mass_matrix_check"] = check
     return _jsonable(d)
 
 
 def _joint_of(name: str) -> int:
-    return int(name.split(".")[0][len("joint"):]) - 1
+    return int(name.split(".")[0][len("joint") :]) - 1
 
 
-def _sections(d: dict) -> List[str]:
+def _sections(d: dict) -> list[str]:
     joints = d["joint_names"]
-    out: List[str] = []
+    out: list[str] = []
     # --- the fit
     log = d.get("log")
     how = "weighted" if d["weighted"] else "ordinary"
-    lines = [f"{len(d['names'])} base parameters and {len(d.get('friction_names', []))} friction coefficients by {how} least squares",
-             f"cond(W) = {_f(d['condition_number'], 4)}"]
+    lines = [
+        f"{len(d['names'])} base parameters and {len(d.get('friction_names', []))} friction coefficients by {how} least squares",
+        f"cond(W) = {_f(d['condition_number'], 4)}",
+    ]
     if d.get("consistent"):
         lines.append("physically consistent: every body's pseudo-inertia positive definite (an SDP through cvxpy)")
     if log is not None:
-        filt = (f", low-pass cut-off {_f(log['cutoff_hz'], 3)} Hz, decimated by {log['decimation']} to {_f(log['rate_hz'], 4)} Hz"
-                if log.get("cutoff_hz") else "")
+        filt = (
+            f", low-pass cut-off {_f(log['cutoff_hz'], 3)} Hz, decimated by {log['decimation']} to {_f(log['rate_hz'], 4)} Hz"
+            if log.get("cutoff_hz")
+            else ""
+        )
         lines.append(f"{log['samples']} samples of {html.escape(str(log['source']))}{filt}")
     sec = ["<section id='fit'><h2>The fit</h2><ul>", *(f"<li>{line}</li>" for line in lines), "</ul>"]
     if d.get("noise") is not None:
-        sec.append(_table(["", *joints], [["noise σ (from the residuals)", *(_f(v, 4) for v in d["noise"])],
-                                         ["residual RMS", *(_f(v, 4) for v in d["residual_rms"])]], cls="noise"))
+        sec.append(
+            _table(
+                ["", *joints],
+                [
+                    ["noise σ (from the residuals)", *(_f(v, 4) for v in d["noise"])],
+                    ["residual RMS", *(_f(v, 4) for v in d["residual_rms"])],
+                ],
+                cls="noise",
+            )
+        )
     if d.get("dropped"):
-        sec.append(f"<p class='bad'>Not excited by the data (regressor columns at round-off level), left out: {html.escape(', '.join(d['dropped']))}.</p>")
+        sec.append(
+            f"<p class='bad'>Not excited by the data (regressor columns at round-off level), left out: {html.escape(', '.join(d['dropped']))}.</p>"
+        )
     sec.append("</section>")
     out.append("".join(sec))
 
     # --- parameters
     true = d.get("true_values")
-    headers = ["base parameter", "estimate", "std", "std %"] + (["true", "error", "error %"] if true is not None else [])
+    headers = ["base parameter", "estimate", "std", "std %"] + (
+        ["true", "error", "error %"] if true is not None else []
+    )
     rows = []
     for k, name in enumerate(d["names"]):
         row = [name, _f(d["estimates"][k]), _f(d["std"][k], 3), _f(d["relative_std_percent"][k], 3)]
@@ -123,9 +147,16 @@ def _sections(d: dict) -> List[str]:
             err = d["estimates"][k] - true[k]
             row += [_f(true[k]), _f(err, 3), _f(100 * abs(err) / max(abs(true[k]), 1e-300), 3)]
         rows.append(row)
-    note = ("<p class='note'>std: from the covariance σ² (WᵀW)⁻¹ of the least-squares fit; std %: 100 std / |estimate| "
-            "(above ~10 % the data do not identify the parameter well).</p>")
-    out.append("<section id='parameters'><h2>Base parameters</h2>" + note + _table(headers, rows, cls="parameters") + "</section>")
+    note = (
+        "<p class='note'>std: from the covariance σ² (WᵀW)⁻¹ of the least-squares fit; std %: 100 std / |estimate| "
+        "(above ~10 % the data do not identify the parameter well).</p>"
+    )
+    out.append(
+        "<section id='parameters'><h2>Base parameters</h2>"
+        + note
+        + _table(headers, rows, cls="parameters")
+        + "</section>"
+    )
 
     # --- friction and rotors
     sec = ["<section id='drives'><h2>Friction and rotor inertia</h2>"]
@@ -147,40 +178,93 @@ def _sections(d: dict) -> List[str]:
         rrows = []
         for r in d["rotors"]:
             if r["armature"] is None:
-                rrows.append([r["joint"], _f(r["gear_ratio"], 5), _f(r["nominal_armature"], 4), "grouped into " + ", ".join(r["grouped_into"]), "–"])
+                rrows.append(
+                    [
+                        r["joint"],
+                        _f(r["gear_ratio"], 5),
+                        _f(r["nominal_armature"], 4),
+                        "grouped into " + ", ".join(r["grouped_into"]),
+                        "–",
+                    ]
+                )
             else:
-                rrows.append([r["joint"], _f(r["gear_ratio"], 5), _f(r["nominal_armature"], 4), f"{_f(r['armature'], 5)} ± {_f(r['std'], 2)}", _f(r["rotor_inertia"], 4)])
+                rrows.append(
+                    [
+                        r["joint"],
+                        _f(r["gear_ratio"], 5),
+                        _f(r["nominal_armature"], 4),
+                        f"{_f(r['armature'], 5)} ± {_f(r['std'], 2)}",
+                        _f(r["rotor_inertia"], 4),
+                    ]
+                )
         sec.append("<h3>Armature r² J_m of the geared joints</h3>")
-        sec.append(_table(["joint", "gear ratio r", "model r² J_m [kg m²]", "identified r² J_m", "J_m = a / r² [kg m²]"], rrows, cls="rotors"))
-        sec.append("<p class='note'>A grouped armature only acts together with the link parameters named: the data cannot "
-                   "separate it, so it has no estimate of its own (the group's estimate is in the table above).</p>")
+        sec.append(
+            _table(
+                ["joint", "gear ratio r", "model r² J_m [kg m²]", "identified r² J_m", "J_m = a / r² [kg m²]"],
+                rrows,
+                cls="rotors",
+            )
+        )
+        sec.append(
+            "<p class='note'>A grouped armature only acts together with the link parameters named: the data cannot "
+            "separate it, so it has no estimate of its own (the group's estimate is in the table above).</p>"
+        )
     else:
-        sec.append("<p class='note'>No joint of the model has a gear ratio or a rotor inertia: no armature estimated.</p>")
+        sec.append(
+            "<p class='note'>No joint of the model has a gear ratio or a rotor inertia: no armature estimated.</p>"
+        )
     sec.append("</section>")
     out.append("".join(sec))
 
     # --- consistency check
     mc = d.get("mass_matrix_check")
     if mc is not None:
-        crow = [["consistent", _f(mc["consistent_min_eigenvalue"], 4), "yes" if mc["consistent_min_eigenvalue"] > 0 else "no"]]
+        crow = [
+            [
+                "consistent",
+                _f(mc["consistent_min_eigenvalue"], 4),
+                "yes" if mc["consistent_min_eigenvalue"] > 0 else "no",
+            ]
+        ]
         if "unconstrained_min_eigenvalue" in mc:
-            crow.append(["unconstrained", _f(mc["unconstrained_min_eigenvalue"], 4),
-                         "yes" if mc["unconstrained_indefinite_states"] == 0 else f"no, at {mc['unconstrained_indefinite_states']} states"])
-        out.append(f"<section id='consistency'><h2>Mass matrix over the log</h2><p class='note'>The smallest eigenvalue of M(q) of each estimate "
-                   f"at {mc['states']} states of the log: only a positive-definite M can be simulated.</p>"
-                   + _table(["estimate", "min eigenvalue of M [kg m²]", "positive definite at every state"], crow, cls="mass-check") + "</section>")
+            crow.append(
+                [
+                    "unconstrained",
+                    _f(mc["unconstrained_min_eigenvalue"], 4),
+                    "yes"
+                    if mc["unconstrained_indefinite_states"] == 0
+                    else f"no, at {mc['unconstrained_indefinite_states']} states",
+                ]
+            )
+        out.append(
+            f"<section id='consistency'><h2>Mass matrix over the log</h2><p class='note'>The smallest eigenvalue of M(q) of each estimate "
+            f"at {mc['states']} states of the log: only a positive-definite M can be simulated.</p>"
+            + _table(
+                ["estimate", "min eigenvalue of M [kg m²]", "positive definite at every state"], crow, cls="mass-check"
+            )
+            + "</section>"
+        )
 
     # --- torques
     for key, title in (("fit", "Torques on the fitted log"), ("validation", "Validation on another log")):
         p = d.get(key)
         if p is None:
             continue
-        sec = [f"<section id='{key}-torques'><h2>{title}</h2>",
-               f"<p class='note'>{html.escape(str(p['source']))}: {p['samples']} samples"
-               + (f", {len(p['index'])} of them plotted" if len(p["index"]) < p["samples"] else "") + ".</p>",
-               _table(["", *joints], [["torque RMS error", *(_f(v, 4) for v in p["rms"])], ["R²", *(_f(v, 7) for v in p["r2"])]], cls="scores")]
-        sec += [f"<div class='id-plot' id='{key}-joint{j + 1}' role='img' aria-label='{html.escape(joints[j])}: measured and predicted torque'></div>"
-                for j in range(len(joints))]
+        sec = [
+            f"<section id='{key}-torques'><h2>{title}</h2>",
+            f"<p class='note'>{html.escape(str(p['source']))}: {p['samples']} samples"
+            + (f", {len(p['index'])} of them plotted" if len(p["index"]) < p["samples"] else "")
+            + ".</p>",
+            _table(
+                ["", *joints],
+                [["torque RMS error", *(_f(v, 4) for v in p["rms"])], ["R²", *(_f(v, 7) for v in p["r2"])]],
+                cls="scores",
+            ),
+        ]
+        sec += [
+            f"<div class='id-plot' id='{key}-joint{j + 1}' role='img' aria-label='{html.escape(joints[j])}: measured and predicted torque'></div>"
+            for j in range(len(joints))
+        ]
         sec.append("</section>")
         out.append("".join(sec))
     return out
@@ -216,7 +300,7 @@ _PLOTS_JS = """
 _EXTRA_CSS = ".id-plot { width: 100%; min-height: 320px; } section ul { margin: 0.3em 0 0.6em 1.2em; }"
 
 
-def identification_report(result: "Identification", validate=None, *, title: Optional[str] = None, **load_options) -> str:
+def identification_report(result: Identification, validate=None, *, title: str | None = None, **load_options) -> str:
     """The report as one HTML string (see the module docstring)."""
     import kinedyn
 
@@ -228,7 +312,7 @@ def identification_report(result: "Identification", validate=None, *, title: Opt
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{html.escape(title)}</title>
 <style>{_asset("report.css")}{_EXTRA_CSS}</style></head>
-<body><header><h1>Identification of {html.escape(d['robot'])}</h1><p>{len(d['joint_names'])} joints · kinedyn {html.escape(kinedyn.__version__)}</p></header>
+<body><header><h1>Identification of {html.escape(d["robot"])}</h1><p>{len(d["joint_names"])} joints · kinedyn {html.escape(kinedyn.__version__)}</p></header>
 <main>{"".join(_sections(d))}</main>
 <footer>Generated by <code>kinedyn identify --data ... -o</code>. Self-contained: no network access, every script and style is in this file.</footer>
 {_json_script(d, "kinedyn-identification")}
@@ -238,7 +322,9 @@ def identification_report(result: "Identification", validate=None, *, title: Opt
 """
 
 
-def write_identification_report(result: "Identification", path="identification.html", validate=None, **load_options) -> Path:
+def write_identification_report(
+    result: Identification, path="identification.html", validate=None, **load_options
+) -> Path:
     """Write :func:`identification_report` to ``path``; returns the path."""
     path = Path(path)
     path.write_text(identification_report(result, validate, **load_options), encoding="utf-8")

@@ -13,18 +13,30 @@ so misprints included); ``QUESTION_DATA`` holds the questions' inputs. Conventio
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence
+from typing import Any
 
 import numpy as np
 import sympy as sp
 
-__all__ = ["QUESTIONS", "PRINTED", "QUESTION_DATA", "Answer", "Comparison", "answer", "work", "to_json", "render_markdown", "render_text"]
+__all__ = [
+    "QUESTIONS",
+    "PRINTED",
+    "QUESTION_DATA",
+    "Answer",
+    "Comparison",
+    "answer",
+    "work",
+    "to_json",
+    "render_markdown",
+    "render_text",
+]
 
 QUESTIONS = ["1a", "1b", "2a", "2b", "3", "challenge"]
 
 # ------------------------------------------------------------------ the tutorial's inputs
-QUESTION_DATA: Dict[str, Dict[str, Any]] = {
+QUESTION_DATA: dict[str, dict[str, Any]] = {
     "2a": {"l1": 2.0, "l2": 3.0, "theta_deg": (167.028, -156.44), "theta_decimals": (3, 2), "qd": (1.0, 3.0)},
     "2b": {"F": (30.0, -20.0)},
     "challenge": {"L1": 3.0, "L2": 2.0, "L3": 1.0, "tool": (1.0, 0.2, 0.5)},
@@ -35,28 +47,32 @@ QUESTION_DATA: Dict[str, Dict[str, Any]] = {
 # strings in th1, th2 (joint angles), thd1, thd2 (rates), thdd1, thdd2, l1, l2, m1, m2, g; numbers are
 # strings so that the printed number of digits is kept. Never used as a source of truth: each is
 # compared with kinedyn and with an independent check.
-PRINTED: Dict[str, Dict[str, Any]] = {
-    "1a": {"J": "Matrix([[-l1*sin(th1) - l2*sin(th1 + th2), -l2*sin(th1 + th2)],"
-                " [l1*cos(th1) + l2*cos(th1 + th2), l2*cos(th1 + th2)]])"},
-    "1b": {"J_inv": "Matrix([[l2*cos(th1 + th2), l2*sin(th1 + th2)],"
-                    " [-l1*cos(th1) - l2*cos(th1 + th2), -l1*sin(th1) - l2*sin(th1 + th2)]])/(l1*l2*sin(th2))"},
+PRINTED: dict[str, dict[str, Any]] = {
+    "1a": {
+        "J": "Matrix([[-l1*sin(th1) - l2*sin(th1 + th2), -l2*sin(th1 + th2)],"
+        " [l1*cos(th1) + l2*cos(th1 + th2), l2*cos(th1 + th2)]])"
+    },
+    "1b": {
+        "J_inv": "Matrix([[l2*cos(th1 + th2), l2*sin(th1 + th2)],"
+        " [-l1*cos(th1) - l2*cos(th1 + th2), -l1*sin(th1) - l2*sin(th1 + th2)]])/(l1*l2*sin(th2))"
+    },
     "2a": {"J": [["-1.0000", "-0.5512"], ["1.0000", "2.9489"]], "v": ["-2.654", "9.847"]},
     "2b": {"tau": ["-50.0", "-75.1"]},
     "3": {
         "v_D^2": "thd1**2*(l1**2 + l2**2/4 + l1*l2*cos(th2)) + thd2**2*(l2**2/4) + thd1*thd2*(l2**2/2 + l1*l2*cos(th2))",
         "K": "thd1**2*(m1*l1**2/6 + m2*l2**2/6 + m2*l1**2/2 + m2*l1*l2*cos(th2)/2) + thd2**2*(m2*l2**2/6)"
-             " + thd1*thd2*(m2*l2**2/3 + m2*l1*l2*cos(th2)/2)",
+        " + thd1*thd2*(m2*l2**2/3 + m2*l1*l2*cos(th2)/2)",
         "P": "m1*g*l1/2*sin(th1) + m2*g*(l1*sin(th1) + l2/2*sin(th1 + th2))",
         # printed with "theta-dot squared" (no index) in the first term; read as thd1**2
         "L": "thd1**2*(m1*l1**2/6 + m2*l2**2/6 + m2*l1**2/2 + m2*l1*l2*cos(th2)/2) + thd2**2*(m2*l2**2/6)"
-             " + thd1*thd2*(m2*l2**2/3 + m2*l1*l2*cos(th2)/2) - m1*g*l1/2*sin(th1) - m2*g*(l1*sin(th1) + l2/2*sin(th1 + th2))",
+        " + thd1*thd2*(m2*l2**2/3 + m2*l1*l2*cos(th2)/2) - m1*g*l1/2*sin(th1) - m2*g*(l1*sin(th1) + l2/2*sin(th1 + th2))",
         "d/dt dL/dthd1": "(m1*l1**2/3 + m2*l1**2 + m2*l2**2/3 + m2*l1*l2*cos(th2))*thdd1 + (m2*l2**2/3 + m2*l1*l2*cos(th2)/2)*thdd2"
-                         " - m2*l1*l2*sin(th2)*thd1*thd2 - m2*l1*l2*sin(th2)*thd2**2/2",
+        " - m2*l1*l2*sin(th2)*thd1*thd2 - m2*l1*l2*sin(th2)*thd2**2/2",
         "dL/dth1": "(m1/2 + m2)*g*l1*cos(th1) + m2*g*l2*cos(th1 + th2)/2",
         "tau1": "(m1*l1**2/3 + m2*l1**2 + m2*l2**2/3 + m2*l1*l2*cos(th2))*thdd1 + (m2*l2**2/3 + m2*l1*l2*cos(th2)/2)*thdd2"
-                " - m2*l1*l2*sin(th2)*thd1*thd2 - m2*l1*l2*sin(th2)*thd2**2/2 + (m1/2 + m2)*g*l1*cos(th1) + m2*g*l2*cos(th1 + th2)/2",
+        " - m2*l1*l2*sin(th2)*thd1*thd2 - m2*l1*l2*sin(th2)*thd2**2/2 + (m1/2 + m2)*g*l1*cos(th1) + m2*g*l2*cos(th1 + th2)/2",
         "d/dt dL/dthd2": "(m2*l2**2/3 + m2*l1*l2*cos(th2)/2)*thdd1 + m2*l2**2/3*thdd2 - m2*l1*l2*sin(th2)*thd1**2/2"
-                         " - m2*l1*l2*sin(th2)*thd1*thd2",
+        " - m2*l1*l2*sin(th2)*thd1*thd2",
         "dL/dth2": "m2*l1*l2*sin(th2)*thd1*thd2 + m2*g*l2*cos(th1 + th2)/2",
         "tau2": "(m2*l2**2/3 + m2*l1*l2*cos(th2)/2)*thdd1 + m2*l2**2/3*thdd2 - m2*l1*l2*sin(th2)*thd1**2/2 + m2*g*l2*cos(th1 + th2)/2",
     },
@@ -66,8 +82,22 @@ PRINTED: Dict[str, Dict[str, Any]] = {
 # the tutorial's symbols
 th1, th2, thd1, thd2, thdd1, thdd2 = sp.symbols("th1 th2 thd1 thd2 thdd1 thdd2", real=True)
 l1, l2, m1, m2, g = sp.symbols("l1 l2 m1 m2 g", positive=True)
-_PRINTED_NS = {"th1": th1, "th2": th2, "thd1": thd1, "thd2": thd2, "thdd1": thdd1, "thdd2": thdd2,
-               "l1": l1, "l2": l2, "m1": m1, "m2": m2, "g": g, "Matrix": sp.Matrix, "sin": sp.sin, "cos": sp.cos}
+_PRINTED_NS = {
+    "th1": th1,
+    "th2": th2,
+    "thd1": thd1,
+    "thd2": thd2,
+    "thdd1": thdd1,
+    "thdd2": thdd2,
+    "l1": l1,
+    "l2": l2,
+    "m1": m1,
+    "m2": m2,
+    "g": g,
+    "Matrix": sp.Matrix,
+    "sin": sp.sin,
+    "cos": sp.cos,
+}
 
 
 def printed(question: str, key: str):
@@ -89,11 +119,17 @@ class Comparison:
     #: the correct value where the printed one is wrong
     correction: str = ""
     #: (printed, kinedyn) as SymPy expressions for symbolic answers (rendering only)
-    exprs: Optional[tuple] = None
+    exprs: tuple | None = None
 
     def to_dict(self) -> dict:
-        return {"quantity": self.quantity, "printed": self.printed, "kinedyn": self.kinedyn, "agrees": self.agrees,
-                "check": self.check, "correction": self.correction}
+        return {
+            "quantity": self.quantity,
+            "printed": self.printed,
+            "kinedyn": self.kinedyn,
+            "agrees": self.agrees,
+            "check": self.check,
+            "correction": self.correction,
+        }
 
 
 @dataclass
@@ -102,10 +138,10 @@ class Answer:
     title: str
     question: str
     #: ("text", str) | ("eq", name, value) | ("table", title, headers, rows)
-    items: List[tuple] = field(default_factory=list)
-    comparisons: List[Comparison] = field(default_factory=list)
+    items: list[tuple] = field(default_factory=list)
+    comparisons: list[Comparison] = field(default_factory=list)
     #: machine-readable results (numbers as floats/lists, expressions as strings)
-    result: Dict[str, Any] = field(default_factory=dict)
+    result: dict[str, Any] = field(default_factory=dict)
 
     def text(self, s: str):
         self.items.append(("text", s))
@@ -117,7 +153,7 @@ class Answer:
         self.items.append(("table", title, list(headers), [list(r) for r in rows]))
 
     @property
-    def misprints(self) -> List[Comparison]:
+    def misprints(self) -> list[Comparison]:
         return [c for c in self.comparisons if not c.agrees]
 
 
@@ -133,7 +169,7 @@ def _vec(v, digits: int = 6) -> str:
     return "(" + ", ".join(_fmt(x, digits) for x in np.ravel(v)) + ")"
 
 
-def _mat_rows(M, digits: int = 6) -> List[List[str]]:
+def _mat_rows(M, digits: int = 6) -> list[list[str]]:
     return [[_fmt(x, digits) for x in row] for row in np.atleast_2d(M)]
 
 
@@ -145,7 +181,7 @@ def _half_unit(s: str) -> float:
     return 0.5 * 10.0 ** (-_decimals(s))
 
 
-def symbolic_frame_pose(robot, q: Sequence[sp.Symbol], frame: Optional[str] = None) -> sp.Matrix:
+def symbolic_frame_pose(robot, q: Sequence[sp.Symbol], frame: str | None = None) -> sp.Matrix:
     """The pose of a frame as a SymPy matrix in the joint symbols ``q``: kinedyn.symbolic.pose with the
     robot's joint symbols renamed to ``q``."""
     from .. import symbolic as ks
@@ -153,7 +189,7 @@ def symbolic_frame_pose(robot, q: Sequence[sp.Symbol], frame: Optional[str] = No
     return ks.pose(robot, frame).xreplace(dict(zip(ks.joint_symbols(robot), q)))
 
 
-def symbolic_jacobian(robot, q: Sequence[sp.Symbol], frame: Optional[str] = None) -> sp.Matrix:
+def symbolic_jacobian(robot, q: Sequence[sp.Symbol], frame: str | None = None) -> sp.Matrix:
     """kinedyn.symbolic.jacobian (rows [v; w], base axes) in the joint symbols ``q``."""
     from .. import symbolic as ks
 
@@ -182,7 +218,14 @@ def _display(expr, tutorial_symbols: bool = True):
     """A SymPy value in the tutorial's notation (theta, dots, C/S shorthand) for rendering."""
     if not isinstance(expr, (sp.Basic, sp.MatrixBase)):
         return expr
-    names = {th1: "theta1", th2: "theta2", thd1: "thetadot1", thd2: "thetadot2", thdd1: "thetaddot1", thdd2: "thetaddot2"}
+    names = {
+        th1: "theta1",
+        th2: "theta2",
+        thd1: "thetadot1",
+        thd2: "thetadot2",
+        thdd1: "thetaddot1",
+        thdd2: "thetaddot2",
+    }
     reps = {s: sp.Symbol(n, real=True) for s, n in names.items()}
     e = _abbreviate(expr, [th1, th2, sp.Symbol("th3", real=True)]) if tutorial_symbols else expr
     return e.xreplace(reps) if isinstance(e, sp.Basic) else e.applyfunc(lambda x: x.xreplace(reps))
@@ -222,11 +265,19 @@ def _q1_jacobian():
 
 
 def _q1a() -> Answer:
-    a = Answer("1a", "Jacobian of the two-link planar arm", "Calculate the Jacobian relating joint velocities to tool-point velocities.")
+    a = Answer(
+        "1a",
+        "Jacobian of the two-link planar arm",
+        "Calculate the Jacobian relating joint velocities to tool-point velocities.",
+    )
     robot, p, J = _q1_jacobian()
-    a.text("kinedyn builds the arm from its DH table (kd.robots.planar_2r(symbolic=True)) and multiplies out the forward kinematics:")
+    a.text(
+        "kinedyn builds the arm from its DH table (kd.robots.planar_2r(symbolic=True)) and multiplies out the forward kinematics:"
+    )
     a.eq("p(theta) = (x, y)", sp.Matrix(p))
-    a.text("The Jacobian is the derivative of the tool position with respect to the joint angles, J = dp/dtheta (rows x, y; these are rows 0-1 of kinedyn's 6 x n geometric Jacobian):")
+    a.text(
+        "The Jacobian is the derivative of the tool position with respect to the joint angles, J = dp/dtheta (rows x, y; these are rows 0-1 of kinedyn's 6 x n geometric Jacobian):"
+    )
     a.eq("J", J)
     # independent check: the numeric engine's geometric Jacobian (a different code path) at random states
     from .. import robots
@@ -244,12 +295,18 @@ def _q1a() -> Answer:
     Jp = printed("1a", "J")
     agrees = _same(J - Jp, sp.zeros(2, 2), [th1, th2, l1, l2])
     a.comparisons.append(Comparison("J", str(Jp), str(J), agrees, check, exprs=(Jp, J)))
-    a.result = {"p": [str(e) for e in p], "J": [[str(e) for e in row] for row in J.tolist()], "numeric_engine_max_difference": worst}
+    a.result = {
+        "p": [str(e) for e in p],
+        "J": [[str(e) for e in row] for row in J.tolist()],
+        "numeric_engine_max_difference": worst,
+    }
     return a
 
 
 def _q1b() -> Answer:
-    a = Answer("1b", "Inverse Jacobian", "Calculate the inverse Jacobian relating tool-point velocities to joint velocities.")
+    a = Answer(
+        "1b", "Inverse Jacobian", "Calculate the inverse Jacobian relating tool-point velocities to joint velocities."
+    )
     from .. import symbolic as ks
 
     _, _, J = _q1_jacobian()
@@ -257,25 +314,35 @@ def _q1b() -> Answer:
     det = inverse.determinant
     a.text("The determinant of the 2 x 2 Jacobian:")
     a.eq("det J", det)
-    a.text("so J is invertible except where sin(theta2) = 0 (arm stretched out or folded back). "
-           "The inverse is the adjugate divided by the determinant, θ̇ = J⁻¹ (ẋ, ẏ):")
+    a.text(
+        "so J is invertible except where sin(theta2) = 0 (arm stretched out or folded back). "
+        "The inverse is the adjugate divided by the determinant, θ̇ = J⁻¹ (ẋ, ẏ):"
+    )
     adj = inverse.adjugate
     Jinv = adj / det
     a.eq("J^-1", sp.MatMul(1 / det, adj, evaluate=False))
     prod = (J * Jinv).applyfunc(lambda e: sp.simplify(sp.expand_trig(e)))
     check_ok = _same(J * Jinv, sp.eye(2), [th1, th2, l1, l2])
-    check = f"J J^-1 = I at random (theta, l1, l2): {'yes' if check_ok else 'NO'}; symbolically J J^-1 = {sp.sstr(prod)}"
+    check = (
+        f"J J^-1 = I at random (theta, l1, l2): {'yes' if check_ok else 'NO'}; symbolically J J^-1 = {sp.sstr(prod)}"
+    )
     a.text("Check: " + check + ".")
     # kinedyn's singularity report at a stretched arm
     from .. import robots
     from ..kinematics import singularity_report
 
     rep = singularity_report(robots.planar_2r(), [0.4, 0.0], task="planar")
-    a.text(f"At theta2 = 0 kinedyn's singularity report (kinedyn jacobian --q 0.4 0 --task planar) says: {rep.summary()}.")
+    a.text(
+        f"At theta2 = 0 kinedyn's singularity report (kinedyn jacobian --q 0.4 0 --task planar) says: {rep.summary()}."
+    )
     Jp = printed("1b", "J_inv")
     agrees = _same(Jinv - Jp, sp.zeros(2, 2), [th1, th2, l1, l2])
     a.comparisons.append(Comparison("J^-1", str(Jp), str(Jinv), agrees, check, exprs=(Jp, Jinv)))
-    a.result = {"det": str(det), "J_inv": [[str(e) for e in row] for row in Jinv.tolist()], "singular_at_theta2_zero": rep.singular}
+    a.result = {
+        "det": str(det),
+        "J_inv": [[str(e) for e in row] for row in Jinv.tolist()],
+        "singular_at_theta2_zero": rep.singular,
+    }
     return a
 
 
@@ -289,12 +356,14 @@ def _q2_state():
     return robot, q, np.array(d["qd"])
 
 
-def _q_box(q_deg: Sequence[float], decimals: Sequence[int]) -> List[np.ndarray]:
+def _q_box(q_deg: Sequence[float], decimals: Sequence[int]) -> list[np.ndarray]:
     """The corners of the rounding box of angles printed with the given decimals (degrees -> rad)."""
     corners = []
     for s1 in (-1, 1):
         for s2 in (-1, 1):
-            corners.append(np.radians([q_deg[0] + s1 * 0.5 * 10.0 ** -decimals[0], q_deg[1] + s2 * 0.5 * 10.0 ** -decimals[1]]))
+            corners.append(
+                np.radians([q_deg[0] + s1 * 0.5 * 10.0 ** -decimals[0], q_deg[1] + s2 * 0.5 * 10.0 ** -decimals[1]])
+            )
     return corners
 
 
@@ -326,8 +395,10 @@ def _exact_pose_note(a: Answer, robot, q):
     """The tutorial's angles are the IK solution for a tool at (1, 1): show it, and solve it exactly with
     kinedyn's inverse kinematics where that exists."""
     p = robot.pose(q)[:3, 3]
-    a.text(f"Where is the tool? kinedyn's FK at these angles gives (x, y) = {_vec(p[:2])} m: the angles are the inverse "
-           "kinematics of a tool at (1, 1) m, rounded.")
+    a.text(
+        f"Where is the tool? kinedyn's FK at these angles gives (x, y) = {_vec(p[:2])} m: the angles are the inverse "
+        "kinematics of a tool at (1, 1) m, rounded."
+    )
     if not hasattr(robot, "inverse_kinematics"):
         return None
     try:
@@ -345,11 +416,17 @@ def _exact_pose_note(a: Answer, robot, q):
 
 def _q2a() -> Answer:
     d = QUESTION_DATA["2a"]
-    a = Answer("2a", "Tool velocity v = J qd", f"Tool-point linear velocity for joint rates (1, 3) rad/s, a1 = 2, a2 = 3, theta = ({d['theta_deg'][0]} deg, {d['theta_deg'][1]} deg).")
+    a = Answer(
+        "2a",
+        "Tool velocity v = J qd",
+        f"Tool-point linear velocity for joint rates (1, 3) rad/s, a1 = 2, a2 = 3, theta = ({d['theta_deg'][0]} deg, {d['theta_deg'][1]} deg).",
+    )
     robot, q, qd = _q2_state()
     J = robot.jacobian(q)[:2]
     v = J @ qd
-    a.text("kinedyn: J = robot.jacobian(q)[:2] (rows x, y), v = J qd (kinedyn.kinematics.tool_velocity(robot, q, qd, task='planar')).")
+    a.text(
+        "kinedyn: J = robot.jacobian(q)[:2] (rows x, y), v = J qd (kinedyn.kinematics.tool_velocity(robot, q, qd, task='planar'))."
+    )
     a.table("J at the tutorial's angles", ["", "theta1", "theta2"], [["x", *_mat_rows(J)[0]], ["y", *_mat_rows(J)[1]]])
     a.eq("v = J qd [m/s]", _vec(v))
     v_fd = _fd_tool_velocity(robot, q, qd)
@@ -361,7 +438,15 @@ def _q2a() -> Answer:
     dec = d["theta_decimals"]
     for (i, j), s in np.ndenumerate(np.array(PRINTED["2a"]["J"])):
         ok = _agrees_within_rounding(s, lambda qq, i=i, j=j: robot.jacobian(qq)[i, j], d["theta_deg"], dec)
-        a.comparisons.append(Comparison(f"J[{i + 1},{j + 1}]", s, _fmt(J[i, j], 7), ok, "within the rounding of the printed angles" if ok else check))
+        a.comparisons.append(
+            Comparison(
+                f"J[{i + 1},{j + 1}]",
+                s,
+                _fmt(J[i, j], 7),
+                ok,
+                "within the rounding of the printed angles" if ok else check,
+            )
+        )
     for i, s in enumerate(PRINTED["2a"]["v"]):
         ok = _agrees_within_rounding(s, lambda qq, i=i: (robot.jacobian(qq)[:2] @ qd)[i], d["theta_deg"], dec)
         a.comparisons.append(Comparison(f"v[{i + 1}] [m/s]", s, _fmt(v[i], 7), ok, check, "" if ok else _fmt(v[i], 4)))
@@ -381,20 +466,29 @@ def _q2b() -> Answer:
     a.text("kinedyn: tau = J^T F (kinedyn.kinematics.joint_torques(robot, q, F, task='planar')).")
     a.table("J^T", ["", "Fx", "Fy"], [["theta1", *_mat_rows(J.T)[0]], ["theta2", *_mat_rows(J.T)[1]]])
     for i in range(2):
-        a.eq(f"tau{i + 1} [N m]", f"{_fmt(J[0, i], 5)} * {_fmt(F[0])} + {_fmt(J[1, i], 5)} * {_fmt(F[1])} = {_fmt(tau[i])}")
+        a.eq(
+            f"tau{i + 1} [N m]",
+            f"{_fmt(J[0, i], 5)} * {_fmt(F[0])} + {_fmt(J[1, i], 5)} * {_fmt(F[1])} = {_fmt(tau[i])}",
+        )
     tau_fd = _fd_virtual_work(robot, q, F)
     Jp = np.array(PRINTED["2a"]["J"], dtype=float)
     by_hand = Jp.T @ F
-    check = (f"virtual work, tau_i = d(F . p)/dq_i by central differences of the forward kinematics, gives tau = {_vec(tau_fd)} N m; "
-             f"and the tutorial's own printed J^T times F gives {_vec(by_hand, 5)} N m "
-             f"({_fmt(Jp[0, 1], 4)} * 30 + {_fmt(Jp[1, 1], 5)} * (-20) = {_fmt(by_hand[1], 5)})")
+    check = (
+        f"virtual work, tau_i = d(F . p)/dq_i by central differences of the forward kinematics, gives tau = {_vec(tau_fd)} N m; "
+        f"and the tutorial's own printed J^T times F gives {_vec(by_hand, 5)} N m "
+        f"({_fmt(Jp[0, 1], 4)} * 30 + {_fmt(Jp[1, 1], 5)} * (-20) = {_fmt(by_hand[1], 5)})"
+    )
     a.text("Check: " + check + ".")
     exact = _exact_pose_note(a, robot, q)
     if exact is not None:
         a.text(f"At the exact angles tau = {_vec(robot.jacobian(exact)[:2].T @ F)} N m.")
     for i, s in enumerate(PRINTED["2b"]["tau"]):
-        ok = _agrees_within_rounding(s, lambda qq, i=i: (robot.jacobian(qq)[:2].T @ F)[i], d["theta_deg"], d["theta_decimals"])
-        a.comparisons.append(Comparison(f"tau{i + 1} [N m]", s, _fmt(tau[i], 7), ok, check, "" if ok else f"{tau[i]:.1f}"))
+        ok = _agrees_within_rounding(
+            s, lambda qq, i=i: (robot.jacobian(qq)[:2].T @ F)[i], d["theta_deg"], d["theta_decimals"]
+        )
+        a.comparisons.append(
+            Comparison(f"tau{i + 1} [N m]", s, _fmt(tau[i], 7), ok, check, "" if ok else f"{tau[i]:.1f}")
+        )
     a.result = {"tau": tau.tolist(), "tau_virtual_work": tau_fd.tolist(), "tau_from_printed_J": by_hand.tolist()}
     if exact is not None:
         a.result["tau_exact_pose"] = (robot.jacobian(exact)[:2].T @ F).tolist()
@@ -411,7 +505,12 @@ class _RodArm:
         self.m1, self.m2, self.l1, self.l2, self.g = m1, m2, l1, l2, g
 
     def D(self, q):
-        return np.array([self.l1 * math.cos(q[0]) + self.l2 / 2 * math.cos(q[0] + q[1]), self.l1 * math.sin(q[0]) + self.l2 / 2 * math.sin(q[0] + q[1])])
+        return np.array(
+            [
+                self.l1 * math.cos(q[0]) + self.l2 / 2 * math.cos(q[0] + q[1]),
+                self.l1 * math.sin(q[0]) + self.l2 / 2 * math.sin(q[0] + q[1]),
+            ]
+        )
 
     def vD(self, q, qd, h=1e-4):
         """v_D = (dD/dq) qd, dD/dq by central differences (so v_D is exactly linear in qd)."""
@@ -462,7 +561,14 @@ def _q3_robot():
     """The tutorial's arm in kinedyn: planar_2r with symbols, uniform rods (lc = l/2, I = m l^2/12)."""
     robot = _arm_2r_symbolic()
     s = {n: sp.Symbol(n, positive=True) for n in ("l1", "l2", "lc1", "lc2", "m1", "m2", "I1", "I2")}
-    return robot.subs({s["lc1"]: s["l1"] / 2, s["lc2"]: s["l2"] / 2, s["I1"]: s["m1"] * s["l1"] ** 2 / 12, s["I2"]: s["m2"] * s["l2"] ** 2 / 12})
+    return robot.subs(
+        {
+            s["lc1"]: s["l1"] / 2,
+            s["lc2"]: s["l2"] / 2,
+            s["I1"]: s["m1"] * s["l1"] ** 2 / 12,
+            s["I2"]: s["m2"] * s["l2"] ** 2 / 12,
+        }
+    )
 
 
 def _to_tutorial(eom):
@@ -488,12 +594,17 @@ _Q3_SAMPLES = [
 
 
 def _q3() -> Answer:
-    a = Answer("3", "Equations of motion of the two-link arm by Lagrange's method",
-               "Derive the equations of motion of the two-link arm of uniform rods (m1, l1; m2, l2; gravity -g along y).")
+    a = Answer(
+        "3",
+        "Equations of motion of the two-link arm by Lagrange's method",
+        "Derive the equations of motion of the two-link arm of uniform rods (m1, l1; m2, l2; gravity -g along y).",
+    )
     robot = _q3_robot()
-    a.text("kinedyn: robot = kd.robots.planar_2r(symbolic=True) with uniform rods (lc_i = l_i/2, I_i = m_i l_i^2/12 about the centre), "
-           "eom = robot.equations_of_motion(). The steps of kinedyn's derivation (eom.steps), in the tutorial's notation "
-           "(theta_i = q_i, C12 = cos(theta1 + theta2), ...):")
+    a.text(
+        "kinedyn: robot = kd.robots.planar_2r(symbolic=True) with uniform rods (lc_i = l_i/2, I_i = m_i l_i^2/12 about the centre), "
+        "eom = robot.equations_of_motion(). The steps of kinedyn's derivation (eom.steps), in the tutorial's notation "
+        "(theta_i = q_i, C12 = cos(theta1 + theta2), ...):"
+    )
     eom = robot.equations_of_motion()
     T = _to_tutorial(eom)
     for k, step in enumerate(eom.steps, start=1):
@@ -531,9 +642,11 @@ def _q3() -> Answer:
         "tau2": T(eom.tau[1]),
     }
     a.text("Step 7 is the answer: the equations of motion τᵢ = d/dt ∂L/∂θ̇ᵢ − ∂L/∂θᵢ.")
-    a.text("Independent check of every step: the arm written from its geometry alone (rod about its end, rod about its centre, "
-           "the centre D of link 2), with every velocity and derivative taken by central finite differences; and the energy "
-           "balance qd . tau = dH/dt (H = K + P) along the motion.")
+    a.text(
+        "Independent check of every step: the arm written from its geometry alone (rod about its end, rod about its centre, "
+        "the centre D of link 2), with every velocity and derivative taken by central finite differences; and the energy "
+        "balance qd . tau = dH/dt (H = K + P) along the motion."
+    )
     arms = [(_RodArm(*s[:5]), np.array(s[5]), np.array(s[6]), np.array(s[7]), s) for s in _Q3_SAMPLES]
     refs = {
         "v_D^2": lambda A, q, qd, qdd: A.vD2(q, qd),
@@ -567,8 +680,10 @@ def _q3() -> Answer:
             shown = shown or (vp, vk, r)
         assert shown is not None  # arms is a fixed, non-empty list of test arms
         diff = sp.simplify(sp.expand_trig(sp.expand(kd_expr - pr)))
-        check = (f"finite differences of the geometric model at m1=1.3, m2=2.1, l1=1.7, l2=2.3, theta=(0.4, -1.1), thetadot=(0.9, 1.6), "
-                 f"thetaddot=(0.7, -0.5): {_fmt(shown[2])}; printed expression: {_fmt(shown[0])}; kinedyn: {_fmt(shown[1])}")
+        check = (
+            f"finite differences of the geometric model at m1=1.3, m2=2.1, l1=1.7, l2=2.3, theta=(0.4, -1.1), thetadot=(0.9, 1.6), "
+            f"thetaddot=(0.7, -0.5): {_fmt(shown[2])}; printed expression: {_fmt(shown[0])}; kinedyn: {_fmt(shown[1])}"
+        )
         if name.startswith("tau"):
             A, q, qd, qdd, s = arms[0]
             k = int(name[-1]) - 1
@@ -576,18 +691,36 @@ def _q3() -> Answer:
             args = [s[0], s[1], s[2], s[3], s[4], *q, *qd, *qdd]
             alt = tp.copy()
             alt[k] = sp.lambdify(syms, pr, "math")(*args)
-            check += (f"; energy balance qd . tau - dH/dt: {_fmt(A.power_balance(q, qd, qdd, tp), 2)} with kinedyn's torques, "
-                      f"{_fmt(A.power_balance(q, qd, qdd, alt), 4)} with the printed {name}")
+            check += (
+                f"; energy balance qd . tau - dH/dt: {_fmt(A.power_balance(q, qd, qdd, tp), 2)} with kinedyn's torques, "
+                f"{_fmt(A.power_balance(q, qd, qdd, alt), 4)} with the printed {name}"
+            )
         checks[name] = check
-        a.comparisons.append(Comparison(name, str(_display(pr)), str(_display(_pretty_collect(kd_expr))), ok_pr, check,
-                                        "" if ok_pr else f"{_display(_pretty_collect(kd_expr))}   (kinedyn - printed = {_display(diff)})",
-                                        exprs=(_pretty_collect(pr), _pretty_collect(kd_expr), diff)))
+        a.comparisons.append(
+            Comparison(
+                name,
+                str(_display(pr)),
+                str(_display(_pretty_collect(kd_expr))),
+                ok_pr,
+                check,
+                "" if ok_pr else f"{_display(_pretty_collect(kd_expr))}   (kinedyn - printed = {_display(diff)})",
+                exprs=(_pretty_collect(pr), _pretty_collect(kd_expr), diff),
+            )
+        )
         rows.append([name, "yes" if ok_pr else "NO", "yes" if ok_kd else "NO"])
-    a.text("kinedyn's value agrees with the finite-difference model for every quantity: " + ("yes" if all(r[2] == "yes" for r in rows) else "NO") + ".")
-    a.text("Remarks on the printed text: the first term of L is printed with an unindexed thetadot^2 (read as thetadot1^2); the chain-rule "
-           "line 'd/dt = d/dtheta2 thetadot2 + d/dthetadot1 thetaddot1' leaves out the d/dthetadot2 thetaddot2 term (and d/dtheta1 thetadot1, "
-           "which is zero here); tau1 is right although dL/dtheta1 above it has the wrong sign.")
-    a.result = {name: str(ours[name]) for name in ours} | {"kinedyn_agrees_with_finite_differences": all(r[2] == "yes" for r in rows)}
+    a.text(
+        "kinedyn's value agrees with the finite-difference model for every quantity: "
+        + ("yes" if all(r[2] == "yes" for r in rows) else "NO")
+        + "."
+    )
+    a.text(
+        "Remarks on the printed text: the first term of L is printed with an unindexed thetadot^2 (read as thetadot1^2); the chain-rule "
+        "line 'd/dt = d/dtheta2 thetadot2 + d/dthetadot1 thetaddot1' leaves out the d/dthetadot2 thetaddot2 term (and d/dtheta1 thetadot1, "
+        "which is zero here); tau1 is right although dL/dtheta1 above it has the wrong sign."
+    )
+    a.result = {name: str(ours[name]) for name in ours} | {
+        "kinedyn_agrees_with_finite_differences": all(r[2] == "yes" for r in rows)
+    }
     return a
 
 
@@ -632,7 +765,10 @@ def elbow_branch_name(robot, q) -> str:
     tool (the upper arm's horizontal direction (cos theta1, sin theta1) points towards the tool's
     horizontal position), and the elbow is "up" when it lies above the shoulder-tool line, i.e. on the
     side of that line that the upward vertical points to, in the arm's plane."""
-    shoulder, elbow, tool = (T[:3, 3] for T in robot.frame_poses(np.asarray(q, dtype=float), [robot.frame_names[1], robot.frame_names[2], robot.tool]))
+    shoulder, elbow, tool = (
+        T[:3, 3]
+        for T in robot.frame_poses(np.asarray(q, dtype=float), [robot.frame_names[1], robot.frame_names[2], robot.tool])
+    )
     front = math.cos(q[0]) * tool[0] + math.sin(q[0]) * tool[1] > 0
     line = (tool - shoulder) / np.linalg.norm(tool - shoulder)
     up_normal = np.array([0.0, 0.0, 1.0]) - line[2] * line  # the vertical, less its part along the line
@@ -644,17 +780,27 @@ def _challenge() -> Answer:
     from .. import robots
 
     d = QUESTION_DATA["challenge"]
-    a = Answer("challenge", "The elbow manipulator", "DH table, inverse kinematic equations, the joint values for the tool at (1.0, 0.2, 0.5) m, the Jacobian (L1 = 3 m, L2 = 2 m, L3 = 1 m).")
-    a.text("The tutorial's figure is missing from the seed; kinedyn follows Spong's elbow (articulated) arm: z0 up along joint 1, "
-           "shoulder at height L1, joints 2 and 3 horizontal, zero pose with both arms along x0 (docs/seed-notes.md §3). "
-           "The tutorial prints no solution, so nothing is compared; every result is checked instead.")
+    a = Answer(
+        "challenge",
+        "The elbow manipulator",
+        "DH table, inverse kinematic equations, the joint values for the tool at (1.0, 0.2, 0.5) m, the Jacobian (L1 = 3 m, L2 = 2 m, L3 = 1 m).",
+    )
+    a.text(
+        "The tutorial's figure is missing from the seed; kinedyn follows Spong's elbow (articulated) arm: z0 up along joint 1, "
+        "shoulder at height L1, joints 2 and 3 horizontal, zero pose with both arms along x0 (docs/seed-notes.md §3). "
+        "The tutorial prints no solution, so nothing is compared; every result is checked instead."
+    )
     robot = robots.elbow_3r(L1=d["L1"], L2=d["L2"], L3=d["L3"])
     dh = robot.dh
     assert dh is not None  # elbow_3r is built from its DH table
     rows = []
     for i, r in enumerate(dh, start=1):
         rows.append([str(i), f"theta{i}*", _fmt(r.d), _fmt(r.a), f"{_fmt(math.degrees(r.alpha))} deg"])
-    a.table("DH table (standard: Rz(theta) Tz(d) Tx(a) Rx(alpha); * = joint variable)", ["link", "theta", "d [m]", "a [m]", "alpha"], rows)
+    a.table(
+        "DH table (standard: Rz(theta) Tz(d) Tx(a) Rx(alpha); * = joint variable)",
+        ["link", "theta", "d [m]", "a [m]", "alpha"],
+        rows,
+    )
     # symbolic FK and Jacobian from the symbolic robot
     from ..robot import Robot
 
@@ -669,7 +815,9 @@ def _challenge() -> Answer:
     a.eq("o3 = (x, y, z)", o3)
     x, y, z = sp.symbols("x y z", real=True)
     L1s, L2s, L3s = sp.symbols("L1 L2 L3", positive=True)
-    a.text("Inverse kinematics (geometric, Spong §3.3): project onto the base plane and the vertical plane through the arm.")
+    a.text(
+        "Inverse kinematics (geometric, Spong §3.3): project onto the base plane and the vertical plane through the arm."
+    )
     r_ = sp.sqrt(x**2 + y**2)
     s_ = z - L1s
     Dexpr = (r_**2 + s_**2 - L2s**2 - L3s**2) / (2 * L2s * L3s)
@@ -677,12 +825,17 @@ def _challenge() -> Answer:
     a.eq("D = cos(theta3)", Dexpr)
     a.eq("theta3", "atan2(±sqrt(1 - D²), D)")
     a.eq("theta2", "atan2(z - L1, ±sqrt(x² + y²)) - atan2(L3 sin(theta3), L2 + L3 cos(theta3))")
-    a.text("reachable when |L2 - L3| <= sqrt(r^2 + s^2) <= L2 + L3 (r = sqrt(x^2 + y^2), s = z - L1); the sign of r picks the shoulder "
-           "(front / back), the sign of the square root the elbow (down / up).")
+    a.text(
+        "reachable when |L2 - L3| <= sqrt(r^2 + s^2) <= L2 + L3 (r = sqrt(x^2 + y^2), s = z - L1); the sign of r picks the shoulder "
+        "(front / back), the sign of the square root the elbow (down / up)."
+    )
     X, Y, Z = d["tool"]
     rn, sn = math.hypot(X, Y), Z - d["L1"]
     Dn = (rn**2 + sn**2 - d["L2"] ** 2 - d["L3"] ** 2) / (2 * d["L2"] * d["L3"])
-    a.eq("at (1.0, 0.2, 0.5) m: r, s, sqrt(r^2 + s^2), D", f"{_fmt(rn)}, {_fmt(sn)}, {_fmt(math.hypot(rn, sn))}, {_fmt(Dn)}")
+    a.eq(
+        "at (1.0, 0.2, 0.5) m: r, s, sqrt(r^2 + s^2), D",
+        f"{_fmt(rn)}, {_fmt(sn)}, {_fmt(math.hypot(rn, sn))}, {_fmt(Dn)}",
+    )
     sols = elbow_ik(X, Y, Z, d["L1"], d["L2"], d["L3"])
     target = np.array(d["tool"])
     names = [elbow_branch_name(robot, qv) for qv in sols]  # labelled by where the elbow is, not by list order
@@ -693,9 +846,15 @@ def _challenge() -> Answer:
         residuals.append(err)
         tab_deg.append([name, *(_fmt(math.degrees(v), 9) for v in qv), f"{err:.1e}"])
         tab_rad.append([name, *(_fmt(v, 9) for v in qv)])
-    a.table("joint values for the tool at (1.0, 0.2, 0.5) m, in degrees", ["branch", "theta1", "theta2", "theta3", "FK error [m]"], tab_deg)
+    a.table(
+        "joint values for the tool at (1.0, 0.2, 0.5) m, in degrees",
+        ["branch", "theta1", "theta2", "theta3", "FK error [m]"],
+        tab_deg,
+    )
     a.table("the same in radians", ["branch", "theta1", "theta2", "theta3"], tab_rad)
-    a.text("Check: kinedyn's forward kinematics (robot.pose) puts the tool back on the target for each solution (FK error column).")
+    a.text(
+        "Check: kinedyn's forward kinematics (robot.pose) puts the tool back on the target for each solution (FK error column)."
+    )
     kd_solutions = None
     if hasattr(robot, "inverse_kinematics"):
         try:
@@ -706,7 +865,9 @@ def _challenge() -> Answer:
     if kd_solutions is not None and kd_solutions.size:
         wrap = lambda A: (A + math.pi) % (2 * math.pi) - math.pi
         matched = sum(any(np.allclose(wrap(s - k), 0, atol=1e-8) for k in kd_solutions) for s in sols)
-        a.text(f"kinedyn's inverse kinematics (robot.inverse_kinematics) returns {len(kd_solutions)} solutions; {matched} of the 4 above are among them.")
+        a.text(
+            f"kinedyn's inverse kinematics (robot.inverse_kinematics) returns {len(kd_solutions)} solutions; {matched} of the 4 above are among them."
+        )
     # Jacobian
     J = symbolic_jacobian(sym, q)
     Jv = J[:3, :]
@@ -718,21 +879,35 @@ def _challenge() -> Answer:
     if not _same(Jv.det(), detJ, [t1, t2, t3, L1s, L2s, L3s]):  # a factored form, checked before it is shown
         detJ = sp.factor(sp.trigsimp(Jv.det()))
     a.eq("det J_v", detJ)
-    a.text("The arm is singular where det J_v = 0: sin(theta3) = 0 (elbow straight or folded) or L2 cos(theta2) + L3 cos(theta2 + theta3) = 0 "
-           "(the tool on the z0 axis).")
-    subs_num = {sp.Symbol("L1", positive=True): d["L1"], sp.Symbol("L2", positive=True): d["L2"], sp.Symbol("L3", positive=True): d["L3"]}
+    a.text(
+        "The arm is singular where det J_v = 0: sin(theta3) = 0 (elbow straight or folded) or L2 cos(theta2) + L3 cos(theta2 + theta3) = 0 "
+        "(the tool on the z0 axis)."
+    )
+    subs_num = {
+        sp.Symbol("L1", positive=True): d["L1"],
+        sp.Symbol("L2", positive=True): d["L2"],
+        sp.Symbol("L3", positive=True): d["L3"],
+    }
     fJ = sp.lambdify(q, J.xreplace(subs_num), "numpy")
     jac = []
     worst = 0.0
-    for name, qv in zip(names, sols):
+    for qv in sols:
         Jn = robot.jacobian(qv)
         worst = max(worst, float(np.max(np.abs(np.asarray(fJ(*qv), dtype=float) - Jn))))
         jac.append(Jn)
-    a.table(f"J at the first solution ({names[0]}), kinedyn robot.jacobian(q)", ["", "theta1", "theta2", "theta3"],
-            [[rn_, *row] for rn_, row in zip(["vx", "vy", "vz", "wx", "wy", "wz"], _mat_rows(jac[0], 7))])
-    a.text(f"Check: the symbolic J evaluated at the four solutions equals the numeric engine's robot.jacobian(q): max difference {worst:.1e}.")
+    a.table(
+        f"J at the first solution ({names[0]}), kinedyn robot.jacobian(q)",
+        ["", "theta1", "theta2", "theta3"],
+        [[rn_, *row] for rn_, row in zip(["vx", "vy", "vz", "wx", "wy", "wz"], _mat_rows(jac[0], 7))],
+    )
+    a.text(
+        f"Check: the symbolic J evaluated at the four solutions equals the numeric engine's robot.jacobian(q): max difference {worst:.1e}."
+    )
     a.result = {
-        "dh": [{"theta": f"theta{i}", "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha)} for i, r in enumerate(dh, 1)],
+        "dh": [
+            {"theta": f"theta{i}", "d": float(r.d), "a": float(r.a), "alpha": float(r.alpha)}
+            for i, r in enumerate(dh, 1)
+        ],
         "solutions_rad": sols.tolist(),
         "branches": names,
         "fk_residuals": residuals,
@@ -757,7 +932,7 @@ def answer(question: str) -> Answer:
     return _SOLVERS[key]()
 
 
-def work(questions: Optional[Sequence[str]] = None) -> List[Answer]:
+def work(questions: Sequence[str] | None = None) -> list[Answer]:
     """Work the questions in order (all of them by default)."""
     return [answer(q) for q in (questions or QUESTIONS)]
 
@@ -776,8 +951,16 @@ def to_json(answers: Sequence[Answer]) -> dict:
             "title": a.title,
             "question": a.question,
             "steps": [
-                {"kind": it[0], **({"text": it[1]} if it[0] == "text" else {"name": it[1], "value": _jsonable_value(it[2])} if it[0] == "eq"
-                                   else {"title": it[1], "headers": it[2], "rows": it[3]})}
+                {
+                    "kind": it[0],
+                    **(
+                        {"text": it[1]}
+                        if it[0] == "text"
+                        else {"name": it[1], "value": _jsonable_value(it[2])}
+                        if it[0] == "eq"
+                        else {"title": it[1], "headers": it[2], "rows": it[3]}
+                    ),
+                }
                 for it in a.items
             ],
             "result": a.result,
@@ -799,7 +982,7 @@ def name_latex(name: str) -> str:
     ``det J_v`` -> ``\\det J_{v}``; the same names the Markdown and the report's MathML show."""
     import re
 
-    def coord(m: "re.Match") -> str:
+    def coord(m: re.Match) -> str:
         dots = {"": "", "d": "dot", "dd": "ddot", "dot": "dot", "ddot": "ddot"}[m.group(2) or ""]
         base = r"\theta"
         return (f"\\{dots}{{{base}}}" if dots else base) + (f"_{{{m.group(3)}}}" if m.group(3) else "")
@@ -822,18 +1005,27 @@ def name_latex(name: str) -> str:
     return t
 
 
-def _rates_mathml() -> Dict[sp.Symbol, str]:
+def _rates_mathml() -> dict[sp.Symbol, str]:
     """MathML of the displayed tutorial symbols theta_k, thetadot_k, thetaddot_k: θ with dots above."""
     from ..symbolic.render import rate_symbols
 
     q = [sp.Symbol(f"theta{k}", real=True) for k in (1, 2)]
-    return rate_symbols(q, [sp.Symbol(f"thetadot{k}", real=True) for k in (1, 2)], [sp.Symbol(f"thetaddot{k}", real=True) for k in (1, 2)])
+    return rate_symbols(
+        q,
+        [sp.Symbol(f"thetadot{k}", real=True) for k in (1, 2)],
+        [sp.Symbol(f"thetaddot{k}", real=True) for k in (1, 2)],
+    )
 
 
 def render_markdown(answers: Sequence[Answer]) -> str:
     out = ["# The METR4202 Tutorial 4, worked with kinedyn", ""]
     for a in answers:
-        out += [f"## Q{a.key}: {a.title}" if a.key != "challenge" else f"## Challenge: {a.title}", "", f"*{a.question}*", ""]
+        out += [
+            f"## Q{a.key}: {a.title}" if a.key != "challenge" else f"## Challenge: {a.title}",
+            "",
+            f"*{a.question}*",
+            "",
+        ]
         for it in a.items:
             if it[0] == "text":
                 out += [it[1], ""]
@@ -849,12 +1041,22 @@ def render_markdown(answers: Sequence[Answer]) -> str:
                 out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
                 out.append("")
         if a.comparisons:
-            out += ["**Against the tutorial's printed answer**", "", "| quantity | printed | kinedyn | verdict |", "|---|---|---|---|"]
+            out += [
+                "**Against the tutorial's printed answer**",
+                "",
+                "| quantity | printed | kinedyn | verdict |",
+                "|---|---|---|---|",
+            ]
             for c in a.comparisons:
-                out.append(f"| {c.quantity} | `{c.printed}` | `{c.kinedyn}` | {'agrees' if c.agrees else '**differs: misprint**'} |")
+                out.append(
+                    f"| {c.quantity} | `{c.printed}` | `{c.kinedyn}` | {'agrees' if c.agrees else '**differs: misprint**'} |"
+                )
             out.append("")
             for c in a.misprints:
-                out += [f"- **{c.quantity}: the printed value is wrong.** Correct: `{c.correction or c.kinedyn}`. Deciding check: {c.check}.", ""]
+                out += [
+                    f"- **{c.quantity}: the printed value is wrong.** Correct: `{c.correction or c.kinedyn}`. Deciding check: {c.check}.",
+                    "",
+                ]
     return "\n".join(out)
 
 
@@ -884,9 +1086,11 @@ def render_html(answers: Sequence[Answer]) -> str:
             return f'<math xmlns="{MATHML_NS}">{value_mathml(_display(expr), rates)}</math>'
         return f"<code>{escape(text)}</code>"
 
-    out = ["<section id='tutorial'><h2>The tutorial, worked</h2>",
-           "<p class='note'>The seed tutorial's questions on this arm, worked by kinedyn step by step (<code>kinedyn tutorial</code> "
-           "prints the same in a terminal). Every printed answer is compared with kinedyn's and decided by an independent check.</p>"]
+    out = [
+        "<section id='tutorial'><h2>The tutorial, worked</h2>",
+        "<p class='note'>The seed tutorial's questions on this arm, worked by kinedyn step by step (<code>kinedyn tutorial</code> "
+        "prints the same in a terminal). Every printed answer is compared with kinedyn's and decided by an independent check.</p>",
+    ]
     for a in answers:
         title = f"Q{a.key}: {a.title}" if a.key != "challenge" else f"Challenge: {a.title}"
         out += [f"<h3>{escape(title)}</h3>", f"<p><i>{escape(a.question)}</i></p>"]
@@ -904,12 +1108,18 @@ def render_html(answers: Sequence[Answer]) -> str:
                 printed, mine = c.exprs[:2] if c.exprs else (None, None)
                 verdict = "<span class='ok'>agrees</span>" if c.agrees else "<span class='bad'>differs: misprint</span>"
                 quantity = f'<math xmlns="{MATHML_NS}">{latex_to_mathml(name_latex(c.quantity))}</math>'
-                rows.append(f"<tr><td>{quantity}</td><td>{value(c.printed, printed)}</td><td>{value(c.kinedyn, mine)}</td><td>{verdict}</td></tr>")
-            out.append("<table class='comparisons'><thead><tr><th>quantity</th><th>printed</th><th>kinedyn</th><th>verdict</th></tr></thead>"
-                       f"<tbody>{''.join(rows)}</tbody></table>")
+                rows.append(
+                    f"<tr><td>{quantity}</td><td>{value(c.printed, printed)}</td><td>{value(c.kinedyn, mine)}</td><td>{verdict}</td></tr>"
+                )
+            out.append(
+                "<table class='comparisons'><thead><tr><th>quantity</th><th>printed</th><th>kinedyn</th><th>verdict</th></tr></thead>"
+                f"<tbody>{''.join(rows)}</tbody></table>"
+            )
             for c in a.misprints:
-                out.append(f"<p><b class='bad'>{escape(c.quantity)}: the printed value is wrong.</b> Correct: "
-                           f"{value(c.correction or c.kinedyn, c.exprs[1] if c.exprs else None)}. Deciding check: {escape(c.check)}.</p>")
+                out.append(
+                    f"<p><b class='bad'>{escape(c.quantity)}: the printed value is wrong.</b> Correct: "
+                    f"{value(c.correction or c.kinedyn, c.exprs[1] if c.exprs else None)}. Deciding check: {escape(c.check)}.</p>"
+                )
     out.append("</section>")
     return "\n".join(out)
 
@@ -949,8 +1159,12 @@ def render_text(answers: Sequence[Answer], console=None) -> None:
                 t.add_column(h)
             for cmp in a.comparisons:
                 sym = cmp.exprs is not None
-                t.add_row(escape(cmp.quantity), "(expression)" if sym else escape(cmp.printed), "(expression)" if sym else escape(cmp.kinedyn),
-                          "[green]agrees[/green]" if cmp.agrees else "[bold red]differs: misprint[/bold red]")
+                t.add_row(
+                    escape(cmp.quantity),
+                    "(expression)" if sym else escape(cmp.printed),
+                    "(expression)" if sym else escape(cmp.kinedyn),
+                    "[green]agrees[/green]" if cmp.agrees else "[bold red]differs: misprint[/bold red]",
+                )
             c.print(t)
             for cmp in a.misprints:
                 c.print(Text.assemble(("MISPRINT ", "bold red"), (f"{cmp.quantity}", "bold")))
@@ -973,7 +1187,9 @@ def _pretty_eq(c, name: str, value) -> None:
     label = f"  {name} = "
     mid = len(lines) // 2
     for k, line in enumerate(lines):
-        c.print(Text.assemble((label if k == mid else " " * len(label), "bold cyan"), line), overflow="ignore", crop=False)
+        c.print(
+            Text.assemble((label if k == mid else " " * len(label), "bold cyan"), line), overflow="ignore", crop=False
+        )
 
 
 def _short(s: str, width: int = 70) -> str:

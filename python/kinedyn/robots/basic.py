@@ -9,7 +9,8 @@ from __future__ import annotations
 import functools
 import inspect
 import math
-from typing import Callable, TypeVar, cast
+from collections.abc import Callable
+from typing import TypeVar, cast
 
 import sympy as sp
 
@@ -70,7 +71,12 @@ def planar_2r(l1=2.0, l2=3.0, m1=1.0, m2=1.0, lc1=None, lc2=None, I1=None, I2=No
         DHRow(a=l1, inertia=_rod_x(m1, l1, lc1, I1)),
         DHRow(a=l2, inertia=_rod_x(m2, l2, lc2, I2)),
     ]
-    return Robot.from_dh(rows, gravity=(0, -g, 0), name="planar_2r", source="METR4202 Tutorial 4 Q1-Q3; Spong, Hutchinson & Vidyasagar, Robot Modeling and Control, §9.4.2")
+    return Robot.from_dh(
+        rows,
+        gravity=(0, -g, 0),
+        name="planar_2r",
+        source="METR4202 Tutorial 4 Q1-Q3; Spong, Hutchinson & Vidyasagar, Robot Modeling and Control, §9.4.2",
+    )
 
 
 @_symbolic_defaults("l1 l2 l3 m1 m2 m3 g")
@@ -116,7 +122,12 @@ def elbow_3r(L1=3.0, L2=2.0, L3=1.0, m1=1.0, m2=1.0, m3=1.0, g=9.81, radius=0.05
         DHRow(a=L2, inertia=_rod_x(m2, L2, L2 / 2, transverse(m2, L2), axial(m2))),
         DHRow(a=L3, inertia=_rod_x(m3, L3, L3 / 2, transverse(m3, L3), axial(m3))),
     ]
-    return Robot.from_dh(rows, gravity=(0, 0, -g), name="elbow_3r", source="METR4202 Tutorial 4 challenge; Spong et al., Robot Modeling and Control, Example 3.5 / Table 3.3")
+    return Robot.from_dh(
+        rows,
+        gravity=(0, 0, -g),
+        name="elbow_3r",
+        source="METR4202 Tutorial 4 challenge; Spong et al., Robot Modeling and Control, Example 3.5 / Table 3.3",
+    )
 
 
 @_symbolic_defaults("m1 m2 g")
@@ -128,4 +139,6 @@ def cartesian_2p(m1=1.0, m2=1.0, g=9.81, symbolic=False) -> Robot:
         DHRow(alpha=minus_half_pi, kind="prismatic", inertia=Inertia(m1)),
         DHRow(kind="prismatic", inertia=Inertia(m2)),
     ]
-    return Robot.from_dh(rows, gravity=(0, 0, -g), name="cartesian_2p", source="Spong et al., Robot Modeling and Control, §9.4.1")
+    return Robot.from_dh(
+        rows, gravity=(0, 0, -g), name="cartesian_2p", source="Spong et al., Robot Modeling and Control, §9.4.1"
+    )

@@ -15,7 +15,8 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from typing import Any, Optional, Sequence, Union
+from collections.abc import Sequence
+from typing import Any, Union
 
 import numpy as np
 
@@ -48,7 +49,7 @@ def _inertia(mass, com, tensor) -> Inertia:
     return Inertia(mass, tuple(com), np.diag(t) if t.shape == (3,) else t)
 
 
-def _pick(given: Optional[Sequence], default: Sequence, what: str) -> list:
+def _pick(given: Sequence | None, default: Sequence, what: str) -> list:
     if given is None:
         return list(default)
     if len(given) != len(default):
@@ -64,10 +65,21 @@ def _rows(kin, limits, masses, coms, inertias, drive, names) -> list:
         gear, rotor, viscous, coulomb = drive[i]
         rows.append(
             DHRow(
-                theta=theta, d=d, a=a, alpha=alpha, kind=kind, name=names[i],
+                theta=theta,
+                d=d,
+                a=a,
+                alpha=alpha,
+                kind=kind,
+                name=names[i],
                 inertia=_inertia(masses[i], coms[i], inertias[i]),
-                lower=lower, upper=upper, velocity_limit=velocity, effort_limit=effort,
-                gear_ratio=gear, rotor_inertia=rotor, viscous=viscous, coulomb=coulomb,
+                lower=lower,
+                upper=upper,
+                velocity_limit=velocity,
+                effort_limit=effort,
+                gear_ratio=gear,
+                rotor_inertia=rotor,
+                viscous=viscous,
+                coulomb=coulomb,
             )
         )
     return rows
@@ -116,9 +128,9 @@ def puma560(
     a3: float = 0.0203,
     d3: float = 0.15005,
     d4: float = 0.4318,
-    masses: Optional[Sequence] = None,
-    coms: Optional[Sequence] = None,
-    inertias: Optional[Sequence] = None,
+    masses: Sequence | None = None,
+    coms: Sequence | None = None,
+    inertias: Sequence | None = None,
     gravity=(0.0, 0.0, -9.81),
     motors: bool = True,
     friction: Union[bool, str] = False,
@@ -165,7 +177,9 @@ def puma560(
     ]
     limits = [(lo * _DEG, hi * _DEG, math.inf, math.inf) for lo, hi in PUMA560_LIMITS_DEG]
     if friction not in (True, False, "symmetric"):
-        raise ValueError(f"friction must be True (Corke's two Coulomb levels), 'symmetric' (their mean) or False, got {friction!r}")
+        raise ValueError(
+            f"friction must be True (Corke's two Coulomb levels), 'symmetric' (their mean) or False, got {friction!r}"
+        )
     drive = []
     for jm, gear, b, (tc_pos, tc_neg) in PUMA560_MOTORS:
         viscous = b * gear**2 if friction else 0.0
@@ -177,12 +191,18 @@ def puma560(
             coulomb = 0.0
         drive.append((gear, jm if motors else 0.0, viscous, coulomb))
     rows = _rows(
-        kin, limits,
-        _pick(masses, PUMA560_MASSES, "masses"), _pick(coms, PUMA560_COMS, "coms"),
-        _pick(inertias, PUMA560_INERTIAS, "inertias"), drive, [f"q{i}" for i in range(1, 7)],
+        kin,
+        limits,
+        _pick(masses, PUMA560_MASSES, "masses"),
+        _pick(coms, PUMA560_COMS, "coms"),
+        _pick(inertias, PUMA560_INERTIAS, "inertias"),
+        drive,
+        [f"q{i}" for i in range(1, 7)],
     )
     return Robot.from_dh(
-        rows, gravity=gravity, name="puma560",
+        rows,
+        gravity=gravity,
+        name="puma560",
         source="Corke & Armstrong-Helouvry 1994; Armstrong, Khatib & Burdick 1986; Corke RTB mdl_puma560.m",
     )
 
@@ -226,9 +246,9 @@ def stanford(
     d1: float = 0.412,
     d2: float = 0.154,
     d6: float = 0.263,
-    masses: Optional[Sequence] = None,
-    coms: Optional[Sequence] = None,
-    inertias: Optional[Sequence] = None,
+    masses: Sequence | None = None,
+    coms: Sequence | None = None,
+    inertias: Sequence | None = None,
     gravity=(0.0, 0.0, -9.81),
     motors: bool = True,
 ) -> Robot:
@@ -275,14 +295,21 @@ def stanford(
     limits = [(lo, hi, math.inf, math.inf) for lo, hi in STANFORD_LIMITS]
     drive = [(1.0, jm if motors else 0.0, 0.0, 0.0) for jm in STANFORD_ROTOR_INERTIAS]
     rows = _rows(
-        kin, limits,
-        _pick(masses, STANFORD_MASSES, "masses"), _pick(coms, STANFORD_COMS, "coms"),
-        _pick(inertias, STANFORD_INERTIAS, "inertias"), drive, [f"q{i}" for i in range(1, 7)],
+        kin,
+        limits,
+        _pick(masses, STANFORD_MASSES, "masses"),
+        _pick(coms, STANFORD_COMS, "coms"),
+        _pick(inertias, STANFORD_INERTIAS, "inertias"),
+        drive,
+        [f"q{i}" for i in range(1, 7)],
     )
     tool = np.eye(4)
     tool[2, 3] = d6  # the published tool transform, transl(0, 0, 0.263)
     return Robot.from_dh(
-        rows, gravity=gravity, name="stanford", tool=tool,
+        rows,
+        gravity=gravity,
+        name="stanford",
+        tool=tool,
         source="Stanford AIM-177; Paul 1981 Tables 6.5-6.6; Corke RTB mdl_stanford.m",
     )
 
@@ -304,7 +331,14 @@ UR5_COMS = (
 # UR publishes no UR5 inertia tensors. Solid cylinders of the link dimensions used by ROS-Industrial's
 # ur_description (ur5.urdf.xacro, cylinder_inertial: radius 0.06 m, lengths 0.15, 0.56, 0.5, 0.12,
 # 0.12, 0.12 m), with their symmetry axis along these DH-frame axes (found by comparing frames):
-UR5_CYLINDERS = ((0.06, 0.15, "y"), (0.06, 0.56, "x"), (0.06, 0.5, "x"), (0.06, 0.12, "z"), (0.06, 0.12, "y"), (0.06, 0.12, "y"))
+UR5_CYLINDERS = (
+    (0.06, 0.15, "y"),
+    (0.06, 0.56, "x"),
+    (0.06, 0.5, "x"),
+    (0.06, 0.12, "z"),
+    (0.06, 0.12, "y"),
+    (0.06, 0.12, "y"),
+)
 # Joint limits: +-360 deg on every joint (UR5 CB3 technical specifications); velocity [rad/s] and
 # effort [N m] limits as in ur_description's ur5.urdf.xacro.
 UR5_VELOCITY_LIMITS = (3.15, 3.15, 3.15, 3.2, 3.2, 3.2)
@@ -326,9 +360,9 @@ def ur5(
     d4: float = 0.10915,
     d5: float = 0.09465,
     d6: float = 0.0823,
-    masses: Optional[Sequence] = None,
-    coms: Optional[Sequence] = None,
-    inertias: Optional[Sequence] = None,
+    masses: Sequence | None = None,
+    coms: Sequence | None = None,
+    inertias: Sequence | None = None,
     gravity=(0.0, 0.0, -9.81),
 ) -> Robot:
     """Universal Robots UR5 (CB3) in UR's standard DH, gravity along -z0.
@@ -358,7 +392,8 @@ def ur5(
     coms = _pick(coms, UR5_COMS, "coms")
     if inertias is None:
         inertias = [
-            np.array(Inertia.cylinder(m, r, length, axis).inertia) for m, (r, length, axis) in zip(masses, UR5_CYLINDERS)
+            np.array(Inertia.cylinder(m, r, length, axis).inertia)
+            for m, (r, length, axis) in zip(masses, UR5_CYLINDERS)
         ]
     kin = [
         (0.0, d1, 0.0, math.pi / 2, "revolute"),
@@ -370,9 +405,18 @@ def ur5(
     ]
     limits = [(-2 * math.pi, 2 * math.pi, v, e) for v, e in zip(UR5_VELOCITY_LIMITS, UR5_EFFORT_LIMITS)]
     drive = [(1.0, 0.0, 0.0, 0.0)] * 6
-    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    names = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
     rows = _rows(kin, limits, masses, coms, _pick(inertias, UR5_CYLINDERS, "inertias"), drive, names)
     return Robot.from_dh(
-        rows, gravity=gravity, name="ur5",
+        rows,
+        gravity=gravity,
+        name="ur5",
         source="Universal Robots DH parameters page (UR5); ur_description ur5.urdf.xacro",
     )

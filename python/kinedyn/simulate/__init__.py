@@ -4,7 +4,15 @@ stabilised by Baumgarte's method) and returns a :class:`Trajectory`; :mod:`.cont
 controllers and reference trajectories. See docs/simulation.md."""
 
 from .control import PD, ComputedTorque, Constant, Cubic, Fourier, FunctionController, PDGravity, Quintic, Reference
-from .core import ADAPTIVE_METHODS, FIXED_METHODS, NonFiniteTorqueError, SimulationError, SimulationOverflowError, SimulationTruncatedWarning, simulate
+from .core import (
+    ADAPTIVE_METHODS,
+    FIXED_METHODS,
+    NonFiniteTorqueError,
+    SimulationError,
+    SimulationOverflowError,
+    SimulationTruncatedWarning,
+    simulate,
+)
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
 

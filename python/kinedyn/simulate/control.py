@@ -31,7 +31,7 @@ References (each ``ref(t) -> (q_d, qd_d, qdd_d)``, ``t`` a number or an array (T
 
 from __future__ import annotations
 
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
@@ -83,7 +83,9 @@ class _PointToPoint(Reference):
         self.q0 = np.asarray(q0, dtype=float)
         self.q1 = np.asarray(q1, dtype=float)
         if self.q0.shape != self.q1.shape or self.q0.ndim != 1:
-            raise ValueError(f"q0 and q1 must be vectors of the same length, got shapes {self.q0.shape} and {self.q1.shape}")
+            raise ValueError(
+                f"q0 and q1 must be vectors of the same length, got shapes {self.q0.shape} and {self.q1.shape}"
+            )
         if not T > 0:
             raise ValueError(f"the duration T must be positive, got {T}")
         self.n = self.q0.size
@@ -142,7 +144,7 @@ class Fourier(Reference):
         return 2 * np.pi / self.wf
 
     @classmethod
-    def random(cls, n: int, harmonics: int = 5, wf: float = 2 * np.pi * 0.1, amplitude=0.8, q0=None, seed=0) -> "Fourier":
+    def random(cls, n: int, harmonics: int = 5, wf: float = 2 * np.pi * 0.1, amplitude=0.8, q0=None, seed=0) -> Fourier:
         rng = np.random.default_rng(seed)
         a = rng.normal(size=(n, harmonics))
         b = rng.normal(size=(n, harmonics))
@@ -213,7 +215,7 @@ class PD(Controller):
 
     name = "PD"
 
-    def __init__(self, kp, kd, reference, n: Optional[int] = None):
+    def __init__(self, kp, kd, reference, n: int | None = None):
         if n is None:
             n = np.asarray(reference).size if not callable(reference) else reference.n
         self.n = n
@@ -308,4 +310,3 @@ def make_controller(robot, kind: str, *, q_goal=None, kp=None, kd=None, T: float
         start = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float)
         return ComputedTorque(robot, kp, kd, Quintic(start, q_goal, T))
     raise ValueError(f"unknown controller '{kind}' (pd, pdg, ct, none)")
-

@@ -35,7 +35,8 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import TYPE_CHECKING, Any, Callable, Optional, Union, cast
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, Union, cast
 
 import numpy as np
 
@@ -49,11 +50,31 @@ if TYPE_CHECKING:
     from ..robot import Robot
     from ..symbolic.system import LagrangianSystem
 
-__all__ = ["simulate", "SimulationError", "NonFiniteTorqueError", "SimulationTruncatedWarning", "FIXED_METHODS", "ADAPTIVE_METHODS", "RK4_STABLE"]
+__all__ = [
+    "simulate",
+    "SimulationError",
+    "NonFiniteTorqueError",
+    "SimulationTruncatedWarning",
+    "FIXED_METHODS",
+    "ADAPTIVE_METHODS",
+    "RK4_STABLE",
+]
 
 FIXED_METHODS = ("rk4", "semi_implicit", "euler", "implicit")
-ADAPTIVE_METHODS = {"rk45": "RK45", "rk23": "RK23", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF", "lsoda": "LSODA"}
-_ALIASES = {"semi_implicit_euler": "semi_implicit", "symplectic_euler": "semi_implicit", "symplectic": "semi_implicit", "implicit_euler": "implicit"}
+ADAPTIVE_METHODS = {
+    "rk45": "RK45",
+    "rk23": "RK23",
+    "dop853": "DOP853",
+    "radau": "Radau",
+    "bdf": "BDF",
+    "lsoda": "LSODA",
+}
+_ALIASES = {
+    "semi_implicit_euler": "semi_implicit",
+    "symplectic_euler": "semi_implicit",
+    "symplectic": "semi_implicit",
+    "implicit_euler": "implicit",
+}
 
 #: ``method="auto"`` keeps RK4 while ``dt`` times the largest eigenvalue modulus of the linearised
 #: dynamics stays below this; RK4's stability region reaches 2.79 on the negative real axis and 2.83
@@ -107,7 +128,9 @@ def _as_mechanical(system, params, baumgarte, points) -> MechanicalSystem:
             system.baumgarte = tuple(baumgarte)
         return system
     if hasattr(system, "euler_lagrange") and hasattr(system, "holonomic"):
-        return MechanicalSystem.from_lagrangian(system, params=params, points=points, baumgarte=tuple(baumgarte) if baumgarte is not None else (10.0, 10.0))
+        return MechanicalSystem.from_lagrangian(
+            system, params=params, points=points, baumgarte=tuple(baumgarte) if baumgarte is not None else (10.0, 10.0)
+        )
     raise TypeError(
         f"simulate needs a kinedyn.Robot, a kinedyn.symbolic.LagrangianSystem or a kinedyn.simulate.MechanicalSystem, got {type(system).__name__}"
     )
@@ -117,7 +140,7 @@ def _names(system) -> list:
     return list(system.joint_names) if hasattr(system, "joint_names") else list(system.names)
 
 
-def _split_state(x0, n: int, name: str, nq: Optional[int] = None):
+def _split_state(x0, n: int, name: str, nq: int | None = None):
     """(q0, qd0) from x0 = concatenate([q0, qd0]): nq + n numbers (nq = n without multi-DOF joints)."""
     from .._arrays import real_array
 
@@ -157,12 +180,14 @@ def _time_grid(t_span, dt, method):
     dt = min(dt, t1 - t0)  # a step longer than the span: one step of the span
     ratio = (t1 - t0) / dt
     if not ratio < 2.0**53:  # beyond this, t0 + k dt no longer advances in float64 (and no run ends)
-        raise ValueError(f"t_span ({t0}, {t1}) with dt = {dt} asks for {ratio:.3g} steps: more than 2**53; raise dt or shorten t_span")
+        raise ValueError(
+            f"t_span ({t0}, {t1}) with dt = {dt} asks for {ratio:.3g} steps: more than 2**53; raise dt or shorten t_span"
+        )
     steps = max(1, int(math.ceil(ratio - 1e-9)))
     return t0, t1, dt, steps
 
 
-def _sampled_u(u, n: int, steps: int, batch: Optional[int]):
+def _sampled_u(u, n: int, steps: int, batch: int | None):
     """u as data: None -> None; (n,) constant -> (1, n); (steps, n) held; (steps + 1, n) linear;
     (N, S, n) per trajectory. Returns (array or None, linear)."""
     if u is None:
@@ -205,14 +230,20 @@ def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/
     which = f" (trajectory {index} of the batch)" if index is not None else ""
     kind = f["kind"]
     if kind == "torque":
-        return NonFiniteTorqueError, f"the controller / input returned a non-finite torque ({f['value']}){where} at {at}{which}"
+        return (
+            NonFiniteTorqueError,
+            f"the controller / input returned a non-finite torque ({f['value']}){where} at {at}{which}",
+        )
     if kind == "diverged":
         return SimulationError, (
             f"simulation of '{system_name}' blew up at {at}{which}: speed {f['value']:.3g} {unit_speed}{where} exceeds "
             f"max_speed; the samples before it are in error.trajectory (reduce dt, use method='implicit' for a stiff robot, check the gains / inputs)"
         )
     if kind == "non_finite":
-        return SimulationError, f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory"
+        return (
+            SimulationError,
+            f"simulation of '{system_name}' blew up at {at}{which}: the state became non-finite{where}; the samples before it are in error.trajectory",
+        )
     if kind == "singular":
         cls = SimulationOverflowError if "too large for float64" in (f["message"] or "") else SimulationError
         return cls, f"simulation of '{system_name}' stopped at {at}{which}: {f['message']}"
@@ -222,11 +253,21 @@ def _failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/
 def _raise_failure(system, names, failures, steps_done, traj_factory, steps):
     for index, f in enumerate(failures):
         if f is not None:
-            cls, message = _failure_message(getattr(system, "name", "system"), names, f, index if len(failures) > 1 else None, steps)
+            cls, message = _failure_message(
+                getattr(system, "name", "system"), names, f, index if len(failures) > 1 else None, steps
+            )
             if f["kind"] == "singular" and isinstance(f.get("joint"), int) and hasattr(system, "_nonphysical_note"):
                 message += system._nonphysical_note(f["joint"])  # a kept non-physical inertia can make M singular
             partial = traj_factory(index, int(steps_done[index]))
-            raise cls(message, t=f["t"], step=f["step"], joint=f.get("joint"), index=index if len(failures) > 1 else None, kind=f["kind"], trajectory=partial)
+            raise cls(
+                message,
+                t=f["t"],
+                step=f["step"],
+                joint=f.get("joint"),
+                index=index if len(failures) > 1 else None,
+                kind=f["kind"],
+                trajectory=partial,
+            )
 
 
 # ------------------------------------------------------------------ stiffness and the implicit step
@@ -253,7 +294,9 @@ def _choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
         if abs(lam[i]) > worst:
             worst = float(abs(lam[i]))
             joint = int(np.argmax(np.abs(vec[:n, i]) + np.abs(vec[n:, i]) / max(worst, 1e-300)))
-            joint = int(robot._dof_body[joint]) if hasattr(robot, "_dof_body") else joint  # a degree of freedom -> its joint
+            joint = (
+                int(robot._dof_body[joint]) if hasattr(robot, "_dof_body") else joint
+            )  # a degree of freedom -> its joint
     stiffness = dt * worst
     if stiffness <= RK4_STABLE:
         return "rk4", f"auto: rk4 (dt |lambda|max = {stiffness:.3g} <= {RK4_STABLE:g}, inside RK4's stability region)"
@@ -348,7 +391,23 @@ class _Deadline:
 
 
 # ------------------------------------------------------------------ the Python fixed-step loop
-def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, max_speed, hold, progress, implicit=None, limits=None, deadline=None):
+def _fixed_python(
+    accel,
+    torque,
+    method,
+    t0,
+    dt,
+    steps,
+    q0,
+    qd0,
+    record_every,
+    max_speed,
+    hold,
+    progress,
+    implicit=None,
+    limits=None,
+    deadline=None,
+):
     """One trajectory with the schemes of integrate.rs, the dynamics called from Python.
     ``implicit``: (derivatives(t, q, qd, tau), jacobian(t, q, qd) or None, coulomb or None) for the
     implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`_Deadline`."""
@@ -395,7 +454,11 @@ def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, m
                 qd = qd + dt * a1
                 q = q + dt * qd
             else:
-                f = (lambda tt, x, v: (tau, accel(tt, x, v, tau))[1]) if hold else (lambda tt, x, v: evaluate(k, tt, x, v)[1])
+                f = (
+                    (lambda tt, x, v: (tau, accel(tt, x, v, tau))[1])
+                    if hold
+                    else (lambda tt, x, v: evaluate(k, tt, x, v)[1])
+                )
                 q2, v2 = q + 0.5 * dt * qd, qd + 0.5 * dt * a1
                 a2 = f(t + 0.5 * dt, q2, v2)
                 q3, v3 = q + 0.5 * dt * v2, qd + 0.5 * dt * a2
@@ -411,11 +474,15 @@ def _fixed_python(accel, torque, method, t0, dt, steps, q0, qd0, record_every, m
                 raise _Stop(dict(step=k, t=t, joint=int(bad[0]), kind="non_finite", value=None, message=""))
             fast = np.flatnonzero(np.abs(qd) > max_speed)
             if fast.size:
-                raise _Stop(dict(step=k, t=t, joint=int(fast[0]), kind="diverged", value=float(qd[fast[0]]), message=""))
+                raise _Stop(
+                    dict(step=k, t=t, joint=int(fast[0]), kind="diverged", value=float(qd[fast[0]]), message="")
+                )
     except _Stop as stop:
         failure = stop.failure
     except np.linalg.LinAlgError as e:
-        failure = dict(step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=f"singular system matrix ({e})")
+        failure = dict(
+            step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=f"singular system matrix ({e})"
+        )
     except RuntimeError as e:
         if "singular" not in str(e):
             raise
@@ -435,22 +502,22 @@ def simulate(
     t_span: Union[float, tuple[float, float]],
     x0: ArrayLike,
     u: Union[None, ArrayLike, Callable] = None,
-    controller: Optional[Callable] = None,
+    controller: Callable | None = None,
     method: str = "auto",
-    dt: Optional[float] = None,
+    dt: float | None = None,
     f_ext: Union[None, ArrayLike, Callable] = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
-    progress: Optional[bool] = None,
+    progress: bool | None = None,
     *,
-    params: Optional[dict] = None,
+    params: dict | None = None,
     hold: bool = False,
     record_every: int = 1,
     max_speed: float = 1e6,
-    baumgarte: Optional[tuple[float, float]] = None,
-    points: Optional[Callable] = None,
+    baumgarte: tuple[float, float] | None = None,
+    points: Callable | None = None,
     joint_limits: bool = False,
-    time_budget: Optional[float] = None,
+    time_budget: float | None = None,
 ) -> Trajectory:
     """Simulate ``system`` from ``x0 = concatenate([q0, qd0])`` over ``t_span`` (T or (t0, t1)).
 
@@ -483,7 +550,9 @@ def simulate(
     """
     method = _ALIASES.get(str(method).lower(), str(method).lower())
     if method != "auto" and method not in FIXED_METHODS and method not in ADAPTIVE_METHODS:
-        raise ValueError(f"unknown method '{method}': auto; fixed-step {', '.join(FIXED_METHODS)}; adaptive {', '.join(ADAPTIVE_METHODS)}")
+        raise ValueError(
+            f"unknown method '{method}': auto; fixed-step {', '.join(FIXED_METHODS)}; adaptive {', '.join(ADAPTIVE_METHODS)}"
+        )
     if time_budget is not None and not (time_budget > 0):
         raise ValueError(f"time_budget must be a positive number of seconds, got {time_budget!r}")
     if int(record_every) < 1:
@@ -514,12 +583,18 @@ def simulate(
     jac = jac if callable(jac) else None
     choice = None
     if method == "auto":
-        method, choice = _choose_method(system, q0, qd0, t0, dt, jac, names) if robot else ("rk4", "auto: rk4 (a mechanical system given as equations)")
+        method, choice = (
+            _choose_method(system, q0, qd0, t0, dt, jac, names)
+            if robot
+            else ("rk4", "auto: rk4 (a mechanical system given as equations)")
+        )
     if joint_limits:
         if not robot:
             raise ValueError("joint_limits applies to robots (their joints' lower and upper limits)")
         if method in ADAPTIVE_METHODS:
-            raise ValueError(f"joint_limits needs a fixed-step method (auto, {', '.join(FIXED_METHODS)}), not '{method}'")
+            raise ValueError(
+                f"joint_limits needs a fixed-step method (auto, {', '.join(FIXED_METHODS)}), not '{method}'"
+            )
         arm = cast("Robot", system)  # a robot: checked just above
         limits = (np.asarray(arm.lower_limits, dtype=float), np.asarray(arm.upper_limits, dtype=float))
     else:
@@ -535,10 +610,14 @@ def simulate(
         fext_fn = f_ext
     elif f_ext is not None:
         if not robot:
-            raise ValueError("f_ext applies to robots (wrenches on links); for a Lagrangian system put the generalised force in u")
+            raise ValueError(
+                "f_ext applies to robots (wrenches on links); for a Lagrangian system put the generalised force in u"
+            )
         fe = np.asarray(f_ext, dtype=float)
         if fe.shape != (n, 6) or not np.all(np.isfinite(fe)):
-            raise ValueError(f"f_ext must be a finite (n, 6) = ({n}, 6) array of link wrenches, or a function of (t, q, qd)")
+            raise ValueError(
+                f"f_ext must be a finite (n, 6) = ({n}, 6) array of link wrenches, or a function of (t, q, qd)"
+            )
         fext_fn = lambda t, q, qd: fe  # noqa: E731
     else:
         fext_fn = None
@@ -549,8 +628,10 @@ def simulate(
     native = robot and method in FIXED_METHODS and fext_fn is None and not getattr(system, "mimic_joints", None)
     if multi_dof and not native:
         why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext or mimic joints"
-        raise ValueError(f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
-                         f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext or mimic joints); {why} needs the Python loop, which steps q + h qd")
+        raise ValueError(
+            f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
+            f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext or mimic joints); {why} needs the Python loop, which steps q + h qd"
+        )
     pure_native = native and u_fn is None and controller is None
     delay = 0.0
     if progress is None:
@@ -583,7 +664,9 @@ def simulate(
         def _checked(value, what, t):
             v = np.asarray(value, dtype=float)
             if v.shape != (n,):
-                raise ValueError(f"{what} returned torques of shape {v.shape} at t = {t:g} s; {name} has {n} joints (shape ({n},))")
+                raise ValueError(
+                    f"{what} returned torques of shape {v.shape} at t = {t:g} s; {name} has {n} joints (shape ({n},))"
+                )
             return v
 
         return torque
@@ -597,14 +680,68 @@ def simulate(
     start = time.perf_counter()
     try:
         if native:
-            out = _run_native(system, method, q0, qd0, t0, dt, steps, u_data, linear, None if pure_native else torque_for, hold, record_every, max_speed, bar, batch,
-                              jac, limits, deadline)
+            out = _run_native(
+                system,
+                method,
+                q0,
+                qd0,
+                t0,
+                dt,
+                steps,
+                u_data,
+                linear,
+                None if pure_native else torque_for,
+                hold,
+                record_every,
+                max_speed,
+                bar,
+                batch,
+                jac,
+                limits,
+                deadline,
+            )
         elif method in FIXED_METHODS:
-            out = _run_python(system if robot else mech, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, record_every, max_speed, bar, batch,
-                              jac, limits, deadline)
+            out = _run_python(
+                system if robot else mech,
+                robot,
+                fext_fn,
+                method,
+                q0,
+                qd0,
+                t0,
+                dt,
+                steps,
+                torque_for,
+                hold,
+                record_every,
+                max_speed,
+                bar,
+                batch,
+                jac,
+                limits,
+                deadline,
+            )
         else:
-            out, nfev = _run_adaptive(system if robot else mech, robot, fext_fn, ADAPTIVE_METHODS[method], q0, qd0, t0, t0 + steps * dt, dt, steps, torque_for, rtol, atol,
-                                      max_speed, bar, batch, deadline, jac if u_fn is None else None)
+            out, nfev = _run_adaptive(
+                system if robot else mech,
+                robot,
+                fext_fn,
+                ADAPTIVE_METHODS[method],
+                q0,
+                qd0,
+                t0,
+                t0 + steps * dt,
+                dt,
+                steps,
+                torque_for,
+                rtol,
+                atol,
+                max_speed,
+                bar,
+                batch,
+                deadline,
+                jac if u_fn is None else None,
+            )
             info["nfev"] = nfev
     finally:
         bar.close()
@@ -617,8 +754,10 @@ def simulate(
         K = deadline.step
         t = _sample_times(t0, dt, K, every)
         Q, QD, QDD, TAU = (a[..., : t.size, :] for a in (Q, QD, QDD, TAU))
-        info["truncated"] = (f"stopped by its time budget of {time_budget:g} s (wall clock) at t = {t[-1]:.6g} s, step {K} of {steps}; "
-                             f"the run was to end at t = {t0 + steps * dt:.6g} s")
+        info["truncated"] = (
+            f"stopped by its time budget of {time_budget:g} s (wall clock) at t = {t[-1]:.6g} s, step {K} of {steps}; "
+            f"the run was to end at t = {t0 + steps * dt:.6g} s"
+        )
         info["steps_done"] = K
         import warnings
 
@@ -642,7 +781,26 @@ def _sample_times(t0, dt, steps, every):
     return t0 + ks * dt
 
 
-def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_for, hold, every, max_speed, bar, batch, jac=None, limits=None, deadline=None):
+def _run_native(
+    robot,
+    method,
+    q0,
+    qd0,
+    t0,
+    dt,
+    steps,
+    u_data,
+    linear,
+    torque_for,
+    hold,
+    every,
+    max_speed,
+    bar,
+    batch,
+    jac=None,
+    limits=None,
+    deadline=None,
+):
     """The core's integrator, in chunks when a progress bar is shown or a time budget is set
     (chunk boundaries on recorded steps, so the samples are the same as in one call)."""
     from .. import _core
@@ -666,18 +824,39 @@ def _run_native(robot, method, q0, qd0, t0, dt, steps, u_data, linear, torque_fo
                     tau = u_data
                 else:
                     tau = np.ascontiguousarray(u_data[..., k0 : k0 + m + (1 if linear else 0), :])
-            res = _core.integrate_fixed(model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper)
+            res = _core.integrate_fixed(
+                model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper
+            )
         else:
             if batch is None:
                 cb = _offset(torque_for(0), k0)
-                res = _core.integrate_callback(model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper)
+                res = _core.integrate_callback(
+                    model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper
+                )
             else:
                 results: list[tuple[Any, ...]] = [
-                    _core.integrate_callback(model, method, q[i], qd[i], t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every, max_speed, jacobian, lower, upper)
+                    _core.integrate_callback(
+                        model,
+                        method,
+                        q[i],
+                        qd[i],
+                        t0 + k0 * dt,
+                        dt,
+                        m,
+                        _offset(torque_for(i), k0),
+                        hold,
+                        every,
+                        max_speed,
+                        jacobian,
+                        lower,
+                        upper,
+                    )
                     for i in range(batch)
                 ]
                 res = tuple(np.stack([r[j] for r in results]) for j in range(4)) + (
-                    np.concatenate([r[4] for r in results]), [r[5][0] for r in results])
+                    np.concatenate([r[4] for r in results]),
+                    [r[5][0] for r in results],
+                )
         Qc, QDc, QDDc, TAUc, done, failures = res
         done = np.asarray(done) + k0
         failures = [None if f is None else {**f, "step": f["step"] + k0} for f in failures]
@@ -707,16 +886,57 @@ def _accel_fn(target, robot, fext_fn):
     return lambda t, q, qd, tau: target.accelerations(q, qd, tau)[0]
 
 
-def _run_python(target, robot, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, every, max_speed, bar, batch, jac=None, limits=None, deadline=None):
+def _run_python(
+    target,
+    robot,
+    fext_fn,
+    method,
+    q0,
+    qd0,
+    t0,
+    dt,
+    steps,
+    torque_for,
+    hold,
+    every,
+    max_speed,
+    bar,
+    batch,
+    jac=None,
+    limits=None,
+    deadline=None,
+):
     accel = _accel_fn(target, robot, fext_fn)
     implicit = None
     if method == "implicit":
         coulomb = np.array([[float(c) for c in j.coulomb_levels] for j in target.joints]).T if robot else None
-        implicit = (_derivatives_fn(target, robot, fext_fn), jac, (coulomb[0], coulomb[1]) if coulomb is not None and np.any(coulomb) else None)
+        implicit = (
+            _derivatives_fn(target, robot, fext_fn),
+            jac,
+            (coulomb[0], coulomb[1]) if coulomb is not None and np.any(coulomb) else None,
+        )
     results = []
     for i in range(batch or 1):
         qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
-        results.append(_fixed_python(accel, torque_for(i), method, t0, dt, steps, qi, qdi, every, max_speed, hold, bar, implicit, limits, deadline))
+        results.append(
+            _fixed_python(
+                accel,
+                torque_for(i),
+                method,
+                t0,
+                dt,
+                steps,
+                qi,
+                qdi,
+                every,
+                max_speed,
+                hold,
+                bar,
+                implicit,
+                limits,
+                deadline,
+            )
+        )
     return _stack(results, batch)
 
 
@@ -731,7 +951,26 @@ class _Budget(Exception):
     """The wall-clock budget ran out inside an adaptive solve."""
 
 
-def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, steps, torque_for, rtol, atol, max_speed, bar, batch, deadline=None, controller_jac=None):
+def _run_adaptive(
+    target,
+    robot,
+    fext_fn,
+    scipy_method,
+    q0,
+    qd0,
+    t0,
+    t1,
+    dt,
+    steps,
+    torque_for,
+    rtol,
+    atol,
+    max_speed,
+    bar,
+    batch,
+    deadline=None,
+    controller_jac=None,
+):
     """SciPy's solve_ivp per trajectory; with a time budget, over segments of the sample grid (a run
     that runs out of time keeps the segments it finished). The implicit methods (Radau, BDF, LSODA)
     of a robot get the analytical Jacobian ``[[0, I], [dqdd/dq, dqdd/dqd]]`` (the controller's
@@ -758,7 +997,9 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
             tau = torque(step_of(t), t, q, qd)
             bad = np.flatnonzero(~np.isfinite(tau))
             if bad.size:
-                raise _Stop(dict(step=step_of(t), t=t, joint=int(bad[0]), kind="torque", value=float(tau[bad[0]]), message=""))
+                raise _Stop(
+                    dict(step=step_of(t), t=t, joint=int(bad[0]), kind="torque", value=float(tau[bad[0]]), message="")
+                )
             if bounded and deadline.expired():
                 raise _Budget()
             bar.update(t)
@@ -767,7 +1008,7 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
         def too_fast(t, x):
             return max_speed - np.abs(x[n:]).max()
 
-        setattr(too_fast, "terminal", True)  # solve_ivp reads its event options from the function's attributes
+        too_fast.terminal = True  # solve_ivp reads its event options from the function's attributes
         options = {}
         if robot and scipy_method in ("Radau", "BDF", "LSODA"):
             derivatives = _derivatives_fn(target, robot, fext_fn)
@@ -783,10 +1024,22 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
             options["jac"] = jacobian
         failure = None
         pieces = [np.concatenate([qi, qdi])[None, :]]
-        edges = np.unique(np.linspace(0, last, min(last, 20) + 1).round().astype(int)) if bounded else np.array([0, last])
+        edges = (
+            np.unique(np.linspace(0, last, min(last, 20) + 1).round().astype(int)) if bounded else np.array([0, last])
+        )
         try:
             for a, b in zip(edges[:-1], edges[1:]):
-                sol = solve_ivp(rhs, (t_eval[a], t_eval[b]), pieces[-1][-1], method=scipy_method, t_eval=t_eval[a : b + 1], rtol=rtol, atol=atol, events=too_fast, **options)
+                sol = solve_ivp(
+                    rhs,
+                    (t_eval[a], t_eval[b]),
+                    pieces[-1][-1],
+                    method=scipy_method,
+                    t_eval=t_eval[a : b + 1],
+                    rtol=rtol,
+                    atol=atol,
+                    events=too_fast,
+                    **options,
+                )
                 nfev += sol.nfev
                 X = sol.y.T
                 pieces.append(X[1:])
@@ -796,8 +1049,14 @@ def _run_adaptive(target, robot, fext_fn, scipy_method, q0, qd0, t0, t1, dt, ste
                     j = int(np.argmax(np.abs(xe[n:])))
                     failure = dict(step=step_of(te), t=te, joint=j, kind="diverged", value=float(xe[n + j]), message="")
                 elif sol.status < 0 or not np.all(np.isfinite(X)):
-                    failure = dict(step=step_of(sol.t[-1] if sol.t.size else t0), t=float(sol.t[-1]) if sol.t.size else t0, joint=None, kind="non_finite", value=None,
-                                   message=f"the adaptive solver failed: {sol.message}")
+                    failure = dict(
+                        step=step_of(sol.t[-1] if sol.t.size else t0),
+                        t=float(sol.t[-1]) if sol.t.size else t0,
+                        joint=None,
+                        kind="non_finite",
+                        value=None,
+                        message=f"the adaptive solver failed: {sol.message}",
+                    )
                 if failure is not None:
                     break
         except _Stop as stop:

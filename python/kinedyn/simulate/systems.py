@@ -24,8 +24,9 @@ system (the KKT matrix of the constrained Euler-Lagrange equations ``M qdd + h +
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -45,18 +46,18 @@ class MechanicalSystem:
     n: int
     mass_matrix: Callable
     bias: Callable
-    constraint_jacobian: Optional[Callable] = None
-    constraint_drift: Optional[Callable] = None
-    constraint: Optional[Callable] = None
-    energy: Optional[Callable] = None
-    kinetic_energy: Optional[Callable] = None
-    potential_energy: Optional[Callable] = None
-    points: Optional[Callable] = None
+    constraint_jacobian: Callable | None = None
+    constraint_drift: Callable | None = None
+    constraint: Callable | None = None
+    energy: Callable | None = None
+    kinetic_energy: Callable | None = None
+    potential_energy: Callable | None = None
+    points: Callable | None = None
     names: Sequence[str] = field(default_factory=tuple)
     name: str = "system"
     baumgarte: tuple = (10.0, 10.0)
     #: optional fast path: ``terms(q, qd) -> (M, h, A, dA/dt qd, phi)`` in one call
-    terms: Optional[Callable] = None
+    terms: Callable | None = None
 
     def __post_init__(self):
         if not self.names:
@@ -68,7 +69,7 @@ class MechanicalSystem:
     def constrained(self) -> bool:
         return self.constraint_jacobian is not None
 
-    def accelerations(self, q, qd, u, baumgarte: Optional[tuple] = None):
+    def accelerations(self, q, qd, u, baumgarte: tuple | None = None):
         """(qdd, lambda) solving the (Baumgarte-stabilised) constrained equations of motion."""
         if self.terms is not None:
             M, h, A, drift, phi = self.terms(q, qd)
@@ -100,12 +101,16 @@ class MechanicalSystem:
     def constraint_residuals(self, q, qd) -> tuple:
         """(position residual |phi(q)|_inf or 0, velocity residual |A(q) qd|_inf) at one state."""
         pos = float(np.abs(np.atleast_1d(self.constraint(q))).max(initial=0.0)) if self.constraint is not None else 0.0
-        vel = float(np.abs(np.atleast_2d(self.constraint_jacobian(q)) @ qd).max(initial=0.0)) if self.constraint_jacobian is not None else 0.0
+        vel = (
+            float(np.abs(np.atleast_2d(self.constraint_jacobian(q)) @ qd).max(initial=0.0))
+            if self.constraint_jacobian is not None
+            else 0.0
+        )
         return pos, vel
 
     # ------------------------------------------------------------------ from a LagrangianSystem
     @classmethod
-    def from_lagrangian(cls, system, params=None, points=None, baumgarte=(10.0, 10.0)) -> "MechanicalSystem":
+    def from_lagrangian(cls, system, params=None, points=None, baumgarte=(10.0, 10.0)) -> MechanicalSystem:
         """Compile a :class:`kinedyn.symbolic.LagrangianSystem` (parameters given by name in
         ``params``; the generalised forces come from the simulation, not from ``system.u``).
         ``points``: optional SymPy expressions (a list of 2- or 3-vectors of q) drawn by animate()."""
@@ -143,7 +148,9 @@ class MechanicalSystem:
         if any(e.has(system.t) for e in exprs.values()):
             raise ValueError("simulate handles time-invariant Lagrangians; give time-dependent forcing as u(t, q, qd)")
         if missing:
-            raise ValueError(f"{system.name or 'the Lagrangian system'}: give values for the parameters {sorted(missing)} (params={{'name': value}})")
+            raise ValueError(
+                f"{system.name or 'the Lagrangian system'}: give values for the parameters {sorted(missing)} (params={{'name': value}})"
+            )
 
         kwargs: dict[str, Any] = {}
 
@@ -158,13 +165,19 @@ class MechanicalSystem:
         n = len(q)
         # one call per stage for everything the accelerations need (common subexpressions shared)
         k_h = exprs["phi"].shape[0]
-        together = sp.lambdify([q, qd], [exprs["M"], exprs["h"], exprs["A"], exprs["drift"], exprs["phi"]], modules="numpy", cse=True)
+        together = sp.lambdify(
+            [q, qd], [exprs["M"], exprs["h"], exprs["A"], exprs["drift"], exprs["phi"]], modules="numpy", cse=True
+        )
 
         def terms(qv, qdv):
             M_, h_, A_, d_, p_ = together(qv, qdv)
-            return (np.asarray(M_, dtype=float).reshape(n, n), np.asarray(h_, dtype=float).reshape(n),
-                    np.asarray(A_, dtype=float).reshape(k, n), np.asarray(d_, dtype=float).reshape(k),
-                    np.asarray(p_, dtype=float).reshape(k_h) if k_h else None)
+            return (
+                np.asarray(M_, dtype=float).reshape(n, n),
+                np.asarray(h_, dtype=float).reshape(n),
+                np.asarray(A_, dtype=float).reshape(k, n),
+                np.asarray(d_, dtype=float).reshape(k),
+                np.asarray(p_, dtype=float).reshape(k_h) if k_h else None,
+            )
 
         kwargs["terms"] = terms
         Mf = compile_(exprs["M"], (n, n))
@@ -179,7 +192,9 @@ class MechanicalSystem:
                 kwargs["constraint"] = lambda x: pf(x, np.zeros(n))
         if "K" in exprs:
             Kf, Pf = compile_(exprs["K"], ()), compile_(exprs["P"], ())
-            kwargs.update(kinetic_energy=lambda x, v: float(Kf(x, v)), potential_energy=lambda x: float(Pf(x, np.zeros(n))))
+            kwargs.update(
+                kinetic_energy=lambda x, v: float(Kf(x, v)), potential_energy=lambda x: float(Pf(x, np.zeros(n)))
+            )
         if "points" in exprs:
             m = exprs["points"]
             pts = compile_(m, tuple(m.shape))

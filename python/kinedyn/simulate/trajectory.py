@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
@@ -34,7 +34,20 @@ def _simpson_cumulative(y: np.ndarray, dx: float) -> np.ndarray:
 class Trajectory:
     """Samples of a simulated motion (see the module docstring)."""
 
-    def __init__(self, system, t, q, qd, qdd, tau, *, method: str = "", dt: Optional[float] = None, info: Optional[dict] = None, failure=None):
+    def __init__(
+        self,
+        system,
+        t,
+        q,
+        qd,
+        qdd,
+        tau,
+        *,
+        method: str = "",
+        dt: float | None = None,
+        info: dict | None = None,
+        failure=None,
+    ):
         self.system = system
         self.t = np.asarray(t, dtype=float)
         self.q = np.asarray(q, dtype=float)
@@ -52,18 +65,28 @@ class Trajectory:
         return self.q.shape[-1]
 
     @property
-    def batch(self) -> Optional[int]:
+    def batch(self) -> int | None:
         """N for a batch of trajectories, else None."""
         return self.q.shape[0] if self.q.ndim == 3 else None
 
     def __len__(self) -> int:
         return self.t.size
 
-    def __getitem__(self, i) -> "Trajectory":
+    def __getitem__(self, i) -> Trajectory:
         """Trajectory ``i`` of a batch."""
         if self.batch is None:
             raise TypeError("this is a single trajectory; index its arrays (.q[k]) instead")
-        return Trajectory(self.system, self.t, self.q[i], self.qd[i], self.qdd[i], self.tau[i], method=self.method, dt=self.dt, info=self.info)
+        return Trajectory(
+            self.system,
+            self.t,
+            self.q[i],
+            self.qd[i],
+            self.qdd[i],
+            self.tau[i],
+            method=self.method,
+            dt=self.dt,
+            info=self.info,
+        )
 
     @property
     def x(self) -> np.ndarray:
@@ -162,7 +185,14 @@ class Trajectory:
         # only the even samples carry Simpson's value; report the residual there
         at = np.arange(0, len(self), 2) if len(self) >= 3 else np.arange(len(self))
         scale = max(1.0, float(np.abs(W).max(initial=0)), float(np.abs(dH).max(initial=0)))
-        return {"t": self.t, "work": W, "dissipated": D, "dH": dH, "residual": residual, "relative": float(np.abs(residual[at]).max(initial=0)) / scale}
+        return {
+            "t": self.t,
+            "work": W,
+            "dissipated": D,
+            "dH": dH,
+            "residual": residual,
+            "relative": float(np.abs(residual[at]).max(initial=0)) / scale,
+        }
 
     # ------------------------------------------------------------------ export
     def _columns(self) -> tuple:
@@ -193,7 +223,9 @@ class Trajectory:
     def to_npz(self, path) -> Path:
         """Arrays t, q, qd, qdd, tau, K, P, H and joint names in one compressed NumPy file."""
         path = Path(path)
-        arrays: dict[str, Any] = dict(t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, names=np.array(self.names))
+        arrays: dict[str, Any] = dict(
+            t=self.t, q=self.q, qd=self.qd, qdd=self.qdd, tau=self.tau, names=np.array(self.names)
+        )
         for key in ("K", "P", "H"):
             try:
                 arrays[key] = getattr(self, key)
@@ -212,7 +244,9 @@ class Trajectory:
             raise TypeError("plot() draws one trajectory: use traj[i].plot()")
         fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
         names = self.names
-        for ax, arr, label in zip(axes[:3], (self.q, self.qd, self.tau), ("q [rad | m]", "qd [rad/s | m/s]", "tau [N m | N]")):
+        for ax, arr, label in zip(
+            axes[:3], (self.q, self.qd, self.tau), ("q [rad | m]", "qd [rad/s | m/s]", "tau [N m | N]")
+        ):
             for i in range(self.n):
                 ax.plot(self.t, arr[:, i], label=names[i])
             ax.set_ylabel(label)
@@ -254,7 +288,7 @@ class Trajectory:
             P = np.concatenate([P, np.zeros(P.shape[:-1] + (1,))], axis=-1)
         return P
 
-    def show(self, *, block: Optional[bool] = None, **kwargs):
+    def show(self, *, block: bool | None = None, **kwargs):
         """Play the motion in the live 3-D viewer (:meth:`kinedyn.Robot.show`, with a time slider and
         play/pause). Returns the viewer; ``block`` as for ``Robot.show``."""
         from ..visual.viewer import show
@@ -265,7 +299,7 @@ class Trajectory:
             raise TypeError("show() needs a trajectory of a kinedyn.Robot; use animate() for other systems")
         return show(self.system, np.asarray(self.q, dtype=float)[0], trajectory=self, block=block, **kwargs)
 
-    def animate(self, path, fps: int = 25, duration: Optional[float] = None, trail: bool = True):
+    def animate(self, path, fps: int = 25, duration: float | None = None, trail: bool = True):
         """A stick figure of the motion: GIF (``.gif``, Pillow), HTML (``.html``, self-contained
         JavaScript player; a robot's is its meshes in a 3-D view, as in the report) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
         z = const (planar arms), else 3-D. Frames are taken every 1/fps seconds of simulated time.
@@ -286,7 +320,9 @@ class Trajectory:
             # a robot: its meshes in the report's 3-D view, sent once, then joint values per frame
             from ..visual.web import animation_page
 
-            path.write_text(animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]), encoding="utf-8")
+            path.write_text(
+                animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]), encoding="utf-8"
+            )
             return path
         P = self._points()
         planar = np.ptp(P[..., 2]) < 1e-9
@@ -311,7 +347,11 @@ class Trajectory:
             (line,) = ax.plot([], [], [], "o-", lw=3, color="tab:blue")
             (path_line,) = ax.plot([], [], [], "-", lw=1, color="tab:orange", alpha=0.6)
         ax.set_title(getattr(self.system, "name", ""))
-        label = ax.text2D(0.02, 0.95, "", transform=ax.transAxes) if not planar else ax.text(0.02, 0.95, "", transform=ax.transAxes)
+        label = (
+            ax.text2D(0.02, 0.95, "", transform=ax.transAxes)
+            if not planar
+            else ax.text(0.02, 0.95, "", transform=ax.transAxes)
+        )
 
         def draw(k):
             i = idx[k]
@@ -347,9 +387,17 @@ class Trajectory:
 
 # matplotlib's JavaScript player draws its buttons with Font Awesome from a CDN: the page would make a
 # network request, and show empty buttons offline. The same buttons as plain characters instead.
-_PLAYER_GLYPHS = {"fa fa-minus": "\u2212", "fa fa-fast-backward": "\u23ee", "fa fa-step-backward": "\u23f4\u23f4",
-                  "fa fa-play fa-flip-horizontal": "\u25c0", "fa fa-pause": "\u23f8", "fa fa-play": "\u25b6",
-                  "fa fa-step-forward": "\u23f5\u23f5", "fa fa-fast-forward": "\u23ed", "fa fa-plus": "+"}
+_PLAYER_GLYPHS = {
+    "fa fa-minus": "\u2212",
+    "fa fa-fast-backward": "\u23ee",
+    "fa fa-step-backward": "\u23f4\u23f4",
+    "fa fa-play fa-flip-horizontal": "\u25c0",
+    "fa fa-pause": "\u23f8",
+    "fa fa-play": "\u25b6",
+    "fa fa-step-forward": "\u23f5\u23f5",
+    "fa fa-fast-forward": "\u23ed",
+    "fa fa-plus": "+",
+}
 
 
 def _offline_jshtml(page: str) -> str:

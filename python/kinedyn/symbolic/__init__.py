@@ -14,11 +14,46 @@
 """
 
 from .eom import EquationsOfMotion, Step, equations_of_motion
-from .kinematics import JacobianInverse, abbreviate, jacobian, jacobian_inverse, joint_symbols, joint_torques, pose, tool_velocity
-from .mechanisms import change_coordinates, closed_chain, closed_chain_system, decoupling_condition, loop_closure, tree_equations
+from .kinematics import (
+    JacobianInverse,
+    abbreviate,
+    jacobian,
+    jacobian_inverse,
+    joint_symbols,
+    joint_torques,
+    pose,
+    tool_velocity,
+)
+from .mechanisms import (
+    change_coordinates,
+    closed_chain,
+    closed_chain_system,
+    decoupling_condition,
+    loop_closure,
+    tree_equations,
+)
 from .simplify import simplify_trig
 from .system import LagrangianSystem, coordinates
 
-__all__ = ["equations_of_motion", "EquationsOfMotion", "LagrangianSystem", "Step", "coordinates", "simplify_trig",
-           "pose", "jacobian", "jacobian_inverse", "JacobianInverse", "tool_velocity", "joint_torques", "abbreviate", "joint_symbols",
-           "change_coordinates", "closed_chain", "closed_chain_system", "decoupling_condition", "loop_closure", "tree_equations"]
+__all__ = [
+    "equations_of_motion",
+    "EquationsOfMotion",
+    "LagrangianSystem",
+    "Step",
+    "coordinates",
+    "simplify_trig",
+    "pose",
+    "jacobian",
+    "jacobian_inverse",
+    "JacobianInverse",
+    "tool_velocity",
+    "joint_torques",
+    "abbreviate",
+    "joint_symbols",
+    "change_coordinates",
+    "closed_chain",
+    "closed_chain_system",
+    "decoupling_condition",
+    "loop_closure",
+    "tree_equations",
+]

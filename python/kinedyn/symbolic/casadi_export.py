@@ -28,7 +28,7 @@ length of the two-link arm). ``pose``/``jacobian`` need the robot (known to equa
 
 from __future__ import annotations
 
-from typing import Any, Dict, List, Optional
+from typing import Any
 
 import sympy as sp
 
@@ -43,10 +43,26 @@ def _casadi():
     return casadi
 
 
-def _functions(ca) -> Dict[str, Any]:
-    return {"sin": ca.sin, "cos": ca.cos, "tan": ca.tan, "exp": ca.exp, "log": ca.log, "sqrt": ca.sqrt,
-            "fabs": ca.fabs, "sign": ca.sign, "asin": ca.asin, "acos": ca.acos, "atan": ca.atan,
-            "atan2": ca.atan2, "sinh": ca.sinh, "cosh": ca.cosh, "tanh": ca.tanh, "fmax": ca.fmax, "fmin": ca.fmin}
+def _functions(ca) -> dict[str, Any]:
+    return {
+        "sin": ca.sin,
+        "cos": ca.cos,
+        "tan": ca.tan,
+        "exp": ca.exp,
+        "log": ca.log,
+        "sqrt": ca.sqrt,
+        "fabs": ca.fabs,
+        "sign": ca.sign,
+        "asin": ca.asin,
+        "acos": ca.acos,
+        "atan": ca.atan,
+        "atan2": ca.atan2,
+        "sinh": ca.sinh,
+        "cosh": ca.cosh,
+        "tanh": ca.tanh,
+        "fmax": ca.fmax,
+        "fmin": ca.fmin,
+    }
 
 
 class CasadiEOM:
@@ -54,7 +70,7 @@ class CasadiEOM:
     ``g``, ``tau``, ``forward_dynamics`` and, for robots, ``pose`` and ``jacobian``; ``parameters``:
     the SymPy symbols of the input ``p`` in order; ``n``: joints."""
 
-    def __init__(self, n: int, parameters: list, functions: Dict[str, Any]):
+    def __init__(self, n: int, parameters: list, functions: dict[str, Any]):
         self.n = n
         self.parameters = parameters
         self.functions = functions
@@ -65,7 +81,7 @@ class CasadiEOM:
         return f"CasadiEOM(n={self.n}, functions={list(self.functions)}, p={[str(s) for s in self.parameters]})"
 
 
-def _sx_matrix(ca, values: List[Any], shape: tuple):
+def _sx_matrix(ca, values: list[Any], shape: tuple):
     rows = shape[0]
     cols = shape[1] if len(shape) == 2 else 1
     out = ca.SX.zeros(rows, cols)
@@ -74,7 +90,7 @@ def _sx_matrix(ca, values: List[Any], shape: tuple):
     return out
 
 
-def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> CasadiEOM:
+def to_casadi(eom, params=None, robot=None, frame: str | None = None) -> CasadiEOM:
     """CasADi Functions of ``eom``; ``params``: {symbol or name: value} fixed now (the others form ``p``);
     ``robot`` (default: the robot the equations came from) and ``frame`` (default: its tool) for the pose
     and Jacobian."""
@@ -92,15 +108,17 @@ def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> Casa
         from . import kinematics
 
         by_name = {str(k): v for k, v in params.items()}
-        for label, matrix in (("pose", kinematics.pose(robot, frame, simplify=False)),
-                              ("jacobian", kinematics.jacobian(robot, frame, simplify=False))):
+        for label, matrix in (
+            ("pose", kinematics.pose(robot, frame, simplify=False)),
+            ("jacobian", kinematics.jacobian(robot, frame, simplify=False)),
+        ):
             fixed = {s: by_name[str(s)] for s in matrix.free_symbols if str(s) in by_name}
             kinematic.append((label, matrix.subs(fixed) if fixed else matrix))
         known = set(state) | set(pars)
         pars = list(pars) + sorted({s for _, m in kinematic for s in m.free_symbols} - known, key=str)
     q, qd, qdd, tau_in = (ca.SX.sym(name, n) for name in ("q", "qd", "qdd", "tau"))
     p = ca.SX.sym("p", len(pars))
-    env: Dict[sp.Symbol, Any] = {}
+    env: dict[sp.Symbol, Any] = {}
     for name, vec in (("q", q), ("qd", qd), ("qdd", qdd)):
         for i in range(n):
             env[sp.Symbol(f"{name}[{i}]")] = vec[i]
@@ -129,7 +147,9 @@ def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> Casa
     # forward dynamics: M qdd = tau - bias, bias = tau(q, qd, 0) = C qd + g + friction (a linear solve,
     # never an inverse; CasADi's symbolic QR for SX)
     bias = ca.substitute(outputs["tau"], qdd, ca.SX.zeros(n))
-    funcs["forward_dynamics"] = function("forward_dynamics", ("q", "qd", "tau"), "qdd", ca.solve(outputs["M"], tau_in - bias))
+    funcs["forward_dynamics"] = function(
+        "forward_dynamics", ("q", "qd", "tau"), "qdd", ca.solve(outputs["M"], tau_in - bias)
+    )
 
     pmap = {s: sp.Symbol(f"p[{i}]") for i, s in enumerate(pars)}
     for label, matrix in kinematic:
@@ -137,6 +157,7 @@ def to_casadi(eom, params=None, robot=None, frame: Optional[str] = None) -> Casa
         reps, reduced = sp.cse(list(m), symbols=sp.numbered_symbols("k"), order="none")
         walker = Walker(env, fns)
         walker.assign(reps)
-        funcs[label] = function(label, ("q",), "T" if label == "pose" else "J",
-                                _sx_matrix(ca, [walker(e) for e in reduced], tuple(m.shape)))
+        funcs[label] = function(
+            label, ("q",), "T" if label == "pose" else "J", _sx_matrix(ca, [walker(e) for e in reduced], tuple(m.shape))
+        )
     return CasadiEOM(n, list(pars), funcs)

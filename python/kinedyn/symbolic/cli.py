@@ -17,7 +17,9 @@ def _robot(args):
         factory = robots.CATALOGUE.get(name)
         if factory is None or "symbolic" not in inspect.signature(factory).parameters:
             symbolic = [n for n, f in robots.CATALOGUE.items() if "symbolic" in inspect.signature(f).parameters]
-            raise ValueError(f"--symbolic needs a built-in with symbolic parameters ({', '.join(symbolic)}); got '{name}'")
+            raise ValueError(
+                f"--symbolic needs a built-in with symbolic parameters ({', '.join(symbolic)}); got '{name}'"
+            )
         return _substitute(factory(symbolic=True), set_values(), name)
     return load_robot(name)
 
@@ -27,9 +29,14 @@ def cmd_derive(args) -> int:
     from ..progress import busy
 
     robot = _robot(args)
-    with busy(f"deriving the equations of motion of '{robot.name}' ({args.method})", progress=False if args.json else None):
+    with busy(
+        f"deriving the equations of motion of '{robot.name}' ({args.method})", progress=False if args.json else None
+    ):
         eom = robot.equations_of_motion(
-            method=args.method, simplify=not args.no_simplify, parameters="general" if args.general else None, form=args.form
+            method=args.method,
+            simplify=not args.no_simplify,
+            parameters="general" if args.general else None,
+            form=args.form,
         )
         fmt = args.format
         if fmt == "latex":
@@ -66,8 +73,8 @@ def _payload(args, robot, eom, text) -> dict:
         entries = {k: [str(e) for e in cf[k].entries] for k in ("M", "C", "g")}
         payload.update(
             form="cse",
-            M=[entries["M"][r * n:(r + 1) * n] for r in range(n)],
-            C=[entries["C"][r * n:(r + 1) * n] for r in range(n)],
+            M=[entries["M"][r * n : (r + 1) * n] for r in range(n)],
+            C=[entries["C"][r * n : (r + 1) * n] for r in range(n)],
             g=entries["g"],
             tau=[str(t + f) for t, f in zip(cf["tau"].entries, eom.friction)],
             intermediates={k: [[str(s), str(e)] for s, e in cf[k].assignments] for k in ("M", "C", "g", "tau")},
@@ -89,15 +96,23 @@ def _payload(args, robot, eom, text) -> dict:
 def add_derive_command(subparsers) -> None:
     from ..cli import OutputPath
 
-    p = subparsers.add_parser("derive", help="symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)")
+    p = subparsers.add_parser(
+        "derive", help="symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)"
+    )
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument("--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)")
+    p.add_argument(
+        "--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)"
+    )
     p.add_argument("--general", action="store_true", help="replace every inertia by ten symbols (M1, MX1, ..., ZZ1)")
     p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
     p.add_argument("--format", default="text", choices=FORMATS)
     p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
-    p.add_argument("--form", default="auto", choices=["auto", "cse", "expanded"],
-                   help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)")
+    p.add_argument(
+        "--form",
+        default="auto",
+        choices=["auto", "cse", "expanded"],
+        help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)",
+    )
     p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
     p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
     p.set_defaults(func=cmd_derive)

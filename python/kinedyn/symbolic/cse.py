@@ -22,20 +22,28 @@ differentiate: ``WP3x_a2`` = d WP3x / d qdd_2, ``W3x_v2`` = d W3x / d qd_2.
 from __future__ import annotations
 
 import re
-from typing import Dict, List, Sequence, Tuple
+from collections.abc import Sequence
 
 import sympy as sp
 
 __all__ = ["Block", "ClosedForm", "closed_form", "closed_form_of_program", "evaluate_block"]
 
-Assignment = Tuple[sp.Symbol, sp.Expr]
+Assignment = tuple[sp.Symbol, sp.Expr]
 
 
 class Block:
     """One result in CSE form: ``assignments`` (symbol, expression) in order, then ``entries`` (row-major,
     ``shape``) in terms of them. ``title``/``text`` describe it for the step-by-step display."""
 
-    def __init__(self, name: str, shape: tuple, assignments: List[Assignment], entries: List[sp.Expr], title: str = "", text: str = ""):
+    def __init__(
+        self,
+        name: str,
+        shape: tuple,
+        assignments: list[Assignment],
+        entries: list[sp.Expr],
+        title: str = "",
+        text: str = "",
+    ):
         self.name = name
         self.shape = shape
         self.assignments = assignments
@@ -43,10 +51,14 @@ class Block:
         self.title = title
         self.text = text
 
-    def entry_symbols(self) -> List[sp.Symbol]:
+    def entry_symbols(self) -> list[sp.Symbol]:
         """Names of the entries (M11, M12, ..., g1, ...), 1-based like the book."""
         if len(self.shape) == 2:
-            return [sp.Symbol(f"{self.name}{r + 1}{c + 1}", real=True) for r in range(self.shape[0]) for c in range(self.shape[1])]
+            return [
+                sp.Symbol(f"{self.name}{r + 1}{c + 1}", real=True)
+                for r in range(self.shape[0])
+                for c in range(self.shape[1])
+            ]
         return [sp.Symbol(f"{self.name}{r + 1}", real=True) for r in range(self.shape[0])]
 
     def symbol_matrix(self) -> sp.Matrix:
@@ -56,7 +68,7 @@ class Block:
         cols = self.shape[1] if len(self.shape) == 2 else 1
         return sp.Matrix(rows, cols, syms)
 
-    def equations(self) -> List[Assignment]:
+    def equations(self) -> list[Assignment]:
         """Intermediate variables, then the non-zero entries: [(lhs symbol, rhs)]."""
         out = list(self.assignments)
         out += [(s, e) for s, e in zip(self.entry_symbols(), self.entries) if e != 0]
@@ -70,7 +82,7 @@ class Block:
             free |= sp.sympify(e).free_symbols
         return free - defined
 
-    def op_count(self) -> Dict[str, int]:
+    def op_count(self) -> dict[str, int]:
         from .eom import _ops
 
         return _ops([e for _, e in self.assignments] + list(self.entries))
@@ -82,7 +94,7 @@ class Block:
 class ClosedForm:
     """The blocks ``M``, ``C``, ``g`` (and ``tau``, the customised model itself) of one robot."""
 
-    def __init__(self, blocks: Dict[str, Block], q, qd, qdd):
+    def __init__(self, blocks: dict[str, Block], q, qd, qdd):
         self.blocks = blocks
         self.q, self.qd, self.qdd = list(q), list(qd), list(qdd)
 
@@ -98,7 +110,7 @@ def _is_trivial(e) -> bool:
     return e.is_Atom or (e.is_Mul and len(e.args) == 2 and e.args[0].is_Number and e.args[1].is_Atom)
 
 
-def _specialise(assignments: Sequence[Assignment], values: dict) -> Tuple[List[Assignment], dict]:
+def _specialise(assignments: Sequence[Assignment], values: dict) -> tuple[list[Assignment], dict]:
     """The program with some inputs fixed (``values``); variables that become numbers or plain symbols are
     propagated instead of assigned. Returns (assignments, env) where env maps every program variable
     that vanished to its value."""
@@ -113,12 +125,14 @@ def _specialise(assignments: Sequence[Assignment], values: dict) -> Tuple[List[A
     return out, env
 
 
-def _tangent(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr], seed: dict, env: dict, suffix: str, names: set):
+def _tangent(
+    assignments: Sequence[Assignment], outputs: Sequence[sp.Expr], seed: dict, env: dict, suffix: str, names: set
+):
     """Forward-mode derivative of a straight-line program along ``seed`` (input symbol -> derivative),
     with the partial derivatives taken on the original right-hand sides and evaluated at the point
     ``env`` (the specialised primal values). Returns (new assignments, derivatives of the outputs)."""
     t = dict(seed)
-    new: List[Assignment] = []
+    new: list[Assignment] = []
 
     def derivative(e):
         return _directional(e, t).xreplace(env)
@@ -156,7 +170,7 @@ def _directional(e, t: dict):
         for i, a in enumerate(args):
             da = _directional(a, t)
             if da != 0:
-                terms.append(sp.Mul(*(args[:i] + (da,) + args[i + 1:])))
+                terms.append(sp.Mul(*(args[:i] + (da,) + args[i + 1 :])))
         return sp.Add(*terms)
     if e.is_Pow and e.exp.is_Integer:
         db = _directional(e.base, t)
@@ -167,7 +181,7 @@ def _directional(e, t: dict):
 _ZERO = sp.Integer(0)
 
 
-def _prune(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr]) -> List[Assignment]:
+def _prune(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr]) -> list[Assignment]:
     needed = set()
     for e in outputs:
         needed |= sp.sympify(e).free_symbols
@@ -179,7 +193,7 @@ def _prune(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr]) -> Lis
     return keep[::-1]
 
 
-def _cse(assignments: List[Assignment], entries: List[sp.Expr], names: set) -> Tuple[List[Assignment], List[sp.Expr]]:
+def _cse(assignments: list[Assignment], entries: list[sp.Expr], names: set) -> tuple[list[Assignment], list[sp.Expr]]:
     """``sympy.cse`` over the right-hand sides; each new variable ``x<k>`` is placed just before its first use
     (its own ingredients are defined by then, since it is a subexpression of that use)."""
     exprs = [e for _, e in assignments] + list(entries)
@@ -197,7 +211,7 @@ def _cse(assignments: List[Assignment], entries: List[sp.Expr], names: set) -> T
         return list(assignments), list(entries)
     defs = dict(repl)
     done: set = set()
-    out: List[Assignment] = []
+    out: list[Assignment] = []
 
     def emit_deps(e):
         for x in sorted(e.free_symbols & defs.keys() - done, key=lambda s: int(s.name[1:])):
@@ -235,46 +249,79 @@ def closed_form_of_program(prog, q, qd, qdd, cse: bool = True) -> ClosedForm:
     tau = [sp.sympify(e) for e in prog.outputs["tau"]]
     names = {str(s) for s, _ in base} | {str(s) for s in list(q) + list(qd) + list(qdd)}
     zero = sp.Integer(0)
-    blocks: Dict[str, Block] = {}
+    blocks: dict[str, Block] = {}
 
     # M: d tau / d qdd_j at qd = qdd = 0
     primal, env = _specialise(base, {**{v: zero for v in qd}, **{a: zero for a in qdd}})
-    m_assign: List[Assignment] = []
+    m_assign: list[Assignment] = []
     columns = []
     for j in range(n):
         new, col = _tangent(base, tau, {qdd[j]: sp.Integer(1)}, env, f"_a{j + 1}", names)
         m_assign += new
         columns.append(col)
-    m_entries = [sp.expand(columns[c][r]) if _small(columns[c][r]) else columns[c][r] for r in range(n) for c in range(n)]
-    blocks["M"] = _finish("M", (n, n), primal + m_assign, m_entries, cse, names,
-                          "Inertia matrix M(q) = d tau / d qdd (customised Newton-Euler model, CSE form)",
-                          "Column j is the derivative of the Newton-Euler program along qdd_j at qd = qdd = 0; "
-                          "X_aj denotes d X / d qdd_j; x1, x2, ... are common subexpressions.")
+    m_entries = [
+        sp.expand(columns[c][r]) if _small(columns[c][r]) else columns[c][r] for r in range(n) for c in range(n)
+    ]
+    blocks["M"] = _finish(
+        "M",
+        (n, n),
+        primal + m_assign,
+        m_entries,
+        cse,
+        names,
+        "Inertia matrix M(q) = d tau / d qdd (customised Newton-Euler model, CSE form)",
+        "Column j is the derivative of the Newton-Euler program along qdd_j at qd = qdd = 0; "
+        "X_aj denotes d X / d qdd_j; x1, x2, ... are common subexpressions.",
+    )
 
     # g: tau(q, 0, 0)
     g_entries = [t.xreplace(env) for t in tau]
-    blocks["g"] = _finish("g", (n,), primal, g_entries, cse, names,
-                          "Gravity vector g(q) = tau(q, 0, 0) (CSE form)",
-                          "The Newton-Euler program with qd = qdd = 0.")
+    blocks["g"] = _finish(
+        "g",
+        (n,),
+        primal,
+        g_entries,
+        cse,
+        names,
+        "Gravity vector g(q) = tau(q, 0, 0) (CSE form)",
+        "The Newton-Euler program with qd = qdd = 0.",
+    )
 
     # C: 1/2 d tau / d qd_j at qdd = 0 (Christoffel C, Spong eqs. 9.58, 9.62)
     c_primal, env_c = _specialise(base, {a: zero for a in qdd})
-    c_assign: List[Assignment] = []
+    c_assign: list[Assignment] = []
     columns = []
     for j in range(n):
         new, col = _tangent(base, tau, {qd[j]: sp.Integer(1)}, env_c, f"_v{j + 1}", names)
         c_assign += new
         columns.append(col)
     half = sp.Rational(1, 2)
-    c_entries = [sp.expand(half * columns[c][r]) if _small(columns[c][r]) else half * columns[c][r] for r in range(n) for c in range(n)]
-    blocks["C"] = _finish("C", (n, n), c_primal + c_assign, c_entries, cse, names,
-                          "Coriolis matrix C(q, qd) = (1/2) d tau / d qd (Christoffel form, CSE)",
-                          "tau's velocity terms are sum_ij c_ijk qd_i qd_j, so their derivative along qd_j is 2 C_kj "
-                          "(Spong eqs. 9.58, 9.62); taken at qdd = 0; X_vj denotes d X / d qd_j.")
+    c_entries = [
+        sp.expand(half * columns[c][r]) if _small(columns[c][r]) else half * columns[c][r]
+        for r in range(n)
+        for c in range(n)
+    ]
+    blocks["C"] = _finish(
+        "C",
+        (n, n),
+        c_primal + c_assign,
+        c_entries,
+        cse,
+        names,
+        "Coriolis matrix C(q, qd) = (1/2) d tau / d qd (Christoffel form, CSE)",
+        "tau's velocity terms are sum_ij c_ijk qd_i qd_j, so their derivative along qd_j is 2 C_kj "
+        "(Spong eqs. 9.58, 9.62); taken at qdd = 0; X_vj denotes d X / d qd_j.",
+    )
 
     # tau: the customised model itself
-    blocks["tau"] = Block("tau", (n,), base, tau, "Joint torques tau (customised Newton-Euler model, Khalil & Dombre)",
-                          "The recursion's intermediate variables, then tau; friction is added separately.")
+    blocks["tau"] = Block(
+        "tau",
+        (n,),
+        base,
+        tau,
+        "Joint torques tau (customised Newton-Euler model, Khalil & Dombre)",
+        "The recursion's intermediate variables, then tau; friction is added separately.",
+    )
     return ClosedForm(blocks, q, qd, qdd)
 
 
@@ -289,7 +336,7 @@ def _finish(name, shape, assignments, entries, cse, names, title, text) -> Block
     return Block(name, shape, assignments, entries, title, text)
 
 
-def evaluate_block(block: Block, values: dict) -> "list":
+def evaluate_block(block: Block, values: dict) -> list:
     """Numbers of a block at ``values`` ({symbol: float}), evaluating its assignments in order (for tests)."""
     env = dict(values)
     for s, e in block.assignments:
@@ -319,12 +366,12 @@ def _lhs(sym):
 def _entry_name(block: Block, sym):
     from .render import name
 
-    idx = sym.name[len(block.name):]
+    idx = sym.name[len(block.name) :]
     base = r"\tau" if block.name == "tau" else block.name
     return name(f"{base}_{{{idx}}}", sym.name, block.name, idx)
 
 
-def block_equations(block: Block) -> Tuple[list, list]:
+def block_equations(block: Block) -> tuple[list, list]:
     """(entries, intermediates) of a block as [(name, value)] for display: the non-zero entries
     (M11 = ...) and the intermediate variables they use, in order."""
     entries = [(_entry_name(block, s), e) for s, e in zip(block.entry_symbols(), block.entries) if e != 0]

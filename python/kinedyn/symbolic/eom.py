@@ -8,8 +8,9 @@ led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and gene
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence
+from typing import Any
 
 import sympy as sp
 
@@ -22,7 +23,7 @@ class Step:
 
     title: str
     text: str = ""
-    equations: List[tuple] = field(default_factory=list)
+    equations: list[tuple] = field(default_factory=list)
 
     def to_latex(self, names=None) -> str:
         """An amsmath ``align*`` block: the title (prose escaped for TeX) and the equations, long ones
@@ -51,7 +52,7 @@ class Step:
         return step_markdown(self)
 
 
-def _ops(exprs) -> Dict[str, int]:
+def _ops(exprs) -> dict[str, int]:
     """Counts of multiplications, additions (subtractions and negations included), divisions and
     function calls (sin, cos, sign) in expressions, the way Khalil & Dombre count them (x**2 counts as
     one product; sign changes are listed under "neg" and left out of the total)."""
@@ -98,10 +99,10 @@ class EquationsOfMotion:
         steps=None,
         name: str = "",
         method: str = "lagrange",
-        latex_names: Optional[dict] = None,
+        latex_names: dict | None = None,
         program=None,
         model=None,
-        extra: Optional[dict] = None,
+        extra: dict | None = None,
     ):
         self.q = sp.Matrix(q)
         self.qd = sp.Matrix(qd)
@@ -120,11 +121,11 @@ class EquationsOfMotion:
         self.model = model  # (RingModel, derivation dict) for robots
         self.extra = dict(extra or {})
         #: robot equations: the Newton-Euler derivation, computed on first use (see robot_eom)
-        self._derived: Optional[Callable[[], Dict[str, Any]]] = None
+        self._derived: Callable[[], dict[str, Any]] | None = None
         #: large robot models: M, C, g in CSE form (kinedyn.symbolic.cse.ClosedForm), and the rendered
         #: result as matrices of the entry names it defines (see robot_eom's ``form``)
-        self.closed_form: Optional[Callable[[], Any]] = None
-        self.final_equations: Optional[Callable[[], list]] = None
+        self.closed_form: Callable[[], Any] | None = None
+        self.final_equations: Callable[[], list] | None = None
         #: the kinedyn.Robot these equations were derived from (None for a LagrangianSystem); to_casadi
         #: takes the tool pose and Jacobian from it
         self.robot: Any = None
@@ -197,7 +198,7 @@ class EquationsOfMotion:
         return self._tau
 
     @property
-    def steps(self) -> List[Step]:
+    def steps(self) -> list[Step]:
         self._steps = self._get(self._steps)
         for step in self._steps or []:
             step._eom = self  # its notebook display prints q̇, q̈ by self's names
@@ -257,7 +258,7 @@ class EquationsOfMotion:
 
         return prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
 
-    def subs(self, mapping) -> "EquationsOfMotion":
+    def subs(self, mapping) -> EquationsOfMotion:
         """The same equations with parameters replaced (numbers or other expressions); keys are
         symbols or their names."""
         from .._math import by_name
@@ -265,9 +266,21 @@ class EquationsOfMotion:
         mapping = by_name(mapping, self.parameters)
         f = lambda m: m.subs(mapping) if m is not None else None
         return EquationsOfMotion(
-            self.q, self.qd, self.qdd, f(self.M), f(self.C), f(self.g), K=f(self.K), P=f(self.P), friction=f(self.friction),
-            christoffel=[[[c.subs(mapping) for c in row] for row in plane] for plane in self.christoffel] if self.christoffel else None,
-            name=self.name, method=self.method, latex_names=self.latex_names,
+            self.q,
+            self.qd,
+            self.qdd,
+            f(self.M),
+            f(self.C),
+            f(self.g),
+            K=f(self.K),
+            P=f(self.P),
+            friction=f(self.friction),
+            christoffel=[[[c.subs(mapping) for c in row] for row in plane] for plane in self.christoffel]
+            if self.christoffel
+            else None,
+            name=self.name,
+            method=self.method,
+            latex_names=self.latex_names,
         )
 
     @property
@@ -286,7 +299,9 @@ class EquationsOfMotion:
         return sorted(free - state, key=str)
 
     # ------------------------------------------------------------------ code
-    def to_code(self, language: str = "numpy", what: Sequence[str] = ("M", "C", "g", "tau"), name: Optional[str] = None) -> str:
+    def to_code(
+        self, language: str = "numpy", what: Sequence[str] = ("M", "C", "g", "tau"), name: str | None = None
+    ) -> str:
         """Source code (``"python"``, ``"numpy"`` or ``"c"``) computing the requested matrices, with
         common subexpressions eliminated; see :mod:`kinedyn.symbolic.codegen`."""
         from .codegen import generate
@@ -304,7 +319,7 @@ class EquationsOfMotion:
 
         return compile_eom(self, what, backend=backend, params=params, p=p)
 
-    def to_casadi(self, params=None, robot=None, frame: Optional[str] = None):
+    def to_casadi(self, params=None, robot=None, frame: str | None = None):
         """CasADi Functions (SX, common subexpressions shared) ``M``, ``C``, ``g``, ``tau``,
         ``forward_dynamics`` and, for a robot, the tool ``pose`` and ``jacobian``; inputs named
         ``q``, ``qd``, ``qdd``/``tau`` and ``p`` (parameters left symbolic, in the order of the
@@ -313,7 +328,7 @@ class EquationsOfMotion:
 
         return to_casadi(self, params=params, robot=robot, frame=frame)
 
-    def op_count(self, what: str = "tau", cse: bool = False) -> Dict[str, int]:
+    def op_count(self, what: str = "tau", cse: bool = False) -> dict[str, int]:
         """Operation counts of ``tau`` (or ``M``, ``g``...) as formed; for the Newton-Euler method the
         customised model with its intermediate variables; ``cse=True`` after common-subexpression
         elimination."""
@@ -331,7 +346,12 @@ class EquationsOfMotion:
 
         if self.final_equations is not None:  # CSE form: entry names, defined in the last steps
             return self.final_equations()
-        return [(of_q("D"), self.M), (of_q("C", rates=True), self.C), (of_q("g"), self.g), (name(r"\tau", "tau", "tau"), self.tau)]
+        return [
+            (of_q("D"), self.M),
+            (of_q("C", rates=True), self.C),
+            (of_q("g"), self.g),
+            (name(r"\tau", "tau", "tau"), self.tau),
+        ]
 
     def to_latex(self, steps: bool = True) -> str:
         """A LaTeX fragment: one amsmath ``align*`` block with the steps of the derivation (if any, each
@@ -358,7 +378,7 @@ class EquationsOfMotion:
 
         names = self.latex_names
 
-        def block(lhs, value) -> List[str]:
+        def block(lhs, value) -> list[str]:
             rows = equation_rows(lhs, value, names=names)
             if len(rows) == 1:
                 return ["$$", rows[0].replace(" &= ", " = ", 1)[: -len(r" \\")], "$$", ""]
@@ -407,7 +427,9 @@ class EquationsOfMotion:
     def __str__(self) -> str:
         from .render import text_of
 
-        out = [f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"]
+        out = [
+            f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
+        ]
         for k, step in enumerate(self.steps, start=1):
             out.append(f"\nStep {k}: {step.title}")
             for lhs, value in step.equations:
@@ -436,7 +458,9 @@ class EquationsOfMotion:
         return eom_markdown(self)
 
 
-def equations_of_motion(robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None, form: str = "auto") -> EquationsOfMotion:
+def equations_of_motion(
+    robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None, form: str = "auto"
+) -> EquationsOfMotion:
     """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
 
     ``method="lagrange"``: Euler-Lagrange from K and P with every step kept (Spong §9.2-9.3).

@@ -24,7 +24,19 @@ import sympy as sp
 
 from .system import LagrangianSystem, coordinates
 
-__all__ = ["remotely_driven_arm", "remotely_driven_arm_from_robot", "five_bar", "five_bar_chains", "five_bar_from_chains", "four_bar_linkage", "sphere_particle", "falling_particle", "simple_variational", "geared_link", "geared_link_robot"]
+__all__ = [
+    "remotely_driven_arm",
+    "remotely_driven_arm_from_robot",
+    "five_bar",
+    "five_bar_chains",
+    "five_bar_from_chains",
+    "four_bar_linkage",
+    "sphere_particle",
+    "falling_particle",
+    "simple_variational",
+    "geared_link",
+    "geared_link_robot",
+]
 
 
 def _u(angle):
@@ -41,7 +53,9 @@ def remotely_driven_arm() -> LagrangianSystem:
         dict(mass=m1, position=lc1 * _u(p1), inertia=I1, angular_velocity=pd1),
         dict(mass=m2, position=l1 * _u(p1) + lc2 * _u(p2), inertia=I2, angular_velocity=pd2),
     ]
-    return LagrangianSystem.from_bodies([p1, p2], bodies, gravity=(0, -g), qd=[pd1, pd2], name="remotely driven two-link arm")
+    return LagrangianSystem.from_bodies(
+        [p1, p2], bodies, gravity=(0, -g), qd=[pd1, pd2], name="remotely driven two-link arm"
+    )
 
 
 def remotely_driven_arm_from_robot():
@@ -53,7 +67,9 @@ def remotely_driven_arm_from_robot():
     from .mechanisms import change_coordinates
 
     eom = planar_2r(symbolic=True).equations_of_motion(steps=False)
-    return change_coordinates(eom, [[1, 0], [-1, 1]], coordinates="p1 p2", name="remotely driven two-link arm (from planar_2r)")
+    return change_coordinates(
+        eom, [[1, 0], [-1, 1]], coordinates="p1 p2", name="remotely driven two-link arm (from planar_2r)"
+    )
 
 
 def five_bar_chains():
@@ -77,10 +93,22 @@ def five_bar_chains():
     def link(mass, x_com, inertia):  # centre of mass on the DH x axis (frame i at link i's far end)
         return Inertia(mass, (x_com, 0, 0), ((0, 0, 0), (0, inertia, 0), (0, 0, inertia)))
 
-    chain_a = Robot.from_dh([DHRow(a=l1, name="q1", inertia=link(m[0], lc1 - l1, I[0])),
-                             DHRow(a=l2, name="phi4", inertia=link(m[3], -l2 - lc4, I[3]))], gravity=(0, -g, 0), name="five-bar chain a (links 1, 4)")
-    chain_b = Robot.from_dh([DHRow(a=l2, name="q2", inertia=link(m[1], lc2 - l2, I[1])),
-                             DHRow(a=l1, name="phi3", inertia=link(m[2], lc3 - l1, I[2]))], gravity=(0, -g, 0), name="five-bar chain b (links 2, 3)")
+    chain_a = Robot.from_dh(
+        [
+            DHRow(a=l1, name="q1", inertia=link(m[0], lc1 - l1, I[0])),
+            DHRow(a=l2, name="phi4", inertia=link(m[3], -l2 - lc4, I[3])),
+        ],
+        gravity=(0, -g, 0),
+        name="five-bar chain a (links 1, 4)",
+    )
+    chain_b = Robot.from_dh(
+        [
+            DHRow(a=l2, name="q2", inertia=link(m[1], lc2 - l2, I[1])),
+            DHRow(a=l1, name="phi3", inertia=link(m[2], lc3 - l1, I[2])),
+        ],
+        gravity=(0, -g, 0),
+        name="five-bar chain b (links 2, 3)",
+    )
     return chain_a, chain_b
 
 
@@ -93,7 +121,13 @@ def five_bar_from_chains():
     chain_a, chain_b = five_bar_chains()
     closure = loop_closure(chain_a, chain_b)
     q1, phi4, q2, phi3 = sp.symbols("q1 phi4 q2 phi3", real=True)
-    return closed_chain([chain_a, chain_b], closure, independent=[q1, q2], solution={phi4: q2 - q1, phi3: q1 - q2}, name="five-bar linkage (from two chains)")
+    return closed_chain(
+        [chain_a, chain_b],
+        closure,
+        independent=[q1, q2],
+        solution={phi4: q2 - q1, phi3: q1 - q2},
+        name="five-bar linkage (from two chains)",
+    )
 
 
 def five_bar() -> LagrangianSystem:
@@ -125,24 +159,37 @@ def four_bar_linkage() -> LagrangianSystem:
     joint = sp.Matrix([l1 / 2, 0])
     bodies = []
     for length, angle, rate in zip((l2, l3, l4), absolute, rates):
-        bodies.append(dict(mass=rho * length, position=joint + length / 2 * _u(angle), inertia=rho * length**3 / 12, angular_velocity=rate))
+        bodies.append(
+            dict(
+                mass=rho * length,
+                position=joint + length / 2 * _u(angle),
+                inertia=rho * length**3 / 12,
+                angular_velocity=rate,
+            )
+        )
         joint = joint + length * _u(angle)
     closure = joint - sp.Matrix([-l1 / 2, 0])
-    return LagrangianSystem.from_bodies([q1, q2, q3], bodies, qd=[qd1, qd2, qd3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar linkage")
+    return LagrangianSystem.from_bodies(
+        [q1, q2, q3], bodies, qd=[qd1, qd2, qd3], holonomic=list(closure), forces=[0, 0, 0], name="four-bar linkage"
+    )
 
 
 def sphere_particle(m=2) -> LagrangianSystem:
     """A particle of mass m on the unit sphere, no gravity: L = m |qd|^2 / 2, g_c = |q|^2 - 1 = 0."""
     q, qd = coordinates("q1 q2 q3")
     K = sp.Rational(1, 2) * m * sum(v**2 for v in qd) if not isinstance(m, float) else 0.5 * m * sum(v**2 for v in qd)
-    return LagrangianSystem(q, K=K, P=0, qd=qd, holonomic=[sum(x**2 for x in q) - 1], forces=[0, 0, 0], name="particle on a sphere")
+    return LagrangianSystem(
+        q, K=K, P=0, qd=qd, holonomic=[sum(x**2 for x in q) - 1], forces=[0, 0, 0], name="particle on a sphere"
+    )
 
 
 def falling_particle() -> LagrangianSystem:
     """A particle of mass m in R^3 with gravity -g along q3: K = m |qd|^2 / 2, P = m g q3."""
     m, g = sp.symbols("m g", positive=True)
     q, qd = coordinates("q1 q2 q3")
-    return LagrangianSystem(q, K=m * sum(v**2 for v in qd) / 2, P=m * g * q[2], qd=qd, forces=[0, 0, 0], name="falling particle")
+    return LagrangianSystem(
+        q, K=m * sum(v**2 for v in qd) / 2, P=m * g * q[2], qd=qd, forces=[0, 0, 0], name="falling particle"
+    )
 
 
 def simple_variational() -> LagrangianSystem:
@@ -161,7 +208,9 @@ def geared_link() -> LagrangianSystem:
     (th,), (thd,) = coordinates("theta")
     K = J_m * (r * thd) ** 2 / 2 + J_l * thd**2 / 2
     P = M * g * ell * (1 - sp.cos(th))
-    return LagrangianSystem([th], K=K, P=P, qd=[thd], forces=[r * tau_m], B=[r**2 * B_m * thd], name="geared single link")
+    return LagrangianSystem(
+        [th], K=K, P=P, qd=[thd], forces=[r * tau_m], B=[r**2 * B_m * thd], name="geared single link"
+    )
 
 
 def geared_link_robot(J_l=None, J_m=None, M=None, g=None, ell=None, r=None, B_m=None):
@@ -179,6 +228,12 @@ def geared_link_robot(J_l=None, J_m=None, M=None, g=None, ell=None, r=None, B_m=
     v = {k: (syms[k] if vals[k] is None else vals[k]) for k in syms}
     # inertia about the centre of mass: J_l - M ell^2 about z (parallel-axis theorem)
     Izz = v["J_l"] - v["M"] * v["ell"] ** 2
-    link = Link("link", None, Joint("theta", "revolute", (0, 0, 1), gear_ratio=v["r"], rotor_inertia=v["J_m"], viscous=v["r"] ** 2 * v["B_m"]),
-                inertia=Inertia(v["M"], (v["ell"], 0, 0), ((0, 0, 0), (0, Izz, 0), (0, 0, Izz))))
+    link = Link(
+        "link",
+        None,
+        Joint(
+            "theta", "revolute", (0, 0, 1), gear_ratio=v["r"], rotor_inertia=v["J_m"], viscous=v["r"] ** 2 * v["B_m"]
+        ),
+        inertia=Inertia(v["M"], (v["ell"], 0, 0), ((0, 0, 0), (0, Izz, 0), (0, 0, Izz))),
+    )
     return Robot([link], gravity=(0, -v["g"], 0), name="geared_link")

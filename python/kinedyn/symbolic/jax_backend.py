@@ -21,7 +21,7 @@ as in kinedyn's analytical derivatives (qd != 0).
 
 from __future__ import annotations
 
-from typing import Any, Dict
+from typing import Any
 
 import numpy as np
 
@@ -49,7 +49,9 @@ def compile_jax(eom, what=("M", "C", "g", "tau"), params=None, p=None):
     params = _params_by_name(eom, params)
     blocks, pars = _blocks(eom, what, params)
     if pars and p is None:
-        raise ValueError(f"the equations still contain the parameters {[str(s) for s in pars]}: give their values, compile(params={{...}})")
+        raise ValueError(
+            f"the equations still contain the parameters {[str(s) for s in pars]}: give their values, compile(params={{...}})"
+        )
     if p is not None and len(p) != len(pars):
         raise ValueError(f"p has {len(p)} values, the equations have {len(pars)} parameters {[str(s) for s in pars]}")
     pvals = jnp.asarray(np.asarray([] if p is None else p, dtype=float), dtype=jnp.float64)
@@ -59,13 +61,17 @@ def compile_jax(eom, what=("M", "C", "g", "tau"), params=None, p=None):
     for name, shape, assignments, exprs in blocks:
         lines.append(f"def single_{name}({', '.join(_ARGS[name])}, p):")
         lines += [f"    {s} = {printer.doprint(e)}" for s, e in assignments]
-        lines.append("    return jnp.stack([" + ", ".join(f"_f({printer.doprint(e)})" for e in exprs) + f"]).reshape({tuple(shape)!r})")
+        lines.append(
+            "    return jnp.stack(["
+            + ", ".join(f"_f({printer.doprint(e)})" for e in exprs)
+            + f"]).reshape({tuple(shape)!r})"
+        )
         lines.append("")
     source = "\n".join(lines).replace("jax.numpy.", "jnp.").replace("numpy.", "jnp.")
-    namespace: Dict[str, Any] = {"jnp": jnp, "jax": jax}
+    namespace: dict[str, Any] = {"jnp": jnp, "jax": jax}
     exec(compile(source, "<kinedyn jax>", "exec"), namespace)
     funcs = {}
-    for name, shape, _, _ in blocks:
+    for name, _shape, _, _ in blocks:
         funcs[name] = _callable(jax, jnp, name, namespace[f"single_{name}"], n, pvals)
     return CompiledEOM("jax", funcs, n, source, [] if p is None else list(p))
 
@@ -88,12 +94,16 @@ def _callable(jax, jnp, name: str, single, n: int, pvals):
                 raise ValueError(f"{name}: {a} has shape {v.shape}, expected {first.shape}")
         pv = pvals if p is None else jnp.asarray(p, dtype=jnp.float64)
         if pv.shape != pvals.shape:
-            raise ValueError(f"{name}: p has shape {pv.shape}, expected {pvals.shape} (the parameters in eom.parameters order)")
+            raise ValueError(
+                f"{name}: p has shape {pv.shape}, expected {pvals.shape} (the parameters in eom.parameters order)"
+            )
         if first.ndim == 1:
             return single(*xs, pv)
         return jax.vmap(lambda *x: single(*x, pv))(*xs)
 
     call.__name__ = name
-    call.__doc__ = (f"{name}({', '.join(args)}, p=None) in JAX: one state (n,) or a batch (N, n); float64; "
-                    "p: parameter values replacing those given at compile time (differentiable).")
+    call.__doc__ = (
+        f"{name}({', '.join(args)}, p=None) in JAX: one state (n,) or a batch (N, n); float64; "
+        "p: parameter values replacing those given at compile time (differentiable)."
+    )
     return jax.jit(call)

@@ -16,18 +16,28 @@ the base origin, angular velocity, base axes).
 
 from __future__ import annotations
 
-from typing import Any, List, NamedTuple, Optional, Sequence
+from collections.abc import Sequence
+from typing import Any, NamedTuple
 
 import sympy as sp
 
 from .lagrange import RingModel, _exact, state_symbols
 
-__all__ = ["pose", "jacobian", "jacobian_inverse", "JacobianInverse", "tool_velocity", "joint_torques", "abbreviate", "joint_symbols"]
+__all__ = [
+    "pose",
+    "jacobian",
+    "jacobian_inverse",
+    "JacobianInverse",
+    "tool_velocity",
+    "joint_torques",
+    "abbreviate",
+    "joint_symbols",
+]
 
 _REFERENCES = ("world", "local", "spatial")
 
 
-def joint_symbols(robot) -> List[sp.Symbol]:
+def joint_symbols(robot) -> list[sp.Symbol]:
     """The joint symbols of ``robot.equations_of_motion().q`` (the same SymPy objects)."""
     return state_symbols(robot)[0]
 
@@ -39,7 +49,7 @@ def _minimal(robot):
     return euler_parametrised(robot)
 
 
-def _model(robot, frame: Optional[str] = None, point=None) -> RingModel:
+def _model(robot, frame: str | None = None, point=None) -> RingModel:
     """The exact kinematics, with the frame's placement and the point among the ring's parameters."""
     q, qd, qdd = state_symbols(robot)
     f = robot.tree.frames[robot.frame_index(frame or robot.tool)]
@@ -51,7 +61,7 @@ def _rows(M) -> list:
     return M.tolist() if hasattr(M, "tolist") else [list(r) for r in M]
 
 
-def _frame(robot, model: RingModel, frame: Optional[str]):
+def _frame(robot, model: RingModel, frame: str | None):
     """(R, p) of the frame in the base and (Rf, pf) of its placement in its body, as ring elements;
     body index (-1 for a frame fixed to the base)."""
     f = robot.tree.frames[robot.frame_index(frame or robot.tool)]
@@ -96,7 +106,7 @@ def _matrix(model, rows, simplify: bool) -> sp.Matrix:
     return sp.Matrix([[_book(model, e) for e in row] for row in rows])
 
 
-def pose(robot, frame: Optional[str] = None, simplify: bool = True, abbreviations: bool = False) -> sp.Matrix:
+def pose(robot, frame: str | None = None, simplify: bool = True, abbreviations: bool = False) -> sp.Matrix:
     """The 4x4 homogeneous pose of ``frame`` (default: the tool) in the base, as a SymPy matrix in the
     joint symbols of ``robot.equations_of_motion().q`` and the robot's parameter symbols.
 
@@ -112,8 +122,14 @@ def pose(robot, frame: Optional[str] = None, simplify: bool = True, abbreviation
     return abbreviate(T, model.q) if abbreviations else T
 
 
-def jacobian(robot, frame: Optional[str] = None, reference: str = "world", point: Optional[Sequence[Any]] = None,
-             simplify: bool = True, abbreviations: bool = False) -> sp.Matrix:
+def jacobian(
+    robot,
+    frame: str | None = None,
+    reference: str = "world",
+    point: Sequence[Any] | None = None,
+    simplify: bool = True,
+    abbreviations: bool = False,
+) -> sp.Matrix:
     """The 6 x n geometric Jacobian of ``frame`` (default: the tool), rows ``[linear; angular]``, in the
     references of ``Robot.jacobian`` ("world", "local", "spatial"; see the module docstring).
 
@@ -160,7 +176,7 @@ def jacobian(robot, frame: Optional[str] = None, reference: str = "world", point
 
 
 # ---------------------------------------------------------------------------------- textbook helpers
-def _coordinates(expr) -> List[sp.Symbol]:
+def _coordinates(expr) -> list[sp.Symbol]:
     """The symbols that appear inside sin/cos (the joint angles of a Jacobian block), sorted by name."""
     out = set()
     for f in sp.sympify(expr).atoms(sp.sin, sp.cos):
@@ -192,7 +208,7 @@ class JacobianInverse(NamedTuple):
         return sp.MatMul(1 / self.determinant, self.adjugate, evaluate=False)
 
 
-def jacobian_inverse(J, coordinates: Optional[Sequence[sp.Symbol]] = None) -> JacobianInverse:
+def jacobian_inverse(J, coordinates: Sequence[sp.Symbol] | None = None) -> JacobianInverse:
     """(inverse, determinant, singular) of a square Jacobian block, in the textbook's form: the
     determinant factored (``l1*l2*sin(q2)`` for the planar arm's linear block), the inverse as the
     adjugate's simplified entries over it, and the singular set as a list of ``Eq(factor, 0)`` for each
@@ -224,14 +240,14 @@ def jacobian_inverse(J, coordinates: Optional[Sequence[sp.Symbol]] = None) -> Ja
     return JacobianInverse(inverse, det, singular)
 
 
-def tool_velocity(J, qd, coordinates: Optional[Sequence[sp.Symbol]] = None) -> sp.Matrix:
+def tool_velocity(J, qd, coordinates: Sequence[sp.Symbol] | None = None) -> sp.Matrix:
     """The twist J qd (or the velocity of any block of rows), simplified to the book's form."""
     J = sp.Matrix(J)
     coords = list(coordinates) if coordinates is not None else _coordinates(J)
     return (J * sp.Matrix(list(qd))).applyfunc(lambda e: _simp(sp.expand(e), coords))
 
 
-def joint_torques(J, F, coordinates: Optional[Sequence[sp.Symbol]] = None) -> sp.Matrix:
+def joint_torques(J, F, coordinates: Sequence[sp.Symbol] | None = None) -> sp.Matrix:
     """The joint torques J^T F that balance a wrench F (ordered as J's rows), in the book's form."""
     J = sp.Matrix(J)
     coords = list(coordinates) if coordinates is not None else _coordinates(J)
@@ -254,5 +270,8 @@ def abbreviate(expr, q: Sequence[sp.Symbol], prefix=("c", "s")):
         else:
             if idx:
                 sep = "" if len(q) < 10 else "_"
-                reps[f] = sp.Symbol((prefix[0] if isinstance(f, sp.cos) else prefix[1]) + sep.join(str(i) for i in sorted(idx)), real=True)
+                reps[f] = sp.Symbol(
+                    (prefix[0] if isinstance(f, sp.cos) else prefix[1]) + sep.join(str(i) for i in sorted(idx)),
+                    real=True,
+                )
     return expr.xreplace(reps)

@@ -30,8 +30,6 @@ All arithmetic is exact, in the normal form of :class:`kinedyn.symbolic.simplify
 
 from __future__ import annotations
 
-from typing import List
-
 import numpy as np
 import sympy as sp
 
@@ -68,7 +66,7 @@ def _rational(f: float):
     return _exact(f)
 
 
-def _matrix(value) -> List[list]:
+def _matrix(value) -> list[list]:
     if isinstance(value, sp.MatrixBase):
         return [[_exact(e) for e in row] for row in value.tolist()]
     return [[_exact(e) for e in row] for row in np.asarray(value).tolist()]
@@ -85,7 +83,9 @@ def state_symbols(robot):
         names = (name, *rate_names(name))
         for n in names:
             if n in taken:
-                raise ValueError(f"joint variable name '{n}' is also a parameter symbol of robot '{robot.name}': rename the joint or the symbol")
+                raise ValueError(
+                    f"joint variable name '{n}' is also a parameter symbol of robot '{robot.name}': rename the joint or the symbol"
+                )
         q.append(sp.Symbol(names[0], real=True))
         qd.append(sp.Symbol(names[1], real=True))
         qdd.append(sp.Symbol(names[2], real=True))
@@ -173,7 +173,9 @@ class RingModel:
             off = _exact(b.joint.offset)
             self.offset.append(off)
             inertia = b.inertia if inertias is None else inertias[k]
-            pi = [sp.expand(sp.cancel(_exact(v))) if isinstance(v, sp.Basic) else _exact(v) for v in inertia.parameters()]
+            pi = [
+                sp.expand(sp.cancel(_exact(v))) if isinstance(v, sp.Basic) else _exact(v) for v in inertia.parameters()
+            ]
             self.pi.append(pi)
             self.com.append([_exact(c) for c in inertia.com])
             self.armature.append(_exact(b.joint.armature))
@@ -213,7 +215,10 @@ class RingModel:
 
     def _matT(self, A, B):  # A^T B
         ring = self.ring
-        return [[ring.dot([A[k][i] for k in range(len(A))], [B[k][j] for k in range(len(B))]) for j in range(len(B[0]))] for i in range(len(A[0]))]
+        return [
+            [ring.dot([A[k][i] for k in range(len(A))], [B[k][j] for k in range(len(B))]) for j in range(len(B[0]))]
+            for i in range(len(A[0]))
+        ]
 
     def _vec(self, A, v):
         return [self.ring.dot(row, v) for row in A]
@@ -230,7 +235,10 @@ class RingModel:
         C, S = self.joint_cos(i), self.joint_sin(i)
         one_c = ring.one - C
         ax = self._skew(a)
-        return [[ring.reduce((C if r == k else ring.zero) + S * ax[r][k] + one_c * a[r] * a[k]) for k in range(3)] for r in range(3)]
+        return [
+            [ring.reduce((C if r == k else ring.zero) + S * ax[r][k] + one_c * a[r] * a[k]) for k in range(3)]
+            for r in range(3)
+        ]
 
     def joint_cos(self, i):
         """cos of body i's joint angle (its coordinate plus the joint offset)."""
@@ -367,7 +375,10 @@ def christoffel(ring: TrigRing, D):
 def coriolis_matrix(ring: TrigRing, c):
     """C[k][j] = sum_i c_ijk qd_i (Spong eq. 9.62)."""
     n = len(c)
-    return [[ring.reduce(sum((c[i][j][k] * ring.velocity(i) for i in range(n)), ring.zero)) for j in range(n)] for k in range(n)]
+    return [
+        [ring.reduce(sum((c[i][j][k] * ring.velocity(i) for i in range(n)), ring.zero)) for j in range(n)]
+        for k in range(n)
+    ]
 
 
 def derive_lagrange(model: RingModel):
@@ -403,4 +414,6 @@ def derive_lagrange(model: RingModel):
         for j in range(n):
             if not ring.is_zero(M[k][j] - D[k][j], D[k][j]):
                 raise RuntimeError("internal error: d tau/d qdd differs from D(q)")
-    return dict(D=D, P=P, K=K, L=L, dL_dqd=dL_dqd, ddt_dL_dqd=ddt_dL_dqd, dL_dq=dL_dq, tau=tau, M=M, g=g, christoffel=c, C=C)
+    return dict(
+        D=D, P=P, K=K, L=L, dL_dqd=dL_dqd, ddt_dL_dqd=ddt_dL_dqd, dL_dq=dL_dq, tau=tau, M=M, g=g, christoffel=c, C=C
+    )

@@ -19,7 +19,7 @@ tree (:func:`width`), in points of 10 pt Computer Modern.
 from __future__ import annotations
 
 import re
-from typing import Dict, List, Optional, Sequence, Tuple
+from collections.abc import Sequence
 
 import sympy as sp
 
@@ -30,12 +30,42 @@ __all__ = ["latex_text", "width", "expression_lines", "equation_rows", "fragment
 TEXT_PT = 483.0
 LINE_PT = 380.0
 
-_SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#", "%": r"\%",
-            "_": r"\_", "^": r"\textasciicircum{}", "~": r"\textasciitilde{}", "<": r"\textless{}", ">": r"\textgreater{}"}
-_GREEK_WORDS = {"tau", "omega", "lambda", "theta", "alpha", "beta", "gamma", "delta", "mu", "nu", "phi", "psi", "sigma", "rho", "epsilon"}
+_SPECIAL = {
+    "\\": r"\textbackslash{}",
+    "{": r"\{",
+    "}": r"\}",
+    "$": r"\$",
+    "&": r"\&",
+    "#": r"\#",
+    "%": r"\%",
+    "_": r"\_",
+    "^": r"\textasciicircum{}",
+    "~": r"\textasciitilde{}",
+    "<": r"\textless{}",
+    ">": r"\textgreater{}",
+}
+_GREEK_WORDS = {
+    "tau",
+    "omega",
+    "lambda",
+    "theta",
+    "alpha",
+    "beta",
+    "gamma",
+    "delta",
+    "mu",
+    "nu",
+    "phi",
+    "psi",
+    "sigma",
+    "rho",
+    "epsilon",
+}
 _RATE_WORDS = {"qd": r"\dot{q}", "qdd": r"\ddot{q}", "qdot": r"\dot{q}", "qddot": r"\ddot{q}", "pdot": r"\dot{p}"}
 # a word of ASCII math: base, optional _subscript, optional ^superscript, optional (arguments)
-_MATH_WORD = re.compile(r"(?<![\w\\])([A-Za-z]+)(?:_([A-Za-z0-9]+))?(?:\^(-?[A-Za-z0-9]+))?(\((?:[A-Za-z0-9_, ]*)\))?(?![\w])")
+_MATH_WORD = re.compile(
+    r"(?<![\w\\])([A-Za-z]+)(?:_([A-Za-z0-9]+))?(?:\^(-?[A-Za-z0-9]+))?(\((?:[A-Za-z0-9_, ]*)\))?(?![\w])"
+)
 
 
 def _escape(s: str) -> str:
@@ -52,10 +82,15 @@ def _math_base(base: str) -> str:
     return base if len(base) == 1 else r"\mathit{" + base + "}"
 
 
-def _math_word(m: re.Match) -> Optional[str]:
+def _math_word(m: re.Match) -> str | None:
     """The inline math of one ASCII-math word, or None for an ordinary word."""
     base, sub, sup, args = m.group(1), m.group(2), m.group(3), m.group(4)
-    is_math = bool(sub or sup) or base in _RATE_WORDS or base in _GREEK_WORDS or (len(base) == 1 and base.isupper() and base != "A")
+    is_math = (
+        bool(sub or sup)
+        or base in _RATE_WORDS
+        or base in _GREEK_WORDS
+        or (len(base) == 1 and base.isupper() and base != "A")
+    )
     if args and len(base) == 1:
         is_math = True
     if not is_math:
@@ -66,8 +101,10 @@ def _math_word(m: re.Match) -> Optional[str]:
     if sup:
         out += "^{" + ("T" if sup == "T" else sup) + "}"
     if args:
-        inner = ", ".join(_math_base(a.strip()) if a.strip() in _RATE_WORDS or a.strip() in _GREEK_WORDS else _escape(a.strip())
-                          for a in args[1:-1].split(","))
+        inner = ", ".join(
+            _math_base(a.strip()) if a.strip() in _RATE_WORDS or a.strip() in _GREEK_WORDS else _escape(a.strip())
+            for a in args[1:-1].split(",")
+        )
         out += r"\left(" + inner + r"\right)" if inner else "()"
     return "$" + out + "$"
 
@@ -79,7 +116,9 @@ def _derivative(m: re.Match) -> str:
     if m.group(0) == "d/dt":
         return r"$\frac{d}{dt}$"
     top, bottom, sub = m.group(1), m.group(2), m.group(3)
-    return r"$\partial " + _math_base(top) + r"/\partial " + _math_base(bottom) + ("_{" + sub + "}" if sub else "") + "$"
+    return (
+        r"$\partial " + _math_base(top) + r"/\partial " + _math_base(bottom) + ("_{" + sub + "}" if sub else "") + "$"
+    )
 
 
 def latex_text(s: str) -> str:
@@ -161,7 +200,7 @@ def latex_width(tex: str) -> float:
         if not m:
             break
         a, b = m.group(1), m.group(2)
-        t = t2[:m.start()] + (a if latex_width(a) >= latex_width(b) else b) + t2[m.end():]
+        t = t2[: m.start()] + (a if latex_width(a) >= latex_width(b) else b) + t2[m.end() :]
     subs = sum(len(re.sub(r"\\[A-Za-z]+", "x", x)) for x in re.findall(r"[_^]\{([^{}]*)\}", t))
     t = re.sub(r"[_^]\{[^{}]*\}", "", t)
     t = re.sub(r"\\[A-Za-z]+", "x", t)
@@ -177,14 +216,14 @@ def rhs_limit(lhs_names: Sequence[str]) -> float:
 
 
 # ------------------------------------------------------------------ breaking
-Line = Tuple[str, float]
+Line = tuple[str, float]
 
 
 def _tex(expr, names) -> str:
     return sp.latex(expr, symbol_names=names)
 
 
-def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None) -> List[Line]:
+def expression_lines(expr, limit: float = LINE_PT, names: dict | None = None) -> list[Line]:
     """``expr`` as LaTeX lines of at most ``limit`` points each where it can be broken (between the
     terms of a sum; inside a long factor of a product, between ``\\Bigl(`` and ``\\Bigr)``); a line
     after the first starts with its sign. Returns ``[(latex, estimated width)]``."""
@@ -194,7 +233,7 @@ def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None)
     if w <= limit:
         return [(_tex(expr, names), w)]
     if expr.is_Add:
-        out: List[Line] = []
+        out: list[Line] = []
         cur, curw = "", 0.0
         for i, term in enumerate(expr.as_ordered_terms()):
             neg = term.could_extract_minus_sign()
@@ -219,7 +258,9 @@ def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None)
         return out
     if expr.is_Mul:
         num, den = sp.fraction(expr)
-        adds = [f for f in sp.Mul.make_args(num) if f.is_Add] + [f.base for f in sp.Mul.make_args(num) if f.is_Pow and f.base.is_Add and f.exp == 1]
+        adds = [f for f in sp.Mul.make_args(num) if f.is_Add] + [
+            f.base for f in sp.Mul.make_args(num) if f.is_Pow and f.base.is_Add and f.exp == 1
+        ]
         if adds:
             big = max(adds, key=width)
             rest = sp.Mul(*[f for f in sp.Mul.make_args(num) if f != big]) / den
@@ -238,13 +279,13 @@ def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None)
             coeff, factors = expr.as_coeff_mul()
             neg = coeff < 0
             coeff = -coeff if neg else coeff
-            groups: List[List[Line]] = ([] if coeff == 1 else [[(_tex(coeff, names), width(coeff))]])
+            groups: list[list[Line]] = [] if coeff == 1 else [[(_tex(coeff, names), width(coeff))]]
             for f in factors:
                 sub = expression_lines(f, limit - 10, names)
                 if len(sub) == 1 and f.is_Add:
                     sub = [(r"\left(" + sub[0][0] + r"\right)", sub[0][1] + 2 * _CHAR)]
                 groups.append(sub)
-            lines: List[Line] = []
+            lines: list[Line] = []
             cur, curw = "", 0.0
             for group in groups:
                 first_tex, first_w = group[0]
@@ -266,15 +307,23 @@ def expression_lines(expr, limit: float = LINE_PT, names: Optional[Dict] = None)
         inner = expression_lines(expr.args[0], limit - 30, names)
         if len(inner) > 1:
             head = "\\" + type(expr).__name__
-            return [(head + r"\Bigl(" + inner[0][0], inner[0][1] + 25), *inner[1:-1], (inner[-1][0] + r"\Bigr)", inner[-1][1] + 5)]
+            return [
+                (head + r"\Bigl(" + inner[0][0], inner[0][1] + 25),
+                *inner[1:-1],
+                (inner[-1][0] + r"\Bigr)", inner[-1][1] + 5),
+            ]
     if expr.is_Pow and expr.base.is_Add and expr.exp.is_Integer and expr.exp > 0:
         inner = expression_lines(expr.base, limit - 20, names)
         if len(inner) > 1:
-            return [(r"\Bigl(" + inner[0][0], inner[0][1] + 5), *inner[1:-1], (inner[-1][0] + r"\Bigr)^{" + str(expr.exp) + "}", inner[-1][1] + 10)]
+            return [
+                (r"\Bigl(" + inner[0][0], inner[0][1] + 5),
+                *inner[1:-1],
+                (inner[-1][0] + r"\Bigr)^{" + str(expr.exp) + "}", inner[-1][1] + 10),
+            ]
     return [(_tex(expr, names), w)]
 
 
-def _entry_name(lhs: str, i: int, j: Optional[int]) -> str:
+def _entry_name(lhs: str, i: int, j: int | None) -> str:
     """``D(q)`` -> ``D_{12}``; ``\\tau`` -> ``\\tau_{1}``; anything else -> ``\\left[lhs\\right]_{12}``."""
     idx = f"{i + 1}" if j is None else f"{i + 1}{j + 1}"
     m = re.fullmatch(r"(\\?[A-Za-z]+)(\(.*\))?", lhs.strip())
@@ -283,14 +332,14 @@ def _entry_name(lhs: str, i: int, j: Optional[int]) -> str:
     return r"\left[" + lhs + r"\right]_{" + idx + "}"
 
 
-def _scalar_rows(lhs: str, value, limit: float, names) -> List[str]:
+def _scalar_rows(lhs: str, value, limit: float, names) -> list[str]:
     lines = expression_lines(value, limit, names)
     rows = [f"{lhs} &= {lines[0][0]} \\\\"]
     rows += [f"&\\quad {tex} \\\\" for tex, _ in lines[1:]]
     return rows
 
 
-def equation_rows(lhs, value, limit: float = LINE_PT, names: Optional[Dict] = None) -> List[str]:
+def equation_rows(lhs, value, limit: float = LINE_PT, names: dict | None = None) -> list[str]:
     """``align*`` rows (each ending in ``\\\\``) for ``lhs = value``: a matrix that fits the line as a
     matrix, a wider one entry by entry (zero entries left out, said in a ``\\text`` row)."""
     names = names or {}
@@ -299,7 +348,7 @@ def equation_rows(lhs, value, limit: float = LINE_PT, names: Optional[Dict] = No
         fits = all(width(e) <= limit for e in value) and width(value) <= limit
         if fits:
             return [f"{lhs} &= {_tex(value, names)} \\\\"]
-        rows: List[str] = []
+        rows: list[str] = []
         zeros = 0
         column = value.cols == 1
         for i in range(value.rows):
@@ -319,11 +368,11 @@ def equation_rows(lhs, value, limit: float = LINE_PT, names: Optional[Dict] = No
 RESULT_TITLE = r"D(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau"
 
 
-def fragment(steps: Sequence, final: Sequence[tuple], names: Optional[Dict] = None, limit: Optional[float] = None) -> str:
+def fragment(steps: Sequence, final: Sequence[tuple], names: dict | None = None, limit: float | None = None) -> str:
     """One ``align*`` block: each step's title as a ``\\text`` row, its equations, then the result."""
     if limit is None:
         limit = rhs_limit([lhs for step in steps for lhs, _ in step.equations] + [lhs for lhs, _ in final])
-    body: List[str] = []
+    body: list[str] = []
     for step in steps:
         body.append(r"&\text{" + latex_text(step.title) + r"} \\")
         for lhs, value in step.equations:
@@ -344,7 +393,7 @@ PREAMBLE = r"""\documentclass[10pt]{article}
 """
 
 
-def _align(rows: List[str]) -> str:
+def _align(rows: list[str]) -> str:
     if not rows:
         return ""
     rows = list(rows)
@@ -352,8 +401,14 @@ def _align(rows: List[str]) -> str:
     return "\\begin{align*}\n" + "\n".join(rows) + "\n\\end{align*}"
 
 
-def document(title: str, steps: Sequence, final: Sequence[tuple], names: Optional[Dict] = None, intro: str = "",
-             limit: Optional[float] = None) -> str:
+def document(
+    title: str,
+    steps: Sequence,
+    final: Sequence[tuple],
+    names: dict | None = None,
+    intro: str = "",
+    limit: float | None = None,
+) -> str:
     """A complete LaTeX document (``pdflatex`` compiles it): a section per step with its prose and its
     equations, and the result."""
     parts = [PREAMBLE, r"\title{" + _escape(title) + "}", r"\date{}", r"\begin{document}", r"\maketitle"]
@@ -363,7 +418,7 @@ def document(title: str, steps: Sequence, final: Sequence[tuple], names: Optiona
         parts.append(r"\section*{Step " + str(k) + ": " + latex_text(step.title) + "}")
         if getattr(step, "text", ""):
             parts.append(latex_text(step.text) + "\n")
-        rows: List[str] = []
+        rows: list[str] = []
         step_limit = limit if limit is not None else rhs_limit([lhs for lhs, _ in step.equations])
         for lhs, value in step.equations:
             rows += equation_rows(lhs, value, step_limit, names)

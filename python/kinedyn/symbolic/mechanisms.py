@@ -30,14 +30,22 @@ independent trigonometric terms, so every coefficient must vanish.
 
 from __future__ import annotations
 
-from typing import Optional, Sequence
+from collections.abc import Sequence
 
 import sympy as sp
 
 from .eom import EquationsOfMotion, Step
 from .simplify import simplify_trig
 
-__all__ = ["change_coordinates", "tree_equations", "loop_closure", "closed_chain", "closed_chain_system", "decoupling_condition", "christoffel_symbols"]
+__all__ = [
+    "change_coordinates",
+    "tree_equations",
+    "loop_closure",
+    "closed_chain",
+    "closed_chain_system",
+    "decoupling_condition",
+    "christoffel_symbols",
+]
 
 
 def _simplify(e, coordinates):
@@ -49,17 +57,36 @@ def christoffel_symbols(D: sp.Matrix, q: Sequence, simplify=None):
     n = len(q)
     simp = simplify or (lambda e: sp.expand(e))
     dD = [[[sp.diff(D[a, b], c) for c in q] for b in range(n)] for a in range(n)]  # dD[a][b][i] = dD_ab/dq_i
-    return [[[simp((dD[k][j][i] + dD[k][i][j] - dD[i][j][k]) / 2) for k in range(n)] for j in range(n)] for i in range(n)]
+    return [
+        [[simp((dD[k][j][i] + dD[k][i][j] - dD[i][j][k]) / 2) for k in range(n)] for j in range(n)] for i in range(n)
+    ]
 
 
-def _from_inertia(q, qd, qdd, D, g, friction, P, *, name, steps, extra, simplify_in, latex_names=None) -> EquationsOfMotion:
+def _from_inertia(
+    q, qd, qdd, D, g, friction, P, *, name, steps, extra, simplify_in, latex_names=None
+) -> EquationsOfMotion:
     """Equations of motion of the natural system K = qd^T D qd / 2, P, with C from D's Christoffel symbols."""
     n = len(q)
     chris = christoffel_symbols(D, q, simplify_in)
     C = sp.Matrix(n, n, lambda k, j: simplify_in(sum(chris[i][j][k] * qd[i] for i in range(n))))
     K = simplify_in((sp.Matrix(qd).T * D * sp.Matrix(qd))[0, 0] / 2)
-    return EquationsOfMotion(q, qd, qdd, D, C, g, K=K, P=P, friction=friction, christoffel=chris, steps=steps, name=name,
-                             method="lagrange", latex_names=latex_names, extra=extra)
+    return EquationsOfMotion(
+        q,
+        qd,
+        qdd,
+        D,
+        C,
+        g,
+        K=K,
+        P=P,
+        friction=friction,
+        christoffel=chris,
+        steps=steps,
+        name=name,
+        method="lagrange",
+        latex_names=latex_names,
+        extra=extra,
+    )
 
 
 def _new_coordinates(coordinates, n, taken):
@@ -77,11 +104,13 @@ def _new_coordinates(coordinates, n, taken):
     pdd = [sp.Symbol(_rate_names(c.name)[1], real=True) for c in p]
     clash = {s.name for s in p + pd + pdd} & {s.name for s in taken}
     if clash:
-        raise ValueError(f"the new coordinates' names {sorted(clash)} are already symbols of the equations: choose other names")
+        raise ValueError(
+            f"the new coordinates' names {sorted(clash)} are already symbols of the equations: choose other names"
+        )
     return p, pd, pdd, latex_names(p, pd, pdd)
 
 
-def change_coordinates(eom: EquationsOfMotion, A, coordinates=None, name: Optional[str] = None) -> EquationsOfMotion:
+def change_coordinates(eom: EquationsOfMotion, A, coordinates=None, name: str | None = None) -> EquationsOfMotion:
     """The equations of ``eom`` (in q) in new coordinates p with q = A p (``A`` constant, n x n,
     invertible): D_p = A^T D_q A, g_p = A^T g_q, friction_p = A^T friction_q, tau_p = A^T tau_q and
     the Christoffel symbols of D_p (see the module docstring). ``coordinates``: names of p (default
@@ -89,24 +118,49 @@ def change_coordinates(eom: EquationsOfMotion, A, coordinates=None, name: Option
     n = eom.n
     A = sp.Matrix(A)
     if A.shape != (n, n):
-        raise ValueError(f"the drive map q = A p needs a square A of shape ({n}, {n}) for {n} coordinates, got {A.shape}")
+        raise ValueError(
+            f"the drive map q = A p needs a square A of shape ({n}, {n}) for {n} coordinates, got {A.shape}"
+        )
     state = set(eom.q) | set(eom.qd) | set(eom.qdd)
     if A.free_symbols & state:
-        raise ValueError("A must be constant (no joint coordinates or velocities in it): q = A p with A depending on q is not a linear change of coordinates")
+        raise ValueError(
+            "A must be constant (no joint coordinates or velocities in it): q = A p with A depending on q is not a linear change of coordinates"
+        )
     if sp.simplify(A.det()) == 0:
         raise ValueError(f"A = {A.tolist()} is singular: the new coordinates would not determine q")
     params = set().union(*(m.free_symbols for m in (eom.M, eom.g, eom.friction))) - state
     p, pd, pdd, names = _new_coordinates(coordinates, n, params | state)
-    to_p = {**dict(zip(eom.q, A * sp.Matrix(p))), **dict(zip(eom.qd, A * sp.Matrix(pd))), **dict(zip(eom.qdd, A * sp.Matrix(pdd)))}
+    to_p = {
+        **dict(zip(eom.q, A * sp.Matrix(p))),
+        **dict(zip(eom.qd, A * sp.Matrix(pd))),
+        **dict(zip(eom.qdd, A * sp.Matrix(pdd))),
+    }
     simp = lambda e: _simplify(e, p)
     D = (A.T * eom.M.xreplace(to_p) * A).applyfunc(simp)
     g = (A.T * eom.g.xreplace(to_p)).applyfunc(simp)
     friction = (A.T * eom.friction.xreplace(to_p)).applyfunc(sp.expand)
     P = simp(sp.sympify(eom.P).xreplace(to_p)) if eom.P is not None else None
-    steps = [Step("Change of coordinates q = A p", "qd = A pd; D_p = A^T D_q A, g_p = A^T g_q, tau_p = A^T tau_q (virtual work)",
-                  [("A", A), (r"D(p)", D), (r"g(p)", g)])]
-    return _from_inertia(p, pd, pdd, D, g, friction, P, name=name or f"{eom.name} in coordinates {', '.join(map(str, p))}",
-                         steps=steps, extra=dict(A=A, original=eom), simplify_in=simp, latex_names=names)
+    steps = [
+        Step(
+            "Change of coordinates q = A p",
+            "qd = A pd; D_p = A^T D_q A, g_p = A^T g_q, tau_p = A^T tau_q (virtual work)",
+            [("A", A), (r"D(p)", D), (r"g(p)", g)],
+        )
+    ]
+    return _from_inertia(
+        p,
+        pd,
+        pdd,
+        D,
+        g,
+        friction,
+        P,
+        name=name or f"{eom.name} in coordinates {', '.join(map(str, p))}",
+        steps=steps,
+        extra=dict(A=A, original=eom),
+        simplify_in=simp,
+        latex_names=names,
+    )
 
 
 def tree_equations(*trees) -> EquationsOfMotion:
@@ -117,7 +171,9 @@ def tree_equations(*trees) -> EquationsOfMotion:
         raise ValueError("tree_equations() needs at least one tree")
     q = [s for e in eoms for s in e.q]
     if len({s.name for s in q}) != len(q):
-        raise ValueError(f"the trees' joint coordinates repeat ({[s.name for s in q]}): name the joints of each tree differently")
+        raise ValueError(
+            f"the trees' joint coordinates repeat ({[s.name for s in q]}): name the joints of each tree differently"
+        )
     qd = [s for e in eoms for s in e.qd]
     qdd = [s for e in eoms for s in e.qdd]
     D = sp.diag(*[e.M for e in eoms])
@@ -139,11 +195,24 @@ def tree_equations(*trees) -> EquationsOfMotion:
                     for k in range(e.n):
                         chris[offset + i][offset + j][offset + k] = e.christoffel[i][j][k]
             offset += e.n
-    return EquationsOfMotion(q, qd, qdd, D, C, g, K=None, P=P, friction=friction, christoffel=chris, name=" + ".join(e.name for e in eoms),
-                             method="lagrange", latex_names=names)
+    return EquationsOfMotion(
+        q,
+        qd,
+        qdd,
+        D,
+        C,
+        g,
+        K=None,
+        P=P,
+        friction=friction,
+        christoffel=chris,
+        name=" + ".join(e.name for e in eoms),
+        method="lagrange",
+        latex_names=names,
+    )
 
 
-def loop_closure(tree_a, tree_b, frame_a: Optional[str] = None, frame_b: Optional[str] = None) -> list:
+def loop_closure(tree_a, tree_b, frame_a: str | None = None, frame_b: str | None = None) -> list:
     """Loop-closure constraints phi = 0 joining two trees (Robots) at a point: the origin of
     ``frame_a`` of tree a (default its tool) coincides with the origin of ``frame_b`` of tree b, both
     in the common base frame; rows that vanish identically (z of a planar mechanism) are left out."""
@@ -163,7 +232,9 @@ def _tree_and_closure(trees, closure):
     velocity = set(tree.qd) | set(tree.qdd)
     for c in closure:
         if c.free_symbols & velocity:
-            raise ValueError(f"loop-closure constraint {c} = 0 depends on velocities; it must be a function of the joint coordinates")
+            raise ValueError(
+                f"loop-closure constraint {c} = 0 depends on velocities; it must be a function of the joint coordinates"
+            )
     return tree, closure
 
 
@@ -187,13 +258,19 @@ def closed_chain(trees, closure, independent, solution: dict, name: str = "close
     solution = {coordinate(k): sp.sympify(v) for k, v in dict(solution).items()}
     dependent = [c for c in tree.q if c not in q]
     if set(solution) != set(dependent):
-        raise ValueError(f"solution must give every dependent coordinate {[c.name for c in dependent]} as an expression of {[c.name for c in q]}, got {[c.name for c in solution]}")
+        raise ValueError(
+            f"solution must give every dependent coordinate {[c.name for c in dependent]} as an expression of {[c.name for c in q]}, got {[c.name for c in solution]}"
+        )
     for k, v in solution.items():
         stray = v.free_symbols & (set(dependent) | set(tree.qd))
         if stray:
-            raise ValueError(f"solution for {k}: {v} must depend on the independent coordinates only, not on {sorted(map(str, stray))}")
+            raise ValueError(
+                f"solution for {k}: {v} must depend on the independent coordinates only, not on {sorted(map(str, stray))}"
+            )
     if len(tree.q) - len(q) != len(closure):
-        raise ValueError(f"{len(closure)} closure constraints for {len(dependent)} dependent coordinates: give as many independent constraints as dependent coordinates")
+        raise ValueError(
+            f"{len(closure)} closure constraints for {len(dependent)} dependent coordinates: give as many independent constraints as dependent coordinates"
+        )
     for r, c in enumerate(closure):
         residual = _simplify(c.xreplace(solution), q)
         if residual != 0 and sp.simplify(residual) != 0:
@@ -211,11 +288,31 @@ def closed_chain(trees, closure, independent, solution: dict, name: str = "close
     friction = (J.T * tree.friction.xreplace(on_manifold)).applyfunc(sp.expand)
     P = simp(sp.sympify(tree.P).xreplace(on_manifold)) if tree.P is not None else None
     steps = [
-        Step("Loop closure", "phi(theta) = 0, and the branch of its solution used", [(r"\phi", sp.Matrix(closure)), (r"\Theta(q)", Theta)]),
-        Step("Reduced dynamics", "J = dTheta/dq, D = J^T D_tree J, g = J^T g_tree, C from the Christoffel symbols of D", [("J", J), ("D(q)", D), ("g(q)", g)]),
+        Step(
+            "Loop closure",
+            "phi(theta) = 0, and the branch of its solution used",
+            [(r"\phi", sp.Matrix(closure)), (r"\Theta(q)", Theta)],
+        ),
+        Step(
+            "Reduced dynamics",
+            "J = dTheta/dq, D = J^T D_tree J, g = J^T g_tree, C from the Christoffel symbols of D",
+            [("J", J), ("D(q)", D), ("g(q)", g)],
+        ),
     ]
-    return _from_inertia(q, qd, qdd, D, g, friction, P, name=name, steps=steps, simplify_in=simp, latex_names=tree.latex_names,
-                         extra=dict(tree=tree, closure=sp.Matrix(closure), embedding=Theta, embedding_jacobian=J))
+    return _from_inertia(
+        q,
+        qd,
+        qdd,
+        D,
+        g,
+        friction,
+        P,
+        name=name,
+        steps=steps,
+        simplify_in=simp,
+        latex_names=tree.latex_names,
+        extra=dict(tree=tree, closure=sp.Matrix(closure), embedding=Theta, embedding_jacobian=J),
+    )
 
 
 def closed_chain_system(trees, closure, name: str = "closed chain"):

@@ -52,7 +52,7 @@ derivation can be shown step by step (:func:`newton_euler_steps`).
 
 from __future__ import annotations
 
-from typing import Any, Dict, List
+from typing import Any
 
 import sympy as sp
 
@@ -67,12 +67,12 @@ class Program:
     """A straight-line program: ordered assignments ``symbol = expression`` and named outputs."""
 
     def __init__(self, reserved=()):
-        self.assignments: List[tuple] = []
-        self.outputs: Dict[str, list] = {}
-        self.tags: Dict[sp.Symbol, tuple] = {}  # variable -> (stage, link) for the step-by-step display
-        self.vectors: Dict[tuple, list] = {}  # (quantity, link) -> 3 expressions (w, wd, vd, F, N, f, n, ...)
+        self.assignments: list[tuple] = []
+        self.outputs: dict[str, list] = {}
+        self.tags: dict[sp.Symbol, tuple] = {}  # variable -> (stage, link) for the step-by-step display
+        self.vectors: dict[tuple, list] = {}  # (quantity, link) -> 3 expressions (w, wd, vd, F, N, f, n, ...)
         self.tag = ("", 0)  # the tag given to variables made now
-        self.all_assignments: List[tuple] = []
+        self.all_assignments: list[tuple] = []
         self._names = {str(s) for s in reserved}
 
     def let(self, name: str, expr):
@@ -88,7 +88,7 @@ class Program:
         self.tags[sym] = self.tag
         return sym
 
-    def prune(self) -> "Program":
+    def prune(self) -> Program:
         """Remove assignments the outputs do not use (dead-code elimination); ``all_assignments`` keeps
         the whole recursion for the step-by-step display."""
         self.all_assignments = list(self.assignments)
@@ -104,21 +104,21 @@ class Program:
         self.assignments = keep[::-1]
         return self
 
-    def op_count(self, cse: bool = False) -> Dict[str, int]:
+    def op_count(self, cse: bool = False) -> dict[str, int]:
         exprs = [e for _, e in self.assignments] + [e for v in self.outputs.values() for e in v]
         if cse:
             repl, red = sp.cse(exprs, order="none")
             exprs = [e for _, e in repl] + list(red)
         return _ops(exprs)
 
-    def expanded(self, name: str = "tau") -> List:
+    def expanded(self, name: str = "tau") -> list:
         """The outputs with every intermediate variable substituted back (can be large)."""
         env: dict = {}
         for sym, expr in self.assignments:
             env[sym] = expr.xreplace(env)
         return [sp.sympify(e).xreplace(env) for e in self.outputs[name]]
 
-    def evaluate(self, convert, name: str = "tau") -> List:
+    def evaluate(self, convert, name: str = "tau") -> list:
         """Evaluate the program in another arithmetic: ``convert(expr, env)`` maps an expression whose
         intermediate symbols are bound in ``env`` to a value (used to get exact ring elements)."""
         env: dict = {}
@@ -201,7 +201,9 @@ def group_parameters(bodies, pi, placements, exact=None, let=None):
                 continue
             z = (k + 2) % 3  # the perpendicular diagonal entry made zero (YY for an axis along z)
             # what stays: XXR = XX - YY (axis z), formed from the expressions so that common terms cancel
-            rest_I = [[sp.expand(I[i][c] - (I[z][z] if (i == c and i != k) else zero)) for c in range(3)] for i in range(3)]
+            rest_I = [
+                [sp.expand(I[i][c] - (I[z][z] if (i == c and i != k) else zero)) for c in range(3)] for i in range(3)
+            ]
             rest = (zero, [zero if i == k else h[i] for i in range(3)], rest_I)
             m = let(f"MR{J}", m)
             hk = let(f"{_PNAMES[1 + k]}R{J}", h[k])
@@ -225,7 +227,9 @@ def group_parameters(bodies, pi, placements, exact=None, let=None):
     return pi
 
 
-def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = True, friction: bool = True, exact=None, group: bool = True) -> Program:
+def newton_euler_program(
+    robot, q, qd, qdd, parameters=None, gravity: bool = True, friction: bool = True, exact=None, group: bool = True
+) -> Program:
     """The customised Newton-Euler model of ``robot`` (see the module docstring).
 
     ``parameters``: optional list of per-body 10-vectors [m, mx, my, mz, XX, XY, YY, XZ, YZ, ZZ]
@@ -243,7 +247,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
     prog = Program(reserved=set(robot.symbols) | set(q_coordinates) | set(qd_coordinates) | set(qdd_coordinates))
     let = prog.let
     zero = sp.Integer(0)
-    children: Dict[int, list] = {i: [] for i in range(-1, n)}
+    children: dict[int, list] = {i: [] for i in range(-1, n)}
     for j, b in enumerate(bodies):
         children[b.parent].append(j)
     # ---- inertial parameters (about each body origin), grouped when asked
@@ -285,7 +289,10 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             Sa = [[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]]
             Rj = [[(C if rr == k else 0) + S * Sa[rr][k] + (1 - C) * a[rr] * a[k] for k in range(3)] for rr in range(3)]
             Rj = [[sp.expand(x) for x in row] for row in Rj]
-            Ej = [[let(f"E{J}{_XYZ[rr]}{_XYZ[k]}", sum((PR[rr][m] * Rj[m][k] for m in range(3)), zero)) for k in range(3)] for rr in range(3)]
+            Ej = [
+                [let(f"E{J}{_XYZ[rr]}{_XYZ[k]}", sum((PR[rr][m] * Rj[m][k] for m in range(3)), zero)) for k in range(3)]
+                for rr in range(3)
+            ]
             rj = Pp
         else:
             Ej = PR
@@ -319,7 +326,16 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
                 ww[a1, a2] = ww[a2, a1] = let(f"WW{J}{_XYZ[a1]}{_XYZ[a2]}", w[j][a1] * w[j][a2])
         WW[j] = ww
         Sw = [[0, -wd[j][2], wd[j][1]], [wd[j][2], 0, -wd[j][0]], [-wd[j][1], wd[j][0], 0]]
-        U[j] = [[let(f"U{J}{_XYZ[a1]}{_XYZ[a2]}", Sw[a1][a2] + ww[a1, a2] - (ww[0, 0] + ww[1, 1] + ww[2, 2] if a1 == a2 else 0)) for a2 in range(3)] for a1 in range(3)]
+        U[j] = [
+            [
+                let(
+                    f"U{J}{_XYZ[a1]}{_XYZ[a2]}",
+                    Sw[a1][a2] + ww[a1, a2] - (ww[0, 0] + ww[1, 1] + ww[2, 2] if a1 == a2 else 0),
+                )
+                for a2 in range(3)
+            ]
+            for a1 in range(3)
+        ]
         prog.vectors[("w", j)], prog.vectors[("wd", j)], prog.vectors[("vd", j)] = w[j], wd[j], vd[j]
         prog.vectors[("U", j)] = U[j]
     # ---- per-body force and moment at the body origin
@@ -332,7 +348,9 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
         F[j] = [let(f"F{J}{_XYZ[k]}", m * vd[j][k] + Uh[k]) for k in range(3)]
         c2 = _cross(h, vd[j])
         if group:
-            N[j] = [let(f"N{J}{_XYZ[k]}", x + c2[k]) for k, x in enumerate(_moment_u_form(prog, J, Io, wd[j], WW[j], U[j]))]
+            N[j] = [
+                let(f"N{J}{_XYZ[k]}", x + c2[k]) for k, x in enumerate(_moment_u_form(prog, J, Io, wd[j], WW[j], U[j]))
+            ]
         else:
             Jw = [let(f"JW{J}{_XYZ[k]}", x) for k, x in enumerate(_matvec(Io, w[j]))]
             Jwd = _matvec(Io, wd[j])
@@ -340,9 +358,9 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             N[j] = [let(f"N{J}{_XYZ[k]}", Jwd[k] + c1[k] + c2[k]) for k in range(3)]
         prog.vectors[("F", j)], prog.vectors[("N", j)] = F[j], N[j]
     # ---- backward recursion: f_j = F_j + sum E_c f_c ; n_j = N_j + sum (E_c n_c + r_c x E_c f_c)
-    f: Dict[int, Any] = {}
-    nn: Dict[int, Any] = {}
-    joint_force: List[Any] = [None] * n
+    f: dict[int, Any] = {}
+    nn: dict[int, Any] = {}
+    joint_force: list[Any] = [None] * n
     for j in reversed(range(n)):
         J = j + 1
         prog.tag = ("backward", J)
@@ -364,7 +382,7 @@ def newton_euler_program(robot, q, qd, qdd, parameters=None, gravity: bool = Tru
             t = t + exact(b.joint.viscous) * qd[j] + b.joint.coulomb_torque(qd[j], exact)
         joint_force[j] = t
     # tau = G^T tau_joints: each joint's force on its coordinate, a follower's times its multiplier
-    tau: List[Any] = [zero] * len(q_coordinates)
+    tau: list[Any] = [zero] * len(q_coordinates)
     for j, (k, m, _) in enumerate(coordinates):
         tau[k] = tau[k] + m * joint_force[j]
     if len(tau) < n:  # mimic joints: the joint forces, for the step-by-step display
@@ -415,20 +433,24 @@ def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
 
     n = len(robot.tree.bodies)
     assignments = prog.all_assignments or prog.assignments
-    by_tag: Dict[tuple, list] = {}
+    by_tag: dict[tuple, list] = {}
     for sym, expr in assignments:
         by_tag.setdefault(prog.tags.get(sym, ("", 0)), []).append((symbol_name(sym), expr))
     V = lambda key, j: sp.Matrix(prog.vectors[(key, j)]) if (key, j) in prog.vectors else None
     steps = []
     # in program order (tips to base), and only those tau uses: the rest reached the fixed base
-    grouped = [(symbol_name(sym), expr) for sym, expr in prog.assignments if prog.tags.get(sym, ("",))[0] == "parameters"]
+    grouped = [
+        (symbol_name(sym), expr) for sym, expr in prog.assignments if prog.tags.get(sym, ("",))[0] == "parameters"
+    ]
     if grouped:
-        steps.append(Step(
-            "Grouped inertial parameters",
-            "Across a revolute joint about z, M_j, MZ_j and YY_j move to the parent (parallel-axis rule), leaving XXR_j = XX_j - YY_j; "
-            "across a prismatic joint the rotational inertia moves (Khalil & Dombre ch. 9; Gautier & Khalil 1990). Differences such as ZZ - YY are formed once.",
-            grouped,
-        ))
+        steps.append(
+            Step(
+                "Grouped inertial parameters",
+                "Across a revolute joint about z, M_j, MZ_j and YY_j move to the parent (parallel-axis rule), leaving XXR_j = XX_j - YY_j; "
+                "across a prismatic joint the rotational inertia moves (Khalil & Dombre ch. 9; Gautier & Khalil 1990). Differences such as ZZ - YY are formed once.",
+                grouped,
+            )
+        )
     for j in range(n):
         J = j + 1
         st = Step(
@@ -437,7 +459,11 @@ def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
             "vd_j = E^T (vd_i + U_i r_j), vd_cj = vd_j + U_j c_j (Craig eqs. 6.45-6.48 in body frames; K&D ch. 9); vd_0 = -gravity.",
             list(by_tag.get(("forward", J), [])),
         )
-        for key, lhs in (("w", vector_name(r"\omega", "w", "ω", J)), ("wd", vector_name(r"\omega", "wd", "ω", J, accent=1)), ("vd", vector_name("v", "vd", "v", J, accent=1))):
+        for key, lhs in (
+            ("w", vector_name(r"\omega", "w", "ω", J)),
+            ("wd", vector_name(r"\omega", "wd", "ω", J, accent=1)),
+            ("vd", vector_name("v", "vd", "v", J, accent=1)),
+        ):
             if V(key, j) is not None:
                 st.equations.append((lhs, V(key, j)))
         inertia = robot.tree.bodies[j].inertia
@@ -480,12 +506,17 @@ def newton_euler_steps(prog: Program, robot, q, qd, qdd) -> list:
         from .lagrange import body_coordinates
 
         number = lambda x: f"{float(x):g}" if x.is_number else str(x)
-        follows = [f"joint {j + 1}: {b.joint.name} = {number(m)} {robot.joint_names[k]} + {number(o)}"
-                   for j, (b, (k, m, o)) in enumerate(zip(robot.tree.bodies, body_coordinates(robot))) if b.joint.name not in robot.joint_names]
-        steps.append(Step(
-            "Mimic joints: the forces on the coordinates, tau = G^T Q",
-            "Q_j is joint j's force from the recursion; a follower joint moves as m q_k + o, so by virtual work its force adds m Q_j "
-            f"to its leader's coordinate k ({'; '.join(follows)}).",
-            [(name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), t) for k, t in enumerate(tau)],
-        ))
+        follows = [
+            f"joint {j + 1}: {b.joint.name} = {number(m)} {robot.joint_names[k]} + {number(o)}"
+            for j, (b, (k, m, o)) in enumerate(zip(robot.tree.bodies, body_coordinates(robot)))
+            if b.joint.name not in robot.joint_names
+        ]
+        steps.append(
+            Step(
+                "Mimic joints: the forces on the coordinates, tau = G^T Q",
+                "Q_j is joint j's force from the recursion; a follower joint moves as m q_k + o, so by virtual work its force adds m Q_j "
+                f"to its leader's coordinate k ({'; '.join(follows)}).",
+                [(name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), t) for k, t in enumerate(tau)],
+            )
+        )
     return steps

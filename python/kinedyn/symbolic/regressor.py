@@ -26,7 +26,7 @@ printed Theta3 and Theta5 differ).
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any, Dict, List
+from typing import Any
 
 import sympy as sp
 
@@ -99,9 +99,9 @@ def _split(ring, tau, known):
     in the greedy order, and the parameter-free part {key: number}."""
     npar = ring.nparams
     is_known = [any(s in known for s in sp.sympify(g).free_symbols) for g in ring.param_gens]
-    coeffs: Dict[tuple, Dict[tuple, object]] = {}
-    free: Dict[tuple, object] = {}
-    order: List[tuple] = []
+    coeffs: dict[tuple, dict[tuple, object]] = {}
+    free: dict[tuple, object] = {}
+    order: list[tuple] = []
     none_known = (0,) * npar
     for row, t in enumerate(tau):
         t = ring.chop(t)
@@ -124,9 +124,9 @@ def _split(ring, tau, known):
 
 def _eliminate(coeffs, order, F):
     """Greedy basis of the coefficient vectors (Gaussian elimination) and each vector's combination."""
-    basis: List[Dict[tuple, object]] = []
-    echelon: List[tuple] = []  # (pivot monomial, reduced vector, combination over the basis)
-    combos: Dict[tuple, list] = {}
+    basis: list[dict[tuple, object]] = []
+    echelon: list[tuple] = []  # (pivot monomial, reduced vector, combination over the basis)
+    combos: dict[tuple, list] = {}
     for key in order:
         vec = {k: F.num(v) for k, v in coeffs[key].items()}
         vec = {k: v for k, v in vec.items() if v != 0}
@@ -241,7 +241,7 @@ def _state_rank(ring, m):
     vel = [m[j] for j in ring.qd_idx]
     trig = sum(m[j] for j in list(ring.c_idx.values()) + list(ring.s_idx.values()))
     group = 0 if any(acc) else (1 if any(vel) else 2)
-    return (group, [-e for e in acc], [-e for e in vel], trig, m[ring.nparams:])
+    return (group, [-e for e in acc], [-e for e in vel], trig, m[ring.nparams :])
 
 
 def _mono(gens, exps):

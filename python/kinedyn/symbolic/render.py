@@ -14,16 +14,41 @@ from __future__ import annotations
 
 import html
 import re
-from typing import Dict, List, Optional
 
 import sympy as sp
 from sympy.printing.mathml import MathMLPresentationPrinter
 
-__all__ = ["rate_names", "legacy_rate_names", "Name", "name", "of_q", "dL_dqd", "ddt_dL_dqd", "dL_dq", "lagrangian", "symbol_name", "vector_name",
-           "latex_to_mathml", "value_mathml", "equation_mathml", "text_of", "mathml_of"]
+__all__ = [
+    "rate_names",
+    "legacy_rate_names",
+    "Name",
+    "name",
+    "of_q",
+    "dL_dqd",
+    "ddt_dL_dqd",
+    "dL_dq",
+    "lagrangian",
+    "symbol_name",
+    "vector_name",
+    "latex_to_mathml",
+    "value_mathml",
+    "equation_mathml",
+    "text_of",
+    "mathml_of",
+]
 
 MATHML_NS = "http://www.w3.org/1998/Math/MathML"
-_GREEK = {"tau": "τ", "omega": "ω", "theta": "θ", "alpha": "α", "partial": "∂", "lambda": "λ", "pi": "π", "mu": "μ", "nu": "ν"}
+_GREEK = {
+    "tau": "τ",
+    "omega": "ω",
+    "theta": "θ",
+    "alpha": "α",
+    "partial": "∂",
+    "lambda": "λ",
+    "pi": "π",
+    "mu": "μ",
+    "nu": "ν",
+}
 
 
 class Name(str):
@@ -56,7 +81,7 @@ def rate_names(name: str) -> tuple:
     base = split_super_sub(name)[0]
     if not base or not name.startswith(base):
         return f"{name}dot", f"{name}ddot"
-    rest = name[len(base):]
+    rest = name[len(base) :]
     return f"{base}dot{rest}", f"{base}ddot{rest}"
 
 
@@ -75,7 +100,12 @@ def _mi(x: str, script: bool = False) -> str:
 def _tokens(s: str) -> str:
     """A subscript such as ``c1`` or ``121``: letters as identifiers, digits as one number each run."""
     parts = re.findall(r"[A-Za-z]+|\d+|.", s)
-    out = "".join(f"<mn>{p}</mn>" if p.isdigit() else (f"<mi>{html.escape(_GREEK.get(p, p))}</mi>" if p.isalpha() else f"<mo>{html.escape(p)}</mo>") for p in parts)
+    out = "".join(
+        f"<mn>{p}</mn>"
+        if p.isdigit()
+        else (f"<mi>{html.escape(_GREEK.get(p, p))}</mi>" if p.isalpha() else f"<mo>{html.escape(p)}</mo>")
+        for p in parts
+    )
     return out if len(parts) == 1 else f"<mrow>{out}</mrow>"
 
 
@@ -113,7 +143,11 @@ def name(latex: str, text: str, base: str, sub: str = "", script: bool = False) 
 def of_q(f: str, rates: bool = False) -> Name:
     """``D(q)``, ``g(q)``, ``A(q)``; ``rates=True``: ``C(q, q̇)``."""
     if rates:
-        return Name(f"{f}(q, \\dot{{q}})", f"{f}(q, qd)", f'<mrow><mi>{f}</mi><mo>(</mo><mi>q</mi><mo>,</mo>{_dot("<mi>q</mi>", 1)}<mo>)</mo></mrow>')
+        return Name(
+            f"{f}(q, \\dot{{q}})",
+            f"{f}(q, qd)",
+            f"<mrow><mi>{f}</mi><mo>(</mo><mi>q</mi><mo>,</mo>{_dot('<mi>q</mi>', 1)}<mo>)</mo></mrow>",
+        )
     return Name(f"{f}(q)", f"{f}(q)", f"<mrow><mi>{f}</mi><mo>(</mo><mi>q</mi><mo>)</mo></mrow>")
 
 
@@ -153,7 +187,11 @@ def ddt_dL_dqd(q, qd) -> Name:
 
 def dL_dq(q) -> Name:
     """∂L/∂q_k."""
-    return Name(f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {sp.latex(q)}}}", f"dL/d{q}", _partial_frac(_mi("L", script=True), _coord_mathml(q)))
+    return Name(
+        f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {sp.latex(q)}}}",
+        f"dL/d{q}",
+        _partial_frac(_mi("L", script=True), _coord_mathml(q)),
+    )
 
 
 def symbol_name(sym) -> Name:
@@ -188,7 +226,7 @@ def mathml_of(lhs) -> str:
 class _Printer(MathMLPresentationPrinter):
     """SymPy's presentation printer, drawing chosen symbols (the rates q̇_k, q̈_k) with given MathML."""
 
-    def __init__(self, symbols: Dict[sp.Symbol, str], settings=None):
+    def __init__(self, symbols: dict[sp.Symbol, str], settings=None):
         super().__init__(settings or {})
         self._given = symbols
 
@@ -202,7 +240,7 @@ class _Printer(MathMLPresentationPrinter):
         return super()._print_Symbol(sym, style)
 
 
-def rate_symbols(q, qd, qdd) -> Dict[sp.Symbol, str]:
+def rate_symbols(q, qd, qdd) -> dict[sp.Symbol, str]:
     """MathML for the coordinates q_k and their velocity and acceleration symbols (dots over the base)."""
     out = {}
     for a, b, c in zip(q, qd, qdd):
@@ -218,10 +256,12 @@ def _xml_entities(m: str) -> str:
     from html.entities import html5
 
     keep = {"amp", "lt", "gt", "quot", "apos"}
-    return re.sub(r"&([A-Za-z]+);", lambda g: g.group(0) if g.group(1) in keep else html5.get(g.group(1) + ";", g.group(0)), m)
+    return re.sub(
+        r"&([A-Za-z]+);", lambda g: g.group(0) if g.group(1) in keep else html5.get(g.group(1) + ";", g.group(0)), m
+    )
 
 
-def value_mathml(value, rates: Optional[Dict[sp.Symbol, str]] = None) -> str:
+def value_mathml(value, rates: dict[sp.Symbol, str] | None = None) -> str:
     """Presentation MathML of a SymPy expression or matrix (``rates`` from :func:`rate_symbols`);
     brackets and parentheses marked stretchy, so they grow around matrices and fractions."""
     printer = _Printer(rates or {})
@@ -231,8 +271,10 @@ def value_mathml(value, rates: Optional[Dict[sp.Symbol, str]] = None) -> str:
 
 def equation_mathml(lhs, value, rates=None, display: str = "block") -> str:
     """One ``<math>`` element: ``lhs = value``."""
-    return (f'<math xmlns="{MATHML_NS}" display="{display}"><mrow>{mathml_of(lhs)}<mo>=</mo>'
-            f"{value_mathml(value, rates)}</mrow></math>")
+    return (
+        f'<math xmlns="{MATHML_NS}" display="{display}"><mrow>{mathml_of(lhs)}<mo>=</mo>'
+        f"{value_mathml(value, rates)}</mrow></math>"
+    )
 
 
 def latex_to_mathml(s: str) -> str:
@@ -287,9 +329,9 @@ def latex_to_mathml(s: str) -> str:
             return ""
         return f"<mo>{html.escape(c)}</mo>"
 
-    def seq(stop: Optional[str]) -> str:
+    def seq(stop: str | None) -> str:
         nonlocal pos
-        parts: List[str] = []
+        parts: list[str] = []
         while pos < len(s) and (stop is None or s[pos] != stop):
             if s[pos] in "_^" and parts:
                 op = s[pos]

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any, Callable, Dict
+from collections.abc import Callable
+from typing import Any
 
 import sympy as sp
 
@@ -10,7 +11,7 @@ from .cse import closed_form_of_program, closed_form_steps, final_equations
 from .eom import EquationsOfMotion, Step
 from .lagrange import RingModel, _exact, christoffel, coriolis_matrix, derive_lagrange, latex_names, state_symbols
 from .newton_euler import newton_euler_program, newton_euler_steps
-from .render import dL_dq, dL_dqd, ddt_dL_dqd, lagrangian, name, of_q
+from .render import ddt_dL_dqd, dL_dq, dL_dqd, lagrangian, name, of_q
 
 __all__ = ["lagrange_eom", "newton_euler_eom", "general_parameters"]
 
@@ -62,11 +63,16 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
     steps = []
     try:
         pc = model.com_positions()
-        st = Step("Centre-of-mass positions r_ci(q) in the base frame", "Each link's centre of mass, from the forward kinematics.")
+        st = Step(
+            "Centre-of-mass positions r_ci(q) in the base frame",
+            "Each link's centre of mass, from the forward kinematics.",
+        )
         for i in range(model.n_bodies):
             st.equations.append((name(f"r_{{c{i + 1}}}", f"r_c{i + 1}", "r", f"c{i + 1}"), vec(pc[i])))
         steps.append(st)
-        st = Step("Velocity Jacobians", "v_ci = J_vci(q) qd and omega_i = J_wi(q) qd (Spong eq. 9.45); J_vci = d r_ci / dq.")
+        st = Step(
+            "Velocity Jacobians", "v_ci = J_vci(q) qd and omega_i = J_wi(q) qd (Spong eq. 9.45); J_vci = d r_ci / dq."
+        )
         for i in range(model.n_bodies):
             Jvc = [[ring.diff_q(pc[i][k], j) for j in range(n)] for k in range(3)]
             st.equations.append((_jac_name("v", f"c{i + 1}"), mat(Jvc)))
@@ -74,31 +80,57 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
         steps.append(st)
     except Exception:  # centre of mass not polynomial (e.g. h/m with symbolic m): skip the display step
         pass
-    qdv = sp.Matrix(qd)
-    steps.append(Step(
-        "Kinetic energy K = qd^T D(q) qd / 2",
-        "D(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
-        [(of_q("D"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
-    ))
-    steps.append(Step("Potential energy P = sum_i m_i g^T r_ci", "(Spong eqs. 9.48-9.49; g points along gravity)", [(name("P", "P", "P"), conv(d["P"]))]))
+    steps.append(
+        Step(
+            "Kinetic energy K = qd^T D(q) qd / 2",
+            "D(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
+            [(of_q("D"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
+        )
+    )
+    steps.append(
+        Step(
+            "Potential energy P = sum_i m_i g^T r_ci",
+            "(Spong eqs. 9.48-9.49; g points along gravity)",
+            [(name("P", "P", "P"), conv(d["P"]))],
+        )
+    )
     steps.append(Step("Lagrangian L = K - P", "", [(lagrangian(), conv(d["L"]))]))
-    st = Step("Derivatives of the Lagrangian", "For each coordinate: dL/dqd_k, its time derivative, and dL/dq_k (Spong eq. 9.40).")
+    st = Step(
+        "Derivatives of the Lagrangian",
+        "For each coordinate: dL/dqd_k, its time derivative, and dL/dq_k (Spong eq. 9.40).",
+    )
     for k in range(n):
         st.equations.append((dL_dqd(q[k], qd[k]), conv(d["dL_dqd"][k])))
         st.equations.append((ddt_dL_dqd(q[k], qd[k]), conv(d["ddt_dL_dqd"][k])))
         st.equations.append((dL_dq(q[k]), conv(d["dL_dq"][k])))
     steps.append(st)
-    st = Step("Joint torques tau_k = d/dt dL/dqd_k - dL/dq_k", "Friction, if any, is added separately: viscous qd + coulomb sign(qd).")
+    st = Step(
+        "Joint torques tau_k = d/dt dL/dqd_k - dL/dq_k",
+        "Friction, if any, is added separately: viscous qd + coulomb sign(qd).",
+    )
     for k in range(n):
         st.equations.append((name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", f"{k + 1}"), conv(d["tau"][k])))
     steps.append(st)
-    st = Step("Christoffel symbols c_ijk (non-zero ones)", "c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2 (Spong eq. 9.58), C_kj = sum_i c_ijk qd_i (eq. 9.62).")
+    st = Step(
+        "Christoffel symbols c_ijk (non-zero ones)",
+        "c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2 (Spong eq. 9.58), C_kj = sum_i c_ijk qd_i (eq. 9.62).",
+    )
     c = d["christoffel"]
     for k in range(n):
         for i in range(n):
             for j in range(i, n):
                 if c[i][j][k]:
-                    st.equations.append((name(f"c_{{{i + 1}{j + 1}{k + 1}}}", f"c_{i + 1}{j + 1}{k + 1}", "c", f"{i + 1}{j + 1}{k + 1}"), conv(c[i][j][k])))
+                    st.equations.append(
+                        (
+                            name(
+                                f"c_{{{i + 1}{j + 1}{k + 1}}}",
+                                f"c_{i + 1}{j + 1}{k + 1}",
+                                "c",
+                                f"{i + 1}{j + 1}{k + 1}",
+                            ),
+                            conv(c[i][j][k]),
+                        )
+                    )
     steps.append(st)
     return steps
 
@@ -108,8 +140,12 @@ def _jac_name(kind, index):
     from .render import Name, _mi, _tokens
 
     if kind == "v":
-        return Name(f"J_{{v_{{{index}}}}}", f"J_v{index}", f"<msub><mi>J</mi><msub><mi>v</mi>{_tokens(index)}</msub></msub>")
-    return Name(f"J_{{\\omega_{{{index}}}}}", f"J_w{index}", f"<msub><mi>J</mi><msub>{_mi('ω')}{_tokens(index)}</msub></msub>")
+        return Name(
+            f"J_{{v_{{{index}}}}}", f"J_v{index}", f"<msub><mi>J</mi><msub><mi>v</mi>{_tokens(index)}</msub></msub>"
+        )
+    return Name(
+        f"J_{{\\omega_{{{index}}}}}", f"J_w{index}", f"<msub><mi>J</mi><msub>{_mi('ω')}{_tokens(index)}</msub></msub>"
+    )
 
 
 def _christoffel_sympy(c, conv):
@@ -129,7 +165,7 @@ def _use_cse(form: str, prog) -> bool:
 
 def _closed_form_getter(prog, q, qd, qdd) -> Callable[[], Any]:
     """A cached getter of M, C, g in CSE form (kinedyn.symbolic.cse), built on first call."""
-    cache: Dict[str, Any] = {}
+    cache: dict[str, Any] = {}
 
     def closed():
         if "cf" not in cache:
@@ -185,7 +221,9 @@ class _LazyDerivation(dict):
         return dict.__len__(self)
 
 
-def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, parameters=None, form: str = "auto") -> EquationsOfMotion:
+def lagrange_eom(
+    robot, simplify: bool = True, with_steps: bool = True, parameters=None, form: str = "auto"
+) -> EquationsOfMotion:
     """Euler-Lagrange equations (Spong §9.2-9.3). With ``form`` "cse" (or "auto" for a large model) the
     rendered results are M, C, g in CSE form from the customised Newton-Euler model -- the same unique M,
     g and Christoffel C -- and the Lagrange steps, too large to read, are replaced by a note; ``eom.M``,
@@ -207,6 +245,7 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
     closed = _closed_form_getter(prog, q, qd, qdd) if cse else None
     steps: Any = None
     if with_steps and cse:
+
         def steps():
             note = Step(
                 "Lagrange's steps omitted (too large to read)",
@@ -219,7 +258,9 @@ def lagrange_eom(robot, simplify: bool = True, with_steps: bool = True, paramete
     elif with_steps:
         steps = lambda: _steps(robot, model, d, conv, mat, vec, q, qd)
     eom = EquationsOfMotion(
-        q, qd, qdd,
+        q,
+        qd,
+        qdd,
         M=lambda: mat(d["M"]),
         C=lambda: mat(d["C"]),
         g=lambda: vec(d["g"]),
@@ -284,7 +325,9 @@ def _ring_converter(model):
     return convert
 
 
-def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: bool = True, form: str = "auto") -> EquationsOfMotion:
+def newton_euler_eom(
+    robot, simplify: bool = True, parameters=None, with_steps: bool = True, form: str = "auto"
+) -> EquationsOfMotion:
     """Equations from the customised Newton-Euler model; tau, M, g, C come from the program alone
     (M = d tau / d qdd and g = tau(q, 0, 0) of the exactly evaluated program, C from M's Christoffel
     symbols), P and K from the kinematics."""
@@ -293,7 +336,7 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
     closed = _closed_form_getter(prog, q, qd, qdd) if _use_cse(form, prog) else None
     friction = _friction(robot, qd)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
-    cache: Dict[str, Any] = {}
+    cache: dict[str, Any] = {}
 
     def derived():
         if not cache:
@@ -317,7 +360,9 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
         return _outputs(model, None, simplify)[0](model.potential_energy())
 
     eom = EquationsOfMotion(
-        q, qd, qdd,
+        q,
+        qd,
+        qdd,
         M=lambda: derived()["mat"](derived()["M"]),
         C=lambda: derived()["mat"](derived()["C"]),
         g=lambda: derived()["vec"](derived()["g"]),
@@ -325,7 +370,14 @@ def newton_euler_eom(robot, simplify: bool = True, parameters=None, with_steps: 
         friction=friction,
         christoffel=lambda: _christoffel_sympy(derived()["christoffel"], derived()["conv"]),
         tau=lambda: derived()["vec"](derived()["tau"]) + friction,
-        steps=(lambda: newton_euler_steps(prog, robot, q, qd, qdd) + (closed_form_steps(closed()) if closed is not None else [])) if with_steps else None,
+        steps=(
+            lambda: (
+                newton_euler_steps(prog, robot, q, qd, qdd)
+                + (closed_form_steps(closed()) if closed is not None else [])
+            )
+        )
+        if with_steps
+        else None,
         name=robot.name,
         method="newton_euler",
         latex_names=latex_names(q, qd, qdd),

@@ -30,9 +30,10 @@ collected and factored when short. Nothing here calls ``sympy.simplify``.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from fractions import Fraction
 from functools import lru_cache
-from typing import Any, Dict, Iterable, Sequence, Tuple
+from typing import Any
 
 import sympy as sp
 from sympy.polys.rings import PolyRing, sring
@@ -57,7 +58,9 @@ class TrigRing:
     (see the module docstring: mimic joints).
     """
 
-    def __init__(self, coordinates, velocities, accelerations, leaves: Iterable = (), extra_symbols=(), multiples=(), angles=()):
+    def __init__(
+        self, coordinates, velocities, accelerations, leaves: Iterable = (), extra_symbols=(), multiples=(), angles=()
+    ):
         self.q = [c for c, _ in coordinates]
         self.kinds = [k for _, k in coordinates]
         self.qd = list(velocities)
@@ -113,7 +116,9 @@ class TrigRing:
             if (i, m) in self.m_idx:
                 continue
             if m == 0 or (i in self.c_idx and m.is_Integer):
-                raise ValueError(f"multiple {m} of coordinate {self.q[i]}: an integer multiple of a revolute coordinate needs no generator")
+                raise ValueError(
+                    f"multiple {m} of coordinate {self.q[i]}: an integer multiple of a revolute coordinate needs no generator"
+                )
             c_m, s_m = sp.Dummy(f"c{i + 1}m"), sp.Dummy(f"s{i + 1}m")
             self.m_idx[i, m] = (len(gens), len(gens) + 1)
             gens += [c_m, s_m]
@@ -251,7 +256,9 @@ class TrigRing:
         try:
             out = self._convert(expr, rep)
         except (ValueError, sp.PolynomialError, sp.CoercionFailed) as exc:
-            raise ValueError(f"expression is not a polynomial in the trigonometric functions of the coordinates: {exc}") from None
+            raise ValueError(
+                f"expression is not a polynomial in the trigonometric functions of the coordinates: {exc}"
+            ) from None
         return self.reduce(out)
 
     def _trig_of_argument(self, f):
@@ -403,7 +410,9 @@ class TrigRing:
 
     # ------------------------------------------------------------------ conversion out
     def _symbol_map(self):
-        return {self.R.symbols[j_c]: sp.cos(angle) for j_c, _, angle in self._pairs} | {self.R.symbols[j_s]: sp.sin(angle) for _, j_s, angle in self._pairs}
+        return {self.R.symbols[j_c]: sp.cos(angle) for j_c, _, angle in self._pairs} | {
+            self.R.symbols[j_s]: sp.sin(angle) for _, j_s, angle in self._pairs
+        }
 
     def to_product_form(self, p):
         """SymPy expression with sin(q_i), cos(q_i) products (no angle sums)."""
@@ -417,7 +426,7 @@ class TrigRing:
         trig_js = sorted([j for j_c, j_s, _ in self._pairs for j in (j_c, j_s)])
         angles = [angle for _, _, angle in self._pairs]
         nparam = self.nparams
-        groups: Dict[tuple, Dict[tuple, Any]] = {}
+        groups: dict[tuple, dict[tuple, Any]] = {}
         to_sym = self.domain.to_sympy
         for m, c in p.items():
             pm = m[:nparam]
@@ -433,7 +442,13 @@ class TrigRing:
         for (other, k, kind), coeffs in groups.items():
             if self.domain == sp.RR:
                 coeffs = {pm: v for pm, v in coeffs.items() if abs(float(v)) > 1e-12 * big}
-            coeff = sp.Add(*[v * sp.Mul(*[g.as_expr() ** e for g, e in zip(self.param_gens, pm) if e]) for pm, v in coeffs.items() if v != 0])
+            coeff = sp.Add(
+                *[
+                    v * sp.Mul(*[g.as_expr() ** e for g, e in zip(self.param_gens, pm) if e])
+                    for pm, v in coeffs.items()
+                    if v != 0
+                ]
+            )
             if coeff == 0:
                 continue
             if factor and self.domain != sp.RR and len(sp.Add.make_args(coeff)) <= 8:
@@ -497,7 +512,7 @@ def _mul_exp(poly, i, n, factor):
     return out
 
 
-def trig_normal_form(expr, coordinates: Sequence, prismatic: Sequence = ()) -> Tuple[TrigRing, object]:
+def trig_normal_form(expr, coordinates: Sequence, prismatic: Sequence = ()) -> tuple[TrigRing, object]:
     """(ring, element): the normal form of ``expr`` in the sines and cosines of ``coordinates``."""
     coords = [(q, "prismatic" if q in set(prismatic) else "revolute") for q in coordinates]
     expr = sp.sympify(expr)
@@ -584,7 +599,7 @@ def textbook_form(expr, coordinates: Sequence = (), prismatic: Sequence = ()):
     except (sp.PolynomialError, ValueError, TypeError, NotImplementedError):
         pass
     if expr.is_Add:  # terms over different denominators (H = p^T M^-1 p / 2 + P): one fraction per denominator
-        groups: Dict[Any, list] = {}
+        groups: dict[Any, list] = {}
         try:
             for term in sp.Add.make_args(expr):
                 n, d = sp.fraction(sp.cancel(sp.together(term)))

@@ -20,7 +20,8 @@ is solved per evaluation (closed chains such as SymPy's four-bar in seconds, not
 from __future__ import annotations
 
 import re
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import sympy as sp
 from sympy.core.function import AppliedUndef
@@ -55,7 +56,9 @@ def _as_list(value, what):
         return []
     if isinstance(value, sp.MatrixBase):
         if value.shape[1] != 1 and value.shape[0] != 1:
-            raise ValueError(f"{what} must be a vector (a list or a column), got a {value.shape[0]}x{value.shape[1]} matrix")
+            raise ValueError(
+                f"{what} must be a vector (a list or a column), got a {value.shape[0]}x{value.shape[1]} matrix"
+            )
         return list(value)
     if isinstance(value, sp.Basic):
         return [value]
@@ -94,7 +97,21 @@ class LagrangianSystem:
     friction); ``holonomic``: expressions g_c(q) = 0; ``pfaffian``: a k x n matrix A(q), A qd = 0.
     """
 
-    def __init__(self, q, K=None, P=0, *, L=None, qd=None, t=None, forces=None, B=None, holonomic=None, pfaffian=None, name: str = ""):
+    def __init__(
+        self,
+        q,
+        K=None,
+        P=0,
+        *,
+        L=None,
+        qd=None,
+        t=None,
+        forces=None,
+        B=None,
+        holonomic=None,
+        pfaffian=None,
+        name: str = "",
+    ):
         q = list(q) if not isinstance(q, (str, sp.Basic)) else [q]
         if not q:
             raise ValueError("a Lagrangian system needs at least one generalised coordinate")
@@ -112,7 +129,9 @@ class LagrangianSystem:
                 fun_rep[c] = sym
                 c = sym
             if not isinstance(c, sp.Symbol):
-                raise ValueError(f"generalised coordinate {c!r} is not a symbol: give plain SymPy symbols (or names), e.g. sympy.symbols('q1 q2')")
+                raise ValueError(
+                    f"generalised coordinate {c!r} is not a symbol: give plain SymPy symbols (or names), e.g. sympy.symbols('q1 q2')"
+                )
             coords.append(c)
         if len(set(coords)) != len(coords):
             raise ValueError(f"generalised coordinates repeat: {coords}")
@@ -153,7 +172,7 @@ class LagrangianSystem:
             self.L: Any = self.K - self.P
         else:
             self.L = sub(_scalar(L, "the Lagrangian L", names))
-        for i, (c, v) in enumerate(zip(coords, qd)):
+        for c, v in zip(coords, qd):
             if not self.L.has(v):
                 src = "kinetic energy K" if K is not None else "Lagrangian L"
                 raise ValueError(
@@ -161,7 +180,11 @@ class LagrangianSystem:
                     f"singular (free symbols of {src}: {sorted(map(str, (self.K if K is not None else self.L).free_symbols))}); "
                     "was the coordinate misspelt, or is the energy written with other velocity symbols?"
                 )
-        self.u = sp.Matrix(sp.symbols(f"u1:{n + 1}", real=True)) if forces is None else sp.Matrix(_as_list(sub(forces), "forces"))
+        self.u = (
+            sp.Matrix(sp.symbols(f"u1:{n + 1}", real=True))
+            if forces is None
+            else sp.Matrix(_as_list(sub(forces), "forces"))
+        )
         if len(self.u) != n:
             raise ValueError(f"forces must have {n} entries (one per coordinate), got {len(self.u)}")
         self.B = sp.zeros(n, 1) if B is None else sp.Matrix(_as_list(sub(B), "B"))
@@ -171,19 +194,25 @@ class LagrangianSystem:
         state = set(qd) | set(self.qdd)
         for e in self.holonomic:
             if e.free_symbols & state:
-                raise ValueError(f"holonomic constraint {e} = 0 depends on velocities; write it as a Pfaffian constraint A(q) qd = 0")
+                raise ValueError(
+                    f"holonomic constraint {e} = 0 depends on velocities; write it as a Pfaffian constraint A(q) qd = 0"
+                )
         rows = []
         if self.holonomic:
             rows.append(sp.Matrix([[sp.diff(e, c) for c in coords] for e in self.holonomic]))
         if pfaffian is not None:
             A = sp.Matrix(sub(sp.Matrix(pfaffian))) if not isinstance(pfaffian, sp.MatrixBase) else sub(pfaffian)
             if A.shape[1] != n:
-                raise ValueError(f"Pfaffian constraint matrix A must have shape (k, {n}) for A(q) qd = 0, got {A.shape}")
+                raise ValueError(
+                    f"Pfaffian constraint matrix A must have shape (k, {n}) for A(q) qd = 0, got {A.shape}"
+                )
             if A.free_symbols & state:
                 raise ValueError("Pfaffian constraint matrix A(q) must not depend on velocities")
             rows.append(A)
         self.A = sp.Matrix.vstack(*rows) if rows else sp.zeros(0, n)
-        self.lam = sp.Matrix(sp.symbols(f"lambda1:{self.A.shape[0] + 1}", real=True)) if self.A.shape[0] else sp.zeros(0, 1)
+        self.lam = (
+            sp.Matrix(sp.symbols(f"lambda1:{self.A.shape[0] + 1}", real=True)) if self.A.shape[0] else sp.zeros(0, 1)
+        )
         self.name = name
 
     def _sub(self, e):
@@ -194,12 +223,16 @@ class LagrangianSystem:
             return [self._sub(x) for x in e]
         e = sp.sympify(parse_expression(e, self._names)) if isinstance(e, str) else sp.sympify(e)
         if rep:
-            e = e.xreplace(rep).xreplace(fun_rep) if not isinstance(e, sp.MatrixBase) else e.xreplace(rep).xreplace(fun_rep)
+            e = (
+                e.xreplace(rep).xreplace(fun_rep)
+                if not isinstance(e, sp.MatrixBase)
+                else e.xreplace(rep).xreplace(fun_rep)
+            )
         return e
 
     # ------------------------------------------------------------------ constructors
     @classmethod
-    def from_bodies(cls, q, bodies: Sequence[dict], gravity=None, qd=None, **kwargs) -> "LagrangianSystem":
+    def from_bodies(cls, q, bodies: Sequence[dict], gravity=None, qd=None, **kwargs) -> LagrangianSystem:
         """Bodies given by expressions of the coordinates (Spong eqs. 9.41, 9.48):
 
         each body is a dict with ``mass``, ``position`` (centre of mass, 2 or 3 coordinates),
@@ -289,7 +322,10 @@ class LagrangianSystem:
             P = -self.L.subs({v: 0 for v in self.qd})
             g = sp.Matrix([simp(sp.diff(P, c)) for c in self.q])
             dM = [[[sp.diff(M[a, b], c) for c in self.q] for b in range(n)] for a in range(n)]
-            chris = [[[simp((dM[k][j][i] + dM[k][i][j] - dM[i][j][k]) / 2) for k in range(n)] for j in range(n)] for i in range(n)]
+            chris = [
+                [[simp((dM[k][j][i] + dM[k][i][j] - dM[i][j][k]) / 2) for k in range(n)] for j in range(n)]
+                for i in range(n)
+            ]
             C = sp.Matrix(n, n, lambda k, j: simp(sum(chris[i][j][k] * self.qd[i] for i in range(n))))
             K = simp((sp.Matrix(self.qd).T * M * sp.Matrix(self.qd))[0, 0] / 2)
             P = simp(P)
@@ -300,17 +336,39 @@ class LagrangianSystem:
             K, P = None, None
         steps = [
             Step("Lagrangian", "L = K - P" if self.K is not None else "given directly", [(lagrangian(), self.L)]),
-            Step("Euler-Lagrange equations d/dt dL/dqd_k - dL/dq_k = u_k - B_k - (A^T lambda)_k", "(LaValle eqs. 13.118, 13.181, 13.173)",
-                 [(name(f"E_{{{k + 1}}}", f"E_{k + 1}", "E", f"{k + 1}"), self._textbook(simp(e))) for k, e in enumerate(EL)]),
+            Step(
+                "Euler-Lagrange equations d/dt dL/dqd_k - dL/dq_k = u_k - B_k - (A^T lambda)_k",
+                "(LaValle eqs. 13.118, 13.181, 13.173)",
+                [
+                    (name(f"E_{{{k + 1}}}", f"E_{k + 1}", "E", f"{k + 1}"), self._textbook(simp(e)))
+                    for k, e in enumerate(EL)
+                ],
+            ),
         ]
         if self.A.shape[0]:
-            steps.append(Step("Constraints A(q) qd = 0", "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows", [(of_q("A"), self.A)]))
+            steps.append(
+                Step(
+                    "Constraints A(q) qd = 0",
+                    "holonomic constraints differentiated (LaValle 13.171) and Pfaffian rows",
+                    [(of_q("A"), self.A)],
+                )
+            )
         from .lagrange import latex_names
 
         eom = EquationsOfMotion(
-            self.q, self.qd, self.qdd, M, C, g,
-            K=K if natural else (lambda: None), P=P if natural else (lambda: None), friction=self.B,
-            christoffel=chris, steps=steps, name=self.name, method="lagrange",
+            self.q,
+            self.qd,
+            self.qdd,
+            M,
+            C,
+            g,
+            K=K if natural else (lambda: None),
+            P=P if natural else (lambda: None),
+            friction=self.B,
+            christoffel=chris,
+            steps=steps,
+            name=self.name,
+            method="lagrange",
             latex_names=latex_names(self.q, self.qd, self.qdd),
             extra=dict(A=self.A, multipliers=self.lam, forces=self.u, natural=natural, bias=h),
         )
@@ -327,8 +385,13 @@ class LagrangianSystem:
         simplified to textbook size (:func:`kinedyn.symbolic.simplify.textbook_form`) when called
         without ``M`` and ``bias`` (phase_space passes them and skips that)."""
         if M is None and bias is None:
-            return self._textbook(self.multipliers(u, sp.hessian(self.L, self.qd),
-                                                   sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()])))
+            return self._textbook(
+                self.multipliers(
+                    u,
+                    sp.hessian(self.L, self.qd),
+                    sp.Matrix([e.subs({a: 0 for a in self.qdd}) for e in self.euler_lagrange()]),
+                )
+            )
         if not self.A.shape[0]:
             return sp.zeros(0, 1)
         u = self.u if u is None else sp.Matrix(u)
@@ -373,7 +436,9 @@ class LagrangianSystem:
         """(p, H(q, p), qdot, pdot): p = dL/dqd, Hamilton's equations qdot = dH/dp, pdot = -dH/dq + u - B
         (natural systems; p = M qd)."""
         if not self.is_natural():
-            raise ValueError("hamiltonian(): the Legendre transform is formed here for natural systems (L = qd^T M qd / 2 - P)")
+            raise ValueError(
+                "hamiltonian(): the Legendre transform is formed here for natural systems (L = qd^T M qd / 2 - P)"
+            )
         p = sp.Matrix([sp.Symbol(f"p_{c.name}", real=True) for c in self.q])  # momentum conjugate to each q
         # M^-1 = adj(M) / det(M), each entry and the determinant simplified on their own: the quotient
         # p^T adj(M) p / (2 det M) is the textbook's form, and simplifying it whole (one fraction of
@@ -381,11 +446,15 @@ class LagrangianSystem:
         M = sp.hessian(self.L, self.qd).applyfunc(self._textbook)
         det = self._textbook(M.det())
         if det == 0:
-            raise ValueError("hamiltonian(): the inertia matrix d2L/dqd2 is singular (det = 0), so p = M qd cannot be inverted")
+            raise ValueError(
+                "hamiltonian(): the inertia matrix d2L/dqd2 is singular (det = 0), so p = M qd cannot be inverted"
+            )
         adj = M.adjugate().applyfunc(self._textbook)
         P = self._textbook(-self.L.subs({v: 0 for v in self.qd}))
         H = self._textbook(sp.expand((p.T * adj * p)[0, 0])) / (2 * det) + P  # H = p^T M^-1 p / 2 + P
-        qdot = sp.Matrix([self._textbook(sp.expand((adj[i, :] * p)[0, 0])) / det for i in range(self.n)])  # dH/dp = M^-1 p
+        qdot = sp.Matrix(
+            [self._textbook(sp.expand((adj[i, :] * p)[0, 0])) / det for i in range(self.n)]
+        )  # dH/dp = M^-1 p
         B = self.B.subs(dict(zip(self.qd, qdot)))
         pdot = sp.Matrix([-sp.diff(H, c) for c in self.q]) + self.u - B  # from the simplified H
         return p, H, qdot, pdot
@@ -414,25 +483,41 @@ class LagrangianSystem:
         free = set().union(*(m.free_symbols for m in parts)) - state
         missing = sorted(str(s) for s in free if str(s) not in values)
         if missing:
-            raise ValueError(f"{self.name or 'the Lagrangian system'}: give values for the parameters {missing} (params={{'name': value}})")
+            raise ValueError(
+                f"{self.name or 'the Lagrangian system'}: give values for the parameters {missing} (params={{'name': value}})"
+            )
         numbers = {s: values[str(s)] for s in free}
         parts = [m.xreplace(numbers) for m in parts]
         together = sp.lambdify([q, qd], parts, modules="numpy", cse=True)
 
         def terms(qv, qdv):
             M_, h_, A_, d_, p_ = together(qv, qdv)
-            return (np.asarray(M_, dtype=float).reshape(n, n), np.asarray(h_, dtype=float).reshape(n),
-                    np.asarray(A_, dtype=float).reshape(k, n), np.asarray(d_, dtype=float).reshape(k),
-                    np.asarray(p_, dtype=float).reshape(k_h) if k_h else None)
+            return (
+                np.asarray(M_, dtype=float).reshape(n, n),
+                np.asarray(h_, dtype=float).reshape(n),
+                np.asarray(A_, dtype=float).reshape(k, n),
+                np.asarray(d_, dtype=float).reshape(k),
+                np.asarray(p_, dtype=float).reshape(k_h) if k_h else None,
+            )
 
         zero = np.zeros(n)
         constraint: dict = {}
         if k:
-            constraint = dict(constraint_jacobian=lambda x: terms(x, zero)[2], constraint_drift=lambda x, v: terms(x, v)[3])
+            constraint = dict(
+                constraint_jacobian=lambda x: terms(x, zero)[2], constraint_drift=lambda x, v: terms(x, v)[3]
+            )
             if k_h:
                 constraint["constraint"] = lambda x: terms(x, zero)[4]
-        return MechanicalSystem(n=n, mass_matrix=lambda x: terms(x, zero)[0], bias=lambda x, v: terms(x, v)[1], terms=terms,
-                                names=tuple(c.name for c in q), name=self.name or "Lagrangian system", baumgarte=baumgarte, **constraint)
+        return MechanicalSystem(
+            n=n,
+            mass_matrix=lambda x: terms(x, zero)[0],
+            bias=lambda x, v: terms(x, v)[1],
+            terms=terms,
+            names=tuple(c.name for c in q),
+            name=self.name or "Lagrangian system",
+            baumgarte=baumgarte,
+            **constraint,
+        )
 
     def numeric_accelerations(self, params=None, u=None, baumgarte=None):
         """``accelerations(t, q, qd) -> (qdd, lambda)``: the constrained equations of motion solved
@@ -454,7 +539,9 @@ class LagrangianSystem:
         import numpy as np
 
         if self._has_time():
-            raise ValueError("numeric_accelerations() handles time-invariant Lagrangians and constraints; this system's L, B or constraints depend on t")
+            raise ValueError(
+                "numeric_accelerations() handles time-invariant Lagrangians and constraints; this system's L, B or constraints depend on t"
+            )
         values = {str(k): v for k, v in dict(params or {}).items()}
         alpha, beta = (0.0, 0.0) if baumgarte is None else baumgarte
         mech = self._kkt_system(values, (float(alpha), float(beta)))
@@ -516,7 +603,7 @@ class LagrangianSystem:
         fn = sp.lambdify([self.t, list(x)], list(f), "numpy")
         return lambda t, y: np.array(fn(t, y), dtype=float)
 
-    def change_coordinates(self, A, coordinates=None, name: str = "") -> "LagrangianSystem":
+    def change_coordinates(self, A, coordinates=None, name: str = "") -> LagrangianSystem:
         """The same system in coordinates p with q = A p (A constant, n x n, invertible; qd = A pd):
         L_p(p, pd) = L(A p, A pd); generalised forces and B map by A^T (virtual work:
         u . dq = (A^T u) . dp); holonomic constraints g_c(A p) and Pfaffian rows A_c(A p) A.
@@ -538,18 +625,28 @@ class LagrangianSystem:
         pd = [sp.Symbol(_rate_names(c.name)[0], real=True) for c in p]
         if len(p) != n:
             raise ValueError(f"coordinates must name {n} coordinates, got {len(p)}")
-        taken = {s.name for e in [self.L, *self.u, *self.B, *self.A] for s in sp.sympify(e).free_symbols} - {c.name for c in self.q + self.qd}
+        taken = {s.name for e in [self.L, *self.u, *self.B, *self.A] for s in sp.sympify(e).free_symbols} - {
+            c.name for c in self.q + self.qd
+        }
         clash = sorted({s.name for s in p + pd} & taken)
         if clash:
-            raise ValueError(f"the new coordinates' names {clash} are already symbols of the system: choose other names")
+            raise ValueError(
+                f"the new coordinates' names {clash} are already symbols of the system: choose other names"
+            )
         rep = {**dict(zip(self.q, A * sp.Matrix(p))), **dict(zip(self.qd, A * sp.Matrix(pd)))}
         pfaffian = None
         if self.A.shape[0] > len(self.holonomic):
-            pfaffian = self.A[len(self.holonomic):, :].xreplace(rep) * A
+            pfaffian = self.A[len(self.holonomic) :, :].xreplace(rep) * A
         return LagrangianSystem(
-            p, L=sp.expand(self.L.xreplace(rep)), qd=pd, t=self.t, forces=list(A.T * self.u.xreplace(rep)),
-            B=list(A.T * self.B.xreplace(rep)), holonomic=[sp.expand(e.xreplace(rep)) for e in self.holonomic] or None,
-            pfaffian=pfaffian, name=name or f"{self.name} in coordinates {', '.join(c.name for c in p)}",
+            p,
+            L=sp.expand(self.L.xreplace(rep)),
+            qd=pd,
+            t=self.t,
+            forces=list(A.T * self.u.xreplace(rep)),
+            B=list(A.T * self.B.xreplace(rep)),
+            holonomic=[sp.expand(e.xreplace(rep)) for e in self.holonomic] or None,
+            pfaffian=pfaffian,
+            name=name or f"{self.name} in coordinates {', '.join(c.name for c in p)}",
         )
 
     def check_properties(self, params=None, **kwargs):

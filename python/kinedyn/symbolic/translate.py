@@ -6,7 +6,8 @@ occurs many times becomes one node of the target graph (shared, not copied)."""
 
 from __future__ import annotations
 
-from typing import Any, Callable, Dict, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import sympy as sp
 
@@ -21,8 +22,10 @@ class Walker:
     ``sinh``, ``cosh``, ``tanh``, ``fmax``, ``fmin`` (missing ones raise an error naming the function when
     an expression needs them). Values must support ``+``, ``*``, ``/``, ``**``."""
 
-    def __init__(self, env: Mapping[sp.Symbol, Any], functions: Mapping[str, Callable], constant: Callable[[float], Any] = float):
-        self.env: Dict[sp.Basic, Any] = dict(env)
+    def __init__(
+        self, env: Mapping[sp.Symbol, Any], functions: Mapping[str, Callable], constant: Callable[[float], Any] = float
+    ):
+        self.env: dict[sp.Basic, Any] = dict(env)
         self.functions = dict(functions)
         self.constant = constant
 
@@ -63,7 +66,7 @@ class Walker:
             num, den = [], []
             for a in e.args:  # x * y**-1 as a division, the way a compiler writes it
                 if a.is_Pow and a.exp.is_Integer and a.exp < 0:
-                    den.append(self(a.base ** -a.exp))
+                    den.append(self(a.base**-a.exp))
                 else:
                     num.append(self(a))
             out = num[0] if num else self.constant(1.0)
@@ -83,12 +86,24 @@ class Walker:
                 b = self(base)
                 if k < 0:
                     return self.constant(1.0) / (b ** (-k) if k != -1 else b)
-                return b * b if k == 2 else b ** k
+                return b * b if k == 2 else b**k
             return self(base) ** self(ex)
         func = type(e)
-        simple = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.exp: "exp", sp.log: "log", sp.Abs: "fabs",
-                  sp.sign: "sign", sp.asin: "asin", sp.acos: "acos", sp.atan: "atan", sp.sinh: "sinh",
-                  sp.cosh: "cosh", sp.tanh: "tanh"}
+        simple = {
+            sp.sin: "sin",
+            sp.cos: "cos",
+            sp.tan: "tan",
+            sp.exp: "exp",
+            sp.log: "log",
+            sp.Abs: "fabs",
+            sp.sign: "sign",
+            sp.asin: "asin",
+            sp.acos: "acos",
+            sp.atan: "atan",
+            sp.sinh: "sinh",
+            sp.cosh: "cosh",
+            sp.tanh: "tanh",
+        }
         if func in simple:
             if len(e.args) != 1:
                 raise ValueError(f"cannot translate {e}: {simple[func]} with {len(e.args)} arguments")

@@ -21,10 +21,18 @@ def cmd_view(args) -> int:
 def add_view_command(subparsers) -> None:
     from ..cli import _state_args
 
-    p = subparsers.add_parser("view", help="open a live 3-D view of a robot in the browser (meshes, joint sliders); Ctrl-C stops it")
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)")
+    p = subparsers.add_parser(
+        "view", help="open a live 3-D view of a robot in the browser (meshes, joint sliders); Ctrl-C stops it"
+    )
+    p.add_argument(
+        "robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)"
+    )
     _state_args(p)
-    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only; over ssh use ssh -L PORT:localhost:PORT)")
+    p.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="address to listen on (default 127.0.0.1: this machine only; over ssh use ssh -L PORT:localhost:PORT)",
+    )
     p.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if it is taken)")
     p.add_argument("--collision", action="store_true", help="draw the collision shapes instead of the visual ones")
     p.add_argument("--no-wait", action="store_true", help="start the server, print its URL and stop (a check)")

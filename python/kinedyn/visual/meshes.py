@@ -14,7 +14,7 @@ import os
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, List, Optional, Tuple
+from typing import Any
 
 import numpy as np
 
@@ -28,13 +28,13 @@ MAX_MESH_TRIANGLES = 4_000_000  # ... and so is one with more triangles than thi
 class Part:
     vertices: np.ndarray  # (V, 3) float32, in the shape's frame [m]
     faces: np.ndarray  # (F, 3) int32, indices into vertices
-    rgba: Optional[Tuple[float, float, float, float]] = None
+    rgba: tuple[float, float, float, float] | None = None
 
     @property
     def triangles(self) -> int:
         return len(self.faces)
 
-    def transformed(self, T: np.ndarray, scale=(1.0, 1.0, 1.0)) -> "Part":
+    def transformed(self, T: np.ndarray, scale=(1.0, 1.0, 1.0)) -> Part:
         """The part scaled per axis, then moved by the 4x4 ``T``."""
         v = self.vertices.astype(np.float64) * np.asarray(scale, dtype=float)
         v = v @ np.asarray(T, dtype=float)[:3, :3].T + np.asarray(T, dtype=float)[:3, 3]
@@ -96,7 +96,7 @@ def sphere(radius: float, rings: int = 12, sections: int = 24) -> Part:
 
 
 # ------------------------------------------------------------------------------ mesh files
-def _colour(geometry) -> Optional[Tuple[float, float, float, float]]:
+def _colour(geometry) -> tuple[float, float, float, float] | None:
     """The main colour trimesh found for a mesh (material colour or face/vertex colours), or None."""
     visual = getattr(geometry, "visual", None)
     if visual is None:
@@ -118,7 +118,7 @@ def _colour(geometry) -> Optional[Tuple[float, float, float, float]]:
 
 
 @lru_cache(maxsize=256)
-def _read(path: str, mtime_ns: int, size: int) -> Tuple[Part, ...]:
+def _read(path: str, mtime_ns: int, size: int) -> tuple[Part, ...]:
     import trimesh
 
     loaded = trimesh.load(path, force="scene", process=False)
@@ -130,7 +130,9 @@ def _read(path: str, mtime_ns: int, size: int) -> Tuple[Part, ...]:
             continue
         total += len(m.faces)
         if total > MAX_MESH_TRIANGLES:
-            raise ValueError(f"mesh '{path}' has more than {MAX_MESH_TRIANGLES:,} triangles (kinedyn draws robots, not scans)")
+            raise ValueError(
+                f"mesh '{path}' has more than {MAX_MESH_TRIANGLES:,} triangles (kinedyn draws robots, not scans)"
+            )
         by_colour.setdefault(_colour(m), []).append(m)
     parts = []
     for rgba, group in by_colour.items():
@@ -147,7 +149,7 @@ def _read(path: str, mtime_ns: int, size: int) -> Tuple[Part, ...]:
     return tuple(parts)
 
 
-def read_mesh(path) -> List[Part]:
+def read_mesh(path) -> list[Part]:
     """The triangles of a mesh file, one :class:`Part` per colour (cached per file: path, size and
     modification time). ValueError naming the file for one too large, unreadable or empty."""
     path = Path(path)
@@ -156,7 +158,9 @@ def read_mesh(path) -> List[Part]:
     except OSError as e:
         raise ValueError(f"mesh '{path}': cannot read it ({e.strerror or e})") from None
     if st.st_size > MAX_MESH_BYTES:
-        raise ValueError(f"mesh '{path}' is {st.st_size / 2**20:.0f} MiB, more than the {MAX_MESH_BYTES // 2**20} MiB kinedyn reads")
+        raise ValueError(
+            f"mesh '{path}' is {st.st_size / 2**20:.0f} MiB, more than the {MAX_MESH_BYTES // 2**20} MiB kinedyn reads"
+        )
     try:
         import trimesh  # noqa: F401
     except ImportError:
@@ -189,7 +193,9 @@ def _decimated(part: Part, faces: int) -> Part:
         import fast_simplification
     except ImportError:
         return part
-    v, f = fast_simplification.simplify(part.vertices.astype(np.float32), part.faces.astype(np.int32), target_count=faces)
+    v, f = fast_simplification.simplify(
+        part.vertices.astype(np.float32), part.faces.astype(np.int32), target_count=faces
+    )
     out = Part(np.asarray(v, dtype=np.float32), np.asarray(f, dtype=np.int32), part.rgba)
     if len(_DECIMATED) > 1024:
         _DECIMATED.clear()

@@ -14,10 +14,8 @@ from the forward kinematics (``Robot.frame_poses``), so an animation sends poses
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
-from typing import List, Optional, Tuple
 
 import numpy as np
 
@@ -45,14 +43,14 @@ class ScenePart:
 
 @dataclass
 class Scene:
-    parts: List[ScenePart] = field(default_factory=list)
+    parts: list[ScenePart] = field(default_factory=list)
     shapes: int = 0  # visuals in the description (of the kind asked for)
     drawn: int = 0  # of those, how many are in ``parts`` (each may give several parts: one per colour)
-    missing: List[str] = field(default_factory=list)  # messages of the shapes left out
+    missing: list[str] = field(default_factory=list)  # messages of the shapes left out
     generated: bool = False  # solid link geometry made from the kinematics (no visuals described)
 
     @property
-    def frames(self) -> List[str]:
+    def frames(self) -> list[str]:
         return sorted({p.frame for p in self.parts})
 
     @property
@@ -60,7 +58,7 @@ class Scene:
         return sum(p.part.triangles for p in self.parts)
 
 
-def _shape_parts(visual: Visual) -> List[Part]:
+def _shape_parts(visual: Visual) -> list[Part]:
     s = visual.shape
     if isinstance(s, Mesh):
         parts = read_mesh(resolve_mesh(s.filename, s.base_dir))
@@ -82,7 +80,7 @@ def robot_scene(robot, geometry: str = "visual", budget: int = DEFAULT_BUDGET, s
     visuals = list(getattr(robot, "visuals" if geometry == "visual" else "collisions", ()) or ())
     frames = set(robot.frame_names)
     scene = Scene(shapes=len(visuals))
-    raw: List[Tuple[str, Part, int]] = []
+    raw: list[tuple[str, Part, int]] = []
     for k, v in enumerate(visuals):
         if v.frame not in frames:
             scene.missing.append(f"{v.describe()} of link '{v.frame}', which is not a frame of the robot")
@@ -96,7 +94,12 @@ def robot_scene(robot, geometry: str = "visual", budget: int = DEFAULT_BUDGET, s
             continue
         scene.drawn += 1
         for p in parts:
-            rgba = v.rgba if v.rgba is not None and (p.rgba is None or isinstance(v.shape, (Box, Cylinder, Sphere)) or _is_plain(p.rgba)) else p.rgba
+            rgba = (
+                v.rgba
+                if v.rgba is not None
+                and (p.rgba is None or isinstance(v.shape, (Box, Cylinder, Sphere)) or _is_plain(p.rgba))
+                else p.rgba
+            )
             raw.append((v.frame, Part(p.vertices, p.faces, rgba or DEFAULT_RGBA), k))
     if not visuals and solid_links:
         raw = [(f, p, -1) for f, p in solid_link_geometry(robot)]
@@ -110,7 +113,7 @@ def robot_scene(robot, geometry: str = "visual", budget: int = DEFAULT_BUDGET, s
     return scene
 
 
-def scene_bounds(robot, scene: Scene, q) -> Tuple[np.ndarray, np.ndarray]:
+def scene_bounds(robot, scene: Scene, q) -> tuple[np.ndarray, np.ndarray]:
     """(lo, hi): the box around the robot drawn at ``q`` (its shapes, frame origins and the base)."""
     poses = robot.frame_poses(np.asarray(q, dtype=float))
     by_name = dict(zip(robot.frame_names, poses))
@@ -126,7 +129,7 @@ def _is_plain(rgba) -> bool:
 
 
 # ------------------------------------------------------------------------------ solid links
-def _segment(start, end, radius: float) -> Optional[Part]:
+def _segment(start, end, radius: float) -> Part | None:
     """A cylinder from ``start`` to ``end`` (3-vectors) of ``radius``; None for a zero length."""
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     d = end - start
@@ -152,7 +155,7 @@ def _carriage(axis: np.ndarray, size: float) -> Part:
     return box((size, size, 1.4 * size)).transformed(T)
 
 
-def _split(p: np.ndarray, axis: np.ndarray, first: bool) -> List[np.ndarray]:
+def _split(p: np.ndarray, axis: np.ndarray, first: bool) -> list[np.ndarray]:
     """Corner points of the path to ``p``: along ``axis`` first (DH standard: d then a) or last
     (modified: a then d); the straight line when the split would not be a right angle."""
     along = float(p @ axis) * axis
@@ -162,18 +165,20 @@ def _split(p: np.ndarray, axis: np.ndarray, first: bool) -> List[np.ndarray]:
     return [corner, p]
 
 
-def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
+def solid_link_geometry(robot) -> list[tuple[str, Part]]:
     """Cylinders for a robot without visuals: one along each joint axis at the joint, and links from
     each body's joint to the joints and frames it carries (DH robots: along d, then a)."""
     tree = robot.tree
-    qs = np.vstack([robot.neutral(), robot.random_configuration(np.random.default_rng(1), size=32)])  # nq entries with multi-DOF joints
+    qs = np.vstack(
+        [robot.neutral(), robot.random_configuration(np.random.default_rng(1), size=32)]
+    )  # nq entries with multi-DOF joints
     reach = max(float(np.max(np.linalg.norm(robot.frame_poses(qs)[..., :3, 3], axis=-1))), 0.05)
     r = 0.03 * reach
-    out: List[Tuple[str, Part]] = []
+    out: list[tuple[str, Part]] = []
     standard = getattr(robot, "dh_convention", None) == "standard"
     modified = getattr(robot, "dh_convention", None) == "modified"
 
-    def body_pose_frame(b: int) -> Tuple[str, np.ndarray]:
+    def body_pose_frame(b: int) -> tuple[str, np.ndarray]:
         """(a frame name fixed to body b, body_from_that_frame) — the body's own link frame when it has one."""
         for f in tree.frames:
             if f.body == b:
@@ -194,7 +199,7 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
             frame, body_from_frame = body_pose_frame(owner)
             link_from_body = np.linalg.inv(body_from_frame)
             own_axis = np.asarray(tree.bodies[owner].joint.axis, dtype=float)
-        seen: List[np.ndarray] = []
+        seen: list[np.ndarray] = []
         for p, child in points:
             if np.linalg.norm(p) < 1e-9 or any(np.linalg.norm(p - s) < 1e-6 for s in seen):
                 continue
@@ -202,7 +207,9 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
             if standard and owner >= 0:
                 corners = _split(p, own_axis / np.linalg.norm(own_axis), first=True)
             elif modified and child is not None:
-                child_axis = np.asarray(tree.bodies[child].placement, dtype=float)[:3, :3] @ np.asarray(tree.bodies[child].joint.axis, dtype=float)
+                child_axis = np.asarray(tree.bodies[child].placement, dtype=float)[:3, :3] @ np.asarray(
+                    tree.bodies[child].joint.axis, dtype=float
+                )
                 corners = _split(p, child_axis / np.linalg.norm(child_axis), first=False)
             else:
                 corners = [p]
@@ -219,16 +226,23 @@ def solid_link_geometry(robot) -> List[Tuple[str, Part]]:
         frame, body_from_frame = body_pose_frame(i)
         axis = np.asarray(b.joint.axis, dtype=float)
         axis /= np.linalg.norm(axis)
-        part = _segment(-1.6 * r * axis, 1.6 * r * axis, 1.7 * r) if b.joint.kind == "revolute" else _carriage(axis, 2.2 * r)
+        part = (
+            _segment(-1.6 * r * axis, 1.6 * r * axis, 1.7 * r)
+            if b.joint.kind == "revolute"
+            else _carriage(axis, 2.2 * r)
+        )
         if part is not None:
             rgba = REVOLUTE_RGBA if b.joint.kind == "revolute" else PRISMATIC_RGBA
             out.append((frame, Part(part.vertices, part.faces, rgba).transformed(np.linalg.inv(body_from_frame))))
     # prismatic joints: a rail fixed to the parent along the joint's travel (its limits, or the
     # robot's reach), on which the joint's block slides
-    for i, b in enumerate(tree.bodies):
+    for b in tree.bodies:
         if b.joint.kind != "prismatic":
             continue
-        lo, hi = float(b.joint.lower), float(b.joint.upper)  # this body's joint (robot.lower_limits has no mimic followers)
+        lo, hi = (
+            float(b.joint.lower),
+            float(b.joint.upper),
+        )  # this body's joint (robot.lower_limits has no mimic followers)
         lo, hi = (lo if np.isfinite(lo) else -0.5 * reach), (hi if np.isfinite(hi) else 0.5 * reach)
         offset = float(b.joint.offset)
         placement = np.asarray(b.placement, dtype=float)

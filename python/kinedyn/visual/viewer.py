@@ -16,7 +16,7 @@ import math
 import sys
 import threading
 import time
-from typing import Any, List, Optional
+from typing import Any
 
 import numpy as np
 
@@ -73,8 +73,18 @@ class Viewer:
     next free port if ``port`` is busy). ``geometry``: "visual" or "collision" shapes. Attributes:
     ``url``, ``server`` (the viser server), ``q``. ``set_q(q)`` moves the robot, ``close()`` stops."""
 
-    def __init__(self, robot, q=None, *, trajectory=None, host: str = "127.0.0.1", port: int = 8080, geometry: str = "visual",
-                 budget: int = DEFAULT_BUDGET, verbose: bool = True):
+    def __init__(
+        self,
+        robot,
+        q=None,
+        *,
+        trajectory=None,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        geometry: str = "visual",
+        budget: int = DEFAULT_BUDGET,
+        verbose: bool = True,
+    ):
         try:
             import viser
         except ImportError:
@@ -105,7 +115,14 @@ class Viewer:
         scene.add_frame("/base_axes", axes_length=0.25 * reach, axes_radius=0.006 * reach)
         up = self._up()
         if abs(up[2]) > 0.99:  # a floor grid through the base, perpendicular to "up"
-            scene.add_grid("/grid", width=2.4 * reach, height=2.4 * reach, cell_size=reach / 5, section_size=reach, position=(0.0, 0.0, 0.0))
+            scene.add_grid(
+                "/grid",
+                width=2.4 * reach,
+                height=2.4 * reach,
+                cell_size=reach / 5,
+                section_size=reach,
+                position=(0.0, 0.0, 0.0),
+            )
         lo, hi = scene_bounds(robot, self.scene, self.q)  # look at the robot as it stands at q
         look = (lo + hi) / 2
         view_from = np.asarray(_view_direction(robot, self.q, up), dtype=float)
@@ -113,21 +130,33 @@ class Viewer:
         camera.look_at = tuple(look)
         camera.position = tuple(look + 0.95 * float(np.linalg.norm(hi - lo)) * view_from / np.linalg.norm(view_from))
         camera.up = tuple(up)
-        self._mesh_handles: List[Any] = []
+        self._mesh_handles: list[Any] = []
         for k, name in enumerate(self.scene.frames):
             self._frames[name] = scene.add_frame(f"/robot/f{k}", show_axes=False)
         for m, sp in enumerate(self.scene.parts):
             frame = self.scene.frames.index(sp.frame)
             rgba = sp.part.rgba or (0.7, 0.7, 0.7, 1.0)
-            self._mesh_handles.append(scene.add_mesh_simple(
-                f"/robot/f{frame}/mesh{m}", np.asarray(sp.part.vertices, dtype=np.float32), np.asarray(sp.part.faces, dtype=np.uint32),
-                color=np.round(255 * np.asarray(rgba[:3], dtype=float)).astype(np.uint8), opacity=None if rgba[3] >= 1 else float(rgba[3]), side="double"))
+            self._mesh_handles.append(
+                scene.add_mesh_simple(
+                    f"/robot/f{frame}/mesh{m}",
+                    np.asarray(sp.part.vertices, dtype=np.float32),
+                    np.asarray(sp.part.faces, dtype=np.uint32),
+                    color=np.round(255 * np.asarray(rgba[:3], dtype=float)).astype(np.uint8),
+                    opacity=None if rgba[3] >= 1 else float(rgba[3]),
+                    side="double",
+                )
+            )
         self._tool = scene.add_frame("/tool", axes_length=0.12 * reach, axes_radius=0.005 * reach)
-        self._stick = scene.add_line_segments("/stick", self._stick_points(self.q), (55, 71, 79), thickness=3.0, thickness_units="screen")
+        self._stick = scene.add_line_segments(
+            "/stick", self._stick_points(self.q), (55, 71, 79), thickness=3.0, thickness_units="screen"
+        )
         self._gui(robot)
         self.set_q(self.q)
         if verbose:
-            print(f"kinedyn viewer of '{robot.name}': {self.url}  (over ssh: ssh -L {self.server.get_port()}:localhost:{self.server.get_port()} HOST)", flush=True)
+            print(
+                f"kinedyn viewer of '{robot.name}': {self.url}  (over ssh: ssh -L {self.server.get_port()}:localhost:{self.server.get_port()} HOST)",
+                flush=True,
+            )
 
     # ------------------------------------------------------------------ drawing
     def _up(self) -> np.ndarray:
@@ -175,8 +204,8 @@ class Viewer:
     # ------------------------------------------------------------------ controls
     def _gui(self, robot) -> None:
         gui = self.server.gui
-        self._sliders: List[Any] = []
-        self._slider_coordinates: List[int] = []  # the entry of q each slider moves
+        self._sliders: list[Any] = []
+        self._slider_coordinates: list[int] = []  # the entry of q each slider moves
         self._quiet = False
         with gui.add_folder("Joints"):
             start = 0
@@ -203,8 +232,13 @@ class Viewer:
         if self.trajectory is not None:
             t = np.asarray(self.trajectory.t, dtype=float)
             with gui.add_folder("Playback"):
-                self._time = gui.add_slider("t [s]", min=float(t[0]), max=float(t[-1]), step=float((t[-1] - t[0]) / max(len(t) - 1, 1)) or 1.0,
-                                            initial_value=float(t[0]))
+                self._time = gui.add_slider(
+                    "t [s]",
+                    min=float(t[0]),
+                    max=float(t[-1]),
+                    step=float((t[-1] - t[0]) / max(len(t) - 1, 1)) or 1.0,
+                    initial_value=float(t[0]),
+                )
                 time_slider = self._time
                 time_slider.on_update(lambda _: None if self._quiet else self.show_time(time_slider.value))
                 play = gui.add_button("play / pause")
@@ -212,12 +246,14 @@ class Viewer:
 
     def _slider_moved(self, k: int, i: int):
         """Slider k moves q[i]."""
+
         def moved(_event) -> None:
             if self._quiet:
                 return
             q = self.q.copy()
             q[i] = float(self._sliders[k].value)
             self.set_q(q)
+
         return moved
 
     # ------------------------------------------------------------------ playback
@@ -272,7 +308,7 @@ class Viewer:
         self._playing = False
         self.server.stop()
 
-    def __enter__(self) -> "Viewer":
+    def __enter__(self) -> Viewer:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -285,11 +321,13 @@ class Viewer:
         import html
 
         url = html.escape(self.url)
-        return (f'<p>kinedyn viewer of {html.escape(self.robot.name)}: <a href="{url}" target="_blank">{url}</a></p>'
-                f'<iframe src="{url}" width="100%" height="520" style="border: 1px solid #ccc"></iframe>')
+        return (
+            f'<p>kinedyn viewer of {html.escape(self.robot.name)}: <a href="{url}" target="_blank">{url}</a></p>'
+            f'<iframe src="{url}" width="100%" height="520" style="border: 1px solid #ccc"></iframe>'
+        )
 
 
-def show(robot, q=None, *, trajectory=None, block: Optional[bool] = None, **kwargs) -> Viewer:
+def show(robot, q=None, *, trajectory=None, block: bool | None = None, **kwargs) -> Viewer:
     """Open the viewer (see :class:`Viewer`); ``block``: wait until Ctrl-C (default: yes from a
     script, no in Jupyter or an interactive session)."""
     viewer = Viewer(robot, q, trajectory=trajectory, **kwargs)

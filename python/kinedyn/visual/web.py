@@ -9,7 +9,6 @@ box, 7.6 micrometres on a 1 m link) and faces stored as 16-bit indices where a m
 from __future__ import annotations
 
 import base64
-from typing import List
 
 import numpy as np
 
@@ -20,7 +19,7 @@ __all__ = ["encode_scene", "PLOTLY_ELEMENT_ID", "plotly_script"]
 PLOTLY_ELEMENT_ID = "plotly-js"
 
 
-def encode_scene(scene: Scene) -> List[dict]:
+def encode_scene(scene: Scene) -> list[dict]:
     """The scene's parts as JSON-ready dicts: frame, visual, rgba, lo, step, vertices, faces, wide."""
     out = []
     for sp in scene.parts:
@@ -32,16 +31,18 @@ def encode_scene(scene: Scene) -> List[dict]:
         u = np.clip(np.round((v - lo) / step), 0, 65535).astype("<u2")
         wide = len(v) >= 65536
         faces = np.asarray(sp.part.faces).astype("<u4" if wide else "<u2")
-        out.append({
-            "frame": sp.frame,
-            "visual": sp.visual,
-            "rgba": [round(float(c), 4) for c in sp.part.rgba or (0.7, 0.7, 0.7, 1.0)],
-            "lo": [float(x) for x in lo],
-            "step": [float(x) for x in step],
-            "vertices": base64.b64encode(u.tobytes()).decode("ascii"),
-            "faces": base64.b64encode(faces.tobytes()).decode("ascii"),
-            "wide": wide,
-        })
+        out.append(
+            {
+                "frame": sp.frame,
+                "visual": sp.visual,
+                "rgba": [round(float(c), 4) for c in sp.part.rgba or (0.7, 0.7, 0.7, 1.0)],
+                "lo": [float(x) for x in lo],
+                "step": [float(x) for x in step],
+                "vertices": base64.b64encode(u.tobytes()).decode("ascii"),
+                "faces": base64.b64encode(faces.tobytes()).decode("ascii"),
+                "wide": wide,
+            }
+        )
     return out
 
 

@@ -17,17 +17,49 @@ fn body(mass: f64, c: [f64; 3], size: f64) -> Inertia {
 
 fn serial(placements: Vec<Transform>, inertias: Vec<Inertia>) -> Model {
     let n = placements.len();
-    let joints = vec![Joint { kind: JointKind::Revolute, axis: Vec3::z() }; n];
+    let joints = vec![
+        Joint {
+            kind: JointKind::Revolute,
+            axis: Vec3::z()
+        };
+        n
+    ];
     let parent = (0..n).map(|i| i.checked_sub(1)).collect();
     let z = vec![0.0; n];
-    Model::new(parent, joints, z.clone(), placements, inertias, z.clone(), z.clone(), z, Vec3::new(0.0, 0.0, -9.81), vec![]).unwrap()
+    Model::new(
+        parent,
+        joints,
+        z.clone(),
+        placements,
+        inertias,
+        z.clone(),
+        z.clone(),
+        z,
+        Vec3::new(0.0, 0.0, -9.81),
+        vec![],
+    )
+    .unwrap()
 }
 
 /// UR5, standard DH `(d, a, alpha)`: body i = joint frame i; placement_i = Tx(a_{i-1}) Rx(alpha_{i-1}) Tz(d_i).
 pub fn ur5() -> Model {
-    let dh = [(0.089159, 0.0, FRAC_PI_2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0), (0.10915, 0.0, FRAC_PI_2), (0.09465, 0.0, -FRAC_PI_2), (0.0823, 0.0, 0.0)];
+    let dh = [
+        (0.089159, 0.0, FRAC_PI_2),
+        (0.0, -0.425, 0.0),
+        (0.0, -0.39225, 0.0),
+        (0.10915, 0.0, FRAC_PI_2),
+        (0.09465, 0.0, -FRAC_PI_2),
+        (0.0823, 0.0, 0.0),
+    ];
     let masses = [3.7, 8.393, 2.275, 1.219, 1.219, 0.1879];
-    let coms = [[0.0, -0.02561, 0.00193], [0.2125, 0.0, 0.11336], [0.15, 0.0, 0.0265], [0.0, -0.0018, 0.01634], [0.0, 0.0018, 0.01634], [0.0, 0.0, -0.001159]];
+    let coms = [
+        [0.0, -0.02561, 0.00193],
+        [0.2125, 0.0, 0.11336],
+        [0.15, 0.0, 0.0265],
+        [0.0, -0.0018, 0.01634],
+        [0.0, 0.0018, 0.01634],
+        [0.0, 0.0, -0.001159],
+    ];
     let mut previous = Transform::identity();
     let mut placements = Vec::new();
     for &(d, a, alpha) in &dh {
@@ -35,21 +67,46 @@ pub fn ur5() -> Model {
         previous = Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0));
     }
     // centres of mass are given in the DH link frames: move them into the joint (body) frames
-    let inertias = (0..6).map(|i| dh_link_to_body(&dh[i], body(masses[i], coms[i], 0.1))).collect();
+    let inertias = (0..6)
+        .map(|i| dh_link_to_body(&dh[i], body(masses[i], coms[i], 0.1)))
+        .collect();
     serial(placements, inertias)
 }
 
 fn dh_link_to_body(&(d, a, alpha): &(f64, f64, f64), link: Inertia) -> Inertia {
-    let body_from_link = Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d)) * Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0));
+    let body_from_link = Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d))
+        * Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0));
     body_from_link.act_inertia(&link)
 }
 
 /// Panda, modified DH `(a, d, alpha)`: placement_i = Rx(alpha_i) Tx(a_i) Tz(d_i), joint about z.
 pub fn panda() -> Model {
-    let dh = [(0.0, 0.333, 0.0), (0.0, 0.0, -FRAC_PI_2), (0.0, 0.316, FRAC_PI_2), (0.0825, 0.0, FRAC_PI_2), (-0.0825, 0.384, -FRAC_PI_2), (0.0, 0.0, FRAC_PI_2), (0.088, 0.0, FRAC_PI_2)];
+    let dh = [
+        (0.0, 0.333, 0.0),
+        (0.0, 0.0, -FRAC_PI_2),
+        (0.0, 0.316, FRAC_PI_2),
+        (0.0825, 0.0, FRAC_PI_2),
+        (-0.0825, 0.384, -FRAC_PI_2),
+        (0.0, 0.0, FRAC_PI_2),
+        (0.088, 0.0, FRAC_PI_2),
+    ];
     let masses = [4.97, 0.646, 3.228, 3.587, 1.225, 1.666, 0.735];
-    let coms = [[0.0035, 0.0029, -0.0762], [-0.0032, -0.0714, 0.0042], [0.0275, 0.0392, -0.0665], [-0.0532, 0.1047, 0.0274], [-0.0119, 0.0413, -0.0383], [0.0601, -0.0141, -0.0104], [0.0105, -0.0043, 0.0616]];
-    let placements = dh.iter().map(|&(a, d, alpha)| Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0)) * Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d))).collect();
+    let coms = [
+        [0.0035, 0.0029, -0.0762],
+        [-0.0032, -0.0714, 0.0042],
+        [0.0275, 0.0392, -0.0665],
+        [-0.0532, 0.1047, 0.0274],
+        [-0.0119, 0.0413, -0.0383],
+        [0.0601, -0.0141, -0.0104],
+        [0.0105, -0.0043, 0.0616],
+    ];
+    let placements = dh
+        .iter()
+        .map(|&(a, d, alpha)| {
+            Transform::new(axis_angle(&Vec3::x(), alpha), Vec3::new(a, 0.0, 0.0))
+                * Transform::new(Mat3::identity(), Vec3::new(0.0, 0.0, d))
+        })
+        .collect();
     let inertias = (0..7).map(|i| body(masses[i], coms[i], 0.12)).collect();
     serial(placements, inertias)
 }
@@ -82,7 +139,14 @@ pub struct TreeFile {
 
 #[allow(dead_code)]
 fn parse_numbers(path: &str, line: &str, words: &mut std::str::SplitWhitespace, count: usize) -> Vec<f64> {
-    let out: Vec<f64> = words.by_ref().take(count).map(|w| w.parse().unwrap_or_else(|e| panic!("{path}: '{w}' in '{line:.40}...': {e}"))).collect();
+    let out: Vec<f64> = words
+        .by_ref()
+        .take(count)
+        .map(|w| {
+            w.parse()
+                .unwrap_or_else(|e| panic!("{path}: '{w}' in '{line:.40}...': {e}"))
+        })
+        .collect();
     assert_eq!(out.len(), count, "{path}: too few numbers in '{line:.40}...'");
     out
 }
@@ -97,7 +161,10 @@ pub fn read_tree(path: &str) -> TreeFile {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
     let mut lines = text.lines();
     let mut next = |key: &str| -> (String, Vec<String>) {
-        let line = lines.next().unwrap_or_else(|| panic!("{path}: ends before its '{key}' line")).to_string();
+        let line = lines
+            .next()
+            .unwrap_or_else(|| panic!("{path}: ends before its '{key}' line"))
+            .to_string();
         let mut words = line.split_whitespace();
         let got = words.next().unwrap_or("");
         assert_eq!(got, key, "{path}: expected a '{key}' line");
@@ -108,7 +175,8 @@ pub fn read_tree(path: &str) -> TreeFile {
     let sizes: Vec<usize> = next("sizes").1.iter().map(|w| w.parse().unwrap()).collect();
     let (nq, nv, nbodies) = (sizes[0], sizes[1], sizes[2]);
     let g: Vec<f64> = next("gravity").1.iter().map(|w| w.parse().unwrap()).collect();
-    let (mut parent, mut joints, mut placements, mut inertias, mut coordinates) = (vec![], vec![], vec![], vec![], vec![]);
+    let (mut parent, mut joints, mut placements, mut inertias, mut coordinates) =
+        (vec![], vec![], vec![], vec![], vec![]);
     let mut last_of_body: Vec<usize> = vec![];
     let mut at = 0usize;
     for b in 0..nbodies {
@@ -130,17 +198,30 @@ pub fn read_tree(path: &str) -> TreeFile {
         match kind.as_str() {
             "free" => {
                 for k in 0..6 {
-                    let column = Joint { kind: if k < 3 { Prismatic } else { Revolute }, axis: Vec3::ith(k % 3, 1.0) };
+                    let column = Joint {
+                        kind: if k < 3 { Prismatic } else { Revolute },
+                        axis: Vec3::ith(k % 3, 1.0),
+                    };
                     joints.push(column);
                     parent.push(if k == 0 { parent_body } else { Some(first + k - 1) });
                     placements.push(if k == 0 { placement } else { Transform::identity() });
                     inertias.push(if k == 5 { inertia } else { Inertia::zero() });
-                    coordinates.push(if k == 0 { Coordinates::Head { block: Block::FreeFlyer, at } } else { Coordinates::Member });
+                    coordinates.push(if k == 0 {
+                        Coordinates::Head {
+                            block: Block::FreeFlyer,
+                            at,
+                        }
+                    } else {
+                        Coordinates::Member
+                    });
                 }
                 at += 7;
             }
             "revolute" | "prismatic" => {
-                joints.push(Joint { kind: if kind == "revolute" { Revolute } else { Prismatic }, axis });
+                joints.push(Joint {
+                    kind: if kind == "revolute" { Revolute } else { Prismatic },
+                    axis,
+                });
                 parent.push(parent_body);
                 placements.push(placement);
                 inertias.push(inertia);
@@ -152,11 +233,26 @@ pub fn read_tree(path: &str) -> TreeFile {
         last_of_body.push(parent.len() - 1);
     }
     let n = parent.len();
-    assert_eq!((at, n), (nq, nv), "{path}: built nq, nv = {at}, {n}, the file says {nq}, {nv}");
+    assert_eq!(
+        (at, n),
+        (nq, nv),
+        "{path}: built nq, nv = {at}, {n}, the file says {nq}, {nv}"
+    );
     let z = vec![0.0; n];
-    let model = Model::new(parent, joints, z.clone(), placements, inertias, z.clone(), z.clone(), z, Vec3::new(g[0], g[1], g[2]), vec![])
-        .and_then(|m| m.with_coordinates(coordinates))
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    let model = Model::new(
+        parent,
+        joints,
+        z.clone(),
+        placements,
+        inertias,
+        z.clone(),
+        z.clone(),
+        z,
+        Vec3::new(g[0], g[1], g[2]),
+        vec![],
+    )
+    .and_then(|m| m.with_coordinates(coordinates))
+    .unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut vector = |key: &str, len: usize| -> Vec<f64> {
         let (line, words) = next(key);
         let joined = words.join(" ");
@@ -164,5 +260,12 @@ pub fn read_tree(path: &str) -> TreeFile {
     };
     let (q, v, a) = (vector("q", nq), vector("v", nv), vector("a", nv));
     let expect_rnea = vector("expect_rnea", nv);
-    TreeFile { name, model, q, v, a, expect_rnea }
+    TreeFile {
+        name,
+        model,
+        q,
+        v,
+        a,
+        expect_rnea,
+    }
 }

@@ -32,7 +32,14 @@ const HUGE_TRACE: f64 = 1e200;
 
 /// `qdd = aba(q, qd, tau, f_ext)` written to `data.qdd`; `f_ext` as in [`super::rnea::rnea`].
 #[inline(always)]
-pub fn aba<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], tau: &[T], f_ext: Option<&[T]>) -> Result<&'d [T]> {
+pub fn aba<'d, T: Real>(
+    model: &Model,
+    data: &'d mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    tau: &[T],
+    f_ext: Option<&[T]>,
+) -> Result<&'d [T]> {
     let n = model.n;
     if f_ext.is_some() {
         forward_kinematics(model, data, q);
@@ -58,7 +65,10 @@ pub fn aba<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T],
         let mut pa = v.cross_force(&inertia.mul_motion(&v));
         if let Some(fx) = f_ext {
             let r = &data.world_from_body[i].rot;
-            let fw = Force::new(Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+            let fw = Force::new(
+                Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
+                Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
+            );
             pa -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
         }
         data.pa[i] = pa;

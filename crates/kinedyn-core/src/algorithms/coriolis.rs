@@ -135,7 +135,11 @@ pub fn christoffel<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], out: &mu
     for i in 0..n {
         // qd = e_i: v_k = s_i for the bodies k that joint i supports, 0 elsewhere
         for k in 0..n {
-            data.v_w[k] = if model.support[k].binary_search(&i).is_ok() { data.s_w[i] } else { Motion::zero() };
+            data.v_w[k] = if model.support[k].binary_search(&i).is_ok() {
+                data.s_w[i]
+            } else {
+                Motion::zero()
+            };
         }
         // out[i][j][k] = C[k][j]: row stride 1, column stride n within block i
         coriolis_from_world(model, data, &mut out[i * n * n..(i + 1) * n * n], 1, n);

@@ -38,7 +38,12 @@ pub fn crba<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T]) -> &'d [
 fn crba_blocks<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     let n = model.n;
     joint_trig(model, data, q);
-    let (parent, joints, armature, end) = (&model.parent[..n], &model.joints[..n], &model.armature[..n], &model.subtree_end[..n]);
+    let (parent, joints, armature, end) = (
+        &model.parent[..n],
+        &model.joints[..n],
+        &model.armature[..n],
+        &model.subtree_end[..n],
+    );
     let (ic, m, f) = (&mut data.ic[..n], &mut data.m[..n * n], &mut data.f[..n]);
     let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
     // I^c_i = I_i ;  H_rr = 0 for the roots r (their children add to it, see below)
@@ -174,9 +179,24 @@ mod tests {
     /// as the general one, on random models (half their axes and placements qualify) and a DH arm.
     #[test]
     fn coordinate_axis_fast_path_equals_general_transform() {
-        let models = [random_model(11, 8, false), random_model(12, 9, true), dh_model(&UR5_DH, 3)];
-        let fast_paths: usize = models.iter().map(|m| m.placement_rotation.iter().filter(|r| !matches!(r, AxisRotation::General)).count()).sum();
-        assert!(fast_paths >= 8, "the models exercise the fast path ({fast_paths} placements)");
+        let models = [
+            random_model(11, 8, false),
+            random_model(12, 9, true),
+            dh_model(&UR5_DH, 3),
+        ];
+        let fast_paths: usize = models
+            .iter()
+            .map(|m| {
+                m.placement_rotation
+                    .iter()
+                    .filter(|r| !matches!(r, AxisRotation::General))
+                    .count()
+            })
+            .sum();
+        assert!(
+            fast_paths >= 8,
+            "the models exercise the fast path ({fast_paths} placements)"
+        );
         for model in models {
             let mut general = model.clone();
             general.placement_rotation.fill(AxisRotation::General);
@@ -195,7 +215,17 @@ mod tests {
     #[test]
     fn blocks_equal_chains() {
         let tree = random_model(7, 9, false);
-        let parent = vec![None, Some(0), Some(1), Some(1), Some(3), Some(0), Some(5), Some(5), Some(0)];
+        let parent = vec![
+            None,
+            Some(0),
+            Some(1),
+            Some(1),
+            Some(3),
+            Some(0),
+            Some(5),
+            Some(5),
+            Some(0),
+        ];
         let tree = Model::new(
             parent,
             tree.joints.clone(),

@@ -99,8 +99,20 @@ fn mass_matrix_from_world<T: Real>(model: &Model, data: &Data<T>, m: &mut [T]) {
 /// derivation, about 2.5 times slower, kept as the reference the world-coordinate form is tested
 /// against (and for anyone who wants to cross-check a result).
 #[allow(clippy::too_many_arguments)]
-pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], f_ext: Option<&[f64]>, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
-    assert!(model.plain, "the tangent-sweep derivatives are written for 1-DOF joints; use rnea_derivatives");
+pub fn rnea_derivatives_tangent(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    f_ext: Option<&[f64]>,
+    dtau_dq: &mut [f64],
+    dtau_dqd: &mut [f64],
+) {
+    assert!(
+        model.plain,
+        "the tangent-sweep derivatives are written for 1-DOF joints; use rnea_derivatives"
+    );
     // the RNEA's own pass: parent_from_body, v_i, a_i and the composite forces f^c_i in data.f
     // (and world_from_body when f_ext is given)
     rnea(model, data, q, qd, qdd, f_ext);
@@ -141,7 +153,16 @@ pub fn rnea_derivatives_tangent(model: &Model, data: &mut Data, q: &[f64], qd: &
 /// subtree k, to `dF_k/dq_j` (Jacobi: `w x (p x f) - (w x p) x f = p x (w x f)`).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn rnea_derivatives_world<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>, dtau_dq: &mut [T], dtau_dqd: &mut [T]) {
+fn rnea_derivatives_world<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    f_ext: Option<&[T]>,
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
+) {
     world_pass(model, data, q, qd, Some(qdd), f_ext);
     world_derivatives(model, data, f_ext.is_some(), dtau_dq, dtau_dqd);
 }
@@ -154,8 +175,18 @@ fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd
     forward_kinematics(model, data, q);
     let a0 = Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros());
     let parent = &model.parent[..n];
-    let (s_w, v_w, a_w, i_w) = (&mut data.s_w[..n], &mut data.v_w[..n], &mut data.a_w[..n], &mut data.i_w[..n]);
-    let (ic, icd, hc, fc) = (&mut data.ic_w[..n], &mut data.icd_w[..n], &mut data.hc_w[..n], &mut data.fc_w[..n]);
+    let (s_w, v_w, a_w, i_w) = (
+        &mut data.s_w[..n],
+        &mut data.v_w[..n],
+        &mut data.a_w[..n],
+        &mut data.i_w[..n],
+    );
+    let (ic, icd, hc, fc) = (
+        &mut data.ic_w[..n],
+        &mut data.icd_w[..n],
+        &mut data.hc_w[..n],
+        &mut data.fc_w[..n],
+    );
     // forward, world coordinates: S_i, v_i = v_p + S_i qd_i, a_i = a_p + S_i qdd_i + (v_p x S_i) qd_i,
     // I_i, dI_i/dt, h_i = I_i v_i, f_i = I_i a_i + v_i x* h_i
     for i in 0..n {
@@ -165,7 +196,11 @@ fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd
         let v = vp + s * qd[i];
         // the velocity product of a multi-DOF joint's column is v_λ x s with λ the joint's parent
         // (summed over the joint: v_λ x v_J = v_child x v_J), not the partial twist of the body before
-        let v_lambda = if model.plain { vp } else { parent[model.group_first[i]].map_or(Motion::zero(), |p| v_w[p]) };
+        let v_lambda = if model.plain {
+            vp
+        } else {
+            parent[model.group_first[i]].map_or(Motion::zero(), |p| v_w[p])
+        };
         let mut a = ap + v_lambda.cross_motion(&s) * qd[i];
         if let Some(qdd) = qdd {
             a += s * qdd[i];
@@ -173,10 +208,18 @@ fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd
         let inertia = x.act_inertia(&model.inertia[i].splat());
         let h = inertia.mul_motion(&v);
         (s_w[i], v_w[i], a_w[i], i_w[i]) = (s, v, a, inertia);
-        (ic[i], icd[i], hc[i], fc[i]) = (inertia, inertia_rate(&inertia, &v), h, inertia.mul_motion(&a) + v.cross_force(&h));
+        (ic[i], icd[i], hc[i], fc[i]) = (
+            inertia,
+            inertia_rate(&inertia, &v),
+            h,
+            inertia.mul_motion(&a) + v.cross_force(&h),
+        );
         if let Some(fx) = f_ext {
             // the wrench about the world origin, and its parts for the composite sums E_k
-            let (f, m) = (Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+            let (f, m) = (
+                Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
+                Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
+            );
             let p = x.trans;
             fc[i] -= Force::new(f, m + cross(&p, &f));
             (data.ext_f[i], data.ext_n[i], data.ext_p[i]) = (f, m, outer(&f, &p));
@@ -200,7 +243,11 @@ fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd
     }
     let (alpha, beta, sigma) = (&mut data.alpha[..n], &mut data.beta[..n], &mut data.sigma[..n]);
     for k in 0..n {
-        (alpha[k], beta[k], sigma[k]) = (ic[k].mul_motion(&s_w[k]), icd[k].mul_motion(&s_w[k]), s_w[k].cross_force(&hc[k]));
+        (alpha[k], beta[k], sigma[k]) = (
+            ic[k].mul_motion(&s_w[k]),
+            icd[k].mul_motion(&s_w[k]),
+            s_w[k].cross_force(&hc[k]),
+        );
     }
 }
 
@@ -253,7 +300,11 @@ fn world_derivatives<T: Real>(model: &Model, data: &Data<T>, wrenches: bool, dta
         let (vp, ap) = parent[head].map_or((Motion::zero(), a0), |p| (v_w[p], a_w[p]));
         let u = s.cross_motion(&vp);
         let w = u.cross_motion(&vp) - s.cross_motion(&ap);
-        let sdot = if head == j && model.group_last[j] == j { vp.cross_motion(&s) } else { (vp + v_w[model.group_last[j]]).cross_motion(&s) * T::splat(0.5) };
+        let sdot = if head == j && model.group_last[j] == j {
+            vp.cross_motion(&s)
+        } else {
+            (vp + v_w[model.group_last[j]]).cross_motion(&s) * T::splat(0.5)
+        };
         // the subtree of j: three dot products per entry
         for k in head..n {
             if k != head && model.support[k].binary_search(&head).is_err() {
@@ -286,11 +337,31 @@ fn world_derivatives<T: Real>(model: &Model, data: &Data<T>, wrenches: bool, dta
 
 /// Columns j of `dtau/dq` and `dtau/dqd`: the two tangent sweeps along q_j and qd_j, side by side
 /// (see the module documentation for each line).
-fn tangent_sweeps(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f64]>, j: usize, dtau_dq: &mut [f64], dtau_dqd: &mut [f64]) {
+fn tangent_sweeps(
+    model: &Model,
+    data: &mut Data,
+    qd: &[f64],
+    f_ext: Option<&[f64]>,
+    j: usize,
+    dtau_dq: &mut [f64],
+    dtau_dqd: &mut [f64],
+) {
     let n = model.n;
     let a0 = Motion::new(-model.gravity, Default::default());
-    let (x_up, s, v, a, fc, iv) = (&data.parent_from_body[..n], &data.s[..n], &data.v[..n], &data.a[..n], &data.f[..n], &data.iv[..n]);
-    let (tq, tqd, psi, moved) = (&mut data.tangent_q[..n], &mut data.tangent_qd[..n], &mut data.dpsi[..n], &mut data.moved[..n]);
+    let (x_up, s, v, a, fc, iv) = (
+        &data.parent_from_body[..n],
+        &data.s[..n],
+        &data.v[..n],
+        &data.a[..n],
+        &data.f[..n],
+        &data.iv[..n],
+    );
+    let (tq, tqd, psi, moved) = (
+        &mut data.tangent_q[..n],
+        &mut data.tangent_qd[..n],
+        &mut data.dpsi[..n],
+        &mut data.moved[..n],
+    );
     // forward: only the subtree of j moves with coordinate j (every other tangent is zero)
     tq.fill(Tangent::default());
     tqd.fill(Tangent::default());
@@ -307,16 +378,36 @@ fn tangent_sweeps(model: &Model, data: &mut Data, qd: &[f64], f_ext: Option<&[f6
             // along q_j: (^iX_λ v_λ) x s_i, (^iX_λ a_λ) x s_i ;  along qd_j: s_i, v_i x s_i
             let vp = p.map_or(Motion::zero(), |p| x.inv_act_motion(&v[p]));
             let ap = x.inv_act_motion(&p.map_or(a0, |p| a[p]));
-            q_i = Tangent { dv: vp.cross_motion(&s[i]), da: ap.cross_motion(&s[i]), dfc: Force::zero() };
-            qd_i = Tangent { dv: s[i], da: v[i].cross_motion(&s[i]), dfc: Force::zero() };
+            q_i = Tangent {
+                dv: vp.cross_motion(&s[i]),
+                da: ap.cross_motion(&s[i]),
+                dfc: Force::zero(),
+            };
+            qd_i = Tangent {
+                dv: s[i],
+                da: v[i].cross_motion(&s[i]),
+                dfc: Force::zero(),
+            };
             psi_i = s[i];
         } else {
             let p = p.expect("a moved body below j has a parent");
             let (tp, tdp) = (&tq[p], &tqd[p]);
-            q_i = Tangent { dv: x.inv_act_motion(&tp.dv), da: x.inv_act_motion(&tp.da), dfc: Force::zero() };
-            qd_i = Tangent { dv: x.inv_act_motion(&tdp.dv), da: x.inv_act_motion(&tdp.da), dfc: Force::zero() };
+            q_i = Tangent {
+                dv: x.inv_act_motion(&tp.dv),
+                da: x.inv_act_motion(&tp.da),
+                dfc: Force::zero(),
+            };
+            qd_i = Tangent {
+                dv: x.inv_act_motion(&tdp.dv),
+                da: x.inv_act_motion(&tdp.da),
+                dfc: Force::zero(),
+            };
             // psi (the moved axis in body axes) is needed only for the external wrenches
-            psi_i = if f_ext.is_some() { x.inv_act_motion(&psi[p]) } else { Motion::zero() };
+            psi_i = if f_ext.is_some() {
+                x.inv_act_motion(&psi[p])
+            } else {
+                Motion::zero()
+            };
         }
         for t in [&mut q_i, &mut qd_i] {
             // da += dv_i x s_i qd_i ;  df_i = I da + dv x* I v + v x* I dv
@@ -425,7 +516,11 @@ mod tests {
     #[test]
     fn derivatives_equal_forward_mode_dual_numbers() {
         use crate::testing::{random_configuration, random_floating_model, Dual};
-        let models = [random_model(31, 7, false), random_model(32, 8, true), random_floating_model(33, 5, false)];
+        let models = [
+            random_model(31, 7, false),
+            random_model(32, 8, true),
+            random_floating_model(33, 5, false),
+        ];
         for model in models {
             let n = model.n;
             let mut rng = Rng::new(5);
@@ -437,26 +532,69 @@ mod tests {
             rnea_derivatives(&model, &mut data, &q, &qd, &qdd, Some(&fx), &mut dq, &mut dqd, None);
             let tau = crate::algorithms::rnea(&model, &mut data, &q, &qd, &qdd, Some(&fx)).to_vec();
             let (mut fq, mut fqd, mut minv) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-            aba_derivatives(&model, &mut data, &q, &qd, &tau, Some(&fx), &mut fq, &mut fqd, &mut minv).unwrap();
+            aba_derivatives(
+                &model,
+                &mut data,
+                &q,
+                &qd,
+                &tau,
+                Some(&fx),
+                &mut fq,
+                &mut fqd,
+                &mut minv,
+            )
+            .unwrap();
             let mut dual = Data::<Dual>::new(&model);
             let fx_d = Dual::seeded(&fx, None);
             let column = |m: &[f64], j: usize| -> Vec<f64> { (0..n).map(|i| m[i * n + j]).collect() };
             for j in 0..n {
                 // rates: qd_j seeded
-                let (qv, qdv, qddv, tauv) = (Dual::seeded(&q, None), Dual::seeded(&qd, Some(j)), Dual::seeded(&qdd, None), Dual::seeded(&tau, None));
-                let t: Vec<f64> = crate::algorithms::rnea(&model, &mut dual, &qv, &qdv, &qddv, Some(&fx_d)).iter().map(|d| d.eps).collect();
+                let (qv, qdv, qddv, tauv) = (
+                    Dual::seeded(&q, None),
+                    Dual::seeded(&qd, Some(j)),
+                    Dual::seeded(&qdd, None),
+                    Dual::seeded(&tau, None),
+                );
+                let t: Vec<f64> = crate::algorithms::rnea(&model, &mut dual, &qv, &qdv, &qddv, Some(&fx_d))
+                    .iter()
+                    .map(|d| d.eps)
+                    .collect();
                 dual_close("dtau/dqd (dual)", &t, &column(&dqd, j));
-                let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &qdv, &tauv, Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &qdv, &tauv, Some(&fx_d))
+                    .unwrap()
+                    .iter()
+                    .map(|d| d.eps)
+                    .collect();
                 dual_close("dqdd/dqd (dual)", &a, &column(&fqd, j));
                 // torques: tau_j seeded
-                let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &Dual::seeded(&tau, Some(j)), Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                let a: Vec<f64> = crate::algorithms::aba(
+                    &model,
+                    &mut dual,
+                    &qv,
+                    &Dual::seeded(&qd, None),
+                    &Dual::seeded(&tau, Some(j)),
+                    Some(&fx_d),
+                )
+                .unwrap()
+                .iter()
+                .map(|d| d.eps)
+                .collect();
                 dual_close("dqdd/dtau (dual)", &a, &column(&minv, j));
                 if model.plain {
                     // configurations: q_j seeded (1-DOF joints: the coordinate itself)
                     let qv = Dual::seeded(&q, Some(j));
-                    let t: Vec<f64> = crate::algorithms::rnea(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &qddv, Some(&fx_d)).iter().map(|d| d.eps).collect();
+                    let t: Vec<f64> =
+                        crate::algorithms::rnea(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &qddv, Some(&fx_d))
+                            .iter()
+                            .map(|d| d.eps)
+                            .collect();
                     dual_close("dtau/dq (dual)", &t, &column(&dq, j));
-                    let a: Vec<f64> = crate::algorithms::aba(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &tauv, Some(&fx_d)).unwrap().iter().map(|d| d.eps).collect();
+                    let a: Vec<f64> =
+                        crate::algorithms::aba(&model, &mut dual, &qv, &Dual::seeded(&qd, None), &tauv, Some(&fx_d))
+                            .unwrap()
+                            .iter()
+                            .map(|d| d.eps)
+                            .collect();
                     dual_close("dqdd/dq (dual)", &a, &column(&fq, j));
                 }
             }
@@ -490,7 +628,10 @@ mod tests {
     fn assert_close(what: &str, got: &[f64], expected: &[f64]) {
         let scale = expected.iter().fold(1.0f64, |s, x| s.max(x.abs()));
         for (k, (g, e)) in got.iter().zip(expected).enumerate() {
-            assert!((g - e).abs() <= 1e-6 * scale, "{what}[{k}]: {g} vs finite difference {e}");
+            assert!(
+                (g - e).abs() <= 1e-6 * scale,
+                "{what}[{k}]: {g} vs finite difference {e}"
+            );
         }
     }
 
@@ -502,7 +643,11 @@ mod tests {
             let mut model = random_model(seed, n, branching);
             model.coulomb.fill(0.0);
             let mut rng = Rng::new(seed + 100);
-            let (q, qd, qdd) = (rng.vector(n, -2.0, 2.0), rng.vector(n, -2.0, 2.0), rng.vector(n, -2.0, 2.0));
+            let (q, qd, qdd) = (
+                rng.vector(n, -2.0, 2.0),
+                rng.vector(n, -2.0, 2.0),
+                rng.vector(n, -2.0, 2.0),
+            );
             let fx = rng.vector(6 * n, -3.0, 3.0);
             for f_ext in [None, Some(&fx[..])] {
                 let mut data = Data::new(&model);

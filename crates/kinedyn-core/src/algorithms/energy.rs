@@ -23,7 +23,8 @@ pub fn kinetic_energy<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &
     // K = sum_i 1/2 v_i . I_i v_i + 1/2 J_m r^2 qd_i^2
     let mut k = T::zero();
     for i in 0..model.n {
-        k += model.inertia[i].splat::<T>().kinetic_energy(&data.v[i]) + T::splat(0.5 * model.armature[i]) * qd[i] * qd[i];
+        k += model.inertia[i].splat::<T>().kinetic_energy(&data.v[i])
+            + T::splat(0.5 * model.armature[i]) * qd[i] * qd[i];
     }
     k
 }

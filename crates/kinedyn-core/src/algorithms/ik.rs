@@ -53,9 +53,9 @@ pub use analytic::{AnalyticIk, Screw, Structure};
 use super::jacobian::{frame_jacobian, frame_pose_at, Reference};
 use super::kinematics::parent_from_body;
 use crate::data::Data;
+use crate::joint::JointKind;
 use crate::lie;
 use crate::model::{Coordinates, Model};
-use crate::joint::JointKind;
 use crate::rng::Rng;
 use crate::spatial::{Mat3, Transform, Vec3};
 use nalgebra::{Matrix6, Vector6};
@@ -77,7 +77,9 @@ pub fn log_so3(r: &Mat3) -> Vec3 {
     }
     // near pi: (R + R^T)/2 - cos(theta) I = (1 - cos(theta)) w w^T; w from its largest column, sign from v
     let b = ((r + r.transpose()) * 0.5 - Mat3::identity() * c) / (1.0 - c);
-    let k = (0..3).max_by(|&i, &j| b[(i, i)].partial_cmp(&b[(j, j)]).unwrap()).unwrap();
+    let k = (0..3)
+        .max_by(|&i, &j| b[(i, i)].partial_cmp(&b[(j, j)]).unwrap())
+        .unwrap();
     let mut w = b.column(k).into_owned() / b[(k, k)].max(1e-300).sqrt();
     w.normalize_mut();
     if w.dot(&v) < 0.0 {
@@ -170,25 +172,51 @@ pub struct Reduction {
 impl Reduction {
     /// Checked against `model`: sizes, indices, each kept coordinate maps to itself, and every
     /// multi-DOF joint is kept whole (its q and v blocks copied, in order).
-    pub fn new(model: &Model, q_source: Vec<(usize, f64, f64)>, v_source: Vec<(usize, f64)>, q_keep: Vec<usize>, nv: usize) -> Result<Self, String> {
+    pub fn new(
+        model: &Model,
+        q_source: Vec<(usize, f64, f64)>,
+        v_source: Vec<(usize, f64)>,
+        q_keep: Vec<usize>,
+        nv: usize,
+    ) -> Result<Self, String> {
         let (nq_full, nv_full, nq) = (model.nq, model.n, q_keep.len());
         if q_source.len() != nq_full || v_source.len() != nv_full {
-            return Err(format!("a reduction maps {nq_full} q and {nv_full} v coordinates of the model; got {} and {}", q_source.len(), v_source.len()));
+            return Err(format!(
+                "a reduction maps {nq_full} q and {nv_full} v coordinates of the model; got {} and {}",
+                q_source.len(),
+                v_source.len()
+            ));
         }
-        if let Some((i, _)) = q_source.iter().enumerate().find(|(_, (k, m, b))| *k >= nq || !m.is_finite() || !b.is_finite()) {
+        if let Some((i, _)) = q_source
+            .iter()
+            .enumerate()
+            .find(|(_, (k, m, b))| *k >= nq || !m.is_finite() || !b.is_finite())
+        {
             return Err(format!("reduction: full q coordinate {i} reads reduced coordinate {} of {nq} (or a non-finite multiplier/offset)", q_source[i].0));
         }
-        if let Some((i, _)) = v_source.iter().enumerate().find(|(_, (k, m))| *k >= nv || !m.is_finite()) {
-            return Err(format!("reduction: full v coordinate {i} reads reduced velocity {} of {nv} (or a non-finite multiplier)", v_source[i].0));
+        if let Some((i, _)) = v_source
+            .iter()
+            .enumerate()
+            .find(|(_, (k, m))| *k >= nv || !m.is_finite())
+        {
+            return Err(format!(
+                "reduction: full v coordinate {i} reads reduced velocity {} of {nv} (or a non-finite multiplier)",
+                v_source[i].0
+            ));
         }
         for (k, &i) in q_keep.iter().enumerate() {
             if i >= nq_full || q_source[i] != (k, 1.0, 0.0) {
-                return Err(format!("reduction: reduced coordinate {k} is kept at full coordinate {i}, which does not copy it"));
+                return Err(format!(
+                    "reduction: reduced coordinate {k} is kept at full coordinate {i}, which does not copy it"
+                ));
             }
         }
         for (qi, vi) in model.scalar_coordinates() {
             if q_keep[q_source[qi].0] == qi && v_source[vi].1 != 1.0 {
-                return Err(format!("reduction: the independent joint at body {vi} must copy its velocity (multiplier 1, got {})", v_source[vi].1));
+                return Err(format!(
+                    "reduction: the independent joint at body {vi} must copy its velocity (multiplier 1, got {})",
+                    v_source[vi].1
+                ));
             }
         }
         for (i, c) in model.coordinates.iter().enumerate() {
@@ -202,7 +230,12 @@ impl Reduction {
                 }
             }
         }
-        Ok(Self { q_source, v_source, q_keep, nv })
+        Ok(Self {
+            q_source,
+            v_source,
+            q_keep,
+            nv,
+        })
     }
 }
 
@@ -240,7 +273,9 @@ impl<'a> Space<'a> {
         // (the full v index of a 1-DOF coordinate is its body's index)
         let (scalars, revolute) = model
             .scalar_coordinates()
-            .filter_map(|(qi, vi)| solver_q(qi).map(|k| ((k, solver_v(vi)), model.joints[vi].kind == JointKind::Revolute)))
+            .filter_map(|(qi, vi)| {
+                solver_q(qi).map(|k| ((k, solver_v(vi)), model.joints[vi].kind == JointKind::Revolute))
+            })
             .unzip();
         let (blocks, block_body) = model
             .coordinates
@@ -295,7 +330,15 @@ impl<'a> Space<'a> {
             return;
         };
         self.expand(q);
-        frame_jacobian(self.model, data, &self.full_q, frame, Reference::World, None, &mut self.full_jac);
+        frame_jacobian(
+            self.model,
+            data,
+            &self.full_q,
+            frame,
+            Reference::World,
+            None,
+            &mut self.full_jac,
+        );
         let (nf, nv) = (self.model.n, self.nv);
         out[..6 * nv].fill(0.0);
         for (i, &(k, m)) in r.v_source.iter().enumerate() {
@@ -315,7 +358,8 @@ impl<'a> Space<'a> {
         for (x, &(k, m)) in self.full_v.iter_mut().zip(&r.v_source) {
             *x = m * dq[k];
         }
-        self.model.integrate_configuration(&self.full_q, &self.full_v, scale, &mut self.full_trial);
+        self.model
+            .integrate_configuration(&self.full_q, &self.full_v, scale, &mut self.full_trial);
         for (x, &i) in out.iter_mut().zip(&r.q_keep) {
             *x = self.full_trial[i];
         }
@@ -344,12 +388,26 @@ impl<'a> Space<'a> {
         // 1-DOF coordinates first, in order: the same draws as for a model of 1-DOF joints only
         for (&(k, _), &revolute) in self.scalars.iter().zip(&self.revolute) {
             let span = if revolute { PI } else { 1.0 };
-            let lo = if lower[k].is_finite() { lower[k] } else if upper[k].is_finite() { upper[k] - 2.0 * span } else { center[k] - span };
-            let hi = if upper[k].is_finite() { upper[k] } else { lo + 2.0 * span };
+            let lo = if lower[k].is_finite() {
+                lower[k]
+            } else if upper[k].is_finite() {
+                upper[k] - 2.0 * span
+            } else {
+                center[k] - span
+            };
+            let hi = if upper[k].is_finite() {
+                upper[k]
+            } else {
+                lo + 2.0 * span
+            };
             out[k] = lo + (hi - lo) * rng.uniform(0.0, 1.0);
         }
         let quaternion = |rng: &mut Rng, out: &mut [f64]| {
-            out[..4].copy_from_slice(&lie::uniform_quaternion([rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)]));
+            out[..4].copy_from_slice(&lie::uniform_quaternion([
+                rng.uniform(0.0, 1.0),
+                rng.uniform(0.0, 1.0),
+                rng.uniform(0.0, 1.0),
+            ]));
         };
         for &(block, at) in &self.blocks {
             match block {
@@ -381,7 +439,13 @@ pub const UNIT_TOLERANCE: f64 = 1e-6;
 /// reduction): finite, each multi-DOF joint's quaternion or (cos, sin) pair of unit norm to within
 /// [`UNIT_TOLERANCE`]; and of the limits: a multi-DOF joint's entries of `lower` / `upper` must be
 /// infinite (the solver keeps limits on 1-DOF joints only). The error names the entries and body.
-pub fn check_start(model: &Model, reduction: Option<&Reduction>, q: &[f64], lower: &[f64], upper: &[f64]) -> Result<(), String> {
+pub fn check_start(
+    model: &Model,
+    reduction: Option<&Reduction>,
+    q: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<(), String> {
     if let Some(k) = q.iter().position(|x| !x.is_finite()) {
         return Err(format!("q0[{k}] is {}: a configuration must be finite", q[k]));
     }
@@ -466,7 +530,14 @@ pub fn numeric_ik_reduced(
     let mut trial = vec![0.0; nq];
     let mut dq = vec![0.0; n];
     let mut blocked = vec![false; n];
-    let mut best = Outcome { q: q.clone(), success: false, position_error: f64::INFINITY, orientation_error: f64::INFINITY, iterations: 0, attempts: 0 };
+    let mut best = Outcome {
+        q: q.clone(),
+        success: false,
+        position_error: f64::INFINITY,
+        orientation_error: f64::INFINITY,
+        iterations: 0,
+        attempts: 0,
+    };
     let mut best_cost = f64::INFINITY;
     let converged = |e: &[f64; 6]| {
         let (ep, er) = residuals(e, w);
@@ -521,7 +592,11 @@ pub fn numeric_ik_reduced(
                 let y = chol.solve(&rhs);
                 // dq = A^T y
                 for j in 0..n {
-                    dq[j] = if blocked[j] { 0.0 } else { (0..6).map(|k| jac[k * n + j] * w_sqrt[k] * y[k]).sum() };
+                    dq[j] = if blocked[j] {
+                        0.0
+                    } else {
+                        (0..6).map(|k| jac[k * n + j] * w_sqrt[k] * y[k]).sum()
+                    };
                 }
                 let mut newly = false;
                 for &(k, j) in &space.scalars {
@@ -546,7 +621,11 @@ pub fn numeric_ik_reduced(
             }
             // no coordinate moves more than max_step (rad or m; a rotation's angle for a multi-DOF joint's)
             let largest = dq.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-            let scale = if largest > settings.max_step { settings.max_step / largest } else { 1.0 };
+            let scale = if largest > settings.max_step {
+                settings.max_step / largest
+            } else {
+                1.0
+            };
             space.integrate(&q, &dq, scale, &mut trial);
             space.clamp(&mut trial, lower, upper);
             let e_new = pose_error(&space.pose(data, &trial, frame), target);
@@ -709,9 +788,24 @@ pub fn analytic_solutions(
     let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
     let mut candidates = Vec::with_capacity(8);
     let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
-    let weights = if position_only { [1.0, 1.0, 1.0, 0.0, 0.0, 0.0] } else { [1.0; 6] };
-    let refine = Settings { weights, max_iterations: 8, restarts: 0, position_tolerance: 1e-13, orientation_tolerance: 1e-13, lambda_min: 1e-12, max_step: 0.1 };
-    let mut out = AnalyticOutcome { singular, ..Default::default() };
+    let weights = if position_only {
+        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+    } else {
+        [1.0; 6]
+    };
+    let refine = Settings {
+        weights,
+        max_iterations: 8,
+        restarts: 0,
+        position_tolerance: 1e-13,
+        orientation_tolerance: 1e-13,
+        lambda_min: 1e-12,
+        max_step: 0.1,
+    };
+    let mut out = AnalyticOutcome {
+        singular,
+        ..Default::default()
+    };
     // (q, position error, orientation error, inside the limits, squared distance to the reference)
     let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len());
     for theta in &candidates {
@@ -742,7 +836,11 @@ pub fn analytic_solutions(
         let same = kept.iter().any(|(k, ..)| {
             (0..n).all(|i| {
                 let d = k[i] - q[i];
-                let d = if model.joints[i].kind == JointKind::Revolute { d - 2.0 * PI * round(d / (2.0 * PI)) } else { d };
+                let d = if model.joints[i].kind == JointKind::Revolute {
+                    d - 2.0 * PI * round(d / (2.0 * PI))
+                } else {
+                    d
+                };
                 d.abs() < 1e-7
             })
         });
@@ -776,7 +874,12 @@ mod tests {
 
     #[test]
     fn log_is_the_inverse_of_exp() {
-        for &(x, y, z) in &[(0.3, -0.2, 0.5), (1e-8, 0.0, 2e-8), (0.0, 0.0, PI - 1e-9), (PI / 3f64.sqrt(), -PI / 3f64.sqrt(), PI / 3f64.sqrt() - 1e-7)] {
+        for &(x, y, z) in &[
+            (0.3, -0.2, 0.5),
+            (1e-8, 0.0, 2e-8),
+            (0.0, 0.0, PI - 1e-9),
+            (PI / 3f64.sqrt(), -PI / 3f64.sqrt(), PI / 3f64.sqrt() - 1e-7),
+        ] {
             let v = Vec3::new(x, y, z);
             let r = axis_angle(&v.normalize(), v.norm());
             let back = log_so3(&r);
@@ -792,9 +895,24 @@ mod tests {
         use crate::spatial::Inertia;
         let mut rng = Rng::new(4);
         let unit = |k: usize| Vec3::ith(k, 1.0);
-        let mut joints: Vec<Joint> = (0..6).map(|k| Joint { kind: if k < 3 { JointKind::Prismatic } else { JointKind::Revolute }, axis: unit(k % 3) }).collect();
-        joints.extend((0..3).map(|k| Joint { kind: JointKind::Revolute, axis: unit(k) }));
-        joints.push(Joint { kind: JointKind::Revolute, axis: rng.unit() });
+        let mut joints: Vec<Joint> = (0..6)
+            .map(|k| Joint {
+                kind: if k < 3 {
+                    JointKind::Prismatic
+                } else {
+                    JointKind::Revolute
+                },
+                axis: unit(k % 3),
+            })
+            .collect();
+        joints.extend((0..3).map(|k| Joint {
+            kind: JointKind::Revolute,
+            axis: unit(k),
+        }));
+        joints.push(Joint {
+            kind: JointKind::Revolute,
+            axis: rng.unit(),
+        });
         let parent = (0..10).map(|i: usize| i.checked_sub(1)).collect();
         let mut placements = vec![Transform::identity(); 10];
         placements[6] = Transform::new(rng.rotation(), rng.vec3(-0.5, 0.5));
@@ -803,15 +921,40 @@ mod tests {
         for i in [5, 8, 9] {
             inertia[i] = crate::testing::random_inertia(&mut rng);
         }
-        let frames = vec![Frame { body: Some(9), body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)) }];
-        let coordinates = [Coordinates::Head { block: Block::FreeFlyer, at: 0 }]
-            .into_iter()
-            .chain([Coordinates::Member; 5])
-            .chain([Coordinates::Head { block: Block::Spherical, at: 7 }, Coordinates::Member, Coordinates::Member, Coordinates::Scalar { at: 11 }])
-            .collect();
-        Model::new(parent, joints, vec![0.0; 10], placements, inertia, vec![0.0; 10], vec![0.0; 10], vec![0.0; 10], Vec3::new(0.0, 0.0, -9.81), frames)
-            .and_then(|m| m.with_coordinates(coordinates))
-            .expect("a valid floating model")
+        let frames = vec![Frame {
+            body: Some(9),
+            body_from_frame: Transform::new(rng.rotation(), rng.vec3(-0.3, 0.3)),
+        }];
+        let coordinates = [Coordinates::Head {
+            block: Block::FreeFlyer,
+            at: 0,
+        }]
+        .into_iter()
+        .chain([Coordinates::Member; 5])
+        .chain([
+            Coordinates::Head {
+                block: Block::Spherical,
+                at: 7,
+            },
+            Coordinates::Member,
+            Coordinates::Member,
+            Coordinates::Scalar { at: 11 },
+        ])
+        .collect();
+        Model::new(
+            parent,
+            joints,
+            vec![0.0; 10],
+            placements,
+            inertia,
+            vec![0.0; 10],
+            vec![0.0; 10],
+            vec![0.0; 10],
+            Vec3::new(0.0, 0.0, -9.81),
+            frames,
+        )
+        .and_then(|m| m.with_coordinates(coordinates))
+        .expect("a valid floating model")
     }
 
     #[test]
@@ -828,12 +971,25 @@ mod tests {
         for trial in 0..5 {
             space.random(&lower, &upper, &neutral, &mut rng, &mut goal);
             let target = frame_pose_at(&model, &mut data, &goal, 0);
-            let out = numeric_ik(&model, &mut data, 0, &target, &neutral, &lower, &upper, &Settings::default(), trial);
+            let out = numeric_ik(
+                &model,
+                &mut data,
+                0,
+                &target,
+                &neutral,
+                &lower,
+                &upper,
+                &Settings::default(),
+                trial,
+            );
             assert!(out.success, "trial {trial}: {out:?}");
             let e = pose_error(&frame_pose_at(&model, &mut data, &out.q, 0), &target);
             assert!(e.iter().all(|x| x.abs() < 1e-9), "trial {trial}: {e:?}");
             for unit in [&out.q[3..7], &out.q[7..11]] {
-                assert!((unit.iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs() < 1e-12, "{unit:?}");
+                assert!(
+                    (unit.iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs() < 1e-12,
+                    "{unit:?}"
+                );
             }
         }
     }
@@ -847,7 +1003,10 @@ mod tests {
         assert!(check_start(&model, None, &q, &lower, &upper).is_ok());
         q[10] = 1.1;
         let e = check_start(&model, None, &q, &lower, &upper).unwrap_err();
-        assert!(e.contains("q0[7:11], the quaternion (qx, qy, qz, qw) of the spherical joint at body 6, has norm 1.1"), "{e}");
+        assert!(
+            e.contains("q0[7:11], the quaternion (qx, qy, qz, qw) of the spherical joint at body 6, has norm 1.1"),
+            "{e}"
+        );
         q[10] = 1.0;
         let mut limited = lower.clone();
         limited[2] = -1.0;
@@ -859,21 +1018,46 @@ mod tests {
     fn a_mimic_reduction_solves_in_reduced_coordinates() {
         // three revolute joints; the second follows the first: q1 = -2 q0 + 0.1
         let model = crate::testing::random_model(3, 3, false);
-        let reduction = Reduction::new(&model, vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)], vec![(0, 1.0), (0, -2.0), (1, 1.0)], vec![0, 2], 2).unwrap();
+        let reduction = Reduction::new(
+            &model,
+            vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)],
+            vec![(0, 1.0), (0, -2.0), (1, 1.0)],
+            vec![0, 2],
+            2,
+        )
+        .unwrap();
         let mut data = Data::new(&model);
         let (lower, upper) = (vec![f64::NEG_INFINITY; 2], vec![f64::INFINITY; 2]);
         let frame = 2; // on the last body
         for (trial, goal) in [[0.4, -0.7], [-1.2, 2.0], [2.5, 0.3]].iter().enumerate() {
             let full = [goal[0], -2.0 * goal[0] + 0.1, goal[1]];
             let target = frame_pose_at(&model, &mut data, &full, frame);
-            let out = numeric_ik_reduced(&model, Some(&reduction), &mut data, frame, &target, &[0.0, 0.0], &lower, &upper, &Settings::default(), trial as u64);
+            let out = numeric_ik_reduced(
+                &model,
+                Some(&reduction),
+                &mut data,
+                frame,
+                &target,
+                &[0.0, 0.0],
+                &lower,
+                &upper,
+                &Settings::default(),
+                trial as u64,
+            );
             assert!(out.success && out.q.len() == 2, "{out:?}");
             let reached = [out.q[0], -2.0 * out.q[0] + 0.1, out.q[1]];
             let e = pose_error(&frame_pose_at(&model, &mut data, &reached, frame), &target);
             assert!(e.iter().all(|x| x.abs() < 1e-9), "trial {trial}: {e:?}");
         }
         // a follower that is not copied back, or a kept coordinate that does not copy itself: refused
-        assert!(Reduction::new(&model, vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)], vec![(0, 1.0), (0, -2.0), (1, 1.0)], vec![1, 2], 2).is_err());
+        assert!(Reduction::new(
+            &model,
+            vec![(0, 1.0, 0.0), (0, -2.0, 0.1), (1, 1.0, 0.0)],
+            vec![(0, 1.0), (0, -2.0), (1, 1.0)],
+            vec![1, 2],
+            2
+        )
+        .is_err());
     }
 
     #[test]

@@ -139,18 +139,40 @@ pub struct Outcome {
 
 /// The torque source: `tau(t, q, qd, out)`; an `Err` stops the run with [`FailureKind::Source`].
 pub trait TorqueFn {
-    fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String>;
+    fn torque(
+        &mut self,
+        step: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<(), String>;
 
     /// `dtau/dq` and `dtau/dqd` (row-major n x n, `[i * n + j] = dtau_i / dx_j`) at a state, for
     /// the implicit method; `Ok(false)` (the default) when the torque does not depend on the state
     /// or its derivatives are unknown (they are then left out of the step's Jacobian).
-    fn jacobian(&mut self, _step: usize, _t: f64, _q: &[f64], _qd: &[f64], _dtau_dq: &mut [f64], _dtau_dqd: &mut [f64]) -> std::result::Result<bool, String> {
+    fn jacobian(
+        &mut self,
+        _step: usize,
+        _t: f64,
+        _q: &[f64],
+        _qd: &[f64],
+        _dtau_dq: &mut [f64],
+        _dtau_dqd: &mut [f64],
+    ) -> std::result::Result<bool, String> {
         Ok(false)
     }
 }
 
 impl<F: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> std::result::Result<(), String>> TorqueFn for F {
-    fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String> {
+    fn torque(
+        &mut self,
+        step: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<(), String> {
         self(step, t, q, qd, out)
     }
 }
@@ -167,7 +189,14 @@ pub struct Sampled<'a> {
 }
 
 impl TorqueFn for Sampled<'_> {
-    fn torque(&mut self, step: usize, t: f64, _q: &[f64], _qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String> {
+    fn torque(
+        &mut self,
+        step: usize,
+        t: f64,
+        _q: &[f64],
+        _qd: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<(), String> {
         let n = self.n;
         let rows = self.values.len() / n.max(1);
         match rows {
@@ -228,7 +257,18 @@ struct ImplicitScratch {
 impl ImplicitScratch {
     fn new(n: usize, nq: usize) -> Self {
         let m = || vec![0.0; n * n];
-        ImplicitScratch { a_q: m(), a_v: m(), minv: m(), k_q: m(), k_v: m(), lu: m(), pivot: vec![0; n], rhs: vec![0.0; n], v0: vec![0.0; n], q_next: vec![0.0; nq] }
+        ImplicitScratch {
+            a_q: m(),
+            a_v: m(),
+            minv: m(),
+            k_q: m(),
+            k_v: m(),
+            lu: m(),
+            pivot: vec![0; n],
+            rhs: vec![0.0; n],
+            v0: vec![0.0; n],
+            q_next: vec![0.0; nq],
+        }
     }
 }
 
@@ -238,7 +278,9 @@ impl ImplicitScratch {
 fn lu_factor(a: &mut [f64], n: usize, pivot: &mut [usize]) -> std::result::Result<(), usize> {
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     for k in 0..n {
-        let p = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs())).unwrap_or(k);
+        let p = (k..n)
+            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
+            .unwrap_or(k);
         pivot[k] = p;
         if !(a[p * n + k].abs() > 1e-300_f64.max(1e-15 * scale)) {
             return Err(k);
@@ -312,12 +354,18 @@ fn implicit_step(
     let n = model.n;
     let fail = |joint, kind| Failure { step, t, joint, kind };
     // A_q = dqdd/dq, A_v = dqdd/dqd, M^-1 at (q, qd, tau)
-    aba_derivatives(model, data, q, qd, tau, None, &mut s.a_q, &mut s.a_v, &mut s.minv).map_err(|e| fail(singular_joint(&e), FailureKind::Singular(e.to_string())))?;
+    aba_derivatives(model, data, q, qd, tau, None, &mut s.a_q, &mut s.a_v, &mut s.minv)
+        .map_err(|e| fail(singular_joint(&e), FailureKind::Singular(e.to_string())))?;
     // the torque's own dependence on the state: A_q += M^-1 dtau/dq ; A_v += M^-1 dtau/dqd
-    let known = source.jacobian(step, t, q, qd, &mut s.k_q, &mut s.k_v).map_err(|m| fail(None, FailureKind::Source(m)))?;
+    let known = source
+        .jacobian(step, t, q, qd, &mut s.k_q, &mut s.k_v)
+        .map_err(|m| fail(None, FailureKind::Source(m)))?;
     if known {
         if let Some(j) = s.k_q.iter().chain(s.k_v.iter()).position(|x| !x.is_finite()) {
-            return Err(fail(Some((j % (n * n)) / n.max(1)), FailureKind::Source("the torque's Jacobian has a non-finite entry".into())));
+            return Err(fail(
+                Some((j % (n * n)) / n.max(1)),
+                FailureKind::Source("the torque's Jacobian has a non-finite entry".into()),
+            ));
         }
         add_product(&mut s.a_q, &s.minv, &s.k_q, n);
         add_product(&mut s.a_v, &s.minv, &s.k_v, n);
@@ -329,14 +377,23 @@ fn implicit_step(
             s.lu[r * n + c] = identity - h * s.a_v[r * n + c] - h * h * s.a_q[r * n + c];
         }
     }
-    lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| fail(Some(k), FailureKind::Singular(format!("the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"))))?;
+    lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| {
+        fail(
+            Some(k),
+            FailureKind::Singular(format!(
+                "the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"
+            )),
+        )
+    })?;
     // without Coulomb friction: a0 = qdd + M^-1 coulomb_torque(qd) (the ABA's qdd includes it)
     let coulomb = (0..n).any(|k| model.has_coulomb(k));
     // dv0 = (I - h A_v - h^2 A_q)^-1 h (a0 + h A_q qd)
     for r in 0..n {
         let mut a0 = qdd[r];
         if coulomb {
-            a0 += (0..n).map(|k| s.minv[r * n + k] * model.coulomb_torque(k, qd[k])).sum::<f64>();
+            a0 += (0..n)
+                .map(|k| s.minv[r * n + k] * model.coulomb_torque(k, qd[k]))
+                .sum::<f64>();
         }
         let spring: f64 = (0..n).map(|k| s.a_q[r * n + k] * qd[k]).sum();
         s.rhs[r] = h * (a0 + h * spring);
@@ -348,13 +405,20 @@ fn implicit_step(
     if coulomb {
         // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb_torque(v0))
         for r in 0..n {
-            s.rhs[r] = -h * (0..n).map(|k| s.minv[r * n + k] * model.coulomb_torque(k, s.v0[k])).sum::<f64>();
+            s.rhs[r] = -h
+                * (0..n)
+                    .map(|k| s.minv[r * n + k] * model.coulomb_torque(k, s.v0[k]))
+                    .sum::<f64>();
         }
         lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
         for j in 0..n {
             let v1 = s.v0[j] + s.rhs[j];
             // friction stops a joint, it does not reverse it
-            qd[j] = if model.has_coulomb(j) && v1 * s.v0[j] < 0.0 { 0.0 } else { v1 };
+            qd[j] = if model.has_coulomb(j) && v1 * s.v0[j] < 0.0 {
+                0.0
+            } else {
+                v1
+            };
         }
     } else {
         qd.copy_from_slice(&s.v0);
@@ -401,7 +465,9 @@ fn derivative(
 ) -> std::result::Result<(), Failure> {
     let fail = |joint, kind| Failure { step, t, joint, kind };
     if evaluate_torque {
-        source.torque(step, t, q, qd, tau).map_err(|m| fail(None, FailureKind::Source(m)))?;
+        source
+            .torque(step, t, q, qd, tau)
+            .map_err(|m| fail(None, FailureKind::Source(m)))?;
         if let Some(j) = tau.iter().position(|x| !x.is_finite()) {
             return Err(fail(Some(j), FailureKind::Torque(tau[j])));
         }
@@ -425,14 +491,29 @@ fn check_state(q: &[f64], qd: &[f64], max_speed: f64, step: usize, t: f64) -> st
     // joint: the velocity coordinate (the q coordinate when only q is non-finite)
     for (j, v) in qd.iter().enumerate() {
         if !v.is_finite() {
-            return Err(Failure { step, t, joint: Some(j), kind: FailureKind::NonFinite });
+            return Err(Failure {
+                step,
+                t,
+                joint: Some(j),
+                kind: FailureKind::NonFinite,
+            });
         }
         if v.abs() > max_speed {
-            return Err(Failure { step, t, joint: Some(j), kind: FailureKind::Diverged(*v) });
+            return Err(Failure {
+                step,
+                t,
+                joint: Some(j),
+                kind: FailureKind::Diverged(*v),
+            });
         }
     }
     if let Some(j) = q.iter().position(|a| !a.is_finite()) {
-        return Err(Failure { step, t, joint: Some(j.min(qd.len().saturating_sub(1))), kind: FailureKind::NonFinite });
+        return Err(Failure {
+            step,
+            t,
+            joint: Some(j.min(qd.len().saturating_sub(1))),
+            kind: FailureKind::NonFinite,
+        });
     }
     Ok(())
 }
@@ -452,30 +533,53 @@ pub fn integrate(
     let h = settings.dt;
     let every = settings.record_every;
     if !(h > 0.0) || !h.is_finite() {
-        return Err(Error::InvalidInput(format!("the step dt must be a positive finite number, got {h}")));
+        return Err(Error::InvalidInput(format!(
+            "the step dt must be a positive finite number, got {h}"
+        )));
     }
     if every == 0 {
         return Err(Error::InvalidInput("record_every must be at least 1".into()));
     }
     if q0.len() != nq || qd0.len() != n {
-        return Err(Error::InvalidInput(format!("q0 and qd0 must have {nq} and {n} entries, got {} and {}", q0.len(), qd0.len())));
+        return Err(Error::InvalidInput(format!(
+            "q0 and qd0 must have {nq} and {n} entries, got {} and {}",
+            q0.len(),
+            qd0.len()
+        )));
     }
     if let Some(l) = &settings.limits {
         if l.lower.len() != nq || l.upper.len() != nq {
-            return Err(Error::InvalidInput(format!("joint limits must have {nq} lower and upper values, got {} and {}", l.lower.len(), l.upper.len())));
+            return Err(Error::InvalidInput(format!(
+                "joint limits must have {nq} lower and upper values, got {} and {}",
+                l.lower.len(),
+                l.upper.len()
+            )));
         }
         if let Some(j) = (0..nq).find(|&j| l.lower[j].is_nan() || l.upper[j].is_nan() || l.lower[j] > l.upper[j]) {
-            return Err(Error::InvalidInput(format!("joint {j} has limits [{}, {}]: lower must not exceed upper", l.lower[j], l.upper[j])));
+            return Err(Error::InvalidInput(format!(
+                "joint {j} has limits [{}, {}]: lower must not exceed upper",
+                l.lower[j], l.upper[j]
+            )));
         }
     }
     let need = settings.samples() * n;
     if out.q.len() < settings.samples() * nq || out.qd.len() < need || out.qdd.len() < need || out.tau.len() < need {
-        return Err(Error::InvalidInput(format!("output arrays must hold {} samples of {n} values", settings.samples())));
+        return Err(Error::InvalidInput(format!(
+            "output arrays must hold {} samples of {n} values",
+            settings.samples()
+        )));
     }
     let mut q = q0.to_vec();
     let mut qd = qd0.to_vec();
     let zeros = || vec![0.0; n];
-    let mut s = Stage { mean: zeros(), q: vec![0.0; nq], qd: zeros(), tau: zeros(), kq: [zeros(), zeros(), zeros(), zeros()], kv: [zeros(), zeros(), zeros(), zeros()] };
+    let mut s = Stage {
+        mean: zeros(),
+        q: vec![0.0; nq],
+        qd: zeros(),
+        tau: zeros(),
+        kq: [zeros(), zeros(), zeros(), zeros()],
+        kv: [zeros(), zeros(), zeros(), zeros()],
+    };
     let mut next_q = vec![0.0; nq];
     let mut implicit = (settings.method == Method::Implicit).then(|| ImplicitScratch::new(n, nq));
     let mut samples = 0;
@@ -492,14 +596,21 @@ pub fn integrate(
     };
 
     if let Err(f) = check_state(&q, &qd, f64::INFINITY, 0, settings.t0) {
-        return Err(Error::InvalidInput(format!("the initial state has a non-finite value at joint {}", f.joint.unwrap_or(0))));
+        return Err(Error::InvalidInput(format!(
+            "the initial state has a non-finite value at joint {}",
+            f.joint.unwrap_or(0)
+        )));
     }
     for k in 0..=settings.steps {
         let t = t_of(k);
         // k1 = f(t_k, x_k): also the recorded qdd_k and tau_k
         let (kv0, rest) = s.kv.split_at_mut(1);
         if let Err(f) = derivative(model, data, source, k, t, &q, &qd, &mut s.tau, true, &mut kv0[0]) {
-            return Ok(Outcome { steps: k, samples, failure: Some(f) });
+            return Ok(Outcome {
+                steps: k,
+                samples,
+                failure: Some(f),
+            });
         }
         if k % every == 0 || k == settings.steps {
             record(&mut samples, &q, &qd, &kv0[0], &s.tau);
@@ -547,7 +658,18 @@ pub fn integrate(
                     let (head, tail) = kq.split_at_mut(stage + 1);
                     model.chart_rate(&s.mean, &s.qd, &mut tail[0]);
                     let _ = head;
-                    derivative(model, data, source, k, t + dt_stage, &s.q, &s.qd, &mut s.tau, evaluate, &mut rest[stage])?;
+                    derivative(
+                        model,
+                        data,
+                        source,
+                        k,
+                        t + dt_stage,
+                        &s.q,
+                        &s.qd,
+                        &mut s.tau,
+                        evaluate,
+                        &mut rest[stage],
+                    )?;
                 }
                 // x_{k+1} = x_k + h/6 (k1 + 2 k2 + 2 k3 + k4), q_{k+1} = q_k ⊕ h/6 (k1 + ...): the
                 // Runge-Kutta-Munthe-Kaas method (fourth order on the manifold too)
@@ -564,10 +686,18 @@ pub fn integrate(
         }
         let checked = step.and_then(|_| check_state(&q, &qd, settings.max_speed, k, t));
         if let Err(f) = checked {
-            return Ok(Outcome { steps: k, samples, failure: Some(f) });
+            return Ok(Outcome {
+                steps: k,
+                samples,
+                failure: Some(f),
+            });
         }
     }
-    Ok(Outcome { steps: settings.steps, samples, failure: None })
+    Ok(Outcome {
+        steps: settings.steps,
+        samples,
+        failure: None,
+    })
 }
 
 #[cfg(test)]
@@ -575,14 +705,50 @@ mod tests {
     use super::*;
     use crate::testing::random_model;
 
-    fn run(model: &Model, method: Method, dt: f64, steps: usize, q0: &[f64], qd0: &[f64]) -> (Outcome, Vec<f64>, Vec<f64>) {
+    fn run(
+        model: &Model,
+        method: Method,
+        dt: f64,
+        steps: usize,
+        q0: &[f64],
+        qd0: &[f64],
+    ) -> (Outcome, Vec<f64>, Vec<f64>) {
         let n = model.n;
-        let settings = Settings { method, dt, steps, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
+        let settings = Settings {
+            method,
+            dt,
+            steps,
+            t0: 0.0,
+            record_every: 1,
+            hold: false,
+            max_speed: 1e6,
+            limits: None,
+        };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut data = Data::new(model);
-        let mut zero = Sampled { values: &[], n, t0: 0.0, dt, linear: false };
-        let out = integrate(model, &mut data, &settings, q0, qd0, &mut zero, Record { q: &mut q, qd: &mut qd, qdd: &mut qdd, tau: &mut tau }).unwrap();
+        let mut zero = Sampled {
+            values: &[],
+            n,
+            t0: 0.0,
+            dt,
+            linear: false,
+        };
+        let out = integrate(
+            model,
+            &mut data,
+            &settings,
+            q0,
+            qd0,
+            &mut zero,
+            Record {
+                q: &mut q,
+                qd: &mut qd,
+                qdd: &mut qdd,
+                tau: &mut tau,
+            },
+        )
+        .unwrap();
         (out, q, qd)
     }
 
@@ -590,10 +756,17 @@ mod tests {
     fn pendulum() -> Model {
         use crate::spatial::{Inertia, Mat3, Transform, Vec3};
         use crate::{Joint, JointKind};
-        let inertia = Inertia::new(1.0, Vec3::new(1.0, 0.0, 0.0), Mat3::zeros() + Mat3::from_diagonal(&Vec3::new(0.0, 1.0, 1.0)));
+        let inertia = Inertia::new(
+            1.0,
+            Vec3::new(1.0, 0.0, 0.0),
+            Mat3::zeros() + Mat3::from_diagonal(&Vec3::new(0.0, 1.0, 1.0)),
+        );
         Model::new(
             vec![None],
-            vec![Joint { kind: JointKind::Revolute, axis: Vec3::z() }],
+            vec![Joint {
+                kind: JointKind::Revolute,
+                axis: Vec3::z(),
+            }],
             vec![0.0],
             vec![Transform::identity()],
             vec![inertia],
@@ -616,7 +789,9 @@ mod tests {
             let steps = (2.0 / dt).round() as usize;
             let (_, q, _) = run(&model, Method::Rk4, dt, steps, &[1.0], &[0.0]);
             let (every, every_ref) = ((0.04 / dt).round() as usize, 400);
-            (0..=50).map(|k| (q[k * every] - q_ref[k * every_ref]).abs()).fold(0.0, f64::max)
+            (0..=50)
+                .map(|k| (q[k * every] - q_ref[k * every_ref]).abs())
+                .fold(0.0, f64::max)
         };
         let ratio = err(0.02) / err(0.01);
         assert!((ratio - 16.0).abs() < 2.0, "RK4 error ratio {ratio}");
@@ -637,7 +812,8 @@ mod tests {
         let qd0 = vec![0.5; n];
         let mut data = Data::new(&model);
         let mut energy = |q: &[f64], qd: &[f64]| {
-            super::super::energy::kinetic_energy(&model, &mut data, q, qd) + super::super::energy::potential_energy(&model, &mut data, q)
+            super::super::energy::kinetic_energy(&model, &mut data, q, qd)
+                + super::super::energy::potential_energy(&model, &mut data, q)
         };
         let e0 = energy(&q0, &qd0);
         let drift = |method| {
@@ -647,17 +823,33 @@ mod tests {
         };
         let (q, qd) = drift(Method::Rk4);
         let e_rk4 = energy(&q[2000 * n..], &qd[2000 * n..]);
-        assert!(((e_rk4 - e0) / e0.abs().max(1.0)).abs() < 1e-7, "RK4 drift {}", e_rk4 - e0);
+        assert!(
+            ((e_rk4 - e0) / e0.abs().max(1.0)).abs() < 1e-7,
+            "RK4 drift {}",
+            e_rk4 - e0
+        );
         let (q, qd) = drift(Method::Euler);
         let e_euler = energy(&q[2000 * n..], &qd[2000 * n..]);
-        assert!((e_euler - e0).abs() > 100.0 * (e_rk4 - e0).abs(), "explicit Euler should drift more");
+        assert!(
+            (e_euler - e0).abs() > 100.0 * (e_rk4 - e0).abs(),
+            "explicit Euler should drift more"
+        );
     }
 
     #[test]
     fn blow_up_is_reported_with_step_and_joint() {
         let model = pendulum();
         let n = model.n;
-        let settings = Settings { method: Method::Rk4, dt: 1e-3, steps: 100, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
+        let settings = Settings {
+            method: Method::Rk4,
+            dt: 1e-3,
+            steps: 100,
+            t0: 0.0,
+            record_every: 1,
+            hold: false,
+            max_speed: 1e6,
+            limits: None,
+        };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut data = Data::new(&model);
@@ -666,7 +858,21 @@ mod tests {
             out[0] = if t >= 0.05 { f64::INFINITY } else { 0.0 };
             Ok(())
         };
-        let out = integrate(&model, &mut data, &settings, &[0.0], &[0.0], &mut source, Record { q: &mut q, qd: &mut qd, qdd: &mut qdd, tau: &mut tau }).unwrap();
+        let out = integrate(
+            &model,
+            &mut data,
+            &settings,
+            &[0.0],
+            &[0.0],
+            &mut source,
+            Record {
+                q: &mut q,
+                qd: &mut qd,
+                qdd: &mut qdd,
+                tau: &mut tau,
+            },
+        )
+        .unwrap();
         let f = out.failure.expect("must fail");
         assert_eq!(f.joint, Some(0));
         assert!(matches!(f.kind, FailureKind::Torque(_)));
@@ -677,18 +883,60 @@ mod tests {
             out[0] = 1e12;
             Ok(())
         };
-        let out = integrate(&model, &mut data, &settings, &[0.0], &[0.0], &mut source, Record { q: &mut q, qd: &mut qd, qdd: &mut qdd, tau: &mut tau }).unwrap();
+        let out = integrate(
+            &model,
+            &mut data,
+            &settings,
+            &[0.0],
+            &[0.0],
+            &mut source,
+            Record {
+                q: &mut q,
+                qd: &mut qd,
+                qdd: &mut qdd,
+                tau: &mut tau,
+            },
+        )
+        .unwrap();
         assert!(matches!(out.failure.unwrap().kind, FailureKind::Diverged(_)));
     }
 
     #[test]
     fn invalid_inputs_are_errors() {
         let model = pendulum();
-        let settings = Settings { method: Method::Rk4, dt: 0.0, steps: 10, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: None };
+        let settings = Settings {
+            method: Method::Rk4,
+            dt: 0.0,
+            steps: 10,
+            t0: 0.0,
+            record_every: 1,
+            hold: false,
+            max_speed: 1e6,
+            limits: None,
+        };
         let mut v = vec![0.0; 11];
         let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
-        let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1.0, linear: false };
-        let r = integrate(&model, &mut Data::new(&model), &settings, &[0.0], &[0.0], &mut zero, Record { q: &mut v, qd: &mut a, qdd: &mut b, tau: &mut c });
+        let mut zero = Sampled {
+            values: &[],
+            n: 1,
+            t0: 0.0,
+            dt: 1.0,
+            linear: false,
+        };
+        let r = integrate(
+            &model,
+            &mut Data::new(&model),
+            &settings,
+            &[0.0],
+            &[0.0],
+            &mut zero,
+            Record {
+                q: &mut v,
+                qd: &mut a,
+                qdd: &mut b,
+                tau: &mut c,
+            },
+        );
         assert!(matches!(r, Err(Error::InvalidInput(_))));
     }
     #[test]
@@ -715,22 +963,68 @@ mod tests {
     }
 
     impl TorqueFn for StiffPd {
-        fn torque(&mut self, _k: usize, _t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> std::result::Result<(), String> {
+        fn torque(
+            &mut self,
+            _k: usize,
+            _t: f64,
+            q: &[f64],
+            qd: &[f64],
+            out: &mut [f64],
+        ) -> std::result::Result<(), String> {
             out[0] = self.kp * (self.goal - q[0]) - self.kd * qd[0];
             Ok(())
         }
-        fn jacobian(&mut self, _k: usize, _t: f64, _q: &[f64], _qd: &[f64], dq: &mut [f64], dqd: &mut [f64]) -> std::result::Result<bool, String> {
+        fn jacobian(
+            &mut self,
+            _k: usize,
+            _t: f64,
+            _q: &[f64],
+            _qd: &[f64],
+            dq: &mut [f64],
+            dqd: &mut [f64],
+        ) -> std::result::Result<bool, String> {
             dq[0] = -self.kp;
             dqd[0] = -self.kd;
             Ok(self.tell_jacobian)
         }
     }
 
-    fn run_with(model: &Model, method: Method, dt: f64, steps: usize, source: &mut dyn TorqueFn, limits: Option<Limits<'_>>, q0: f64) -> (Outcome, Vec<f64>, Vec<f64>) {
-        let settings = Settings { method, dt, steps, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits };
+    fn run_with(
+        model: &Model,
+        method: Method,
+        dt: f64,
+        steps: usize,
+        source: &mut dyn TorqueFn,
+        limits: Option<Limits<'_>>,
+        q0: f64,
+    ) -> (Outcome, Vec<f64>, Vec<f64>) {
+        let settings = Settings {
+            method,
+            dt,
+            steps,
+            t0: 0.0,
+            record_every: 1,
+            hold: false,
+            max_speed: 1e6,
+            limits,
+        };
         let m = settings.samples();
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-        let out = integrate(model, &mut Data::new(model), &settings, &[q0], &[0.0], source, Record { q: &mut q, qd: &mut qd, qdd: &mut qdd, tau: &mut tau }).unwrap();
+        let out = integrate(
+            model,
+            &mut Data::new(model),
+            &settings,
+            &[q0],
+            &[0.0],
+            source,
+            Record {
+                q: &mut q,
+                qd: &mut qd,
+                qdd: &mut qdd,
+                tau: &mut tau,
+            },
+        )
+        .unwrap();
         (out, q, qd)
     }
 
@@ -739,27 +1033,59 @@ mod tests {
         // viscous damping 10 N m s on an inertia of 1e-4 kg m^2 (pendulum scaled): h b / I = 100
         let mut model = pendulum();
         // mass 1e-4 at (1, 0, 0): first moment (1e-4, 0, 0), inertia about the joint diag(0, 1e-4, 1e-4)
-        model.inertia[0] = crate::spatial::Inertia::new(1e-4, crate::spatial::Vec3::new(1e-4, 0.0, 0.0), crate::spatial::Mat3::from_diagonal(&crate::spatial::Vec3::new(0.0, 1e-4, 1e-4)));
+        model.inertia[0] = crate::spatial::Inertia::new(
+            1e-4,
+            crate::spatial::Vec3::new(1e-4, 0.0, 0.0),
+            crate::spatial::Mat3::from_diagonal(&crate::spatial::Vec3::new(0.0, 1e-4, 1e-4)),
+        );
         model.viscous[0] = 10.0;
-        let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+        let mut zero = Sampled {
+            values: &[],
+            n: 1,
+            t0: 0.0,
+            dt: 1e-3,
+            linear: false,
+        };
         let (o, _, _) = run_with(&model, Method::Rk4, 1e-3, 100, &mut zero, None, 1.0);
         assert!(o.failure.is_some(), "RK4 must blow up here (the test's premise)");
         let (o, q, qd) = run_with(&model, Method::Implicit, 1e-3, 2000, &mut zero, None, 1.0);
         assert!(o.failure.is_none(), "{:?}", o.failure);
         // overdamped: it creeps at the speed where damping balances gravity, b qd = -m g l cos q
         let creep = -1e-4 * 9.81 * q[2000].cos() / 10.0;
-        assert!((qd[2000] - creep).abs() < 1e-3 * creep.abs(), "qd(T) = {}, creep speed {creep}", qd[2000]);
+        assert!(
+            (qd[2000] - creep).abs() < 1e-3 * creep.abs(),
+            "qd(T) = {}, creep speed {creep}",
+            qd[2000]
+        );
         // a stiff PD law (kp = 1e4, kd = 1e2 on the same tiny inertia) converges to its set point;
         // without the gains in the Jacobian the same step is unstable
         let mut model = model.clone();
         model.viscous[0] = 0.0;
         model.gravity = crate::spatial::Vec3::zeros();
-        let mut pd = StiffPd { kp: 1e4, kd: 1e2, goal: 0.5, tell_jacobian: true };
+        let mut pd = StiffPd {
+            kp: 1e4,
+            kd: 1e2,
+            goal: 0.5,
+            tell_jacobian: true,
+        };
         let (o, q, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut pd, None, 0.0);
-        assert!(o.failure.is_none() && (q[500] - 0.5).abs() < 1e-6, "{:?} q = {}", o.failure, q[500]);
-        let mut pd = StiffPd { kp: 1e4, kd: 1e2, goal: 0.5, tell_jacobian: false };
+        assert!(
+            o.failure.is_none() && (q[500] - 0.5).abs() < 1e-6,
+            "{:?} q = {}",
+            o.failure,
+            q[500]
+        );
+        let mut pd = StiffPd {
+            kp: 1e4,
+            kd: 1e2,
+            goal: 0.5,
+            tell_jacobian: false,
+        };
         let (o, _, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut pd, None, 0.0);
-        assert!(o.failure.is_some(), "without the controller's Jacobian the stiff PD law must blow up");
+        assert!(
+            o.failure.is_some(),
+            "without the controller's Jacobian the stiff PD law must blow up"
+        );
     }
 
     #[test]
@@ -768,7 +1094,13 @@ mod tests {
         for (coulomb, holds) in [(20.0, true), (5.0, false)] {
             let mut model = pendulum();
             model.coulomb[0] = coulomb;
-            let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
+            let mut zero = Sampled {
+                values: &[],
+                n: 1,
+                t0: 0.0,
+                dt: 1e-3,
+                linear: false,
+            };
             let (o, q, _) = run_with(&model, Method::Implicit, 1e-3, 500, &mut zero, None, 0.0);
             assert!(o.failure.is_none());
             assert_eq!(q[500].abs() < 1e-9, holds, "coulomb {coulomb}: q(T) = {}", q[500]);
@@ -780,20 +1112,73 @@ mod tests {
         let model = pendulum();
         let (lower, upper) = ([-0.3], [0.3]);
         for method in [Method::Rk4, Method::SemiImplicitEuler, Method::Euler, Method::Implicit] {
-            let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
-            let (o, q, qd) = run_with(&model, method, 1e-3, 1000, &mut zero, Some(Limits { lower: &lower, upper: &upper }), 0.0);
+            let mut zero = Sampled {
+                values: &[],
+                n: 1,
+                t0: 0.0,
+                dt: 1e-3,
+                linear: false,
+            };
+            let (o, q, qd) = run_with(
+                &model,
+                method,
+                1e-3,
+                1000,
+                &mut zero,
+                Some(Limits {
+                    lower: &lower,
+                    upper: &upper,
+                }),
+                0.0,
+            );
             assert!(o.failure.is_none());
             assert!(q.iter().all(|x| (-0.3..=0.3).contains(x)), "{method:?} left its limits");
             // it falls onto the lower stop and rests there
-            assert!((q[1000] + 0.3).abs() < 1e-12 && qd[1000] == 0.0, "{method:?}: q(T) = {}, qd(T) = {}", q[1000], qd[1000]);
+            assert!(
+                (q[1000] + 0.3).abs() < 1e-12 && qd[1000] == 0.0,
+                "{method:?}: q(T) = {}, qd(T) = {}",
+                q[1000],
+                qd[1000]
+            );
             let (_, q, _) = run_with(&model, method, 1e-3, 1000, &mut zero, None, 0.0);
             assert!(q.iter().any(|x| *x < -0.3), "{method:?} without limits passes through");
         }
-        let mut zero = Sampled { values: &[], n: 1, t0: 0.0, dt: 1e-3, linear: false };
-        let settings = Settings { method: Method::Rk4, dt: 1e-3, steps: 1, t0: 0.0, record_every: 1, hold: false, max_speed: 1e6, limits: Some(Limits { lower: &[1.0], upper: &[0.0] }) };
+        let mut zero = Sampled {
+            values: &[],
+            n: 1,
+            t0: 0.0,
+            dt: 1e-3,
+            linear: false,
+        };
+        let settings = Settings {
+            method: Method::Rk4,
+            dt: 1e-3,
+            steps: 1,
+            t0: 0.0,
+            record_every: 1,
+            hold: false,
+            max_speed: 1e6,
+            limits: Some(Limits {
+                lower: &[1.0],
+                upper: &[0.0],
+            }),
+        };
         let mut v = vec![0.0; 2];
         let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
-        let r = integrate(&model, &mut Data::new(&model), &settings, &[0.0], &[0.0], &mut zero, Record { q: &mut v, qd: &mut a, qdd: &mut b, tau: &mut c });
+        let r = integrate(
+            &model,
+            &mut Data::new(&model),
+            &settings,
+            &[0.0],
+            &[0.0],
+            &mut zero,
+            Record {
+                q: &mut v,
+                qd: &mut a,
+                qdd: &mut b,
+                tau: &mut c,
+            },
+        );
         assert!(matches!(r, Err(Error::InvalidInput(_))));
     }
 }

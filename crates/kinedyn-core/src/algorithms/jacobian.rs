@@ -45,7 +45,15 @@ fn express(reference: Reference, world_from_frame: &Transform, local: &Motion) -
 
 /// The Jacobian of `frame` (or of a point fixed in it) at `q`, written row-major `6 x n` to `out`.
 #[inline(always)]
-pub fn frame_jacobian<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], frame: usize, reference: Reference, point: Option<&Vec3>, out: &mut [T]) {
+pub fn frame_jacobian<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    q: &[T],
+    frame: usize,
+    reference: Reference,
+    point: Option<&Vec3>,
+    out: &mut [T],
+) {
     let n = model.n;
     out[..6 * n].fill(T::zero());
     forward_kinematics(model, data, q);
@@ -68,26 +76,53 @@ pub fn frame_jacobian<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], frame
 }
 
 /// Twist `J qd` of `frame` (or a point fixed in it), by the recursive velocity pass.
-pub fn frame_velocity(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], frame: usize, reference: Reference, point: Option<&Vec3>) -> Motion {
+pub fn frame_velocity(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    frame: usize,
+    reference: Reference,
+    point: Option<&Vec3>,
+) -> Motion {
     forward_velocity(model, data, q, qd);
-    let Some(body) = model.frames[frame].body else { return Motion::zero() };
+    let Some(body) = model.frames[frame].body else {
+        return Motion::zero();
+    };
     let body_from_frame = body_from_point(model, frame, point);
     let world_from_frame = data.world_from_body[body] * body_from_frame;
-    express(reference, &world_from_frame, &body_from_frame.inv_act_motion(&data.v[body]))
+    express(
+        reference,
+        &world_from_frame,
+        &body_from_frame.inv_act_motion(&data.v[body]),
+    )
 }
 
 /// Acceleration drift `dJ/dt qd`: the frame's acceleration at `qdd = 0`, as the time derivative
 /// of `J qd` in the chosen reference. In `World` it is the classical acceleration of the origin,
 /// `R (a_lin + w x v)` (the spatial acceleration plus the `w x v` term), and `R a_ang`.
-pub fn jacobian_dot_qd(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], frame: usize, reference: Reference, point: Option<&Vec3>) -> Motion {
+pub fn jacobian_dot_qd(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    frame: usize,
+    reference: Reference,
+    point: Option<&Vec3>,
+) -> Motion {
     forward_acceleration(model, data, q, qd, None);
-    let Some(body) = model.frames[frame].body else { return Motion::zero() };
+    let Some(body) = model.frames[frame].body else {
+        return Motion::zero();
+    };
     let body_from_frame = body_from_point(model, frame, point);
     let world_from_frame = data.world_from_body[body] * body_from_frame;
     let v = body_from_frame.inv_act_motion(&data.v[body]);
     let a = body_from_frame.inv_act_motion(&data.a[body]);
     match reference {
-        Reference::World => Motion::new(world_from_frame.rot * (a.lin + v.ang.cross(&v.lin)), world_from_frame.rot * a.ang),
+        Reference::World => Motion::new(
+            world_from_frame.rot * (a.lin + v.ang.cross(&v.lin)),
+            world_from_frame.rot * a.ang,
+        ),
         _ => express(reference, &world_from_frame, &a),
     }
 }
@@ -124,7 +159,15 @@ pub fn frame_pose_at(model: &Model, data: &mut Data, q: &[f64], frame: usize) ->
 /// diag(R^T, R^T) (dJ_j/dq_i - [w_i x Jv_j; w_i x w_j])`, which is 0 for `i <= j` and
 /// `[R^T (w_j x Jv_i - w_i x Jv_j); R^T (w_j x w_i)]` for `j < i`.
 /// Columns of joints that do not support the frame's body are zero, as are their derivatives.
-pub fn frame_jacobian_hessian(model: &Model, data: &mut Data, q: &[f64], frame: usize, reference: Reference, point: Option<&Vec3>, out: &mut [f64]) {
+pub fn frame_jacobian_hessian(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    frame: usize,
+    reference: Reference,
+    point: Option<&Vec3>,
+    out: &mut [f64],
+) {
     let n = model.n;
     out[..6 * n * n].fill(0.0);
     forward_kinematics(model, data, q);
@@ -133,8 +176,14 @@ pub fn frame_jacobian_hessian(model: &Model, data: &mut Data, q: &[f64], frame: 
     let (r, p) = (world_from_frame.rot, world_from_frame.trans);
     let support = &model.support[body];
     // spatial columns S_j and World columns J_j of the supporting joints, in support (chain) order
-    let spatial: Vec<Motion> = support.iter().map(|&j| data.world_from_body[j].act_motion(&data.s[j])).collect();
-    let world: Vec<Motion> = spatial.iter().map(|s| Motion::new(s.lin + s.ang.cross(&p), s.ang)).collect();
+    let spatial: Vec<Motion> = support
+        .iter()
+        .map(|&j| data.world_from_body[j].act_motion(&data.s[j]))
+        .collect();
+    let world: Vec<Motion> = spatial
+        .iter()
+        .map(|s| Motion::new(s.lin + s.ang.cross(&p), s.ang))
+        .collect();
     let rt = r.transpose();
     let mut put = |i: usize, j: usize, h: Motion| {
         for (k, value) in h.to_array().iter().enumerate() {
@@ -152,7 +201,10 @@ pub fn frame_jacobian_hessian(model: &Model, data: &mut Data, q: &[f64], frame: 
                 Reference::Spatial if i_supports_j => spatial[a].cross_motion(&spatial[b]),
                 Reference::Spatial => continue,
                 Reference::Local if i_supports_j => continue,
-                Reference::Local => Motion::new(rt * (wj.cross(&world[a].lin) - wi.cross(&world[b].lin)), rt * wj.cross(&wi)),
+                Reference::Local => Motion::new(
+                    rt * (wj.cross(&world[a].lin) - wi.cross(&world[b].lin)),
+                    rt * wj.cross(&wi),
+                ),
             };
             put(i, j, h);
         }

@@ -4,8 +4,8 @@
 //! `v_i = ^iX_p v_p + S_i qd_i`, `a_i = ^iX_p a_p + S_i qdd_i + v_i x S_i qd_i`.
 
 use crate::data::Data;
-use crate::model::{Coordinates, Model};
 use crate::joint::JointKind;
+use crate::model::{Coordinates, Model};
 use crate::spatial::{AxisRotation, Inertia, Real, Transform};
 
 /// Joint coordinate seen by `jcalc`: q plus the model's offset (0 for the bodies of a multi-DOF
@@ -64,7 +64,12 @@ pub fn parent_from_body_trig<T: Real>(model: &Model, q: &[T], sin: &[T], cos: &[
             return model.parent_from_joint[i].splat() * model.block_transform(i, block, &q[at..at + block.nq()]);
         }
     }
-    model.joints[i].compose_trig(&model.parent_from_joint[i], joint_coordinate(model, q, i), sin[i], cos[i])
+    model.joints[i].compose_trig(
+        &model.parent_from_joint[i],
+        joint_coordinate(model, q, i),
+        sin[i],
+        cos[i],
+    )
 }
 
 /// `^λX_i^* I ^iX_λ`: an inertia given in body i's frame, expressed in its parent's, where
@@ -74,9 +79,18 @@ pub fn parent_from_body_trig<T: Real>(model: &Model, q: &[T], sin: &[T], cos: &[
 /// `R_T` is the identity or about a coordinate axis (DH tables, most URDFs), the two factors are
 /// applied one after the other, 17 products each (`Inertia::rotated_about`) instead of 54.
 #[inline(always)]
-pub fn inertia_to_parent<T: Real>(model: &Model, i: usize, x: &Transform<T>, s: T, c: T, inertia: &Inertia<T>) -> Inertia<T> {
+pub fn inertia_to_parent<T: Real>(
+    model: &Model,
+    i: usize,
+    x: &Transform<T>,
+    s: T,
+    c: T,
+    inertia: &Inertia<T>,
+) -> Inertia<T> {
     let (joint, placement) = (&model.joints[i], &model.placement_rotation[i]);
-    if matches!(placement, AxisRotation::General) || (!model.plain && matches!(model.coordinates[i], Coordinates::Head { .. })) {
+    if matches!(placement, AxisRotation::General)
+        || (!model.plain && matches!(model.coordinates[i], Coordinates::Head { .. }))
+    {
         return x.act_inertia(inertia);
     }
     let a = &joint.axis;
@@ -87,7 +101,9 @@ pub fn inertia_to_parent<T: Real>(model: &Model, i: usize, x: &Transform<T>, s: 
         JointKind::Revolute if a.x == 0.0 && a.z == 0.0 => inertia.rotated_about::<2, 0>(c, s * T::splat(a.y)),
         JointKind::Revolute => return x.act_inertia(inertia),
     };
-    placement.rotate_inertia(&model.parent_from_joint[i].rot, &in_joint_frame).translated(&x.trans)
+    placement
+        .rotate_inertia(&model.parent_from_joint[i].rot, &in_joint_frame)
+        .translated(&x.trans)
 }
 
 /// Fills `data.parent_from_body` at `q` (RBDA's `X_J X_T`, inverted), every joint's trigonometry first.
@@ -107,7 +123,11 @@ pub fn joint_transforms<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
 pub fn forward_kinematics<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     joint_transforms(model, data, q);
     let n = model.n;
-    let (parent, x_up, world) = (&model.parent[..n], &data.parent_from_body[..n], &mut data.world_from_body[..n]);
+    let (parent, x_up, world) = (
+        &model.parent[..n],
+        &data.parent_from_body[..n],
+        &mut data.world_from_body[..n],
+    );
     for i in 0..n {
         world[i] = match parent[i] {
             Some(p) => world[p] * x_up[i],

@@ -17,12 +17,12 @@
 //! subtree that coordinate j moves times its axis, `I^c_j s_j` (world coordinates, about the
 //! origin), with the moment moved to the centre of mass: `n_G = n_O - c x f`.
 
+use super::kinematics::forward_kinematics as fk;
 use super::kinematics::{forward_kinematics, forward_velocity};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::{Force, Vec3};
-use super::kinematics::forward_kinematics as fk;
 
 /// Centre of mass of the moving bodies, base coordinates; an error if their total mass is zero.
 pub fn center_of_mass(model: &Model, data: &mut Data, q: &[f64]) -> Result<Vec3> {
@@ -36,7 +36,9 @@ pub fn center_of_mass(model: &Model, data: &mut Data, q: &[f64]) -> Result<Vec3>
         h += x.rot * inertia.h + inertia.mass * x.trans;
     }
     if !(m > 0.0) {
-        return Err(Error::InvalidModel("the centre of mass is undefined: the moving bodies have zero total mass".into()));
+        return Err(Error::InvalidModel(
+            "the centre of mass is undefined: the moving bodies have zero total mass".into(),
+        ));
     }
     Ok(h / m)
 }
@@ -45,7 +47,9 @@ pub fn center_of_mass(model: &Model, data: &mut Data, q: &[f64]) -> Result<Vec3>
 pub fn spatial_momentum(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) -> Force {
     forward_velocity(model, data, q, qd);
     // h = sum_i ^0X_i^* (I_i v_i)
-    (0..model.n).fold(Force::zero(), |acc, i| acc + data.world_from_body[i].act_force(&model.inertia[i].mul_motion(&data.v[i])))
+    (0..model.n).fold(Force::zero(), |acc, i| {
+        acc + data.world_from_body[i].act_force(&model.inertia[i].mul_motion(&data.v[i]))
+    })
 }
 
 /// The centroidal momentum matrix `A_G` (6 x n, row-major, `[linear; angular about the centre of
@@ -73,13 +77,22 @@ pub fn centroidal_momentum_matrix(model: &Model, data: &mut Data, q: &[f64], out
         }
     }
     if !(mass > 0.0) {
-        return Err(Error::InvalidModel("the centre of mass is undefined: the moving bodies have zero total mass".into()));
+        return Err(Error::InvalidModel(
+            "the centre of mass is undefined: the moving bodies have zero total mass".into(),
+        ));
     }
     let c = first_moment / mass;
     for j in 0..n {
         // A_G[:, j] = (f, n_O - c x f) with (f, n_O) = I^c_j s_j
         let f = data.ic_w[j].mul_motion(&data.s_w[j]);
-        let column = [f.lin.x, f.lin.y, f.lin.z, f.ang.x - (c.y * f.lin.z - c.z * f.lin.y), f.ang.y - (c.z * f.lin.x - c.x * f.lin.z), f.ang.z - (c.x * f.lin.y - c.y * f.lin.x)];
+        let column = [
+            f.lin.x,
+            f.lin.y,
+            f.lin.z,
+            f.ang.x - (c.y * f.lin.z - c.z * f.lin.y),
+            f.ang.y - (c.z * f.lin.x - c.x * f.lin.z),
+            f.ang.z - (c.x * f.lin.y - c.y * f.lin.x),
+        ];
         for (r, value) in column.iter().enumerate() {
             out[r * n + j] = *value;
         }

@@ -30,7 +30,10 @@ fn body_columns<T: Real>(v: &Motion<T>, a: &Motion<T>) -> [Force<T>; 10] {
     for k in 0..3 {
         let e = splat3::<T>(&Vec3::ith(k, 1.0));
         let we = cross(w, &e);
-        cols[1 + k] = Force::new(cross(aw, &e) + cross(w, &we), cross(&e, al) + cross(w, &cross(&e, vl)) + cross(vl, &we));
+        cols[1 + k] = Force::new(
+            cross(aw, &e) + cross(w, &we),
+            cross(&e, al) + cross(w, &cross(&e, vl)) + cross(vl, &we),
+        );
     }
     // I_o = E (Ixx, Ixy, Iyy, Ixz, Iyz, Izz): f = [0; E a_w + w x (E w)]
     const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)];

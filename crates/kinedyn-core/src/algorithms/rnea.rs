@@ -36,21 +36,42 @@ pub struct RneaTerms {
 }
 
 impl RneaTerms {
-    pub const ALL: Self = Self { gravity: true, drives: true };
-    pub const RIGID: Self = Self { gravity: true, drives: false };
+    pub const ALL: Self = Self {
+        gravity: true,
+        drives: true,
+    };
+    pub const RIGID: Self = Self {
+        gravity: true,
+        drives: false,
+    };
 }
 
 /// `tau = rnea(q, qd, qdd, f_ext)` with gravity, friction and armature (written to `data.tau`).
 ///
 /// `f_ext`: `n * 6` numbers, per body `[force; moment]` in base axes about the body-frame origin.
 #[inline(always)]
-pub fn rnea<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>) -> &'d [T] {
+pub fn rnea<'d, T: Real>(
+    model: &Model,
+    data: &'d mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    f_ext: Option<&[T]>,
+) -> &'d [T] {
     rnea_with(model, data, q, qd, qdd, f_ext, RneaTerms::ALL)
 }
 
 /// RNEA with a choice of terms (the bias `C qd + g` is `rnea_with(q, qd, 0, None, RIGID)`).
 #[inline(always)]
-pub fn rnea_with<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd: &[T], qdd: &[T], f_ext: Option<&[T]>, terms: RneaTerms) -> &'d [T] {
+pub fn rnea_with<'d, T: Real>(
+    model: &Model,
+    data: &'d mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    f_ext: Option<&[T]>,
+    terms: RneaTerms,
+) -> &'d [T] {
     let n = model.n;
     if f_ext.is_some() {
         // world_from_body rotations are needed to bring f_ext into body axes
@@ -61,9 +82,18 @@ pub fn rnea_with<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd:
     // every per-body array sliced to n once: the loops below index them without bounds checks
     let (parent, joints, inertia) = (&model.parent[..n], &model.joints[..n], &model.inertia[..n]);
     let (qd, qdd) = (&qd[..n], &qdd[..n]);
-    let (x_up, v, a, f) = (&mut data.parent_from_body[..n], &mut data.v[..n], &mut data.a[..n], &mut data.f[..n]);
+    let (x_up, v, a, f) = (
+        &mut data.parent_from_body[..n],
+        &mut data.v[..n],
+        &mut data.a[..n],
+        &mut data.f[..n],
+    );
     // a_0 = -g (a fictitious upward acceleration of the base replaces gravity)
-    let a0 = if terms.gravity { Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros()) } else { Motion::zero() };
+    let a0 = if terms.gravity {
+        Motion::new(-splat3::<T>(&model.gravity), Vec3::zeros())
+    } else {
+        Motion::zero()
+    };
     for i in 0..n {
         // X_J, s = jcalc(q_i);  ^iX_λ = X_J X_T (stored as its inverse, parent_from_body)
         let x = x_up[i];
@@ -80,7 +110,10 @@ pub fn rnea_with<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T], qd:
         let mut fi = body.mul_motion(&ai) + vi.cross_force(&body.mul_motion(&vi));
         if let Some(fx) = f_ext {
             let r = &data.world_from_body[i].rot;
-            let fw = Force::new(Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]), Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+            let fw = Force::new(
+                Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
+                Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
+            );
             fi -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
         }
         v[i] = vi;

@@ -16,7 +16,11 @@ pub struct ArticulatedInertia<T: Real = f64> {
 impl<T: Real> Default for ArticulatedInertia<T> {
     #[inline(always)]
     fn default() -> Self {
-        Self { a: Mat3::zeros(), b: Mat3::zeros(), c: Mat3::zeros() }
+        Self {
+            a: Mat3::zeros(),
+            b: Mat3::zeros(),
+            c: Mat3::zeros(),
+        }
     }
 }
 
@@ -38,7 +42,10 @@ impl<T: Real> ArticulatedInertia<T> {
     /// `IA m`.
     #[inline(always)]
     pub fn mul_motion(&self, m: &Motion<T>) -> Force<T> {
-        Force::new(mv(&self.a, &m.lin) + mv(&self.b, &m.ang), mtv(&self.b, &m.lin) + mv(&self.c, &m.ang))
+        Force::new(
+            mv(&self.a, &m.lin) + mv(&self.b, &m.ang),
+            mtv(&self.b, &m.lin) + mv(&self.c, &m.ang),
+        )
     }
     /// `IA s` for a joint's subspace: revolute `s = [0; a]` gives `[b a; c a]`, prismatic
     /// `s = [a; 0]` gives `[a_blk a; b^T a]` (half the work of a general product).
@@ -55,7 +62,11 @@ impl<T: Real> ArticulatedInertia<T> {
     pub fn sub_rank_one(&self, u: &Force<T>, d_inv: T) -> Self {
         let ul = u.lin * d_inv;
         let ua = u.ang * d_inv;
-        Self { a: self.a - outer(&ul, &u.lin), b: self.b - outer(&ul, &u.ang), c: self.c - outer(&ua, &u.ang) }
+        Self {
+            a: self.a - outer(&ul, &u.lin),
+            b: self.b - outer(&ul, &u.ang),
+            c: self.c - outer(&ua, &u.ang),
+        }
     }
     /// Trace of the 6x6 matrix (a scale for singularity tests; >= 0 for a positive semidefinite IA).
     #[inline(always)]
@@ -81,7 +92,11 @@ impl<T: Real> Transform<T> {
         let at = -cross_columns(t, &ra).transpose();
         let tb = cross_columns(t, &rb);
         let tat = cross_columns(t, &at);
-        ArticulatedInertia { a: ra, b: rb - at, c: rc + tb + tb.transpose() - tat }
+        ArticulatedInertia {
+            a: ra,
+            b: rb - at,
+            c: rc + tb + tb.transpose() - tat,
+        }
     }
 }
 

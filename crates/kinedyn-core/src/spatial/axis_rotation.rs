@@ -7,9 +7,18 @@ use super::{Inertia, Mat3, Real};
 pub enum AxisRotation {
     Identity,
     /// About x, y or z by the angle with cosine `c` and sine `s`.
-    X { c: f64, s: f64 },
-    Y { c: f64, s: f64 },
-    Z { c: f64, s: f64 },
+    X {
+        c: f64,
+        s: f64,
+    },
+    Y {
+        c: f64,
+        s: f64,
+    },
+    Z {
+        c: f64,
+        s: f64,
+    },
     General,
 }
 
@@ -24,7 +33,10 @@ impl AxisRotation {
         // about axis k with (i, j) its cyclic successors: column/row k is e_k, the (i, j) block [[c, -s], [s, c]]
         let about = |i: usize, j: usize, k: usize| {
             let (c, s) = (r[(i, i)], r[(j, i)]);
-            let axis_fixed = near(r[(k, k)], 1.0) && [r[(i, k)], r[(j, k)], r[(k, i)], r[(k, j)]].iter().all(|&x| near(x, 0.0));
+            let axis_fixed = near(r[(k, k)], 1.0)
+                && [r[(i, k)], r[(j, k)], r[(k, i)], r[(k, j)]]
+                    .iter()
+                    .all(|&x| near(x, 0.0));
             (axis_fixed && near(r[(j, j)], c) && near(r[(i, j)], -s)).then_some((c, s))
         };
         if (r - Mat3::identity()).abs().max() <= Self::TOL {
@@ -60,7 +72,11 @@ mod tests {
     use crate::spatial::Vec3;
 
     fn inertia() -> Inertia {
-        Inertia::new(2.5, Vec3::new(0.3, -0.2, 0.7), Mat3::new(3.0, 0.4, -0.5, 0.4, 2.0, 0.6, -0.5, 0.6, 1.5))
+        Inertia::new(
+            2.5,
+            Vec3::new(0.3, -0.2, 0.7),
+            Mat3::new(3.0, 0.4, -0.5, 0.4, 2.0, 0.6, -0.5, 0.6, 1.5),
+        )
     }
 
     /// Every class rotates an inertia as the full `R I R^T` does, and is recognised in the
@@ -82,7 +98,10 @@ mod tests {
                 let class = AxisRotation::classify(&r);
                 assert!(expected(&class), "{axis:?} {angle}: {class:?}");
                 let (got, full) = (class.rotate_inertia(&r, &inertia()), inertia().rotated(&r));
-                assert!((got.i_o - full.i_o).abs().max() < 1e-14 && (got.h - full.h).abs().max() < 1e-15, "{axis:?} {angle}");
+                assert!(
+                    (got.i_o - full.i_o).abs().max() < 1e-14 && (got.h - full.h).abs().max() < 1e-15,
+                    "{axis:?} {angle}"
+                );
             }
         }
         assert_eq!(AxisRotation::classify(&Mat3::identity()), AxisRotation::Identity);

@@ -29,7 +29,18 @@ impl Inertia {
     }
     pub fn to_parameters(&self) -> [f64; 10] {
         let i = &self.i_o;
-        [self.mass, self.h.x, self.h.y, self.h.z, i[(0, 0)], i[(0, 1)], i[(1, 1)], i[(0, 2)], i[(1, 2)], i[(2, 2)]]
+        [
+            self.mass,
+            self.h.x,
+            self.h.y,
+            self.h.z,
+            i[(0, 0)],
+            i[(0, 1)],
+            i[(1, 1)],
+            i[(0, 2)],
+            i[(1, 2)],
+            i[(2, 2)],
+        ]
     }
     /// This constant inertia broadcast to every lane of `T`.
     #[inline(always)]
@@ -50,7 +61,10 @@ impl<T: Real> Inertia<T> {
     /// Momentum `I v` of a body moving with twist `v`: `[m v_o - h x w; I_o w + h x v_o]`.
     #[inline(always)]
     pub fn mul_motion(&self, v: &Motion<T>) -> Force<T> {
-        Force::new(v.lin * self.mass - cross(&self.h, &v.ang), mv(&self.i_o, &v.ang) + cross(&self.h, &v.lin))
+        Force::new(
+            v.lin * self.mass - cross(&self.h, &v.ang),
+            mv(&self.i_o, &v.ang) + cross(&self.h, &v.lin),
+        )
     }
     /// Kinetic energy `1/2 v . I v`.
     #[inline(always)]

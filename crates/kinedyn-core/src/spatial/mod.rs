@@ -119,20 +119,50 @@ pub fn mtv<T: Real>(m: &Mat3<T>, v: &Vec3<T>) -> Vec3<T> {
 #[inline(always)]
 pub fn mm<T: Real>(a: &Mat3<T>, b: &Mat3<T>) -> Mat3<T> {
     let e = |i: usize, j: usize| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)];
-    Mat3::new(e(0, 0), e(0, 1), e(0, 2), e(1, 0), e(1, 1), e(1, 2), e(2, 0), e(2, 1), e(2, 2))
+    Mat3::new(
+        e(0, 0),
+        e(0, 1),
+        e(0, 2),
+        e(1, 0),
+        e(1, 1),
+        e(1, 2),
+        e(2, 0),
+        e(2, 1),
+        e(2, 2),
+    )
 }
 
 /// `a b^T`.
 #[inline(always)]
 pub fn mmt<T: Real>(a: &Mat3<T>, b: &Mat3<T>) -> Mat3<T> {
     let e = |i: usize, j: usize| a[(i, 0)] * b[(j, 0)] + a[(i, 1)] * b[(j, 1)] + a[(i, 2)] * b[(j, 2)];
-    Mat3::new(e(0, 0), e(0, 1), e(0, 2), e(1, 0), e(1, 1), e(1, 2), e(2, 0), e(2, 1), e(2, 2))
+    Mat3::new(
+        e(0, 0),
+        e(0, 1),
+        e(0, 2),
+        e(1, 0),
+        e(1, 1),
+        e(1, 2),
+        e(2, 0),
+        e(2, 1),
+        e(2, 2),
+    )
 }
 
 /// `u v^T`.
 #[inline(always)]
 pub fn outer<T: Real>(u: &Vec3<T>, v: &Vec3<T>) -> Mat3<T> {
-    Mat3::new(u.x * v.x, u.x * v.y, u.x * v.z, u.y * v.x, u.y * v.y, u.y * v.z, u.z * v.x, u.z * v.y, u.z * v.z)
+    Mat3::new(
+        u.x * v.x,
+        u.x * v.y,
+        u.x * v.z,
+        u.y * v.x,
+        u.y * v.y,
+        u.y * v.z,
+        u.z * v.x,
+        u.z * v.y,
+        u.z * v.z,
+    )
 }
 
 /// A model constant (f64) broadcast to every lane of `T`.
@@ -146,5 +176,15 @@ pub fn splat3<T: Real>(v: &Vec3) -> Vec3<T> {
 pub fn splat33<T: Real>(m: &Mat3) -> Mat3<T> {
     // written out, not `m.map(T::splat)`: for f64 a plain copy the optimiser can drop
     let e = |i: usize, j: usize| T::splat(m[(i, j)]);
-    Mat3::new(e(0, 0), e(0, 1), e(0, 2), e(1, 0), e(1, 1), e(1, 2), e(2, 0), e(2, 1), e(2, 2))
+    Mat3::new(
+        e(0, 0),
+        e(0, 1),
+        e(0, 2),
+        e(1, 0),
+        e(1, 1),
+        e(1, 2),
+        e(2, 0),
+        e(2, 1),
+        e(2, 2),
+    )
 }

@@ -44,12 +44,18 @@ impl<T: Real> Motion<T> {
     /// `self x m` (RBDA eq. 2.31): `[w x m_lin + v x m_ang; w x m_ang]`.
     #[inline(always)]
     pub fn cross_motion(&self, m: &Motion<T>) -> Motion<T> {
-        Motion::new(cross(&self.ang, &m.lin) + cross(&self.lin, &m.ang), cross(&self.ang, &m.ang))
+        Motion::new(
+            cross(&self.ang, &m.lin) + cross(&self.lin, &m.ang),
+            cross(&self.ang, &m.ang),
+        )
     }
     /// `self x* f` (RBDA eq. 2.32): `[w x f_lin; w x f_ang + v x f_lin]`.
     #[inline(always)]
     pub fn cross_force(&self, f: &Force<T>) -> Force<T> {
-        Force::new(cross(&self.ang, &f.lin), cross(&self.ang, &f.ang) + cross(&self.lin, &f.lin))
+        Force::new(
+            cross(&self.ang, &f.lin),
+            cross(&self.ang, &f.ang) + cross(&self.lin, &f.lin),
+        )
     }
     /// Power `m . f` of a force on a motion.
     #[inline(always)]

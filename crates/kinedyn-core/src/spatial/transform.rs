@@ -35,10 +35,22 @@ impl Transform {
     pub fn to_homogeneous(&self) -> [f64; 16] {
         let (r, t) = (&self.rot, &self.trans);
         [
-            r[(0, 0)], r[(0, 1)], r[(0, 2)], t.x,
-            r[(1, 0)], r[(1, 1)], r[(1, 2)], t.y,
-            r[(2, 0)], r[(2, 1)], r[(2, 2)], t.z,
-            0.0, 0.0, 0.0, 1.0,
+            r[(0, 0)],
+            r[(0, 1)],
+            r[(0, 2)],
+            t.x,
+            r[(1, 0)],
+            r[(1, 1)],
+            r[(1, 2)],
+            t.y,
+            r[(2, 0)],
+            r[(2, 1)],
+            r[(2, 2)],
+            t.z,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
         ]
     }
 }
@@ -71,7 +83,10 @@ impl<T: Real> Transform<T> {
     /// A motion given in a's frame, expressed in b's (RBDA's `^B X_A m`).
     #[inline(always)]
     pub fn inv_act_motion(&self, m: &Motion<T>) -> Motion<T> {
-        Motion::new(mtv(&self.rot, &(m.lin - cross(&self.trans, &m.ang))), mtv(&self.rot, &m.ang))
+        Motion::new(
+            mtv(&self.rot, &(m.lin - cross(&self.trans, &m.ang))),
+            mtv(&self.rot, &m.ang),
+        )
     }
     /// A force given in b's frame, expressed in a's: `f_a = R f_b`, `n_a = R n_b + t x f_a`.
     #[inline(always)]
@@ -82,7 +97,10 @@ impl<T: Real> Transform<T> {
     /// A force given in a's frame, expressed in b's (RBDA's `^B X_A^* f`).
     #[inline(always)]
     pub fn inv_act_force(&self, f: &Force<T>) -> Force<T> {
-        Force::new(mtv(&self.rot, &f.lin), mtv(&self.rot, &(f.ang - cross(&self.trans, &f.lin))))
+        Force::new(
+            mtv(&self.rot, &f.lin),
+            mtv(&self.rot, &(f.ang - cross(&self.trans, &f.lin))),
+        )
     }
     /// A rigid-body inertia given in b's frame, expressed in a's (RBDA eq. 2.66).
     #[inline(always)]

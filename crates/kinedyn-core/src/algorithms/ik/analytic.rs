@@ -80,7 +80,10 @@ impl Structure {
     }
     /// Whether the structure solves a position-only target (else it needs a full pose).
     pub fn solves_position(&self) -> bool {
-        matches!(self, Structure::Planar2R | Structure::ArmIntersecting | Structure::ArmParallel)
+        matches!(
+            self,
+            Structure::Planar2R | Structure::ArmIntersecting | Structure::ArmParallel
+        )
     }
 }
 
@@ -148,7 +151,14 @@ impl AnalyticIk {
             .max(1.0);
         let tol = GEOMETRY_TOL * size;
         let rev = |i: usize| screws.get(i).and_then(|s| s.axis()).copied();
-        let mut me = Self { structure: Structure::Planar2R, arm: None, screws: screws.clone(), home, shoulder: Vec3::zeros(), wrist: Vec3::zeros() };
+        let mut me = Self {
+            structure: Structure::Planar2R,
+            arm: None,
+            screws: screws.clone(),
+            home,
+            shoulder: Vec3::zeros(),
+            wrist: Vec3::zeros(),
+        };
         // an arm on joints 0..3 moving the point p0
         let arm = |p0: &Vec3| -> Option<(Structure, Vec3)> {
             let (a0, a1) = (rev(0)?, rev(1)?);
@@ -162,7 +172,11 @@ impl AnalyticIk {
                 }
             }
             let a2 = rev(2)?;
-            if parallel(&a1.w, &a2.w) && !parallel(&a0.w, &a1.w) && distance_to_line(&a1, &a2.r) > tol && distance_to_line(&a2, p0) > tol {
+            if parallel(&a1.w, &a2.w)
+                && !parallel(&a0.w, &a1.w)
+                && distance_to_line(&a1, &a2.r) > tol
+                && distance_to_line(&a2, p0) > tol
+            {
                 return Some((Structure::ArmParallel, Vec3::zeros()));
             }
             None
@@ -170,7 +184,10 @@ impl AnalyticIk {
         match n {
             2 => {
                 let (a0, a1) = (rev(0)?, rev(1)?);
-                if parallel(&a0.w, &a1.w) && distance_to_line(&a0, &a1.r) > tol && distance_to_line(&a1, &home.trans) > tol {
+                if parallel(&a0.w, &a1.w)
+                    && distance_to_line(&a0, &a1.r) > tol
+                    && distance_to_line(&a1, &home.trans) > tol
+                {
                     me.structure = Structure::Planar2R;
                     return Some(me);
                 }
@@ -208,7 +225,11 @@ impl AnalyticIk {
                 }
                 // three parallel axes 2, 3, 4; axes 5 and 6 meet
                 let (a0, a1, a2) = (rev(0)?, rev(1)?, rev(2)?);
-                if parallel(&a1.w, &a2.w) && parallel(&a2.w, &a3.w) && !parallel(&a0.w, &a1.w) && !parallel(&a4.w, &a1.w) {
+                if parallel(&a1.w, &a2.w)
+                    && parallel(&a2.w, &a3.w)
+                    && !parallel(&a0.w, &a1.w)
+                    && !parallel(&a4.w, &a1.w)
+                {
                     if let Some(w) = intersection(&a4, &a5, tol) {
                         if distance_to_line(&a2, &a1.r) > tol && distance_to_line(&a2, &a3.r) > tol {
                             me.structure = Structure::ThreeParallel;
@@ -244,7 +265,9 @@ impl AnalyticIk {
         match self.structure {
             Structure::Planar2R => self.planar_2r(0, &self.home.trans, &target.trans, [0.0; 6], reference, out),
             Structure::Planar3R => self.planar_3r(&g, reference, out),
-            Structure::ArmIntersecting | Structure::ArmParallel => self.arm(self.structure, &self.home.trans, &target.trans, reference, out),
+            Structure::ArmIntersecting | Structure::ArmParallel => {
+                self.arm(self.structure, &self.home.trans, &target.trans, reference, out)
+            }
             Structure::SphericalWrist => self.spherical_wrist(&g, reference, out),
             Structure::ThreeParallel => self.three_parallel(&g, reference, out),
         }
@@ -252,7 +275,15 @@ impl AnalyticIk {
 
     /// Joints i, i+1 (parallel axes) moving p0 to p: theta_{i+1} by subproblem 3 (distance from
     /// axis i is kept by joint i), then theta_i by subproblem 1 (free on axis i: the reference).
-    fn planar_2r(&self, i: usize, p0: &Vec3, p: &Vec3, prefix: [f64; 6], reference: &[f64], out: &mut Solutions) -> bool {
+    fn planar_2r(
+        &self,
+        i: usize,
+        p0: &Vec3,
+        p: &Vec3,
+        prefix: [f64; 6],
+        reference: &[f64],
+        out: &mut Solutions,
+    ) -> bool {
         let (a0, a1) = (self.axis(i), self.axis(i + 1));
         // |exp(xi_{i+1} theta) p0 - r_i| = |p - r_i|
         let t1 = sp3(&a1, p0, &a0.r, (p - a0.r).norm());
@@ -262,7 +293,11 @@ impl AnalyticIk {
             let t0 = sp1(&a0, &p1, p);
             singular |= t0.singular;
             let mut row = prefix;
-            row[i] = if t0.singular { reference.get(i).copied().unwrap_or(0.0) } else { t0.values[0] };
+            row[i] = if t0.singular {
+                reference.get(i).copied().unwrap_or(0.0)
+            } else {
+                t0.values[0]
+            };
             row[i + 1] = theta1;
             out.push(row);
         }
@@ -337,7 +372,11 @@ impl AnalyticIk {
                 singular |= t0.singular;
                 for &phi in t0.as_slice() {
                     // on axis 1 theta_1 is free: keep the reference
-                    let phi = if t0.singular { -reference.first().copied().unwrap_or(0.0) } else { phi };
+                    let phi = if t0.singular {
+                        -reference.first().copied().unwrap_or(0.0)
+                    } else {
+                        phi
+                    };
                     let theta0 = -phi;
                     let p1 = rotate_point(&a0, phi, p);
                     let prefix = [theta0, 0.0, 0.0, 0.0, 0.0, 0.0];
@@ -364,8 +403,18 @@ impl AnalyticIk {
         let w = self.wrist;
         // joints 4-6 fix w: exp(xi_1 theta_1) exp(xi_2 theta_2) exp(xi_3 theta_3) w = G w
         let mut arms = Vec::with_capacity(4);
-        let mut singular = self.arm(self.arm.expect("arm of a wrist"), &w, &g.act_point(&w), reference, &mut arms);
-        let (a3, a4, a5) = (Axis { r: w, ..self.axis(3) }, Axis { r: w, ..self.axis(4) }, Axis { r: w, ..self.axis(5) });
+        let mut singular = self.arm(
+            self.arm.expect("arm of a wrist"),
+            &w,
+            &g.act_point(&w),
+            reference,
+            &mut arms,
+        );
+        let (a3, a4, a5) = (
+            Axis { r: w, ..self.axis(3) },
+            Axis { r: w, ..self.axis(4) },
+            Axis { r: w, ..self.axis(5) },
+        );
         let p = w + a5.w; // on axis 6, not w
         let x = w + normal_to(&a5.w); // off axis 6
         for arm in &arms {
@@ -404,13 +453,21 @@ impl AnalyticIk {
         singular |= t0.singular;
         let x = normal_to(&w2);
         for &phi in t0.as_slice() {
-            let theta0 = if t0.singular { reference.first().copied().unwrap_or(0.0) } else { -phi };
+            let theta0 = if t0.singular {
+                reference.first().copied().unwrap_or(0.0)
+            } else {
+                -phi
+            };
             let r0 = axis_angle(&a0.w, theta0);
             // w2 . R5(theta_5) w6 = w2 . R1^T R_G w6
             let t4 = sp4(&w2, &a4.w, &a5.w, w2.dot(&(r0.transpose() * (g.rot * a5.w))));
             singular |= t4.singular;
             for &theta4 in t4.as_slice() {
-                let theta4 = if t4.singular { reference.get(4).copied().unwrap_or(0.0) } else { theta4 };
+                let theta4 = if t4.singular {
+                    reference.get(4).copied().unwrap_or(0.0)
+                } else {
+                    theta4
+                };
                 // R6 (R_G^T R1 w2) = R5^T w2
                 let v = g.rot.transpose() * (r0 * w2);
                 let u = rotate(&a4.w, -theta4, &w2);
@@ -426,7 +483,14 @@ impl AnalyticIk {
                 let phi234 = sp1_dir(&w2, &x, &(h.rot * x)).values[0];
                 let mut planar = Vec::with_capacity(2);
                 // e2 e3 r4 = H r4 (joint 4 fixes a point on its axis)
-                singular |= self.planar_2r(1, &a3.r, &h.act_point(&a3.r), [theta0, 0.0, 0.0, 0.0, theta4, theta5], reference, &mut planar);
+                singular |= self.planar_2r(
+                    1,
+                    &a3.r,
+                    &h.act_point(&a3.r),
+                    [theta0, 0.0, 0.0, 0.0, theta4, theta5],
+                    reference,
+                    &mut planar,
+                );
                 for mut row in planar {
                     row[3] = phi234 - row[1] - row[2];
                     out.push(row);

@@ -39,10 +39,18 @@ impl Angles {
         Self::default()
     }
     fn one(a: f64, singular: bool) -> Self {
-        Self { count: 1, values: [a, 0.0], singular }
+        Self {
+            count: 1,
+            values: [a, 0.0],
+            singular,
+        }
     }
     fn two(a: f64, b: f64) -> Self {
-        Self { count: 2, values: [a, b], singular: false }
+        Self {
+            count: 2,
+            values: [a, b],
+            singular: false,
+        }
     }
     pub fn as_slice(&self) -> &[f64] {
         &self.values[..self.count]
@@ -142,7 +150,11 @@ pub fn sp3(axis: &Axis, p: &Vec3, q: &Vec3, delta: f64) -> Angles {
     if nu <= TOL * scale || nv <= TOL * scale {
         // p (or q) on the axis: the distance does not depend on theta
         let d0 = (up - vp).norm_squared();
-        return if (d0 - dp2).abs() <= 1e-9 * scale * scale { Angles::one(0.0, true) } else { Angles::none() };
+        return if (d0 - dp2).abs() <= 1e-9 * scale * scale {
+            Angles::one(0.0, true)
+        } else {
+            Angles::none()
+        };
     }
     let theta0 = w.dot(&up.cross(&vp)).atan2(up.dot(&vp));
     let cosine = (nu * nu + nv * nv - dp2) / (2.0 * nu * nv);
@@ -170,7 +182,11 @@ pub fn sp4(h: &Vec3, w: &Vec3, p: &Vec3, d: f64) -> Angles {
     let rho = a.hypot(b);
     let scale = (p.norm() * h.norm()).max(d.abs()).max(1e-300);
     if rho <= TOL * scale {
-        return if c.abs() <= 1e-9 * scale { Angles::one(0.0, true) } else { Angles::none() };
+        return if c.abs() <= 1e-9 * scale {
+            Angles::one(0.0, true)
+        } else {
+            Angles::none()
+        };
     }
     let base = b.atan2(a);
     let cosine = c / rho;
@@ -194,7 +210,10 @@ mod tests {
 
     #[test]
     fn subproblem1_recovers_the_angle() {
-        let axis = Axis { w: unit(0.3, -0.2, 0.9), r: Vec3::new(0.1, 0.4, -0.3) };
+        let axis = Axis {
+            w: unit(0.3, -0.2, 0.9),
+            r: Vec3::new(0.1, 0.4, -0.3),
+        };
         let p = Vec3::new(1.0, 0.5, 0.2);
         for &theta in &[0.3, -2.0, 3.0] {
             let q = rotate_point(&axis, theta, &p);
@@ -207,8 +226,14 @@ mod tests {
     #[test]
     fn subproblem2_finds_both_pairs() {
         let r = Vec3::new(0.2, -0.1, 0.5);
-        let a1 = Axis { w: unit(0.0, 0.1, 1.0), r };
-        let a2 = Axis { w: unit(1.0, 0.2, 0.1), r };
+        let a1 = Axis {
+            w: unit(0.0, 0.1, 1.0),
+            r,
+        };
+        let a2 = Axis {
+            w: unit(1.0, 0.2, 0.1),
+            r,
+        };
         let p = Vec3::new(1.0, 0.7, -0.4);
         let q = rotate_point(&a1, 0.7, &rotate_point(&a2, -1.1, &p));
         let (pairs, count, _) = sp2(&a1, &a2, &p, &q);
@@ -224,7 +249,10 @@ mod tests {
 
     #[test]
     fn subproblem3_gives_the_distance() {
-        let axis = Axis { w: unit(0.1, 0.0, 1.0), r: Vec3::new(0.0, 0.3, 0.0) };
+        let axis = Axis {
+            w: unit(0.1, 0.0, 1.0),
+            r: Vec3::new(0.0, 0.3, 0.0),
+        };
         let (p, q) = (Vec3::new(1.0, 0.0, 0.2), Vec3::new(-0.5, 0.8, 0.6));
         let delta = (rotate_point(&axis, 1.2, &p) - q).norm();
         let s = sp3(&axis, &p, &q, delta);
