@@ -411,7 +411,7 @@ def test_python_reproduces_the_vectors_shared_with_the_rust_core():
 
     integrate_part, difference_part = shared.split("const DIFFERENCE_VECTORS")
     rows = re.findall(
-        r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*([-+.\deE]+),\s*&\[([^\]]*)\],?\s*\)", integrate_part
+        r"\(\s*Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*([-+.\deE]+),\s*&\[([^\]]*)\],?\s*\)", integrate_part
     )
     assert len(rows) == 16
     for kind, q, v, dt, expected in rows:
@@ -419,7 +419,7 @@ def test_python_reproduces_the_vectors_shared_with_the_rust_core():
         np.testing.assert_allclose(
             space.integrate(numbers(q), numbers(v), float(dt)), numbers(expected), atol=1e-15, rtol=0
         )
-    rows = re.findall(r"\(Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],?\s*\)", difference_part)
+    rows = re.findall(r"\(\s*Block::(\w+),\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],\s*&\[([^\]]*)\],?\s*\)", difference_part)
     assert len(rows) == 16
     for kind, q0, q1, expected in rows:
         space = cfg.ConfigurationSpace([Joint("j", kind=kinds[kind])])
