@@ -1,7 +1,8 @@
-"""What every ``kinedyn`` command shares: loading the robot (a built-in name or
-a robot file, with ``--set`` values, xacro arguments and a floating base, all passed explicitly as
-:class:`RobotOptions`), reading joint values, printing tables or JSON (docs/architecture.md, "Add a CLI command"). Argument values and
-output paths are in :mod:`kinedyn.cli.options`."""
+"""What every ``kinedyn`` command shares: loading the robot (a built-in name or a robot file, with
+``--set`` values, xacro arguments and a floating base, all passed explicitly as :class:`RobotOptions`
+built from the parsed command line), reading joint values, and printing tables or JSON
+(docs/architecture.md, "Add a CLI command"). Argument values and output paths are in
+:mod:`kinedyn.cli.options`, which ``kinedyn --help`` loads without this module."""
 
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ class RobotOptions:
         return cls(
             command,
             set_values((getattr(args, "set_global", None) or []) + (getattr(args, "set", None) or [])),
-            command not in SYMBOLIC_COMMANDS,
+            bool(command) and command not in SYMBOLIC_COMMANDS,
             dict(getattr(args, "xacro_args", None) or []),
             bool(getattr(args, "trust_xacro", False)),
             bool(getattr(args, "floating_base", False)),

@@ -10,7 +10,7 @@ from rich.table import Table
 from ...analysis.properties import check_properties, prove_properties
 from .. import app
 from ..app import console, emit, esc
-from ..options import nonnegative_int, positive_float, positive_int, robot_argument
+from ..options import EXIT_NO, EXIT_OK, nonnegative_int, positive_float, positive_int, robot_argument
 
 
 def add_arguments(p) -> None:
@@ -56,4 +56,4 @@ def run(args) -> int:
         c.print(t)
 
     emit(args, report.to_dict(), render)
-    return 0 if report.passed else 2
+    return EXIT_OK if report.passed else EXIT_NO

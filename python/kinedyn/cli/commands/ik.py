@@ -16,7 +16,7 @@ from ...configuration import COORDINATE_NAMES
 from ...ik.solve import METHODS, inverse_kinematics
 from .. import app
 from ..app import console, emit, esc, parse_q
-from ..options import finite_float, in_cli_terms
+from ..options import EXIT_NO, EXIT_OK, finite_float, in_cli_terms
 
 # the solver's messages name its Python arguments; on the command line they are these flags
 FLAG_PHRASES = {
@@ -141,7 +141,7 @@ def run(args) -> int:
         c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
 
     emit(args, payload, render)
-    return 0 if result.success else 2
+    return EXIT_OK if result.success else EXIT_NO
 
 
 def _coordinate_labels(robot) -> list:
