@@ -185,7 +185,7 @@ def test_dynamics_json_equals_the_library(capsys):
 def test_jsonable_converts_every_numpy_scalar():
     import json as _json
 
-    from kinedyn.cli import _jsonable
+    from kinedyn._ui.json import jsonable as _jsonable
 
     payload = {
         "b": np.bool_(True),
@@ -222,7 +222,7 @@ def test_simulate_energy_drift_has_a_scale_when_H0_is_zero(capsys):
 def test_simulate_energy_drift_at_rest_has_no_relative_value():
     from types import SimpleNamespace
 
-    from kinedyn.simulate.cli import _energy_drift
+    from kinedyn.cli.commands.simulate import energy_drift as _energy_drift
 
     still = SimpleNamespace(H=np.full(5, -3.0), K=np.zeros(5), P=np.full(5, -3.0))
     assert _energy_drift(still) == {

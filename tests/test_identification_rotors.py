@@ -91,7 +91,7 @@ def test_identified_armatures_match_the_real_motors(prior, true_robot, fit):
             assert r.armature == pytest.approx(true_robot.armature[k], rel=0.03), name
             assert abs(r.armature - prior.armature[k]) > 5 * r.std  # the data moved it off the prior
             assert r.rotor_inertia == pytest.approx(r.armature / float(prior.joints[k].gear_ratio) ** 2)
-    from kinedyn.cli import _jsonable
+    from kinedyn._ui.json import jsonable as _jsonable
 
     payload = json.loads(json.dumps(_jsonable(fit.to_dict())))
     assert payload["rotors"][0]["armature"] is None and payload["rotors"][0]["grouped_into"] == ["link1.Izz"]

@@ -535,10 +535,12 @@ def test_cli_ik_tutorial(capsys):
 def test_cli_ik_parser_registers_standalone():
     import argparse
 
-    from kinedyn.ik.cli import add_ik_command
+    from kinedyn.cli import build_parser
+    from kinedyn.cli.commands import ik as ik_command
 
     parser = argparse.ArgumentParser()
-    sub = parser.add_subparsers()
-    add_ik_command(sub)
-    args = parser.parse_args(["ik", "puma560", "--xyz", "0.5", "0.1", "0.2", "--rpy", "0", "1.57", "0"])
-    assert args.func.__name__ == "run_ik" and args.rpy == [0.0, 1.57, 0.0]
+    ik_command.add_arguments(parser)
+    args = parser.parse_args(["puma560", "--xyz", "0.5", "0.1", "0.2", "--rpy", "0", "1.57", "0"])
+    assert args.rpy == [0.0, 1.57, 0.0]
+    args = build_parser(load=()).parse_args(["ik", "puma560", "--xyz", "0.5", "0.1", "0.2", "--rpy", "0", "1.57", "0"])
+    assert args.func is ik_command.run and args.rpy == [0.0, 1.57, 0.0]

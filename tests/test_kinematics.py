@@ -301,3 +301,15 @@ def test_frame_poses_of_no_frames_is_an_empty_array():
     robot = kd.robots.ur5()
     assert robot.frame_poses(np.zeros(6), []).shape == (0, 4, 4)
     assert robot.frame_poses(np.zeros((3, 6)), []).shape == (3, 0, 4, 4)
+
+
+def test_analysis_rows_are_the_rows_an_arm_spans():
+    """kin.analysis_rows: the rows on which rank and manipulability are measured, and why."""
+    elbow, planar, puma = kd.robots.get("elbow_3r"), kd.robots.get("planar_2r"), kd.robots.get("puma560")
+    full = kin.task_rows("full")
+    assert kin.spanned_rows(elbow) == [0, 1, 2]
+    assert kin.spanned_rows(planar) == [0, 1]
+    assert kin.analysis_rows(elbow, full, False) == ([0, 1, 2], "spanned")
+    assert kin.analysis_rows(puma, full, False) == (full, "all")
+    assert kin.analysis_rows(elbow, [0, 1], True) == ([0, 1], "given")
+    assert [kin.ROW_NAMES[r] for r in kin.spanned_rows(elbow)] == ["vx", "vy", "vz"]

@@ -18,7 +18,7 @@ pytest.importorskip("kinedyn._core", reason="the native module is not built")
 from reference import erd  # noqa: E402
 
 import kinedyn as kd  # noqa: E402
-from kinedyn.terminal import NUMBER, fit_table  # noqa: E402
+from kinedyn._ui.terminal import NUMBER, fit_table  # noqa: E402
 
 
 def run_piped(*argv, columns="80") -> str:

@@ -25,6 +25,7 @@ pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
 import kinedyn as kd  # noqa: E402
 import kinedyn.cli as cli  # noqa: E402
+import kinedyn.cli.commands.fk as fk_command  # noqa: E402
 from kinedyn.cli import main  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -274,8 +275,8 @@ def test_unwritable_outputs_fail_before_the_work(capsys, tmp_path, monkeypatch):
     (tmp_path / "a file").write_text("x")
     build = cli.build_parser
 
-    def no_work_parser():
-        parser = build()
+    def no_work_parser(*args, **kwargs):
+        parser = build(*args, **kwargs)
         sub = next(a for a in parser._actions if a.dest == "command")
         for p in sub.choices.values():
             p.set_defaults(func=lambda args: pytest.fail("the command started its work before checking its outputs"))
@@ -479,9 +480,9 @@ def test_set_on_built_ins_and_bad_set_values(capsys):
     for argv, first, second in bad:
         code, _, err = run(capsys, *argv)
         assert_one_line_error(code, err, first, second)
-    assert cli._parse_set_value("0.25") == 0.25
+    assert cli.parse_set_value("0.25") == 0.25
     with pytest.raises(ValueError):
-        cli._parse_set_value("1/0")
+        cli.parse_set_value("1/0")
 
 
 # ------------------------------------------------------------------ the mechanism: every exception is one line
@@ -519,7 +520,7 @@ def test_every_exception_is_one_line(capsys, monkeypatch, exc, code, words):
     def boom(args):
         raise exc
 
-    monkeypatch.setattr(cli, "cmd_fk", boom)
+    monkeypatch.setattr(fk_command, "run", boom)
     got, _, err = run(capsys, "fk", "planar_2r")
     assert got == code
     assert_one_line_error(got, err, *words)
@@ -533,7 +534,7 @@ def test_interrupt_exits_130_quietly(capsys, monkeypatch):
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "cmd_fk", interrupted)
+    monkeypatch.setattr(fk_command, "run", interrupted)
     code, out, err = run(capsys, "fk", "planar_2r")
     assert code == 130 and err == ""
 
@@ -563,7 +564,7 @@ def test_warnings_are_one_line(capsys, monkeypatch):
         )
         return 0
 
-    monkeypatch.setattr(cli, "cmd_fk", warns)
+    monkeypatch.setattr(fk_command, "run", warns)
     code, _, err = run(capsys, "fk", "planar_2r")
     assert (
         code == 0
@@ -677,7 +678,7 @@ def test_output_into_a_closed_pipe_is_quiet(capsys, monkeypatch):
     def closed(args):
         raise BrokenPipeError(32, "Broken pipe")
 
-    monkeypatch.setattr(cli, "cmd_fk", closed)
+    monkeypatch.setattr(fk_command, "run", closed)
     code, _, err = run(capsys, "fk", "planar_2r")
     assert code == 0 and err == ""
 

@@ -260,7 +260,7 @@ def test_cli_per_joint_gains_and_limits(capsys):
 
 # ------------------------------------------------------------------ progress
 def test_progress_is_on_stderr_only_when_asked_or_on_a_terminal(capsys, puma):
-    from kinedyn.progress import Steps
+    from kinedyn._ui.progress import Steps
 
     with Steps("work", 2, progress=None) as s:  # pytest's stderr is not a terminal
         assert s.bar is None
@@ -320,7 +320,7 @@ def test_a_batch_ik_with_progress_gives_the_same_answers(monkeypatch, capsys):
 @pytest.mark.parametrize("name", ["[/bold] arm", "a[red]b", "x[/]"])
 def test_progress_shows_names_that_look_like_markup(name, monkeypatch, capsys):
     """Progress labels carry robot names; rich would read '[/bold]' as markup and fail."""
-    from kinedyn import progress
+    from kinedyn._ui import progress
 
     bar = progress.Delayed(True, 10, f"simulate {name}")
     bar.update(5)
@@ -333,7 +333,7 @@ def test_progress_shows_names_that_look_like_markup(name, monkeypatch, capsys):
 
 
 def test_derive_runs_under_a_spinner_on_a_terminal(monkeypatch, capsys):
-    from kinedyn import progress
+    from kinedyn._ui import progress
 
     labels = []
     real_busy = progress.busy

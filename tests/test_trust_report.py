@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 html5lib = pytest.importorskip("html5lib")
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
-from kinedyn.cli import _jsonable  # noqa: E402
+from kinedyn._ui.json import jsonable as _jsonable  # noqa: E402
 from kinedyn.description.files import robot_from_mapping  # noqa: E402
 from kinedyn.report.html import _asset, _model_for_view, build_report, collect, script_json  # noqa: E402
 

@@ -7,6 +7,7 @@ Poses are 4x4 homogeneous transforms ``a_from_b`` (a point in b's coordinates ->
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from typing import Any
 
@@ -22,6 +23,7 @@ __all__ = [
     "rot_z",
     "rot_axis",
     "rpy_to_matrix",
+    "rpy_from_matrix",
     "translation",
     "homogeneous",
     "pose_inverse",
@@ -125,6 +127,28 @@ def rot_axis(axis: Iterable, angle):
 def rpy_to_matrix(roll, pitch, yaw):
     """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll), as a 4x4 pose."""
     return matmul(rot_z(yaw), rot_y(pitch), rot_x(roll))
+
+
+def rpy_from_matrix(R) -> tuple[float, float, float]:
+    """The inverse of :func:`rpy_to_matrix`: URDF's (roll, pitch, yaw) with R = Rz(yaw) Ry(pitch)
+    Rx(roll), pitch in [-pi/2, pi/2], for a numeric rotation (3x3, or the rotation of a 4x4 pose).
+
+    Pitch is read from the first column, (cos p cos y, cos p sin y, -sin p): its z and its length,
+    which is well conditioned everywhere. Yaw is the direction of that column's (x, y) part, exact
+    however short it is; at gimbal lock (cos p = 0) only yaw + roll (or yaw - roll) is defined, and
+    the choice made is yaw = 0. Roll is then read off the rotation that remains,
+    Rx(roll) = Ry(p)^T Rz(y)^T R, rather than from R's last row, so a yaw that rounding made
+    uncertain near the lock is compensated by roll, and Rz Ry Rx reproduces R to rounding."""
+    R = np.asarray(R, dtype=float)[:3, :3]
+    cos_pitch = math.hypot(R[0, 0], R[1, 0])
+    pitch = math.atan2(-R[2, 0], cos_pitch)
+    yaw = math.atan2(R[1, 0], R[0, 0]) if cos_pitch > 0.0 else 0.0
+    cy, sy, cp, sp_ = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    Rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    Ry = np.array([[cp, 0.0, sp_], [0.0, 1.0, 0.0], [-sp_, 0.0, cp]])
+    Rx = Ry.T @ Rz.T @ R
+    roll = math.atan2(Rx[2, 1], Rx[1, 1])
+    return (roll + 0.0, pitch + 0.0, yaw + 0.0)  # + 0.0: no -0.0 in what is printed or written
 
 
 def translation(x, y, z):

@@ -59,6 +59,7 @@ __all__ = [
     "quaternion_to_matrix",
     "exp3",
     "log3",
+    "COORDINATE_NAMES",
 ]
 
 #: How far from 1 the norm of a quaternion or of a planar joint's (cos θ, sin θ) may be before
@@ -76,6 +77,8 @@ _Q_NAMES = {
     "floating": ("x", "y", "z", "qx", "qy", "qz", "qw"),
     "planar": ("x", "y", "cos theta", "sin theta"),
 }
+#: The names of a joint kind's q coordinates, in order (docs/conventions.md).
+COORDINATE_NAMES = _Q_NAMES
 
 
 # ----------------------------------------------------------------------------- SO(3) by quaternions

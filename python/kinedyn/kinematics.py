@@ -25,7 +25,10 @@ if TYPE_CHECKING:
     from .robot import Robot
 
 __all__ = [
+    "ROW_NAMES",
     "task_rows",
+    "spanned_rows",
+    "analysis_rows",
     "task_jacobian",
     "tool_velocity",
     "joint_torques",
@@ -46,7 +49,7 @@ _TASKS = {
     "planar": [0, 1],
     "planar_pose": [0, 1, 5],
 }
-_ROW_NAMES = ["vx", "vy", "vz", "wx", "wy", "wz"]
+ROW_NAMES = ["vx", "vy", "vz", "wx", "wy", "wz"]
 
 Task = Union[str, Sequence[int]]
 
@@ -335,6 +338,44 @@ def _report(J: np.ndarray, rows: list, n: int, tol: float) -> SingularityReport:
         singular_values=s,
         lost_directions=lost,
         null_motions=null,
-        row_names=[_ROW_NAMES[r] for r in rows],
+        row_names=[ROW_NAMES[r] for r in rows],
         condition_number=cond,
     )
+
+
+def spanned_rows(robot: Robot, frame: str | None = None, reference: str = "world", samples: int = 8, seed: int = 0):
+    """The task rows an arm with fewer than six joints can span, for its manipulability: the linear rows
+    that move at some configuration, then the angular ones, kept when there are at most n of them and
+    they have rank min(rows, n) at a generic configuration; None when no such subset exists (then the
+    measure is taken in the Jacobian's column space, sqrt(det J^T J)).
+
+    Rows are tested at ``samples`` seeded random configurations inside the finite joint limits, so
+    the choice is deterministic (elbow_3r: vx, vy, vz; planar_2r: vx, vy; a SCARA: vx, vy, vz, wz)."""
+    rng = np.random.default_rng(seed)
+    lo = np.where(np.isfinite(robot.lower_limits), robot.lower_limits, -np.pi)
+    hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
+    Js = np.array([robot.jacobian(lo + (hi - lo) * rng.random(robot.n), frame, reference) for _ in range(samples)])
+    scale = max(1.0, float(np.abs(Js).max(initial=0.0)))
+    moving = [r for r in range(6) if np.abs(Js[:, r, :]).max() > 1e-9 * scale]
+    linear, angular = [r for r in moving if r < 3], [r for r in moving if r >= 3]
+    rows = linear if len(linear) >= robot.n else linear + angular
+    if not rows or len(rows) > robot.n:
+        return None
+    if max(np.linalg.matrix_rank(J[rows], tol=1e-9 * scale) for J in Js) < len(rows):
+        return None
+    return rows
+
+
+def analysis_rows(robot: Robot, rows: list, explicit: bool, frame: str | None = None, reference: str = "world"):
+    """(rows, why): the task rows on which to measure rank and manipulability, and why those.
+    ``rows`` given ``explicit``-ly are kept ("given"); otherwise all six are kept for n >= 6 ("all"),
+    or the rows a shorter arm spans (:func:`spanned_rows`, "spanned"), or, when it spans no subset,
+    all six, the measure then taken in the Jacobian's column space ("column_space")."""
+    if explicit:
+        return rows, "given"
+    if len(rows) <= robot.n:
+        return rows, "all"
+    chosen = spanned_rows(robot, frame, reference)
+    if chosen is None:
+        return rows, "column_space"
+    return chosen, "spanned"

@@ -270,7 +270,7 @@ def _progress(progress, total: int):
     """A function (done, total) -> None reporting progress, with a close()."""
     if callable(progress):
         return progress
-    from .progress import Delayed, wanted
+    from ._ui.progress import Delayed, wanted
 
     bar = Delayed(wanted(progress), total, "sweep", "{task.completed:.0f} / {task.total:.0f} states", 0.0)
 

@@ -498,7 +498,7 @@ def _levenberg_marquardt(
     goes to the core in chunks (each target's restarts follow from the seed and its index in the
     whole batch, so the answers do not change)."""
     from .. import _core
-    from ..progress import SHOW_AFTER, Delayed, wanted
+    from .._ui.progress import SHOW_AFTER, Delayed, wanted
 
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
     tol = min(tolerance, 1e-10)

@@ -411,8 +411,8 @@ def collect(
 ) -> dict:
     """Every number of the report (JSON-friendly, plus the symbolic equations under "_eom").
     ``time_budget``: wall-clock seconds for the simulation (None: unbounded); ``progress``: a progress
-    bar on stderr (None: on a terminal); ``steps``: a :class:`kinedyn.progress.Steps` to advance."""
-    from ..progress import Steps
+    bar on stderr (None: on a terminal); ``steps``: a :class:`kinedyn._ui.progress.Steps` to advance."""
+    from .._ui.progress import Steps
 
     own = steps is None
     steps = Steps("report", 4, progress) if own else steps
@@ -775,7 +775,7 @@ def build_report(
     tutorial's questions worked step by step (its arm is the default robot, planar_2r).
     ``geometry``: the 3-D view draws the "visual" shapes of the description, or the "collision" ones.
     ``progress``: a progress bar of the steps on stderr (None: on a terminal)."""
-    from ..progress import Steps
+    from .._ui.progress import Steps
 
     total = (0 if data is not None else 4) + 2 + (len(_tutorial_questions()) if tutorial else 0)
     with Steps("report", total, progress) as steps:
@@ -795,7 +795,7 @@ def _build_report(
 ) -> str:
     import kinedyn
 
-    from ..cli import _jsonable
+    from .._ui.json import jsonable as _jsonable
     from ..visual.web import plotly_script
 
     d = (

@@ -60,7 +60,7 @@ def identification_data(result: Identification, validate=None, **load_options) -
     """Every number of the report (JSON-friendly): the result's own (``to_dict``), the fit's and the
     validation's torques at the plotted samples, and the mass-matrix check of a consistent fit.
     ``validate``: a second log (anything :meth:`Identification.validate` takes)."""
-    from ..cli import _jsonable
+    from .._ui.json import jsonable as _jsonable
 
     robot = result.nominal
     data = result.data

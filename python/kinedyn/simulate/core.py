@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any, Union, cast
 import numpy as np
 
 from .._core import NonFiniteResultError
-from ..progress import SHOW_AFTER, Delayed
+from .._ui.progress import SHOW_AFTER, Delayed
 from .systems import MechanicalSystem
 from .trajectory import Trajectory
 

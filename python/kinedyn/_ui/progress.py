@@ -3,7 +3,10 @@ terminal (or when asked), never on stdout, transient (it disappears when the wor
 
 ``Steps`` counts named steps (the report's sections, the tutorial's questions); ``Delayed`` is a bar
 over an amount of work (simulated time, targets of a batch) that appears only once the work has
-taken ``delay`` seconds, so that short runs stay silent."""
+taken ``delay`` seconds, so that short runs stay silent.
+
+``import kinedyn`` loads this module (the simulator and IK report progress through it), so rich
+(about 65 ms to import) is imported only where a bar or spinner is drawn."""
 
 from __future__ import annotations
 
@@ -37,7 +40,7 @@ class Steps:
         self.total = max(int(total), 1)
         self.bar: Progress | None = None
         self.task: TaskID | None = None
-        if wanted(progress):
+        if wanted(progress):  # rich loads only when a bar is drawn (module docstring)
             from rich.console import Console
             from rich.markup import escape
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -60,7 +63,7 @@ class Steps:
             done = self.bar.tasks[0].completed
             if self.bar.tasks[0].description:
                 done += 1
-            from rich.markup import escape
+            from rich.markup import escape  # rich: only with a bar (module docstring)
 
             self.bar.update(self.task, description=escape(description), completed=min(done, self.total))
 
@@ -99,6 +102,7 @@ class Delayed:
             self._show()
 
     def _show(self) -> None:
+        # rich loads only when a bar is drawn (module docstring)
         from rich.console import Console
         from rich.markup import escape
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -140,7 +144,7 @@ def busy(label: str, progress: bool | None = None) -> Iterator[None]:
     if not wanted(progress):
         yield
         return
-    from rich.console import Console
+    from rich.console import Console  # rich loads only when a spinner is drawn (module docstring)
     from rich.markup import escape
 
     with Console(file=sys.stderr).status(escape(label)):

@@ -2,32 +2,17 @@
 
 from __future__ import annotations
 
-
-def cmd_view(args) -> int:
-    from ..cli import _robot, parse_q
-    from .viewer import Viewer
-
-    robot = _robot(args)
-    q = None if args.q is None else parse_q(args.q, robot, args.deg)
-    viewer = Viewer(robot, q, host=args.host, port=args.port, geometry="collision" if args.collision else "visual")
-    if args.no_wait:  # for tests and scripts that only want the server checked
-        viewer.close()
-        return 0
-    print("Ctrl-C stops the viewer.", flush=True)
-    viewer.wait()
-    return 0
+from ...visual.viewer import Viewer
+from .. import app
+from ..app import parse_q
+from ..options import state_arguments
 
 
-def add_view_command(subparsers) -> None:
-    from ..cli import _state_args
-
-    p = subparsers.add_parser(
-        "view", help="open a live 3-D view of a robot in the browser (meshes, joint sliders); Ctrl-C stops it"
-    )
+def add_arguments(p) -> None:
     p.add_argument(
         "robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r, the tutorial's arm)"
     )
-    _state_args(p)
+    state_arguments(p)
     p.add_argument(
         "--host",
         default="127.0.0.1",
@@ -36,4 +21,15 @@ def add_view_command(subparsers) -> None:
     p.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if it is taken)")
     p.add_argument("--collision", action="store_true", help="draw the collision shapes instead of the visual ones")
     p.add_argument("--no-wait", action="store_true", help="start the server, print its URL and stop (a check)")
-    p.set_defaults(func=cmd_view)
+
+
+def run(args) -> int:
+    robot = app.robot(args)
+    q = None if args.q is None else parse_q(args.q, robot, args.deg)
+    viewer = Viewer(robot, q, host=args.host, port=args.port, geometry="collision" if args.collision else "visual")
+    if args.no_wait:  # for tests and scripts that only want the server checked
+        viewer.close()
+        return 0
+    print("Ctrl-C stops the viewer.", flush=True)
+    viewer.wait()
+    return 0

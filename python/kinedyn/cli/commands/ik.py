@@ -1,7 +1,7 @@
 """``kinedyn ik ROBOT --xyz X Y Z [--rpy R P Y] [--all] [--json]``: inverse kinematics from the shell.
 
-Registered by ``kinedyn.cli`` through :func:`add_ik_command`. Exit status 0 when a solution was
-found, 2 when none exists (out of reach, or every solution outside the joint limits).
+Exit status 0 when a solution was found, 2 when none exists (out of reach, or every solution
+outside the joint limits).
 """
 
 from __future__ import annotations
@@ -9,10 +9,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from rich.table import Table
 
-from .solve import METHODS, inverse_kinematics
-
-__all__ = ["add_ik_command", "run_ik", "target_from_args"]
+from ..._math import rpy_to_matrix
+from ...configuration import COORDINATE_NAMES
+from ...ik.solve import METHODS, inverse_kinematics
+from .. import app
+from ..app import console, emit, esc, parse_q
+from ..options import EXIT_NO, EXIT_OK, finite_float, in_cli_terms
 
 # the solver's messages name its Python arguments; on the command line they are these flags
 FLAG_PHRASES = {
@@ -24,21 +28,14 @@ FLAG_PHRASES = {
 }
 
 
-def add_ik_command(subparsers):
-    """Register the ``ik`` subcommand on an argparse ``subparsers`` object; returns its parser."""
-    p = subparsers.add_parser(
-        "ik",
-        help="inverse kinematics: the joint values that put the tool at a target",
-        description=(
-            "Every joint vector that puts the tool (or --frame) at the target, nearest --q0 first: closed form when "
-            "the robot's geometry has one (planar 2R/3R, elbow arms, spherical wrists, UR-type arms), else "
-            "Levenberg-Marquardt. Without --rpy the target is the position only. Example (the tutorial's challenge): "
-            "kinedyn ik elbow_3r --xyz 1.0 0.2 0.5 --all"
-        ),
+def add_arguments(p) -> None:
+    p.description = (
+        "Every joint vector that puts the tool (or --frame) at the target, nearest --q0 first: closed form when "
+        "the robot's geometry has one (planar 2R/3R, elbow arms, spherical wrists, UR-type arms), else "
+        "Levenberg-Marquardt. Without --rpy the target is the position only. Example (the tutorial's challenge): "
+        "kinedyn ik elbow_3r --xyz 1.0 0.2 0.5 --all"
     )
     p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    from ..cli import finite_float
-
     p.add_argument(
         "--xyz",
         nargs=3,
@@ -61,8 +58,7 @@ def add_ik_command(subparsers):
     p.add_argument("--method", default="auto", choices=METHODS, help="closed form, numeric, or auto (default)")
     p.add_argument("--ignore-limits", action="store_true", help="keep solutions outside the joint limits")
     p.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-    p.set_defaults(func=run_ik, _flag_phrases=FLAG_PHRASES)
-    return p
+    p.set_defaults(_flag_phrases=FLAG_PHRASES)
 
 
 def target_from_args(xyz, rpy=None, degrees: bool = False) -> np.ndarray:
@@ -70,31 +66,17 @@ def target_from_args(xyz, rpy=None, degrees: bool = False) -> np.ndarray:
     p = np.array(xyz, dtype=float)
     if rpy is None:
         return p
-    from .._math import rpy_to_matrix
-
     r, pi, y = (math.radians(v) if degrees else float(v) for v in rpy)
     T = np.array(rpy_to_matrix(r, pi, y), dtype=float)
     T[:3, 3] = p
     return T
 
 
-def _load(spec):
-    from .. import robots
-
-    try:
-        from ..cli import load_robot
-    except ImportError:  # pragma: no cover - the CLI module is always there in a full install
-        return robots.get(spec or robots.DEFAULT)
-    return load_robot(spec or robots.DEFAULT)
-
-
-def run_ik(args) -> int:
-    robot = _load(args.robot)
+def run(args) -> int:
+    robot = app.robot(args)
     target = target_from_args(args.xyz, args.rpy, args.deg)
     q0 = None
     if args.q0 is not None:
-        from ..cli import parse_q
-
         q0 = parse_q(args.q0, robot, args.deg, "--q0")
     result = inverse_kinematics(
         robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame
@@ -120,17 +102,11 @@ def run_ik(args) -> int:
         "count": len(result.solutions),
     }
     if "message" in payload:
-        from ..cli import in_cli_terms
-
         payload["message"] = in_cli_terms(payload["message"], FLAG_PHRASES)
     if payload["nearest_q"] is not None:
         payload["nearest_q"] = angles(result.nearest_q)
 
     def render():
-        from rich.table import Table
-
-        from ..cli import console, esc, in_cli_terms
-
         c = console()
         what = (
             f"position {np.array2string(target, precision=6)}"
@@ -164,21 +140,20 @@ def run_ik(args) -> int:
         style = "green" if result.success else "bold red"
         c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
 
-    from ..cli import emit
-
     emit(args, payload, render)
-    return 0 if result.success else 2
+    return EXIT_OK if result.success else EXIT_NO
 
 
 def _coordinate_labels(robot) -> list:
     """A column name per q coordinate: ``q<k>`` for the k-th joint, ``q<k>.<part>`` inside a floating,
     spherical or planar joint's block (``q1.x`` ... ``q1.qw``; docs/conventions.md)."""
-    from ..configuration import _Q_NAMES
-
     labels = []
     for k, j in enumerate(robot.joints):
         labels.extend(
-            [f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}" for part in _Q_NAMES[j.kind]]
+            [
+                f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}"
+                for part in COORDINATE_NAMES[j.kind]
+            ]
             if j.is_multi_dof
             else [f"q{k + 1}"]
         )

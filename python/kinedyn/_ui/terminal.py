@@ -14,6 +14,12 @@ from __future__ import annotations
 import copy
 import re
 
+from rich.cells import cell_len
+from rich.console import Console
+from rich.measure import Measurement
+from rich.table import Table
+from rich.text import Text
+
 __all__ = ["console", "fit_table", "NUMBER"]
 
 #: A cell that is one number as kinedyn prints them (``-1.5``, `` 2.44929e-21``, ``inf``, ``nan``,
@@ -24,8 +30,6 @@ NUMBER = re.compile(
 
 
 def _plain(cell) -> str:
-    from rich.text import Text
-
     if isinstance(cell, Text):
         return cell.plain
     if isinstance(cell, str):
@@ -38,9 +42,6 @@ def fit_table(table, width: int, console) -> list:
     numeric columns (every cell a :data:`NUMBER`) do not wrap, other columns fold rather than cut;
     if the table is still too wide, its columns go into several tables, each keeping the first column
     (the row labels) and titled with the columns it shows."""
-    from rich.cells import cell_len
-    from rich.measure import Measurement
-
     for k, column in enumerate(table.columns):
         cells = [_plain(c) for c in column._cells]
         column.overflow = "fold"
@@ -87,14 +88,14 @@ def fit_table(table, width: int, console) -> list:
 def console():
     """The console kinedyn's commands print with: no highlighting, long lines not broken, and every
     rich Table printed through :func:`fit_table` at the console's width."""
-    from rich.console import Console
-    from rich.table import Table
-
-    class _Console(Console):
-        def print(self, *objects, **kwargs):
-            parts: list = []
-            for obj in objects:
-                parts.extend(fit_table(obj, self.width, self) if isinstance(obj, Table) else [obj])
-            super().print(*parts, **kwargs)
-
     return _Console(highlight=False, soft_wrap=True)
+
+
+class _Console(Console):
+    """A rich Console whose tables are printed through :func:`fit_table`."""
+
+    def print(self, *objects, **kwargs):
+        parts: list = []
+        for obj in objects:
+            parts.extend(fit_table(obj, self.width, self) if isinstance(obj, Table) else [obj])
+        super().print(*parts, **kwargs)

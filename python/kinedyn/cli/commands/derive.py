@@ -2,34 +2,53 @@
 
 from __future__ import annotations
 
-import inspect
 from pathlib import Path
+
+from ... import robots
+from ..._ui import progress
+from .. import app
+from ..app import console, emit, esc
+from ..options import OutputPath
 
 FORMATS = ("text", "latex", "markdown", "mathml", "python", "numpy", "c")
 
 
-def _robot(args):
-    from .. import robots
-    from ..cli import _substitute, load_robot, set_values
+def add_arguments(p) -> None:
+    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
+    p.add_argument(
+        "--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)"
+    )
+    p.add_argument("--general", action="store_true", help="replace every inertia by ten symbols (M1, MX1, ..., ZZ1)")
+    p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
+    p.add_argument("--format", default="text", choices=FORMATS)
+    p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
+    p.add_argument(
+        "--form",
+        default="auto",
+        choices=["auto", "cse", "expanded"],
+        help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)",
+    )
+    p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
+    p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
 
+
+def _robot(args):
     name = args.robot or robots.DEFAULT
+    options = app.RobotOptions.from_args(args)
     if args.symbolic:
-        factory = robots.CATALOGUE.get(name)
-        if factory is None or "symbolic" not in inspect.signature(factory).parameters:
-            symbolic = [n for n, f in robots.CATALOGUE.items() if "symbolic" in inspect.signature(f).parameters]
+        factory = app.symbolic_builtin(name)
+        if factory is None:
+            symbolic = [n for n in robots.CATALOGUE if app.symbolic_builtin(n) is not None]
             raise ValueError(
                 f"--symbolic needs a built-in with symbolic parameters ({', '.join(symbolic)}); got '{name}'"
             )
-        return _substitute(factory(symbolic=True), set_values(), name)
-    return load_robot(name)
+        return app.substitute(factory(symbolic=True), options.values, name)
+    return app.load_robot(name, options)
 
 
-def cmd_derive(args) -> int:
-    from ..cli import console, emit, esc
-    from ..progress import busy
-
+def run(args) -> int:
     robot = _robot(args)
-    with busy(
+    with progress.busy(
         f"deriving the equations of motion of '{robot.name}' ({args.method})", progress=False if args.json else None
     ):
         eom = robot.equations_of_motion(
@@ -91,28 +110,3 @@ def _payload(args, robot, eom, text) -> dict:
         )
     payload.update(output=args.output, text=None if args.output else text)
     return payload
-
-
-def add_derive_command(subparsers) -> None:
-    from ..cli import OutputPath
-
-    p = subparsers.add_parser(
-        "derive", help="symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)"
-    )
-    p.add_argument("robot", nargs="?", default=None, help="built-in name or robot file (default: planar_2r)")
-    p.add_argument(
-        "--symbolic", action="store_true", help="use the built-in's symbolic parameters (l1, m1, I1, g, ...)"
-    )
-    p.add_argument("--general", action="store_true", help="replace every inertia by ten symbols (M1, MX1, ..., ZZ1)")
-    p.add_argument("--method", default="lagrange", choices=["lagrange", "newton_euler"])
-    p.add_argument("--format", default="text", choices=FORMATS)
-    p.add_argument("--no-simplify", action="store_true", help="keep products of sines and cosines (faster)")
-    p.add_argument(
-        "--form",
-        default="auto",
-        choices=["auto", "cse", "expanded"],
-        help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)",
-    )
-    p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
-    p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
-    p.set_defaults(func=cmd_derive)

@@ -1,0 +1,203 @@
+"""``kinedyn identify ROBOT``: base inertial parameters (and friction) identified from a robot's log
+(``--data``) or from a simulated Fourier excitation; ``--excite`` writes an optimised excitation."""
+
+from __future__ import annotations
+
+from rich.table import Table
+
+from ...analysis.excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+from ...analysis.identification import excitation, identify, simulate_measurements
+from ...analysis.logs import load_log
+from .. import app
+from ..app import console, emit, esc
+from ..options import OutputPath, nonnegative_float, nonnegative_int, positive_float, positive_int, robot_argument
+
+
+def add_arguments(p) -> None:
+    robot_argument(p)
+    p.add_argument(
+        "--noise", type=nonnegative_float, default=0.0, help="torque noise standard deviation, N m (default 0)"
+    )
+    p.add_argument("--harmonics", type=positive_int, default=5)
+    p.add_argument("--period", type=positive_float, default=10.0, help="period of the excitation, s (default 10)")
+    p.add_argument("--periods", type=positive_float, default=2.0, help="measured periods (default 2)")
+    p.add_argument("--amplitude", type=nonnegative_float, default=0.6, help="joint excursion, rad or m (default 0.6)")
+    p.add_argument("--rate", type=positive_float, default=100.0, help="sample rate, Hz (default 100)")
+    p.add_argument("--weighted", action="store_true", help="weighted least squares (per-joint noise levels)")
+    p.add_argument("--seed", type=nonnegative_int, default=0)
+    p.add_argument(
+        "--data",
+        metavar="LOG",
+        help="identify from a log (CSV or NPZ: t, q1..qn, tau1..taun) instead of a simulated excitation",
+    )
+    p.add_argument(
+        "--friction",
+        default="viscous+coulomb",
+        help="friction terms estimated with --data: viscous, coulomb, offset joined by '+', or none / known (default viscous+coulomb)",
+    )
+    p.add_argument(
+        "--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s"
+    )
+    p.add_argument(
+        "--consistent",
+        action="store_true",
+        help="physically consistent parameters (pseudo-inertias positive definite; an SDP through cvxpy)",
+    )
+    p.add_argument(
+        "--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model"
+    )
+    p.add_argument(
+        "--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)"
+    )
+    p.add_argument(
+        "--decimate",
+        type=positive_int,
+        default=None,
+        help="keep every k-th sample after filtering (default: rate / (5 cut-off))",
+    )
+    p.add_argument(
+        "--excite",
+        metavar="CSV",
+        action=OutputPath,
+        help="write an optimised excitation (min cond(Y_base), at rest at both ends; --period, --harmonics, --rate) for a controller, and stop",
+    )
+    p.add_argument(
+        "--plot", metavar="FILE", action=OutputPath, help="save measured vs predicted torques (PNG, PDF, SVG)"
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="HTML",
+        action=OutputPath,
+        default=None,
+        help="write a self-contained HTML identification report (parameters, friction, rotor inertia, torque and residual plots)",
+    )
+
+
+def run(args) -> int:
+    robot = app.robot(args)
+    if args.excite:
+        return _write_excitation(robot, args)
+    if args.data:
+        return _identify_from_log(robot, args)
+    ref = excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
+    data = simulate_measurements(
+        robot, ref, T=args.periods * args.period, rate=args.rate, noise=args.noise, seed=args.seed
+    )
+    result = identify(robot, data, weighted=args.weighted)
+    payload = dict(robot=robot.name, samples=len(data.t), noise=args.noise, **result.to_dict())
+    if args.output:
+        payload["report"] = str(result.write_html(args.output))
+
+    def render():
+        c = console()
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters from {len(data.t)} samples "
+            f"({args.periods:g} periods of a {args.harmonics}-harmonic Fourier excitation, noise {args.noise:g}); "
+            f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+        )
+        t = Table(title_justify="left")
+        for col in ("parameter", "estimate", "std", "true", "error", "error / std"):
+            t.add_column(col, justify="right")
+        true = result.true_values
+        assert true is not None  # identify() on a known robot always has the true values
+        for k, nm in enumerate(result.names):
+            e = result.estimates[k] - true[k]
+            t.add_row(
+                esc(nm),
+                f"{result.estimates[k]:.8g}",
+                f"{result.std[k]:.2g}",
+                f"{true[k]:.8g}",
+                f"{e:.2g}",
+                f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-",
+            )
+        c.print(t)
+        if result.dropped:
+            c.print(f"not excited (zero regressor columns on the data): {esc(', '.join(result.dropped))}")
+
+    emit(args, payload, render)
+    return 0
+
+
+def _write_excitation(robot, args) -> int:
+    """``kinedyn identify ROBOT --excite traj.csv``: an optimised excitation for a controller."""
+    ref = optimize_excitation(robot, period=args.period, harmonics=args.harmonics, seed=args.seed)
+    write_trajectory_csv(ref, args.excite, rate=args.rate)
+    cond = excitation_condition(robot, ref)
+    random_cond = excitation_condition(
+        robot, excitation(robot, harmonics=args.harmonics, period=args.period, amplitude=args.amplitude, seed=args.seed)
+    )
+    payload = dict(
+        robot=robot.name,
+        trajectory=str(args.excite),
+        period=args.period,
+        harmonics=args.harmonics,
+        rate=args.rate,
+        condition_number=cond,
+        random_condition_number=random_cond,
+    )
+
+    def render():
+        console().print(
+            f"[bold]{esc(robot.name)}[/bold]: excitation of {args.harmonics} harmonics, period {args.period:g} s, "
+            f"at rest at both ends, written to {esc(str(args.excite))} at {args.rate:g} Hz; "
+            f"cond(Y_base) {cond:.4g} (a random Fourier excitation of the same band: {random_cond:.4g})"
+        )
+
+    emit(args, payload, render)
+    return 0
+
+
+def _identify_from_log(robot, args) -> int:
+    """``kinedyn identify ROBOT --data log.csv``: a real robot's log (see docs/analysis.md)."""
+    options = dict(cutoff=args.cutoff, decimate=args.decimate)
+    log = load_log(args.data, n=robot.n, **options)
+    result = identify(
+        robot, log, weighted=args.weighted, friction=args.friction, consistent=args.consistent, smoothing=args.smoothing
+    )
+    payload = dict(robot=robot.name, data=str(args.data), cutoff_hz=log.cutoff, rate_hz=log.rate, **result.to_dict())
+    check = None
+    if args.validate:
+        check = result.validate(args.validate, **options)
+        payload["validation"] = check.to_dict()
+    if args.plot:
+        fig = result.plot(args.validate or log)
+        fig.savefig(args.plot)
+        payload["plot"] = str(args.plot)
+    if args.output:
+        payload["report"] = str(result.write_html(args.output, args.validate, **options))
+
+    def render():
+        c = console()
+        c.print(
+            f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters and {len(result.friction_names)} friction coefficients "
+            f"from {len(log)} samples of {esc(str(args.data))} (cut-off {log.cutoff or 0:.3g} Hz, {log.rate:.4g} Hz after decimation); "
+            f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+            + (", physically consistent (SDP)" if result.consistent else "")
+        )
+        t = Table(title_justify="left")
+        for col in ("parameter", "estimate", "std", "std %"):
+            t.add_column(col, justify="right")
+        for nm, e, sd, rel in zip(result.names, result.estimates, result.std, result.relative_std):
+            t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{rel:.3g}")
+        for nm, e, sd in zip(result.friction_names, result.friction_estimates, result.friction_std):
+            t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{100 * sd / max(abs(e), 1e-300):.3g}")
+        c.print(t)
+        grouped = [r for r in result.rotors if r.armature is None]
+        if grouped:
+            c.print(
+                "armatures r² J_m grouped with link parameters (not identifiable on their own): "
+                + "; ".join(f"{esc(r.joint)} into {esc(', '.join(r.grouped_into))}" for r in grouped)
+            )
+        if args.output:
+            c.print(f"report written to {esc(str(args.output))}")
+        if check is not None:
+            v = Table(title=f"validation on {esc(str(args.validate))}", title_justify="left")
+            for col in ("joint", "torque RMS", "R²"):
+                v.add_column(col, justify="right")
+            for j, (rms, r2) in enumerate(zip(check.rms, check.r2)):
+                v.add_row(str(j + 1), f"{rms:.4g}", f"{r2:.5f}")
+            c.print(v)
+
+    emit(args, payload, render)
+    return 0
