@@ -1,5 +1,5 @@
 """The identification report: one self-contained HTML page about an identification from a log
-(``kinedyn identify ROBOT --data log.csv -o report.html``, :meth:`Identification.to_html`).
+(``kinedyn identify ROBOT --data log.csv -o report.html``, :func:`identification_html`).
 
 Sections: what was fitted (the log, its filtering, the estimator, cond(W)); the base parameters with
 their standard deviations and relative standard deviations (and the errors when the true values are
@@ -9,7 +9,7 @@ predicted torque and the residual per joint, on the fitted log and on the valida
 R² per joint) when one is given; and, for a physically consistent fit, the smallest eigenvalue of
 M(q) over the log's states for the consistent and the unconstrained estimates.
 
-It shares the robot report's page, style and tables (:mod:`kinedyn.report.html`); the plots are
+It shares the robot report's style and tables (:mod:`kinedyn.report.tables`); the plots are
 drawn by plotly.js inlined from the plotly package, from the JSON block ``#kinedyn-identification``
 which holds every number shown (nothing is fetched).
 """
@@ -22,12 +22,23 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .html import _asset, _f, _json_script, _table
+from .. import __version__
+from .._ui.json import jsonable
+from ..visual.web import plotly_script
+from .tables import fmt, table
+from .view import asset, json_script
 
 if TYPE_CHECKING:
     from ..analysis.identification import Identification, Validation
 
-__all__ = ["identification_data", "identification_report", "write_identification_report", "PLOT_POINTS"]
+__all__ = [
+    "identification_html",
+    "write_identification_html",
+    "identification_data",
+    "identification_report",
+    "write_identification_report",
+    "PLOT_POINTS",
+]
 
 #: at most this many samples of each log are plotted (evenly spaced; the tables use them all)
 PLOT_POINTS = 1500
@@ -60,12 +71,10 @@ def identification_data(result: Identification, validate=None, **load_options) -
     """Every number of the report (JSON-friendly): the result's own (``to_dict``), the fit's and the
     validation's torques at the plotted samples, and the mass-matrix check of a consistent fit.
     ``validate``: a second log (anything :meth:`Identification.validate` takes)."""
-    from ..cli import _jsonable
-
     robot = result.nominal
     data = result.data
-    d: dict = {"robot": robot.name, "joint_names": list(robot.joint_names), **_jsonable(result.to_dict())}
-    d["relative_std_percent"] = _jsonable(result.relative_std)
+    d: dict = {"robot": robot.name, "joint_names": list(robot.joint_names), **jsonable(result.to_dict())}
+    d["relative_std_percent"] = jsonable(result.relative_std)
     d["friction_terms"] = list(result.friction.terms)
     d["friction_known"] = bool(result.friction.known)
     d["rotors"] = [r.to_dict() for r in result.rotors]
@@ -90,7 +99,7 @@ def identification_data(result: Identification, validate=None, **load_options) -
                 unconstrained_min_eigenvalue=float(eig.min()), unconstrained_indefinite_states=int(np.sum(eig <= 0))
             )
         d["mass_matrix_check"] = check
-    return _jsonable(d)
+    return jsonable(d)
 
 
 def _joint_of(name: str) -> int:
@@ -105,13 +114,13 @@ def _sections(d: dict) -> list[str]:
     how = "weighted" if d["weighted"] else "ordinary"
     lines = [
         f"{len(d['names'])} base parameters and {len(d.get('friction_names', []))} friction coefficients by {how} least squares",
-        f"cond(W) = {_f(d['condition_number'], 4)}",
+        f"cond(W) = {fmt(d['condition_number'], 4)}",
     ]
     if d.get("consistent"):
         lines.append("physically consistent: every body's pseudo-inertia positive definite (an SDP through cvxpy)")
     if log is not None:
         filt = (
-            f", low-pass cut-off {_f(log['cutoff_hz'], 3)} Hz, decimated by {log['decimation']} to {_f(log['rate_hz'], 4)} Hz"
+            f", low-pass cut-off {fmt(log['cutoff_hz'], 3)} Hz, decimated by {log['decimation']} to {fmt(log['rate_hz'], 4)} Hz"
             if log.get("cutoff_hz")
             else ""
         )
@@ -119,11 +128,11 @@ def _sections(d: dict) -> list[str]:
     sec = ["<section id='fit'><h2>The fit</h2><ul>", *(f"<li>{line}</li>" for line in lines), "</ul>"]
     if d.get("noise") is not None:
         sec.append(
-            _table(
+            table(
                 ["", *joints],
                 [
-                    ["noise σ (from the residuals)", *(_f(v, 4) for v in d["noise"])],
-                    ["residual RMS", *(_f(v, 4) for v in d["residual_rms"])],
+                    ["noise σ (from the residuals)", *(fmt(v, 4) for v in d["noise"])],
+                    ["residual RMS", *(fmt(v, 4) for v in d["residual_rms"])],
                 ],
                 cls="noise",
             )
@@ -142,10 +151,10 @@ def _sections(d: dict) -> list[str]:
     )
     rows = []
     for k, name in enumerate(d["names"]):
-        row = [name, _f(d["estimates"][k]), _f(d["std"][k], 3), _f(d["relative_std_percent"][k], 3)]
+        row = [name, fmt(d["estimates"][k]), fmt(d["std"][k], 3), fmt(d["relative_std_percent"][k], 3)]
         if true is not None:
             err = d["estimates"][k] - true[k]
-            row += [_f(true[k]), _f(err, 3), _f(100 * abs(err) / max(abs(true[k]), 1e-300), 3)]
+            row += [fmt(true[k]), fmt(err, 3), fmt(100 * abs(err) / max(abs(true[k]), 1e-300), 3)]
         rows.append(row)
     note = (
         "<p class='note'>std: from the covariance σ² (WᵀW)⁻¹ of the least-squares fit; std %: 100 std / |estimate| "
@@ -154,7 +163,7 @@ def _sections(d: dict) -> list[str]:
     out.append(
         "<section id='parameters'><h2>Base parameters</h2>"
         + note
-        + _table(headers, rows, cls="parameters")
+        + table(headers, rows, cls="parameters")
         + "</section>"
     )
 
@@ -167,9 +176,9 @@ def _sections(d: dict) -> list[str]:
         for name, est, sd in zip(d["friction_names"], d["friction_estimates"], d["friction_std"]):
             by_joint.setdefault(_joint_of(name), {})[name.split(".", 1)[1]] = (est, sd)
         for j in sorted(by_joint):
-            frows.append([joints[j], *(f"{_f(by_joint[j][t][0], 5)} ± {_f(by_joint[j][t][1], 2)}" for t in terms)])
+            frows.append([joints[j], *(f"{fmt(by_joint[j][t][0], 5)} ± {fmt(by_joint[j][t][1], 2)}" for t in terms)])
         units = {"viscous": "viscous [N m s/rad]", "coulomb": "Coulomb [N m]", "offset": "offset [N m]"}
-        sec.append(_table(["joint", *(units[t] for t in terms)], frows, cls="friction"))
+        sec.append(table(["joint", *(units[t] for t in terms)], frows, cls="friction"))
     elif d["friction_known"]:
         sec.append("<p class='note'>Friction taken from the model (subtracted, not estimated).</p>")
     else:
@@ -181,8 +190,8 @@ def _sections(d: dict) -> list[str]:
                 rrows.append(
                     [
                         r["joint"],
-                        _f(r["gear_ratio"], 5),
-                        _f(r["nominal_armature"], 4),
+                        fmt(r["gear_ratio"], 5),
+                        fmt(r["nominal_armature"], 4),
                         "grouped into " + ", ".join(r["grouped_into"]),
                         "–",
                     ]
@@ -191,15 +200,15 @@ def _sections(d: dict) -> list[str]:
                 rrows.append(
                     [
                         r["joint"],
-                        _f(r["gear_ratio"], 5),
-                        _f(r["nominal_armature"], 4),
-                        f"{_f(r['armature'], 5)} ± {_f(r['std'], 2)}",
-                        _f(r["rotor_inertia"], 4),
+                        fmt(r["gear_ratio"], 5),
+                        fmt(r["nominal_armature"], 4),
+                        f"{fmt(r['armature'], 5)} ± {fmt(r['std'], 2)}",
+                        fmt(r["rotor_inertia"], 4),
                     ]
                 )
         sec.append("<h3>Armature r² J_m of the geared joints</h3>")
         sec.append(
-            _table(
+            table(
                 ["joint", "gear ratio r", "model r² J_m [kg m²]", "identified r² J_m", "J_m = a / r² [kg m²]"],
                 rrows,
                 cls="rotors",
@@ -222,7 +231,7 @@ def _sections(d: dict) -> list[str]:
         crow = [
             [
                 "consistent",
-                _f(mc["consistent_min_eigenvalue"], 4),
+                fmt(mc["consistent_min_eigenvalue"], 4),
                 "yes" if mc["consistent_min_eigenvalue"] > 0 else "no",
             ]
         ]
@@ -230,7 +239,7 @@ def _sections(d: dict) -> list[str]:
             crow.append(
                 [
                     "unconstrained",
-                    _f(mc["unconstrained_min_eigenvalue"], 4),
+                    fmt(mc["unconstrained_min_eigenvalue"], 4),
                     "yes"
                     if mc["unconstrained_indefinite_states"] == 0
                     else f"no, at {mc['unconstrained_indefinite_states']} states",
@@ -239,7 +248,7 @@ def _sections(d: dict) -> list[str]:
         out.append(
             f"<section id='consistency'><h2>Mass matrix over the log</h2><p class='note'>The smallest eigenvalue of M(q) of each estimate "
             f"at {mc['states']} states of the log: only a positive-definite M can be simulated.</p>"
-            + _table(
+            + table(
                 ["estimate", "min eigenvalue of M [kg m²]", "positive definite at every state"], crow, cls="mass-check"
             )
             + "</section>"
@@ -255,9 +264,9 @@ def _sections(d: dict) -> list[str]:
             f"<p class='note'>{html.escape(str(p['source']))}: {p['samples']} samples"
             + (f", {len(p['index'])} of them plotted" if len(p["index"]) < p["samples"] else "")
             + ".</p>",
-            _table(
+            table(
                 ["", *joints],
-                [["torque RMS error", *(_f(v, 4) for v in p["rms"])], ["R²", *(_f(v, 7) for v in p["r2"])]],
+                [["torque RMS error", *(fmt(v, 4) for v in p["rms"])], ["R²", *(fmt(v, 7) for v in p["r2"])]],
                 cls="scores",
             ),
         ]
@@ -302,20 +311,16 @@ _EXTRA_CSS = ".id-plot { width: 100%; min-height: 320px; } section ul { margin: 
 
 def identification_report(result: Identification, validate=None, *, title: str | None = None, **load_options) -> str:
     """The report as one HTML string (see the module docstring)."""
-    import kinedyn
-
-    from ..visual.web import plotly_script
-
     d = identification_data(result, validate, **load_options)
     title = title or f"kinedyn identification: {d['robot']}"
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{html.escape(title)}</title>
-<style>{_asset("report.css")}{_EXTRA_CSS}</style></head>
-<body><header><h1>Identification of {html.escape(d["robot"])}</h1><p>{len(d["joint_names"])} joints · kinedyn {html.escape(kinedyn.__version__)}</p></header>
+<style>{asset("report.css")}{_EXTRA_CSS}</style></head>
+<body><header><h1>Identification of {html.escape(d["robot"])}</h1><p>{len(d["joint_names"])} joints · kinedyn {html.escape(__version__)}</p></header>
 <main>{"".join(_sections(d))}</main>
 <footer>Generated by <code>kinedyn identify --data ... -o</code>. Self-contained: no network access, every script and style is in this file.</footer>
-{_json_script(d, "kinedyn-identification")}
+{json_script(d, "kinedyn-identification")}
 {plotly_script()}
 <script>{_PLOTS_JS}</script>
 </body></html>
@@ -329,3 +334,17 @@ def write_identification_report(
     path = Path(path)
     path.write_text(identification_report(result, validate, **load_options), encoding="utf-8")
     return path
+
+
+def identification_html(result: Identification, validate=None, **load_options) -> str:
+    """The identification report of ``result`` (a :class:`kinedyn.analysis.Identification`) as one
+    self-contained HTML string; ``validate``: a second log to check the fit on (anything
+    :meth:`Identification.validate` takes, with its ``load_options``)."""
+    return identification_report(result, validate, **load_options)
+
+
+def write_identification_html(
+    result: Identification, path="identification.html", validate=None, **load_options
+) -> Path:
+    """Write :func:`identification_html` to ``path``; returns the path."""
+    return write_identification_report(result, path, validate, **load_options)
