@@ -1,2 +1,3 @@
-"""Low helpers for what a person sees: JSON-ready values (:mod:`.json`) and inline SVG plots (:mod:`.svg`).
-Nothing here imports a robot or a room above; the report, the CLI and the notebook displays share them."""
+"""What kinedyn shows people: terminal tables that keep numbers whole (``terminal``), progress bars
+for long work (``progress``) and values made fit for JSON (``json``). The ground floor of the layers
+in docs/architecture.md: it imports nothing else of kinedyn."""

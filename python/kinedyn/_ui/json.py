@@ -1,4 +1,5 @@
-"""Values made ready for :func:`json.dumps`: NumPy arrays and scalars become Python lists and numbers."""
+"""Values made fit for :func:`json.dumps`: the command line's ``--json`` output and the data the
+HTML reports embed."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ __all__ = ["jsonable"]
 
 
 def jsonable(x):
-    """``x`` with every NumPy array and scalar replaced by its Python value, tuples by lists, dict keys by
-    strings; a non-finite float becomes None (NaN) or "inf"/"-inf", a complex number [real, imag]."""
+    """``x`` with NumPy arrays and scalars turned into lists and Python numbers, a complex number
+    into [real, imag], NaN into null and an infinity into "inf"/"-inf" (JSON has no non-finite
+    numbers), dict keys into strings; containers are converted element by element."""
     if isinstance(x, np.ndarray):
         return jsonable(x.tolist())
     if isinstance(x, np.generic):

@@ -151,6 +151,6 @@ def same_function(a, b, symbols: Sequence[sp.Symbol], trials: int = 4, seed: int
     return True
 
 
-# ------------------------------------------------------------------ Q1: the Jacobian of the 2R arm
 def arm_2r_symbolic():
+    """The tutorial's two-link arm with its lengths, masses and g as symbols (Q1's Jacobian, Q3's dynamics)."""
     return robots.planar_2r(symbolic=True)

@@ -29,6 +29,7 @@ from .lagrange import question_3
 from .printed import PRINTED, QUESTION_DATA, QUESTIONS, l1, l2, printed, th1, th2
 
 
+# ------------------------------------------------------------------ Q1: the Jacobian of the 2R arm
 def _q1_jacobian():
     """(robot, p, J) with p the tool position (x, y) and J = dp/dtheta, in the tutorial's symbols."""
     robot = arm_2r_symbolic()
