@@ -36,7 +36,8 @@ from .._ui.svg import svg_plot
 from ..configuration import default_configuration, log3
 from ..progress import Steps
 from ..symbolic.cse import block_equations
-from ..symbolic.render import latex_to_mathml, name, of_q
+from ..symbolic.render import latex_to_mathml, of_q
+from ..symbolic.render import name as mathml_name
 from ..tutorial import QUESTIONS, answer, render_html
 from ..visual.web import plotly_script
 from .data import (
@@ -263,7 +264,7 @@ def _equations(eom) -> dict:
         ]
         # one line per joint: the torques are long
         out["plain"] += [
-            _equation(eom, name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), eom.tau[k])
+            _equation(eom, mathml_name(f"\\tau_{{{k + 1}}}", f"tau_{k + 1}", "tau", str(k + 1)), eom.tau[k])
             for k in range(eom.n)
         ]
     out["steps"] = [
