@@ -215,13 +215,8 @@ def symbolic_equations(robot, name: str | None, max_joints: int):
             subject = robots.get(name, symbolic=True)
         except (TypeError, ValueError, AttributeError):
             subject = robot
-    if not hasattr(subject, "equations_of_motion"):
-        return None, "This kinedyn has no symbolic engine."
-    try:
-        # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
-        eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")
-    except ImportError:
-        return None, "This kinedyn has no symbolic engine."
+    # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
+    eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")
     return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
 
 
