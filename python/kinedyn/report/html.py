@@ -27,7 +27,6 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from jinja2 import Environment, PackageLoader, select_autoescape
 from markupsafe import Markup
 
 from .. import __version__
@@ -49,7 +48,8 @@ from .data import (
     in_multi_dof_block,
     velocity_labels,
 )
-from .tables import fmt, matrix_table, table
+from .page import TEMPLATES
+from .tables import fmt
 from .view import asset, json_script, script_json, view_model
 
 __all__ = [
@@ -66,21 +66,6 @@ __all__ = [
     "velocity_labels",
     "SIMULATION_BUDGET",
 ]
-
-#: the templates of the report's page (report/templates/*.html.j2), escaping every value put in them
-TEMPLATES = Environment(
-    loader=PackageLoader("kinedyn.report", "templates"),
-    autoescape=select_autoescape(["html", "j2"], default_for_string=True),
-    trim_blocks=True,
-    lstrip_blocks=True,
-    keep_trailing_newline=True,
-)
-TEMPLATES.filters["fmt"] = fmt
-# the tables are built as HTML text (the identification page concatenates them); in a template they are markup
-TEMPLATES.globals.update(
-    table=lambda *args, **kwargs: Markup(table(*args, **kwargs)),
-    matrix_table=lambda *args, **kwargs: Markup(matrix_table(*args, **kwargs)),
-)
 
 
 def q_text(q, labels: Sequence[str], units: Sequence[str], named: Sequence[bool]) -> str:

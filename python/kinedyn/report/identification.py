@@ -9,23 +9,24 @@ predicted torque and the residual per joint, on the fitted log and on the valida
 R² per joint) when one is given; and, for a physically consistent fit, the smallest eigenvalue of
 M(q) over the log's states for the consistent and the unconstrained estimates.
 
-It shares the robot report's style and tables (:mod:`kinedyn.report.tables`); the plots are
-drawn by plotly.js inlined from the plotly package, from the JSON block ``#kinedyn-identification``
+It shares the robot report's style, tables and templates (templates/identification.html.j2); the plots are
+drawn by plotly.js inlined from the plotly package (assets/identification.js), from the JSON block ``#kinedyn-identification``
 which holds every number shown (nothing is fetched).
 """
 
 from __future__ import annotations
 
-import html
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from markupsafe import Markup
 
 from .. import __version__
 from .._ui.json import jsonable
 from ..visual.web import plotly_script
-from .tables import fmt, table
+from .page import TEMPLATES
+from .tables import fmt
 from .view import asset, json_script
 
 if TYPE_CHECKING:
@@ -106,10 +107,8 @@ def _joint_of(name: str) -> int:
     return int(name.split(".")[0][len("joint") :]) - 1
 
 
-def _sections(d: dict) -> list[str]:
-    joints = d["joint_names"]
-    out: list[str] = []
-    # --- the fit
+def _fit_lines(d: dict) -> list[str]:
+    """What was fitted, one line each: the estimator and cond(W), consistency, the log and its filtering."""
     log = d.get("log")
     how = "weighted" if d["weighted"] else "ordinary"
     lines = [
@@ -124,27 +123,12 @@ def _sections(d: dict) -> list[str]:
             if log.get("cutoff_hz")
             else ""
         )
-        lines.append(f"{log['samples']} samples of {html.escape(str(log['source']))}{filt}")
-    sec = ["<section id='fit'><h2>The fit</h2><ul>", *(f"<li>{line}</li>" for line in lines), "</ul>"]
-    if d.get("noise") is not None:
-        sec.append(
-            table(
-                ["", *joints],
-                [
-                    ["noise σ (from the residuals)", *(fmt(v, 4) for v in d["noise"])],
-                    ["residual RMS", *(fmt(v, 4) for v in d["residual_rms"])],
-                ],
-                cls="noise",
-            )
-        )
-    if d.get("dropped"):
-        sec.append(
-            f"<p class='bad'>Not excited by the data (regressor columns at round-off level), left out: {html.escape(', '.join(d['dropped']))}.</p>"
-        )
-    sec.append("</section>")
-    out.append("".join(sec))
+        lines.append(f"{log['samples']} samples of {log['source']}{filt}")
+    return lines
 
-    # --- parameters
+
+def _parameters(d: dict) -> tuple[list[str], list[list[str]]]:
+    """The base parameters with std and std %, and the errors where the true values are known."""
     true = d.get("true_values")
     headers = ["base parameter", "estimate", "std", "std %"] + (
         ["true", "error", "error %"] if true is not None else []
@@ -156,155 +140,52 @@ def _sections(d: dict) -> list[str]:
             err = d["estimates"][k] - true[k]
             row += [fmt(true[k]), fmt(err, 3), fmt(100 * abs(err) / max(abs(true[k]), 1e-300), 3)]
         rows.append(row)
-    note = (
-        "<p class='note'>std: from the covariance σ² (WᵀW)⁻¹ of the least-squares fit; std %: 100 std / |estimate| "
-        "(above ~10 % the data do not identify the parameter well).</p>"
-    )
-    out.append(
-        "<section id='parameters'><h2>Base parameters</h2>"
-        + note
-        + table(headers, rows, cls="parameters")
-        + "</section>"
-    )
+    return headers, rows
 
-    # --- friction and rotors
-    sec = ["<section id='drives'><h2>Friction and rotor inertia</h2>"]
+
+def _friction(d: dict) -> tuple[list[str], list[list[str]] | None]:
+    """Per joint, each estimated friction term as estimate ± std; None where no term was estimated."""
     terms = d["friction_terms"]
-    if terms:
-        frows = []
-        by_joint: dict = {}
-        for name, est, sd in zip(d["friction_names"], d["friction_estimates"], d["friction_std"]):
-            by_joint.setdefault(_joint_of(name), {})[name.split(".", 1)[1]] = (est, sd)
-        for j in sorted(by_joint):
-            frows.append([joints[j], *(f"{fmt(by_joint[j][t][0], 5)} ± {fmt(by_joint[j][t][1], 2)}" for t in terms)])
-        units = {"viscous": "viscous [N m s/rad]", "coulomb": "Coulomb [N m]", "offset": "offset [N m]"}
-        sec.append(table(["joint", *(units[t] for t in terms)], frows, cls="friction"))
-    elif d["friction_known"]:
-        sec.append("<p class='note'>Friction taken from the model (subtracted, not estimated).</p>")
-    else:
-        sec.append("<p class='note'>No friction estimated (friction='none').</p>")
-    if d["rotors"]:
-        rrows = []
-        for r in d["rotors"]:
-            if r["armature"] is None:
-                rrows.append(
-                    [
-                        r["joint"],
-                        fmt(r["gear_ratio"], 5),
-                        fmt(r["nominal_armature"], 4),
-                        "grouped into " + ", ".join(r["grouped_into"]),
-                        "–",
-                    ]
-                )
-            else:
-                rrows.append(
-                    [
-                        r["joint"],
-                        fmt(r["gear_ratio"], 5),
-                        fmt(r["nominal_armature"], 4),
-                        f"{fmt(r['armature'], 5)} ± {fmt(r['std'], 2)}",
-                        fmt(r["rotor_inertia"], 4),
-                    ]
-                )
-        sec.append("<h3>Armature r² J_m of the geared joints</h3>")
-        sec.append(
-            table(
-                ["joint", "gear ratio r", "model r² J_m [kg m²]", "identified r² J_m", "J_m = a / r² [kg m²]"],
-                rrows,
-                cls="rotors",
-            )
-        )
-        sec.append(
-            "<p class='note'>A grouped armature only acts together with the link parameters named: the data cannot "
-            "separate it, so it has no estimate of its own (the group's estimate is in the table above).</p>"
-        )
-    else:
-        sec.append(
-            "<p class='note'>No joint of the model has a gear ratio or a rotor inertia: no armature estimated.</p>"
-        )
-    sec.append("</section>")
-    out.append("".join(sec))
+    if not terms:
+        return [], None
+    by_joint: dict = {}
+    for name, est, sd in zip(d["friction_names"], d["friction_estimates"], d["friction_std"]):
+        by_joint.setdefault(_joint_of(name), {})[name.split(".", 1)[1]] = (est, sd)
+    rows = [
+        [d["joint_names"][j], *(f"{fmt(by_joint[j][t][0], 5)} ± {fmt(by_joint[j][t][1], 2)}" for t in terms)]
+        for j in sorted(by_joint)
+    ]
+    units = {"viscous": "viscous [N m s/rad]", "coulomb": "Coulomb [N m]", "offset": "offset [N m]"}
+    return ["joint", *(units[t] for t in terms)], rows
 
-    # --- consistency check
+
+def _rotor_rows(d: dict) -> list[list[str]]:
+    """Per geared joint: its gear ratio, the model's armature and the identified one (or its group)."""
+    rows = []
+    for r in d["rotors"]:
+        head = [r["joint"], fmt(r["gear_ratio"], 5), fmt(r["nominal_armature"], 4)]
+        if r["armature"] is None:
+            rows.append([*head, "grouped into " + ", ".join(r["grouped_into"]), "–"])
+        else:
+            rows.append([*head, f"{fmt(r['armature'], 5)} ± {fmt(r['std'], 2)}", fmt(r["rotor_inertia"], 4)])
+    return rows
+
+
+def _mass_check_rows(d: dict) -> list[list[str]] | None:
+    """The smallest eigenvalue of M(q) over the log for the consistent and the unconstrained estimates."""
     mc = d.get("mass_matrix_check")
-    if mc is not None:
-        crow = [
-            [
-                "consistent",
-                fmt(mc["consistent_min_eigenvalue"], 4),
-                "yes" if mc["consistent_min_eigenvalue"] > 0 else "no",
-            ]
-        ]
-        if "unconstrained_min_eigenvalue" in mc:
-            crow.append(
-                [
-                    "unconstrained",
-                    fmt(mc["unconstrained_min_eigenvalue"], 4),
-                    "yes"
-                    if mc["unconstrained_indefinite_states"] == 0
-                    else f"no, at {mc['unconstrained_indefinite_states']} states",
-                ]
-            )
-        out.append(
-            f"<section id='consistency'><h2>Mass matrix over the log</h2><p class='note'>The smallest eigenvalue of M(q) of each estimate "
-            f"at {mc['states']} states of the log: only a positive-definite M can be simulated.</p>"
-            + table(
-                ["estimate", "min eigenvalue of M [kg m²]", "positive definite at every state"], crow, cls="mass-check"
-            )
-            + "</section>"
+    if mc is None:
+        return None
+    rows = [
+        ["consistent", fmt(mc["consistent_min_eigenvalue"], 4), "yes" if mc["consistent_min_eigenvalue"] > 0 else "no"]
+    ]
+    if "unconstrained_min_eigenvalue" in mc:
+        bad = mc["unconstrained_indefinite_states"]
+        rows.append(
+            ["unconstrained", fmt(mc["unconstrained_min_eigenvalue"], 4), "yes" if bad == 0 else f"no, at {bad} states"]
         )
+    return rows
 
-    # --- torques
-    for key, title in (("fit", "Torques on the fitted log"), ("validation", "Validation on another log")):
-        p = d.get(key)
-        if p is None:
-            continue
-        sec = [
-            f"<section id='{key}-torques'><h2>{title}</h2>",
-            f"<p class='note'>{html.escape(str(p['source']))}: {p['samples']} samples"
-            + (f", {len(p['index'])} of them plotted" if len(p["index"]) < p["samples"] else "")
-            + ".</p>",
-            table(
-                ["", *joints],
-                [["torque RMS error", *(fmt(v, 4) for v in p["rms"])], ["R²", *(fmt(v, 7) for v in p["r2"])]],
-                cls="scores",
-            ),
-        ]
-        sec += [
-            f"<div class='id-plot' id='{key}-joint{j + 1}' role='img' aria-label='{html.escape(joints[j])}: measured and predicted torque'></div>"
-            for j in range(len(joints))
-        ]
-        sec.append("</section>")
-        out.append("".join(sec))
-    return out
-
-
-_PLOTS_JS = """
-(function () {
-  const d = JSON.parse(document.getElementById("kinedyn-identification").textContent);
-  if (!window.Plotly) return;
-  for (const key of ["fit", "validation"]) {
-    const p = d[key];
-    if (!p) continue;
-    d.joint_names.forEach((name, j) => {
-      const el = document.getElementById(key + "-joint" + (j + 1));
-      const traces = [
-        {x: p.t, y: p.measured[j], name: "measured", mode: "lines", line: {width: 1.2, color: "#1f77b4"}},
-        {x: p.t, y: p.predicted[j], name: "predicted", mode: "lines", line: {width: 1.2, dash: "dash", color: "#ff7f0e"}},
-        {x: p.t, y: p.residual[j], name: "residual", mode: "lines", yaxis: "y2", line: {width: 1, color: "#d62728"}},
-      ];
-      const layout = {
-        title: {text: name + ": RMS " + p.rms[j].toPrecision(3) + ", R² " + p.r2[j].toFixed(6), font: {size: 13}, y: 0.98},
-        margin: {l: 60, r: 10, t: 50, b: 40}, height: 320, autosize: true,
-        legend: {orientation: "h", x: 0, y: 1.0, yanchor: "bottom", font: {size: 11}},
-        xaxis: {title: {text: "t [s]"}, anchor: "y2"}, yaxis: {title: {text: "τ [N m]"}, domain: [0.36, 1], anchor: "x"},
-        yaxis2: {title: {text: "residual"}, domain: [0, 0.27], anchor: "x"},
-      };
-      window.Plotly.newPlot(el, traces, layout, {responsive: true, displaylogo: false});
-    });
-  }
-})();
-"""
 
 _EXTRA_CSS = ".id-plot { width: 100%; min-height: 320px; } section ul { margin: 0.3em 0 0.6em 1.2em; }"
 
@@ -312,19 +193,30 @@ _EXTRA_CSS = ".id-plot { width: 100%; min-height: 320px; } section ul { margin: 
 def identification_report(result: Identification, validate=None, *, title: str | None = None, **load_options) -> str:
     """The report as one HTML string (see the module docstring)."""
     d = identification_data(result, validate, **load_options)
-    title = title or f"kinedyn identification: {d['robot']}"
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{html.escape(title)}</title>
-<style>{asset("report.css")}{_EXTRA_CSS}</style></head>
-<body><header><h1>Identification of {html.escape(d["robot"])}</h1><p>{len(d["joint_names"])} joints · kinedyn {html.escape(__version__)}</p></header>
-<main>{"".join(_sections(d))}</main>
-<footer>Generated by <code>kinedyn identify --data ... -o</code>. Self-contained: no network access, every script and style is in this file.</footer>
-{json_script(d, "kinedyn-identification")}
-{plotly_script()}
-<script>{_PLOTS_JS}</script>
-</body></html>
-"""
+    parameter_headers, parameter_rows = _parameters(d)
+    friction_headers, friction_rows = _friction(d)
+    return TEMPLATES.get_template("identification.html.j2").render(
+        d=d,
+        title=title or f"kinedyn identification: {d['robot']}",
+        version=__version__,
+        css=Markup(asset("report.css")),
+        extra_css=Markup(_EXTRA_CSS),
+        fit_lines=_fit_lines(d),
+        parameter_headers=parameter_headers,
+        parameter_rows=parameter_rows,
+        friction_headers=friction_headers,
+        friction_rows=friction_rows,
+        rotor_rows=_rotor_rows(d),
+        mass_check_rows=_mass_check_rows(d),
+        torque_sections=[
+            (k, t)
+            for k, t in (("fit", "Torques on the fitted log"), ("validation", "Validation on another log"))
+            if d.get(k) is not None
+        ],
+        data_json=Markup(json_script(d, "kinedyn-identification")),
+        plotly=Markup(plotly_script()),
+        plots_js=Markup(asset("identification.js")),
+    )
 
 
 def write_identification_report(
