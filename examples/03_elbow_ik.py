@@ -7,7 +7,7 @@ Run: python examples/03_elbow_ik.py
 import numpy as np
 
 import kinedyn as kd
-from kinedyn.report.tutorial import elbow_ik
+from kinedyn.tutorial import elbow_ik
 
 robot = kd.robots.elbow_3r(L1=3.0, L2=2.0, L3=1.0)
 for i, row in enumerate(robot.dh, 1):

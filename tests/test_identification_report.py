@@ -111,13 +111,20 @@ def test_report_parses_and_holds_the_results_numbers(written):
 
 
 def test_result_methods_and_simulated_data(tmp_path):
-    """to_html / write_html / plot() with no log (the fitted data) work for simulated Measurements too."""
+    """identification_html / write_identification_html / plot() with no log (the fitted data) work for simulated
+    Measurements too; the older Identification.to_html / write_html still work and warn."""
+    from kinedyn.report import identification_html, write_identification_html
+
     robot = kd.robots.planar_2r()
     data = an.simulate_measurements(robot, an.excitation(robot, harmonics=3, period=4.0), T=4.0, rate=50.0, noise=0.01)
     result = an.identify(robot, data)
-    path = result.write_html(tmp_path / "sim.html")
+    path = write_identification_html(result, tmp_path / "sim.html")
     page = path.read_text(encoding="utf-8")
-    assert page == result.to_html()
+    assert page == identification_html(result)
+    with pytest.warns(DeprecationWarning, match="identification_html"):
+        assert result.to_html() == page
+    with pytest.warns(DeprecationWarning, match="write_identification_html"):
+        assert result.write_html(tmp_path / "old.html").read_text(encoding="utf-8") == page
     assert "error %" in page  # true values known: errors shown
     assert len(result.plot().axes) == 4
 

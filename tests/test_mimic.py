@@ -548,7 +548,7 @@ def test_report_on_a_mimic_robot(tmp_path):
 
     robot = kd.Robot.from_urdf(gripper_urdf())
     data = collect(robot, name="gripper", t_end=0.2)
-    assert data["_eom"] is not None and data["_eom"].n == 3  # the symbolic engine reduces the follower too
+    assert data.eom is not None and data.eom.n == 3  # the symbolic engine reduces the follower too
 
 
 def test_the_reports_viewer_moves_the_followers(browser, tmp_path):

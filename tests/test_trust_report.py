@@ -21,9 +21,10 @@ from hypothesis import strategies as st
 html5lib = pytest.importorskip("html5lib")
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
-from kinedyn._ui.json import jsonable as _jsonable  # noqa: E402
+from kinedyn._ui.json import jsonable  # noqa: E402
 from kinedyn.description.files import robot_from_mapping  # noqa: E402
-from kinedyn.report.html import _asset, _model_for_view, build_report, collect, script_json  # noqa: E402
+from kinedyn.report.html import build_report, collect, script_json  # noqa: E402
+from kinedyn.report.view import asset, view_model  # noqa: E402
 
 XHTML = "{http://www.w3.org/1999/xhtml}"
 
@@ -178,8 +179,8 @@ def check_report(robot, shown: bool):
     (``shown``) the names visible as themselves in the header and the tables."""
     q = np.array([0.3, -0.4])
     data = collect(robot, q, t_end=0.05, eom_joints=0)
-    expected_data = json.loads(json.dumps(_jsonable({k: v for k, v in data.items() if not k.startswith("_")})))
-    expected_model = json.loads(json.dumps(_model_for_view(robot, q)))
+    expected_data = json.loads(json.dumps(jsonable({k: v for k, v in data.items() if not k.startswith("_")})))
+    expected_model = json.loads(json.dumps(view_model(robot, q)))
     page = build_report(robot, q, data=data)
     # plotly.js (5 MB, the same in every report, no names in it) is taken out before html5lib, which
     # is pure Python, parses the page; its element stays, and is checked to be plotly's code
@@ -193,7 +194,7 @@ def check_report(robot, shown: bool):
     assert [s.get("id") for s in found] == ["kinedyn-model", "kinedyn-data", "plotly-js", None]
     assert json.loads(found[0].text) == expected_model
     assert json.loads(found[1].text) == expected_data
-    assert found[3].text == _asset("viewer.js")
+    assert found[3].text == asset("viewer.js")
     assert [e.get("id") for e in doc.iter(f"{XHTML}div") if e.get("id") == "kinedyn-view"] == ["kinedyn-view"]
     assert len(list(doc.iter(f"{XHTML}footer"))) == 1  # the page after the names is all there
     if shown:

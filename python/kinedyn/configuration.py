@@ -52,6 +52,7 @@ __all__ = [
     "random_configuration",
     "normalize",
     "check_configuration",
+    "default_configuration",
     "integrate_jacobians",
     "difference_jacobians",
     "quaternion_multiply",
@@ -719,3 +720,16 @@ def integrate_jacobians(robot: Robot, q: ArrayLike, v: ArrayLike, dt: float = 1.
 def difference_jacobians(robot: Robot, q0: ArrayLike, q1: ArrayLike) -> tuple:
     """(∂ difference/∂q0, ∂ difference/∂q1): see :meth:`ConfigurationSpace.difference_jacobians`."""
     return space(robot).difference_jacobians(q0, q1)
+
+
+def default_configuration(robot: Robot) -> np.ndarray:
+    """A generic (non-singular) configuration: 0.5, -0.7, 0.5, -0.7, ... rad (m for prismatic joints,
+    x 0.2), clipped to the joint limits; a multi-DOF joint keeps its neutral block (identity rotation).
+    The report, the viewer and the notebook drawings start here, where the structure shows (q = 0 is
+    often singular)."""
+    q, start = robot.neutral(), 0
+    for i, j in enumerate(robot.joints):
+        if not j.is_multi_dof:
+            q[start] = (0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2)
+        start += j.nq
+    return np.clip(q, robot.lower_limits, robot.upper_limits)

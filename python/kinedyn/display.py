@@ -23,6 +23,9 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
+from ._ui.svg import svg_plot
+from .configuration import default_configuration
+
 __all__ = [
     "robot_html",
     "robot_markdown",
@@ -118,8 +121,6 @@ def stick_figure_svg(robot, q=None, size: int = 220) -> str | None:
     the base (up = against gravity), the tool frame in red. None for a robot whose geometry is symbolic."""
     try:
         if q is None:  # the report's generic pose (0.5, -0.7, ... rad): the structure shows, unlike at a singular q = 0
-            from .report.html import default_configuration
-
             q = default_configuration(robot)
         q = np.asarray(q, dtype=float)
         poses = np.asarray(robot.frame_poses(q), dtype=float)
@@ -304,8 +305,6 @@ def ik_markdown(result) -> str:
 # ------------------------------------------------------------------ simulation
 def trajectory_html(traj) -> str:
     """q(t) as an inline SVG plot (the first trajectory of a batch), with a summary line."""
-    from .report.html import svg_plot
-
     q = traj.q[0] if traj.batch is not None else traj.q
     names = traj.names
     batch = f", batch of {traj.batch} (the first is plotted)" if traj.batch is not None else ""

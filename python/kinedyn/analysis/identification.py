@@ -255,18 +255,28 @@ class Identification:
         return self.validate(log, **load_options).plot()
 
     def to_html(self, validate=None, **load_options) -> str:
-        """A self-contained HTML report (:mod:`kinedyn.report.identification`): the parameters with
-        their standard deviations, friction, rotor inertia, measured vs predicted torques and the
-        residuals per joint on the fitted log and on ``validate`` (another log) when given."""
-        from ..report.identification import identification_report
+        """Deprecated: ``kinedyn.report.identification_html(result, validate)`` (the report sits above
+        the analysis; this forwards to it)."""
+        warnings.warn(
+            "Identification.to_html is deprecated: use kinedyn.report.identification_html(result, validate)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        # the one import of the report from the analysis (declared in the import contract): the old spelling
+        from ..report.identification import identification_html
 
-        return identification_report(self, validate, **load_options)
+        return identification_html(self, validate, **load_options)
 
     def write_html(self, path, validate=None, **load_options):
-        """Write :meth:`to_html` to ``path``; returns the path."""
-        from ..report.identification import write_identification_report
+        """Deprecated: ``kinedyn.report.write_identification_html(result, path, validate)``."""
+        warnings.warn(
+            "Identification.write_html is deprecated: use kinedyn.report.write_identification_html(result, path, validate)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        from ..report.identification import write_identification_html
 
-        return write_identification_report(self, path, validate, **load_options)
+        return write_identification_html(self, path, validate, **load_options)
 
     def to_dict(self) -> dict:
         d = dict(

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ..configuration import default_configuration
 from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
 
 __all__ = ["Viewer", "show"]
@@ -89,7 +90,6 @@ class Viewer:
             import viser
         except ImportError:
             raise ImportError("the live viewer needs viser: pip install 'kinedyn[viz]'") from None
-        from ..report.html import default_configuration
 
         self.robot = robot
         self.trajectory = trajectory

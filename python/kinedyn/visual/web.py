@@ -63,27 +63,31 @@ def animation_page(robot, t, q, title: str = "") -> str:
     with its meshes (the report's 3-D view: each mesh once, then joint values per frame)."""
     import html
 
-    from ..report.html import _asset, _json_script, _model_for_view
+    from ..report.view import (  # the report's viewer (above this room: see the lead's notes)
+        asset,
+        json_script,
+        view_model,
+    )
 
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     if q.ndim != 2 or q.shape != (len(t), robot.nq):
         raise ValueError(f"animation_page needs q of shape ({len(t)}, {robot.nq}), got {q.shape}")
-    model = _model_for_view(robot, q[0])
+    model = view_model(robot, q[0])
     data = {"simulation": {"t": t.tolist(), "q": q.tolist()}}
     name = html.escape(title or robot.name)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{name}: motion</title><style>{_asset("report.css")}</style></head>
+<title>{name}: motion</title><style>{asset("report.css")}</style></head>
 <body><main><section id='view'><h2>{name}</h2><div class='grid'><div>
 <div id="kinedyn-view" role="img" aria-label="3-D view of the motion"></div>
 <div id='kinedyn-playback' hidden><button id='kinedyn-play' type='button'>▶ play</button> <input id='kinedyn-time' type='range' aria-label='time'> <span id='kinedyn-clock'></span></div>
 <p class='note'>Drag to rotate, scroll to zoom. Written by kinedyn (Trajectory.animate); self-contained, nothing is fetched.</p>
 </div><div><h3>Joints</h3><div id='kinedyn-sliders'></div><p><button id='kinedyn-reset' type='button'>reset</button> <span id='kinedyn-tool'></span></p>
 <p class='note' id='kinedyn-q'></p></div></div></section></main>
-{_json_script(model, "kinedyn-model")}
-{_json_script(data, "kinedyn-data")}
+{json_script(model, "kinedyn-model")}
+{json_script(data, "kinedyn-data")}
 {plotly_script()}
-<script>{_asset("viewer.js")}</script>
+<script>{asset("viewer.js")}</script>
 </body></html>
 """

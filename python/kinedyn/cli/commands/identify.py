@@ -8,6 +8,7 @@ from rich.table import Table
 from ...analysis.excitation import excitation_condition, optimize_excitation, write_trajectory_csv
 from ...analysis.identification import excitation, identify, simulate_measurements
 from ...analysis.logs import load_log
+from ...report.identification import write_identification_html
 from .. import app
 from ..app import console, emit, esc
 from ..options import OutputPath, nonnegative_float, nonnegative_int, positive_float, positive_int, robot_argument
@@ -87,7 +88,7 @@ def run(args) -> int:
     result = identify(robot, data, weighted=args.weighted)
     payload = dict(robot=robot.name, samples=len(data.t), noise=args.noise, **result.to_dict())
     if args.output:
-        payload["report"] = str(result.write_html(args.output))
+        payload["report"] = str(write_identification_html(result, args.output))
 
     def render():
         c = console()
@@ -165,7 +166,7 @@ def _identify_from_log(robot, args) -> int:
         fig.savefig(args.plot)
         payload["plot"] = str(args.plot)
     if args.output:
-        payload["report"] = str(result.write_html(args.output, args.validate, **options))
+        payload["report"] = str(write_identification_html(result, args.output, args.validate, **options))
 
     def render():
         c = console()
