@@ -17,7 +17,6 @@ pub mod scalar;
 pub mod sim;
 pub mod spatial;
 pub mod testing;
-pub mod trig;
 
 pub use data::Data;
 pub use error::{Error, Result};

@@ -388,7 +388,7 @@ impl crate::Real for Dual {
         Dual::new(x, 0.0)
     }
     fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = crate::trig::sin_cos(self.re);
+        let (s, c) = crate::scalar::trig::sin_cos(self.re);
         (Dual::new(s, c * self.eps), Dual::new(c, -s * self.eps))
     }
     fn sin_cos_in_place(x: &mut [Self], cos: &mut [Self]) {
