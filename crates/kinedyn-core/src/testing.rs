@@ -89,6 +89,36 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
     .expect("random models are valid by construction")
 }
 
+/// `random_model(seed, n, true)` cut into a forest: after the first body, each body hangs from
+/// the base instead of its parent with probability 1/4 (seeded), so that several subtrees share
+/// the fixed base (two arms on one table); joints, placements, inertias and drives unchanged.
+pub fn random_forest(seed: u64, n: usize) -> Model {
+    let tree = random_model(seed, n, true);
+    let mut rng = Rng::new(seed ^ 0xf0_2e57);
+    let parent = (0..n)
+        .map(|i| {
+            if i > 0 && rng.next_u64() % 4 == 0 {
+                None
+            } else {
+                tree.parent[i]
+            }
+        })
+        .collect();
+    Model::new(
+        parent,
+        tree.joints,
+        tree.offset,
+        tree.parent_from_joint,
+        tree.inertia,
+        tree.armature,
+        tree.viscous,
+        tree.coulomb,
+        tree.gravity,
+        tree.frames,
+    )
+    .expect("a forest of a valid tree is valid")
+}
+
 /// A random unit vector, or (half of the time) a signed coordinate axis.
 fn random_axis(rng: &mut Rng) -> Vec3 {
     let k = rng.next_u64() % 12;
