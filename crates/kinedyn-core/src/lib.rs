@@ -2,7 +2,7 @@
 //!
 //! A [`Model`] (immutable, built once) and a [`Data`] (scratch and outputs, one per thread) are
 //! passed to free functions in [`algorithms`], `algorithm(&model, &mut data, inputs)`, as in
-//! Featherstone's RBDA and Pinocchio. Spatial vectors are `[linear; angular]` (DESIGN.md).
+//! Featherstone's RBDA and Pinocchio. Spatial vectors are `[linear; angular]` (docs/architecture.md).
 
 pub mod algorithms;
 pub mod batch;

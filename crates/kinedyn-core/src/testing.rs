@@ -97,7 +97,7 @@ pub fn random_forest(seed: u64, n: usize) -> Model {
     let mut rng = Rng::new(seed ^ 0xf0_2e57);
     let parent = (0..n)
         .map(|i| {
-            if i > 0 && rng.next_u64() % 4 == 0 {
+            if i > 0 && rng.next_u64().is_multiple_of(4) {
                 None
             } else {
                 tree.parent[i]
@@ -125,7 +125,7 @@ fn random_axis(rng: &mut Rng) -> Vec3 {
     if k >= 6 {
         return rng.unit();
     }
-    let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
     let mut axis = Vec3::zeros();
     axis[(k / 2) as usize] = sign;
     axis
@@ -307,8 +307,8 @@ pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
                     Block::Spherical => (at, true),
                     Block::Planar => (at + 2, false),
                 };
-                for k in at..start {
-                    q[k] = rng.uniform(-1.0, 1.0);
+                for x in &mut q[at..start] {
+                    *x = rng.uniform(-1.0, 1.0);
                 }
                 if quaternion {
                     let v: Vec<f64> = (0..4).map(|_| rng.uniform(-1.0, 1.0)).collect();

@@ -561,10 +561,10 @@ fn asymmetric_coulomb_friction_gives_each_direction_its_level() {
                 &qdd,
                 1e-10,
             );
-            for i in 0..n {
+            for (i, &level) in negative.iter().enumerate() {
                 assert_eq!(asym.coulomb_torque(i, 0.0), 0.0);
                 assert_eq!(asym.coulomb_torque(i, 1e-300), asym.coulomb[i]);
-                assert_eq!(asym.coulomb_torque(i, -1e-300), -negative[i]);
+                assert_eq!(asym.coulomb_torque(i, -1e-300), -level);
             }
         }
     }

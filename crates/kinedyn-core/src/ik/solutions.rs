@@ -84,7 +84,7 @@ fn frame_pose_lean(model: &Model, q: &[f64], frame: usize) -> Transform {
     let first = support.next().copied().unwrap_or(body);
     let mut world_from_body = parent_from_body(model, q, first);
     for &i in support {
-        world_from_body = &world_from_body * &parent_from_body(model, q, i);
+        world_from_body = world_from_body * parent_from_body(model, q, i);
     }
     if f.body_from_frame == Transform::identity() {
         world_from_body

@@ -61,7 +61,8 @@ fn lu_factor(a: &mut [f64], n: usize, pivot: &mut [usize]) -> std::result::Resul
             .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
             .unwrap_or(k);
         pivot[k] = p;
-        if !(a[p * n + k].abs() > 1e-300_f64.max(1e-15 * scale)) {
+        let size = a[p * n + k].abs();
+        if size.is_nan() || size <= 1e-300_f64.max(1e-15 * scale) {
             return Err(k);
         }
         if p != k {
@@ -86,8 +87,8 @@ fn lu_factor(a: &mut [f64], n: usize, pivot: &mut [usize]) -> std::result::Resul
 
 /// Solve `a x = b` in place in `b` with the factors of [`lu_factor`].
 fn lu_solve(lu: &[f64], n: usize, pivot: &[usize], b: &mut [f64]) {
-    for k in 0..n {
-        b.swap(k, pivot[k]);
+    for (k, &p) in pivot[..n].iter().enumerate() {
+        b.swap(k, p);
     }
     // L y = P b (unit lower) ; U x = y
     for i in 0..n {
@@ -116,7 +117,8 @@ fn add_product(out: &mut [f64], a: &[f64], b: &[f64], n: usize) {
 
 /// One linearly implicit Euler step from `(q, qd)` at `t` (see the module header), `qdd` the ABA's
 /// acceleration there and `tau` the torque applied; `q`, `qd` are overwritten with the new state.
-#[allow(clippy::too_many_arguments)]
+// r, j, k: row and column indices of the n x n row-major matrices and of the joint vectors alike
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
 pub(super) fn implicit_step(
     model: &Model,
     data: &mut Data,

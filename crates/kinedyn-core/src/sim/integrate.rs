@@ -130,7 +130,7 @@ pub fn integrate(
     let (n, nq) = (model.n, model.nq);
     let h = settings.dt;
     let every = settings.record_every;
-    if !(h > 0.0) || !h.is_finite() {
+    if !h.is_finite() || h <= 0.0 {
         return Err(Error::InvalidInput(format!(
             "the step dt must be a positive finite number, got {h}"
         )));
@@ -250,8 +250,8 @@ pub fn integrate(
                         s.qd[j] = qd[j] + c * prev_v[j];
                     }
                     // RKMK4: the chart's rate dexp⁻¹(v) at Ω = c k_stage (v on 1-DOF joints)
-                    for j in 0..n {
-                        s.mean[j] = c * kq[stage][j];
+                    for (m, k) in s.mean.iter_mut().zip(&kq[stage]) {
+                        *m = c * k;
                     }
                     let (head, tail) = kq.split_at_mut(stage + 1);
                     model.chart_rate(&s.mean, &s.qd, &mut tail[0]);
