@@ -38,6 +38,10 @@
 //! reference), verified by forward kinematics and refined by a few Gauss-Newton steps
 //! (`analytic_solutions`).
 //!
+//! Files: `numeric.rs` (the solver, its settings and start checks), `reduction.rs` (mimic joints),
+//! `analytic.rs` (structures and their closed forms), `subproblems.rs` (Paden-Kahan), `solutions.rs`
+//! (closed-form candidates to checked joint vectors); the pose error is here.
+//!
 //! | symbol   | here          | meaning                                                  |
 //! |----------|---------------|----------------------------------------------------------|
 //! | `e`      | `e: [f64; 6]` | pose error `[p_d - p; log(R_d R^T)]`, base axes          |

@@ -38,6 +38,9 @@
 //! joint speed above `max_speed`, a torque that is not finite, or a singular mass matrix stops the
 //! run: the samples before it are kept and a [`Failure`] says when and where.
 //!
+//! Files: the types of a run are here; `integrate.rs` (the runner: checks, stages, limits, samples),
+//! `implicit.rs` (the linearly implicit step), `torque.rs` (torque sources).
+//!
 //! | symbol      | here                  | meaning                                          |
 //! |-------------|-----------------------|--------------------------------------------------|
 //! | `h`         | `settings.dt`         | step (s)                                         |
