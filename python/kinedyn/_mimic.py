@@ -249,7 +249,7 @@ def inverse_kinematics(robot, target, q0, mask, method, respect_limits, **kwargs
       the frame does not see).
     - A frame that a follower moves (a finger): the numeric solver in the reduced coordinates, with
       the Jacobian ``J G`` (chain rule, ``v_full = G v``) and the update ``q_full ⊕ G dq`` read back
-      at the independent coordinates (crates/kinedyn-core/src/algorithms/ik.rs, ``Reduction``);
+      at the independent coordinates (crates/kinedyn-core/src/ik/reduction.rs, ``Reduction``);
       limits are those of the independent joints."""
     import dataclasses
 

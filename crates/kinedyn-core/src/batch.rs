@@ -167,11 +167,10 @@ pub fn run<K: Kernel>(
     simd: Simd,
 ) -> Result<(), StateError> {
     let width = kernel.output_len(model);
-    let states = if width > 0 {
-        out.len() / width
-    } else {
-        inputs.first().map_or(0, |x| x.values.len() / x.width.max(1))
-    };
+    let states = out
+        .len()
+        .checked_div(width)
+        .unwrap_or_else(|| inputs.first().map_or(0, |x| x.values.len() / x.width.max(1)));
     assert!(
         inputs.iter().all(|x| x.values.len() == states * x.width) && out.len() == states * width,
         "batch::run: inputs and output disagree on the number of states"

@@ -3,9 +3,17 @@
 //! Algorithms overwrite what they use; nothing here is a precondition of another algorithm
 //! (no dirty flags): an algorithm that needs forward kinematics runs it.
 
-use crate::algorithms::derivatives::Tangent;
 use crate::model::Model;
 use crate::spatial::{ArticulatedInertia, Force, Inertia, Mat3, Motion, Real, Transform, Vec3};
+
+/// The derivatives of one body's twist, acceleration and composite force along one coordinate
+/// (the tangent sweep of `algorithms::derivatives`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tangent<T: Real = f64> {
+    pub dv: Motion<T>,
+    pub da: Motion<T>,
+    pub dfc: Force<T>,
+}
 
 /// Generic over the scalar: `Data` (f64) for single calls, `Data<Lanes<N>>` for N states at once
 /// (`crate::batch`).

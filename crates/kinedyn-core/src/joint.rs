@@ -21,7 +21,7 @@ pub struct Joint {
 /// Rotation matrix about the unit vector `a` by `angle` (Rodrigues' formula).
 #[inline]
 pub fn axis_angle(a: &Vec3, angle: f64) -> Mat3 {
-    let (s, c) = crate::trig::sin_cos(angle);
+    let (s, c) = crate::scalar::trig::sin_cos(angle);
     axis_angle_trig(a, s, c)
 }
 
@@ -79,7 +79,7 @@ impl Joint {
     /// columns of the placement's rotation, `R Rz(x) = [c r0 + s r1, c r1 - s r0, r2]`.
     #[inline]
     pub fn compose(&self, parent_from_joint: &Transform, x: f64) -> Transform {
-        let (s, c) = crate::trig::sin_cos(x);
+        let (s, c) = crate::scalar::trig::sin_cos(x);
         self.compose_trig(parent_from_joint, x, s, c)
     }
 

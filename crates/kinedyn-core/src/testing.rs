@@ -89,13 +89,43 @@ pub fn random_model(seed: u64, n: usize, branching: bool) -> Model {
     .expect("random models are valid by construction")
 }
 
+/// `random_model(seed, n, true)` cut into a forest: after the first body, each body hangs from
+/// the base instead of its parent with probability 1/4 (seeded), so that several subtrees share
+/// the fixed base (two arms on one table); joints, placements, inertias and drives unchanged.
+pub fn random_forest(seed: u64, n: usize) -> Model {
+    let tree = random_model(seed, n, true);
+    let mut rng = Rng::new(seed ^ 0xf0_2e57);
+    let parent = (0..n)
+        .map(|i| {
+            if i > 0 && rng.next_u64().is_multiple_of(4) {
+                None
+            } else {
+                tree.parent[i]
+            }
+        })
+        .collect();
+    Model::new(
+        parent,
+        tree.joints,
+        tree.offset,
+        tree.parent_from_joint,
+        tree.inertia,
+        tree.armature,
+        tree.viscous,
+        tree.coulomb,
+        tree.gravity,
+        tree.frames,
+    )
+    .expect("a forest of a valid tree is valid")
+}
+
 /// A random unit vector, or (half of the time) a signed coordinate axis.
 fn random_axis(rng: &mut Rng) -> Vec3 {
     let k = rng.next_u64() % 12;
     if k >= 6 {
         return rng.unit();
     }
-    let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
     let mut axis = Vec3::zeros();
     axis[(k / 2) as usize] = sign;
     axis
@@ -277,8 +307,8 @@ pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
                     Block::Spherical => (at, true),
                     Block::Planar => (at + 2, false),
                 };
-                for k in at..start {
-                    q[k] = rng.uniform(-1.0, 1.0);
+                for x in &mut q[at..start] {
+                    *x = rng.uniform(-1.0, 1.0);
                 }
                 if quaternion {
                     let v: Vec<f64> = (0..4).map(|_| rng.uniform(-1.0, 1.0)).collect();
@@ -388,7 +418,7 @@ impl crate::Real for Dual {
         Dual::new(x, 0.0)
     }
     fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = crate::trig::sin_cos(self.re);
+        let (s, c) = crate::scalar::trig::sin_cos(self.re);
         (Dual::new(s, c * self.eps), Dual::new(c, -s * self.eps))
     }
     fn sin_cos_in_place(x: &mut [Self], cos: &mut [Self]) {

@@ -1,130 +1,40 @@
-//! Identities between the dynamics algorithms on random chains and branching trees (seeded RNG),
-//! finite-difference checks of the derivative quantities, and a closed-form double pendulum.
+//! Identities between the dynamics algorithms on random chains, trees and forests (the seeded
+//! generator of `kinedyn_core::testing`), finite-difference checks of the derivative quantities,
+//! and a closed-form double pendulum.
 
 use kinedyn_core::algorithms::{self as alg, Reference, RneaTerms};
 use kinedyn_core::spatial::{Inertia, Mat3, Transform, Vec3};
-use kinedyn_core::{Data, Error, Frame, Joint, JointKind, Model};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
+use kinedyn_core::testing::{random_forest, random_model, Rng};
+use kinedyn_core::{Data, Error, Joint, JointKind, Model};
 
-fn unit(rng: &mut StdRng) -> Vec3 {
-    loop {
-        let v = Vec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        if v.norm() > 0.2 {
-            return v.normalize();
-        }
-    }
+/// Gravity off the coordinate axes, so that no identity leans on its direction.
+const GRAVITY: [f64; 3] = [0.3, -0.5, -9.81];
+
+fn tilted(mut model: Model) -> Model {
+    model.gravity = Vec3::from(GRAVITY);
+    model
 }
 
-fn rotation(rng: &mut StdRng) -> Mat3 {
-    kinedyn_core::joint::axis_angle(&unit(rng), rng.random_range(-3.0..3.0))
-}
-
-/// A physically valid random inertia: mass, centre of mass, principal moments obeying the
-/// triangle inequality, rotated principal axes; expressed about the body origin.
-fn random_inertia(rng: &mut StdRng, massless: bool) -> Inertia {
-    if massless {
-        return Inertia::zero();
-    }
-    let m = rng.random_range(0.2..3.0);
-    let c = Vec3::new(
-        rng.random_range(-0.3..0.3),
-        rng.random_range(-0.3..0.3),
-        rng.random_range(-0.3..0.3),
-    );
-    let (a, b): (f64, f64) = (rng.random_range(0.01..0.2), rng.random_range(0.01..0.2));
-    let d = rng.random_range((a - b).abs() + 0.005..a + b);
-    let r = rotation(rng);
-    let ic = r * Mat3::from_diagonal(&Vec3::new(a, b, d)) * r.transpose();
-    // about the origin: I_o = I_c + m ([c]x^T [c]x)
-    let cx = kinedyn_core::spatial::skew(&c);
-    Inertia::new(m, m * c, ic + m * cx.transpose() * cx)
-}
-
-/// A random model: `tree` gives random parents (else a chain); drives add armature and friction.
-fn random_model(seed: u64, n: usize, tree: bool, drives: bool, massless: bool) -> Model {
-    let mut rng = StdRng::seed_from_u64(seed);
-    let parent: Vec<Option<usize>> = (0..n)
-        .map(|i| {
-            if i == 0 {
-                None
-            } else if tree {
-                if rng.random_range(0..4) == 0 {
-                    None
-                } else {
-                    Some(rng.random_range(0..i))
-                }
-            } else {
-                Some(i - 1)
-            }
-        })
-        .collect();
-    let joints = (0..n)
-        .map(|_| Joint {
-            kind: if rng.random_range(0..4) == 0 {
-                JointKind::Prismatic
-            } else {
-                JointKind::Revolute
-            },
-            axis: unit(&mut rng),
-        })
-        .collect();
-    let offset = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
-    let placement = (0..n)
-        .map(|_| {
-            Transform::new(
-                rotation(&mut rng),
-                Vec3::new(
-                    rng.random_range(-0.5..0.5),
-                    rng.random_range(-0.5..0.5),
-                    rng.random_range(-0.5..0.5),
-                ),
-            )
-        })
-        .collect();
-    let inertia = (0..n).map(|_| random_inertia(&mut rng, massless)).collect();
-    let mut coef = |on: bool| -> Vec<f64> {
-        (0..n)
-            .map(|_| if on { rng.random_range(0.0..0.5) } else { 0.0 })
-            .collect()
-    };
-    let armature = coef(drives);
-    let viscous = coef(drives);
-    let coulomb = coef(drives);
-    let gravity = Vec3::new(0.3, -0.5, -9.81);
-    let frames = (0..n)
-        .map(|i| Frame {
-            body: Some(i),
-            body_from_frame: Transform::identity(),
-        })
-        .collect();
-    Model::new(
-        parent, joints, offset, placement, inertia, armature, viscous, coulomb, gravity, frames,
-    )
-    .unwrap()
-}
-
+/// Chains, trees (each body's parent any earlier body) and forests (some bodies on the base), all
+/// with armature and viscous and Coulomb friction.
 fn models() -> Vec<(String, Model)> {
     let mut out = Vec::new();
     for (seed, n) in [(1u64, 1usize), (2, 2), (3, 5), (4, 7), (5, 12)] {
-        out.push((
-            format!("chain n={n} seed={seed}"),
-            random_model(seed, n, false, true, false),
-        ));
+        out.push((format!("chain n={n} seed={seed}"), tilted(random_model(seed, n, false))));
         out.push((
             format!("tree n={n} seed={seed}"),
-            random_model(100 + seed, n, true, true, false),
+            tilted(random_model(100 + seed, n, true)),
+        ));
+        out.push((
+            format!("forest n={n} seed={seed}"),
+            tilted(random_forest(200 + seed, n)),
         ));
     }
     out
 }
 
-fn vector(rng: &mut StdRng, n: usize, scale: f64) -> Vec<f64> {
-    (0..n).map(|_| rng.random_range(-scale..scale)).collect()
+fn vector(rng: &mut Rng, n: usize, scale: f64) -> Vec<f64> {
+    rng.vector(n, -scale, scale)
 }
 
 fn matvec(m: &[f64], x: &[f64]) -> Vec<f64> {
@@ -162,7 +72,7 @@ fn friction(model: &Model, qd: &[f64]) -> Vec<f64> {
 
 /// A random state (q, qd, qdd) for each model.
 fn states(model: &Model, seed: u64) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = Rng::new(seed);
     (0..3)
         .map(|_| {
             (
@@ -242,7 +152,7 @@ fn forward_dynamics_inverts_inverse_dynamics_with_external_forces() {
     for (name, model) in models() {
         let n = model.n;
         let mut data = Data::new(&model);
-        let mut rng = StdRng::seed_from_u64(9);
+        let mut rng = Rng::new(9);
         for (q, qd, qdd) in states(&model, 10) {
             for with_f in [false, true] {
                 let f = vector(&mut rng, 6 * n, 5.0);
@@ -260,7 +170,7 @@ fn external_wrench_enters_as_minus_jacobian_transpose() {
     for (name, model) in models() {
         let n = model.n;
         let mut data = Data::new(&model);
-        let mut rng = StdRng::seed_from_u64(11);
+        let mut rng = Rng::new(11);
         let (q, qd, qdd) = states(&model, 12).remove(0);
         let f = vector(&mut rng, 6 * n, 5.0);
         let with = alg::rnea(&model, &mut data, &q, &qd, &qdd, Some(&f)).to_vec();
@@ -269,7 +179,9 @@ fn external_wrench_enters_as_minus_jacobian_transpose() {
         let mut want = vec![0.0; n];
         let mut jac = vec![0.0; 6 * n];
         for i in 0..n {
-            alg::frame_jacobian(&model, &mut data, &q, i, Reference::World, None, &mut jac);
+            // frame i sits on body i; its Jacobian at body i's origin (a point fixed in the frame)
+            let origin = model.frames[i].body_from_frame.inverse().trans;
+            alg::frame_jacobian(&model, &mut data, &q, i, Reference::World, Some(&origin), &mut jac);
             for k in 0..n {
                 want[k] -= (0..6).map(|r| jac[r * n + k] * f[6 * i + r]).sum::<f64>();
             }
@@ -491,7 +403,10 @@ fn mass_matrix_inverse_times_mass_matrix_is_identity() {
 
 #[test]
 fn singular_mass_matrix_is_an_error_naming_the_joint() {
-    let model = random_model(3, 4, false, false, true);
+    // a massless chain without rotor inertia: the last joint moves nothing
+    let mut model = random_model(3, 4, false);
+    model.inertia = vec![Inertia::zero(); 4];
+    model.armature = vec![0.0; 4];
     let mut data = Data::new(&model);
     let z = vec![0.0; 4];
     match alg::aba(&model, &mut data, &z, &z, &z, None) {
@@ -534,8 +449,21 @@ fn singular_mass_matrix_is_an_error_naming_the_joint() {
 }
 
 #[test]
+fn forests_have_several_roots_and_trees_branch() {
+    // else the forests and trees of `models` would test nothing that the chains do not
+    let (mut forests, mut trees) = (0, 0);
+    for (name, model) in models() {
+        let roots = model.parent.iter().filter(|p| p.is_none()).count();
+        let branching = (1..model.n).any(|i| model.parent[i] != Some(i - 1));
+        forests += (name.starts_with("forest") && roots > 1) as usize;
+        trees += (name.starts_with("tree") && roots == 1 && branching) as usize;
+    }
+    assert!(forests >= 2 && trees >= 2, "{forests} forests, {trees} trees");
+}
+
+#[test]
 fn branches_do_not_couple() {
-    for (name, model) in models().into_iter().filter(|(n, _)| n.starts_with("tree")) {
+    for (name, model) in models().into_iter().filter(|(n, _)| !n.starts_with("chain")) {
         let n = model.n;
         let mut data = Data::new(&model);
         let (q, qd, _) = states(&model, 21).remove(0);
@@ -633,14 +561,14 @@ fn asymmetric_coulomb_friction_gives_each_direction_its_level() {
                 &qdd,
                 1e-10,
             );
-            for i in 0..n {
+            for (i, &level) in negative.iter().enumerate() {
                 assert_eq!(asym.coulomb_torque(i, 0.0), 0.0);
                 assert_eq!(asym.coulomb_torque(i, 1e-300), asym.coulomb[i]);
-                assert_eq!(asym.coulomb_torque(i, -1e-300), -negative[i]);
+                assert_eq!(asym.coulomb_torque(i, -1e-300), -level);
             }
         }
     }
-    let model = random_model(1, 2, false, true, false);
+    let model = random_model(1, 2, false);
     let short = model.clone().with_coulomb_negative(vec![0.1]).unwrap_err();
     assert!(
         format!("{short:?}").contains("coulomb_negative has 1 entries for 2 bodies"),

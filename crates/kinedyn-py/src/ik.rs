@@ -1,10 +1,10 @@
 //! Inverse kinematics glue: `solve_ik` (batched Levenberg-Marquardt) and `AnalyticIk` (closed
 //! forms detected from a model's geometry). Shapes and targets are checked here; the work is in
-//! `kinedyn_core::algorithms::ik`, run with the GIL released.
+//! `kinedyn_core::ik`, run with the GIL released.
 
 use std::sync::Mutex;
 
-use kinedyn_core::algorithms::ik::{self, AnalyticIk as CoreAnalytic, Settings};
+use kinedyn_core::ik::{self, AnalyticIk as CoreAnalytic, Settings};
 use kinedyn_core::spatial::{Mat3, Transform, Vec3};
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -136,7 +136,7 @@ fn reduction(model: &Model, args: Option<ReductionArgs>) -> PyResult<Option<ik::
 }
 
 /// Levenberg-Marquardt inverse kinematics of `frame` for one target or a batch, on the
-/// configuration manifold (multi-DOF joints: q ⊕ dq; see `kinedyn_core::algorithms::ik`).
+/// configuration manifold (multi-DOF joints: q ⊕ dq; see `kinedyn_core::ik`).
 ///
 /// targets: (4, 4) | (3,) | (N, 4, 4) | (N, 3) (positions use weights on x, y, z only);
 /// q0: (nq,) or (N, nq); lower, upper: (nq,) (infinite on multi-DOF joints' entries);

@@ -1,5 +1,5 @@
 //! Simulation glue: whole trajectories (one state or a batch) integrated by
-//! `kinedyn_core::algorithms::integrate`, with the torque as samples (no GIL, batches in parallel) or
+//! `kinedyn_core::sim`, with the torque as samples (no GIL, batches in parallel) or
 //! from a Python callable evaluated by the core's loop (GIL held while it runs).
 //!
 //! Both return `(q, qd, qdd, tau, steps, failures)`: arrays `(samples, n)` or `(N, samples, n)`,
@@ -8,9 +8,7 @@
 
 use std::cell::RefCell;
 
-use kinedyn_core::algorithms::integrate::{
-    self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn,
-};
+use kinedyn_core::sim::{self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn};
 use kinedyn_core::Data;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -288,7 +286,7 @@ pub fn integrate_fixed<'py>(
                 linear,
             };
             let mut data = Data::new(model_ref);
-            integrate::integrate(
+            sim::integrate(
                 model_ref,
                 &mut data,
                 &settings,
@@ -483,7 +481,7 @@ pub fn integrate_callback<'py>(
                 qdd: &mut oqdd[r.clone()],
                 tau: &mut otau[r],
             };
-            let outcome = integrate::integrate(
+            let outcome = sim::integrate(
                 &m.model,
                 &mut data,
                 &settings,

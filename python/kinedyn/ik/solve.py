@@ -1,6 +1,6 @@
 """``inverse_kinematics``: closed forms where the chain's geometry has one, Levenberg-Marquardt else.
 
-Both solvers run in the native core (``crates/kinedyn-core/src/algorithms/ik.rs``); this module
+Both solvers run in the native core (``crates/kinedyn-core/src/ik/``); this module
 checks the inputs, picks the solver and packs the answer into an :class:`IKResult`.
 
 Target: a 4x4 pose of ``frame`` (default: the robot's tool) in the base, or a 3-vector position of

@@ -8,7 +8,7 @@ Where the work happens (DESIGN.md: Rust does every hot loop):
 - A robot, a fixed-step method (``rk4``, ``implicit``, ``semi_implicit``, ``euler``) and torques given as data (none,
   a constant, or samples per step): the whole trajectory, or a batch of initial states (in
   parallel), is one native call (``kinedyn._core.integrate_fixed``; the scheme is in
-  ``crates/kinedyn-core/src/algorithms/integrate.rs``).
+  ``crates/kinedyn-core/src/sim/``).
 - A robot with a Python controller or a torque function ``u(t, q, qd)``: the core's integration loop
   calls the Python function through a callback, at every Runge-Kutta stage (a continuous-time control
   law, exact to the integrator's order) or, with ``hold=True``, once per step (a digital controller
@@ -314,7 +314,7 @@ def _coulomb_torque(coulomb, v):
 
 
 def _implicit_step(q, qd, a, h, A_q, A_v, Minv, coulomb):
-    """The linearly implicit Euler step of integrate.rs (``Method::Implicit``) in NumPy: returns the
+    """The linearly implicit Euler step of the core's ``sim/implicit.rs`` (``Method::Implicit``) in NumPy: returns the
     new (q, qd). ``a``: the acceleration at (q, qd) (Coulomb friction included), ``coulomb``: the
     levels (positive, negative), each (n,), or None."""
     n = q.size
@@ -370,7 +370,7 @@ def _derivatives_fn(target, robot, fext_fn):
 
 
 def _clamp_to_limits(q, qd, lower, upper):
-    """Inelastic stops (integrate.rs ``apply_limits``)."""
+    """Inelastic stops (the core's ``sim/integrate.rs`` ``apply_limits``)."""
     low, high = q <= lower, q >= upper
     q = np.where(low, lower, np.where(high, upper, q))
     qd = np.where(low, np.maximum(qd, 0.0), np.where(high, np.minimum(qd, 0.0), qd))
@@ -408,7 +408,7 @@ def _fixed_python(
     limits=None,
     deadline=None,
 ):
-    """One trajectory with the schemes of integrate.rs, the dynamics called from Python.
+    """One trajectory with the schemes of the core's ``sim/``, the dynamics called from Python.
     ``implicit``: (derivatives(t, q, qd, tau), jacobian(t, q, qd) or None, coulomb or None) for the
     implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`_Deadline`."""
     n = q0.size

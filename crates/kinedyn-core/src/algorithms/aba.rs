@@ -1,7 +1,7 @@
 //! Forward dynamics by the articulated-body algorithm.
 //!
 //! Source: RBDA Table 7.1 (Featherstone 2008, §7.3), gravity as the base acceleration `a_0 = -g`.
-//! Drives as in DESIGN.md: the reflected rotor inertia adds to the joint's articulated inertia,
+//! Drives as in docs/architecture.md: the reflected rotor inertia adds to the joint's articulated inertia,
 //! `D_i = s_i^T IA_i s_i + armature_i`, and friction is moved to the input side,
 //! `tau_i - viscous_i qd_i - coulomb_i sign(qd_i)` (direction-dependent Coulomb levels:
 //! `Model::coulomb_torque`). A joint whose `D_i` vanishes (a massless subtree, a point mass on the
@@ -31,6 +31,8 @@ const EPS_D: f64 = 1e-13;
 const HUGE_TRACE: f64 = 1e200;
 
 /// `qdd = aba(q, qd, tau, f_ext)` written to `data.qdd`; `f_ext` as in [`super::rnea::rnea`].
+// `!(a > b)` is the pivot test that NaN also fails, in one comparison per lane
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 #[inline(always)]
 pub fn aba<'d, T: Real>(
     model: &Model,

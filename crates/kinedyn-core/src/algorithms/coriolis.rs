@@ -14,7 +14,7 @@
 //! - k supports j, k != j: `C[j][k] = ds_k/dt . (I^c_j s_j) + s_k . (B^c_j^T s_j)`.
 //!
 //! The armature is constant and adds nothing to `C`. The Christoffel symbols follow from
-//! linearity in qd: `c_ijk = C(q, e_i)[k][j]`, with `C[k][j] = sum_i c_ijk qd_i` (DESIGN.md).
+//! linearity in qd: `c_ijk = C(q, e_i)[k][j]`, with `C[k][j] = sum_i c_ijk qd_i` (docs/architecture.md).
 //!
 //! | symbol             | here                 | meaning (world coordinates)                      |
 //! |--------------------|----------------------|--------------------------------------------------|

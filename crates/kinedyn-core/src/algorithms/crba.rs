@@ -1,7 +1,7 @@
 //! The joint-space mass matrix by the composite-rigid-body algorithm.
 //!
 //! Source: RBDA Table 6.2 (Featherstone 2008, §6.2). Reflected rotor inertia is added on the
-//! diagonal (DESIGN.md: `M` includes `r^2 J_m`). Only the lower triangle is computed; the upper is
+//! diagonal (docs/architecture.md: `M` includes `r^2 J_m`). Only the lower triangle is computed; the upper is
 //! its mirror image, so `M` is symmetric to the last bit.
 //!
 //! | symbol      | here                       | meaning                                          |

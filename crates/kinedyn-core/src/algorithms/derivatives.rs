@@ -44,18 +44,10 @@ use super::coriolis::inertia_rate;
 use super::kinematics::forward_kinematics;
 use super::minv::inverse_of_mass_matrix;
 use super::rnea::rnea;
-use crate::data::Data;
+use crate::data::{Data, Tangent};
 use crate::error::Result;
 use crate::model::Model;
 use crate::spatial::{cross, mv, outer, splat3, Force, Motion, Real, Vec3};
-
-/// The derivatives of one body's twist, acceleration and composite force along one coordinate.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Tangent<T: Real = f64> {
-    pub dv: Motion<T>,
-    pub da: Motion<T>,
-    pub dfc: Force<T>,
-}
 
 /// `dtau/dq` and `dtau/dqd` (row-major n x n: `[i * n + j] = dtau_i / dx_j`) at `(q, qd, qdd)`,
 /// for the same `tau` as [`rnea`] (gravity, friction, armature, `f_ext`), and when asked for,

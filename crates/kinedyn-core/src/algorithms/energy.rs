@@ -2,7 +2,7 @@
 //!
 //! Sources: RBDA eq. 2.71 (`T = 1/2 v . I v` per body) and Spong, Hutchinson & Vidyasagar,
 //! *Robot Modeling and Control* (2006) §7.1: `K = 1/2 qd^T M qd`, `P = -sum_i m_i g . c_i`.
-//! The reflected rotor inertia is part of `M` (DESIGN.md), so `K` counts `1/2 armature qd^2`.
+//! The reflected rotor inertia is part of `M` (docs/architecture.md), so `K` counts `1/2 armature qd^2`.
 //!
 //! | symbol   | here                      | meaning                                        |
 //! |----------|---------------------------|------------------------------------------------|
@@ -17,6 +17,8 @@ use crate::model::Model;
 use crate::spatial::{mv, splat3, Real};
 
 /// `K(q, qd) = 1/2 sum_i v_i . I_i v_i + 1/2 sum_i armature_i qd_i^2 (= 1/2 qd^T M qd)`.
+// i: the body number, indexing the model's and the data's per-body arrays together
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn kinetic_energy<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T]) -> T {
     forward_velocity(model, data, q, qd);

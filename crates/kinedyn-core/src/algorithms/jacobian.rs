@@ -2,7 +2,7 @@
 //!
 //! Column j of the spatial Jacobian is joint j's motion subspace in world coordinates,
 //! `world_from_body[j] . s_j` (RBDA eq. 3.39 / Murray, Li & Sastry eq. 3.54), for the joints that
-//! support the frame's body. The three references of DESIGN.md:
+//! support the frame's body. The three references of docs/architecture.md:
 //! - `World` (Pinocchio's LOCAL_WORLD_ALIGNED, the textbook `[J_v; J_w]`): velocity of the frame
 //!   origin and angular velocity, both in base axes: `[v_o + w x p; w]`;
 //! - `Local`: the same twist in the frame's own axes;

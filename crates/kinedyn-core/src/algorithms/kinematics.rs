@@ -137,6 +137,8 @@ pub fn forward_kinematics<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
 }
 
 /// Forward kinematics, then body twists `v_i` (body coordinates) at `(q, qd)`.
+// i: the body number, indexing the model's and the data's per-body arrays together
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn forward_velocity<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T]) {
     forward_kinematics(model, data, q);

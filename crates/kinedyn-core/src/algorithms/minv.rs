@@ -29,6 +29,8 @@ const EPS_M: f64 = 1e-26;
 const HUGE_M: f64 = 1e200;
 
 /// Factor `data.m` (= M) into `data.m2` as `L^T D L` (RBDA Table 6.3).
+// `!(a > b && c > d)` is the pivot test that NaN also fails, one comparison per bound
+#[allow(clippy::neg_cmp_op_on_partial_ord, clippy::nonminimal_bool)]
 #[inline(always)]
 pub fn ltdl<T: Real>(model: &Model, data: &mut Data<T>) -> Result<()> {
     let n = model.n;
@@ -36,8 +38,8 @@ pub fn ltdl<T: Real>(model: &Model, data: &mut Data<T>) -> Result<()> {
     h.copy_from_slice(&data.m[..n * n]);
     // the largest diagonal entry, lane by lane (one lane per state of a batch)
     let mut scale = [0.0f64; 16];
-    for l in 0..T::LANES {
-        scale[l] = (0..n).map(|i| data.m[i * n + i].lane(l)).fold(0.0, f64::max);
+    for (l, s) in scale[..T::LANES].iter_mut().enumerate() {
+        *s = (0..n).map(|i| data.m[i * n + i].lane(l)).fold(0.0, f64::max);
     }
     for k in (0..n).rev() {
         let (hkk, mkk) = (h[k * n + k], data.m[k * n + k]);

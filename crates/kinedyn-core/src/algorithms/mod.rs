@@ -6,8 +6,6 @@ pub mod crba;
 pub mod derivatives;
 pub mod energy;
 pub mod gravity;
-pub mod ik;
-pub mod integrate;
 pub mod jacobian;
 pub mod kinematics;
 pub mod minv;

@@ -35,7 +35,7 @@ pub fn center_of_mass(model: &Model, data: &mut Data, q: &[f64]) -> Result<Vec3>
         m += inertia.mass;
         h += x.rot * inertia.h + inertia.mass * x.trans;
     }
-    if !(m > 0.0) {
+    if m.is_nan() || m <= 0.0 {
         return Err(Error::InvalidModel(
             "the centre of mass is undefined: the moving bodies have zero total mass".into(),
         ));
@@ -76,7 +76,7 @@ pub fn centroidal_momentum_matrix(model: &Model, data: &mut Data, q: &[f64], out
             }
         }
     }
-    if !(mass > 0.0) {
+    if mass.is_nan() || mass <= 0.0 {
         return Err(Error::InvalidModel(
             "the centre of mass is undefined: the moving bodies have zero total mass".into(),
         ));

@@ -4,7 +4,7 @@
 //! links", IJRR 5(3), 1986, in spatial form (RBDA Table 5.1 with `f_i` written as `A_i pi_i`):
 //! `f_i = I_i a_i + v_i x* I_i v_i` is linear in body i's parameters
 //! `pi_i = [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (about the body origin, body axes;
-//! DESIGN.md's order), and joint j carries body i's force when j supports i:
+//! docs/architecture.md's order), and joint j carries body i's force when j supports i:
 //! `Y[j][10 i + c] = s_j . ^jX_i^* A_i[:, c]`. Gravity enters as `a_0 = -g`; friction and the
 //! armature are not inertial parameters of a body and are left out.
 //!

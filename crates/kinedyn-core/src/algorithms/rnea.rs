@@ -2,7 +2,7 @@
 //!
 //! Source: R. Featherstone, *Rigid Body Dynamics Algorithms* (RBDA), Springer 2008, Table 5.1
 //! (gravity as a fictitious base acceleration `a_0 = -g`, §5.3), with external forces as in
-//! eq. 5.20 and the drive terms of DESIGN.md: `tau = M qdd + C qd + g + friction - J^T f_ext`.
+//! eq. 5.20 and the drive terms of docs/architecture.md: `tau = M qdd + C qd + g + friction - J^T f_ext`.
 //!
 //! | symbol      | here                       | meaning                                            |
 //! |-------------|----------------------------|----------------------------------------------------|

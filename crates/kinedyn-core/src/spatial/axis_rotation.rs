@@ -83,7 +83,9 @@ mod tests {
     /// matrices Rodrigues' formula makes (including the ones with rounding in the 1 entry).
     #[test]
     fn classes_rotate_like_the_full_matrix() {
-        let cases: [(Vec3, fn(&AxisRotation) -> bool); 7] = [
+        // an axis and the class its rotations must have
+        type Case = (Vec3, fn(&AxisRotation) -> bool);
+        let cases: [Case; 7] = [
             (Vec3::x(), |k| matches!(k, AxisRotation::X { .. })),
             (Vec3::y(), |k| matches!(k, AxisRotation::Y { .. })),
             (Vec3::z(), |k| matches!(k, AxisRotation::Z { .. })),

@@ -1,4 +1,4 @@
-//! Spatial (6-D) vector algebra, ordered `[linear; angular]` as in DESIGN.md (Pinocchio's order).
+//! Spatial (6-D) vector algebra, ordered `[linear; angular]` as in docs/architecture.md (Pinocchio's order).
 //!
 //! Featherstone, *Rigid Body Dynamics Algorithms* (RBDA), ch. 2, writes motion vectors `[w; v]`;
 //! here the same quantities are stored as named 3-vectors, so the ordering is only a convention of

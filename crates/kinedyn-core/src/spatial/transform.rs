@@ -117,6 +117,8 @@ impl<T: Real> Transform<T> {
 impl<T: Real> Mul for Transform<T> {
     type Output = Transform<T>;
     /// `a_from_b * b_from_c = a_from_c`.
+    // composition: (R_ab, p_ab) (R_bc, p_bc) = (R_ab R_bc, R_ab p_bc + p_ab), a sum inside a product
+    #[allow(clippy::suspicious_arithmetic_impl)]
     #[inline(always)]
     fn mul(self, o: Transform<T>) -> Transform<T> {
         Transform::new(mm(&self.rot, &o.rot), mv(&self.rot, &o.trans) + self.trans)
@@ -125,6 +127,8 @@ impl<T: Real> Mul for Transform<T> {
 
 impl<T: Real> Mul<&Transform<T>> for &Transform<T> {
     type Output = Transform<T>;
+    // composition, as for values
+    #[allow(clippy::suspicious_arithmetic_impl)]
     #[inline(always)]
     fn mul(self, o: &Transform<T>) -> Transform<T> {
         Transform::new(mm(&self.rot, &o.rot), mv(&self.rot, &o.trans) + self.trans)

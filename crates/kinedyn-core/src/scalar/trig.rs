@@ -8,12 +8,16 @@
 //! `pi/2` split in three parts so that `k * part` is exact; then `sin r`, `cos r` by minimax
 //! polynomials in `z = r^2`, and the quadrant `k mod 4` swaps and negates them.
 
+// The constants keep the digits fdlibm prints for them (e_rem_pio2.c, k_sin.c, k_cos.c), so that
+// they can be checked against the source; each literal is the double fdlibm's hex words give.
+#![allow(clippy::excessive_precision)]
+
 // pi/2 = PIO2_1 + PIO2_2 + PIO2_3, the first two with 33 significant bits (k PIO2_i exact for |k| < 2^20)
 const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
 const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
 const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
-const TWO_OVER_PI: f64 = 6.366_197_723_675_813_824_33e-01;
-// sin r = r + r z (S1 + z (S2 + ... + z S6))
+const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI; // fdlibm's invpio2 6.36619772367581382433e-01, the same double
+                                                      // sin r = r + r z (S1 + z (S2 + ... + z S6))
 const S1: f64 = -1.666_666_666_666_663_243_48e-01;
 const S2: f64 = 8.333_333_333_322_489_461_24e-03;
 const S3: f64 = -1.984_126_982_985_794_931_34e-04;
@@ -29,6 +33,8 @@ const C5: f64 = 2.087_572_321_298_174_827_90e-09;
 const C6: f64 = -1.135_964_755_778_819_482_65e-11;
 
 /// `(sin x, cos x)`.
+// `!(|x| < LIMIT)` also sends NaN to the standard library, in one comparison
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 #[inline(always)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() < LIMIT) {

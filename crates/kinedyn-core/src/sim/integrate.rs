@@ -1,42 +1,5 @@
-//! Fixed-step integration of the equations of motion over a whole trajectory.
-//!
-//! State `x = (q, qd)`, `dx/dt = (qd, qdd)`, `qdd = aba(q, qd, tau(t, q, qd))` (LaValle eq. 13.148,
-//! the phase form of `M qdd + C qd + g + friction = tau`). The torque comes from a [`TorqueFn`]:
-//! zero, a constant, samples held or interpolated over each step, or any closure (the Python
-//! binding passes a controller through one).
-//!
-//! Methods (step `h`, `t_k = t0 + k h`):
-//! - `Rk4`, classical Runge-Kutta (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.1, Table 1.2):
-//!   `k1 = f(t_k, x_k)`, `k2 = f(t_k + h/2, x_k + h/2 k1)`, `k3 = f(t_k + h/2, x_k + h/2 k2)`,
-//!   `k4 = f(t_k + h, x_k + h k3)`, `x_{k+1} = x_k + h/6 (k1 + 2 k2 + 2 k3 + k4)`; global error O(h^4).
-//! - `SemiImplicitEuler` (symplectic Euler; Hairer, Lubich & Wanner, *Geometric Numerical
-//!   Integration*, §VI.3): `qd_{k+1} = qd_k + h qdd(q_k, qd_k)`, `q_{k+1} = q_k + h qd_{k+1}`;
-//!   first order, but the energy of a conservative system stays bounded instead of drifting.
-//! - `Euler` (explicit): `x_{k+1} = x_k + h f(t_k, x_k)`; first order, energy grows. For comparison.
-//! - `Implicit`, the linearly implicit (Rosenbrock-) Euler step (Hairer & Wanner, *Solving ODEs II*,
-//!   §IV.7, eq. 7.4 with gamma = 1): `x_{k+1} = x_k + (I - h J)^-1 h f(t_k, x_k)`, `J = df/dx` from the
-//!   analytical derivatives of the articulated-body algorithm ([`aba_derivatives`]: `A_q = dqdd/dq`,
-//!   `A_v = dqdd/dqd`) plus, when the torque source knows them ([`TorqueFn::jacobian`], e.g. a PD
-//!   law: `dtau/dq = -Kp`, `dtau/dqd = -Kd`), the controller's gains through `dqdd/dtau = M^-1`.
-//!   With `J = [[0, I], [A_q, A_v]]` the 2n x 2n solve reduces to one n x n solve for the velocity
-//!   increment, `(I - h A_v - h^2 A_q) dv = h (qdd_k + h A_q qd_k)`, then `qd_{k+1} = qd_k + dv`,
-//!   `q_{k+1} = q_k + h qd_{k+1}`. First order, but exact for linear dynamics' stability: stable
-//!   for any step on damped and spring-like (PD) terms however stiff (MuJoCo's `implicit`
-//!   integrator linearises the damping the same way; this one also linearises the springs). It
-//!   dissipates energy at O(h) (numerical damping), so free motion loses energy slowly.
-//!   Coulomb friction `coulomb sign(qd)` is not differentiable: it is applied in the direction
-//!   of the velocity the step predicts without it, through the same matrix, and it may stop a joint
-//!   but not reverse it within one step (stiction, a per-joint approximation of the set-valued law
-//!   of time-stepping schemes such as Stewart & Trinkle 1996).
-//!
-//! Joint limits (`settings.limits`): after every step a joint beyond a limit is put back on it
-//! and its velocity into the limit set to zero (an inelastic stop; a projection, first order at the
-//! impact).
-//!
-//! Recorded per sample `k` (every `record_every` steps, and the last): `q_k`, `qd_k`, the torque
-//! applied at `t_k` and `qdd_k = aba(q_k, qd_k, tau_k)`. A step that produces a non-finite state or a
-//! joint speed above `max_speed`, a torque that is not finite, or a singular mass matrix stops the
-//! run: the samples before it are kept and a [`Failure`] says when and where.
+//! The runner: one fixed-step trajectory, its inputs checked, stages evaluated, limits applied,
+//! blow-ups caught and samples recorded (the schemes and their sources are in `sim/mod.rs`).
 //!
 //! | symbol      | here                  | meaning                                          |
 //! |-------------|-----------------------|--------------------------------------------------|
@@ -45,188 +8,12 @@
 //! | `k1..k4`    | `kq[s]`, `kv[s]`      | stage derivatives of `q` and `qd`                |
 //! | `tau`       | `tau`                 | joint torque at a stage, length `n`              |
 
-use super::aba::aba;
-use super::derivatives::aba_derivatives;
+use super::implicit::{implicit_step, ImplicitScratch};
+use super::{Failure, FailureKind, Limits, Method, Outcome, Record, Settings, TorqueFn};
+use crate::algorithms::aba::aba;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
-
-/// The fixed-step schemes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    Rk4,
-    SemiImplicitEuler,
-    Euler,
-    Implicit,
-}
-
-impl Method {
-    /// Evaluations of the dynamics per step.
-    pub fn stages(self) -> usize {
-        match self {
-            Method::Rk4 => 4,
-            Method::SemiImplicitEuler | Method::Euler | Method::Implicit => 1,
-        }
-    }
-}
-
-/// Joint position limits, each length `n` (infinite for an unlimited joint).
-#[derive(Clone, Copy, Debug)]
-pub struct Limits<'a> {
-    pub lower: &'a [f64],
-    pub upper: &'a [f64],
-}
-
-/// Step size, length and stop conditions of a run.
-#[derive(Clone, Copy, Debug)]
-pub struct Settings<'a> {
-    pub method: Method,
-    /// Step `h` (s), > 0.
-    pub dt: f64,
-    /// Number of steps; the trajectory has `steps / record_every + 1` samples (the last step is
-    /// always recorded).
-    pub steps: usize,
-    /// Start time (s).
-    pub t0: f64,
-    /// Record every `record_every`-th step (>= 1).
-    pub record_every: usize,
-    /// Evaluate the torque once per step, at `(t_k, x_k)`, and hold it over the stages (a digital
-    /// controller at the integration rate); otherwise at every stage (a continuous-time law).
-    pub hold: bool,
-    /// A joint speed above this (rad/s or m/s) counts as a blow-up.
-    pub max_speed: f64,
-    /// Joint position limits to honour (inelastic stops), or None: free motion passes through.
-    pub limits: Option<Limits<'a>>,
-}
-
-impl Settings<'_> {
-    pub fn samples(&self) -> usize {
-        self.steps.div_ceil(self.record_every.max(1)) + 1
-    }
-}
-
-/// Why a run stopped early.
-#[derive(Clone, Debug, PartialEq)]
-pub enum FailureKind {
-    /// A joint position or speed became NaN or infinite.
-    NonFinite,
-    /// A joint speed exceeded `max_speed` (value attached).
-    Diverged(f64),
-    /// The torque source returned a non-finite value.
-    Torque(f64),
-    /// The torque source reported an error (message attached).
-    Source(String),
-    /// The mass matrix was singular (message from the articulated-body algorithm).
-    Singular(String),
-}
-
-/// When and where a run stopped: during step `step` (from `t` to `t + dt`), at joint `joint`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Failure {
-    pub step: usize,
-    pub t: f64,
-    pub joint: Option<usize>,
-    pub kind: FailureKind,
-}
-
-/// How a run ended: `steps` steps were completed and `samples` samples written.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
-    pub steps: usize,
-    pub samples: usize,
-    pub failure: Option<Failure>,
-}
-
-/// The torque source: `tau(t, q, qd, out)`; an `Err` stops the run with [`FailureKind::Source`].
-pub trait TorqueFn {
-    fn torque(
-        &mut self,
-        step: usize,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        out: &mut [f64],
-    ) -> std::result::Result<(), String>;
-
-    /// `dtau/dq` and `dtau/dqd` (row-major n x n, `[i * n + j] = dtau_i / dx_j`) at a state, for
-    /// the implicit method; `Ok(false)` (the default) when the torque does not depend on the state
-    /// or its derivatives are unknown (they are then left out of the step's Jacobian).
-    fn jacobian(
-        &mut self,
-        _step: usize,
-        _t: f64,
-        _q: &[f64],
-        _qd: &[f64],
-        _dtau_dq: &mut [f64],
-        _dtau_dqd: &mut [f64],
-    ) -> std::result::Result<bool, String> {
-        Ok(false)
-    }
-}
-
-impl<F: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> std::result::Result<(), String>> TorqueFn for F {
-    fn torque(
-        &mut self,
-        step: usize,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        out: &mut [f64],
-    ) -> std::result::Result<(), String> {
-        self(step, t, q, qd, out)
-    }
-}
-
-/// Torque from samples at `t0 + k dt`, `k = 0..`, row-major `(samples, n)`: one row is a constant,
-/// no rows is zero. `linear`: interpolate between samples `k` and `k + 1` (needs `steps + 1` rows);
-/// else hold sample `k` over step `k` (zero-order hold; needs `steps` rows).
-pub struct Sampled<'a> {
-    pub values: &'a [f64],
-    pub n: usize,
-    pub t0: f64,
-    pub dt: f64,
-    pub linear: bool,
-}
-
-impl TorqueFn for Sampled<'_> {
-    fn torque(
-        &mut self,
-        step: usize,
-        t: f64,
-        _q: &[f64],
-        _qd: &[f64],
-        out: &mut [f64],
-    ) -> std::result::Result<(), String> {
-        let n = self.n;
-        let rows = self.values.len() / n.max(1);
-        match rows {
-            0 => out.fill(0.0),
-            1 => out.copy_from_slice(&self.values[..n]),
-            _ => {
-                let k = step.min(rows - 1);
-                let row = |k: usize| &self.values[k * n..(k + 1) * n];
-                if self.linear && k + 1 < rows {
-                    // tau(t) = (1 - s) tau_k + s tau_{k+1},  s = (t - t_k) / dt
-                    let s = ((t - (self.t0 + k as f64 * self.dt)) / self.dt).clamp(0.0, 1.0);
-                    for ((o, a), b) in out.iter_mut().zip(row(k)).zip(row(k + 1)) {
-                        *o = (1.0 - s) * a + s * b;
-                    }
-                } else {
-                    out.copy_from_slice(row(k));
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Output arrays, each row-major `(settings.samples(), n)`.
-pub struct Record<'a> {
-    pub q: &'a mut [f64],
-    pub qd: &'a mut [f64],
-    pub qdd: &'a mut [f64],
-    pub tau: &'a mut [f64],
-}
 
 /// Scratch of one run (allocated once per trajectory).
 struct Stage {
@@ -239,197 +26,8 @@ struct Stage {
     kv: [Vec<f64>; 4],
 }
 
-/// Scratch of the implicit step (n x n matrices row-major, allocated once per trajectory).
-struct ImplicitScratch {
-    a_q: Vec<f64>,
-    a_v: Vec<f64>,
-    minv: Vec<f64>,
-    k_q: Vec<f64>,
-    k_v: Vec<f64>,
-    lu: Vec<f64>,
-    pivot: Vec<usize>,
-    rhs: Vec<f64>,
-    v0: Vec<f64>,
-    /// The next configuration (nq numbers).
-    q_next: Vec<f64>,
-}
-
-impl ImplicitScratch {
-    fn new(n: usize, nq: usize) -> Self {
-        let m = || vec![0.0; n * n];
-        ImplicitScratch {
-            a_q: m(),
-            a_v: m(),
-            minv: m(),
-            k_q: m(),
-            k_v: m(),
-            lu: m(),
-            pivot: vec![0; n],
-            rhs: vec![0.0; n],
-            v0: vec![0.0; n],
-            q_next: vec![0.0; nq],
-        }
-    }
-}
-
-/// LU factorisation with partial pivoting of the row-major n x n `a`, in place (Golub & Van Loan,
-/// *Matrix Computations*, 4th ed., Algorithm 3.4.1): `P a = L U`, `pivot[k]` the row swapped into
-/// row k. `Err(k)` if column k has no usable pivot (the matrix is singular).
-fn lu_factor(a: &mut [f64], n: usize, pivot: &mut [usize]) -> std::result::Result<(), usize> {
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    for k in 0..n {
-        let p = (k..n)
-            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
-            .unwrap_or(k);
-        pivot[k] = p;
-        if !(a[p * n + k].abs() > 1e-300_f64.max(1e-15 * scale)) {
-            return Err(k);
-        }
-        if p != k {
-            for j in 0..n {
-                a.swap(k * n + j, p * n + j);
-            }
-        }
-        // below the pivot: l_ik = a_ik / a_kk ; a_ij -= l_ik a_kj
-        let akk = a[k * n + k];
-        for i in k + 1..n {
-            let l = a[i * n + k] / akk;
-            a[i * n + k] = l;
-            if l != 0.0 {
-                for j in k + 1..n {
-                    a[i * n + j] -= l * a[k * n + j];
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Solve `a x = b` in place in `b` with the factors of [`lu_factor`].
-fn lu_solve(lu: &[f64], n: usize, pivot: &[usize], b: &mut [f64]) {
-    for k in 0..n {
-        b.swap(k, pivot[k]);
-    }
-    // L y = P b (unit lower) ; U x = y
-    for i in 0..n {
-        let s: f64 = (0..i).map(|j| lu[i * n + j] * b[j]).sum();
-        b[i] -= s;
-    }
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|j| lu[i * n + j] * b[j]).sum();
-        b[i] = (b[i] - s) / lu[i * n + i];
-    }
-}
-
-/// `out += a b` for row-major n x n matrices.
-fn add_product(out: &mut [f64], a: &[f64], b: &[f64], n: usize) {
-    for r in 0..n {
-        for k in 0..n {
-            let c = a[r * n + k];
-            if c != 0.0 {
-                for j in 0..n {
-                    out[r * n + j] += c * b[k * n + j];
-                }
-            }
-        }
-    }
-}
-
-/// One linearly implicit Euler step from `(q, qd)` at `t` (see the module header), `qdd` the ABA's
-/// acceleration there and `tau` the torque applied; `q`, `qd` are overwritten with the new state.
-#[allow(clippy::too_many_arguments)]
-fn implicit_step(
-    model: &Model,
-    data: &mut Data,
-    source: &mut dyn TorqueFn,
-    s: &mut ImplicitScratch,
-    step: usize,
-    t: f64,
-    h: f64,
-    q: &mut [f64],
-    qd: &mut [f64],
-    qdd: &[f64],
-    tau: &[f64],
-) -> std::result::Result<(), Failure> {
-    let n = model.n;
-    let fail = |joint, kind| Failure { step, t, joint, kind };
-    // A_q = dqdd/dq, A_v = dqdd/dqd, M^-1 at (q, qd, tau)
-    aba_derivatives(model, data, q, qd, tau, None, &mut s.a_q, &mut s.a_v, &mut s.minv)
-        .map_err(|e| fail(singular_joint(&e), FailureKind::Singular(e.to_string())))?;
-    // the torque's own dependence on the state: A_q += M^-1 dtau/dq ; A_v += M^-1 dtau/dqd
-    let known = source
-        .jacobian(step, t, q, qd, &mut s.k_q, &mut s.k_v)
-        .map_err(|m| fail(None, FailureKind::Source(m)))?;
-    if known {
-        if let Some(j) = s.k_q.iter().chain(s.k_v.iter()).position(|x| !x.is_finite()) {
-            return Err(fail(
-                Some((j % (n * n)) / n.max(1)),
-                FailureKind::Source("the torque's Jacobian has a non-finite entry".into()),
-            ));
-        }
-        add_product(&mut s.a_q, &s.minv, &s.k_q, n);
-        add_product(&mut s.a_v, &s.minv, &s.k_v, n);
-    }
-    // LU of I - h A_v - h^2 A_q
-    for r in 0..n {
-        for c in 0..n {
-            let identity = if r == c { 1.0 } else { 0.0 };
-            s.lu[r * n + c] = identity - h * s.a_v[r * n + c] - h * h * s.a_q[r * n + c];
-        }
-    }
-    lu_factor(&mut s.lu, n, &mut s.pivot).map_err(|k| {
-        fail(
-            Some(k),
-            FailureKind::Singular(format!(
-                "the implicit step's matrix I - h dqdd/dqd - h^2 dqdd/dq is singular at joint {k}"
-            )),
-        )
-    })?;
-    // without Coulomb friction: a0 = qdd + M^-1 coulomb_torque(qd) (the ABA's qdd includes it)
-    let coulomb = (0..n).any(|k| model.has_coulomb(k));
-    // dv0 = (I - h A_v - h^2 A_q)^-1 h (a0 + h A_q qd)
-    for r in 0..n {
-        let mut a0 = qdd[r];
-        if coulomb {
-            a0 += (0..n)
-                .map(|k| s.minv[r * n + k] * model.coulomb_torque(k, qd[k]))
-                .sum::<f64>();
-        }
-        let spring: f64 = (0..n).map(|k| s.a_q[r * n + k] * qd[k]).sum();
-        s.rhs[r] = h * (a0 + h * spring);
-    }
-    lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
-    for j in 0..n {
-        s.v0[j] = qd[j] + s.rhs[j];
-    }
-    if coulomb {
-        // Coulomb along the predicted velocity: dvc = (I - h A_v - h^2 A_q)^-1 (-h M^-1 coulomb_torque(v0))
-        for r in 0..n {
-            s.rhs[r] = -h
-                * (0..n)
-                    .map(|k| s.minv[r * n + k] * model.coulomb_torque(k, s.v0[k]))
-                    .sum::<f64>();
-        }
-        lu_solve(&s.lu, n, &s.pivot, &mut s.rhs);
-        for j in 0..n {
-            let v1 = s.v0[j] + s.rhs[j];
-            // friction stops a joint, it does not reverse it
-            qd[j] = if model.has_coulomb(j) && v1 * s.v0[j] < 0.0 {
-                0.0
-            } else {
-                v1
-            };
-        }
-    } else {
-        qd.copy_from_slice(&s.v0);
-    }
-    // q_{k+1} = q_k ⊕ h qd_{k+1}
-    step_configuration(model, q, qd, h, &mut s.q_next);
-    Ok(())
-}
-
 /// `q = q ⊕ h v` in place (`scratch`: nq numbers).
-fn step_configuration(model: &Model, q: &mut [f64], v: &[f64], h: f64, scratch: &mut [f64]) {
+pub(super) fn step_configuration(model: &Model, q: &mut [f64], v: &[f64], h: f64, scratch: &mut [f64]) {
     model.integrate_configuration(q, v, h, scratch);
     q.copy_from_slice(&scratch[..q.len()]);
 }
@@ -481,7 +79,7 @@ fn derivative(
     }
 }
 
-fn singular_joint(e: &Error) -> Option<usize> {
+pub(super) fn singular_joint(e: &Error) -> Option<usize> {
     let Error::SingularMassMatrix(m) = e else { return None };
     m.strip_prefix("joint ")?.split_whitespace().next()?.parse().ok()
 }
@@ -532,7 +130,7 @@ pub fn integrate(
     let (n, nq) = (model.n, model.nq);
     let h = settings.dt;
     let every = settings.record_every;
-    if !(h > 0.0) || !h.is_finite() {
+    if !h.is_finite() || h <= 0.0 {
         return Err(Error::InvalidInput(format!(
             "the step dt must be a positive finite number, got {h}"
         )));
@@ -652,8 +250,8 @@ pub fn integrate(
                         s.qd[j] = qd[j] + c * prev_v[j];
                     }
                     // RKMK4: the chart's rate dexp⁻¹(v) at Ω = c k_stage (v on 1-DOF joints)
-                    for j in 0..n {
-                        s.mean[j] = c * kq[stage][j];
+                    for (m, k) in s.mean.iter_mut().zip(&kq[stage]) {
+                        *m = c * k;
                     }
                     let (head, tail) = kq.split_at_mut(stage + 1);
                     model.chart_rate(&s.mean, &s.qd, &mut tail[0]);
@@ -703,6 +301,7 @@ pub fn integrate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::Sampled;
     use crate::testing::random_model;
 
     fn run(
@@ -812,8 +411,8 @@ mod tests {
         let qd0 = vec![0.5; n];
         let mut data = Data::new(&model);
         let mut energy = |q: &[f64], qd: &[f64]| {
-            super::super::energy::kinetic_energy(&model, &mut data, q, qd)
-                + super::super::energy::potential_energy(&model, &mut data, q)
+            crate::algorithms::energy::kinetic_energy(&model, &mut data, q, qd)
+                + crate::algorithms::energy::potential_energy(&model, &mut data, q)
         };
         let e0 = energy(&q0, &qd0);
         let drift = |method| {

@@ -1,42 +1,5 @@
-//! Inverse kinematics: closed forms where the geometry has one, Levenberg-Marquardt everywhere.
-//!
-//! **Pose error** (base axes, `[linear; angular]` as everywhere in kinedyn):
-//!
-//! ```text
-//! e(q) = [ p_d - p(q) ;  log(R_d R(q)^T) ]          (6,)
-//! ```
-//!
-//! the log map of the pose error on R^3 x SO(3) expressed in base axes; to first order
-//! `de = J(q) dq` with `J` the world-aligned geometric Jacobian (`Reference::World`), which is why
-//! masks and weights act on base-axis components (x, y, z, rx, ry, rz).
-//!
-//! **Numeric solver** (`numeric_ik`): Levenberg-Marquardt with Sugihara's damping, "Solvability-
-//! unconcerned inverse kinematics by the Levenberg-Marquardt method", IEEE T-RO 27(5), 2011:
-//!
-//! ```text
-//! (J^T W J + lambda I) dq = J^T W e,     lambda = E + mu,     E = 1/2 e^T W e
-//! ```
-//!
-//! where Sugihara's constant bias `w_bar` (`lambda_min`) is made adaptive as in Marquardt's method:
-//! `mu` starts at `lambda_min`, shrinks tenfold after an accepted step (to 1e-14, so that the last
-//! steps are Gauss-Newton steps even near a singularity) and grows tenfold after a rejected one.
-//! The system is solved in task space, `dq = A^T (A A^T + lambda I)^-1 W^1/2 e` with `A = W^1/2 J` (a 6 x 6
-//! Cholesky solve whatever n is). A step is accepted only if it lowers E; joint limits are kept by
-//! projecting q on its box after each step, holding the joints that rest on a limit the step
-//! would cross (an active set); a run that stalls restarts from a random
-//! configuration inside the limits (seeded, so batches are reproducible).
-//!
-//! **On the configuration manifold** (floating, spherical, planar joints): q has nq entries, the
-//! step `dq` and the Jacobian's columns nv (one per velocity coordinate, the joint's velocity in its
-//! child frame), and the update is `q ⊕ dq` ([`Model::integrate_configuration`]: `M Exp(dq)` on
-//! SE(3), SO(3) or SE(2)), so quaternions stay unit; `e` is unchanged, and to first order
-//! `e(q ⊕ dq) = e(q) - J dq`. Only 1-DOF coordinates have limits; restarts draw uniform rotations.
-//! With a [`Reduction`] (mimic joints) the solver works in the reduced coordinates, with `J G`.
-//!
-//! **Closed forms** (`analytic`, `subproblems`): candidates from the Paden-Kahan subproblems, mapped
-//! to q (`q = theta - offset`, revolute angles moved by 2 pi k into the limits, nearest the caller's
-//! reference), verified by forward kinematics and refined by a few Gauss-Newton steps
-//! (`analytic_solutions`).
+//! The numeric solver: Levenberg-Marquardt with Sugihara's damping on the configuration manifold
+//! (the derivation, the step and the symbol table are in the header of `ik/mod.rs`).
 //!
 //! | symbol   | here          | meaning                                                  |
 //! |----------|---------------|----------------------------------------------------------|
@@ -44,69 +7,18 @@
 //! | `W`      | `weights`     | diagonal weights (mask) of the six error components      |
 //! | `J`      | `jac`         | world-aligned geometric Jacobian, 6 x nv row-major        |
 //! | `lambda` | `lambda`      | damping                                                  |
+//! | `mu`     | `mu`          | adaptive part of the damping (Marquardt)                 |
 
-pub mod analytic;
-pub mod subproblems;
-
-pub use analytic::{AnalyticIk, Screw, Structure};
-
-use super::jacobian::{frame_jacobian, frame_pose_at, Reference};
-use super::kinematics::parent_from_body;
+use super::{cost, pose_error, residuals, Reduction};
+use crate::algorithms::jacobian::{frame_jacobian, frame_pose_at, Reference};
 use crate::data::Data;
 use crate::joint::JointKind;
 use crate::lie;
 use crate::model::{Coordinates, Model};
 use crate::rng::Rng;
-use crate::spatial::{Mat3, Transform, Vec3};
+use crate::spatial::Transform;
 use nalgebra::{Matrix6, Vector6};
 use std::f64::consts::PI;
-
-/// `log(R)` of a rotation matrix as a rotation vector (angle in [0, pi]), accurate near 0 and pi.
-pub fn log_so3(r: &Mat3) -> Vec3 {
-    // vee(R - R^T) = 2 sin(theta) w,  trace(R) = 1 + 2 cos(theta)
-    let v = Vec3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
-    let s = 0.5 * v.norm();
-    let c = 0.5 * (r.trace() - 1.0);
-    let theta = s.atan2(c);
-    if theta < 1e-6 {
-        // theta / (2 sin theta) = 1/2 + theta^2 / 12 + ...
-        return v * (0.5 + theta * theta / 12.0);
-    }
-    if theta < PI - 1e-4 {
-        return v * (theta / (2.0 * s));
-    }
-    // near pi: (R + R^T)/2 - cos(theta) I = (1 - cos(theta)) w w^T; w from its largest column, sign from v
-    let b = ((r + r.transpose()) * 0.5 - Mat3::identity() * c) / (1.0 - c);
-    let k = (0..3)
-        .max_by(|&i, &j| b[(i, i)].partial_cmp(&b[(j, j)]).unwrap())
-        .unwrap();
-    let mut w = b.column(k).into_owned() / b[(k, k)].max(1e-300).sqrt();
-    w.normalize_mut();
-    if w.dot(&v) < 0.0 {
-        w = -w;
-    }
-    w * theta
-}
-
-/// Pose error `[p_d - p; log(R_d R^T)]` of `current` towards `target` (base axes).
-#[inline]
-pub fn pose_error(current: &Transform, target: &Transform) -> [f64; 6] {
-    let dp = target.trans - current.trans;
-    let dr = log_so3(&(target.rot * current.rot.transpose()));
-    [dp.x, dp.y, dp.z, dr.x, dr.y, dr.z]
-}
-
-/// Norms of the weighted position and orientation parts (components with weight 0 are ignored).
-#[inline]
-fn residuals(e: &[f64; 6], weights: &[f64; 6]) -> (f64, f64) {
-    let mut sq = [0.0; 2];
-    for k in 0..6 {
-        if weights[k] > 0.0 {
-            sq[k / 3] += e[k] * e[k];
-        }
-    }
-    (sq[0].sqrt(), sq[1].sqrt())
-}
 
 /// Settings of the numeric solver.
 #[derive(Clone, Copy, Debug)]
@@ -151,92 +63,6 @@ pub struct Outcome {
     pub iterations: usize,
     /// Attempts made (1 + restarts used).
     pub attempts: usize,
-}
-
-/// Reduced coordinates of a model whose mimic joints follow their leaders (as Pinocchio 3 reduces
-/// them; `python/kinedyn/description/mimic.py`): `q_full = expand(q)` is affine and `v_full = G v`
-/// with a constant `G` whose every row has one nonzero, so a frame's Jacobian in the reduced
-/// coordinates is `J G` (chain rule) and `q ⊕ dq` is `q_full ⊕ G dq` read back at the kept entries.
-#[derive(Clone, Debug)]
-pub struct Reduction {
-    /// Per full q coordinate i: `(k, m, b)` with `q_full[i] = m q[k] + b`.
-    pub q_source: Vec<(usize, f64, f64)>,
-    /// Per full velocity coordinate i: `(k, m)` with `v_full[i] = m v[k]` (row i of G).
-    pub v_source: Vec<(usize, f64)>,
-    /// The full q index of each reduced coordinate: `q[k] = q_full[q_keep[k]]`.
-    pub q_keep: Vec<usize>,
-    /// Number of reduced velocity coordinates.
-    pub nv: usize,
-}
-
-impl Reduction {
-    /// Checked against `model`: sizes, indices, each kept coordinate maps to itself, and every
-    /// multi-DOF joint is kept whole (its q and v blocks copied, in order).
-    pub fn new(
-        model: &Model,
-        q_source: Vec<(usize, f64, f64)>,
-        v_source: Vec<(usize, f64)>,
-        q_keep: Vec<usize>,
-        nv: usize,
-    ) -> Result<Self, String> {
-        let (nq_full, nv_full, nq) = (model.nq, model.n, q_keep.len());
-        if q_source.len() != nq_full || v_source.len() != nv_full {
-            return Err(format!(
-                "a reduction maps {nq_full} q and {nv_full} v coordinates of the model; got {} and {}",
-                q_source.len(),
-                v_source.len()
-            ));
-        }
-        if let Some((i, _)) = q_source
-            .iter()
-            .enumerate()
-            .find(|(_, (k, m, b))| *k >= nq || !m.is_finite() || !b.is_finite())
-        {
-            return Err(format!("reduction: full q coordinate {i} reads reduced coordinate {} of {nq} (or a non-finite multiplier/offset)", q_source[i].0));
-        }
-        if let Some((i, _)) = v_source
-            .iter()
-            .enumerate()
-            .find(|(_, (k, m))| *k >= nv || !m.is_finite())
-        {
-            return Err(format!(
-                "reduction: full v coordinate {i} reads reduced velocity {} of {nv} (or a non-finite multiplier)",
-                v_source[i].0
-            ));
-        }
-        for (k, &i) in q_keep.iter().enumerate() {
-            if i >= nq_full || q_source[i] != (k, 1.0, 0.0) {
-                return Err(format!(
-                    "reduction: reduced coordinate {k} is kept at full coordinate {i}, which does not copy it"
-                ));
-            }
-        }
-        for (qi, vi) in model.scalar_coordinates() {
-            if q_keep[q_source[qi].0] == qi && v_source[vi].1 != 1.0 {
-                return Err(format!(
-                    "reduction: the independent joint at body {vi} must copy its velocity (multiplier 1, got {})",
-                    v_source[vi].1
-                ));
-            }
-        }
-        for (i, c) in model.coordinates.iter().enumerate() {
-            if let Coordinates::Head { block, at } = *c {
-                let k0 = q_source[at].0;
-                let kv0 = v_source[i].0;
-                let whole = (0..block.nq()).all(|j| q_source[at + j] == (k0 + j, 1.0, 0.0) && q_keep[k0 + j] == at + j)
-                    && (0..block.nv()).all(|j| v_source[i + j] == (kv0 + j, 1.0));
-                if !whole {
-                    return Err(format!("reduction: the {block:?} joint at body {i} must be kept whole (no mimic joint follows a multi-DOF joint)"));
-                }
-            }
-        }
-        Ok(Self {
-            q_source,
-            v_source,
-            q_keep,
-            nv,
-        })
-    }
 }
 
 /// The coordinates the solver works in: the model's own (q of size nq, steps of size nv), or
@@ -479,12 +305,6 @@ pub fn solver_sizes(model: &Model, reduction: Option<&Reduction>) -> (usize, usi
     reduction.map_or((model.nq, model.n), |r| (r.q_keep.len(), r.nv))
 }
 
-/// Weighted cost `E = 1/2 e^T W e`.
-#[inline]
-fn cost(e: &[f64; 6], weights: &[f64; 6]) -> f64 {
-    0.5 * (0..6).map(|k| weights[k] * e[k] * e[k]).sum::<f64>()
-}
-
 /// Levenberg-Marquardt towards `target` for `frame`, from `q0`, within `[lower, upper]`, in the
 /// model's own coordinates (see [`numeric_ik_reduced`]).
 #[allow(clippy::too_many_arguments)]
@@ -662,230 +482,10 @@ pub fn numeric_ik_reduced(
     best
 }
 
-/// The chain's joints as screws at theta = 0 (q = -offset) and the home pose of `frame`, if
-/// `frame` is carried by the last body of a serial chain moved by every joint (`parent[i] = i - 1`).
-pub fn chain_screws(model: &Model, data: &mut Data, frame: usize) -> Option<(Vec<Screw>, Transform)> {
-    let n = model.n;
-    if !model.plain {
-        return None; // a multi-DOF joint is no screw
-    }
-    if model.frames[frame].body != Some(n.checked_sub(1)?) || (0..n).any(|i| model.parent[i] != i.checked_sub(1)) {
-        return None;
-    }
-    let zero: Vec<f64> = model.offset.iter().map(|o| -o).collect();
-    let home = frame_pose_at(model, data, &zero, frame);
-    let screws = (0..n)
-        .map(|i| {
-            // body frame = joint frame at theta = 0: the axis through its origin
-            let x = &data.world_from_body[i];
-            let w = x.rot * model.joints[i].axis;
-            match model.joints[i].kind {
-                JointKind::Revolute => Screw::Revolute(subproblems::Axis { w, r: x.trans }),
-                JointKind::Prismatic => Screw::Prismatic(w),
-            }
-        })
-        .collect();
-    Some((screws, home))
-}
-
-/// The closed-form solver of `frame`'s chain, if its geometry has one (see `analytic`).
-pub fn detect_analytic(model: &Model, data: &mut Data, frame: usize) -> Option<AnalyticIk> {
-    let (screws, home) = chain_screws(model, data, frame)?;
-    AnalyticIk::detect(screws, home)
-}
-
-/// Solutions of a closed-form solve after mapping, checking and limits.
-#[derive(Clone, Debug, Default)]
-pub struct AnalyticOutcome {
-    /// Joint vectors (q, offsets removed), nearest to the reference first.
-    pub solutions: Vec<Vec<f64>>,
-    pub position_error: Vec<f64>,
-    pub orientation_error: Vec<f64>,
-    /// Distinct verified solutions before the joint-limit filter.
-    pub found: usize,
-    /// A non-isolated solution set was met (a free joint was set from the reference).
-    pub singular: bool,
-}
-
-/// The integer nearest `x` (ties to even): adding and removing 1.5 2^52 rounds without a call to
-/// `round`, which baseline x86-64 lacks as an instruction; `|x| >= 2^51` is already an integer.
-#[inline]
-fn round(x: f64) -> f64 {
-    const ROUND: f64 = 6_755_399_441_055_744.0;
-    if x.abs() < 2_251_799_813_685_248.0 {
-        (x + ROUND) - ROUND
-    } else {
-        x
-    }
-}
-
-/// Pose of `frame` at `q`: the products of `world_from_body` along the frame body's support, in
-/// the order `forward_kinematics` takes them (the same numbers), without filling `Data`.
-fn frame_pose_lean(model: &Model, q: &[f64], frame: usize) -> Transform {
-    let f = &model.frames[frame];
-    let Some(body) = f.body else { return f.body_from_frame };
-    let mut support = model.support[body].iter();
-    let first = support.next().copied().unwrap_or(body);
-    let mut world_from_body = parent_from_body(model, q, first);
-    for &i in support {
-        world_from_body = &world_from_body * &parent_from_body(model, q, i);
-    }
-    if f.body_from_frame == Transform::identity() {
-        world_from_body
-    } else {
-        world_from_body * f.body_from_frame
-    }
-}
-
-/// Move a revolute angle by 2 pi k: inside `[lo, hi]` nearest `reference` when possible, else
-/// nearest `reference`.
-#[inline]
-fn wrap_angle(x: f64, lo: f64, hi: f64, reference: f64) -> f64 {
-    let two_pi = 2.0 * PI;
-    let near = x + two_pi * round((reference - x) / two_pi);
-    if near >= lo && near <= hi {
-        return near;
-    }
-    // the representatives inside [lo, hi], if any: the one nearest reference
-    let mut best: Option<f64> = None;
-    if lo.is_finite() {
-        let first = x + two_pi * ((lo - x) / two_pi).ceil();
-        let mut v = first;
-        while v <= hi + 1e-12 && v <= first + 4.0 * two_pi {
-            if best.is_none_or(|b| (v - reference).abs() < (b - reference).abs()) {
-                best = Some(v);
-            }
-            v += two_pi;
-        }
-    } else if hi.is_finite() {
-        let v = x - two_pi * ((x - hi) / two_pi).ceil();
-        best = Some(v);
-    }
-    best.unwrap_or(near)
-}
-
-/// Closed-form solutions of `solver` for `frame` at `target`, as joint vectors.
-///
-/// `reference`: the caller's q0 (wrapping, ordering and free joints at singular targets);
-/// `respect_limits`: drop solutions outside `[lower, upper]` (revolute angles are first moved by
-/// 2 pi k into them); `tolerance`: largest accepted position (m) / orientation (rad) error after
-/// refinement.
-#[allow(clippy::too_many_arguments)]
-pub fn analytic_solutions(
-    model: &Model,
-    data: &mut Data,
-    solver: &AnalyticIk,
-    frame: usize,
-    target: &Transform,
-    position_only: bool,
-    reference: &[f64],
-    lower: &[f64],
-    upper: &[f64],
-    respect_limits: bool,
-    tolerance: f64,
-) -> AnalyticOutcome {
-    let n = model.n;
-    let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
-    let mut candidates = Vec::with_capacity(8);
-    let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
-    let weights = if position_only {
-        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
-    } else {
-        [1.0; 6]
-    };
-    let refine = Settings {
-        weights,
-        max_iterations: 8,
-        restarts: 0,
-        position_tolerance: 1e-13,
-        orientation_tolerance: 1e-13,
-        lambda_min: 1e-12,
-        max_step: 0.1,
-    };
-    let mut out = AnalyticOutcome {
-        singular,
-        ..Default::default()
-    };
-    // (q, position error, orientation error, inside the limits, squared distance to the reference)
-    let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len());
-    for theta in &candidates {
-        let mut q: Vec<f64> = (0..n).map(|i| theta[i] - model.offset[i]).collect();
-        for i in 0..n {
-            if model.joints[i].kind == JointKind::Revolute {
-                q[i] = wrap_angle(q[i], lower[i], upper[i], reference[i]);
-            }
-        }
-        let e = pose_error(&frame_pose_lean(model, &q, frame), target);
-        let (mut ep, mut er) = residuals(&e, &weights);
-        if ep > 1e-12 || er > 1e-12 {
-            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits)
-            if ep < 1e-4 && er < 1e-4 {
-                let (free, neg_free) = (vec![f64::INFINITY; n], vec![f64::NEG_INFINITY; n]);
-                let r = numeric_ik(model, data, frame, target, &q, &neg_free, &free, &refine, 0);
-                if r.position_error <= ep && r.orientation_error <= er {
-                    q = r.q;
-                    ep = r.position_error;
-                    er = r.orientation_error;
-                }
-            }
-        }
-        if ep > tolerance || er > tolerance {
-            continue;
-        }
-        // distinct modulo 2 pi
-        let same = kept.iter().any(|(k, ..)| {
-            (0..n).all(|i| {
-                let d = k[i] - q[i];
-                let d = if model.joints[i].kind == JointKind::Revolute {
-                    d - 2.0 * PI * round(d / (2.0 * PI))
-                } else {
-                    d
-                };
-                d.abs() < 1e-7
-            })
-        });
-        if same {
-            continue;
-        }
-        let inside = (0..n).all(|i| q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
-        let distance = (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
-        kept.push((q, ep, er, inside, distance));
-    }
-    out.found = kept.len();
-    if respect_limits {
-        kept.retain(|k| k.3);
-    }
-    kept.sort_by(|a, b| a.4.partial_cmp(&b.4).unwrap_or(std::cmp::Ordering::Equal));
-    out.solutions.reserve_exact(kept.len());
-    out.position_error.reserve_exact(kept.len());
-    out.orientation_error.reserve_exact(kept.len());
-    for (q, ep, er, ..) in kept {
-        out.solutions.push(q);
-        out.position_error.push(ep);
-        out.orientation_error.push(er);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::joint::axis_angle;
-
-    #[test]
-    fn log_is_the_inverse_of_exp() {
-        for &(x, y, z) in &[
-            (0.3, -0.2, 0.5),
-            (1e-8, 0.0, 2e-8),
-            (0.0, 0.0, PI - 1e-9),
-            (PI / 3f64.sqrt(), -PI / 3f64.sqrt(), PI / 3f64.sqrt() - 1e-7),
-        ] {
-            let v = Vec3::new(x, y, z);
-            let r = axis_angle(&v.normalize(), v.norm());
-            let back = log_so3(&r);
-            assert!((back - v).norm() < 1e-7, "{v:?} -> {back:?}");
-        }
-    }
+    use crate::spatial::{Mat3, Vec3};
 
     /// A free-flyer (bodies 0-5), a spherical joint (6-8) and a revolute joint (9) carrying frame 0:
     /// nq = 12, nv = 10.
@@ -1073,12 +673,5 @@ mod tests {
         }
         // each entry's standard deviation is 1/sqrt(3 count) ~ 0.004
         assert!(mean.abs().max() < 0.03, "{mean}");
-    }
-
-    #[test]
-    fn wrap_prefers_the_reference_inside_limits() {
-        assert!((wrap_angle(3.0 * PI / 2.0, -PI, PI, 0.0) + PI / 2.0).abs() < 1e-12);
-        assert!((wrap_angle(-PI / 2.0, -2.0 * PI, 2.0 * PI, 4.0) - 3.0 * PI / 2.0).abs() < 1e-12);
-        assert!((wrap_angle(3.0, -1.0, 1.0, 0.0) - 3.0).abs() < 1e-12 || wrap_angle(3.0, -1.0, 1.0, 0.0) < -1.0);
     }
 }
