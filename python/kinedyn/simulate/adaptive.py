@@ -74,7 +74,7 @@ def run_adaptive(
         def too_fast(t, x):
             return max_speed - np.abs(x[n:]).max()
 
-        too_fast.terminal = True  # solve_ivp reads its event options from the function's attributes
+        too_fast.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads its event options from the function's attributes
         options = {}
         if robot and scipy_method in ("Radau", "BDF", "LSODA"):
             derivatives = derivatives_fn(target, robot, fext_fn)

@@ -204,8 +204,11 @@ def simulate(
     fext_fn = external_wrenches(f_ext, n, robot)
     count = batch or 1
     work = steps * count * (4 if method == "rk4" else 1)
-    # a robot with reduced mimic joints runs the Python loop on its reduced methods (the native
-    # integrators take the full model)
+    # The one place that sends a robot to the Python fixed-step loop (:mod:`.fixed_step`): wrenches
+    # about link frames (f_ext) are applied in Python (Robot.forward_dynamics), and a robot with reduced
+    # mimic joints runs on its reduced methods (the native integrators take the full model). Once the
+    # core takes both, this is `robot and method in FIXED_METHODS`, and the Python loop serves
+    # MechanicalSystem / LagrangianSystem alone.
     native = robot and method in FIXED_METHODS and fext_fn is None and not getattr(system, "mimic_joints", None)
     if multi_dof and not native:
         why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext or mimic joints"
@@ -254,7 +257,7 @@ def simulate(
                 limits,
                 deadline,
             )
-        elif method in FIXED_METHODS:
+        elif method in FIXED_METHODS:  # a MechanicalSystem, or a robot the core cannot run (see `native`)
             out = run_fixed_step(
                 system if robot else mech,
                 robot,
