@@ -12,7 +12,7 @@ import pytest
 
 import kinedyn as kd
 import kinedyn.analysis as an
-from kinedyn.analysis.identification import _with_armatures, rotor_regressor
+from kinedyn.analysis.parameters import rotor_regressor, with_armatures
 
 RATE = 1000.0
 ENCODER = 2 * np.pi / 2**17
@@ -26,7 +26,7 @@ def prior():
 
 @pytest.fixture(scope="module")
 def true_robot(prior):
-    return _with_armatures(prior, {k: a * f for k, (a, f) in enumerate(zip(prior.armature, FACTORS))})
+    return with_armatures(prior, {k: a * f for k, (a, f) in enumerate(zip(prior.armature, FACTORS))})
 
 
 def _log(robot, seed, T=10.0):

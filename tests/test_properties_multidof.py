@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import kinedyn as kd
-from kinedyn.analysis.properties import _inertia_bounds, _ManifoldChart, check_properties, mass_matrix_rate
+from kinedyn.analysis.bounds import ManifoldChart, robot_inertia_bounds
+from kinedyn.analysis.properties import check_properties, mass_matrix_rate
 from kinedyn.testing import example_robot_data_dir, random_robot
 
 
@@ -72,12 +73,12 @@ def test_dM_dt_needs_the_manifold_derivative_on_a_floating_robot():
 
 
 def test_the_search_chart_moves_on_the_manifold():
-    """_ManifoldChart's tangent map T is the derivative of its configurations (by robot.difference
+    """ManifoldChart's tangent map T is the derivative of its configurations (by robot.difference
     of central differences), its wrap keeps the configuration, and M does not depend on the
     floating base's configuration, which the chart holds at the identity."""
     robot = random_robot(5, n=4, floating=True, spherical=0.4, planar=0.3, friction=False)
     assert {j.kind for j in robot.joints} >= {"floating", "spherical", "planar", "prismatic"}
-    chart = _ManifoldChart(robot)
+    chart = ManifoldChart(robot)
     assert chart.nx == robot.nv - 6
     rng = np.random.default_rng(1)
     for _ in range(3):
@@ -102,7 +103,7 @@ def test_the_search_chart_moves_on_the_manifold():
 
 def test_inertia_bounds_over_the_manifold_are_attained_and_no_worse_than_uniform_samples():
     robot = random_robot(2, n=4, floating=True, spherical=0.4, friction=False)
-    b = _inertia_bounds(robot, samples=48, starts=4, seed=0)
+    b = robot_inertia_bounds(robot, samples=48, starts=4, seed=0)
     for q, value, end in ((b.q_lambda_min, b.lambda_min, 0), (b.q_lambda_max, b.lambda_max, -1)):
         assert q.shape == (robot.nq,)
         robot.integrate(q, np.zeros(robot.nv))  # its quaternions are unit (integrate checks them)

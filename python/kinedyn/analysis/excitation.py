@@ -64,7 +64,7 @@ def optimize_excitation(
     within ``limits``: a dict with ``q`` ((lower, upper) arrays; default the robot's finite joint
     limits, else +-pi about 0), ``qd`` and ``qdd`` (per joint maxima; default 1.5 rad/s and 5 rad/s^2).
     The start is the SLSQP optimisation from a random (seeded) trajectory scaled into the limits."""
-    from scipy.optimize import minimize
+    from scipy.optimize import minimize  # scipy loads only when an excitation is optimised
 
     if harmonics < 2:
         raise ValueError(f"an excitation at rest at both ends needs at least 2 harmonics, got {harmonics}")

@@ -108,7 +108,7 @@ def _columns_from_table(names: Sequence[str], data: np.ndarray) -> dict:
 def _read(source: Any) -> tuple[dict, str]:
     """A mapping column name -> 1-D array, and a name for messages."""
     try:
-        import pandas as pd  # type: ignore[import-untyped]
+        import pandas as pd  # type: ignore[import-untyped]  # optional and heavy: only to recognise a DataFrame
     except ImportError:  # pragma: no cover - pandas is optional
         pd = None
     if pd is not None and isinstance(source, pd.DataFrame):
@@ -160,7 +160,7 @@ def _numbered(cols: dict, prefix: str) -> list:
 
 
 def _lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray:
-    from scipy.signal import butter, sosfiltfilt
+    from scipy.signal import butter, sosfiltfilt  # scipy loads only when a log is filtered
 
     sos = butter(order, cutoff, btype="low", fs=rate, output="sos")
     return sosfiltfilt(sos, x, axis=0)

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sympy as sp
 
-from .properties import Check, PropertiesReport
+from .results import Check, PropertiesReport
 
 if TYPE_CHECKING:
     from ..symbolic.system import LagrangianSystem
@@ -148,7 +148,7 @@ def check_system_properties(
     ``samples`` random configurations for positive definiteness; a trajectory of ``T`` seconds
     (solve_ivp, rtol 1e-10) from a seeded random state under forces ``a_k sin(w_k t + phi_k)`` for
     the energy balance, whose relative residual must be below ``tolerance``."""
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp  # scipy loads only when the properties are checked
 
     eom = system.equations_of_motion()
     checks = _exact_checks(system, eom)

@@ -3,6 +3,9 @@ schemes in the Rust core, adaptive ones with SciPy) or of a Lagrangian system (c
 stabilised by Baumgarte's method) and returns a :class:`Trajectory`; :mod:`.control` holds the
 controllers and reference trajectories. See docs/simulation.md."""
 
+import sys
+import types
+
 from .control import PD, ComputedTorque, Constant, Cubic, Fourier, FunctionController, PDGravity, Quintic, Reference
 from .core import (
     ADAPTIVE_METHODS,
@@ -41,9 +44,6 @@ __all__ = [
 # ``kd.simulate(...)`` calls :func:`simulate` while ``kd.simulate.PD`` etc. stay reachable: the package
 # module is made callable (a function of the same name would shadow the package in ``kinedyn``).
 def _make_callable() -> None:
-    import sys
-    import types
-
     class _SimulateModule(types.ModuleType):
         def __call__(self, *args, **kwargs):
             return simulate(*args, **kwargs)

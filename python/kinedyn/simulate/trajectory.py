@@ -10,11 +10,16 @@ largest holonomic residual |phi(q)| and velocity residual |A(q) qd|.
 from __future__ import annotations
 
 import math
+import re
 from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from ..display import trajectory_html
+from ..visual.viewer import show as show_in_viewer
+from ..visual.web import animation_page
 
 __all__ = ["Trajectory"]
 
@@ -105,8 +110,6 @@ class Trajectory:
         return f"Trajectory(system={getattr(self.system, 'name', '?')!r}, samples={len(self)}, t=[{self.t[0]:g}, {self.t[-1]:g}] s, method={self.method!r}{b})"
 
     def _repr_html_(self) -> str:  # notebooks: q(t) plotted as inline SVG (kinedyn.display)
-        from ..display import trajectory_html
-
         return trajectory_html(self)
 
     # ------------------------------------------------------------------ energies
@@ -238,7 +241,7 @@ class Trajectory:
     def plot(self, path=None, show: bool = False):
         """Joint positions, velocities, torques and energies against time (matplotlib); saved to
         ``path`` if given. Returns the Figure. Works with any backend (Agg included)."""
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # matplotlib loads only when a figure is drawn
 
         if self.batch is not None:
             raise TypeError("plot() draws one trajectory: use traj[i].plot()")
@@ -291,20 +294,18 @@ class Trajectory:
     def show(self, *, block: bool | None = None, **kwargs):
         """Play the motion in the live 3-D viewer (:meth:`kinedyn.Robot.show`, with a time slider and
         play/pause). Returns the viewer; ``block`` as for ``Robot.show``."""
-        from ..visual.viewer import show
-
         if self.batch is not None:
             raise TypeError("show() plays one trajectory: use traj[i].show()")
         if not hasattr(self.system, "frame_poses"):
             raise TypeError("show() needs a trajectory of a kinedyn.Robot; use animate() for other systems")
-        return show(self.system, np.asarray(self.q, dtype=float)[0], trajectory=self, block=block, **kwargs)
+        return show_in_viewer(self.system, np.asarray(self.q, dtype=float)[0], trajectory=self, block=block, **kwargs)
 
     def animate(self, path, fps: int = 25, duration: float | None = None, trail: bool = True):
         """A stick figure of the motion: GIF (``.gif``, Pillow), HTML (``.html``, self-contained
         JavaScript player; a robot's is its meshes in a 3-D view, as in the report) or MP4 (``.mp4``, needs ffmpeg). 2-D when every point stays in a plane
         z = const (planar arms), else 3-D. Frames are taken every 1/fps seconds of simulated time.
         Returns the path."""
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # matplotlib loads only when a figure is drawn
         from matplotlib import animation
 
         if self.batch is not None:
@@ -318,8 +319,6 @@ class Trajectory:
         idx = np.unique(np.round(np.linspace(0, len(self) - 1, frames)).astype(int))
         if suffix == ".html" and hasattr(self.system, "frame_poses"):
             # a robot: its meshes in the report's 3-D view, sent once, then joint values per frame
-            from ..visual.web import animation_page
-
             path.write_text(
                 animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]), encoding="utf-8"
             )
@@ -402,8 +401,6 @@ _PLAYER_GLYPHS = {
 
 def _offline_jshtml(page: str) -> str:
     """matplotlib's to_jshtml() page without its Font Awesome stylesheet link (see _PLAYER_GLYPHS)."""
-    import re
-
     page = re.sub(r"<link[^>]*font-awesome[^>]*>", "", page)
     for css, glyph in _PLAYER_GLYPHS.items():
         page = page.replace(f'<i class="{css}"></i>', f"<span>{glyph}</span>")
