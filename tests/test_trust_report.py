@@ -22,8 +22,8 @@ html5lib = pytest.importorskip("html5lib")
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
 from kinedyn.cli import _jsonable  # noqa: E402
-from kinedyn.description.files import robot_from_mapping  # noqa: E402
 from kinedyn.report.html import _asset, _model_for_view, build_report, collect, script_json  # noqa: E402
+from kinedyn.robot_files import robot_from_mapping  # noqa: E402
 
 XHTML = "{http://www.w3.org/1999/xhtml}"
 

@@ -108,7 +108,7 @@ def load_robot(spec: str, *, values: dict[str, float] | None = None, numeric: bo
 
 def _robot_file(spec: str):
     from . import robots
-    from .description.files import load
+    from .robot_files import load
 
     path = Path(spec)
     ext = path.suffix.lower()
@@ -1015,7 +1015,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_convert(args) -> int:
-    from .description.convert import convert
+    from .convert import convert
 
     robot = load_robot(args.robot)
     if args.inertia is not None:

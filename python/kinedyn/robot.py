@@ -7,8 +7,8 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 
 from __future__ import annotations
 
+import dataclasses
 import math
-import os
 import sys
 from collections.abc import Mapping, Sequence
 from functools import cached_property
@@ -20,12 +20,14 @@ import sympy as sp
 from ._arrays import finite_result, real_array
 from ._dask import batched, is_dask_array
 from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
-from .description.checks import vector
-from .description.dh import DHRow, links_from_dh
+from .description.description import Description
+from .description.dh import DHRow, description_from_dh
+from .description.files import save as save_robot_file
 from .description.geometry import Visual
 from .description.joint import Joint
-from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
-from .description.mimic import mimic_map as _mimic_map
+from .description.link import Frame, Link
+from .description.mjcf import description_from_mjcf
+from .description.urdf import description_from_urdf
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -132,7 +134,7 @@ class Robot:
 
     def __init__(
         self,
-        links: Sequence[Link],
+        links: Sequence[Link] | Description,
         frames: Sequence[Frame] = (),
         *,
         gravity=(0.0, 0.0, -9.81),
@@ -147,35 +149,61 @@ class Robot:
         collisions: Sequence[Visual] = (),
         mimic: str = "reduce",
     ):
-        self.name = name
-        # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
-        # kinedyn.visual draws them (a robot without any gets solid links along its kinematics)
-        self.visuals: tuple = tuple(visuals)
-        self.collisions: tuple = tuple(collisions)
-        # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
-        self.links, self.nonphysical = judge_inertias(links, inertia)
-        self.inertia_policy = inertia
-        self.frames = tuple(frames)
-        self.base = base
-        self.gravity = vector(gravity, 3, "gravity")
-        self.dh = tuple(dh) if dh is not None else None
-        self.dh_convention = dh_convention
-        self.source = source
-        self.tree: KinematicTree = build_tree(self.links, self.frames, base)
-        if self.tree.n == 0:
-            raise ValueError(f"robot '{name}' has no moving joint")
-        # mimic joints (Joint.mimic): "reduce" removes the followers' coordinates, "independent" keeps
-        # them (kinedyn.description.mimic); None when no joint follows another
-        self.mimic_mode = mimic
-        self._mimic = _mimic_map([b.joint for b in self.tree.bodies], [link.joint for link in self.links], mimic, name)
-        names = [f.name for f in self.tree.frames]
-        if tool is None:
-            from .description.tool import default_tool
+        """``Robot(description)`` (what the readers return), or ``Robot(links, frames, ...)`` with the
+        fields of :class:`~kinedyn.description.description.Description` as keywords. ``inertia``: the
+        policy for tensors no rigid body can have (docs/model-files.md); ``mimic``: "reduce" removes
+        the followers' coordinates, "independent" keeps them (:mod:`kinedyn.description.mimic`);
+        ``visuals``/``collisions``: what :mod:`kinedyn.visual` draws, by frame name."""
+        if isinstance(links, Description):
+            description = links
+        else:
+            description = Description(
+                tuple(links),
+                tuple(frames),
+                gravity=gravity,
+                base=base,
+                tool=tool,
+                name=name,
+                dh=dh,
+                dh_convention=dh_convention,
+                source=source,
+                inertia=inertia,
+                visuals=visuals,
+                collisions=collisions,
+                mimic=mimic,
+            )
+        object.__setattr__(self, "description", description)
 
-            tool = "tool" if "tool" in names else default_tool(self.links, base)
-        if tool not in names:
-            raise ValueError(f"tool frame '{tool}' is not a frame of robot '{name}' (frames: {names})")
-        self.tool = tool
+    def __setattr__(self, name: str, value) -> None:
+        # frozen: the native model and the caches are built from the description once, so a changed
+        # field would leave them stale; a changed robot is a new one (replace, subs, lock_joints)
+        raise AttributeError(f"a Robot is immutable: robot.replace({name}=...) builds a changed copy")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError("a Robot is immutable")
+
+    @classmethod
+    def from_description(cls, description: Description) -> Robot:
+        """The robot of a :class:`~kinedyn.description.description.Description` (= ``Robot(description)``)."""
+        return cls(description)
+
+    # the description's fields, read through the robot
+    name = property(lambda self: self.description.name)
+    links = property(lambda self: self.description.links)
+    frames = property(lambda self: self.description.frames)
+    base = property(lambda self: self.description.base)
+    gravity = property(lambda self: self.description.gravity)
+    tool = property(lambda self: self.description.tool)
+    dh = property(lambda self: self.description.dh)
+    dh_convention = property(lambda self: self.description.dh_convention)
+    source = property(lambda self: self.description.source)
+    visuals = property(lambda self: self.description.visuals)
+    collisions = property(lambda self: self.description.collisions)
+    tree = property(lambda self: self.description.tree)
+    nonphysical = property(lambda self: self.description.nonphysical)
+    inertia_policy = property(lambda self: self.description.inertia)
+    mimic_mode = property(lambda self: self.description.mimic)
+    _mimic = property(lambda self: self.description.mimic_map)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -198,22 +226,17 @@ class Robot:
         ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always
         added; identity if not given). ``inertia``: the inertia policy (as :meth:`from_urdf`).
         """
-        links, dh_rows = links_from_dh(rows, convention)
-        if base_pose is not None:
-            first = links[0]
-            links[0] = Link(
-                first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia
-            )
-        frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
         return cls(
-            links,
-            frames,
-            gravity=gravity,
-            name=name,
-            dh=dh_rows,
-            dh_convention=convention,
-            source=source,
-            inertia=inertia,
+            description_from_dh(
+                rows,
+                convention,
+                gravity=gravity,
+                base_pose=base_pose,
+                tool=tool,
+                name=name,
+                source=source,
+                inertia=inertia,
+            )
         )
 
     @classmethod
@@ -243,24 +266,18 @@ class Robot:
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
         Python expressions from the file, so it needs ``trust_xacro=True``
         (:mod:`kinedyn.description.xacro`)."""
-        from .description.urdf import robot_from_urdf
-        from .description.xacro import expand_xacro, is_xacro
-
-        if is_xacro(path_or_string):
-            text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
-            return robot_from_urdf(
-                text,
+        return cls(
+            description_from_urdf(
+                path_or_string,
                 gravity=gravity,
                 tool=tool,
                 inertia=inertia,
                 floating_base=floating_base,
-                source_path=os.fsdecode(path_or_string),
                 mimic=mimic,
+                xacro_args=xacro_args,
+                trust_xacro=trust_xacro,
+                package_dirs=package_dirs,
             )
-        if xacro_args:
-            raise ValueError("xacro_args are for a .xacro file")
-        return robot_from_urdf(
-            path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic
         )
 
     @classmethod
@@ -275,29 +292,11 @@ class Robot:
         """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
         and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
         ``tool`` and ``inertia`` as :meth:`from_urdf`."""
-        from .description.mjcf import robot_from_mjcf
-
-        return robot_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
+        return cls(description_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia))
 
     def replace(self, **changes) -> Robot:
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
-        kwargs = dict(
-            links=self.links,
-            frames=self.frames,
-            gravity=self.gravity,
-            base=self.base,
-            tool=self.tool,
-            name=self.name,
-            dh=self.dh,
-            dh_convention=self.dh_convention,
-            source=self.source,
-            inertia=self.inertia_policy,
-            visuals=self.visuals,
-            collisions=self.collisions,
-            mimic=self.mimic_mode,
-        )
-        kwargs.update(changes)
-        return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
+        return Robot(dataclasses.replace(self.description, **changes))
 
     def lock_joints(self, joints, at=None) -> Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
@@ -650,9 +649,7 @@ class Robot:
 
     def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
-        from .description.files import save
-
-        save(self, path)
+        save_robot_file(self, path)
 
     def to_urdf(
         self, path: PathLike | None = None, *, geometry: bool = True, floating_base_as_root: bool = True

@@ -49,6 +49,7 @@ bounded; every problem is a ValueError naming the file, the line, the element an
 
 from __future__ import annotations
 
+import importlib
 import math
 import os
 import types
@@ -58,12 +59,13 @@ import numpy as np
 
 from .bounded_xml import parse_bounded
 from .checks import LARGEST
+from .description import Description
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Frame, Link
 
-__all__ = ["robot_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
+__all__ = ["description_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
 
 MAX_DEPTH = 200  # deepest element nesting accepted (bodies nest; guards the parser's memory)
 MAX_INCLUDE_DEPTH = 8  # <include> inside included files, at most this deep
@@ -81,15 +83,14 @@ _REFUSED = ("replicate", "attach", "composite", "flexcomp")
 
 
 # ============================================================================== entry point
-def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "warn", gravity=None):
-    """A :class:`kinedyn.Robot` from an MJCF file path or an XML string (see the module docstring).
+def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "warn", gravity=None):
+    """The :class:`~kinedyn.description.description.Description` of an MJCF file path or an XML string
+    (see the module docstring; ``kinedyn.Robot.from_mjcf`` builds the robot from it).
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path (an XML string
     may not ``<include>`` files). ``gravity``: overrides ``<option gravity>``. ``tool`` and
-    ``inertia`` as :func:`kinedyn.description.urdf.robot_from_urdf`.
+    ``inertia`` as :func:`kinedyn.description.urdf.description_from_urdf`.
     """
-    from ..robot import Robot
-
     src, root = _parse_model(path_or_string)
     if root.tag != "mujoco":
         raise src.error(root, f"the root element is <{root.tag}>, expected <mujoco>")
@@ -112,9 +113,9 @@ def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(
-                links,
-                frames,
+            description = Description(
+                tuple(links),
+                tuple(frames),
                 gravity=gravity,
                 base="world",
                 tool=tool,
@@ -128,7 +129,7 @@ def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "
         raise ValueError(f"{src.label}: {e}") from None
     for w in caught:
         warnings.warn(f"{src.label}: {w.message}", w.category, stacklevel=_caller_level())
-    return robot
+    return description
 
 
 def _caller_level() -> int:
@@ -168,7 +169,7 @@ def _parse_model(path_or_string):
     if isinstance(text, bytes):
         text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
     if not isinstance(text, str):
-        raise TypeError(f"robot_from_mjcf expects a path or an XML string, got {type(path_or_string).__name__}")
+        raise TypeError(f"the MJCF reader expects a path or an XML string, got {type(path_or_string).__name__}")
     if "<" in text or "\n" in text:
         src = _Sources("<MJCF string>", None)
         data = text.encode("utf-8")
@@ -882,3 +883,17 @@ class _Reader:
             )
         body_inertia = Inertia(mass, (0.0, 0.0, 0.0), np.diag([mass * u for u in unit]))
         return body_inertia.transformed(g["pose"])
+
+
+def __getattr__(name: str):
+    # robot_from_mjcf built a Robot from this layer; it lives above the description now
+    # (kinedyn.robot_files), loaded by name so that the description never imports the facade
+    if name == "robot_from_mjcf":
+        warnings.warn(
+            "kinedyn.description.mjcf.robot_from_mjcf moved: use kinedyn.Robot.from_mjcf "
+            "(or description_from_mjcf for the description alone)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return importlib.import_module("kinedyn.robot_files").robot_from_mjcf
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
