@@ -128,7 +128,7 @@ def _model_for_view(robot, q, geometry: str = "visual", budget: int | None = Non
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MissingMeshWarning)  # said in the report instead (model["missing"])
         scene = robot_scene(robot, geometry, DEFAULT_BUDGET if budget is None else budget)
-    from ..robot import _planar_basis
+    from ..description.joint import planar_basis as _planar_basis
 
     tree = robot.tree
     # where each joint's block starts in q: a multi-DOF joint's q[start:start + nq] moves its body as a
