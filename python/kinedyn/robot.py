@@ -17,17 +17,21 @@ from typing import TYPE_CHECKING, Union
 import numpy as np
 import sympy as sp
 
+from . import configuration, display, dynamics, symbolic
 from ._arrays import finite_result, real_array
-from ._dask import batched, is_dask_array
-from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
+from ._dask import batched, is_dask_array, lazy_inverse_kinematics
+from ._math import by_name, is_symbolic, to_float_array
+from .description import export, mimic
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
+from .description.edit import lock, substitute
 from .description.files import save as save_robot_file
 from .description.geometry import Visual
-from .description.joint import Joint
 from .description.link import Frame, Link
+from .description.mimic import lock_followers
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
+from .ik.dispatch import inverse_kinematics as solve_ik
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -36,18 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Robot"]
 
-_IK_SOLVE = None  # kinedyn.ik.inverse_kinematics, imported on first use (it loads the IK bindings)
-
-
-def _load_ik():
-    global _IK_SOLVE
-    from .ik import inverse_kinematics
-
-    _IK_SOLVE = inverse_kinematics
-    return _IK_SOLVE
-
-
-_DASK_ARRAYS = ("dask.array",)  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
+_DASK_ARRAY = "dask.array"  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
 
 
 def _dask_targets(target, q0):
@@ -307,8 +300,6 @@ class Robot:
         every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
         position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
-        from ._math import rot_axis, translation
-
         names = self.joint_names
         n_joints = len(names)
         starts = np.cumsum([0] + [j.nq for j in self.joints])
@@ -359,24 +350,8 @@ class Robot:
                 raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
             values[names[i]] = v
         if followers:
-            from .description.mimic import lock_followers
-
             values = lock_followers(followers, values, follower_values)
-        links = []
-        for link in self.links:
-            j = link.joint
-            if j.name in values and j.is_multi_dof:
-                fixed = Joint(j.name, "fixed")
-                link = Link(
-                    link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia
-                )
-            elif j.name in values and j.is_moving:
-                x = values[j.name] + j.offset
-                motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
-                fixed = Joint(j.name, "fixed", j.axis)
-                link = Link(link.name, link.parent, fixed, matmul(link.placement, motion), link.post, link.inertia)
-            links.append(link)
-        return self.replace(links=links, dh=None)
+        return Robot(lock(self.description, values))
 
     # ------------------------------------------------------------------ pickling
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
@@ -494,9 +469,7 @@ class Robot:
     def armature(self) -> np.ndarray:
         """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "armature")
+            return mimic.reduced_coefficient(self, "armature")
         return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
 
     @property
@@ -504,18 +477,14 @@ class Robot:
         """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
         (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "viscous")
+            return mimic.reduced_coefficient(self, "viscous")
         return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
 
     @property
     def coulomb(self) -> np.ndarray:
         """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "coulomb")
+            return mimic.reduced_coefficient(self, "coulomb")
         return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
 
     @property
@@ -523,9 +492,7 @@ class Robot:
         """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
         symmetric friction)."""
         if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "coulomb_negative")
+            return mimic.reduced_coefficient(self, "coulomb_negative")
         return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
 
     @cached_property
@@ -587,65 +554,7 @@ class Robot:
     def subs(self, mapping: Mapping) -> Robot:
         """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);
         keys are symbols or their names."""
-        mapping = by_name(mapping, self.symbols)
-
-        def f(v):
-            if isinstance(v, (sp.Basic, sp.MatrixBase)):
-                out = v.subs(mapping)
-                if isinstance(out, sp.MatrixBase):
-                    return out if is_symbolic(out) else np.array(out.tolist(), dtype=float)
-                return as_value(out)
-            return v
-
-        links = []
-        for link in self.links:
-            j = link.joint
-            joint = Joint(
-                j.name,
-                j.kind,
-                tuple(f(a) for a in j.axis),
-                f(j.offset),
-                j.lower,
-                j.upper,
-                j.velocity_limit,
-                j.effort_limit,
-                f(j.gear_ratio),
-                f(j.rotor_inertia),
-                f(j.viscous),
-                f(j.coulomb),
-                f(j.coulomb_negative),
-                mimic=j.mimic,
-            )
-            try:
-                inertia = link.inertia.subs(mapping)
-            except ValueError as e:
-                raise ValueError(f"robot '{self.name}', link '{link.name}': {e}") from None
-            links.append(Link(link.name, link.parent, joint, f(link.placement), f(link.post), inertia))
-        frames = [Frame(fr.name, fr.link, f(fr.placement)) for fr in self.frames]
-        dh = None
-        if self.dh is not None:
-            dh = [
-                DHRow(
-                    f(r.theta),
-                    f(r.d),
-                    f(r.a),
-                    f(r.alpha),
-                    r.kind,
-                    r.name,
-                    r.inertia.subs(mapping),
-                    r.lower,
-                    r.upper,
-                    r.velocity_limit,
-                    r.effort_limit,
-                    f(r.gear_ratio),
-                    f(r.rotor_inertia),
-                    f(r.viscous),
-                    f(r.coulomb),
-                    f(r.coulomb_negative),
-                )
-                for r in self.dh
-            ]
-        return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
+        return Robot(substitute(self.description, by_name(mapping, self.symbols)))
 
     def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
@@ -658,16 +567,12 @@ class Robot:
         origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
         robots"). ``geometry``: cylinders along the links of a robot without visuals;
         ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
-        from .description.export import to_urdf
-
-        return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
+        return export.to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
         """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
         :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
-        from .description.export import to_mjcf
-
-        return to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
+        return export.to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
 
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
@@ -700,14 +605,10 @@ class Robot:
 
     # notebooks (kinedyn.display): joint table, mass, gravity, tool and a small stick figure
     def _repr_html_(self) -> str:
-        from .display import robot_html
-
-        return robot_html(self)
+        return display.robot_html(self)
 
     def _repr_markdown_(self) -> str:
-        from .display import robot_markdown
-
-        return robot_markdown(self)
+        return display.robot_markdown(self)
 
     # ------------------------------------------------------------------ numeric engine
     @cached_property
@@ -933,9 +834,7 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
-        if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
-            from ._dask import lazy_inverse_kinematics
-
+        if _DASK_ARRAY in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             return lazy_inverse_kinematics(
                 self,
                 target if is_dask_array(target) else _dask_targets(target, q0),
@@ -945,12 +844,7 @@ class Robot:
                 respect_limits,
                 kwargs,
             )
-        if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
-            from ._mimic import inverse_kinematics
-
-            return inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
-        solve = _IK_SOLVE or _load_ik()
-        return solve(self, target, q0, mask, method, respect_limits, **kwargs)
+        return solve_ik(self, target, q0, mask, method, respect_limits, **kwargs)
 
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
@@ -1220,52 +1114,36 @@ class Robot:
         indices of the regressor kept, the grouping matrix with ``pi_base = grouping @ pi``, and
         ``pi_base`` of this robot, so that ``Y[:, indices] @ pi_base == Y @ pi``. Found by QR with
         column pivoting on regressors stacked at ``samples`` random states."""
-        from .dynamics import base_parameters
-
-        return base_parameters(self, samples=samples, rng=rng, tol=tol)
+        return dynamics.base_parameters(self, samples=samples, rng=rng, tol=tol)
 
     # symbolic engine ----------------------------------------------------------------------
     def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs) -> EquationsOfMotion:
         """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
-        from .symbolic import equations_of_motion
-
-        return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
+        return symbolic.equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
     # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------
     def neutral(self) -> np.ndarray:
         """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
-        from .configuration import neutral
-
-        return neutral(self)
+        return configuration.neutral(self)
 
     def random_configuration(self, rng: SeedLike = None, size: int | None = None) -> np.ndarray:
         """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
         uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
-        from .configuration import random_configuration
-
-        return random_configuration(self, rng, size)
+        return configuration.random_configuration(self, rng, size)
 
     def integrate(self, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
         """q ⊕ v dt (nq,) or (N, nq): q + v dt for 1-DOF joints, M(q) Exp(v dt) for floating, spherical and
         planar joints (v in the child's frame): see :mod:`kinedyn.configuration`."""
-        from .configuration import integrate
-
-        return integrate(self, q, v, dt)
+        return configuration.integrate(self, q, v, dt)
 
     def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
         """v (nv,) or (N, nv) with integrate(q0, v) == q1: Log(M(q0)^-1 M(q1)), rotations the short way."""
-        from .configuration import difference
-
-        return difference(self, q0, q1)
+        return configuration.difference(self, q0, q1)
 
     def interpolate(self, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
         """integrate(q0, t * difference(q0, q1)): the geodesic from q0 (t = 0) to q1 (t = 1)."""
-        from .configuration import interpolate
-
-        return interpolate(self, q0, q1, t)
+        return configuration.interpolate(self, q0, q1, t)
 
     def normalize(self, q: ArrayLike) -> np.ndarray:
         """``q`` with each quaternion and planar (cos, sin) pair divided by its norm."""
-        from .configuration import normalize
-
-        return normalize(self, q)
+        return configuration.normalize(self, q)
