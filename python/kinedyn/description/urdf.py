@@ -39,14 +39,13 @@ import importlib
 import math
 import os
 import re
-import types
 import warnings
 
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
 from .bounded_xml import parse_bounded
-from .checks import LARGEST
+from .checks import LARGEST, caller_level
 from .description import Description
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
@@ -172,20 +171,8 @@ def description_from_urdf(
         message = str(w.message)
         if issubclass(w.category, PhysicalConsistencyWarning):
             message = f"{src.at(_line_of(message, lines))}: {message}"
-        warnings.warn(message, w.category, stacklevel=_caller_level())
+        warnings.warn(message, w.category, stacklevel=caller_level())
     return description
-
-
-def _caller_level() -> int:
-    """The stacklevel of the first frame outside kinedyn (so a warning points at the user's call)."""
-    import sys
-
-    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame: types.FrameType | None = sys._getframe(1)
-    level = 1
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
-        frame, level = frame.f_back, level + 1
-    return level
 
 
 def _line_of(message: str, lines: dict) -> int | None:
