@@ -8,27 +8,24 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 from __future__ import annotations
 
 import dataclasses
-import math
 import sys
 from collections.abc import Mapping, Sequence
 from functools import cached_property
 from typing import TYPE_CHECKING, Union
 
 import numpy as np
-import sympy as sp
 
 from . import configuration, display, dynamics, symbolic
 from ._arrays import finite_result, real_array
 from ._dask import batched, is_dask_array, lazy_inverse_kinematics
-from ._math import by_name, is_symbolic, to_float_array
-from .description import export, mimic
+from ._math import by_name, to_float_array
+from .description import export
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
-from .description.edit import lock, substitute
+from .description.edit import lock_joints, substitute
 from .description.files import save as save_robot_file
 from .description.geometry import Visual
 from .description.link import Frame, Link
-from .description.mimic import lock_followers
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
@@ -116,6 +113,11 @@ def _joint_columns(joint) -> list:
 
 
 _F64 = np.dtype(np.float64)
+
+
+def _described(name: str) -> property:
+    """A read-only property of the Robot that is the description's own (with its docstring)."""
+    return property(lambda self: getattr(self.description, name), doc=getattr(Description, name).__doc__)
 
 
 class Robot:
@@ -300,58 +302,9 @@ class Robot:
         every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
         position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
-        names = self.joint_names
-        n_joints = len(names)
-        starts = np.cumsum([0] + [j.nq for j in self.joints])
-        if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
-            raise TypeError(
-                f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}"
-            )
-        if isinstance(joints, Mapping):
-            items = list(joints.items())
-        else:
-            q_at = self.neutral() if at is None else real_array(at, "at")
-            if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
-                raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
-            items = [(j, None) for j in joints]
-        followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
-        unknown = sorted(
-            str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers
-        )
-        if unknown:
-            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
-        values: dict = {}
-        follower_values: dict = {}
-        for key, value in items:
-            if isinstance(key, str) and key in followers:
-                follower_values[key] = value
-                continue
-            if isinstance(key, str):
-                i = names.index(key)
-            elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not -n_joints <= key < n_joints:
-                    raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
-                i = int(key) % n_joints
-            else:
-                raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
-            if self.joints[i].is_multi_dof:
-                block = q_at[starts[i] : starts[i + 1]] if value is None else value
-                values[names[i]] = _locked_block(self.joints[i], block)
-                continue
-            if value is None:
-                value = q_at[starts[i]]
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}"
-                ) from None
-            if not math.isfinite(v):
-                raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
-            values[names[i]] = v
-        if followers:
-            values = lock_followers(followers, values, follower_values)
-        return Robot(lock(self.description, values))
+        if at is None and not isinstance(joints, (Mapping, str, bytes)):
+            at = self.neutral()
+        return Robot(lock_joints(self.description, joints, at, _locked_block))
 
     # ------------------------------------------------------------------ pickling
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
@@ -373,15 +326,8 @@ class Robot:
         ``q`` has :attr:`nq` entries (docs/conventions.md)."""
         return self.nv
 
-    @property
-    def nq(self) -> int:
-        """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
-        return sum(j.nq for j in self.joints)
-
-    @property
-    def nv(self) -> int:
-        """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
-        return sum(j.nv for j in self.joints)
+    nq = _described("nq")
+    nv = _described("nv")
 
     @property
     def has_multi_dof_joints(self) -> bool:
@@ -397,18 +343,8 @@ class Robot:
                     f"{b.joint.kind} joint '{b.joint.name}' (nq={self.nq}, nv={self.nv})"
                 )
 
-    @property
-    def joints(self) -> tuple:
-        """The joints of the coordinates, in q's order: every moving joint, less the mimic followers
-        when they are reduced (:attr:`mimic_joints`)."""
-        bodies = self.tree.bodies
-        if self._mimic is None:
-            return tuple(b.joint for b in bodies)
-        return tuple(bodies[i].joint for i in self._mimic.independent)
-
-    @property
-    def joint_names(self) -> list:
-        return [j.name for j in self.joints]
+    joints = _described("joints")
+    joint_names = _described("joint_names")
 
     @property
     def mimic_joints(self) -> dict:
@@ -438,62 +374,14 @@ class Robot:
     def parents(self) -> list:
         return self.tree.parents
 
-    def _per_coordinate(self, value, size: str, multi=math.inf) -> np.ndarray:
-        """``value(joint)`` for each q coordinate (``size="nq"``) or degree of freedom (``"nv"``);
-        a multi-DOF joint's coordinates get ``multi`` (no limits, no drive data)."""
-        out = []
-        for j in self.joints:
-            k = j.nq if size == "nq" else j.nv
-            out.extend([multi] * k if j.is_multi_dof else [value(j)])
-        return np.array(out, dtype=float)
-
-    @property
-    def lower_limits(self) -> np.ndarray:
-        """Lower position limit per q coordinate (nq,); -inf for multi-DOF joints' coordinates."""
-        return self._per_coordinate(lambda j: j.lower, "nq", -math.inf)
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        """Upper position limit per q coordinate (nq,); inf for multi-DOF joints' coordinates."""
-        return self._per_coordinate(lambda j: j.upper, "nq")
-
-    @property
-    def velocity_limits(self) -> np.ndarray:
-        return self._per_coordinate(lambda j: j.velocity_limit, "nv")
-
-    @property
-    def effort_limits(self) -> np.ndarray:
-        return self._per_coordinate(lambda j: j.effort_limit, "nv")
-
-    @property
-    def armature(self) -> np.ndarray:
-        """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            return mimic.reduced_coefficient(self, "armature")
-        return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
-
-    @property
-    def viscous(self) -> np.ndarray:
-        """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
-        (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            return mimic.reduced_coefficient(self, "viscous")
-        return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
-
-    @property
-    def coulomb(self) -> np.ndarray:
-        """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            return mimic.reduced_coefficient(self, "coulomb")
-        return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
-
-    @property
-    def coulomb_negative(self) -> np.ndarray:
-        """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
-        symmetric friction)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            return mimic.reduced_coefficient(self, "coulomb_negative")
-        return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
+    lower_limits = _described("lower_limits")
+    upper_limits = _described("upper_limits")
+    velocity_limits = _described("velocity_limits")
+    effort_limits = _described("effort_limits")
+    armature = _described("armature")
+    viscous = _described("viscous")
+    coulomb = _described("coulomb")
+    coulomb_negative = _described("coulomb_negative")
 
     @cached_property
     def _dof_body(self) -> np.ndarray:
@@ -519,37 +407,8 @@ class Robot:
             tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
         return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
-    @property
-    def is_symbolic(self) -> bool:
-        return bool(self.symbols)
-
-    @cached_property
-    def symbols(self) -> set:
-        """Free SymPy symbols in the description (empty for a numeric robot)."""
-        free: set = set()
-
-        def add(v):
-            if isinstance(v, sp.MatrixBase):
-                free.update(v.free_symbols)
-            elif isinstance(v, sp.Basic):
-                free.update(v.free_symbols)
-            elif isinstance(v, (tuple, list)):
-                for e in v:
-                    add(e)
-
-        add(self.gravity)
-        for link in self.links:
-            j = link.joint
-            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb, j.coulomb_negative])
-            add([link.inertia.mass, link.inertia.com, link.inertia.inertia])
-            if is_symbolic(link.placement):
-                add(link.placement)
-            if is_symbolic(link.post):
-                add(link.post)
-        for f in self.frames:
-            if is_symbolic(f.placement):
-                add(f.placement)
-        return free
+    is_symbolic = _described("is_symbolic")
+    symbols = _described("symbols")
 
     def subs(self, mapping: Mapping) -> Robot:
         """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);

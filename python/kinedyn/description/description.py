@@ -15,12 +15,18 @@ and ``Robot(links, ..., gravity=...)`` take the same names; ``tree``, ``nonphysi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
+import numpy as np
+import sympy as sp
+
+from .._math import is_symbolic
 from .checks import vector
 from .link import KinematicTree, build_tree, judge_inertias
-from .mimic import MimicMap, mimic_map
+from .mimic import MimicMap, mimic_map, reduced_coefficient
 from .tool import default_tool
 
 __all__ = ["Description"]
@@ -81,6 +87,119 @@ class Description:
         if tool not in names:
             raise ValueError(f"tool frame '{tool}' is not a frame of robot '{self.name}' (frames: {names})")
         put(self, "tool", tool)
+
+    # ------------------------------------------------------------------ per coordinate
+    @property
+    def nq(self) -> int:
+        """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
+        return sum(j.nq for j in self.joints)
+
+    @property
+    def nv(self) -> int:
+        """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
+        return sum(j.nv for j in self.joints)
+
+    @property
+    def joints(self) -> tuple:
+        """The joints of the coordinates, in q's order: every moving joint, less the mimic followers
+        when they are reduced (:attr:`mimic_joints`)."""
+        bodies = self.tree.bodies
+        if self.mimic_map is None:
+            return tuple(b.joint for b in bodies)
+        return tuple(bodies[i].joint for i in self.mimic_map.independent)
+
+    @property
+    def joint_names(self) -> list:
+        return [j.name for j in self.joints]
+
+    def per_coordinate(self, value, size: str, multi=math.inf) -> np.ndarray:
+        """``value(joint)`` for each q coordinate (``size="nq"``) or degree of freedom (``"nv"``);
+        a multi-DOF joint's coordinates get ``multi`` (no limits, no drive data)."""
+        out = []
+        for j in self.joints:
+            k = j.nq if size == "nq" else j.nv
+            out.extend([multi] * k if j.is_multi_dof else [value(j)])
+        return np.array(out, dtype=float)
+
+    @property
+    def lower_limits(self) -> np.ndarray:
+        """Lower position limit per q coordinate (nq,); -inf for multi-DOF joints' coordinates."""
+        return self.per_coordinate(lambda j: j.lower, "nq", -math.inf)
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        """Upper position limit per q coordinate (nq,); inf for multi-DOF joints' coordinates."""
+        return self.per_coordinate(lambda j: j.upper, "nq")
+
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        return self.per_coordinate(lambda j: j.velocity_limit, "nv")
+
+    @property
+    def effort_limits(self) -> np.ndarray:
+        return self.per_coordinate(lambda j: j.effort_limit, "nv")
+
+    @property
+    def armature(self) -> np.ndarray:
+        """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
+        if self.mimic_map is not None:  # with the reduced mimic followers' (description/mimic.py)
+            return reduced_coefficient(self, "armature")
+        return self.per_coordinate(lambda j: float(j.armature), "nv", 0.0)
+
+    @property
+    def viscous(self) -> np.ndarray:
+        """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
+        (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
+        if self.mimic_map is not None:  # with the reduced mimic followers' (description/mimic.py)
+            return reduced_coefficient(self, "viscous")
+        return self.per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
+
+    @property
+    def coulomb(self) -> np.ndarray:
+        """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
+        if self.mimic_map is not None:  # with the reduced mimic followers' (description/mimic.py)
+            return reduced_coefficient(self, "coulomb")
+        return self.per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
+
+    @property
+    def coulomb_negative(self) -> np.ndarray:
+        """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
+        symmetric friction)."""
+        if self.mimic_map is not None:  # with the reduced mimic followers' (description/mimic.py)
+            return reduced_coefficient(self, "coulomb_negative")
+        return self.per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
+
+    @property
+    def is_symbolic(self) -> bool:
+        return bool(self.symbols)
+
+    @cached_property
+    def symbols(self) -> set:
+        """Free SymPy symbols in the description (empty for a numeric robot)."""
+        free: set = set()
+
+        def add(v):
+            if isinstance(v, sp.MatrixBase):
+                free.update(v.free_symbols)
+            elif isinstance(v, sp.Basic):
+                free.update(v.free_symbols)
+            elif isinstance(v, (tuple, list)):
+                for e in v:
+                    add(e)
+
+        add(self.gravity)
+        for link in self.links:
+            j = link.joint
+            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb, j.coulomb_negative])
+            add([link.inertia.mass, link.inertia.com, link.inertia.inertia])
+            if is_symbolic(link.placement):
+                add(link.placement)
+            if is_symbolic(link.post):
+                add(link.post)
+        for f in self.frames:
+            if is_symbolic(f.placement):
+                add(f.placement)
+        return free
 
     def arguments(self) -> dict[str, Any]:
         """The constructor's arguments (no derived fields): what ``dataclasses.replace`` starts from."""

@@ -8,16 +8,19 @@ call these; every field not named is carried over by ``dataclasses.replace``, so
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 
 import numpy as np
 import sympy as sp
 
+from .._arrays import real_array
 from .._math import as_value, is_symbolic, matmul, rot_axis, translation
 from .description import Description
 from .joint import Joint
+from .mimic import lock_followers
 
-__all__ = ["substitute", "lock"]
+__all__ = ["substitute", "lock", "lock_joints"]
 
 
 def substitute(description: Description, mapping: Mapping) -> Description:
@@ -88,3 +91,63 @@ def lock(description: Description, values: Mapping) -> Description:
             )
         links.append(link)
     return dataclasses.replace(description, links=links, dh=None)
+
+
+def lock_joints(description: Description, joints, at, block_motion) -> Description:
+    """``Robot.lock_joints``: ``description`` with ``joints`` fixed (see :meth:`kinedyn.Robot.lock_joints`).
+
+    ``joints``: a mapping ``{joint: value}`` or a sequence of joint names or indices locked at their
+    value in the configuration ``at`` (nq,). ``block_motion(joint, block)``: the 4x4 motion of a
+    multi-DOF joint at its block of q (the native model's convention, given by the caller).
+    Reduced mimic followers are locked with their leader (:func:`kinedyn.description.mimic.lock_followers`).
+    """
+    names = description.joint_names
+    n_joints = len(names)
+    starts = np.cumsum([0] + [j.nq for j in description.joints])
+    if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
+        raise TypeError(
+            f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}"
+        )
+    if isinstance(joints, Mapping):
+        items = list(joints.items())
+    else:
+        q_at = real_array(at, "at")
+        if q_at.shape != (description.nq,) or not np.all(np.isfinite(q_at)):
+            raise ValueError(f"lock_joints: at must be {description.nq} finite joint values, got shape {q_at.shape}")
+        items = [(j, None) for j in joints]
+    followers = (
+        {} if description.mimic_map is None else description.mimic_map.relations
+    )  # reduced mimic followers: locked with their leader (description/mimic.py)
+    unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
+    if unknown:
+        raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
+    values: dict = {}
+    follower_values: dict = {}
+    for key, value in items:
+        if isinstance(key, str) and key in followers:
+            follower_values[key] = value
+            continue
+        if isinstance(key, str):
+            i = names.index(key)
+        elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+            if not -n_joints <= key < n_joints:
+                raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
+            i = int(key) % n_joints
+        else:
+            raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
+        if description.joints[i].is_multi_dof:
+            block = q_at[starts[i] : starts[i + 1]] if value is None else value
+            values[names[i]] = block_motion(description.joints[i], block)
+            continue
+        if value is None:
+            value = q_at[starts[i]]
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}") from None
+        if not math.isfinite(v):
+            raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
+        values[names[i]] = v
+    if followers:
+        values = lock_followers(followers, values, follower_values)
+    return lock(description, values)
