@@ -329,50 +329,21 @@ class Robot:
     nq = _described("nq")
     nv = _described("nv")
 
-    @property
-    def has_multi_dof_joints(self) -> bool:
-        """Whether a joint is floating, spherical or planar (then nq may differ from nv)."""
-        return any(b.joint.is_multi_dof for b in self.tree.bodies)
+    has_multi_dof_joints = _described("has_multi_dof_joints")
+    joints = _described("joints")
+    joint_names = _described("joint_names")
+    mimic_joints = _described("mimic_joints")
+    body_names = _described("body_names")
+    frame_names = _described("frame_names")
+    parents = _described("parents")
 
     def require_one_dof_joints(self, feature: str) -> None:
         """Raise a ValueError naming the joint when ``feature`` does not handle multi-DOF joints yet."""
-        for b in self.tree.bodies:
-            if b.joint.is_multi_dof:
-                raise ValueError(
-                    f"{feature} handles revolute and prismatic joints only; robot '{self.name}' has the "
-                    f"{b.joint.kind} joint '{b.joint.name}' (nq={self.nq}, nv={self.nv})"
-                )
-
-    joints = _described("joints")
-    joint_names = _described("joint_names")
-
-    @property
-    def mimic_joints(self) -> dict:
-        """The reduced mimic followers: ``{follower: Mimic(leader, multiplier, offset)}`` with each
-        leader an independent joint (chains resolved); empty without them or with mimic="independent"."""
-        return {} if self._mimic is None else dict(self._mimic.relations)
+        self.description.require_one_dof_joints(feature)
 
     def require_no_mimic_joints(self, feature: str) -> None:
         """Raise a ValueError naming a follower when ``feature`` does not handle reduced mimic joints."""
-        if self._mimic is not None:
-            follower, relation = next(iter(self._mimic.relations.items()))
-            raise ValueError(
-                f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
-                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)"
-            )
-
-    @property
-    def body_names(self) -> list:
-        """Names of the moving links, in joint order."""
-        return [b.name for b in self.tree.bodies]
-
-    @property
-    def frame_names(self) -> list:
-        return [f.name for f in self.tree.frames]
-
-    @property
-    def parents(self) -> list:
-        return self.tree.parents
+        self.description.require_no_mimic_joints(feature)
 
     lower_limits = _described("lower_limits")
     upper_limits = _described("upper_limits")

@@ -88,6 +88,49 @@ class Description:
             raise ValueError(f"tool frame '{tool}' is not a frame of robot '{self.name}' (frames: {names})")
         put(self, "tool", tool)
 
+    # ------------------------------------------------------------------ joints and frames
+    @property
+    def has_multi_dof_joints(self) -> bool:
+        """Whether a joint is floating, spherical or planar (then nq may differ from nv)."""
+        return any(b.joint.is_multi_dof for b in self.tree.bodies)
+
+    def require_one_dof_joints(self, feature: str) -> None:
+        """Raise a ValueError naming the joint when ``feature`` does not handle multi-DOF joints yet."""
+        for b in self.tree.bodies:
+            if b.joint.is_multi_dof:
+                raise ValueError(
+                    f"{feature} handles revolute and prismatic joints only; robot '{self.name}' has the "
+                    f"{b.joint.kind} joint '{b.joint.name}' (nq={self.nq}, nv={self.nv})"
+                )
+
+    @property
+    def mimic_joints(self) -> dict:
+        """The reduced mimic followers: ``{follower: Mimic(leader, multiplier, offset)}`` with each
+        leader an independent joint (chains resolved); empty without them or with mimic="independent"."""
+        return {} if self.mimic_map is None else dict(self.mimic_map.relations)
+
+    def require_no_mimic_joints(self, feature: str) -> None:
+        """Raise a ValueError naming a follower when ``feature`` does not handle reduced mimic joints."""
+        if self.mimic_map is not None:
+            follower, relation = next(iter(self.mimic_map.relations.items()))
+            raise ValueError(
+                f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
+                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)"
+            )
+
+    @property
+    def body_names(self) -> list:
+        """Names of the moving links, in joint order."""
+        return [b.name for b in self.tree.bodies]
+
+    @property
+    def frame_names(self) -> list:
+        return [f.name for f in self.tree.frames]
+
+    @property
+    def parents(self) -> list:
+        return self.tree.parents
+
     # ------------------------------------------------------------------ per coordinate
     @property
     def nq(self) -> int:
