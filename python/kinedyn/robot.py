@@ -42,7 +42,7 @@ _DASK_ARRAY = "dask.array"  # batch IK goes lazy only once dask.array was import
 
 def _dask_targets(target, q0):
     """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
-    import dask.array as da
+    import dask.array as da  # optional and heavy: only a dask batch of starts gets here
 
     target = np.asarray(target, dtype=np.float64)
     return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
@@ -426,7 +426,7 @@ class Robot:
         URL is printed): meshes, frames, a slider per joint. Returns the :class:`kinedyn.visual.viewer.Viewer`;
         ``block``: wait until Ctrl-C (default: from a script yes, in Jupyter no). ``kwargs``: host,
         port, geometry ("visual" or "collision"). See docs/visualisation.md."""
-        from .visual.viewer import show
+        from .visual.viewer import show  # viser (optional, heavy) loads with the viewer
 
         return show(self, q, block=block, **kwargs)
 
