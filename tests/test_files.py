@@ -13,7 +13,8 @@ import sympy as sp
 from reference import PANDA, UR5, all_frame_poses, erd, random_q
 
 import kinedyn as kd
-from kinedyn.description.files import load, save
+from kinedyn.description.files import save
+from kinedyn.robot_files import load
 
 DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs" / "model-files.md"
 
@@ -258,17 +259,18 @@ def test_toml_reader_imports_tomli_before_python_3_11(monkeypatch, tmp_path):
 
     import tomllib
 
-    import kinedyn.description.files as files
+    import kinedyn.description.file_reader as files
 
     path = tmp_path / "robot.toml"
     save(kd.robots.planar_2r(), path)
     monkeypatch.setattr(sys, "version_info", (3, 10, 14, "final", 0))
     monkeypatch.setitem(sys.modules, "tomllib", None)  # import tomllib raises ImportError
     monkeypatch.setitem(sys.modules, "tomli", tomllib)
-    name = "kinedyn.description._files_on_310"
+    name = "kinedyn.description._file_reader_on_310"
     spec = importlib.util.spec_from_file_location(name, files.__file__)
     module = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, name, module)
     spec.loader.exec_module(module)
     assert module.tomllib is tomllib
-    assert module.load(path).n == 2
+    data = module.parse_toml(module.read_text(str(path)), str(path))
+    assert kd.Robot(module.description_from_mapping(data, str(path))).n == 2

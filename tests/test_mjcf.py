@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import kinedyn as kd
-from kinedyn.description.mjcf import MAX_DEPTH, MAX_INCLUDE_DEPTH, robot_from_mjcf
+from kinedyn.description.mjcf import MAX_DEPTH, MAX_INCLUDE_DEPTH
+from kinedyn.robot_files import robot_from_mjcf
 
 mujoco = pytest.importorskip("mujoco", reason="MuJoCo (pip install mujoco) is an optional test oracle")
 

@@ -542,7 +542,7 @@ def test_interrupt_exits_130_quietly(capsys, monkeypatch):
 def test_a_loader_bug_names_the_file(capsys, monkeypatch, tmp_path):
     """A loader that raises something other than ValueError is a bug in kinedyn, reported as one,
     with the file it was reading."""
-    import kinedyn.description.files as files
+    import kinedyn.robot_files as files
 
     def broken(path, **kwargs):
         raise TypeError("unsupported operand")

@@ -18,7 +18,8 @@ from reference import erd
 import kinedyn as kd
 from kinedyn import Inertia, Joint, Link
 from kinedyn.description import inertia as inertia_module
-from kinedyn.description.urdf import MAX_DEPTH, robot_from_urdf
+from kinedyn.description.urdf import MAX_DEPTH
+from kinedyn.robot_files import robot_from_urdf
 
 BODY = '<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
 

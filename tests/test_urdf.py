@@ -11,7 +11,7 @@ import pytest
 from reference import PANDA, UR5, all_frame_poses, erd, frame_pose, joint_motion, pose, random_q, rpy
 
 import kinedyn as kd
-from kinedyn.description.urdf import robot_from_urdf
+from kinedyn.robot_files import robot_from_urdf
 
 # A small tree: base -> a (revolute) -> b (prismatic) -> tip (fixed); a -> side (continuous)
 TREE = """<?xml version="1.0"?>

@@ -12,6 +12,7 @@ from ._core import (
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
+from .robot_files import load as _load
 from .scale import sweep  # configuration-space sweeps into Zarr on a dask scheduler (docs/scale.md)
 
 if TYPE_CHECKING:
@@ -43,8 +44,6 @@ def load(path: PathLike, **kwargs) -> Robot:
     """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension.
     ``inertia="warn"|"repair"|"strict"``: the policy for an inertia no rigid body can have
     (docs/model-files.md); other keywords as :meth:`Robot.from_urdf` or the Robot constructor."""
-    from .description.files import load as _load
-
     return _load(path, **kwargs)
 
 

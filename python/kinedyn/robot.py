@@ -7,25 +7,28 @@ numeric method takes ``q`` of shape (n,) or a batch (N, n) and calls the core on
 
 from __future__ import annotations
 
-import math
-import os
+import dataclasses
 import sys
 from collections.abc import Mapping, Sequence
 from functools import cached_property
 from typing import TYPE_CHECKING, Union
 
 import numpy as np
-import sympy as sp
 
+from . import configuration, display, dynamics, symbolic
 from ._arrays import finite_result, real_array
-from ._dask import batched, is_dask_array
-from ._math import as_value, by_name, is_symbolic, matmul, to_float_array
-from .description.checks import vector
-from .description.dh import DHRow, links_from_dh
+from ._dask import batched, is_dask_array, lazy_inverse_kinematics
+from ._math import by_name, to_float_array
+from .description import export
+from .description.description import Description
+from .description.dh import DHRow, description_from_dh
+from .description.edit import lock_joints, substitute
+from .description.files import save as save_robot_file
 from .description.geometry import Visual
-from .description.joint import Joint
-from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
-from .description.mimic import mimic_map as _mimic_map
+from .description.link import Frame, Link
+from .description.mjcf import description_from_mjcf
+from .description.urdf import description_from_urdf
+from .ik.dispatch import inverse_kinematics as solve_ik
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -34,23 +37,12 @@ if TYPE_CHECKING:
 
 __all__ = ["Robot"]
 
-_IK_SOLVE = None  # kinedyn.ik.inverse_kinematics, imported on first use (it loads the IK bindings)
-
-
-def _load_ik():
-    global _IK_SOLVE
-    from .ik import inverse_kinematics
-
-    _IK_SOLVE = inverse_kinematics
-    return _IK_SOLVE
-
-
-_DASK_ARRAYS = ("dask.array",)  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
+_DASK_ARRAY = "dask.array"  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
 
 
 def _dask_targets(target, q0):
     """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
-    import dask.array as da
+    import dask.array as da  # optional and heavy: only a dask batch of starts gets here
 
     target = np.asarray(target, dtype=np.float64)
     return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
@@ -123,6 +115,11 @@ def _joint_columns(joint) -> list:
 _F64 = np.dtype(np.float64)
 
 
+def _described(name: str) -> property:
+    """A read-only property of the Robot that is the description's own (with its docstring)."""
+    return property(lambda self: getattr(self.description, name), doc=getattr(Description, name).__doc__)
+
+
 class Robot:
     """A kinematic tree of links connected by revolute, prismatic and fixed joints.
 
@@ -132,7 +129,7 @@ class Robot:
 
     def __init__(
         self,
-        links: Sequence[Link],
+        links: Sequence[Link] | Description,
         frames: Sequence[Frame] = (),
         *,
         gravity=(0.0, 0.0, -9.81),
@@ -147,35 +144,61 @@ class Robot:
         collisions: Sequence[Visual] = (),
         mimic: str = "reduce",
     ):
-        self.name = name
-        # what the robot looks like (URDF <visual>/<collision>, robot files' visuals:), by frame name;
-        # kinedyn.visual draws them (a robot without any gets solid links along its kinematics)
-        self.visuals: tuple = tuple(visuals)
-        self.collisions: tuple = tuple(collisions)
-        # inertia policy for tensors no rigid body can have: "warn" | "repair" | "strict" (docs/model-files.md)
-        self.links, self.nonphysical = judge_inertias(links, inertia)
-        self.inertia_policy = inertia
-        self.frames = tuple(frames)
-        self.base = base
-        self.gravity = vector(gravity, 3, "gravity")
-        self.dh = tuple(dh) if dh is not None else None
-        self.dh_convention = dh_convention
-        self.source = source
-        self.tree: KinematicTree = build_tree(self.links, self.frames, base)
-        if self.tree.n == 0:
-            raise ValueError(f"robot '{name}' has no moving joint")
-        # mimic joints (Joint.mimic): "reduce" removes the followers' coordinates, "independent" keeps
-        # them (kinedyn.description.mimic); None when no joint follows another
-        self.mimic_mode = mimic
-        self._mimic = _mimic_map([b.joint for b in self.tree.bodies], [link.joint for link in self.links], mimic, name)
-        names = [f.name for f in self.tree.frames]
-        if tool is None:
-            from .description.tool import default_tool
+        """``Robot(description)`` (what the readers return), or ``Robot(links, frames, ...)`` with the
+        fields of :class:`~kinedyn.description.description.Description` as keywords. ``inertia``: the
+        policy for tensors no rigid body can have (docs/model-files.md); ``mimic``: "reduce" removes
+        the followers' coordinates, "independent" keeps them (:mod:`kinedyn.description.mimic`);
+        ``visuals``/``collisions``: what :mod:`kinedyn.visual` draws, by frame name."""
+        if isinstance(links, Description):
+            description = links
+        else:
+            description = Description(
+                tuple(links),
+                tuple(frames),
+                gravity=gravity,
+                base=base,
+                tool=tool,
+                name=name,
+                dh=dh,
+                dh_convention=dh_convention,
+                source=source,
+                inertia=inertia,
+                visuals=visuals,
+                collisions=collisions,
+                mimic=mimic,
+            )
+        object.__setattr__(self, "description", description)
 
-            tool = "tool" if "tool" in names else default_tool(self.links, base)
-        if tool not in names:
-            raise ValueError(f"tool frame '{tool}' is not a frame of robot '{name}' (frames: {names})")
-        self.tool = tool
+    def __setattr__(self, name: str, value) -> None:
+        # frozen: the native model and the caches are built from the description once, so a changed
+        # field would leave them stale; a changed robot is a new one (replace, subs, lock_joints)
+        raise AttributeError(f"a Robot is immutable: robot.replace({name}=...) builds a changed copy")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError("a Robot is immutable")
+
+    @classmethod
+    def from_description(cls, description: Description) -> Robot:
+        """The robot of a :class:`~kinedyn.description.description.Description` (= ``Robot(description)``)."""
+        return cls(description)
+
+    # the description's fields, read through the robot
+    name = property(lambda self: self.description.name)
+    links = property(lambda self: self.description.links)
+    frames = property(lambda self: self.description.frames)
+    base = property(lambda self: self.description.base)
+    gravity = property(lambda self: self.description.gravity)
+    tool = property(lambda self: self.description.tool)
+    dh = property(lambda self: self.description.dh)
+    dh_convention = property(lambda self: self.description.dh_convention)
+    source = property(lambda self: self.description.source)
+    visuals = property(lambda self: self.description.visuals)
+    collisions = property(lambda self: self.description.collisions)
+    tree = property(lambda self: self.description.tree)
+    nonphysical = property(lambda self: self.description.nonphysical)
+    inertia_policy = property(lambda self: self.description.inertia)
+    mimic_mode = property(lambda self: self.description.mimic)
+    _mimic = property(lambda self: self.description.mimic_map)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -198,22 +221,17 @@ class Robot:
         ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always
         added; identity if not given). ``inertia``: the inertia policy (as :meth:`from_urdf`).
         """
-        links, dh_rows = links_from_dh(rows, convention)
-        if base_pose is not None:
-            first = links[0]
-            links[0] = Link(
-                first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia
-            )
-        frames = [Frame("tool", links[-1].name, np.eye(4) if tool is None else tool)]
         return cls(
-            links,
-            frames,
-            gravity=gravity,
-            name=name,
-            dh=dh_rows,
-            dh_convention=convention,
-            source=source,
-            inertia=inertia,
+            description_from_dh(
+                rows,
+                convention,
+                gravity=gravity,
+                base_pose=base_pose,
+                tool=tool,
+                name=name,
+                source=source,
+                inertia=inertia,
+            )
         )
 
     @classmethod
@@ -243,24 +261,18 @@ class Robot:
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
         Python expressions from the file, so it needs ``trust_xacro=True``
         (:mod:`kinedyn.description.xacro`)."""
-        from .description.urdf import robot_from_urdf
-        from .description.xacro import expand_xacro, is_xacro
-
-        if is_xacro(path_or_string):
-            text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
-            return robot_from_urdf(
-                text,
+        return cls(
+            description_from_urdf(
+                path_or_string,
                 gravity=gravity,
                 tool=tool,
                 inertia=inertia,
                 floating_base=floating_base,
-                source_path=os.fsdecode(path_or_string),
                 mimic=mimic,
+                xacro_args=xacro_args,
+                trust_xacro=trust_xacro,
+                package_dirs=package_dirs,
             )
-        if xacro_args:
-            raise ValueError("xacro_args are for a .xacro file")
-        return robot_from_urdf(
-            path_or_string, gravity=gravity, tool=tool, inertia=inertia, floating_base=floating_base, mimic=mimic
         )
 
     @classmethod
@@ -275,29 +287,11 @@ class Robot:
         """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
         and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
         ``tool`` and ``inertia`` as :meth:`from_urdf`."""
-        from .description.mjcf import robot_from_mjcf
-
-        return robot_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia)
+        return cls(description_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia))
 
     def replace(self, **changes) -> Robot:
         """A copy with some constructor arguments changed (links, frames, gravity, tool, name...)."""
-        kwargs = dict(
-            links=self.links,
-            frames=self.frames,
-            gravity=self.gravity,
-            base=self.base,
-            tool=self.tool,
-            name=self.name,
-            dh=self.dh,
-            dh_convention=self.dh_convention,
-            source=self.source,
-            inertia=self.inertia_policy,
-            visuals=self.visuals,
-            collisions=self.collisions,
-            mimic=self.mimic_mode,
-        )
-        kwargs.update(changes)
-        return Robot(kwargs.pop("links"), kwargs.pop("frames"), **kwargs)
+        return Robot(dataclasses.replace(self.description, **changes))
 
     def lock_joints(self, joints, at=None) -> Robot:
         """A new robot with some joints fixed (e.g. a gripper's fingers).
@@ -308,76 +302,9 @@ class Robot:
         every joint has one coordinate). A multi-DOF joint's value is its block of q (a free-flyer's
         position and unit quaternion: locking it gives the fixed-base robot at that base pose).
         """
-        from ._math import rot_axis, translation
-
-        names = self.joint_names
-        n_joints = len(names)
-        starts = np.cumsum([0] + [j.nq for j in self.joints])
-        if isinstance(joints, (str, bytes)) or not hasattr(joints, "__iter__"):
-            raise TypeError(
-                f"lock_joints takes a mapping {{joint: value}} or a sequence of joint names or indices, got {joints!r}"
-            )
-        if isinstance(joints, Mapping):
-            items = list(joints.items())
-        else:
-            q_at = self.neutral() if at is None else real_array(at, "at")
-            if q_at.shape != (self.nq,) or not np.all(np.isfinite(q_at)):
-                raise ValueError(f"lock_joints: at must be {self.nq} finite joint values, got shape {q_at.shape}")
-            items = [(j, None) for j in joints]
-        followers = self.mimic_joints  # reduced mimic followers: locked with their leader (description/mimic.py)
-        unknown = sorted(
-            str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers
-        )
-        if unknown:
-            raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
-        values: dict = {}
-        follower_values: dict = {}
-        for key, value in items:
-            if isinstance(key, str) and key in followers:
-                follower_values[key] = value
-                continue
-            if isinstance(key, str):
-                i = names.index(key)
-            elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not -n_joints <= key < n_joints:
-                    raise ValueError(f"lock_joints: joint index {key} is out of range for {n_joints} joints")
-                i = int(key) % n_joints
-            else:
-                raise TypeError(f"lock_joints: a joint is a name or an index, got {key!r}")
-            if self.joints[i].is_multi_dof:
-                block = q_at[starts[i] : starts[i + 1]] if value is None else value
-                values[names[i]] = _locked_block(self.joints[i], block)
-                continue
-            if value is None:
-                value = q_at[starts[i]]
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"lock_joints: the value of joint '{names[i]}' must be a number, got {value!r}"
-                ) from None
-            if not math.isfinite(v):
-                raise ValueError(f"lock_joints: the value of joint '{names[i]}' must be finite, got {v}")
-            values[names[i]] = v
-        if followers:
-            from .description.mimic import lock_followers
-
-            values = lock_followers(followers, values, follower_values)
-        links = []
-        for link in self.links:
-            j = link.joint
-            if j.name in values and j.is_multi_dof:
-                fixed = Joint(j.name, "fixed")
-                link = Link(
-                    link.name, link.parent, fixed, matmul(link.placement, values[j.name]), link.post, link.inertia
-                )
-            elif j.name in values and j.is_moving:
-                x = values[j.name] + j.offset
-                motion = rot_axis(j.axis, x) if j.kind == "revolute" else translation(*(a * x for a in j.axis))
-                fixed = Joint(j.name, "fixed", j.axis)
-                link = Link(link.name, link.parent, fixed, matmul(link.placement, motion), link.post, link.inertia)
-            links.append(link)
-        return self.replace(links=links, dh=None)
+        if at is None and not isinstance(joints, (Mapping, str, bytes)):
+            at = self.neutral()
+        return Robot(lock_joints(self.description, joints, at, _locked_block))
 
     # ------------------------------------------------------------------ pickling
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
@@ -399,135 +326,33 @@ class Robot:
         ``q`` has :attr:`nq` entries (docs/conventions.md)."""
         return self.nv
 
-    @property
-    def nq(self) -> int:
-        """Length of a configuration ``q`` (a free-flyer takes 7: position, then unit quaternion x, y, z, w)."""
-        return sum(j.nq for j in self.joints)
+    nq = _described("nq")
+    nv = _described("nv")
 
-    @property
-    def nv(self) -> int:
-        """Length of a velocity ``qd`` (a free-flyer takes 6: [linear; angular] in the base's own frame)."""
-        return sum(j.nv for j in self.joints)
-
-    @property
-    def has_multi_dof_joints(self) -> bool:
-        """Whether a joint is floating, spherical or planar (then nq may differ from nv)."""
-        return any(b.joint.is_multi_dof for b in self.tree.bodies)
+    has_multi_dof_joints = _described("has_multi_dof_joints")
+    joints = _described("joints")
+    joint_names = _described("joint_names")
+    mimic_joints = _described("mimic_joints")
+    body_names = _described("body_names")
+    frame_names = _described("frame_names")
+    parents = _described("parents")
 
     def require_one_dof_joints(self, feature: str) -> None:
         """Raise a ValueError naming the joint when ``feature`` does not handle multi-DOF joints yet."""
-        for b in self.tree.bodies:
-            if b.joint.is_multi_dof:
-                raise ValueError(
-                    f"{feature} handles revolute and prismatic joints only; robot '{self.name}' has the "
-                    f"{b.joint.kind} joint '{b.joint.name}' (nq={self.nq}, nv={self.nv})"
-                )
-
-    @property
-    def joints(self) -> tuple:
-        """The joints of the coordinates, in q's order: every moving joint, less the mimic followers
-        when they are reduced (:attr:`mimic_joints`)."""
-        bodies = self.tree.bodies
-        if self._mimic is None:
-            return tuple(b.joint for b in bodies)
-        return tuple(bodies[i].joint for i in self._mimic.independent)
-
-    @property
-    def joint_names(self) -> list:
-        return [j.name for j in self.joints]
-
-    @property
-    def mimic_joints(self) -> dict:
-        """The reduced mimic followers: ``{follower: Mimic(leader, multiplier, offset)}`` with each
-        leader an independent joint (chains resolved); empty without them or with mimic="independent"."""
-        return {} if self._mimic is None else dict(self._mimic.relations)
+        self.description.require_one_dof_joints(feature)
 
     def require_no_mimic_joints(self, feature: str) -> None:
         """Raise a ValueError naming a follower when ``feature`` does not handle reduced mimic joints."""
-        if self._mimic is not None:
-            follower, relation = next(iter(self._mimic.relations.items()))
-            raise ValueError(
-                f"{feature} does not handle mimic joints yet; robot '{self.name}' has the follower joint '{follower}' "
-                f"(mimics '{relation.leader}'): load it with mimic='independent', or lock the leader (robot.lock_joints)"
-            )
+        self.description.require_no_mimic_joints(feature)
 
-    @property
-    def body_names(self) -> list:
-        """Names of the moving links, in joint order."""
-        return [b.name for b in self.tree.bodies]
-
-    @property
-    def frame_names(self) -> list:
-        return [f.name for f in self.tree.frames]
-
-    @property
-    def parents(self) -> list:
-        return self.tree.parents
-
-    def _per_coordinate(self, value, size: str, multi=math.inf) -> np.ndarray:
-        """``value(joint)`` for each q coordinate (``size="nq"``) or degree of freedom (``"nv"``);
-        a multi-DOF joint's coordinates get ``multi`` (no limits, no drive data)."""
-        out = []
-        for j in self.joints:
-            k = j.nq if size == "nq" else j.nv
-            out.extend([multi] * k if j.is_multi_dof else [value(j)])
-        return np.array(out, dtype=float)
-
-    @property
-    def lower_limits(self) -> np.ndarray:
-        """Lower position limit per q coordinate (nq,); -inf for multi-DOF joints' coordinates."""
-        return self._per_coordinate(lambda j: j.lower, "nq", -math.inf)
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        """Upper position limit per q coordinate (nq,); inf for multi-DOF joints' coordinates."""
-        return self._per_coordinate(lambda j: j.upper, "nq")
-
-    @property
-    def velocity_limits(self) -> np.ndarray:
-        return self._per_coordinate(lambda j: j.velocity_limit, "nv")
-
-    @property
-    def effort_limits(self) -> np.ndarray:
-        return self._per_coordinate(lambda j: j.effort_limit, "nv")
-
-    @property
-    def armature(self) -> np.ndarray:
-        """Reflected rotor inertia r^2 J_m per degree of freedom (added to the diagonal of M)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "armature")
-        return self._per_coordinate(lambda j: float(j.armature), "nv", 0.0)
-
-    @property
-    def viscous(self) -> np.ndarray:
-        """Viscous friction coefficient per degree of freedom: tau_f = viscous * qd + coulomb * sign(qd)
-        (with direction-dependent Coulomb levels: :meth:`friction_torque`)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "viscous")
-        return self._per_coordinate(lambda j: float(j.viscous), "nv", 0.0)
-
-    @property
-    def coulomb(self) -> np.ndarray:
-        """Coulomb friction level per degree of freedom for qd > 0 (the only level when friction is symmetric)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "coulomb")
-        return self._per_coordinate(lambda j: float(j.coulomb), "nv", 0.0)
-
-    @property
-    def coulomb_negative(self) -> np.ndarray:
-        """Coulomb friction level per degree of freedom for qd < 0 (a magnitude; equals :attr:`coulomb` for
-        symmetric friction)."""
-        if self._mimic is not None:  # with the reduced mimic followers' (description/mimic.py)
-            from .description.mimic import reduced_coefficient
-
-            return reduced_coefficient(self, "coulomb_negative")
-        return self._per_coordinate(lambda j: float(j.coulomb_levels[1]), "nv", 0.0)
+    lower_limits = _described("lower_limits")
+    upper_limits = _described("upper_limits")
+    velocity_limits = _described("velocity_limits")
+    effort_limits = _described("effort_limits")
+    armature = _described("armature")
+    viscous = _described("viscous")
+    coulomb = _described("coulomb")
+    coulomb_negative = _described("coulomb_negative")
 
     @cached_property
     def _dof_body(self) -> np.ndarray:
@@ -553,106 +378,17 @@ class Robot:
             tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
         return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
 
-    @property
-    def is_symbolic(self) -> bool:
-        return bool(self.symbols)
-
-    @cached_property
-    def symbols(self) -> set:
-        """Free SymPy symbols in the description (empty for a numeric robot)."""
-        free: set = set()
-
-        def add(v):
-            if isinstance(v, sp.MatrixBase):
-                free.update(v.free_symbols)
-            elif isinstance(v, sp.Basic):
-                free.update(v.free_symbols)
-            elif isinstance(v, (tuple, list)):
-                for e in v:
-                    add(e)
-
-        add(self.gravity)
-        for link in self.links:
-            j = link.joint
-            add([j.axis, j.offset, j.gear_ratio, j.rotor_inertia, j.viscous, j.coulomb, j.coulomb_negative])
-            add([link.inertia.mass, link.inertia.com, link.inertia.inertia])
-            if is_symbolic(link.placement):
-                add(link.placement)
-            if is_symbolic(link.post):
-                add(link.post)
-        for f in self.frames:
-            if is_symbolic(f.placement):
-                add(f.placement)
-        return free
+    is_symbolic = _described("is_symbolic")
+    symbols = _described("symbols")
 
     def subs(self, mapping: Mapping) -> Robot:
         """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);
         keys are symbols or their names."""
-        mapping = by_name(mapping, self.symbols)
-
-        def f(v):
-            if isinstance(v, (sp.Basic, sp.MatrixBase)):
-                out = v.subs(mapping)
-                if isinstance(out, sp.MatrixBase):
-                    return out if is_symbolic(out) else np.array(out.tolist(), dtype=float)
-                return as_value(out)
-            return v
-
-        links = []
-        for link in self.links:
-            j = link.joint
-            joint = Joint(
-                j.name,
-                j.kind,
-                tuple(f(a) for a in j.axis),
-                f(j.offset),
-                j.lower,
-                j.upper,
-                j.velocity_limit,
-                j.effort_limit,
-                f(j.gear_ratio),
-                f(j.rotor_inertia),
-                f(j.viscous),
-                f(j.coulomb),
-                f(j.coulomb_negative),
-                mimic=j.mimic,
-            )
-            try:
-                inertia = link.inertia.subs(mapping)
-            except ValueError as e:
-                raise ValueError(f"robot '{self.name}', link '{link.name}': {e}") from None
-            links.append(Link(link.name, link.parent, joint, f(link.placement), f(link.post), inertia))
-        frames = [Frame(fr.name, fr.link, f(fr.placement)) for fr in self.frames]
-        dh = None
-        if self.dh is not None:
-            dh = [
-                DHRow(
-                    f(r.theta),
-                    f(r.d),
-                    f(r.a),
-                    f(r.alpha),
-                    r.kind,
-                    r.name,
-                    r.inertia.subs(mapping),
-                    r.lower,
-                    r.upper,
-                    r.velocity_limit,
-                    r.effort_limit,
-                    f(r.gear_ratio),
-                    f(r.rotor_inertia),
-                    f(r.viscous),
-                    f(r.coulomb),
-                    f(r.coulomb_negative),
-                )
-                for r in self.dh
-            ]
-        return self.replace(links=links, frames=frames, gravity=tuple(f(g) for g in self.gravity), dh=dh)
+        return Robot(substitute(self.description, by_name(mapping, self.symbols)))
 
     def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
-        from .description.files import save
-
-        save(self, path)
+        save_robot_file(self, path)
 
     def to_urdf(
         self, path: PathLike | None = None, *, geometry: bool = True, floating_base_as_root: bool = True
@@ -661,16 +397,12 @@ class Robot:
         origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
         robots"). ``geometry``: cylinders along the links of a robot without visuals;
         ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
-        from .description.export import to_urdf
-
-        return to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
+        return export.to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
         """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
         :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
-        from .description.export import to_mjcf
-
-        return to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
+        return export.to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
 
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
@@ -694,7 +426,7 @@ class Robot:
         URL is printed): meshes, frames, a slider per joint. Returns the :class:`kinedyn.visual.viewer.Viewer`;
         ``block``: wait until Ctrl-C (default: from a script yes, in Jupyter no). ``kwargs``: host,
         port, geometry ("visual" or "collision"). See docs/visualisation.md."""
-        from .visual.viewer import show
+        from .visual.viewer import show  # viser (optional, heavy) loads with the viewer
 
         return show(self, q, block=block, **kwargs)
 
@@ -703,14 +435,10 @@ class Robot:
 
     # notebooks (kinedyn.display): joint table, mass, gravity, tool and a small stick figure
     def _repr_html_(self) -> str:
-        from .display import robot_html
-
-        return robot_html(self)
+        return display.robot_html(self)
 
     def _repr_markdown_(self) -> str:
-        from .display import robot_markdown
-
-        return robot_markdown(self)
+        return display.robot_markdown(self)
 
     # ------------------------------------------------------------------ numeric engine
     @cached_property
@@ -936,9 +664,7 @@ class Robot:
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
         ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
-        if _DASK_ARRAYS[0] in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
-            from ._dask import lazy_inverse_kinematics
-
+        if _DASK_ARRAY in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             return lazy_inverse_kinematics(
                 self,
                 target if is_dask_array(target) else _dask_targets(target, q0),
@@ -948,12 +674,7 @@ class Robot:
                 respect_limits,
                 kwargs,
             )
-        if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
-            from ._mimic import inverse_kinematics
-
-            return inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
-        solve = _IK_SOLVE or _load_ik()
-        return solve(self, target, q0, mask, method, respect_limits, **kwargs)
+        return solve_ik(self, target, q0, mask, method, respect_limits, **kwargs)
 
     # dynamics -----------------------------------------------------------------------------
     # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
@@ -1223,52 +944,36 @@ class Robot:
         indices of the regressor kept, the grouping matrix with ``pi_base = grouping @ pi``, and
         ``pi_base`` of this robot, so that ``Y[:, indices] @ pi_base == Y @ pi``. Found by QR with
         column pivoting on regressors stacked at ``samples`` random states."""
-        from .dynamics import base_parameters
-
-        return base_parameters(self, samples=samples, rng=rng, tol=tol)
+        return dynamics.base_parameters(self, samples=samples, rng=rng, tol=tol)
 
     # symbolic engine ----------------------------------------------------------------------
     def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs) -> EquationsOfMotion:
         """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
-        from .symbolic import equations_of_motion
-
-        return equations_of_motion(self, method=method, simplify=simplify, **kwargs)
+        return symbolic.equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
     # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------
     def neutral(self) -> np.ndarray:
         """The neutral configuration (nq,): zeros, identity quaternions (0, 0, 0, 1), planar (0, 0, 1, 0)."""
-        from .configuration import neutral
-
-        return neutral(self)
+        return configuration.neutral(self)
 
     def random_configuration(self, rng: SeedLike = None, size: int | None = None) -> np.ndarray:
         """Uniform within finite joint limits, in [-pi, pi] (revolute) or [-1, 1] (prismatic) else;
         uniformly distributed rotations for quaternions (see :func:`kinedyn.configuration.random_configuration`)."""
-        from .configuration import random_configuration
-
-        return random_configuration(self, rng, size)
+        return configuration.random_configuration(self, rng, size)
 
     def integrate(self, q: ArrayLike, v: ArrayLike, dt: ArrayLike = 1.0) -> np.ndarray:
         """q ⊕ v dt (nq,) or (N, nq): q + v dt for 1-DOF joints, M(q) Exp(v dt) for floating, spherical and
         planar joints (v in the child's frame): see :mod:`kinedyn.configuration`."""
-        from .configuration import integrate
-
-        return integrate(self, q, v, dt)
+        return configuration.integrate(self, q, v, dt)
 
     def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
         """v (nv,) or (N, nv) with integrate(q0, v) == q1: Log(M(q0)^-1 M(q1)), rotations the short way."""
-        from .configuration import difference
-
-        return difference(self, q0, q1)
+        return configuration.difference(self, q0, q1)
 
     def interpolate(self, q0: ArrayLike, q1: ArrayLike, t: ArrayLike) -> np.ndarray:
         """integrate(q0, t * difference(q0, q1)): the geodesic from q0 (t = 0) to q1 (t = 1)."""
-        from .configuration import interpolate
-
-        return interpolate(self, q0, q1, t)
+        return configuration.interpolate(self, q0, q1, t)
 
     def normalize(self, q: ArrayLike) -> np.ndarray:
         """``q`` with each quaternion and planar (cos, sin) pair divided by its norm."""
-        from .configuration import normalize
-
-        return normalize(self, q)
+        return configuration.normalize(self, q)

@@ -19,10 +19,9 @@ import numpy as np
 from rich.markup import escape
 from rich.table import Table
 
-from .. import robots
+from .. import robot_files, robots
 from .._ui import terminal
 from .._ui.json import jsonable
-from ..description import files
 from .options import ROBOT_FILE_EXTENSIONS, SYMBOLIC_COMMANDS, set_values
 
 
@@ -115,7 +114,7 @@ def robot_file(spec: str, options: RobotOptions):
         loader_options["floating_base"] = True
     try:
         try:
-            return files.load(path, **loader_options)
+            return robot_files.load(path, **loader_options)
         except ValueError as e:
             if ext == ".xacro" and "trust_xacro=True" in str(e):
                 raise ValueError(

@@ -1,8 +1,10 @@
-"""Robot descriptions: inertias, joints, links, DH tables, URDF and robot files."""
+"""Robot descriptions: inertias, joints, links, DH tables, URDF, MJCF and robot files; every reader
+returns a :class:`Description`, from which the caller builds ``kinedyn.Robot(description)``."""
 
+from .description import Description
 from .dh import DHRow
 from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
 
-__all__ = ["DHRow", "Inertia", "Joint", "Link", "Frame"]
+__all__ = ["DHRow", "Description", "Inertia", "Joint", "Link", "Frame"]

@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+import sys
+import types
 from typing import Any
 
 import numpy as np
@@ -95,3 +98,14 @@ def real_array(value: Any, shape: tuple) -> Any:
     if not np.all(np.abs(a) <= LARGEST):  # NaN fails the comparison too
         return None
     return a
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` for a warning raised in the function that calls this: that of the first
+    frame outside kinedyn, so the warning points at the user's call (a file load, a robot built)."""
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame: types.FrameType | None = sys._getframe(1)
+    level = 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level

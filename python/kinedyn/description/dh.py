@@ -15,15 +15,17 @@ import math
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+import numpy as np
 import sympy as sp
 
-from .._math import matmul, rot_x, rot_z, translation
+from .._math import identity, matmul, pose_inverse, rot_axis, rot_x, rot_z, translation
 from .checks import number
+from .description import Description
 from .inertia import Inertia
 from .joint import Joint
-from .link import Link
+from .link import Frame, Link
 
-__all__ = ["DHRow", "links_from_dh", "dh_from_robot", "DHExtraction"]
+__all__ = ["DHRow", "links_from_dh", "description_from_dh", "dh_from_robot", "DHExtraction"]
 
 
 @dataclass(frozen=True)
@@ -140,6 +142,41 @@ def links_from_dh(rows, convention: str = "standard"):
 
 # ------------------------------------------------------------------------------------------------
 # Robot -> DH table (the reverse direction): where a chain admits a DH description
+def description_from_dh(
+    rows,
+    convention: str = "standard",
+    *,
+    gravity=(0.0, 0.0, -9.81),
+    base_pose=None,
+    tool=None,
+    name: str = "dh_robot",
+    source: str = "",
+    inertia: str = "warn",
+) -> Description:
+    """The description of a serial arm from a DH table (what :meth:`kinedyn.Robot.from_dh` builds).
+
+    ``rows``: DHRow objects, mappings with keys theta/d/a/alpha/kind/inertia/limits..., or tuples
+    ``(theta, d, a, alpha[, kind])``. ``base_pose``: the 4x4 pose of DH frame 0 in the world.
+    ``tool``: the 4x4 pose of the tool in the last link frame (a frame named "tool" is always added;
+    identity if not given). ``inertia``: the inertia policy (docs/model-files.md).
+    """
+    links, dh_rows = links_from_dh(rows, convention)
+    if base_pose is not None:
+        first = links[0]
+        links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
+    frames = (Frame("tool", links[-1].name, identity() if tool is None else tool),)
+    return Description(
+        tuple(links),
+        frames,
+        gravity=gravity,
+        name=name,
+        dh=dh_rows,
+        dh_convention=convention,
+        source=source,
+        inertia=inertia,
+    )
+
+
 @dataclass(frozen=True)
 class DHExtraction:
     """What :func:`dh_from_robot` found: the DH ``rows``, their ``convention``, ``base_pose`` (DH frame
@@ -160,7 +197,6 @@ class DHExtraction:
 def _common_normal(p1, u1, p2, u2, eps: float):
     """Feet (f1 on line 1, f2 on line 2) and unit direction x of the common normal of the lines
     p + s u, or None when they are parallel. Intersecting lines: f1 == f2, x = ±u1 × u2."""
-    import numpy as np
 
     w = np.cross(u1, u2)
     if np.linalg.norm(w) < eps:
@@ -177,7 +213,6 @@ def _common_normal(p1, u1, p2, u2, eps: float):
 
 
 def _frame(origin, x, z):
-    import numpy as np
 
     T = np.eye(4)
     T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, np.cross(z, x), z, origin
@@ -186,7 +221,6 @@ def _frame(origin, x, z):
 
 def _perpendicular(v, z, fallback):
     """The unit part of v perpendicular to z, or of ``fallback`` when v has none."""
-    import numpy as np
 
     for c in (v, fallback, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
         p = c - (c @ z) * z
@@ -212,10 +246,6 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
     ValueError naming the joint where the robot is no such chain: a branch (two moving joints on
     one link), a floating, spherical or planar joint, symbolic parameters. ``tolerance``: axes
     closer to parallel (|u1 × u2|), and lines closer (m), count as parallel / intersecting."""
-    import numpy as np
-
-    from .._math import pose_inverse, rot_axis, translation
-    from .link import Frame
 
     if convention not in ("standard", "modified"):
         raise ValueError(f"DH convention must be 'standard' or 'modified', got '{convention}'")
@@ -337,11 +367,9 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
                 j.coulomb_negative,
             )
         )
-    from ..robot import Robot
-
     base_pose = frames[0]
     tool = np.asarray(pose_inverse(frames[n]), dtype=float) @ world_tool
-    dh_robot = Robot.from_dh(
+    description = description_from_dh(
         rows,
         convention,
         gravity=robot.gravity,
@@ -351,15 +379,17 @@ def dh_from_robot(robot, convention: str = "standard", *, tolerance: float = 1e-
         source=robot.source,
         inertia=robot.inertia_policy if robot.inertia_policy != "strict" else "strict",
     )
-    taken = set(dh_robot.frame_names)
+    taken = {f.name for f in description.tree.frames}
     extra, source_frames = [], {}
     for f in robot.tree.frames[1:]:
         owner = None if f.body < 0 else f"link{f.body + 1}"
         owner_world = np.eye(4) if f.body < 0 else frames[f.body + 1]
         placement = np.asarray(pose_inverse(owner_world), dtype=float) @ world_frame(f.name)
-        source_frames[f.name] = (owner or dh_robot.base, placement)
+        source_frames[f.name] = (owner or description.base, placement)
         if f.name not in taken:
             extra.append(Frame(f.name, owner, placement))
     if extra:
-        dh_robot = dh_robot.replace(frames=tuple(dh_robot.frames) + tuple(extra))
+        description = replace(description, frames=description.frames + tuple(extra))
+    # a robot of the input's own class, built from the description (this layer never imports Robot)
+    dh_robot = robot.from_description(description)
     return DHExtraction(tuple(rows), convention, base_pose, tool, dh_robot, source_frames)

@@ -26,10 +26,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from .._math import is_symbolic
 from .checks import number, real, vector
 
-__all__ = ["Joint", "Mimic", "JOINT_KINDS", "JOINT_SIZES", "MULTI_DOF_KINDS"]
+__all__ = ["Joint", "Mimic", "JOINT_KINDS", "JOINT_SIZES", "MULTI_DOF_KINDS", "planar_basis"]
 
 JOINT_KINDS = ("revolute", "prismatic", "fixed", "floating", "spherical", "planar")
 
@@ -239,3 +241,17 @@ class Joint:
     def armature(self):
         """Reflected rotor inertia r^2 J_m added to M[i, i]."""
         return self.gear_ratio**2 * self.rotor_inertia
+
+
+def planar_basis(normal) -> tuple:
+    """The in-plane unit axes (e1, e2) of a planar joint with unit ``normal`` (its axis), e1 x e2 =
+    normal: x and y for the normal z (Pinocchio's JointModelPlanar), else e1 along the coordinate axis
+    most orthogonal to the normal, projected into the plane. The planar joint's q = (x, y, cos, sin)
+    moves along x e1 + y e2 (docs/conventions.md)."""
+    n = np.asarray(normal, dtype=float)
+    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
+        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    e = np.eye(3)[int(np.argmin(np.abs(n)))]
+    e1 = e - n * (n @ e)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(n, e1)

@@ -165,7 +165,7 @@ def mimic_map(joints: Sequence, all_joints: Sequence, mode: str = "reduce", robo
     )
 
 
-def reduced_coefficient(robot, name: str) -> np.ndarray:
+def reduced_coefficient(description, name: str) -> np.ndarray:
     """A drive coefficient of a robot with reduced mimic joints, followers included, per degree of
     freedom of the independent joints (a leader ``k`` is 1-DOF): the followers' friction and rotor inertia act on ``G qd`` and come back
     through ``G^T``; each full coordinate lies in one column of G, so ``G^T diag(a) G`` is diagonal:
@@ -175,17 +175,18 @@ def reduced_coefficient(robot, name: str) -> np.ndarray:
       with ``m_f < 0`` moves the other way and adds ``|m_f|`` times its opposite level: ``coulomb``
       (qd > 0) gets ``|m_f| (c_f+ if m_f > 0 else c_f-)``, ``coulomb_negative`` the reverse.
 
-    so that ``robot.friction_torque(qd) == G^T friction_full(G qd)`` and ``M_r`` has ``armature`` on
+    so that ``robot.friction_torque(qd) == G^T friction_full(G qd)`` (``description``: the robot's
+    :class:`~kinedyn.description.description.Description`) and ``M_r`` has ``armature`` on
     its diagonal, as without mimic joints."""
-    m = robot._mimic
-    joints = [b.joint for b in robot.tree.bodies]
+    m = description.mimic_map
+    joints = [b.joint for b in description.tree.bodies]
 
     def own(j, key):
         return float(j.coulomb_levels[1] if key == "coulomb_negative" else getattr(j, key))
 
     values: list = []  # per reduced degree of freedom (a multi-DOF joint has no drive data: zeros)
     start = {}
-    for j in robot.joints:
+    for j in description.joints:
         start[j.name] = len(values)
         values.extend([0.0] * j.nv if j.is_multi_dof else [own(j, name)])
     out = np.array(values)

@@ -49,26 +49,38 @@ bounded; every problem is a ValueError naming the file, the line, the element an
 
 from __future__ import annotations
 
+import importlib
 import math
 import os
-import types
 import warnings
 
 import numpy as np
 
-from .bounded_xml import parse_bounded
-from .checks import LARGEST
+from .checks import caller_level
+from .description import Description
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Frame, Link
 
-__all__ = ["robot_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
+__all__ = ["description_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
 
-MAX_DEPTH = 200  # deepest element nesting accepted (bodies nest; guards the parser's memory)
-MAX_INCLUDE_DEPTH = 8  # <include> inside included files, at most this deep
-MAX_FILE_BYTES = 16 * 2**20  # per file, and for all included files together
-MAX_INCLUDES = 256  # <include> elements in one model
+from .mjcf_xml import (
+    MAX_DEPTH,
+    MAX_FILE_BYTES,
+    MAX_INCLUDE_DEPTH,
+    REFUSED,
+    Sources,
+    axis_angle,
+    numbers,
+    parse_model,
+    pose,
+    quat_matrix,
+    short,
+    solid_volume_and_moments,
+    translation_of,
+    z_to,
+)
 
 _JOINT_KINDS = {"hinge": "revolute", "slide": "prismatic", "ball": "spherical", "free": "floating"}
 _SHAPES = ("sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "plane", "hfield", "sdf")
@@ -77,20 +89,18 @@ _DEFAULTED = ("joint", "geom", "site", "mesh")
 _UNMODELLED = ("actuator", "tendon", "equality", "contact", "sensor", "keyframe", "deformable")
 # sections or elements kinedyn skips silently (presentation, bookkeeping)
 _PRESENTATION = ("visual", "statistic", "size", "custom", "extension", "light", "camera", "asset")
-_REFUSED = ("replicate", "attach", "composite", "flexcomp")
 
 
 # ============================================================================== entry point
-def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "warn", gravity=None):
-    """A :class:`kinedyn.Robot` from an MJCF file path or an XML string (see the module docstring).
+def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "warn", gravity=None):
+    """The :class:`~kinedyn.description.description.Description` of an MJCF file path or an XML string
+    (see the module docstring; ``kinedyn.Robot.from_mjcf`` builds the robot from it).
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path (an XML string
     may not ``<include>`` files). ``gravity``: overrides ``<option gravity>``. ``tool`` and
-    ``inertia`` as :func:`kinedyn.description.urdf.robot_from_urdf`.
+    ``inertia`` as :func:`kinedyn.description.urdf.description_from_urdf`.
     """
-    from ..robot import Robot
-
-    src, root = _parse_model(path_or_string)
+    src, root = parse_model(path_or_string)
     if root.tag != "mujoco":
         raise src.error(root, f"the root element is <{root.tag}>, expected <mujoco>")
     reader = _Reader(src, root)
@@ -105,16 +115,16 @@ def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "
             f"{src.label}: kinedyn does not model, and ignores: {'; '.join(shown[:20])}"
             + (f" and {len(shown) - 20} more" if len(shown) > 20 else ""),
             UserWarning,
-            stacklevel=_caller_level(),
+            stacklevel=caller_level(),
         )
     if not any(link.joint.is_moving for link in links):
         raise ValueError(f"{src.label}: model '{name}' has no joint (kinedyn needs at least one moving joint)")
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(
-                links,
-                frames,
+            description = Description(
+                tuple(links),
+                tuple(frames),
                 gravity=gravity,
                 base="world",
                 tool=tool,
@@ -127,202 +137,13 @@ def robot_from_mjcf(path_or_string, *, tool: str | None = None, inertia: str = "
     except ValueError as e:
         raise ValueError(f"{src.label}: {e}") from None
     for w in caught:
-        warnings.warn(f"{src.label}: {w.message}", w.category, stacklevel=_caller_level())
-    return robot
-
-
-def _caller_level() -> int:
-    """The stacklevel, for a warning raised in the function that calls this, of the first frame
-    outside kinedyn (so the warning points at the user's call)."""
-    import sys
-
-    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame: types.FrameType | None = sys._getframe(2)
-    level = 2
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
-        frame, level = frame.f_back, level + 1
-    return level
-
-
-# ============================================================================== XML, bounded
-class _Sources:
-    """Where each element came from: (file label, line), for messages; the model's folder."""
-
-    def __init__(self, label: str, base_dir: str | None):
-        self.label = label
-        self.base_dir = base_dir
-        self.where: dict = {}  # id(element) -> (label, line)
-        self.total_bytes = 0
-        self.includes = 0
-
-    def at(self, element) -> str:
-        label, line = self.where.get(id(element), (self.label, None))
-        return label if line is None else f"{label}:{line}"
-
-    def error(self, element, message: str) -> ValueError:
-        return ValueError(f"{self.at(element)}: <{element.tag}> {message}")
-
-
-def _parse_model(path_or_string):
-    text = os.fspath(path_or_string) if isinstance(path_or_string, os.PathLike) else path_or_string
-    if isinstance(text, bytes):
-        text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
-    if not isinstance(text, str):
-        raise TypeError(f"robot_from_mjcf expects a path or an XML string, got {type(path_or_string).__name__}")
-    if "<" in text or "\n" in text:
-        src = _Sources("<MJCF string>", None)
-        data = text.encode("utf-8")
-        if len(data) > MAX_FILE_BYTES:
-            raise ValueError(
-                f"{src.label}: the XML is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model"
-            )
-        src.total_bytes += len(data)
-        root = _parse_xml(data, src.label, src)
-    else:
-        src = _Sources(text, os.path.dirname(os.path.abspath(text)))
-        root = _parse_xml(_read(text, src), text, src)
-    _expand_includes(root, src, src.base_dir, 0)
-    return src, root
-
-
-def _read(path: str, src: _Sources, element=None) -> bytes:
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_FILE_BYTES + 1)
-    except OSError as e:
-        where = f"{src.at(element)}: <include> " if element is not None else f"{path}: "
-        raise ValueError(f"{where}cannot read MJCF file '{path}' ({e.strerror or e})") from None
-    src.total_bytes += len(data)
-    if len(data) > MAX_FILE_BYTES or src.total_bytes > MAX_FILE_BYTES:
-        raise ValueError(
-            f"{path}: the model (with its includes) is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot model"
-        )
-    return data
-
-
-def _parse_xml(data: bytes, label: str, src: _Sources):
-    """The root element of ``data``, parsed by expat without entity declarations and with bounded depth."""
-
-    def record(element, line):
-        src.where[id(element)] = (label, line)
-
-    return parse_bounded(data, label, "an MJCF model", MAX_DEPTH, record)
-
-
-def _expand_includes(element, src: _Sources, folder: str | None, depth: int) -> None:
-    """Replace every ``<include file>`` below ``element`` by the children of the included ``<mujoco>``."""
-    k = 0
-    while k < len(element):
-        child = element[k]
-        if child.tag != "include":
-            _expand_includes(child, src, folder, depth)
-            k += 1
-            continue
-        name = child.get("file")
-        if not name:
-            raise src.error(child, "has no 'file' attribute")
-        if folder is None or src.base_dir is None:
-            raise src.error(
-                child, f"file='{name}': a model given as an XML string cannot include files (load it from its file)"
-            )
-        if depth >= MAX_INCLUDE_DEPTH:
-            raise src.error(child, f"file='{name}': includes nested deeper than {MAX_INCLUDE_DEPTH} levels")
-        src.includes += 1
-        if src.includes > MAX_INCLUDES:
-            raise src.error(child, f"file='{name}': more than {MAX_INCLUDES} includes in one model")
-        path = os.path.realpath(os.path.join(folder, name))
-        top = os.path.realpath(src.base_dir)
-        if os.path.commonpath([path, top]) != top:
-            raise src.error(
-                child, f"file='{name}' is outside the model's folder {top} (an included file must lie inside it)"
-            )
-        label = os.path.relpath(path) if not os.path.isabs(src.label) else path
-        included = _parse_xml(_read(path, src, child), label, src)
-        if included.tag != "mujoco":
-            raise src.error(
-                child, f"file='{name}': the included file's root element is <{included.tag}>, expected <mujoco>"
-            )
-        _expand_includes(included, src, os.path.dirname(path), depth + 1)
-        element[k : k + 1] = list(included)
-        k += len(included)
-
-
-# ============================================================================== numbers, poses
-def _numbers(
-    element, attribute: str, src: _Sources, n: int | None = None, text: str | None = None, at_most: int | None = None
-) -> tuple:
-    text = element.get(attribute) if text is None else text
-    assert text is not None
-    try:
-        values = tuple(float(v) for v in text.split())
-    except ValueError:
-        raise src.error(element, f"attribute '{attribute}' must be numbers, got '{_short(text)}'") from None
-    if n is not None and len(values) != n:
-        raise src.error(element, f"attribute '{attribute}' must be {n} numbers, got {len(values)}: '{_short(text)}'")
-    if at_most is not None and not 1 <= len(values) <= at_most:
-        raise src.error(
-            element, f"attribute '{attribute}' must be 1 to {at_most} numbers, got {len(values)}: '{_short(text)}'"
-        )
-    for v in values:
-        if not math.isfinite(v) or abs(v) > LARGEST:
-            raise src.error(
-                element,
-                f"attribute '{attribute}' must hold finite numbers of magnitude at most {LARGEST:g}, got '{_short(text)}'",
-            )
-    return values
-
-
-def _short(text: str) -> str:
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _quat_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (w, x, y, z)."""
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def _axis_angle(axis, angle: float) -> np.ndarray:
-    x, y, z = axis
-    c, s, v = math.cos(angle), math.sin(angle), 1 - math.cos(angle)
-    return np.array(
-        [
-            [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
-            [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
-            [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
-        ]
-    )
-
-
-def _z_to(vector: np.ndarray) -> np.ndarray:
-    """The smallest rotation taking the z axis to the unit ``vector``."""
-    z = np.array([0.0, 0.0, 1.0])
-    axis = np.cross(z, vector)
-    s, c = np.linalg.norm(axis), float(vector @ z)
-    if s < 1e-14:
-        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])  # MuJoCo: 180 degrees about x
-    return _axis_angle(axis / s, math.atan2(s, c))
-
-
-def _pose(p, R) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = p
-    return T
-
-
-def _translation(p) -> np.ndarray:
-    return _pose(p, np.eye(3))
+        warnings.warn(f"{src.label}: {w.message}", w.category, stacklevel=caller_level())
+    return description
 
 
 # ============================================================================== the reader
 class _Reader:
-    def __init__(self, src: _Sources, root):
+    def __init__(self, src: Sources, root):
         self.src = src
         self.root = root
         self.ignored: set = set()
@@ -348,14 +169,12 @@ class _Reader:
             for attribute, value in c.attrib.items():
                 if attribute == "angle":
                     if value not in ("degree", "radian"):
-                        raise self.src.error(
-                            c, f"attribute 'angle' must be 'degree' or 'radian', got '{_short(value)}'"
-                        )
+                        raise self.src.error(c, f"attribute 'angle' must be 'degree' or 'radian', got '{short(value)}'")
                     self.degrees = value == "degree"
                 elif attribute == "eulerseq":
                     if len(value) != 3 or any(ch not in "xyzXYZ" for ch in value):
                         raise self.src.error(
-                            c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{_short(value)}'"
+                            c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{short(value)}'"
                         )
                     self.eulerseq = value
                 elif attribute == "autolimits":
@@ -363,11 +182,11 @@ class _Reader:
                 elif attribute == "inertiafromgeom":
                     if value not in ("true", "false", "auto"):
                         raise self.src.error(
-                            c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{_short(value)}'"
+                            c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{short(value)}'"
                         )
                     self.inertiafromgeom = value
                 elif attribute == "inertiagrouprange":
-                    lo, hi = _numbers(c, attribute, self.src, 2)
+                    lo, hi = numbers(c, attribute, self.src, 2)
                     self.groups = (int(lo), int(hi))
                 elif attribute in ("meshdir", "assetdir"):
                     if self.src.base_dir is not None and (attribute == "meshdir" or c.get("meshdir") is None):
@@ -377,7 +196,7 @@ class _Reader:
                         c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)"
                     )
                 elif attribute in ("boundmass", "boundinertia", "settotalmass"):
-                    setattr(self, attribute, _numbers(c, attribute, self.src, 1)[0])
+                    setattr(self, attribute, numbers(c, attribute, self.src, 1)[0])
                 elif attribute == "balanceinertia":
                     self.balanceinertia = self.boolean(c, attribute, value)
 
@@ -388,14 +207,14 @@ class _Reader:
     def boolean(self, element, attribute: str, value: str) -> bool:
         b = self.boolean_value(value)
         if b is None:
-            raise self.src.error(element, f"attribute '{attribute}' must be true or false, got '{_short(value)}'")
+            raise self.src.error(element, f"attribute '{attribute}' must be true or false, got '{short(value)}'")
         return b
 
     def option(self) -> tuple:
         gravity = (0.0, 0.0, -9.81)
         for o in self.root.iter("option"):
             if o.get("gravity") is not None:
-                gravity = _numbers(o, "gravity", self.src, 3)
+                gravity = numbers(o, "gravity", self.src, 3)
             for flag in o.iterfind("flag"):
                 if flag.get("gravity") == "disable":
                     gravity = (0.0, 0.0, 0.0)
@@ -447,14 +266,14 @@ class _Reader:
                 name = a.get("name") or (os.path.splitext(os.path.basename(file))[0] if file else None)
                 if not name:
                     raise self.src.error(mesh, "has neither 'name' nor 'file'")
-                scale = _numbers(mesh, "scale", self.src, 3, text=a.get("scale", "1 1 1"))
+                scale = numbers(mesh, "scale", self.src, 3, text=a.get("scale", "1 1 1"))
                 meshes[name] = (file, scale, mesh)
         return materials, meshes
 
     def rgba(self, element, text: str) -> tuple:
-        values = _numbers(element, "rgba", self.src, 4, text=text)
+        values = numbers(element, "rgba", self.src, 4, text=text)
         if any(not 0.0 <= v <= 1.0 for v in values):
-            raise self.src.error(element, f"attribute 'rgba' must be 4 numbers between 0 and 1, got '{_short(text)}'")
+            raise self.src.error(element, f"attribute 'rgba' must be 4 numbers between 0 and 1, got '{short(text)}'")
         return values
 
     # --------------------------------------------------------------------- orientation
@@ -470,29 +289,29 @@ class _Reader:
             return np.eye(3)
         key = given[0]
         if key == "quat":
-            q = np.array(_numbers(element, key, self.src, 4, text=a[key]))
+            q = np.array(numbers(element, key, self.src, 4, text=a[key]))
             norm = np.linalg.norm(q)
             if norm < 1e-12:
                 raise self.src.error(element, f"attribute 'quat' is zero: '{a[key]}'")
-            return _quat_matrix(*(q / norm))
+            return quat_matrix(*(q / norm))
         if key == "axisangle":
-            *axis, angle = _numbers(element, key, self.src, 4, text=a[key])
-            return _axis_angle(self.unit(element, key, axis), self.angle(angle))
+            *axis, angle = numbers(element, key, self.src, 4, text=a[key])
+            return axis_angle(self.unit(element, key, axis), self.angle(angle))
         if key == "euler":
-            angles = _numbers(element, key, self.src, 3, text=a[key])
+            angles = numbers(element, key, self.src, 3, text=a[key])
             R = np.eye(3)
             for letter, angle in zip(self.eulerseq, angles):
-                step = _axis_angle(np.eye(3)["xyz".index(letter.lower())], self.angle(angle))
+                step = axis_angle(np.eye(3)["xyz".index(letter.lower())], self.angle(angle))
                 # lower case: axes that move with the body (R = R1 R2 R3); upper case: fixed axes (R3 R2 R1)
                 R = R @ step if letter.islower() else step @ R
             return R
         if key == "xyaxes":
-            v = _numbers(element, key, self.src, 6, text=a[key])
+            v = numbers(element, key, self.src, 6, text=a[key])
             x = self.unit(element, key, v[:3])
             y = np.array(v[3:]) - (np.array(v[3:]) @ x) * x
             y = self.unit(element, key, y)
             return np.column_stack([x, y, np.cross(x, y)])
-        return _z_to(self.unit(element, key, _numbers(element, key, self.src, 3, text=a[key])))
+        return z_to(self.unit(element, key, numbers(element, key, self.src, 3, text=a[key])))
 
     def unit(self, element, key: str, v) -> np.ndarray:
         v = np.asarray(v, dtype=float)
@@ -502,8 +321,8 @@ class _Reader:
         return v / norm
 
     def frame(self, element, a: dict) -> np.ndarray:
-        p = _numbers(element, "pos", self.src, 3, text=a["pos"]) if "pos" in a else (0.0, 0.0, 0.0)
-        return _pose(p, self.rotation(element, a))
+        p = numbers(element, "pos", self.src, 3, text=a["pos"]) if "pos" in a else (0.0, 0.0, 0.0)
+        return pose(p, self.rotation(element, a))
 
     # --------------------------------------------------------------------- bodies
     def read(self):
@@ -515,7 +334,7 @@ class _Reader:
         for child in self.root:
             if child.tag in _UNMODELLED and len(child):
                 self.ignored.add(f"<{child.tag}> ({len(child)} elements)")
-            elif child.tag in _REFUSED:
+            elif child.tag in REFUSED:
                 raise self.src.error(
                     child,
                     "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)",
@@ -578,7 +397,7 @@ class _Reader:
                 geoms.append(self.geom(child, link, link_from_here, childclass))
             elif tag == "site":
                 self.site(child, link, link_from_here, childclass)
-            elif tag in _REFUSED:
+            elif tag in REFUSED:
                 raise self.src.error(
                     child,
                     "is not read by kinedyn (it generates bodies); expand the model in MuJoCo and save it (mj_saveLastXML)",
@@ -616,7 +435,7 @@ class _Reader:
                 # MuJoCo places a free body at qpos in the world; its pos/quat are only qpos0
                 joint_frame, post = np.eye(4), np.eye(4)
             else:
-                joint_frame, post = placement @ _translation(pos), _translation(-np.asarray(pos))
+                joint_frame, post = placement @ translation_of(pos), translation_of(-np.asarray(pos))
             try:
                 self.links.append(Link(link_name, link_parent, joint, joint_frame, post))
             except ValueError as e:
@@ -643,18 +462,18 @@ class _Reader:
         what = f"joint '{name}'"
         if kind not in _JOINT_KINDS:
             raise self.src.error(
-                element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_JOINT_KINDS)}"
+                element, f"{what}: attribute 'type' is '{short(kind)}', expected one of {', '.join(_JOINT_KINDS)}"
             )
         if kind == "free" and not (top_level and count == 1):
             raise self.src.error(
                 element, f"{what}: a free joint must be the only joint of a body whose parent is the world body"
             )
-        axis = _numbers(element, "axis", self.src, 3, text=a.get("axis", "0 0 1"))
-        pos = _numbers(element, "pos", self.src, 3, text=a.get("pos", "0 0 0"))
+        axis = numbers(element, "axis", self.src, 3, text=a.get("axis", "0 0 1"))
+        pos = numbers(element, "pos", self.src, 3, text=a.get("pos", "0 0 0"))
         scalars = {}
         for attribute in ("armature", "damping", "frictionloss", "ref", "stiffness"):
             scalars[attribute] = (
-                _numbers(element, attribute, self.src, 1, text=a[attribute])[0] if attribute in a else 0.0
+                numbers(element, attribute, self.src, 1, text=a[attribute])[0] if attribute in a else 0.0
             )
         if scalars["stiffness"] != 0:
             self.ignored.add(f"the spring (stiffness) of {what}")
@@ -668,14 +487,14 @@ class _Reader:
             limited = a.get("limited", "auto")
             if limited not in ("true", "false", "auto"):
                 raise self.src.error(
-                    element, f"{what}: attribute 'limited' must be true, false or auto, got '{_short(limited)}'"
+                    element, f"{what}: attribute 'limited' must be true, false or auto, got '{short(limited)}'"
                 )
             if limited == "auto" and not self.autolimits and "range" in a:
                 raise self.src.error(
                     element, f"{what}: has a range but limited='auto' with autolimits off (MuJoCo refuses it too)"
                 )
             if limited == "true" or (limited == "auto" and "range" in a):
-                lower, upper = _numbers(element, "range", self.src, 2, text=a.get("range", "0 0"))
+                lower, upper = numbers(element, "range", self.src, 2, text=a.get("range", "0 0"))
                 if lower > upper:
                     raise self.src.error(
                         element, f"{what}: attribute 'range' has lower {lower:g} above upper {upper:g}"
@@ -719,12 +538,12 @@ class _Reader:
     def segment(self, element, text: str) -> tuple:
         """(pose at the middle of ``fromto``, its z axis along it, from the second end towards the
         first as MuJoCo's compiler orients it; the segment's length)."""
-        ends = np.array(_numbers(element, "fromto", self.src, 6, text=text))
+        ends = np.array(numbers(element, "fromto", self.src, 6, text=text))
         d = ends[:3] - ends[3:]
         length = float(np.linalg.norm(d))
         if length < 1e-12:
             raise self.src.error(element, "attribute 'fromto' has two equal ends")
-        return _pose((ends[:3] + ends[3:]) / 2, _z_to(d / length)), length
+        return pose((ends[:3] + ends[3:]) / 2, z_to(d / length)), length
 
     def geom(self, element, link: str, link_from_here: np.ndarray, childclass: str) -> dict:
         """The geom's shape, pose (in the link) and mass properties; its visual/collision is recorded."""
@@ -733,9 +552,9 @@ class _Reader:
         what = f"geom '{a['name']}'" if a.get("name") else "geom"
         if kind not in _SHAPES:
             raise self.src.error(
-                element, f"{what}: attribute 'type' is '{_short(kind)}', expected one of {', '.join(_SHAPES)}"
+                element, f"{what}: attribute 'type' is '{short(kind)}', expected one of {', '.join(_SHAPES)}"
             )
-        size = list(_numbers(element, "size", self.src, text=a["size"], at_most=3)) if "size" in a else []
+        size = list(numbers(element, "size", self.src, text=a["size"], at_most=3)) if "size" in a else []
         size += [0.0] * (3 - len(size))
         pose = self.frame(element, a)
         if "fromto" in a:
@@ -754,7 +573,7 @@ class _Reader:
                 element,
                 f"{what}: a {kind} needs {needed} positive size number{'s' if needed > 1 else ''}, got size='{a.get('size', '')}'",
             )
-        group = int(_numbers(element, "group", self.src, 1, text=a.get("group", "0"))[0])
+        group = int(numbers(element, "group", self.src, 1, text=a.get("group", "0"))[0])
         shape = self.shape(element, kind, size, a, what)
         where = self.src.at(element)
         in_link = link_from_here @ pose
@@ -817,7 +636,7 @@ class _Reader:
         for required in ("pos", "mass"):
             if required not in a:
                 raise self.src.error(element, f"of body '{body}' has no '{required}' attribute (MuJoCo requires it)")
-        mass = _numbers(element, "mass", self.src, 1)[0]
+        mass = numbers(element, "mass", self.src, 1)[0]
         if mass < 0:
             raise self.src.error(element, f"of body '{body}': attribute 'mass' is negative ({mass:g})")
         if "diaginertia" in a and "fullinertia" in a:
@@ -827,9 +646,9 @@ class _Reader:
                 raise self.src.error(
                     element, f"of body '{body}': 'fullinertia' takes no orientation (MuJoCo refuses it too)"
                 )
-            ixx, iyy, izz, ixy, ixz, iyz = _numbers(element, "fullinertia", self.src, 6)
+            ixx, iyy, izz, ixy, ixz, iyz = numbers(element, "fullinertia", self.src, 6)
         elif "diaginertia" in a:
-            ixx, iyy, izz = _numbers(element, "diaginertia", self.src, 3)
+            ixx, iyy, izz = numbers(element, "diaginertia", self.src, 3)
             ixy = ixz = iyz = 0.0
         else:
             raise self.src.error(element, f"of body '{body}' has neither 'diaginertia' nor 'fullinertia'")
@@ -847,33 +666,11 @@ class _Reader:
                 element,
                 f"{what}: kinedyn does not compute a mesh's inertia; give body '{body}' an <inertial> (MuJoCo's compiled model shows it: model.body_inertia)",
             )
-        if kind == "sphere":
-            volume = 4 / 3 * math.pi * s0**3
-            unit = (2 / 5 * s0**2,) * 3  # moments per unit mass
-        elif kind == "box":
-            volume = 8 * s0 * s1 * s2
-            unit = ((s1**2 + s2**2) / 3, (s0**2 + s2**2) / 3, (s0**2 + s1**2) / 3)
-        elif kind == "ellipsoid":
-            volume = 4 / 3 * math.pi * s0 * s1 * s2
-            unit = ((s1**2 + s2**2) / 5, (s0**2 + s2**2) / 5, (s0**2 + s1**2) / 5)
-        elif kind == "cylinder":
-            volume = math.pi * s0**2 * 2 * s1
-            across = (3 * s0**2 + (2 * s1) ** 2) / 12
-            unit = (across, across, s0**2 / 2)
-        else:  # capsule: a cylinder of length 2 s1 and two hemispherical caps of radius s0
-            r, h = s0, 2 * s1
-            cylinder, sphere = math.pi * r**2 * h, 4 / 3 * math.pi * r**3
-            volume = cylinder + sphere
-            # each cap (half the sphere's volume): about its own centre of mass (3r/8 from its flat
-            # face) 83/320 m r^2 across, shifted to the capsule's centre by h/2 + 3r/8
-            cap = (83 / 320 * r**2 + (h / 2 + 3 * r / 8) ** 2) * sphere  # both caps, times their volume
-            across = (cylinder * (3 * r**2 + h**2) / 12 + cap) / volume
-            axial = (cylinder * r**2 / 2 + sphere * 2 / 5 * r**2) / volume
-            unit = (across, across, axial)
+        volume, unit = solid_volume_and_moments(kind, s0, s1, s2)
         if "mass" in a:
-            mass = _numbers(element, "mass", self.src, 1, text=a["mass"])[0]
+            mass = numbers(element, "mass", self.src, 1, text=a["mass"])[0]
         else:
-            mass = volume * _numbers(element, "density", self.src, 1, text=a.get("density", "1000"))[0]
+            mass = volume * numbers(element, "density", self.src, 1, text=a.get("density", "1000"))[0]
         if mass < 0:
             raise self.src.error(element, f"{what}: its mass is negative ({mass:g})")
         if a.get("shellinertia") == "true":
@@ -882,3 +679,17 @@ class _Reader:
             )
         body_inertia = Inertia(mass, (0.0, 0.0, 0.0), np.diag([mass * u for u in unit]))
         return body_inertia.transformed(g["pose"])
+
+
+def __getattr__(name: str):
+    # robot_from_mjcf built a Robot from this layer; it lives above the description now
+    # (kinedyn.robot_files), loaded by name so that the description never imports the facade
+    if name == "robot_from_mjcf":
+        warnings.warn(
+            "kinedyn.description.mjcf.robot_from_mjcf moved: use kinedyn.Robot.from_mjcf "
+            "(or description_from_mjcf for the description alone)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return importlib.import_module("kinedyn.robot_files").robot_from_mjcf
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .joint import Joint
+from .joint import Joint, planar_basis
 from .link import Link
 
 __all__ = ["euler_parametrised", "EULER_SUFFIXES"]
@@ -49,10 +49,8 @@ def _chain(joint: Joint) -> list:
     elif joint.kind == "spherical":
         kinds, axes = ["revolute"] * 3, [e[2], e[1], e[0]]
     else:  # planar, in the plane normal to the joint's axis
-        from ..robot import _planar_basis
-
         n = np.asarray(joint.axis, dtype=float)
-        e1, e2 = _planar_basis(n)
+        e1, e2 = planar_basis(n)
         kinds, axes = ["prismatic", "prismatic", "revolute"], [e1, e2, np.cross(e1, e2)]
     return [
         (suffix, kind, tuple(float(a) for a in axis))
@@ -118,9 +116,7 @@ def euler_velocity_map(robot, q_euler) -> np.ndarray:
             J = expanded.jacobian(q_euler, frame=body, reference="local")
             rows = [0, 1, 5] if joint.kind == "planar" else (list(range(6)) if joint.kind == "floating" else [3, 4, 5])
             if joint.kind == "planar":
-                from ..robot import _planar_basis
-
-                e1, e2 = _planar_basis(np.asarray(joint.axis, dtype=float))
+                e1, e2 = planar_basis(np.asarray(joint.axis, dtype=float))
                 basis = np.array([[*e1, 0, 0, 0], [*e2, 0, 0, 0], [0, 0, 0, *np.cross(e1, e2)]])
                 T[k : k + 3, k : k + 3] = basis @ J[:, k : k + 3]
             else:

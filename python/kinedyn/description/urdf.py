@@ -35,24 +35,26 @@ children in the order their joints appear in the file; every URDF link becomes a
 
 from __future__ import annotations
 
+import importlib
 import math
 import os
 import re
-import types
 import warnings
 
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
 from .bounded_xml import parse_bounded
-from .checks import LARGEST
+from .checks import LARGEST, caller_level
+from .description import Description
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint, Mimic
 from .link import Link
 from .tool import default_tool
+from .xacro import expand_xacro, is_xacro
 
-__all__ = ["robot_from_urdf", "MAX_DEPTH"]
+__all__ = ["description_from_urdf", "MAX_DEPTH"]
 
 _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 #: the name Pinocchio gives the free-flyer joint that ``floating_base=True`` adds above the root link
@@ -62,7 +64,7 @@ FLOATING_BASE_FRAME = "universe"
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
-def robot_from_urdf(
+def description_from_urdf(
     path_or_string,
     *,
     gravity=(0.0, 0.0, -9.81),
@@ -71,8 +73,12 @@ def robot_from_urdf(
     floating_base: bool = False,
     source_path: str | None = None,
     mimic: str = "reduce",
-):
-    """A :class:`kinedyn.Robot` from a URDF file path or an XML string.
+    xacro_args=None,
+    trust_xacro: bool = False,
+    package_dirs=(),
+) -> Description:
+    """The :class:`~kinedyn.description.description.Description` of a URDF file path or an XML
+    string (``kinedyn.Robot.from_urdf`` builds the robot from it).
 
     A string holding ``<`` or a line break is parsed as XML, anything else is a path.
     ``gravity``: the gravity vector in base (root link) coordinates. ``tool``: the name of the frame
@@ -91,9 +97,24 @@ def robot_from_urdf(
     source in messages and its folder is where relative mesh paths start. The XML may not declare entities (no DOCTYPE with an internal subset or an external
     DTD: entity expansion is unbounded work) nor nest elements deeper than ``MAX_DEPTH``; the work is
     linear in the size of the file.
-    """
-    from ..robot import Robot
 
+    A path ending in ``.xacro`` is expanded by the ``xacro`` package first, with ``xacro_args``
+    (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
+    Python expressions from the file, so it needs ``trust_xacro=True`` (:mod:`kinedyn.description.xacro`).
+    """
+    if is_xacro(path_or_string):
+        text = expand_xacro(path_or_string, xacro_args, trust_xacro=trust_xacro, package_dirs=package_dirs)
+        return description_from_urdf(
+            text,
+            gravity=gravity,
+            tool=tool,
+            inertia=inertia,
+            floating_base=floating_base,
+            source_path=os.fsdecode(path_or_string),
+            mimic=mimic,
+        )
+    if xacro_args:
+        raise ValueError("xacro_args are for a .xacro file")
     src, root = _parse(path_or_string, source_path)
     if root.tag != "robot":
         raise src.error(root, f"the root element is <{root.tag}>, expected <robot>")
@@ -123,7 +144,7 @@ def robot_from_urdf(
     name = root.get("name") or "urdf_robot"
     source = src.label if not src.label.startswith("<") else "URDF string"
     visuals, collisions = _geometry(root, list(link_elements.items()), src)
-    # the Robot judges the inertias (policy) and checks the tree: its errors and warnings name a
+    # the Description judges the inertias (policy) and checks the tree: its errors and warnings name a
     # link or joint, to which the file and line are added here, once
     lines = {
         **{n: src.line(e) for n, e in link_elements.items()},
@@ -132,8 +153,8 @@ def robot_from_urdf(
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
-            robot = Robot(
-                links,
+            description = Description(
+                tuple(links),
                 gravity=gravity,
                 base=base,
                 tool=tool,
@@ -150,20 +171,8 @@ def robot_from_urdf(
         message = str(w.message)
         if issubclass(w.category, PhysicalConsistencyWarning):
             message = f"{src.at(_line_of(message, lines))}: {message}"
-        warnings.warn(message, w.category, stacklevel=_caller_level())
-    return robot
-
-
-def _caller_level() -> int:
-    """The stacklevel of the first frame outside kinedyn (so a warning points at the user's call)."""
-    import sys
-
-    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame: types.FrameType | None = sys._getframe(1)
-    level = 1
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
-        frame, level = frame.f_back, level + 1
-    return level
+        warnings.warn(message, w.category, stacklevel=caller_level())
+    return description
 
 
 def _line_of(message: str, lines: dict) -> int | None:
@@ -197,7 +206,7 @@ def _parse(path_or_string, source_path: str | None = None):
     if isinstance(text, bytes):
         text = text.decode("utf-8", errors="replace") if b"<" in text or b"\n" in text else os.fsdecode(text)
     if not isinstance(text, str):
-        raise TypeError(f"robot_from_urdf expects a path or an XML string, got {type(path_or_string).__name__}")
+        raise TypeError(f"a URDF reader expects a path or an XML string, got {type(path_or_string).__name__}")
     data: str | bytes
     if "<" in text or "\n" in text:  # XML (perhaps malformed), never a file name
         src, data = _Source(os.fspath(source_path) if source_path is not None else "<URDF string>"), text
@@ -514,3 +523,17 @@ def _cycle(parent_joint: dict) -> str:
             return " <- ".join(cycle)
         position[link] = len(path)
         path.append(link)
+
+
+def __getattr__(name: str):
+    # robot_from_urdf built a Robot from this layer; it lives above the description now
+    # (kinedyn.robot_files), loaded by name so that the description never imports the facade
+    if name == "robot_from_urdf":
+        warnings.warn(
+            "kinedyn.description.urdf.robot_from_urdf moved: use kinedyn.Robot.from_urdf "
+            "(or description_from_urdf for the description alone)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return importlib.import_module("kinedyn.robot_files").robot_from_urdf
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

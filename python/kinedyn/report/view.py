@@ -12,8 +12,8 @@ from importlib import resources
 
 import numpy as np
 
+from ..description.joint import planar_basis
 from ..description.mimic import body_coordinates
-from ..robot import _planar_basis
 from ..visual.scene import DEFAULT_BUDGET, MissingMeshWarning, robot_scene, scene_bounds
 from ..visual.web import encode_scene
 from .data import coordinate_labels, coordinate_units, in_multi_dof_block
@@ -47,7 +47,7 @@ def view_model(robot, q, geometry: str = "visual", budget: int | None = None) ->
         if b.joint.name in starts:
             body["q"] = starts[b.joint.name]
         if b.joint.kind == "planar":  # the plane's in-plane axes (x along e1, y along e2; the rotation about e1 x e2)
-            e1, e2 = _planar_basis(np.asarray(b.joint.axis, dtype=float))
+            e1, e2 = planar_basis(np.asarray(b.joint.axis, dtype=float))
             body["e1"], body["e2"] = e1.tolist(), e2.tolist()
         bodies.append(body)
     if robot.mimic_joints:  # each body's coordinate: q[q] for its own, scale * q[q] + shift for a mimic follower

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from ...description.convert import convert
+from ...convert import convert
 from .. import app
 from ..options import EXIT_ERROR, EXIT_OK, OutputPath, one_line
 
