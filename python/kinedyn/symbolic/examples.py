@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .system import LagrangianSystem, coordinates
+from .derive.system import LagrangianSystem, coordinates
 
 __all__ = [
     "remotely_driven_arm",
@@ -64,7 +64,7 @@ def remotely_driven_arm_from_robot():
     q = A p with A = [[1, 0], [-1, 1]] (p1 = q1). Returns EquationsOfMotion in p1, p2 (D_p = A^T D_q A;
     the same symbols as :func:`remotely_driven_arm`)."""
     from ..robots import planar_2r
-    from .mechanisms import change_coordinates
+    from .derive.mechanisms import change_coordinates
 
     eom = planar_2r(symbolic=True).equations_of_motion(steps=False)
     return change_coordinates(
@@ -116,7 +116,7 @@ def five_bar_from_chains():
     """The five-bar's reduced equations in q1, q2 from :func:`five_bar_chains` and the loop closure
     (their tool points coincide), on the parallelogram branch phi4 = q2 - q1, phi3 = q1 - q2 (links
     4 and 3 parallel to links 2 and 1)."""
-    from .mechanisms import closed_chain, loop_closure
+    from .derive.mechanisms import closed_chain, loop_closure
 
     chain_a, chain_b = five_bar_chains()
     closure = loop_closure(chain_a, chain_b)
