@@ -17,7 +17,7 @@ import sympy as sp
 from .. import display
 from .._math import by_name
 from .backends import c_numpy, casadi
-from .derive import cse, regressor
+from .derive import cse, proofs, regressor
 from .render import latex
 from .render.mathml import equation_mathml, name, of_q, rate_symbols, text_of
 from .steps import Step, op_counts
@@ -203,9 +203,7 @@ class EquationsOfMotion:
         decide), and the inertia bounds of eq. 9.120 by a global search with the configurations that
         attain them (``params`` gives values to free parameters). A
         :class:`kinedyn.analysis.PropertiesReport`; see :func:`kinedyn.analysis.prove_properties`."""
-        from ..analysis.properties import prove_properties
-
-        return prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
+        return proofs.prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
 
     def subs(self, mapping) -> EquationsOfMotion:
         """The same equations with parameters replaced (numbers or other expressions); keys are

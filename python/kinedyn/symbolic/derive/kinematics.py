@@ -22,6 +22,7 @@ from typing import Any, NamedTuple
 import sympy as sp
 
 from ...description.parametrise import euler_parametrised
+from ..render.text import abbreviate
 from ..values import exact
 from .lagrange import RingModel, state_symbols
 from .simplify import simplify_trig
@@ -251,26 +252,3 @@ def joint_torques(J, F, coordinates: Sequence[sp.Symbol] | None = None) -> sp.Ma
     J = sp.Matrix(J)
     coords = list(coordinates) if coordinates is not None else _coordinates(J)
     return (J.T * sp.Matrix(list(F))).applyfunc(lambda e: _simp(sp.expand(e), coords))
-
-
-def abbreviate(expr, q: Sequence[sp.Symbol], prefix=("c", "s")):
-    """cos(q1 + q2) -> c12, sin(q2) -> s2 (the textbook's shorthand), for display only: the indices
-    are the joints' positions in ``q``; angles with other terms (q2 - q3, q1 + pi/2) are kept."""
-    expr = sp.sympify(expr)
-    q = list(q)
-    reps = {}
-    for f in expr.atoms(sp.cos, sp.sin):
-        arg = sp.expand(f.args[0])
-        idx = []
-        for term in sp.Add.make_args(arg):
-            if term not in q:
-                break
-            idx.append(q.index(term) + 1)
-        else:
-            if idx:
-                sep = "" if len(q) < 10 else "_"
-                reps[f] = sp.Symbol(
-                    (prefix[0] if isinstance(f, sp.cos) else prefix[1]) + sep.join(str(i) for i in sorted(idx)),
-                    real=True,
-                )
-    return expr.xreplace(reps)

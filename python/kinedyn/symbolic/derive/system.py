@@ -28,11 +28,13 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from ...description.expressions import parse_expression
+from ...mechanical import MechanicalSystem
 from ..eom import EquationsOfMotion
 from ..render.mathml import lagrangian, legacy_rate_names, name, of_q, rate_names  # q1 -> qdot1, qddot1
 from ..steps import Step
 from .lagrange import latex_names
 from .simplify import simplify_trig, textbook_form
+from .system_properties import check_system_properties
 
 __all__ = ["LagrangianSystem", "coordinates"]
 
@@ -457,8 +459,6 @@ class LagrangianSystem:
         M = d2L/dqd2 (evaluated at the state: it may depend on qd for a Lagrangian that is not
         quadratic), h = sum_j d2L/dqd dq_j qd_j - dL/dq + B (the Euler-Lagrange bias of a
         time-invariant L, without forming its qdd terms), A, (dA/dt) qd = d(A qd)/dq qd, g_c."""
-        from ...simulate.systems import MechanicalSystem
-
         q, qd = list(self.q), list(self.qd)
         n, k, k_h = self.n, self.A.shape[0], len(self.holonomic)
         dL_dqd = sp.Matrix([sp.diff(self.L, v) for v in qd])
@@ -636,8 +636,6 @@ class LagrangianSystem:
     def check_properties(self, params=None, **kwargs):
         """M symmetric and dM/dt - 2C skew-symmetric proven by exact simplification, M positive
         definite and passivity measured: :func:`kinedyn.analysis.check_system_properties`."""
-        from ...analysis.system_properties import check_system_properties
-
         return check_system_properties(self, params, **kwargs)
 
     def __repr__(self) -> str:
