@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .backends import casadi as _module
+from .backends import casadi
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = casadi

@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .backends import c_numpy as _module
+from .backends import c_numpy
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = c_numpy

@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .derive import lagrange as _module
+from .derive import lagrange
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = lagrange

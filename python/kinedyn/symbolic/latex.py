@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .render import latex as _module
+from .render import latex
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = latex

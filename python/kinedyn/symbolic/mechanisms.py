@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .derive import mechanisms as _module
+from .derive import mechanisms
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = mechanisms

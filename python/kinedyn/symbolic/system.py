@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .derive import system as _module
+from .derive import system
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = system

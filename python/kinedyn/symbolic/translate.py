@@ -3,6 +3,6 @@ makes the old path name that module itself (so its attributes, and patches of th
 
 import sys
 
-from .backends import walker as _module
+from .backends import walker
 
-sys.modules[__name__] = _module
+sys.modules[__name__] = walker
