@@ -17,7 +17,7 @@ from ..description.inertia import Inertia
 from ..description.joint import Joint
 from ..description.link import Link
 from ..robot import Robot
-from ..symbolic.derive.mechanisms import change_coordinates, closed_chain, loop_closure
+from ..symbolic.systems.mechanisms import change_coordinates, closed_chain, loop_closure
 from .basic import planar_2r
 
 __all__ = ["remotely_driven_arm_from_robot", "five_bar_chains", "five_bar_from_chains", "geared_link_robot"]

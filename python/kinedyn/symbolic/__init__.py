@@ -23,7 +23,10 @@ from .derive.kinematics import (
     pose,
     tool_velocity,
 )
-from .derive.mechanisms import (
+from .derive.simplify import simplify_trig
+from .eom import EquationsOfMotion
+from .steps import Step
+from .systems.mechanisms import (
     change_coordinates,
     closed_chain,
     closed_chain_system,
@@ -31,11 +34,8 @@ from .derive.mechanisms import (
     loop_closure,
     tree_equations,
 )
-from .derive.robot_eom import equations_of_motion
-from .derive.simplify import simplify_trig
-from .derive.system import LagrangianSystem, coordinates
-from .eom import EquationsOfMotion
-from .steps import Step
+from .systems.robot_eom import equations_of_motion
+from .systems.system import LagrangianSystem, coordinates
 
 __all__ = [
     "equations_of_motion",

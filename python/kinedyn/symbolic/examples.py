@@ -24,7 +24,7 @@ import warnings
 
 import sympy as sp
 
-from .derive.system import LagrangianSystem, coordinates
+from .systems.system import LagrangianSystem, coordinates
 
 __all__ = [
     "remotely_driven_arm",

@@ -42,7 +42,7 @@ def _jax():
 
 def compile_jax(eom, what=("M", "C", "g", "tau"), params=None, p=None):
     """JAX functions of ``eom`` (see the module docstring); ``params`` and ``p`` as in ``eom.compile``."""
-    from sympy.printing.numpy import JaxPrinter
+    from sympy.printing.numpy import JaxPrinter  # with the JAX back-end only, as jax itself
 
     jax = _jax()
     import jax.numpy as jnp

@@ -25,6 +25,7 @@ import re
 from collections.abc import Sequence
 
 import sympy as sp
+from sympy.simplify.cse_main import tree_cse
 
 from ..render.mathml import Name, name, of_q
 from ..steps import Step, op_counts
@@ -204,8 +205,6 @@ def _cse(assignments: list[Assignment], entries: list[sp.Expr], names: set) -> t
         start += 1000
     symbols = sp.numbered_symbols("x", start=start, real=True)
     try:  # the tree pass of sympy.cse without its costly search for common sub-sums/products (opt_cse)
-        from sympy.simplify.cse_main import tree_cse
-
         repl, reduced = tree_cse(exprs, symbols, opt_subs={}, order="none")
     except ImportError:  # pragma: no cover - a SymPy without the helper
         repl, reduced = sp.cse(exprs, symbols=symbols, order="none")

@@ -26,6 +26,7 @@ printed Theta3 and Theta5 differ).
 from __future__ import annotations
 
 from fractions import Fraction
+from math import gcd
 from typing import Any
 
 import sympy as sp
@@ -174,8 +175,6 @@ def _reduce(vec, echelon, nb):
 def _content(vec):
     vals = list(vec.values())
     if all(isinstance(v, Fraction) for v in vals):
-        from math import gcd
-
         g, l = 0, 1
         for v in vals:
             g = gcd(g, abs(v.numerator))

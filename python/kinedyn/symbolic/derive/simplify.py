@@ -30,6 +30,7 @@ collected and factored when short. Nothing here calls ``sympy.simplify``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from fractions import Fraction
 from functools import lru_cache
@@ -185,8 +186,6 @@ class TrigRing:
     def _shifted(self, c, s, offset, which):
         """cos or sin of (x + offset) from c = cos x, s = sin x."""
         if isinstance(offset, float) or (isinstance(offset, sp.Basic) and offset.is_number and offset.has(sp.Float)):
-            import math
-
             co, so = self.const(math.cos(float(offset))), self.const(math.sin(float(offset)))
         else:
             co, so = self.const(sp.cos(offset)), self.const(sp.sin(offset))

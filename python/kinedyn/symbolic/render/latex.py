@@ -22,6 +22,7 @@ import re
 from collections.abc import Sequence
 
 import sympy as sp
+from sympy.printing.conventions import split_super_sub
 
 __all__ = ["latex_text", "width", "expression_lines", "equation_rows", "fragment", "document", "LINE_PT"]
 
@@ -150,8 +151,6 @@ _CHAR, _SUB, _OP, _FUN = 5.5, 3.8, 7.8, 14.0
 
 
 def _symbol_width(sym) -> float:
-    from sympy.printing.conventions import split_super_sub
-
     name, sups, subs = split_super_sub(sym.name)
     base = re.sub(r"(ddot|dot|hat|bar|vec|tilde|prime)$", "", name)
     base_w = _CHAR if base.lower() in _GREEK_WORDS else _CHAR * max(1, len(base))

@@ -14,8 +14,11 @@ from __future__ import annotations
 
 import html
 import re
+from html.entities import html5
+from xml.dom.minidom import parseString
 
 import sympy as sp
+from sympy.printing.conventions import split_super_sub
 from sympy.printing.mathml import MathMLPresentationPrinter
 
 __all__ = [
@@ -76,8 +79,6 @@ def rate_names(name: str) -> tuple:
     draw them with the accent — ``sp.pretty`` q̇₁, ``sp.latex`` ``\\dot{q}_{1}`` (kinedyn's MathML via
     :func:`rate_symbols`) — while ``str`` stays the plain identifier ``qdot1`` that code generation, ``sympify``
     and JSON need."""
-    from sympy.printing.conventions import split_super_sub
-
     base = split_super_sub(name)[0]
     if not base or not name.startswith(base):
         return f"{name}dot", f"{name}ddot"
@@ -232,8 +233,6 @@ class _Printer(MathMLPresentationPrinter):
 
     def _print_Symbol(self, sym, style="plain"):
         if sym in self._given:
-            from xml.dom.minidom import parseString
-
             root = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement
             assert root is not None  # a parsed document always has its root element
             return root.firstChild
@@ -253,8 +252,6 @@ def rate_symbols(q, qd, qdd) -> dict[sp.Symbol, str]:
 def _xml_entities(m: str) -> str:
     """HTML named entities (SymPy writes &InvisibleTimes;, &ApplyFunction;) as characters, so the MathML
     is well-formed XML as well as HTML."""
-    from html.entities import html5
-
     keep = {"amp", "lt", "gt", "quot", "apos"}
     return re.sub(
         r"&([A-Za-z]+);", lambda g: g.group(0) if g.group(1) in keep else html5.get(g.group(1) + ";", g.group(0)), m

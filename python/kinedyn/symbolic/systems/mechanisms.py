@@ -34,12 +34,12 @@ from collections.abc import Sequence
 
 import sympy as sp
 
+from ..derive.kinematics import pose
+from ..derive.lagrange import latex_names
+from ..derive.simplify import simplify_trig
 from ..eom import EquationsOfMotion
 from ..render.mathml import rate_names
 from ..steps import Step
-from .kinematics import pose
-from .lagrange import latex_names
-from .simplify import simplify_trig
 from .system import LagrangianSystem
 
 __all__ = [

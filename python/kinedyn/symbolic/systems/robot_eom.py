@@ -9,12 +9,8 @@ from typing import Any
 import sympy as sp
 
 from ...description.parametrise import euler_parametrised
-from ..eom import EquationsOfMotion
-from ..render.mathml import Name, ddt_dL_dqd, dL_dq, dL_dqd, lagrangian, mi, name, of_q, tokens
-from ..steps import Step
-from ..values import exact
-from .cse import CSE_THRESHOLD, closed_form_of_program, closed_form_steps
-from .lagrange import (
+from ..derive.cse import CSE_THRESHOLD, closed_form_of_program, closed_form_steps
+from ..derive.lagrange import (
     RingModel,
     body_coordinates,
     christoffel,
@@ -23,7 +19,11 @@ from .lagrange import (
     latex_names,
     state_symbols,
 )
-from .newton_euler import newton_euler_program, newton_euler_steps
+from ..derive.newton_euler import newton_euler_program, newton_euler_steps
+from ..eom import EquationsOfMotion
+from ..render.mathml import Name, ddt_dL_dqd, dL_dq, dL_dqd, lagrangian, mi, name, of_q, tokens
+from ..steps import Step
+from ..values import exact
 
 __all__ = ["equations_of_motion", "lagrange_eom", "newton_euler_eom", "general_parameters"]
 

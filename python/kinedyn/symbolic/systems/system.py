@@ -29,11 +29,11 @@ from sympy.core.function import AppliedUndef
 
 from ...description.expressions import parse_expression
 from ...mechanical import MechanicalSystem
+from ..derive.lagrange import latex_names
+from ..derive.simplify import simplify_trig, textbook_form
 from ..eom import EquationsOfMotion
 from ..render.mathml import lagrangian, legacy_rate_names, name, of_q, rate_names  # q1 -> qdot1, qddot1
 from ..steps import Step
-from .lagrange import latex_names
-from .simplify import simplify_trig, textbook_form
 from .system_properties import check_system_properties
 
 __all__ = ["LagrangianSystem", "coordinates"]
