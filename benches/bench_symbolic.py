@@ -32,9 +32,10 @@ import sympy as sp
 import kinedyn as kd
 from kinedyn.description.dh import DHRow
 from kinedyn.description.inertia import Inertia
-from kinedyn.symbolic.eom import _ops
-from kinedyn.symbolic.lagrange import _exact, _matrix
 from kinedyn.symbolic.robot_eom import general_parameters, newton_euler_eom
+from kinedyn.symbolic.steps import op_counts as _ops
+from kinedyn.symbolic.values import exact as _exact
+from kinedyn.symbolic.values import matrix as _matrix
 
 warnings.filterwarnings("ignore")
 

@@ -419,7 +419,7 @@ def test_simplify_false_gives_equal_product_form():
 
 
 def test_rotor_inertia_and_friction_enter_as_documented():
-    from kinedyn.symbolic.examples import geared_link_robot
+    from kinedyn.robots.examples import geared_link_robot
 
     eom = geared_link_robot().equations_of_motion()
     J_l, J_m, r, B_m, M, g, ell = sp.symbols("J_l J_m r B_m M g ell", positive=True)

@@ -22,6 +22,7 @@ import sympy as sp
 
 import kinedyn as kd
 from kinedyn.cli import main
+from kinedyn.robots import examples as robot_examples
 from kinedyn.symbolic import examples
 from kinedyn.symbolic.eom import EquationsOfMotion
 from kinedyn.symbolic.latex import equation_rows, expression_lines, latex_text
@@ -67,10 +68,9 @@ MECHANISMS = [
     "falling_particle",
     "simple_variational",
     "geared_link",
-    "remotely_driven_arm_from_robot",
-    "five_bar_from_chains",
     "four_bar_linkage",
 ]
+ROBOT_MECHANISMS = ["remotely_driven_arm_from_robot", "five_bar_from_chains"]  # from Robots: kinedyn.robots.examples
 
 
 def test_every_builtin_and_mechanism_is_listed():
@@ -79,11 +79,15 @@ def test_every_builtin_and_mechanism_is_listed():
     makers = {
         n
         for n, f in inspect.getmembers(examples, inspect.isfunction)
-        if f.__module__ == examples.__name__
-        and not n.startswith("_")
-        and n not in ("geared_link_robot", "five_bar_chains")
-    }  # a Robot; two Robots
+        if f.__module__ == examples.__name__ and not n.startswith("_")
+    }
     assert makers == set(MECHANISMS)
+    from_robots = {
+        n
+        for n, f in inspect.getmembers(robot_examples, inspect.isfunction)
+        if f.__module__ == robot_examples.__name__ and n not in ("geared_link_robot", "five_bar_chains")
+    }  # a Robot; two Robots
+    assert from_robots == set(ROBOT_MECHANISMS)
 
 
 @needs_tex
@@ -100,9 +104,9 @@ def test_derive_latex_document_compiles(tmp_path, capsys, name, symbolic):
 
 
 @needs_tex
-@pytest.mark.parametrize("maker", MECHANISMS)
+@pytest.mark.parametrize("maker", MECHANISMS + ROBOT_MECHANISMS)
 def test_mechanism_document_and_fragment_compile(tmp_path, maker):
-    made = getattr(examples, maker)()
+    made = getattr(examples if maker in MECHANISMS else robot_examples, maker)()
     eom = made if isinstance(made, EquationsOfMotion) else made.equations_of_motion()
     compile_tex(tmp_path, "doc", eom.to_latex_document())
     fragment = eom.to_latex()

@@ -9,6 +9,7 @@ import pytest
 import sympy as sp
 
 import kinedyn as kd
+from kinedyn.robots import examples as rex
 from kinedyn.symbolic import examples as ex
 from kinedyn.symbolic.mechanisms import (
     change_coordinates,
@@ -37,7 +38,7 @@ def _same(a: sp.Matrix, b: sp.Matrix) -> bool:
 
 # ----------------------------------------------------------------------------- change of coordinates
 def test_remotely_driven_arm_from_robot_equals_the_hand_written_bodies():
-    from_robot = ex.remotely_driven_arm_from_robot()
+    from_robot = rex.remotely_driven_arm_from_robot()
     by_hand = ex.remotely_driven_arm().equations_of_motion()
     assert [s.name for s in from_robot.q] == ["p1", "p2"] and list(from_robot.qd) == list(by_hand.qd)
     assert _same(from_robot.M, by_hand.M)
@@ -104,7 +105,7 @@ FIVE_BAR_PARAMS = "l1 l2 lc1 lc2 lc3 lc4 m1 m2 m3 m4 I1 I2 I3 I4 g"
 
 
 def test_five_bar_from_chains_equals_the_hand_written_bodies():
-    reduced = ex.five_bar_from_chains()
+    reduced = rex.five_bar_from_chains()
     by_hand = ex.five_bar().equations_of_motion()
     assert [s.name for s in reduced.q] == ["q1", "q2"]
     assert _same(reduced.M, by_hand.M)
@@ -137,8 +138,8 @@ def _tree_projection(chains, values, q_red):
 
 
 def test_five_bar_reduced_dynamics_equal_the_numeric_projection_of_the_trees():
-    reduced = ex.five_bar_from_chains()
-    chains = ex.five_bar_chains()
+    reduced = rex.five_bar_from_chains()
+    chains = rex.five_bar_chains()
     values = _random_values(FIVE_BAR_PARAMS)
     subs = _by_name(values)
     D = sp.lambdify([list(reduced.q)], reduced.M.xreplace(subs))
@@ -151,7 +152,7 @@ def test_five_bar_reduced_dynamics_equal_the_numeric_projection_of_the_trees():
 
 
 def test_five_bar_decoupling_condition_solved():
-    reduced = ex.five_bar_from_chains()
+    reduced = rex.five_bar_from_chains()
     m3, m4, l1, l2, lc3, lc4 = sp.symbols("m3 m4 l1 l2 lc3 lc4", positive=True)
     conditions, solution = decoupling_condition(reduced, solve_for="m3")
     assert len(conditions) == 1
@@ -166,7 +167,7 @@ def test_five_bar_decoupling_condition_solved():
     assert decoupled.M[0, 1].simplify() == 0 and not decoupled.M.free_symbols & set(reduced.q)
     assert decoupled.C.applyfunc(sp.simplify) == sp.zeros(2, 2)
     # numerically, from the trees: with m3 from the solution the projected D is diagonal; off it, not
-    chains = ex.five_bar_chains()
+    chains = rex.five_bar_chains()
     values = _random_values(FIVE_BAR_PARAMS)
     values["m3"] = float(solution[m3].xreplace(_by_name(values)))
     q = RNG.uniform(-1.0, 1.0, 2)
@@ -180,11 +181,11 @@ def test_five_bar_constrained_tree_system_moves_as_the_reduced_equations():
     """The other route: the two trees plus the holonomic closure as one constrained
     LagrangianSystem (4 coordinates, 2 constraints, solved by the KKT system); on the manifold its
     accelerations are J times the reduced equations' (J constant on the parallelogram branch)."""
-    chains = ex.five_bar_chains()
+    chains = rex.five_bar_chains()
     closure = loop_closure(*chains)
     assert len(closure) == 2
     system = closed_chain_system(chains, closure)
-    reduced = ex.five_bar_from_chains()
+    reduced = rex.five_bar_from_chains()
     values = _random_values(FIVE_BAR_PARAMS)
     accelerations = system.numeric_accelerations(values)
     subs = _by_name(values)
@@ -201,7 +202,7 @@ def test_five_bar_constrained_tree_system_moves_as_the_reduced_equations():
 
 
 def test_closed_chain_rejects_a_branch_that_does_not_close_the_loop():
-    chains = ex.five_bar_chains()
+    chains = rex.five_bar_chains()
     closure = loop_closure(*chains)
     q1, phi4, q2, phi3 = sp.symbols("q1 phi4 q2 phi3", real=True)
     with pytest.raises(ValueError, match="does not close the loop"):

@@ -8,6 +8,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import kinedyn as kd
+from kinedyn.robots import examples as rex
 from kinedyn.symbolic import LagrangianSystem, coordinates
 from kinedyn.symbolic import examples as ex
 
@@ -146,7 +147,7 @@ def test_geared_link_system_equals_robot_description():
     theta_sys = theta_robot + pi/2 (hanging down vs. along x)."""
     s = ex.geared_link()
     es = s.equations_of_motion()
-    er = ex.geared_link_robot().equations_of_motion()
+    er = rex.geared_link_robot().equations_of_motion()
     th_r, thd, thdd = er.q[0], er.qd[0], er.qdd[0]
     lhs_sys = (es.M * sp.Matrix(es.qdd) + es.C * sp.Matrix(es.qd) + es.g + s.B)[0]
     lhs_sys = lhs_sys.subs({es.q[0]: th_r + sp.pi / 2, es.qd[0]: thd, es.qdd[0]: thdd})

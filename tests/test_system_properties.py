@@ -10,6 +10,7 @@ import pytest
 import sympy as sp
 
 import kinedyn as kd
+from kinedyn.robots import examples as rex
 from kinedyn.symbolic import LagrangianSystem, coordinates
 from kinedyn.symbolic import examples as ex
 from kinedyn.symbolic.mechanisms import closed_chain_system, loop_closure
@@ -35,7 +36,7 @@ def _values(system, seed=0):
 
 def _five_bar_trees():
     return closed_chain_system(
-        ex.five_bar_chains(), loop_closure(*ex.five_bar_chains()), name="five-bar (trees + closure)"
+        rex.five_bar_chains(), loop_closure(*rex.five_bar_chains()), name="five-bar (trees + closure)"
     )
 
 

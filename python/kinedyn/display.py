@@ -212,11 +212,14 @@ def eom_html(eom) -> str:
         f"<p><b>Equations of motion{' of ' + html.escape(eom.name) if eom.name else ''}</b> ({html.escape(str(eom.method))}): "
         "M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</p>"
     )
-    result = "".join(_eq_box(eom.equation_mathml(lhs, value)) for lhs, value in eom._final_equations())
+    result = "".join(_eq_box(eom.equation_mathml(lhs, value)) for lhs, value in eom.result_equations())
     steps = eom.steps
     folded = ""
     if steps:
-        inner = "".join(step_html(step, k) for k, step in enumerate(steps, start=1))
+        inner = "".join(
+            step_html(step, k, mathml=[eom.equation_mathml(lhs, value) for lhs, value in step.equations])
+            for k, step in enumerate(steps, start=1)
+        )
         folded = f"<details><summary>{len(steps)} steps of the derivation</summary>{inner}</details>"
     return _box("kinedyn-eom", head + result + folded)
 
@@ -230,39 +233,30 @@ def eom_markdown(eom) -> str:
     return eom.to_markdown()
 
 
-def _step_owner(step):
-    return getattr(step, "_eom", None)
-
-
-def step_html(step, number: int | None = None) -> str:
-    owner = _step_owner(step)
-    if owner is not None:
-        equation = owner.equation_mathml
-    else:
-        from .symbolic.render import equation_mathml as equation
+def step_html(step, number: int | None = None, mathml: Sequence[str] = ()) -> str:
+    """A step of a derivation: its title, sentence and equations; ``mathml`` holds one rendered
+    ``<math>`` element per equation (the symbolic engine renders them, so that q̇ prints with its dot)."""
     title = f"Step {number}: {step.title}" if number else step.title
     parts = [f"<p><b>{html.escape(title)}</b></p>"]
     if step.text:
         parts.append(f"<p>{html.escape(step.text)}</p>")
-    parts += [_eq_box(equation(lhs, value)) for lhs, value in step.equations]
+    parts += [_eq_box(element) for element in mathml]
     return "".join(parts) if number else _box("kinedyn-step", "".join(parts))
 
 
-def step_latex(step) -> str:
-    owner = _step_owner(step)
-    return "$$\\begin{gathered}" + step.to_latex(owner.latex_names if owner is not None else None) + "\\end{gathered}$$"
+def step_latex(step, names: dict | None = None) -> str:
+    """A step as display LaTeX; ``names``: LaTeX names of symbols (q̇ as ``\\dot{q}``)."""
+    return "$$\\begin{gathered}" + step.to_latex(names) + "\\end{gathered}$$"
 
 
-def step_markdown(step) -> str:
-    import sympy as sp
+def step_markdown(step, names: dict | None = None) -> str:
+    import sympy as sp  # only a step of symbolic equations comes here; sympy is already loaded then
 
-    owner = _step_owner(step)
-    names = owner.latex_names if owner is not None else {}
     out = [f"**{step.title}**", ""]
     if step.text:
         out += [step.text, ""]
     for lhs, value in step.equations:
-        out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names)}", "$$", ""]
+        out += ["$$", f"{lhs} = {sp.latex(value, symbol_names=names or {})}", "$$", ""]
     return "\n".join(out)
 
 

@@ -5,13 +5,12 @@ joints, the coordinates of :class:`ManifoldChart` with multi-DOF joints)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..configuration import exp3, quaternion_to_matrix
+from ..property_checks import InertiaBounds, global_inertia_bounds
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -24,138 +23,6 @@ __all__ = [
     "joint_box",
     "configuration_box",
 ]
-
-
-@dataclass
-class InertiaBounds:
-    """Uniform bounds ``lambda_min I <= M(q) <= lambda_max I`` over a box of configurations (Spong eq.
-    9.120), each with the configuration that attains it (``eigvalsh(M(q_lambda_min))[0] ==
-    lambda_min``), and the extremes of the random sample the search started from."""
-
-    lambda_min: float
-    q_lambda_min: np.ndarray
-    lambda_max: float
-    q_lambda_max: np.ndarray
-    sampled_min: float
-    sampled_max: float
-    samples: int
-    starts: int
-    lower: np.ndarray
-    upper: np.ndarray
-    periodic: np.ndarray
-    #: how the configurations were searched, when not the box ``lower``/``upper`` of the coordinates
-    #: themselves (a robot with multi-DOF joints: the chart of :class:`ManifoldChart`)
-    space: str = ""
-
-    def describe(self) -> str:
-        box = self.space or ", ".join(
-            ("periodic" if p else f"[{lo:.3g}, {hi:.3g}]") for lo, hi, p in zip(self.lower, self.upper, self.periodic)
-        )
-        if self.starts == 0 and self.space:  # nothing to search (M constant)
-            return f"lambda_min = {self.lambda_min:.8g}, lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)} ({self.space})"
-        return (
-            f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
-            f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
-            f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
-            f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box})"
-        )
-
-
-def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
-    q = np.array(q, dtype=float)
-    q[periodic] = (q[periodic] + np.pi) % (2 * np.pi) - np.pi
-    return q
-
-
-def global_inertia_bounds(
-    mass_matrix: Callable[[np.ndarray], np.ndarray],
-    mass_matrix_gradient: Callable[[np.ndarray], np.ndarray],
-    lower,
-    upper,
-    periodic=None,
-    samples: int = 256,
-    starts: int = 12,
-    seed: int = 0,
-    wrap: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> InertiaBounds:
-    """The least and greatest eigenvalue of M(q) over the box ``lower <= q <= upper`` (coordinates
-    marked ``periodic`` are searched without bounds, M being 2 pi-periodic in them, and reported in
-    [-pi, pi)), by a multistart local optimisation: ``samples`` uniform random configurations, then
-    truncated Newton (SciPy TNC: bounded, and free of the BLAS threading that made L-BFGS-B 30x slower on a
-    loaded machine) from the ``starts`` best of them (and as many more random ones), minimising lambda_min(q)
-    and -lambda_max(q) with the analytic gradient of a simple eigenvalue, d lambda / dq_k = v^T (dM/dq_k) v
-    (v its unit eigenvector). ``mass_matrix(q)``: (n, n) for one q, (N, n, n) for a batch (N, n);
-    ``mass_matrix_gradient(q)``: (n_q, n, n), dM/dq_k stacked. ``wrap(q)``: the representative of a
-    searched point to report (default: periodic coordinates into [-pi, pi)); the box of the periodic
-    coordinates is where the samples are drawn. A search, not a proof: the reported bounds are
-    attained (at the returned configurations) and no worse than every sample."""
-    from scipy.optimize import minimize  # scipy loads only when bounds are searched
-
-    lower = np.asarray(lower, dtype=float)
-    upper = np.asarray(upper, dtype=float)
-    nq = len(lower)
-    periodic = np.zeros(nq, dtype=bool) if periodic is None else np.asarray(periodic, dtype=bool)
-    if (
-        upper.shape != lower.shape
-        or periodic.shape != lower.shape
-        or np.any(~np.isfinite(lower))
-        or np.any(~np.isfinite(upper))
-        or np.any(upper < lower)
-    ):
-        raise ValueError(
-            f"the search box must be finite with lower <= upper, one entry per coordinate: lower {lower}, upper {upper}"
-        )
-    if samples < 1 or starts < 0:
-        raise ValueError(f"samples must be >= 1 and starts >= 0, got {samples} and {starts}")
-    rng = np.random.default_rng(seed)
-    Q = rng.uniform(lower, upper, size=(samples, nq))
-    eig = np.linalg.eigvalsh(np.asarray(mass_matrix(Q), dtype=float))
-    lo_s, hi_s = eig[:, 0], eig[:, -1]
-    bounds = [(None, None) if p else (a, b) for a, b, p in zip(lower, upper, periodic)]
-
-    def extreme(sign: float, column: int):
-        def f(q):
-            w, V = np.linalg.eigh(np.asarray(mass_matrix(q), dtype=float))
-            v = V[:, column]
-            dM = np.asarray(mass_matrix_gradient(q), dtype=float)
-            return sign * w[column], sign * np.einsum("i,kij,j->k", v, dM, v)
-
-        values = sign * (lo_s if column == 0 else hi_s)
-        order = np.argsort(values)
-        picks = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
-        best_q, best = Q[order[0]].copy(), values[order[0]]
-        for k in dict.fromkeys(int(i) for i in picks):
-            res = minimize(
-                f,
-                Q[k],
-                jac=True,
-                method="TNC",
-                bounds=bounds,
-                options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12),
-            )
-            x = np.array(res.x, dtype=float)
-            x[~periodic] = np.clip(x[~periodic], lower[~periodic], upper[~periodic])
-            x = _wrap(x, periodic) if wrap is None else wrap(x)
-            val = sign * np.linalg.eigvalsh(np.asarray(mass_matrix(x), dtype=float))[column]
-            if val < best:
-                best, best_q = val, x
-        return sign * best, best_q
-
-    lmin, qmin = extreme(1.0, 0)
-    lmax, qmax = extreme(-1.0, -1)
-    return InertiaBounds(
-        float(lmin),
-        qmin,
-        float(lmax),
-        qmax,
-        float(lo_s.min()),
-        float(hi_s.max()),
-        samples,
-        starts,
-        lower,
-        upper,
-        periodic,
-    )
 
 
 def joint_box(joint) -> tuple:

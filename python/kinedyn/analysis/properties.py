@@ -24,8 +24,9 @@ q ⊕ t qd, the inertia bounds searched in the coordinates of :class:`~kinedyn.a
 model by exact simplification (status "proved"), says "sampled" where simplification cannot decide
 and random states find no counterexample, and "failed" with the state that shows a counterexample.
 
-The results are :class:`Check` and :class:`PropertiesReport` (:mod:`.results`); the inertia bounds'
-search is :mod:`.bounds`, the symbolic proofs :mod:`.proofs`. This module measures a numeric robot
+The results are :class:`Check` and :class:`PropertiesReport` (:mod:`kinedyn.property_checks`, beside the
+inertia bounds' search, which the symbolic proofs share); the robot's chart of the search is :mod:`.bounds`,
+the symbolic proofs :mod:`kinedyn.symbolic.derive.proofs`. This module measures a numeric robot
 and keeps every name importable from ``kinedyn.analysis.properties``.
 """
 
@@ -35,11 +36,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..property_checks import STATUSES, Check, InertiaBounds, PropertiesReport, global_inertia_bounds  # noqa: F401 (STATUSES: its old home)
 from ..simulate import PDGravity, SimulationError, simulate
 from ..simulate.control import Controller
-from .bounds import InertiaBounds, global_inertia_bounds, robot_inertia_bounds
-from .proofs import prove_properties
-from .results import STATUSES, Check, PropertiesReport  # noqa: F401 (STATUSES: its old home)
+from ..symbolic.derive.proofs import prove_properties
+from .bounds import robot_inertia_bounds
 
 if TYPE_CHECKING:
     from ..robot import Robot

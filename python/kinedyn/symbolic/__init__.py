@@ -13,8 +13,7 @@
   :func:`loop_closure`), :func:`decoupling_condition` (Spong §9.4).
 """
 
-from .eom import EquationsOfMotion, Step, equations_of_motion
-from .kinematics import (
+from .derive.kinematics import (
     JacobianInverse,
     abbreviate,
     jacobian,
@@ -24,7 +23,10 @@ from .kinematics import (
     pose,
     tool_velocity,
 )
-from .mechanisms import (
+from .derive.simplify import simplify_trig
+from .eom import EquationsOfMotion
+from .steps import Step
+from .systems.mechanisms import (
     change_coordinates,
     closed_chain,
     closed_chain_system,
@@ -32,8 +34,8 @@ from .mechanisms import (
     loop_closure,
     tree_equations,
 )
-from .simplify import simplify_trig
-from .system import LagrangianSystem, coordinates
+from .systems.robot_eom import equations_of_motion
+from .systems.system import LagrangianSystem, coordinates
 
 __all__ = [
     "equations_of_motion",

@@ -9,73 +9,20 @@ led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and gene
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from html import escape
 from typing import Any
 
 import sympy as sp
 
-__all__ = ["EquationsOfMotion", "Step", "equations_of_motion"]
+from .. import display
+from .._math import by_name
+from .backends import c_numpy, casadi
+from .derive import cse, proofs, regressor
+from .render import latex
+from .render.mathml import equation_mathml, name, of_q, rate_symbols, text_of
+from .steps import Step, op_counts
 
-
-@dataclass
-class Step:
-    """One step of a derivation: a title, a sentence, and equations ``(lhs LaTeX, SymPy value)``."""
-
-    title: str
-    text: str = ""
-    equations: list[tuple] = field(default_factory=list)
-
-    def to_latex(self, names=None) -> str:
-        """An amsmath ``align*`` block: the title (prose escaped for TeX) and the equations, long ones
-        broken over lines (see :mod:`kinedyn.symbolic.latex`)."""
-        from .latex import _align, equation_rows, latex_text
-
-        rows = [r"&\text{" + latex_text(self.title) + r"} \\"]
-        for lhs, value in self.equations:
-            rows += equation_rows(lhs, value, names=names or {})
-        return _align(rows)
-
-    # notebooks (kinedyn.display); a step of an EquationsOfMotion prints q̇, q̈ with its names
-    def _repr_html_(self) -> str:
-        from ..display import step_html
-
-        return step_html(self)
-
-    def _repr_latex_(self) -> str:
-        from ..display import step_latex
-
-        return step_latex(self)
-
-    def _repr_markdown_(self) -> str:
-        from ..display import step_markdown
-
-        return step_markdown(self)
-
-
-def _ops(exprs) -> dict[str, int]:
-    """Counts of multiplications, additions (subtractions and negations included), divisions and
-    function calls (sin, cos, sign) in expressions, the way Khalil & Dombre count them (x**2 counts as
-    one product; sign changes are listed under "neg" and left out of the total)."""
-    counts = {"mul": 0, "add": 0, "div": 0, "fun": 0, "neg": 0}
-    for e in exprs:
-        v = sp.count_ops(e, visual=True)
-        if v == 0:
-            continue
-        for term in sp.Add.make_args(v):
-            coeff, sym = term.as_coeff_Mul()
-            name = str(sym)
-            if name in ("MUL", "POW"):
-                counts["mul"] += int(coeff)
-            elif name in ("ADD", "SUB"):
-                counts["add"] += int(coeff)
-            elif name == "NEG":  # a sign change, folded into the next addition by any compiler
-                counts["neg"] += int(coeff)
-            elif name == "DIV":
-                counts["div"] += int(coeff)
-            else:
-                counts["fun"] += int(coeff)
-    counts["total"] = counts["mul"] + counts["add"] + counts["div"] + counts["fun"]
-    return counts
+__all__ = ["EquationsOfMotion", "Step"]
 
 
 class EquationsOfMotion:
@@ -103,6 +50,9 @@ class EquationsOfMotion:
         program=None,
         model=None,
         extra: dict | None = None,
+        closed_form: Callable[[], Any] | None = None,
+        derivation: Callable[[], dict[str, Any]] | None = None,
+        robot: Any = None,
     ):
         self.q = sp.Matrix(q)
         self.qd = sp.Matrix(qd)
@@ -120,15 +70,18 @@ class EquationsOfMotion:
         self.program = program  # Newton-Euler customised model (kinedyn.symbolic.newton_euler.Program)
         self.model = model  # (RingModel, derivation dict) for robots
         self.extra = dict(extra or {})
-        #: robot equations: the Newton-Euler derivation, computed on first use (see robot_eom)
-        self._derived: Callable[[], dict[str, Any]] | None = None
+        #: robot equations by Newton-Euler: the exact derivation (ring model, M, C, g, tau), computed
+        #: on first call (see robot_eom); the regressor reads it
+        self.derivation = derivation
         #: large robot models: M, C, g in CSE form (kinedyn.symbolic.cse.ClosedForm), and the rendered
         #: result as matrices of the entry names it defines (see robot_eom's ``form``)
-        self.closed_form: Callable[[], Any] | None = None
-        self.final_equations: Callable[[], list] | None = None
+        self.closed_form = closed_form
+        self.final_equations: Callable[[], list] | None = (
+            (lambda: cse.final_equations(closed_form(), self.friction)) if closed_form is not None else None
+        )
         #: the kinedyn.Robot these equations were derived from (None for a LagrangianSystem); to_casadi
         #: takes the tool pose and Jacobian from it
-        self.robot: Any = None
+        self.robot = robot
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod
@@ -201,7 +154,7 @@ class EquationsOfMotion:
     def steps(self) -> list[Step]:
         self._steps = self._get(self._steps)
         for step in self._steps or []:
-            step._eom = self  # its notebook display prints q̇, q̈ by self's names
+            step.owner = self  # its notebook display prints q̇, q̈ by self's names
         return self._steps or []
 
     # ------------------------------------------------------------------ derived forms
@@ -236,16 +189,12 @@ class EquationsOfMotion:
         minimal vector of grouped parameters; the result also has ``.tau_known``, the part of tau free
         of unknown parameters (numeric rotor inertia; usually zero). See
         :mod:`kinedyn.symbolic.regressor`."""
-        from .regressor import regressor
-
-        return regressor(self, known=known)
+        return regressor.regressor(self, known=known)
 
     def base_parameters(self, known=None) -> sp.Matrix:
         """Theta of :meth:`regressor` without forming Y (much faster for a 6-DOF arm): the grouped base
         parameters; ``len`` equals the numeric ``robot.base_parameters()`` count."""
-        from .regressor import base_parameters
-
-        return base_parameters(self, known=known)
+        return regressor.base_parameters(self, known=known)
 
     def check_properties(self, params=None, limits=None, samples: int = 256, starts: int = 12, seed: int = 0):
         """The properties of Spong §9.5 decided on these symbolic equations: D symmetric, dD/dt - 2C
@@ -254,15 +203,11 @@ class EquationsOfMotion:
         decide), and the inertia bounds of eq. 9.120 by a global search with the configurations that
         attain them (``params`` gives values to free parameters). A
         :class:`kinedyn.analysis.PropertiesReport`; see :func:`kinedyn.analysis.prove_properties`."""
-        from ..analysis.properties import prove_properties
-
-        return prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
+        return proofs.prove_properties(self, params=params, limits=limits, samples=samples, starts=starts, seed=seed)
 
     def subs(self, mapping) -> EquationsOfMotion:
         """The same equations with parameters replaced (numbers or other expressions); keys are
         symbols or their names."""
-        from .._math import by_name
-
         mapping = by_name(mapping, self.parameters)
         f = lambda m: m.subs(mapping) if m is not None else None
         return EquationsOfMotion(
@@ -304,9 +249,7 @@ class EquationsOfMotion:
     ) -> str:
         """Source code (``"python"``, ``"numpy"`` or ``"c"``) computing the requested matrices, with
         common subexpressions eliminated; see :mod:`kinedyn.symbolic.codegen`."""
-        from .codegen import generate
-
-        return generate(self, language, what, name=name)
+        return c_numpy.generate(self, language, what, name=name)
 
     def compile(self, what: Sequence[str] = ("M", "C", "g", "tau"), backend: str = "auto", params=None, p=None):
         """Fast callables for the requested matrices: C compiled with the system compiler when
@@ -315,18 +258,14 @@ class EquationsOfMotion:
         ``jax_enable_x64``; see :mod:`kinedyn.symbolic.jax_backend`).
         ``params``: {symbol or name: value} substituted before generation; ``p``: values of the
         parameters left symbolic, in ``eom.parameters`` order, passed to every call."""
-        from .codegen import compile_eom
-
-        return compile_eom(self, what, backend=backend, params=params, p=p)
+        return c_numpy.compile_eom(self, what, backend=backend, params=params, p=p)
 
     def to_casadi(self, params=None, robot=None, frame: str | None = None):
         """CasADi Functions (SX, common subexpressions shared) ``M``, ``C``, ``g``, ``tau``,
         ``forward_dynamics`` and, for a robot, the tool ``pose`` and ``jacobian``; inputs named
         ``q``, ``qd``, ``qdd``/``tau`` and ``p`` (parameters left symbolic, in the order of the
         result's ``parameters``). See :mod:`kinedyn.symbolic.casadi_export`."""
-        from .casadi_export import to_casadi
-
-        return to_casadi(self, params=params, robot=robot, frame=frame)
+        return casadi.to_casadi(self, params=params, robot=robot, frame=frame)
 
     def op_count(self, what: str = "tau", cse: bool = False) -> dict[str, int]:
         """Operation counts of ``tau`` (or ``M``, ``g``...) as formed; for the Newton-Euler method the
@@ -338,12 +277,12 @@ class EquationsOfMotion:
         if cse:
             repl, red = sp.cse(exprs, order="none")
             exprs = [e for _, e in repl] + list(red)
-        return _ops(exprs)
+        return op_counts(exprs)
 
     # ------------------------------------------------------------------ rendering
-    def _final_equations(self):
-        from .render import name, of_q
-
+    def result_equations(self) -> list[tuple]:
+        """The result as (left-hand side, value) pairs: D, C, g, tau, or in CSE form the entry names
+        (defined in the last steps)."""
         if self.final_equations is not None:  # CSE form: entry names, defined in the last steps
             return self.final_equations()
         return [
@@ -359,27 +298,21 @@ class EquationsOfMotion:
         (also valid KaTeX/MathJax input). Long sums are broken over lines and wide matrices written
         entry by entry so that every line fits a 17 cm text width. :meth:`to_latex_document` gives a
         complete document (``kinedyn derive --format latex``)."""
-        from .latex import fragment
-
-        return fragment(self.steps if steps else [], self._final_equations(), self.latex_names)
+        return latex.fragment(self.steps if steps else [], self.result_equations(), self.latex_names)
 
     def to_latex_document(self, steps: bool = True) -> str:
         """A complete LaTeX document (article, amsmath only) that ``pdflatex`` compiles: a section per
         step with its prose and equations, then the result; see :mod:`kinedyn.symbolic.latex`."""
-        from .latex import document
-
         title = f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method.replace('_', '-')})"
-        return document(title, self.steps if steps else [], self._final_equations(), self.latex_names)
+        return latex.document(title, self.steps if steps else [], self.result_equations(), self.latex_names)
 
     def to_markdown(self) -> str:
         """Markdown with LaTeX math (``$$ ... $$``, long equations as ``aligned`` blocks broken over
         lines), one section per step."""
-        from .latex import equation_rows
-
         names = self.latex_names
 
         def block(lhs, value) -> list[str]:
-            rows = equation_rows(lhs, value, names=names)
+            rows = latex.equation_rows(lhs, value, names=names)
             if len(rows) == 1:
                 return ["$$", rows[0].replace(" &= ", " = ", 1)[: -len(r" \\")], "$$", ""]
             rows[-1] = rows[-1][: -len(r" \\")]
@@ -393,15 +326,13 @@ class EquationsOfMotion:
             for lhs, value in step.equations:
                 out += block(lhs, value)
         out += ["## Result: $D(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
-        for lhs, value in self._final_equations():
+        for lhs, value in self.result_equations():
             out += block(lhs, value)
         return "\n".join(out)
 
     def equation_mathml(self, lhs, value, display: str = "block") -> str:
         """One ``<math>`` element ``lhs = value`` in presentation MathML (SymPy's printer; q̇, q̈ with
         dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
-        from .render import equation_mathml, rate_symbols
-
         rates = self.__dict__.get("_rate_symbols")
         if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
             rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
@@ -410,8 +341,6 @@ class EquationsOfMotion:
     def to_mathml(self, steps: bool = True) -> str:
         """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per
         equation) and the result, inside one ``<div>`` (well-formed XML, embeddable in HTML)."""
-        from html import escape
-
         parts = ['<div class="kinedyn-eom">']
         for k, step in enumerate(self.steps if steps else [], start=1):
             parts.append(f"<section><h3>Step {k}: {escape(step.title)}</h3>")
@@ -420,13 +349,11 @@ class EquationsOfMotion:
             parts += [self.equation_mathml(lhs, value) for lhs, value in step.equations]
             parts.append("</section>")
         parts.append("<section><h3>Result: M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</h3>")
-        parts += [self.equation_mathml(lhs, value) for lhs, value in self._final_equations()]
+        parts += [self.equation_mathml(lhs, value) for lhs, value in self.result_equations()]
         parts.append("</section></div>")
         return "\n".join(parts)
 
     def __str__(self) -> str:
-        from .render import text_of
-
         out = [
             f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
         ]
@@ -434,7 +361,7 @@ class EquationsOfMotion:
             out.append(f"\nStep {k}: {step.title}")
             for lhs, value in step.equations:
                 out.append(f"  {text_of(lhs)} = {value}")
-        for lhs, value in self._final_equations():
+        for lhs, value in self.result_equations():
             out.append(f"{text_of(lhs)} = {value}")
         return "\n".join(out)
 
@@ -443,64 +370,10 @@ class EquationsOfMotion:
 
     # notebooks (kinedyn.display): the result typeset, the steps under a fold
     def _repr_html_(self) -> str:
-        from ..display import eom_html
-
-        return eom_html(self)
+        return display.eom_html(self)
 
     def _repr_latex_(self) -> str:
-        from ..display import eom_latex
-
-        return eom_latex(self)
+        return display.eom_latex(self)
 
     def _repr_markdown_(self) -> str:
-        from ..display import eom_markdown
-
-        return eom_markdown(self)
-
-
-def equations_of_motion(
-    robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None, form: str = "auto"
-) -> EquationsOfMotion:
-    """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
-
-    ``method="lagrange"``: Euler-Lagrange from K and P with every step kept (Spong §9.2-9.3).
-    ``method="newton_euler"``: the customised symbolic recursive Newton-Euler model with intermediate
-    variables (Khalil & Dombre); M, g and C are formed from it as well.
-    ``simplify=True`` gives the textbook (Fourier) form of every entry; ``False`` the product form.
-    ``parameters="general"`` replaces every body's inertia by the ten symbols M_j, MX_j, MY_j, MZ_j,
-    XX_j, XY_j, YY_j, XZ_j, YZ_j, ZZ_j (about the body origin, Khalil & Dombre's names), so that
-    ``eom.regressor()`` groups them into base parameters; a list of per-body 10-vectors is used as given.
-    ``form``: how the renderings (``str``, ``to_latex`` ...) show M, C, g: ``"expanded"``, ``"cse"``
-    (named intermediate variables, Khalil & Dombre's way; :mod:`kinedyn.symbolic.cse`) or ``"auto"``
-    (CSE for a large model, e.g. a 6-joint arm with general inertias). ``eom.M`` etc. are the same.
-
-    Floating, spherical and planar joints are derived in minimal coordinates: position and ZYX Euler
-    angles (x, y, z, yaw, pitch, roll), (yaw, pitch, roll), (x, y, theta), with their rates as the
-    velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot). Reduced mimic
-    joints stay reduced: a follower's joint variable is ``m q_leader + o`` (docs/symbolic.md, "Mimic
-    joints"; :mod:`kinedyn.symbolic.lagrange`).
-    """
-    from ..description.parametrise import euler_parametrised
-
-    robot = euler_parametrised(robot)
-    if isinstance(parameters, str):
-        if parameters != "general":
-            raise ValueError(f"parameters must be 'general' or a list of per-body 10-vectors, got {parameters!r}")
-        from .robot_eom import general_parameters
-
-        parameters = general_parameters(robot)
-    bodies = len(robot.tree.bodies)  # robot.n, or more with reduced mimic joints
-    if parameters is not None and (len(parameters) != bodies or any(len(p) != 10 for p in parameters)):
-        raise ValueError(f"parameters must hold {bodies} vectors of 10 inertial parameters (one per moving body)")
-    if method == "lagrange":
-        from .robot_eom import lagrange_eom
-
-        eom = lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
-    elif method in ("newton_euler", "newton-euler", "rnea"):
-        from .robot_eom import newton_euler_eom
-
-        eom = newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
-    else:
-        raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
-    eom.robot = robot
-    return eom
+        return display.eom_markdown(self)

@@ -14,8 +14,11 @@ from __future__ import annotations
 
 import html
 import re
+from html.entities import html5
+from xml.dom.minidom import parseString
 
 import sympy as sp
+from sympy.printing.conventions import split_super_sub
 from sympy.printing.mathml import MathMLPresentationPrinter
 
 __all__ = [
@@ -76,8 +79,6 @@ def rate_names(name: str) -> tuple:
     draw them with the accent — ``sp.pretty`` q̇₁, ``sp.latex`` ``\\dot{q}_{1}`` (kinedyn's MathML via
     :func:`rate_symbols`) — while ``str`` stays the plain identifier ``qdot1`` that code generation, ``sympify``
     and JSON need."""
-    from sympy.printing.conventions import split_super_sub
-
     base = split_super_sub(name)[0]
     if not base or not name.startswith(base):
         return f"{name}dot", f"{name}ddot"
@@ -93,11 +94,11 @@ def legacy_rate_names(name: str) -> tuple:
 
 
 # ------------------------------------------------------------------ MathML pieces
-def _mi(x: str, script: bool = False) -> str:
+def mi(x: str, script: bool = False) -> str:
     return f'<mi mathvariant="script">{html.escape(x)}</mi>' if script else f"<mi>{html.escape(x)}</mi>"
 
 
-def _tokens(s: str) -> str:
+def tokens(s: str) -> str:
     """A subscript such as ``c1`` or ``121``: letters as identifiers, digits as one number each run."""
     parts = re.findall(r"[A-Za-z]+|\d+|.", s)
     out = "".join(
@@ -123,21 +124,21 @@ def _split_symbol(sym) -> tuple:
 def _rate_mathml(q, n: int) -> str:
     """q̇_k (n = 1) or q̈_k (n = 2) as MathML: the dot over the base, the index below."""
     base, sub = _split_symbol(q)
-    b = _dot(_mi(_GREEK.get(base, base)), n)
-    return f"<msub>{b}{_tokens(sub)}</msub>" if sub else b
+    b = _dot(mi(_GREEK.get(base, base)), n)
+    return f"<msub>{b}{tokens(sub)}</msub>" if sub else b
 
 
 def _coord_mathml(q) -> str:
     base, sub = _split_symbol(q)
-    b = _mi(_GREEK.get(base, base))
-    return f"<msub>{b}{_tokens(sub)}</msub>" if sub else b
+    b = mi(_GREEK.get(base, base))
+    return f"<msub>{b}{tokens(sub)}</msub>" if sub else b
 
 
 # ------------------------------------------------------------------ names
 def name(latex: str, text: str, base: str, sub: str = "", script: bool = False) -> Name:
     """A plain name ``base_sub``: ``name("r_{c1}", "r_c1", "r", "c1")``; Greek bases by name."""
-    b = _mi(_GREEK.get(base, base), script)
-    return Name(latex, text, f"<msub>{b}{_tokens(sub)}</msub>" if sub else b)
+    b = mi(_GREEK.get(base, base), script)
+    return Name(latex, text, f"<msub>{b}{tokens(sub)}</msub>" if sub else b)
 
 
 def of_q(f: str, rates: bool = False) -> Name:
@@ -152,7 +153,7 @@ def of_q(f: str, rates: bool = False) -> Name:
 
 
 def lagrangian() -> Name:
-    return Name(r"\mathcal{L}", "L", _mi("L", script=True))
+    return Name(r"\mathcal{L}", "L", mi("L", script=True))
 
 
 def _partial_frac(num: str, den: str) -> str:
@@ -172,7 +173,7 @@ def dL_dqd(q, qd) -> Name:
     return Name(
         f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {_rate_latex(q)}}}",
         f"dL/d{qd}",
-        _partial_frac(_mi("L", script=True), _rate_mathml(q, 1)),
+        _partial_frac(mi("L", script=True), _rate_mathml(q, 1)),
     )
 
 
@@ -181,7 +182,7 @@ def ddt_dL_dqd(q, qd) -> Name:
     return Name(
         f"\\frac{{d}}{{dt}}\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {_rate_latex(q)}}}",
         f"d/dt dL/d{qd}",
-        f"<mrow><mfrac><mi>d</mi><mrow><mi>d</mi><mi>t</mi></mrow></mfrac>{_partial_frac(_mi('L', script=True), _rate_mathml(q, 1))}</mrow>",
+        f"<mrow><mfrac><mi>d</mi><mrow><mi>d</mi><mi>t</mi></mrow></mfrac>{_partial_frac(mi('L', script=True), _rate_mathml(q, 1))}</mrow>",
     )
 
 
@@ -190,7 +191,7 @@ def dL_dq(q) -> Name:
     return Name(
         f"\\frac{{\\partial \\mathcal{{L}}}}{{\\partial {sp.latex(q)}}}",
         f"dL/d{q}",
-        _partial_frac(_mi("L", script=True), _coord_mathml(q)),
+        _partial_frac(mi("L", script=True), _coord_mathml(q)),
     )
 
 
@@ -201,11 +202,11 @@ def symbol_name(sym) -> Name:
 
 def vector_name(latex_base: str, text_base: str, mathml_base: str, index, accent: int = 0) -> Name:
     """A per-link vector such as ω̇_3: ``vector_name(r"\\omega", "w", "ω", 3, accent=1)``."""
-    b = _mi(mathml_base)
+    b = mi(mathml_base)
     if accent:
         b = _dot(b, accent)
         latex_base = ("\\dot{" if accent == 1 else "\\ddot{") + latex_base + "}"
-    return Name(f"{latex_base}_{{{index}}}", f"{text_base}{index}", f"<msub>{b}{_tokens(str(index))}</msub>")
+    return Name(f"{latex_base}_{{{index}}}", f"{text_base}{index}", f"<msub>{b}{tokens(str(index))}</msub>")
 
 
 def text_of(lhs) -> str:
@@ -232,8 +233,6 @@ class _Printer(MathMLPresentationPrinter):
 
     def _print_Symbol(self, sym, style="plain"):
         if sym in self._given:
-            from xml.dom.minidom import parseString
-
             root = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement
             assert root is not None  # a parsed document always has its root element
             return root.firstChild
@@ -253,8 +252,6 @@ def rate_symbols(q, qd, qdd) -> dict[sp.Symbol, str]:
 def _xml_entities(m: str) -> str:
     """HTML named entities (SymPy writes &InvisibleTimes;, &ApplyFunction;) as characters, so the MathML
     is well-formed XML as well as HTML."""
-    from html.entities import html5
-
     keep = {"amp", "lt", "gt", "quot", "apos"}
     return re.sub(
         r"&([A-Za-z]+);", lambda g: g.group(0) if g.group(1) in keep else html5.get(g.group(1) + ";", g.group(0)), m

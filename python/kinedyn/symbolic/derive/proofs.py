@@ -1,15 +1,14 @@
-"""The properties of Spong §9.5 proved on symbolic equations of motion (:func:`prove_properties`,
-``eom.check_properties()``): identities decided by exact simplification, the inertia bounds by the
-global search of :mod:`.bounds` on the lambdified mass matrix."""
+"""The properties of Spong §9.5 *proved* on symbolic equations of motion (``eom.check_properties()``):
+identities decided by an exact trigonometric normal form, the inertia bounds by a global search.
+The numeric checks of a robot are :func:`kinedyn.analysis.check_properties`."""
 
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
-from .._math import by_name
-from .bounds import global_inertia_bounds
-from .results import Check, PropertiesReport
+from ..._math import by_name
+from ...property_checks import Check, PropertiesReport, global_inertia_bounds
 
 __all__ = ["prove_properties"]
 
