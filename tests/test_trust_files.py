@@ -21,7 +21,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import kinedyn as kd
-from kinedyn.description.expressions import FUNCTIONS, parse_expression, parse_number
+from kinedyn.expressions import FUNCTIONS, parse_expression, parse_number
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

@@ -23,8 +23,8 @@ pytest.importorskip("kinedyn._core", reason="the native module is not built")
 
 from kinedyn._ui.json import jsonable  # noqa: E402
 from kinedyn.report.html import build_report, collect, script_json  # noqa: E402
-from kinedyn.report.view import asset, view_model  # noqa: E402
 from kinedyn.robot_files import robot_from_mapping  # noqa: E402
+from kinedyn.visual.page import asset, view_model  # noqa: E402
 
 XHTML = "{http://www.w3.org/1999/xhtml}"
 

@@ -23,10 +23,9 @@ if TYPE_CHECKING:
     from .simulate._callable import simulate
 else:
     from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
+from ._version import __version__
 from .simulate import Trajectory
 from .symbolic import LagrangianSystem
-
-__version__ = "0.1.0"
 
 _SUBMODULES = ("analysis", "configuration", "dynamics", "ik", "kinematics", "symbolic", "testing")
 

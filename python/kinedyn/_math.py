@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from .expressions import parse_expression
+
 __all__ = [
     "is_symbolic",
     "as_value",
@@ -56,8 +58,6 @@ def as_value(x: Any) -> Any:
     if isinstance(x, sp.Basic):
         return float(x) if x.is_number and x.is_real is not False and not x.free_symbols else x
     if isinstance(x, str):  # read as data by kinedyn's own parser, never evaluated as Python
-        from .description.expressions import parse_expression
-
         return parse_expression(x)
     return float(x)
 

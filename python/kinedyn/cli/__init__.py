@@ -24,8 +24,7 @@ import traceback
 import warnings
 from collections.abc import Iterable, Sequence
 
-import kinedyn
-
+from .._version import __version__
 from .options import (
     EXIT_ERROR,
     EXIT_INTERNAL,
@@ -173,7 +172,7 @@ def build_parser(load: Iterable[str] | None = None) -> argparse.ArgumentParser:
     command, for tools and tests that read the whole parser); the others add theirs when the
     command line names them, which keeps ``kinedyn --help`` from importing every capability."""
     parser = _Parser(prog="kinedyn", description="Robot kinematics and dynamics, symbolic and numeric.")
-    parser.add_argument("--version", action="version", version=f"kinedyn {kinedyn.__version__}")
+    parser.add_argument("--version", action="version", version=f"kinedyn {__version__}")
     _common_options(parser, global_=True)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_CommandParser)
     for command, (_, summary) in COMMANDS.items():

@@ -10,7 +10,7 @@ import os
 import re
 from pathlib import Path
 
-from ..description.expressions import parse_number
+from ..expressions import parse_number
 
 EXIT_OK = 0
 EXIT_ERROR = 1  # the user's mistake: bad argument, bad robot file, unwritable output

@@ -26,9 +26,9 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 import yaml
 
 from .._math import matmul, rpy_to_matrix, translation
+from ..expressions import parse_expression
 from .description import Description
 from .dh import DHRow, description_from_dh
-from .expressions import parse_expression
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia
 from .joint import Joint, Mimic

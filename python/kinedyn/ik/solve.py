@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._arrays import real_array, whole_number
+from .._core import AnalyticIk, solve_ik
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -153,8 +154,6 @@ class _Chain:
     )
 
     def __init__(self, robot: Robot, frame: str):
-        from .. import _core
-
         self.frame = robot.frame_index(frame)
         self.n = robot.nq
         model = robot._model
@@ -173,7 +172,7 @@ class _Chain:
         # the q entries that are revolute angles (wrapped into (-pi, pi] when limits are not kept)
         self.revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)], dtype=bool)
         plain = not self.multi_dof and self.reduction is None
-        self.solver = _core.AnalyticIk.detect(self.model, self.frame, self.lower, self.upper) if plain else None
+        self.solver = AnalyticIk.detect(self.model, self.frame, self.lower, self.upper) if plain else None
         self.position_ok = self.solver is not None and self.solver.solves_position
 
 
@@ -470,9 +469,7 @@ def _analytic(
 
 def _nearest(robot: Robot, chain: _Chain, p, q_ref, result: IKResult, seed: int) -> None:
     """The reachable point nearest an unreachable position (least squares by LM with restarts)."""
-    from .. import _core
-
-    q, _, _, _, _ = _core.solve_ik(
+    q, _, _, _, _ = solve_ik(
         chain.model, chain.frame, p, q_ref, chain.lower, chain.upper, np.ones(6), 200, 8, 1e-12, 1e-12, 1e-6, 0.5, seed
     )
     result.nearest_q = q
@@ -497,7 +494,6 @@ def _levenberg_marquardt(
     error, iterations), revolute angles wrapped when the limits are not kept. With progress, a batch
     goes to the core in chunks (each target's restarts follow from the seed and its index in the
     whole batch, so the answers do not change)."""
-    from .. import _core
     from .._ui.progress import SHOW_AFTER, Delayed, wanted
 
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
@@ -506,7 +502,7 @@ def _levenberg_marquardt(
     def solve(first: int, stop: int | None):
         tk = t if stop is None else t[first:stop]
         qk = q0 if (stop is None or q0.ndim == 1) else q0[first:stop]
-        return _core.solve_ik(
+        return solve_ik(
             chain.model,
             chain.frame,
             tk,

@@ -29,15 +29,16 @@ from pathlib import Path
 import numpy as np
 from markupsafe import Markup
 
-from .. import __version__
 from .._ui.json import jsonable
 from .._ui.progress import Steps
 from .._ui.svg import svg_plot
+from .._version import __version__
 from ..configuration import default_configuration, log3
 from ..symbolic.cse import block_equations
 from ..symbolic.render import latex_to_mathml, of_q
 from ..symbolic.render import name as mathml_name
 from ..tutorial import QUESTIONS, answer, render_html
+from ..visual.page import asset, json_script, script_json, view_model
 from ..visual.web import plotly_script
 from .data import (
     SIMULATION_BUDGET,
@@ -50,7 +51,6 @@ from .data import (
 )
 from .page import TEMPLATES
 from .tables import fmt
-from .view import asset, json_script, script_json, view_model
 
 __all__ = [
     "default_configuration",
@@ -344,7 +344,7 @@ def _render(robot, d: ReportData, tutorial: bool, steps, geometry: str) -> str:
         d=d,
         multi=multi,
         version=__version__,
-        css=Markup(asset("report.css")),
+        css=Markup(asset("page.css")),
         viewer_js=Markup(asset("viewer.js")),
         plotly=Markup(plotly_script()),
         model_json=Markup(json_script(model, "kinedyn-model")),

@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from markupsafe import Markup
 
-from .. import __version__
 from .._ui.json import jsonable
+from .._version import __version__
+from ..visual.page import asset, json_script
 from ..visual.web import plotly_script
-from .page import TEMPLATES
+from .page import TEMPLATES, report_asset
 from .tables import fmt
-from .view import asset, json_script
 
 if TYPE_CHECKING:
     from ..analysis.identification import Identification, Validation
@@ -199,7 +199,7 @@ def identification_report(result: Identification, validate=None, *, title: str |
         d=d,
         title=title or f"kinedyn identification: {d['robot']}",
         version=__version__,
-        css=Markup(asset("report.css")),
+        css=Markup(asset("page.css")),
         extra_css=Markup(_EXTRA_CSS),
         fit_lines=_fit_lines(d),
         parameter_headers=parameter_headers,
@@ -215,7 +215,7 @@ def identification_report(result: Identification, validate=None, *, title: str |
         ],
         data_json=Markup(json_script(d, "kinedyn-identification")),
         plotly=Markup(plotly_script()),
-        plots_js=Markup(asset("identification.js")),
+        plots_js=Markup(report_asset("identification.js")),
     )
 
 

@@ -4,12 +4,14 @@ from a robot file or a log is text, never markup; the numbers' format (``fmt``) 
 
 from __future__ import annotations
 
+from importlib import resources
+
 from jinja2 import Environment, PackageLoader, select_autoescape
 from markupsafe import Markup
 
 from .tables import fmt, matrix_table, table
 
-__all__ = ["TEMPLATES"]
+__all__ = ["TEMPLATES", "report_asset"]
 
 #: the templates of the report's pages (report/templates/*.html.j2), escaping every value put in them
 TEMPLATES = Environment(
@@ -25,3 +27,8 @@ TEMPLATES.globals.update(
     table=lambda *args, **kwargs: Markup(table(*args, **kwargs)),
     matrix_table=lambda *args, **kwargs: Markup(matrix_table(*args, **kwargs)),
 )
+
+
+def report_asset(name: str) -> str:
+    """A file of the report's own assets (report/assets/), as text to inline in a page."""
+    return resources.files("kinedyn.report").joinpath("assets").joinpath(name).read_text(encoding="utf-8")

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 
 from ..display import trajectory_html
+from ..visual.page import animation_page
 from ..visual.viewer import show as show_in_viewer
-from ..visual.web import animation_page
 
 __all__ = ["Trajectory"]
 

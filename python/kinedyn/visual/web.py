@@ -3,7 +3,7 @@
 Vertices are quantised to 16 bits over each mesh's bounding box (an error of at most 1/131070 of the
 box, 7.6 micrometres on a 1 m link) and faces stored as 16-bit indices where a mesh has fewer than
 65,536 vertices, both base64 in the JSON; the page moves each mesh by its frame's pose
-(report/assets/viewer.js), so a trajectory sends joint values, never vertices again.
+(visual/assets/viewer.js), so a trajectory sends joint values, never vertices again.
 """
 
 from __future__ import annotations
@@ -56,38 +56,3 @@ def plotly_script() -> str:
     if "</script" in js.lower() or "<!--" in js:
         raise RuntimeError("this plotly.js cannot be inlined in a <script> element")
     return f'<script id="{PLOTLY_ELEMENT_ID}">{js}</script>'
-
-
-def animation_page(robot, t, q, title: str = "") -> str:
-    """A self-contained HTML page that plays the motion ``q`` (S, n) at times ``t`` (S,) of ``robot``
-    with its meshes (the report's 3-D view: each mesh once, then joint values per frame)."""
-    import html
-
-    from ..report.view import (  # the report's viewer (above this room: see the lead's notes)
-        asset,
-        json_script,
-        view_model,
-    )
-
-    t = np.asarray(t, dtype=float)
-    q = np.asarray(q, dtype=float)
-    if q.ndim != 2 or q.shape != (len(t), robot.nq):
-        raise ValueError(f"animation_page needs q of shape ({len(t)}, {robot.nq}), got {q.shape}")
-    model = view_model(robot, q[0])
-    data = {"simulation": {"t": t.tolist(), "q": q.tolist()}}
-    name = html.escape(title or robot.name)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{name}: motion</title><style>{asset("report.css")}</style></head>
-<body><main><section id='view'><h2>{name}</h2><div class='grid'><div>
-<div id="kinedyn-view" role="img" aria-label="3-D view of the motion"></div>
-<div id='kinedyn-playback' hidden><button id='kinedyn-play' type='button'>▶ play</button> <input id='kinedyn-time' type='range' aria-label='time'> <span id='kinedyn-clock'></span></div>
-<p class='note'>Drag to rotate, scroll to zoom. Written by kinedyn (Trajectory.animate); self-contained, nothing is fetched.</p>
-</div><div><h3>Joints</h3><div id='kinedyn-sliders'></div><p><button id='kinedyn-reset' type='button'>reset</button> <span id='kinedyn-tool'></span></p>
-<p class='note' id='kinedyn-q'></p></div></div></section></main>
-{json_script(model, "kinedyn-model")}
-{json_script(data, "kinedyn-data")}
-{plotly_script()}
-<script>{asset("viewer.js")}</script>
-</body></html>
-"""

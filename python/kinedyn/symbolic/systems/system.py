@@ -27,7 +27,7 @@ import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ...description.expressions import parse_expression
+from ...expressions import parse_expression
 from ...mechanical import MechanicalSystem
 from ..derive.lagrange import latex_names
 from ..derive.simplify import simplify_trig, textbook_form
