@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
+from .ik.solve import IKBatchResult
+
 if TYPE_CHECKING:
     from .robot import Robot
 
@@ -274,8 +276,6 @@ def lazy_inverse_kinematics(robot: Robot, target, q0, mask, method: str, respect
     solver draws its random restarts per chunk (from ``seed`` and the index in the chunk), so where
     restarts are needed it may find other, equally valid, solutions than one NumPy call."""
     import dask.array as da
-
-    from .ik.solve import IKBatchResult
 
     _check_chunks("target", target)
     if target.shape[1:] not in ((4, 4), (3,)):

@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .kinematics import jacobian_rank_report, task_jacobian, task_rows
+
 if TYPE_CHECKING:
     from ._typing import ArrayLike, SeedLike
     from .robot import Robot
@@ -141,8 +143,6 @@ def linearize(
 def _task_mobility(robot: Robot, q, frame, task, reference) -> tuple:
     """``(J, Minv, A)``: the task Jacobian (..., m, n), ``M^-1`` (..., n, n) and the inverse
     operational-space inertia ``A = J M^-1 J^T`` (..., m, m), symmetrised."""
-    from .kinematics import task_jacobian
-
     J = task_jacobian(robot, q, frame, task, reference)
     Minv = robot.mass_matrix_inverse(q)
     A = J @ Minv @ np.swapaxes(J, -1, -2)
@@ -151,8 +151,6 @@ def _task_mobility(robot: Robot, q, frame, task, reference) -> tuple:
 
 def _check_task_rank(robot: Robot, q, J: np.ndarray, task, tol: float, what: str) -> None:
     """ValueError naming the configuration and the lost task direction if J has rank < its rows."""
-    from .kinematics import _report, task_rows
-
     rows = task_rows(task)
     m, n = J.shape[-2:]
     if m > n:
@@ -166,7 +164,7 @@ def _check_task_rank(robot: Robot, q, J: np.ndarray, task, tol: float, what: str
         k = int(np.argmax(np.reshape(deficient, -1)))
         qs = np.asarray(q, dtype=float).reshape(-1, n)
         where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
-        report = _report(J.reshape(-1, m, n)[k], rows, n, tol)
+        report = jacobian_rank_report(J.reshape(-1, m, n)[k], rows, n, tol)
         raise ValueError(
             f"{what}: the task Jacobian is singular at q = {np.array2string(qs[k], precision=6)}{where}, so "
             f"J M^-1 J^T has no inverse ({report.summary()}); method='pinv' gives the pseudo-inverse"

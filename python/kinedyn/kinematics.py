@@ -153,7 +153,7 @@ def joint_velocities(
             )
         qs = np.asarray(q, dtype=float).reshape(-1, robot.n)
         for k, Jk in enumerate(J.reshape(-1, *J.shape[-2:])):
-            report = _report(Jk, task_rows(task), robot.n, 1e-9)
+            report = jacobian_rank_report(Jk, task_rows(task), robot.n, 1e-9)
             if report.singular:
                 where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
                 raise ValueError(
@@ -263,7 +263,7 @@ def manipulability_jacobian(
         k = int(np.argmax(one_zero.reshape(-1)))
         qs = np.asarray(q, dtype=float).reshape(-1, n)
         where = f" (configuration {k} of the batch)" if J.ndim == 3 else ""
-        report = _report(J.reshape(-1, m, n)[k], rows, n, tol)
+        report = jacobian_rank_report(J.reshape(-1, m, n)[k], rows, n, tol)
         raise ValueError(
             f"manipulability_jacobian: w = sqrt(det(J J^T)) is 0 at q = {np.array2string(qs[k], precision=6)}{where} "
             f"and has no derivative there (one singular value of the task Jacobian is 0: {report.summary()})"
@@ -320,10 +320,12 @@ def singularity_report(
     J = task_jacobian(robot, q, frame, rows, reference)
     if J.ndim != 2:
         raise ValueError(f"singularity_report takes one configuration q of shape ({robot.n},), got shape {np.shape(q)}")
-    return _report(J, rows, robot.n, tol)
+    return jacobian_rank_report(J, rows, robot.n, tol)
 
 
-def _report(J: np.ndarray, rows: list, n: int, tol: float) -> SingularityReport:
+def jacobian_rank_report(J: np.ndarray, rows: list, n: int, tol: float) -> SingularityReport:
+    """The singularity report of a Jacobian J (m, n) whose rows are the task's ``rows``: its rank by SVD (singular
+    values above ``tol`` times the largest), the lost task directions and the joint motions that do nothing."""
     U, s, Vt = np.linalg.svd(J)
     threshold = tol * max(1.0, s[0] if s.size else 1.0)
     rank = int(np.sum(s > threshold))

@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 
+from ._ui.progress import Delayed, wanted
+
 if TYPE_CHECKING:
     from ._typing import PathLike
     from .robot import Robot
@@ -270,8 +272,6 @@ def _progress(progress, total: int):
     """A function (done, total) -> None reporting progress, with a close()."""
     if callable(progress):
         return progress
-    from ._ui.progress import Delayed, wanted
-
     bar = Delayed(wanted(progress), total, "sweep", "{task.completed:.0f} / {task.total:.0f} states", 0.0)
 
     class Report:

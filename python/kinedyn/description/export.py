@@ -32,7 +32,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._math import pose_inverse, rot_axis, translation
-from .geometry import Box, Cylinder, Mesh, Sphere, Visual
+from .geometry import Box, Cylinder, Mesh, Sphere, Visual, resolve_mesh
+from .inertia import Inertia
+from .link import Link
 
 if TYPE_CHECKING:
     from .._typing import PathLike
@@ -245,9 +247,6 @@ def _default_inertias(robot: Robot) -> Robot:
     """The robot with the documented default inertia for every moving link whose subtree has no
     mass at all (a DH table without inertial data): 1 kg spread along the link's cylinders,
     approximated as a solid cylinder of the link's length and 4% of it in radius."""
-    from .inertia import Inertia
-    from .link import Link
-
     carried: dict[str, float] = {}
     for link in reversed(robot.links):
         carried[link.name] = carried.get(link.name, 0.0) + float(link.inertia.mass)
@@ -627,8 +626,6 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
                     )
                     continue
                 if file.startswith("package://"):
-                    from .geometry import resolve_mesh
-
                     file = str(resolve_mesh(file, shape.base_dir))
                 mesh_name = _unique(f"{v.frame}_mesh", names)
                 mesh = ET.SubElement(asset, "mesh", name=mesh_name, file=file)

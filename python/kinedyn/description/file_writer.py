@@ -19,6 +19,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 
 from .._math import is_symbolic, matmul, pose_inverse
 from .dh import links_from_dh
+from .geometry import Box, Cylinder, Mesh
 from .inertia import Inertia
 
 if TYPE_CHECKING:
@@ -45,8 +46,6 @@ def robot_to_mapping(robot: Robot) -> dict:
 
 
 def _visual_mapping(v) -> dict:
-    from .geometry import Box, Cylinder, Mesh
-
     out: dict = {"link": v.frame}
     s = v.shape
     if isinstance(s, Mesh):

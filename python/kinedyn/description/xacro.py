@@ -22,6 +22,8 @@ import threading
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from .geometry import mesh_search_folders
+
 __all__ = ["expand_xacro", "is_xacro", "XACRO_REFUSED"]
 
 XACRO_REFUSED = (
@@ -62,8 +64,6 @@ def expand_xacro(
     folders = [Path(d) for d in package_dirs]
 
     def find(package: str) -> str:
-        from .geometry import mesh_search_folders
-
         candidates = [c for d in folders for c in (d / package, d)] + list(
             mesh_search_folders(package, os.path.dirname(os.path.abspath(path)))
         )

@@ -18,6 +18,9 @@ import numpy as np
 
 from .._arrays import real_array, whole_number
 from .._core import AnalyticIk, solve_ik
+from .._ui.progress import SHOW_AFTER, Delayed, wanted
+from ..configuration import space
+from ..display import ik_html, ik_markdown
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -95,13 +98,9 @@ class IKResult:
         )
 
     def _repr_html_(self) -> str:  # notebooks: the solutions table (kinedyn.display)
-        from ..display import ik_html
-
         return ik_html(self)
 
     def _repr_markdown_(self) -> str:
-        from ..display import ik_markdown
-
         return ik_markdown(self)
 
 
@@ -281,8 +280,6 @@ def _q0(q0, chain: _Chain, batch: int | None, robot: Robot | None = None) -> np.
         raise ValueError("q0 contains a non-finite value (NaN or inf)")
     if chain.multi_dof and robot is not None:
         # unit quaternions and (cos, sin) pairs, the error naming the joint (kinedyn.configuration)
-        from ..configuration import space
-
         space(robot).check(q, "q0")
     return q
 
@@ -494,8 +491,6 @@ def _levenberg_marquardt(
     error, iterations), revolute angles wrapped when the limits are not kept. With progress, a batch
     goes to the core in chunks (each target's restarts follow from the seed and its index in the
     whole batch, so the answers do not change)."""
-    from .._ui.progress import SHOW_AFTER, Delayed, wanted
-
     lower, upper = (chain.lower, chain.upper) if respect_limits else (chain.free_lower, chain.free_upper)
     tol = min(tolerance, 1e-10)
 
