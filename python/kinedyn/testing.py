@@ -2,7 +2,7 @@
 
 ``random_robot(seed, n, branching)`` builds a physically valid random chain or tree (random joint
 kinds, axes, placements, inertias, offsets, rotor inertia and friction). ``check_identities(robot)``
-evaluates the identities of DESIGN.md at random states and returns their residuals, so a test, the
+evaluates the identities of docs/architecture.md ("Checking ourselves") at random states and returns their residuals, so a test, the
 report and a user can all ask "does the engine agree with itself on this robot?".
 """
 

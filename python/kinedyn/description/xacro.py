@@ -6,7 +6,7 @@ whose globals hold Python's full builtins, so a file can call ``exec`` and impor
 ``$(eval exec('import os; os.system(...)', dict()))`` runs a shell command (its parentheses smuggled
 in through properties, as ``tests/test_xacro.py`` shows). ``<xacro:include>``,
 ``xacro.load_yaml`` and ``$(env VAR)`` also read any file or environment variable. kinedyn's robot
-files are data (DESIGN.md, "Robot files are data"), so a xacro file is expanded only when the caller
+files are data (docs/architecture.md, "Robot files are data"), so a xacro file is expanded only when the caller
 says it trusts it: ``trust_xacro=True`` (CLI ``--trust-xacro``); without it loading refuses, saying why.
 
 ``xacro_args``: the file's ``<xacro:arg>`` values (``name:=value`` on xacro's command line).

@@ -1,7 +1,7 @@
 """``EquationsOfMotion``: the symbolic equations of one robot or Lagrangian system, with the steps that
 led to them, renderings (LaTeX, Markdown, MathML, text), the regressor, and generated code.
 
-    M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau           (Spong eq. 9.61, DESIGN.md)
+    M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau           (Spong eq. 9.61; docs/architecture.md)
 
 ``eom.christoffel[i][j][k]`` is c_ijk of Spong eq. 9.58 (0-based indices), ``C[k, j] = sum_i c_ijk qd_i``.
 """
