@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._math import pose_inverse, rot_axis, translation
+from .._math import pose_inverse, rot_axis, rpy_from_matrix, translation
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual, resolve_mesh
 from .inertia import Inertia
 from .link import Link
@@ -63,28 +63,6 @@ def _f(x) -> str:
 
 def _fs(values) -> str:
     return " ".join(_f(v) for v in values)
-
-
-def rpy_from_matrix(R) -> tuple[float, float, float]:
-    """URDF's (roll, pitch, yaw) with R = Rz(yaw) Ry(pitch) Rx(roll), exact to rounding everywhere,
-    gimbal lock (pitch = ±90°) and its neighbourhood included.
-
-    Pitch comes from the first column's z and length; yaw from the direction of its x, y (however
-    short: at exact gimbal lock they are 0 and yaw is 0, where only yaw ± roll is defined); roll is then read off the remaining rotation
-    ``Rx(roll) = Ry(pitch)ᵀ Rz(yaw)ᵀ R`` instead of from R's last row, so an ill-conditioned yaw near
-    the lock is compensated by roll and Rz Ry Rx reproduces R to rounding."""
-    R = np.asarray(R, dtype=float)
-    cos_pitch = math.hypot(R[0, 0], R[1, 0])
-    pitch = math.atan2(-R[2, 0], cos_pitch)
-    yaw = math.atan2(
-        R[1, 0], R[0, 0]
-    )  # the direction of (R00, R10) = cos(pitch) (cos yaw, sin yaw): exact even when tiny
-    cy, sy, cp, sp_ = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
-    Rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    Ry = np.array([[cp, 0.0, sp_], [0.0, 1.0, 0.0], [-sp_, 0.0, cp]])
-    Rx = Ry.T @ Rz.T @ R
-    roll = math.atan2(Rx[2, 1], Rx[1, 1])
-    return (roll + 0.0, pitch + 0.0, yaw + 0.0)
 
 
 def quaternion_from_matrix(R) -> tuple[float, float, float, float]:

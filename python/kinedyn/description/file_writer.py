@@ -17,7 +17,7 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard library since 3.11
     pass
 
-from .._math import is_symbolic, matmul, pose_inverse
+from .._math import is_symbolic, matmul, pose_inverse, rpy_from_matrix
 from .dh import links_from_dh
 from .geometry import Box, Cylinder, Mesh
 from .inertia import Inertia
@@ -63,7 +63,7 @@ def _visual_mapping(v) -> dict:
         out["sphere"] = float(s.radius)
     T = np.asarray(v.origin, dtype=float)
     if not np.allclose(T, np.eye(4)):
-        out["origin"] = {"xyz": [float(x) for x in T[:3, 3]], "rpy": [float(x) for x in _rpy(T[:3, :3])]}
+        out["origin"] = {"xyz": [float(x) for x in T[:3, 3]], "rpy": list(rpy_from_matrix(T[:3, :3]))}
     if v.rgba is not None:
         out["color"] = [float(x) for x in v.rgba]
     return out
@@ -73,17 +73,6 @@ def _dump(v):
     if isinstance(v, sp.Basic):
         return float(v) if not v.free_symbols else str(v)
     return float(v)
-
-
-def _rpy(R) -> list:
-    """Inverse of rpy_to_matrix: R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    R = np.asarray(R, dtype=float)
-    pitch = math.atan2(-R[2, 0], math.hypot(R[0, 0], R[1, 0]))
-    if math.hypot(R[0, 0], R[1, 0]) < 1e-12:  # gimbal lock: put everything in yaw
-        angles = [0.0, pitch, math.atan2(-R[0, 1], R[1, 1])]
-    else:
-        angles = [math.atan2(R[2, 1], R[2, 2]), pitch, math.atan2(R[1, 0], R[0, 0])]
-    return [a + 0.0 for a in angles]  # no -0.0 in files
 
 
 def _is_identity(T) -> bool:
@@ -97,7 +86,7 @@ def _pose_mapping(T, what: str) -> dict:
     if is_symbolic(T[:3, :3]):
         raise ValueError(f"cannot save {what}: its rotation is symbolic (only translations may hold symbols)")
     R = np.array(sp.Matrix(T[:3, :3]).tolist(), dtype=float) if isinstance(T, sp.MatrixBase) else T[:3, :3]
-    return {"xyz": [_dump(T[i, 3]) for i in range(3)], "rpy": _rpy(R)}
+    return {"xyz": [_dump(T[i, 3]) for i in range(3)], "rpy": list(rpy_from_matrix(R))}
 
 
 def _same_pose(A, B) -> bool:
