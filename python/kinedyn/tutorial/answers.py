@@ -103,24 +103,6 @@ def symbolic_jacobian(robot, q: Sequence[sp.Symbol], frame: str | None = None) -
     return ks.jacobian(robot, frame).xreplace(dict(zip(ks.joint_symbols(robot), q)))
 
 
-def abbreviate_trig(expr, q: Sequence[sp.Symbol], prefix=("C", "S")):
-    """cos(th1 + th2) -> C12, sin(th2) -> S2: the tutorial's shorthand, for display only."""
-    reps = {}
-    for f in expr.atoms(sp.cos, sp.sin):
-        arg = sp.expand(f.args[0])
-        idx = []
-        ok = True
-        for term in sp.Add.make_args(arg):
-            if term in q:
-                idx.append(str(list(q).index(term) + 1))
-            else:
-                ok = False
-        if ok and idx:
-            name = (prefix[0] if isinstance(f, sp.cos) else prefix[1]) + "".join(sorted(idx))
-            reps[f] = sp.Symbol(name)
-    return expr.xreplace(reps)
-
-
 def tutorial_display(expr, tutorial_symbols: bool = True):
     """A SymPy value in the tutorial's notation (theta, dots, C/S shorthand) for rendering."""
     if not isinstance(expr, (sp.Basic, sp.MatrixBase)):
@@ -134,7 +116,7 @@ def tutorial_display(expr, tutorial_symbols: bool = True):
         thdd2: "thetaddot2",
     }
     reps = {s: sp.Symbol(n, real=True) for s, n in names.items()}
-    e = abbreviate_trig(expr, [th1, th2, sp.Symbol("th3", real=True)]) if tutorial_symbols else expr
+    e = ks.abbreviate(expr, [th1, th2, sp.Symbol("th3", real=True)], prefix=("C", "S")) if tutorial_symbols else expr
     return e.xreplace(reps) if isinstance(e, sp.Basic) else e.applyfunc(lambda x: x.xreplace(reps))
 
 
