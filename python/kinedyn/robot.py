@@ -127,6 +127,8 @@ class Robot:
     ``kinedyn.robots``, or directly from :class:`Link` and :class:`Frame` objects.
     """
 
+    description: Description  # set once in __init__; the Robot is immutable (see __setattr__)
+
     def __init__(
         self,
         links: Sequence[Link] | Description,
@@ -159,12 +161,12 @@ class Robot:
                 base=base,
                 tool=tool,
                 name=name,
-                dh=dh,
+                dh=None if dh is None else tuple(dh),
                 dh_convention=dh_convention,
                 source=source,
                 inertia=inertia,
-                visuals=visuals,
-                collisions=collisions,
+                visuals=tuple(visuals),
+                collisions=tuple(collisions),
                 mimic=mimic,
             )
         object.__setattr__(self, "description", description)

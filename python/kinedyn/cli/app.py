@@ -128,7 +128,7 @@ def robot_file(spec: str, options: RobotOptions):
     except (OSError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as e:  # a loader should raise only ValueError: say which file it was reading
-        e.kinedyn_context = f"while loading robot file '{spec}'"  # read by the error handler
+        e.kinedyn_context = f"while loading robot file '{spec}'"  # type: ignore[attr-defined]  # read by the error handler
         raise
 
 

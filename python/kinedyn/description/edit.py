@@ -68,7 +68,11 @@ def substitute(description: Description, mapping: Mapping) -> Description:
             for r in description.dh
         ]
     return dataclasses.replace(
-        description, links=links, frames=frames, gravity=tuple(f(g) for g in description.gravity), dh=dh
+        description,
+        links=tuple(links),
+        frames=tuple(frames),
+        gravity=tuple(f(g) for g in description.gravity),
+        dh=None if dh is None else tuple(dh),
     )
 
 
@@ -90,7 +94,7 @@ def lock(description: Description, values: Mapping) -> Description:
                 link, joint=Joint(j.name, "fixed", j.axis), placement=matmul(link.placement, motion)
             )
         links.append(link)
-    return dataclasses.replace(description, links=links, dh=None)
+    return dataclasses.replace(description, links=tuple(links), dh=None)
 
 
 def lock_joints(description: Description, joints, at, block_motion) -> Description:

@@ -476,7 +476,7 @@ def description_from_mapping(data, where: str = "<robot mapping>", inertia: str 
             unknown = sorted({v.frame for v in visuals} - set(frame_names))
             if unknown:
                 r.fail("visuals", f"names links {unknown} that the robot does not have (frames: {frame_names})")
-            description = replace(description, visuals=visuals)
+            description = replace(description, visuals=tuple(visuals))
         return description
     except ValueError as e:
         if str(e).startswith(where):
@@ -549,9 +549,14 @@ def _visuals(r: _Reader, raw, where: str) -> list:
         origin = r.pose(v["origin"], f"{ctx}.origin") if "origin" in v else np.eye(4)
         out.append(
             Visual(
-                r.text(v["link"], f"{ctx}.link"), shape, np.asarray(origin, dtype=float), rgba, None, f"{where} {ctx}"
+                r.text(v["link"], f"{ctx}.link"),
+                shape,
+                np.asarray(origin, dtype=float),
+                rgba,  # type: ignore[arg-type]  # four numbers: r.vector(..., n=4) checked the length
+                None,
+                f"{where} {ctx}",
             )
-        )  # type: ignore[arg-type]
+        )
     return out
 
 

@@ -24,13 +24,14 @@ from .inertia import Inertia
 
 if TYPE_CHECKING:
     from ..robot import Robot
+    from .description import Description
 
 __all__ = ["robot_to_mapping"]
 
 _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
-def robot_to_mapping(robot: Robot) -> dict:
+def robot_to_mapping(robot: Robot | Description) -> dict:
     """The YAML/TOML contents for ``robot``: DH flavour when it has a consistent DH table."""
     data: dict = {"name": robot.name, "gravity": [_dump(g) for g in robot.gravity]}
     if robot.source:
@@ -95,7 +96,7 @@ def _same_pose(A, B) -> bool:
     return np.allclose(np.asarray(A, dtype=float), np.asarray(B, dtype=float), atol=1e-12)
 
 
-def _dh_base_pose(robot: Robot):
+def _dh_base_pose(robot: Robot | Description):
     """The base pose of the DH table if ``robot.links`` are exactly what its DH table gives, else None."""
     if robot.dh is None or robot.dh_convention is None:
         return None
@@ -156,7 +157,7 @@ def _frames_mapping(frames) -> list:
     return out
 
 
-def _dh_mapping(robot: Robot, base_pose) -> dict:
+def _dh_mapping(robot: Robot | Description, base_pose) -> dict:
     out: dict = {"convention": robot.dh_convention, "units": {"angle": "rad"}}
     if not _is_identity(base_pose):
         out["base_pose"] = _pose_mapping(base_pose, "the base pose")
@@ -184,7 +185,7 @@ def _dh_mapping(robot: Robot, base_pose) -> dict:
     return out
 
 
-def _tree_mapping(robot: Robot) -> dict:
+def _tree_mapping(robot: Robot | Description) -> dict:
     out: dict = {"base": robot.base, "tool": robot.tool, "units": {"angle": "rad"}}
     links = []
     for link in robot.links:

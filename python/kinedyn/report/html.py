@@ -34,7 +34,7 @@ from .._ui.progress import Steps
 from .._ui.svg import svg_plot
 from .._version import __version__
 from ..configuration import default_configuration, log3
-from ..symbolic.cse import block_equations
+from ..symbolic.derive.cse import block_equations
 from ..symbolic.render import latex_to_mathml, of_q
 from ..symbolic.render import name as mathml_name
 from ..tutorial import QUESTIONS, answer, render_html

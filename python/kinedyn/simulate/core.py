@@ -78,7 +78,7 @@ from .trajectory import Trajectory
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..robot import Robot
-    from ..symbolic.system import LagrangianSystem
+    from ..symbolic.systems.system import LagrangianSystem
 
 __all__ = [
     "simulate",
