@@ -48,44 +48,17 @@ impl PyModel {
         }
     }
 
-    /// Every multi-DOF joint's block of q (all states of `q`, nq numbers each) is unit where it must
-    /// be (a quaternion, or (cos, sin) of a planar joint) to 1e-6: the algorithms read it as a
-    /// rotation, so any other number would give a silently wrong result.
+    /// Every state of `q` (nq numbers each) passes the core's `Model::check_configuration`.
     pub(crate) fn check_configurations(&self, q: &[f64]) -> PyResult<()> {
         let model = &self.model;
         if model.plain || model.nq == 0 {
             return Ok(());
         }
+        let batch = q.len() > model.nq;
         for (k, state) in q.chunks(model.nq).enumerate() {
-            for (i, c) in model.coordinates.iter().enumerate() {
-                if let Coordinates::Head { block, at } = *c {
-                    let (unit, what) = match block {
-                        Block::FreeFlyer => (&state[at + 3..at + 7], "quaternion (qx, qy, qz, qw)"),
-                        Block::Spherical => (&state[at..at + 4], "quaternion (qx, qy, qz, qw)"),
-                        Block::Planar => (&state[at + 2..at + 4], "(cos, sin) pair"),
-                    };
-                    let norm = unit.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    if (norm - 1.0).abs() > 1e-6 {
-                        let batch = if q.len() > model.nq {
-                            format!(" of state {k}")
-                        } else {
-                            String::new()
-                        };
-                        return Err(PyValueError::new_err(format!(
-                            "q[{}..{}]{batch}, the {what} of the {block:?} joint at body {i}, has norm {norm}, not 1 \
-                             (to 1e-6): normalise it (robot.normalize(q))",
-                            at + if block == Block::FreeFlyer {
-                                3
-                            } else if block == Block::Planar {
-                                2
-                            } else {
-                                0
-                            },
-                            at + block.nq()
-                        )));
-                    }
-                }
-            }
+            model
+                .check_configuration(state, batch.then_some(k))
+                .map_err(PyValueError::new_err)?;
         }
         Ok(())
     }

@@ -14,6 +14,10 @@
 //! these joints), which must use the whole joint velocity: [`Model::velocity_product`] puts it on
 //! the last member (the members before it are massless, so their accelerations never act).
 
+mod configuration;
+
+pub use configuration::UNIT_TOLERANCE;
+
 use crate::error::{Error, Result};
 use crate::joint::Joint;
 use crate::spatial::{splat3, AxisRotation, Inertia, Mat3, Motion, Real, Transform, Vec3};
