@@ -26,6 +26,7 @@ from .description.geometry import Visual
 from .description.joint import Joint
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
 from .description.mimic import mimic_map as _mimic_map
+from .native.errors import SingularMassMatrixError, singular_mass_matrix_error
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -1003,32 +1004,20 @@ class Robot:
         return f
 
     def _singular(self, error: RuntimeError) -> Exception:
-        """The core's singular-mass-matrix error with the joint's name added: a RuntimeError, or a
-        NonFiniteResultError (a ValueError) when the core found numbers too large for float64."""
-        import re
+        """The core's singular-mass-matrix error with the joint's name added
+        (:func:`kinedyn.native.singular_mass_matrix_error`); other RuntimeErrors unchanged."""
+        if not isinstance(error, SingularMassMatrixError):
+            return error
+        return singular_mass_matrix_error(
+            error, self.name, self._dof_label, lambda dof: self._nonphysical_note(int(self._dof_body[dof]))
+        )
 
-        message = str(error)
-
-        seen = set()
-
-        def named(match):
-            dof = int(match.group(1))
-            if dof >= self.n:
-                return match.group(0)
-            i = int(self._dof_body[dof])  # the native body (a degree of freedom) -> its link
-            if i in seen:
-                return match.group(0)
-            seen.add(i)
-            return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
-
-        message = re.sub(r"\bjoint (\d+)", named, message)
-        if "too large for float64" in message:  # finite inputs, but the numbers overflowed on the way (§8)
-            from ._core import NonFiniteResultError
-
-            return NonFiniteResultError(f"robot '{self.name}': {message}")
-        if seen:
-            message += self._nonphysical_note(min(seen))
-        return RuntimeError(f"robot '{self.name}': {message}")
+    def _dof_label(self, dof: int) -> str | None:
+        """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
+        if not 0 <= dof < self.n:
+            return None
+        i = int(self._dof_body[dof])
+        return f"('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
 
     def _nonphysical_note(self, joint: int) -> str:
         """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not

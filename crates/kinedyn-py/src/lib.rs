@@ -32,6 +32,10 @@ fn simd() -> (&'static str, usize) {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     m.add_function(wrap_pyfunction!(simd, m)?)?;
+    m.add(
+        "SingularMassMatrixError",
+        m.py().get_type::<run::SingularMassMatrixError>(),
+    )?;
     guard::register(m)?;
     ik::register(m)?;
     simulate::register(m)?;

@@ -16,9 +16,34 @@ use crate::conv::{Batch, MAX_INPUTS};
 use crate::guard::{self, shape_text};
 use crate::model::PyModel;
 
+pyo3::create_exception!(
+    kinedyn._core,
+    SingularMassMatrixError,
+    PyRuntimeError,
+    "The core's singular mass matrix: attributes `joint` (the degree of freedom whose pivot failed), \
+     `overflow` (numbers too large for float64 rather than a physically singular M) and `message`."
+);
+
+/// A core error as a Python exception: `SingularMassMatrixError` (a RuntimeError) carrying the
+/// joint, else a ValueError.
 pub(crate) fn core_err(e: CoreError) -> PyErr {
     match e {
-        CoreError::SingularMassMatrix(_) => PyRuntimeError::new_err(e.to_string()),
+        CoreError::SingularMassMatrix {
+            joint,
+            overflow,
+            ref message,
+        } => Python::attach(|py| {
+            let err = SingularMassMatrixError::new_err(e.to_string());
+            let value = err.value(py);
+            let set = value
+                .setattr("joint", joint)
+                .and_then(|()| value.setattr("overflow", overflow))
+                .and_then(|()| value.setattr("message", message.as_str()));
+            match set {
+                Ok(()) => err,
+                Err(failed) => failed,
+            }
+        }),
         _ => PyValueError::new_err(e.to_string()),
     }
 }
