@@ -27,6 +27,7 @@ from .description.joint import Joint
 from .description.link import Frame, KinematicTree, Link, build_tree, judge_inertias
 from .description.mimic import mimic_map as _mimic_map
 from .native.errors import SingularMassMatrixError, singular_mass_matrix_error
+from .native.mimic import ReducedModel
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -792,7 +793,6 @@ class Robot:
         )
         if self._mimic is None:
             return native
-        from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
 
         return ReducedModel(native, self._mimic, self.name)
 
@@ -949,10 +949,10 @@ class Robot:
                 respect_limits,
                 kwargs,
             )
-        if self._mimic is not None:  # through the robot with independent joints (kinedyn/_mimic.py)
-            from ._mimic import inverse_kinematics
+        if self._mimic is not None:  # through the robot with independent joints (kinedyn/ik/mimic.py)
+            from .ik.mimic import mimic_inverse_kinematics  # kinedyn.ik loads the IK bindings on first use
 
-            return inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
+            return mimic_inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
         solve = _IK_SOLVE or _load_ik()
         return solve(self, target, q0, mask, method, respect_limits, **kwargs)
 
