@@ -96,6 +96,9 @@ class SingularMassMatrixError(RuntimeError):
 class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""
 
+def planar_basis(
+    normal: F64,
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]: ...  # (e1, e2), e1 x e2 = normal
 def simd() -> tuple[str, int]: ...  # (kind, states per block) of batches: "avx512" | "avx2" | "portable" | "off"
 def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
     """TEST-ONLY: panics inside a guarded binding (on a batch worker thread if ``in_worker``), to

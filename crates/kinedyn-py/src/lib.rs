@@ -28,10 +28,18 @@ fn simd() -> (&'static str, usize) {
     (s.name(), s.lanes())
 }
 
+/// The in-plane unit axes (e1, e2) of a planar joint with unit normal `normal` (e1 x e2 = normal).
+#[pyfunction]
+fn planar_basis(normal: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let (e1, e2) = kinedyn_core::joint::planar_basis(kinedyn_core::spatial::Vec3::from(normal));
+    (e1.into(), e2.into())
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     m.add_function(wrap_pyfunction!(simd, m)?)?;
+    m.add_function(wrap_pyfunction!(planar_basis, m)?)?;
     m.add(
         "SingularMassMatrixError",
         m.py().get_type::<run::SingularMassMatrixError>(),

@@ -28,14 +28,10 @@ _BLOCK_CODES = {"floating": 1, "spherical": 2, "planar": 3}
 
 def planar_basis(normal) -> tuple:
     """In-plane unit axes (e1, e2) with e1 x e2 = normal: x and y for the normal z (Pinocchio's
-    JointModelPlanar), else e1 along the coordinate axis most orthogonal to the normal."""
-    n = np.asarray(normal, dtype=float)
-    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
-        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-    e = np.eye(3)[int(np.argmin(np.abs(n)))]
-    e1 = e - n * (n @ e)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(n, e1)
+    JointModelPlanar), else e1 along the coordinate axis most orthogonal to the normal (the core's
+    ``joint::planar_basis``, the one the compiled model checks its planar members against)."""
+    e1, e2 = _core.planar_basis(np.asarray(normal, dtype=float))
+    return np.array(e1), np.array(e2)
 
 
 def locked_block(joint, block) -> np.ndarray:
