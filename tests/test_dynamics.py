@@ -359,6 +359,12 @@ def test_massless_chain_is_a_clear_error_from_forward_dynamics():
         robot.forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2))
     with pytest.raises(RuntimeError, match="singular mass matrix"):
         robot.mass_matrix_inverse(np.zeros(2))
+    # the core's error carries the degree of freedom (no message parsing): the last one, 'elbow'
+    with pytest.raises(kd._core.SingularMassMatrixError) as raised:
+        robot._model.forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2))
+    assert isinstance(raised.value, RuntimeError)
+    assert (raised.value.joint, raised.value.overflow) == (1, False)
+    assert raised.value.message in str(raised.value) and "joint 1" in raised.value.message
     # rotor inertia alone makes the joints accelerate: qdd = tau / (r^2 J_m)
     geared = [
         dataclasses.replace(l, joint=dataclasses.replace(l.joint, gear_ratio=10.0, rotor_inertia=1e-3)) for l in links

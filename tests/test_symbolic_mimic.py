@@ -1,7 +1,7 @@
 """The symbolic engine on robots with reduced mimic joints (issue 14): a follower's coordinate is
 ``m q_leader + o``, so the equations live in the independent coordinates only.
 
-Oracles: the numeric engine's reduced model (kinedyn/_mimic.py: M_r = G^T M G, C_r = G^T C G,
+Oracles: the numeric engine's reduced model (kinedyn/native/mimic.py: M_r = G^T M G, C_r = G^T C G,
 g_r = G^T g, J_r = J G), evaluated at random states; the Lagrange route against the customised
 Newton-Euler route and its CSE (forward-mode) form; dM/dt formed here by SymPy's own differentiation
 of the printed M (not the ring's chain rule) against C + C^T, and dM/dt - 2C skew-symmetric."""

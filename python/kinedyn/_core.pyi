@@ -86,9 +86,19 @@ class Model:
     def momentum(self, q: F64, qd: F64) -> F64: ...  # (6,) | (N, 6), [p; L about the base origin]
     def centroidal_momentum_matrix(self, q: F64) -> F64: ...  # (6, n) | (N, 6, n), h_G = A_G qd
 
+class SingularMassMatrixError(RuntimeError):
+    """Forward dynamics or M^-1 undefined at a state: the pivot of degree of freedom ``joint`` failed."""
+
+    joint: int  # the native body (degree of freedom) whose pivot failed
+    overflow: bool  # numbers too large for float64 (finite inputs), not a physically singular M
+    message: str  # the core's message, without the "singular mass matrix: " prefix
+
 class NonFiniteResultError(FloatingPointError, ValueError):
     """Finite inputs gave a non-finite result (the numbers overflowed float64)."""
 
+def planar_basis(
+    normal: F64,
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]: ...  # (e1, e2), e1 x e2 = normal
 def simd() -> tuple[str, int]: ...  # (kind, states per block) of batches: "avx512" | "avx2" | "portable" | "off"
 def _debug_panic(message: str = ..., in_worker: bool = False) -> None:
     """TEST-ONLY: panics inside a guarded binding (on a batch worker thread if ``in_worker``), to

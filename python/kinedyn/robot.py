@@ -29,6 +29,9 @@ from .description.link import Frame, Link
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
+from .native.compile import REFERENCES as _REFERENCES
+from .native.compile import compile_model, locked_block
+from .native.errors import SingularMassMatrixError, singular_mass_matrix_error
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -46,70 +49,6 @@ def _dask_targets(target, q0):
 
     target = np.asarray(target, dtype=np.float64)
     return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
-
-
-_REFERENCES = {"world": 0, "local": 1, "spatial": 2}
-
-# the native model's code for the first body of each multi-DOF joint (crates/kinedyn-py/src/lib.rs)
-_BLOCK_CODES = {"floating": 1, "spherical": 2, "planar": 3}
-
-
-def _planar_basis(normal) -> tuple:
-    """In-plane unit axes (e1, e2) with e1 x e2 = normal: x and y for the normal z (Pinocchio's
-    JointModelPlanar), else e1 along the coordinate axis most orthogonal to the normal."""
-    n = np.asarray(normal, dtype=float)
-    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
-        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-    e = np.eye(3)[int(np.argmin(np.abs(n)))]
-    e1 = e - n * (n @ e)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(n, e1)
-
-
-def _locked_block(joint, block) -> np.ndarray:
-    """The 4x4 joint motion of a multi-DOF ``joint`` at its q ``block`` (unit quaternion / (cos, sin)
-    checked): what :meth:`Robot.lock_joints` folds into the placement."""
-    b = real_array(block, f"value of joint '{joint.name}'").ravel()
-    if b.shape != (joint.nq,) or not np.all(np.isfinite(b)):
-        raise ValueError(
-            f"lock_joints: the value of {joint.kind} joint '{joint.name}' must be its {joint.nq} finite q coordinates, got {block!r}"
-        )
-    T = np.eye(4)
-    unit = b[-4:] if joint.kind != "planar" else b[2:]
-    if abs(np.linalg.norm(unit) - 1.0) > 1e-6:
-        raise ValueError(
-            f"lock_joints: joint '{joint.name}': {'(cos, sin)' if joint.kind == 'planar' else 'quaternion'} {list(unit)} is not unit"
-        )
-    if joint.kind == "planar":
-        e1, e2 = _planar_basis(to_float_array(joint.axis, (3,), "axis"))
-        n = np.cross(e1, e2)
-        c, s = b[2], b[3]
-        K = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
-        T[:3, :3] = c * np.eye(3) + s * K + (1 - c) * np.outer(n, n)
-        T[:3, 3] = b[0] * e1 + b[1] * e2
-        return T
-    from .configuration import quaternion_to_matrix
-
-    T[:3, :3] = quaternion_to_matrix(b[-4:])
-    if joint.kind == "floating":
-        T[:3, 3] = b[:3]
-    return T
-
-
-def _joint_columns(joint) -> list:
-    """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
-    1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
-    planar: linear e1, e2, angular normal (0 revolute, 1 prismatic)."""
-    e = np.eye(3)
-    if joint.kind == "floating":
-        return [(1, e[k]) for k in range(3)] + [(0, e[k]) for k in range(3)]
-    if joint.kind == "spherical":
-        return [(0, e[k]) for k in range(3)]
-    axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
-    if joint.kind == "planar":
-        e1, e2 = _planar_basis(axis)
-        return [(1, e1), (1, e2), (0, np.cross(e1, e2))]
-    return [(0 if joint.kind == "revolute" else 1, axis)]
 
 
 _F64 = np.dtype(np.float64)
@@ -306,7 +245,7 @@ class Robot:
         """
         if at is None and not isinstance(joints, (Mapping, str, bytes)):
             at = self.neutral()
-        return Robot(lock_joints(self.description, joints, at, _locked_block))
+        return Robot(lock_joints(self.description, joints, at, locked_block))
 
     # ------------------------------------------------------------------ pickling
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
@@ -445,85 +384,8 @@ class Robot:
     # ------------------------------------------------------------------ numeric engine
     @cached_property
     def _model(self):
-        """The compiled native model (built once; numeric descriptions only)."""
-        from . import _core
-
-        if self.symbols:
-            raise ValueError(
-                f"robot '{self.name}' has symbolic parameters {sorted(map(str, self.symbols))}: "
-                "use robot.subs({...}) to give them values before numeric computation"
-            )
-        bodies = self.tree.bodies
-        last = self._body_last_dof
-        # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
-        # transform, read from q) and members at the identity on it, the last carrying the link
-        # (crates/kinedyn-core/src/model.rs); a 1-DOF joint is one body
-        parent: list = []
-        kind: list = []
-        axis: list = []
-        offset: list = []
-        placement: list = []
-        blocks: list = []
-        link_inertia = self.inertial_parameters().reshape(len(bodies), 10)
-        inertia = np.zeros((len(self._dof_body), 10))  # every native body (mimic followers' too)
-        for b, body in enumerate(bodies):
-            joint = body.joint
-            first = len(parent)
-            parent.append(-1 if body.parent < 0 else int(last[body.parent]))
-            placement.append(to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"))
-            offset.append(float(joint.offset))
-            columns = _joint_columns(joint)
-            for m, (k, a) in enumerate(columns):
-                if m > 0:
-                    parent.append(first + m - 1)
-                    placement.append(np.eye(4))
-                    offset.append(0.0)
-                kind.append(k)
-                axis.append(a)
-            blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
-            inertia[last[b]] = link_inertia[b]
-
-        # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
-        def per_dof(value):
-            return np.array(
-                [
-                    x
-                    for body in bodies
-                    for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])
-                ]
-            )
-
-        armature, viscous, coulomb = (
-            per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb")
-        )
-        gravity = to_float_array(self.gravity, (3,), "gravity")
-        frames = self.tree.frames
-        frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
-        frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
-        # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-        coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
-        asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-        native = _core.Model(
-            np.array(parent, dtype=np.int64),
-            np.array(kind, dtype=np.int64),
-            np.array(axis, dtype=float).reshape(-1, 3),
-            np.array(offset),
-            np.array(placement).reshape(-1, 4, 4),
-            inertia,
-            armature,
-            viscous,
-            coulomb,
-            gravity,
-            frame_body,
-            frame_placement,
-            coulomb_negative=asymmetric,
-            blocks=np.array(blocks, dtype=np.int64) if self.has_multi_dof_joints else None,
-        )
-        if self._mimic is None:
-            return native
-        from ._mimic import ReducedModel  # mimic joints: the same methods in reduced coordinates
-
-        return ReducedModel(native, self._mimic, self.name)
+        """The compiled native model (built once; numeric descriptions only): :func:`kinedyn.native.compile_model`."""
+        return compile_model(self)
 
     @cached_property
     def _multi_dof(self) -> bool:
@@ -726,32 +588,20 @@ class Robot:
         return f
 
     def _singular(self, error: RuntimeError) -> Exception:
-        """The core's singular-mass-matrix error with the joint's name added: a RuntimeError, or a
-        NonFiniteResultError (a ValueError) when the core found numbers too large for float64."""
-        import re
+        """The core's singular-mass-matrix error with the joint's name added
+        (:func:`kinedyn.native.singular_mass_matrix_error`); other RuntimeErrors unchanged."""
+        if not isinstance(error, SingularMassMatrixError):
+            return error
+        return singular_mass_matrix_error(
+            error, self.name, self._dof_label, lambda dof: self._nonphysical_note(int(self._dof_body[dof]))
+        )
 
-        message = str(error)
-
-        seen = set()
-
-        def named(match):
-            dof = int(match.group(1))
-            if dof >= self.n:
-                return match.group(0)
-            i = int(self._dof_body[dof])  # the native body (a degree of freedom) -> its link
-            if i in seen:
-                return match.group(0)
-            seen.add(i)
-            return f"{match.group(0)} ('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
-
-        message = re.sub(r"\bjoint (\d+)", named, message)
-        if "too large for float64" in message:  # finite inputs, but the numbers overflowed on the way (§8)
-            from ._core import NonFiniteResultError
-
-            return NonFiniteResultError(f"robot '{self.name}': {message}")
-        if seen:
-            message += self._nonphysical_note(min(seen))
-        return RuntimeError(f"robot '{self.name}': {message}")
+    def _dof_label(self, dof: int) -> str | None:
+        """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
+        if not 0 <= dof < self.n:
+            return None
+        i = int(self._dof_body[dof])
+        return f"('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
 
     def _nonphysical_note(self, joint: int) -> str:
         """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not

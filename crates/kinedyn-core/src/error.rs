@@ -7,8 +7,15 @@ pub enum Error {
     InvalidModel(String),
     #[error("invalid input: {0}")]
     InvalidInput(String),
-    #[error("singular mass matrix: {0}")]
-    SingularMassMatrix(String),
+    /// Forward dynamics or M^-1 is undefined: the pivot of `joint` (a body, a degree of freedom) is
+    /// not a positive part of M. `overflow`: the numbers were too large for float64 (finite
+    /// inputs, an inertia or a state beyond float64's range), not a physically singular M.
+    #[error("singular mass matrix: {message}")]
+    SingularMassMatrix {
+        joint: usize,
+        overflow: bool,
+        message: String,
+    },
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -204,6 +204,42 @@ impl Joint {
     }
 }
 
+/// The in-plane unit axes `(e1, e2)` of a planar joint with unit normal `n`, `e1 x e2 = n`: x and y
+/// when `n` is z (Pinocchio's JointModelPlanar; "is z" as NumPy's `allclose(n, z, atol=1e-15)`),
+/// else `e1` the coordinate axis most orthogonal to `n` (the first of equals) with its component
+/// along `n` removed, normalised. The compiled model's planar members take their columns from it.
+pub fn planar_basis(n: Vec3) -> (Vec3, Vec3) {
+    let z: Vec3 = Vec3::z();
+    if (0..3).all(|k: usize| (n[k] - z[k]).abs() <= 1e-15 + 1e-5 * z[k].abs()) {
+        return (Vec3::x(), Vec3::y());
+    }
+    let k = (0..3).fold(0, |b, k| if n[k].abs() < n[b].abs() { k } else { b });
+    let mut e: Vec3 = Vec3::zeros();
+    e[k] = 1.0;
+    let e1 = e - n * n.dot(&e);
+    let e1 = e1 / e1.norm();
+    (e1, n.cross(&e1))
+}
+
+#[cfg(test)]
+mod planar_basis_tests {
+    use super::*;
+
+    #[test]
+    fn the_basis_is_right_handed_about_the_normal() {
+        assert_eq!(planar_basis(Vec3::z()), (Vec3::x(), Vec3::y()));
+        for n in [
+            Vec3::x(),
+            Vec3::new(1.0, 2.0, -0.5).normalize(),
+            Vec3::new(0.0, 0.0, -1.0),
+        ] {
+            let (e1, e2) = planar_basis(n);
+            assert!((e1.norm() - 1.0).abs() < 1e-15 && e1.dot(&n).abs() < 1e-15, "{n}");
+            assert!((e1.cross(&e2) - n).norm() < 1e-15, "{n}");
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

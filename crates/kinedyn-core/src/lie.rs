@@ -18,6 +18,8 @@
 //! Symbols: `omega` ω rotation vector (rad), `theta` θ = |ω|, `rho` ρ linear part of a twist, `quat`
 //! a quaternion stored (x, y, z, w), `p` a translation.
 
+use crate::spatial::{Mat3, Real};
+
 /// A quaternion (x, y, z, w), w the scalar part (Pinocchio's and Eigen's storage order).
 pub type Quat = [f64; 4];
 
@@ -360,6 +362,57 @@ pub fn uniform_quaternion(u: [f64; 3]) -> Quat {
     let (a, b) = ((1.0 - u[0]).sqrt(), u[0].sqrt());
     let (t1, t2) = (2.0 * std::f64::consts::PI * u[1], 2.0 * std::f64::consts::PI * u[2]);
     [a * t1.sin(), a * t1.cos(), b * t2.sin(), b * t2.cos()]
+}
+
+/// The rotation matrix of a unit quaternion `(x, y, z, w)`.
+#[inline(always)]
+pub fn quaternion_matrix<T: Real>(q: &[T]) -> Mat3<T> {
+    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    let (one, two) = (T::one(), T::splat(2.0));
+    Mat3::new(
+        one - two * (y * y + z * z),
+        two * (x * y - z * w),
+        two * (x * z + y * w),
+        two * (x * y + z * w),
+        one - two * (x * x + z * z),
+        two * (y * z - x * w),
+        two * (x * z - y * w),
+        two * (y * z + x * w),
+        one - two * (x * x + y * y),
+    )
+}
+
+/// The Lie bracket `[a, b]` of two velocities of a multi-DOF joint (the first `block.nv()` entries):
+/// so(3) `a x b`; se(3) `[a_lin; a_ang]`: `(a_ang x b_lin - b_ang x a_lin, a_ang x b_ang)`; se(2)
+/// `(vx, vy, w)`: `(w_a J v_b - w_b J v_a, 0)` with `J` the quarter turn; zero for a 1-DOF joint.
+pub fn lie_bracket(block: Block, a: &[f64], b: &[f64]) -> [f64; 6] {
+    let cross = |x: &[f64], y: &[f64]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    match block {
+        Block::Spherical => {
+            let c = cross(a, b);
+            [c[0], c[1], c[2], 0.0, 0.0, 0.0]
+        }
+        Block::FreeFlyer => {
+            let (p, q) = (cross(&a[3..6], &b[0..3]), cross(&b[3..6], &a[0..3]));
+            let w = cross(&a[3..6], &b[3..6]);
+            [p[0] - q[0], p[1] - q[1], p[2] - q[2], w[0], w[1], w[2]]
+        }
+        Block::Scalar => [0.0; 6],
+        Block::Planar => [
+            -a[2] * b[1] + b[2] * a[1],
+            a[2] * b[0] - b[2] * a[0],
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ],
+    }
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .._core import planar_basis as core_planar_basis
 from .._math import is_symbolic
 from .checks import number, real, vector
 
@@ -247,11 +248,7 @@ def planar_basis(normal) -> tuple:
     """The in-plane unit axes (e1, e2) of a planar joint with unit ``normal`` (its axis), e1 x e2 =
     normal: x and y for the normal z (Pinocchio's JointModelPlanar), else e1 along the coordinate axis
     most orthogonal to the normal, projected into the plane. The planar joint's q = (x, y, cos, sin)
-    moves along x e1 + y e2 (docs/conventions.md)."""
-    n = np.asarray(normal, dtype=float)
-    if np.allclose(n, (0.0, 0.0, 1.0), atol=1e-15):
-        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-    e = np.eye(3)[int(np.argmin(np.abs(n)))]
-    e1 = e - n * (n @ e)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(n, e1)
+    moves along x e1 + y e2 (docs/conventions.md). Computed by the core (``joint::planar_basis``), so
+    the description, the compiled model and the viewer agree to the bit."""
+    e1, e2 = core_planar_basis(np.asarray(normal, dtype=float))
+    return np.array(e1), np.array(e2)

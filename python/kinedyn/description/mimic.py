@@ -14,7 +14,7 @@ They are related by constant maps::
 built by index ranges from each joint's ``nq`` and ``nv`` so that multi-DOF blocks (floating,
 spherical, planar joints, which can neither lead nor follow) are copied whole. A follower of a
 follower is resolved to the first leader (the relations compose: ``m2 (m1 q + o1) + o2``); a cycle
-of followers is an error. How the dynamics reduce with G: :mod:`kinedyn._mimic`.
+of followers is an error. How the dynamics reduce with G: :mod:`kinedyn.native.mimic`.
 """
 
 from __future__ import annotations

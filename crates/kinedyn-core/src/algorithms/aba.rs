@@ -87,7 +87,8 @@ pub fn aba<'d, T: Real>(
         // the pivot test lane by lane (one lane per state of a batch)
         if let Some(k) = (0..T::LANES).find(|&k| !(d.lane(k) > EPS_D * trace.lane(k)) || !d.lane(k).is_finite()) {
             let (d, trace) = (d.lane(k), trace.lane(k));
-            let why = if !d.is_finite() || !trace.is_finite() || trace.abs().max(d.abs()) > HUGE_TRACE {
+            let overflow = !d.is_finite() || !trace.is_finite() || trace.abs().max(d.abs()) > HUGE_TRACE;
+            let why = if overflow {
                 "an inertia or a state too large for float64".to_string()
             } else if d < 0.0 {
                 "a negative inertia about the axis: M is indefinite, so some body of the subtree has an inertia \
@@ -102,9 +103,13 @@ pub fn aba<'d, T: Real>(
                     d / trace
                 )
             };
-            return Err(Error::SingularMassMatrix(format!(
-                "joint {i} has articulated inertia D = {d:e} about its axis ({why}); forward dynamics is undefined"
-            )));
+            return Err(Error::SingularMassMatrix {
+                joint: i,
+                overflow,
+                message: format!(
+                    "joint {i} has articulated inertia D = {d:e} about its axis ({why}); forward dynamics is undefined"
+                ),
+            });
         }
         let d_inv = T::one() / d;
         let u = tau[i] - friction(model, i, qd[i]) - joint.project(&data.pa[i]);

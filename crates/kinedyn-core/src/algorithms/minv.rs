@@ -48,7 +48,11 @@ pub fn ltdl<T: Real>(model: &Model, data: &mut Data<T>) -> Result<()> {
             let (hkk, mkk, scale) = (hkk.lane(l), mkk.lane(l), scale[l]);
             if !(hkk > EPS_D * mkk && mkk > EPS_M * scale) || !hkk.is_finite() || !scale.is_finite() {
                 let diagonal: Vec<f64> = (0..n).map(|i| data.m[i * n + i].lane(l)).collect();
-                return Err(Error::SingularMassMatrix(singular_pivot(&diagonal, k, hkk, scale)));
+                return Err(Error::SingularMassMatrix {
+                    joint: k,
+                    overflow: !hkk.is_finite() || !scale.is_finite() || scale > HUGE_M,
+                    message: singular_pivot(&diagonal, k, hkk, scale),
+                });
             }
         }
         // for i = λ(k) up the tree: a = H_ki / H_kk ; H_ij -= a H_kj for j = i, λ(i), ... ; H_ki = a

@@ -257,9 +257,7 @@ impl<'a> Space<'a> {
     }
 }
 
-/// Largest distance from 1 of the norm of a quaternion or (cos, sin) pair in a start accepted by
-/// [`check_start`] (the solver normalises it).
-pub const UNIT_TOLERANCE: f64 = 1e-6;
+pub use crate::model::UNIT_TOLERANCE;
 
 /// The checks of a start or reference `q` (configuration coordinates, reduced ones with a
 /// reduction): finite, each multi-DOF joint's quaternion or (cos, sin) pair of unit norm to within

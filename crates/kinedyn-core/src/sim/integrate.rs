@@ -80,8 +80,10 @@ fn derivative(
 }
 
 pub(super) fn singular_joint(e: &Error) -> Option<usize> {
-    let Error::SingularMassMatrix(m) = e else { return None };
-    m.strip_prefix("joint ")?.split_whitespace().next()?.parse().ok()
+    let Error::SingularMassMatrix { joint, .. } = e else {
+        return None;
+    };
+    Some(*joint)
 }
 
 /// Check a state after a step: finite, and no joint faster than `max_speed`.

@@ -14,27 +14,15 @@
 //! these joints), which must use the whole joint velocity: [`Model::velocity_product`] puts it on
 //! the last member (the members before it are massless, so their accelerations never act).
 
+mod configuration;
+
+/// Kept here for the algorithms that read it from the model's module.
+pub use crate::lie::quaternion_matrix;
+pub use configuration::UNIT_TOLERANCE;
+
 use crate::error::{Error, Result};
 use crate::joint::Joint;
 use crate::spatial::{splat3, AxisRotation, Inertia, Mat3, Motion, Real, Transform, Vec3};
-
-/// The rotation matrix of a unit quaternion `(x, y, z, w)`.
-#[inline(always)]
-pub fn quaternion_matrix<T: Real>(q: &[T]) -> Mat3<T> {
-    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
-    let (one, two) = (T::one(), T::splat(2.0));
-    Mat3::new(
-        one - two * (y * y + z * z),
-        two * (x * y - z * w),
-        two * (x * z + y * w),
-        two * (x * y + z * w),
-        one - two * (x * x + z * z),
-        two * (y * z - x * w),
-        two * (x * z - y * w),
-        two * (y * z + x * w),
-        one - two * (x * x + y * y),
-    )
-}
 
 /// The multi-DOF joint kinds (their columns and q blocks, Pinocchio's conventions).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -209,9 +197,9 @@ impl Model {
             finite(&format!("placement of frame {k}"), &f.body_from_frame.to_homogeneous())?;
         }
         let mut support: Vec<Vec<usize>> = Vec::with_capacity(n);
-        for i in 0..n {
-            let mut s = match parent[i] {
-                Some(p) => support[p].clone(),
+        for (i, p) in parent.iter().enumerate().take(n) {
+            let mut s = match p {
+                Some(p) => support[*p].clone(),
                 None => Vec::new(),
             };
             s.push(i);
@@ -409,13 +397,14 @@ impl Model {
             match *c {
                 Coordinates::Scalar { at } => out[at] = q[at] + v[i] * dt,
                 Coordinates::Head { block, at } => {
-                    let lie_block = match block {
-                        Block::FreeFlyer => crate::lie::Block::FreeFlyer,
-                        Block::Spherical => crate::lie::Block::Spherical,
-                        Block::Planar => crate::lie::Block::Planar,
-                    };
                     let end = at + block.nq();
-                    crate::lie::integrate_block(lie_block, &q[at..end], &v[i..i + block.nv()], dt, &mut out[at..end]);
+                    crate::lie::integrate_block(
+                        block.into(),
+                        &q[at..end],
+                        &v[i..i + block.nv()],
+                        dt,
+                        &mut out[at..end],
+                    );
                 }
                 Coordinates::Member => {}
             }
@@ -435,7 +424,7 @@ impl Model {
             if let Coordinates::Head { block, .. } = *c {
                 let k = block.nv();
                 let (w, x) = (&omega[i..i + k], &v[i..i + k]);
-                let bracket = |a: &[f64], b: &[f64]| -> [f64; 6] { lie_bracket(block, a, b) };
+                let bracket = |a: &[f64], b: &[f64]| -> [f64; 6] { crate::lie::lie_bracket(block.into(), a, b) };
                 let wx = bracket(w, x);
                 let wwx = bracket(w, &wx[..k]);
                 for j in 0..k {
@@ -468,8 +457,8 @@ impl Model {
             Motion::zero()
         } else {
             let mut vj = Motion::zero();
-            for l in first..=last {
-                vj += self.joints[l].motion(qd[l]);
+            for (joint, &qd_l) in self.joints[first..=last].iter().zip(&qd[first..=last]) {
+                vj += joint.motion(qd_l);
             }
             v.cross_motion(&vj)
         }
@@ -510,37 +499,5 @@ impl Model {
     #[inline]
     pub fn has_coulomb(&self, i: usize) -> bool {
         self.coulomb[i] != 0.0 || self.coulomb_negative.as_ref().is_some_and(|c| c[i] != 0.0)
-    }
-}
-
-/// The Lie bracket `[a, b]` of two velocities of a multi-DOF joint (the first `block.nv()` entries):
-/// so(3) `a x b`; se(3) `[a_lin; a_ang]`: `(a_ang x b_lin - b_ang x a_lin, a_ang x b_ang)`; se(2)
-/// `(vx, vy, w)`: `(w_a J v_b - w_b J v_a, 0)` with `J` the quarter turn.
-fn lie_bracket(block: Block, a: &[f64], b: &[f64]) -> [f64; 6] {
-    let cross = |x: &[f64], y: &[f64]| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    match block {
-        Block::Spherical => {
-            let c = cross(a, b);
-            [c[0], c[1], c[2], 0.0, 0.0, 0.0]
-        }
-        Block::FreeFlyer => {
-            let (p, q) = (cross(&a[3..6], &b[0..3]), cross(&b[3..6], &a[0..3]));
-            let w = cross(&a[3..6], &b[3..6]);
-            [p[0] - q[0], p[1] - q[1], p[2] - q[2], w[0], w[1], w[2]]
-        }
-        Block::Planar => [
-            -a[2] * b[1] + b[2] * a[1],
-            a[2] * b[0] - b[2] * a[0],
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-        ],
     }
 }

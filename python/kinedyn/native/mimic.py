@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._arrays import finite_result, real_array
-from .description.mimic import MimicMap
+from .._arrays import finite_result, real_array
+from .._core import NonFiniteResultError
+from ..description.mimic import MimicMap
 
 __all__ = ["ReducedModel"]
 
@@ -66,7 +67,7 @@ class ReducedModel:
         if callable(getattr(self.native, name, None)):
             raise NotImplementedError(
                 f"robot '{self.robot}': '{name}' is not mapped to reduced mimic coordinates yet "
-                "(kinedyn/_mimic.py); load the robot with mimic='independent'"
+                "(kinedyn/native/mimic.py); load the robot with mimic='independent'"
             )
         raise AttributeError(f"'ReducedModel' object has no attribute '{name}'")
 
@@ -154,8 +155,6 @@ class ReducedModel:
             return np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             if np.abs(M).max() > 1e150:  # its factorisation squares the entries
-                from ._core import NonFiniteResultError
-
                 raise NonFiniteResultError(
                     f"robot '{self.robot}': the reduced mass matrix G^T M G has entries of "
                     f"{np.abs(M).max():.3g}, too large for float64 to factor"

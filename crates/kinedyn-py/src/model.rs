@@ -1,0 +1,552 @@
+//! `kinedyn._core.Model`: the compiled model and its numeric methods, each a call into the core
+//! run by `run.rs` over one state or a batch.
+
+use std::sync::Mutex;
+
+use kinedyn_core::algorithms;
+use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
+use kinedyn_core::model::{Block, Coordinates};
+use kinedyn_core::spatial::{Inertia, Transform, Vec3};
+use kinedyn_core::{Data, Frame, Joint, JointKind, Model};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::conv::{self, f64_array, optional, vec_of, Batch};
+use crate::guard::guarded;
+use crate::run::{core_err, Arrays3};
+
+/// The compiled model plus one cached `Data` for single-state calls.
+#[pyclass(name = "Model", module = "kinedyn._core", frozen)]
+pub(crate) struct PyModel {
+    pub(crate) model: Model,
+    pub(crate) data: Mutex<Data>,
+}
+
+impl PyModel {
+    pub(crate) fn n(&self) -> usize {
+        self.model.n
+    }
+
+    /// A frame of this model by index.
+    pub(crate) fn frame(&self, frame: i64) -> PyResult<usize> {
+        conv::frame(frame, self.model.frames.len())
+    }
+
+    /// The three state arrays of a dynamics call (q (nq,), then two of (n,)) and the optional
+    /// external wrenches f_ext (n, 6), checked against each other.
+    fn gather_dynamics<'a>(
+        &self,
+        [(a, x), (b, y), (c, z)]: [(&str, &'a Bound<'_, PyArrayDyn<f64>>); 3],
+        f_ext: Option<&'a Bound<'_, PyArrayDyn<f64>>>,
+    ) -> PyResult<Batch<'a>> {
+        let (n, nq) = (self.n(), self.model.nq);
+        let (sq, s1, s6) = ([nq], [n], [n, 6]);
+        match f_ext {
+            Some(f) => Batch::gather(&[(a, x, &sq), (b, y, &s1), (c, z, &s1), ("f_ext", f, &s6)]),
+            None => Batch::gather(&[(a, x, &sq), (b, y, &s1), (c, z, &s1)]),
+        }
+    }
+
+    /// Every state of `q` (nq numbers each) passes the core's `Model::check_configuration`.
+    pub(crate) fn check_configurations(&self, q: &[f64]) -> PyResult<()> {
+        let model = &self.model;
+        if model.plain || model.nq == 0 {
+            return Ok(());
+        }
+        let batch = q.len() > model.nq;
+        for (k, state) in q.chunks(model.nq).enumerate() {
+            model
+                .check_configuration(state, batch.then_some(k))
+                .map_err(PyValueError::new_err)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes `#[pymethods] impl PyModel` from one table of the methods that run one core batch
+/// `Kernel`, each row `fn name(input: width, ..; f_ext) -> "result" [per-state shape], out = kernel;`
+/// (`; f_ext` where the call takes external wrenches (n, 6), `, out` where it takes NumPy's
+/// `out=`), followed by the methods written by hand (`by_hand { .. }`). `|n, nq|` names the
+/// model's velocity and configuration sizes for the table.
+macro_rules! model_methods {
+    (
+        |$n:ident, $nq:ident|
+        $(
+            $(#[doc = $doc:literal])*
+            fn $name:ident ( $($arg:ident : $w:ident),+ $(; $fext:ident)? ) -> $quantity:literal [$($dim:expr),*]
+            $(, $out:ident)? = $kernel:expr;
+        )*
+        by_hand { $($by_hand:tt)* }
+    ) => {
+        #[pymethods]
+        impl PyModel {
+            $(
+                $(#[doc = $doc])*
+                #[pyo3(signature = ($($arg),+ $(, $fext = None)? $(, $out = None)?))]
+                fn $name<'py>(
+                    &self,
+                    py: Python<'py>,
+                    $($arg: Bound<'py, PyAny>,)+
+                    $($fext: Option<Bound<'py, PyAny>>,)?
+                    $($out: Option<Bound<'py, PyAny>>,)?
+                ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+                    guarded(concat!("Model.", stringify!($name)), || {
+                        $(let $fext = $fext.map(|f| f64_array("f_ext", &f)).transpose()?;)?
+                        $(let $arg = f64_array(stringify!($arg), &$arg)?;)+
+                        #[allow(unused_variables)]
+                        let ($n, $nq) = (self.n(), self.model.nq);
+                        let batch = model_methods!(@gather self [$(($arg, $w)),+] $($fext)?);
+                        let out = model_methods!(@out $($out)?);
+                        batch.run_kernel(py, self, (stringify!($name), $quantity), &[$($dim),*], out, $kernel)
+                    })
+                }
+            )*
+            $($by_hand)*
+        }
+    };
+    (@gather $self:ident [$(($arg:ident, $w:ident)),+]) => {
+        Batch::gather(&[$((stringify!($arg), &$arg, &[$w] as &[usize])),+])?
+    };
+    (@gather $self:ident [$(($arg:ident, $w:ident)),+] $fext:ident) => {
+        $self.gather_dynamics([$((stringify!($arg), &$arg)),+], $fext.as_ref())?
+    };
+    (@out) => {
+        None
+    };
+    (@out $out:ident) => {
+        $out
+    };
+}
+
+model_methods! {
+    |n, nq|
+    /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
+    fn inverse_dynamics(q: nq, qd: n, qdd: n; f_ext) -> "tau" [n], out = kernels::InverseDynamics;
+    /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
+    fn forward_dynamics(q: nq, qd: n, tau: n; f_ext) -> "qdd" [n], out = kernels::ForwardDynamics;
+    /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
+    fn mass_matrix(q: nq) -> "M" [n, n], out = kernels::MassMatrix;
+    /// M^-1 (n, n) | (N, n, n).
+    fn mass_matrix_inverse(q: nq) -> "M^-1" [n, n], out = kernels::MassMatrixInverse;
+    /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
+    fn coriolis_matrix(q: nq, qd: n) -> "C" [n, n], out = kernels::Coriolis;
+    /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
+    fn christoffel(q: nq) -> "c" [n, n, n] = kernels::Christoffel;
+    /// g (n,) | (N, n).
+    fn gravity_torque(q: nq) -> "g" [n], out = kernels::Gravity;
+    /// C qd + g (n,) | (N, n), without friction.
+    fn bias_torque(q: nq, qd: n) -> "bias" [n], out = kernels::Bias;
+    /// K () | (N,).
+    fn kinetic_energy(q: nq, qd: n) -> "K" [] = kernels::KineticEnergy;
+    /// P () | (N,).
+    fn potential_energy(q: nq) -> "P" [] = kernels::PotentialEnergy;
+    /// Y (n, 10 n) | (N, n, 10 n).
+    fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernels::Regressor;
+
+    by_hand {
+        #[new]
+        #[allow(clippy::too_many_arguments)]
+        #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None, blocks=None))]
+        fn new(
+            parent: Vec<i64>,
+            kind: Vec<i64>,
+            axis: PyReadonlyArrayDyn<f64>,
+            offset: Vec<f64>,
+            placement: PyReadonlyArrayDyn<f64>,
+            inertia: PyReadonlyArrayDyn<f64>,
+            armature: Vec<f64>,
+            viscous: Vec<f64>,
+            coulomb: Vec<f64>,
+            gravity: Vec<f64>,
+            frame_body: Vec<i64>,
+            frame_placement: PyReadonlyArrayDyn<f64>,
+            coulomb_negative: Option<Vec<f64>>,
+            blocks: Option<Vec<i64>>,
+        ) -> PyResult<Self> {
+            guarded("Model.__new__", || {
+                let n = parent.len();
+                let nf = frame_body.len();
+                let axis = vec_of("axis", &axis, &[n, 3])?;
+                let placement = vec_of("placement", &placement, &[n, 4, 4])?;
+                let inertia = vec_of("inertia", &inertia, &[n, 10])?;
+                let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
+                if kind.len() != n {
+                    return Err(PyValueError::new_err(format!(
+                        "kind has {} entries for {n} bodies",
+                        kind.len()
+                    )));
+                }
+                if gravity.len() != 3 {
+                    return Err(PyValueError::new_err(format!(
+                        "gravity must have 3 components, got {}",
+                        gravity.len()
+                    )));
+                }
+                let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
+                    match p {
+                        -1 => Ok(None),
+                        p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
+                        p => Err(PyValueError::new_err(format!(
+                            "{what} {k}: body index {p} is out of range (-1..{n})"
+                        ))),
+                    }
+                };
+                let parent = parent
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &p)| body_index("parent of body", i, p))
+                    .collect::<PyResult<Vec<_>>>()?;
+                let joints = kind
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &k)| {
+                        let kind = match k {
+                            0 => JointKind::Revolute,
+                            1 => JointKind::Prismatic,
+                            _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
+                        };
+                        Ok(Joint {
+                            kind,
+                            axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]),
+                        })
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
+                let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
+                let frames = frame_body
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &b)| {
+                        Ok(Frame {
+                            body: body_index("frame", k, b)?,
+                            body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]),
+                        })
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                let mut model = Model::new(
+                    parent,
+                    joints,
+                    offset,
+                    placements,
+                    inertias,
+                    armature,
+                    viscous,
+                    coulomb,
+                    Vec3::new(gravity[0], gravity[1], gravity[2]),
+                    frames,
+                )
+                .map_err(core_err)?;
+                if let Some(levels) = coulomb_negative {
+                    model = model.with_coulomb_negative(levels).map_err(core_err)?;
+                }
+                if let Some(codes) = blocks {
+                    // per body: 0 a 1-DOF joint, 1 / 2 / 3 the head of a free-flyer / spherical / planar
+                    // joint, -1 a further member of the multi-DOF joint before it
+                    if codes.len() != n {
+                        return Err(PyValueError::new_err(format!(
+                            "blocks has {} entries for {n} bodies",
+                            codes.len()
+                        )));
+                    }
+                    let mut at = 0;
+                    let mut coordinates = Vec::with_capacity(n);
+                    for (i, &code) in codes.iter().enumerate() {
+                        let c = match code {
+                            0 => Coordinates::Scalar { at },
+                            1 => Coordinates::Head {
+                                block: Block::FreeFlyer,
+                                at,
+                            },
+                            2 => Coordinates::Head {
+                                block: Block::Spherical,
+                                at,
+                            },
+                            3 => Coordinates::Head {
+                                block: Block::Planar,
+                                at,
+                            },
+                            -1 => Coordinates::Member,
+                            _ => return Err(PyValueError::new_err(format!("body {i}: unknown block code {code}"))),
+                        };
+                        at += match c {
+                            Coordinates::Scalar { .. } => 1,
+                            Coordinates::Head { block, .. } => block.nq(),
+                            Coordinates::Member => 0,
+                        };
+                        coordinates.push(c);
+                    }
+                    model = model.with_coordinates(coordinates).map_err(core_err)?;
+                }
+                let data = Mutex::new(Data::new(&model));
+                Ok(Self { model, data })
+            })
+        }
+
+        #[getter(n)]
+        fn get_n(&self) -> usize {
+            self.model.n
+        }
+
+        /// Length of a configuration q.
+        #[getter]
+        fn nq(&self) -> usize {
+            self.model.nq
+        }
+
+        #[getter]
+        fn n_frames(&self) -> usize {
+            self.model.frames.len()
+        }
+
+        /// Poses of the given frames: (k, 4, 4) or (N, k, 4, 4).
+        fn frame_poses<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyArrayDyn<f64>>,
+            frames: Bound<'py, PyArray1<i64>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.frame_poses", || {
+                // SAFETY: read under the GIL with no Python code running, so nothing writes to it meanwhile
+                let ids = unsafe { frames.as_array() }
+                    .iter()
+                    .map(|&f| self.frame(f))
+                    .collect::<PyResult<Vec<_>>>()?;
+                let nq = self.model.nq;
+                let batch = Batch::gather(&[("q", &q, &[nq])])?;
+                batch.run_kernel(
+                    py,
+                    self,
+                    ("frame_poses", "pose"),
+                    &[ids.len(), 4, 4],
+                    None,
+                    kernels::FramePoses { frames: &ids },
+                )
+            })
+        }
+
+        /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
+        #[pyo3(signature = (q, frame, reference, point=None))]
+        fn jacobian<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyArrayDyn<f64>>,
+            frame: i64,
+            reference: i64,
+            point: Option<PyReadonlyArrayDyn<f64>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.jacobian", || {
+                let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq])])?;
+                batch.run_kernel(
+                    py,
+                    self,
+                    ("jacobian", "J"),
+                    &[6, n],
+                    None,
+                    kernels::Jacobian {
+                        frame: f,
+                        reference: r,
+                        point: p,
+                    },
+                )
+            })
+        }
+
+        /// Kinematic Hessian dJ/dq (n, 6, n) or (N, n, 6, n): `H[i, r, j] = dJ[r, j]/dq_i`.
+        #[pyo3(signature = (q, frame, reference, point=None))]
+        fn jacobian_hessian<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyArrayDyn<f64>>,
+            frame: i64,
+            reference: i64,
+            point: Option<PyReadonlyArrayDyn<f64>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.jacobian_hessian", || {
+                let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq])])?;
+                batch.run(
+                    py,
+                    self,
+                    ("jacobian_hessian", "dJ/dq"),
+                    &[n, 6, n],
+                    |model, data, x, out| {
+                        algorithms::frame_jacobian_hessian(model, data, x[0], f, r, p.as_ref(), out);
+                        Ok(())
+                    },
+                )
+            })
+        }
+
+        /// Twist J qd (6,) or (N, 6).
+        #[pyo3(signature = (q, qd, frame, reference, point=None))]
+        fn frame_velocity<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyArrayDyn<f64>>,
+            qd: Bound<'py, PyArrayDyn<f64>>,
+            frame: i64,
+            reference: i64,
+            point: Option<PyReadonlyArrayDyn<f64>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.frame_velocity", || {
+                let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
+                batch.run(py, self, ("frame_velocity", "twist"), &[6], |model, data, x, out| {
+                    out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+                    Ok(())
+                })
+            })
+        }
+
+        /// Acceleration drift dJ/dt qd (6,) or (N, 6).
+        #[pyo3(signature = (q, qd, frame, reference, point=None))]
+        fn jdot_qd<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyArrayDyn<f64>>,
+            qd: Bound<'py, PyArrayDyn<f64>>,
+            frame: i64,
+            reference: i64,
+            point: Option<PyReadonlyArrayDyn<f64>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.jdot_qd", || {
+                let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
+                batch.run(py, self, ("jdot_qd", "dJ/dt qd"), &[6], |model, data, x, out| {
+                    out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
+                    Ok(())
+                })
+            })
+        }
+
+        /// (dtau/dq, dtau/dqd, M), each (n, n) | (N, n, n): analytical derivatives of the RNEA.
+        #[pyo3(signature = (q, qd, qdd, f_ext=None))]
+        fn inverse_dynamics_derivatives<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+            qdd: Bound<'py, PyAny>,
+            f_ext: Option<Bound<'py, PyAny>>,
+        ) -> PyResult<Arrays3<'py>> {
+            guarded("Model.inverse_dynamics_derivatives", || {
+                let (q, qd, qdd) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("qdd", &qdd)?);
+                let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+                let n = self.n();
+                let batch = self.gather_dynamics([("q", &q), ("qd", &qd), ("qdd", &qdd)], f_ext.as_ref())?;
+                let simd = Simd::detected();
+                let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| {
+                    batch::run(model, scratch, &kernels::InverseDynamicsDerivatives, x, out, simd)
+                };
+                let [dq, dqd, m] = batch.run_many::<3, _>(
+                    py,
+                    self,
+                    ("inverse_dynamics_derivatives", ["dtau/dq", "dtau/dqd", "M"]),
+                    &[n, n],
+                    [None, None, None],
+                    Some(&lanes),
+                    |model, data, x, [dq, dqd, m]| {
+                        algorithms::rnea_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, Some(m));
+                        Ok(())
+                    },
+                )?;
+                Ok((dq, dqd, m))
+            })
+        }
+
+        /// (dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1), each (n, n) | (N, n, n): derivatives of the ABA.
+        #[pyo3(signature = (q, qd, tau, f_ext=None))]
+        fn forward_dynamics_derivatives<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+            tau: Bound<'py, PyAny>,
+            f_ext: Option<Bound<'py, PyAny>>,
+        ) -> PyResult<Arrays3<'py>> {
+            guarded("Model.forward_dynamics_derivatives", || {
+                let (q, qd, tau) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("tau", &tau)?);
+                let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+                let n = self.n();
+                let batch = self.gather_dynamics([("q", &q), ("qd", &qd), ("tau", &tau)], f_ext.as_ref())?;
+                let simd = Simd::detected();
+                let lanes = |model: &Model, scratch: &mut Scratch, x: &[Input], out: &mut [f64]| {
+                    batch::run(model, scratch, &kernels::ForwardDynamicsDerivatives, x, out, simd)
+                };
+                let [dq, dqd, dtau] = batch.run_many::<3, _>(
+                    py,
+                    self,
+                    ("forward_dynamics_derivatives", ["dqdd/dq", "dqdd/dqd", "M^-1"]),
+                    &[n, n],
+                    [None, None, None],
+                    Some(&lanes),
+                    |model, data, x, [dq, dqd, dtau]| {
+                        algorithms::aba_derivatives(model, data, x[0], x[1], x[2], optional(x, 3), dq, dqd, dtau)
+                    },
+                )?;
+                Ok((dq, dqd, dtau))
+            })
+        }
+
+        /// Centre of mass (3,) | (N, 3) in base coordinates.
+        fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.center_of_mass", || {
+                let q = f64_array("q", &q)?;
+                let nq = self.model.nq;
+                let batch = Batch::gather(&[("q", &q, &[nq])])?;
+                batch.run(py, self, ("center_of_mass", "com"), &[3], |model, data, x, out| {
+                    out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
+                    Ok(())
+                })
+            })
+        }
+
+        /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
+        fn centroidal_momentum_matrix<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.centroidal_momentum_matrix", || {
+                let q = f64_array("q", &q)?;
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq])])?;
+                batch.run(
+                    py,
+                    self,
+                    ("centroidal_momentum_matrix", "A_G"),
+                    &[6, n],
+                    |model, data, x, out| {
+                        algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
+                        Ok(())
+                    },
+                )
+            })
+        }
+
+        /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
+        fn momentum<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.momentum", || {
+                let q = f64_array("q", &q)?;
+                let qd = f64_array("qd", &qd)?;
+                let (n, nq) = (self.n(), self.model.nq);
+                let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
+                batch.run(py, self, ("momentum", "h"), &[6], |model, data, x, out| {
+                    out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
+                    Ok(())
+                })
+            })
+        }
+    }
+}
