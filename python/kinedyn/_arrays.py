@@ -17,7 +17,15 @@ import numpy as np
 
 from ._core import NonFiniteResultError
 
-__all__ = ["NonFiniteResultError", "real_array", "finite_result", "whole_number"]
+__all__ = [
+    "NonFiniteResultError",
+    "real_array",
+    "finite_result",
+    "whole_number",
+    "float64_array",
+    "point_in_frame",
+    "scalar_or_array",
+]
 
 _F64 = np.dtype(np.float64)
 _REAL_KINDS = frozenset("fiubO")
@@ -80,3 +88,29 @@ def whole_number(value, name: str, low: int = 0, high: int = 2**31 - 1) -> int:
     if not low <= v <= high:
         raise ValueError(f"{name} must be a whole number in [{low}, {high}], got {v}")
     return v
+
+
+_F64 = np.dtype(np.float64)
+
+
+def float64_array(x, name: str = "q") -> np.ndarray:
+    """``x`` for the native core: a float64 array passes through (the core reads any layout); anything
+    else is converted by :func:`real_array` (complex numbers and text refused, naming ``name``)."""
+    if type(x) is np.ndarray and x.dtype is _F64:
+        return x
+    return real_array(x, name)
+
+
+def point_in_frame(point) -> np.ndarray | None:
+    """A point given in a frame's axes: three finite coordinates, or None."""
+    if point is None:
+        return None
+    p = real_array(point, "point")
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"point must be 3 finite coordinates in the frame's axes, got {point!r}")
+    return p
+
+
+def scalar_or_array(x):
+    """A 0-d result as a Python float (one state), else the array (a batch)."""
+    return float(x) if np.ndim(x) == 0 else x

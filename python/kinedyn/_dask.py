@@ -342,3 +342,11 @@ def _ik_block(carrier: _RobotByContent, names: tuple, fixed: dict, *blocks):
     return np.concatenate(
         [np.asarray(result.q, dtype=np.float64)] + [np.asarray(c, dtype=np.float64)[:, None] for c in columns], axis=1
     )
+
+
+def dask_targets(target, q0):
+    """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
+    import dask.array as da  # optional and heavy: only a dask batch of starts gets here
+
+    target = np.asarray(target, dtype=np.float64)
+    return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._arrays import finite_result, real_array
 from .kinematics import jacobian_rank_report, task_jacobian, task_rows
 
 if TYPE_CHECKING:
@@ -34,6 +35,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BaseParameters",
+    "friction_torque",
     "base_parameters",
     "linearize",
     "operational_space_inertia",
@@ -232,3 +234,16 @@ def dynamically_consistent_inverse(
         _check_task_rank(robot, q, J, task, tol, "dynamically_consistent_inverse")
     L = _lambda(A, method, tol)
     return Minv @ np.swapaxes(J, -1, -2) @ ((L + np.swapaxes(L, -1, -2)) / 2)
+
+
+def friction_torque(robot: Robot, qd: ArrayLike) -> np.ndarray:
+    """viscous * qd + Coulomb friction of ``robot``'s joints, (n,) or (N, n): ``coulomb`` for qd > 0,
+    ``-coulomb_negative`` for qd < 0, 0 at rest (``coulomb * sign(qd)`` when symmetric)."""
+    qd = real_array(qd, "qd")
+    if qd.shape[-1:] != (robot.n,) or qd.ndim > 2:
+        raise ValueError(f"qd must have shape ({robot.n},) or a batch (N, {robot.n}), got {qd.shape}")
+    if not np.all(np.isfinite(qd)):
+        raise ValueError("qd contains a non-finite value (NaN or inf)")
+    with np.errstate(over="ignore"):
+        tau = robot.viscous * qd + np.where(qd > 0, robot.coulomb, 0.0) - np.where(qd < 0, robot.coulomb_negative, 0.0)
+    return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)

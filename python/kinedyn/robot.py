@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Union
 import numpy as np
 
 from . import configuration, display, dynamics, symbolic
-from ._arrays import finite_result, real_array
-from ._dask import batched, is_dask_array, lazy_inverse_kinematics
+from ._arrays import float64_array, point_in_frame, scalar_or_array
+from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from .description import export
 from .description.description import Description
@@ -31,7 +31,8 @@ from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
 from .native.compile import REFERENCES as _REFERENCES
 from .native.compile import compile_model, locked_block
-from .native.errors import SingularMassMatrixError, singular_mass_matrix_error
+from .native.errors import robot_error
+from .native.wrenches import body_wrenches, link_origin_in_body, moment_shift_derivative
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -41,17 +42,6 @@ if TYPE_CHECKING:
 __all__ = ["Robot"]
 
 _DASK_ARRAY = "dask.array"  # batch IK goes lazy only once dask.array was imported (kinedyn/_dask.py)
-
-
-def _dask_targets(target, q0):
-    """NumPy targets with a dask batch of starts q0: the targets chunked as q0."""
-    import dask.array as da  # optional and heavy: only a dask batch of starts gets here
-
-    target = np.asarray(target, dtype=np.float64)
-    return da.from_array(target, chunks=(q0.chunks[0],) + target.shape[1:])
-
-
-_F64 = np.dtype(np.float64)
 
 
 def _described(name: str) -> property:
@@ -249,7 +239,7 @@ class Robot:
 
     # ------------------------------------------------------------------ pickling
     # The native model (and what holds it: the IK solvers of each frame) is dropped when a Robot is
-    # pickled or copied, and built again on first use on the other side (DESIGN.md: "a Robot
+    # pickled or copied, and built again on first use on the other side (docs/architecture.md: "a Robot
     # pickles"). Everything else is the frozen description: numbers, NumPy arrays, SymPy objects.
     _NATIVE_STATE = ("_model", "_ik_chains", "_independent_robot")
 
@@ -308,16 +298,8 @@ class Robot:
 
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
-        """viscous * qd + Coulomb friction, (n,) or (N, n): ``coulomb`` for qd > 0,
-        ``-coulomb_negative`` for qd < 0, 0 at rest (``coulomb * sign(qd)`` when symmetric)."""
-        qd = real_array(qd, "qd")
-        if qd.shape[-1:] != (self.n,) or qd.ndim > 2:
-            raise ValueError(f"qd must have shape ({self.n},) or a batch (N, {self.n}), got {qd.shape}")
-        if not np.all(np.isfinite(qd)):
-            raise ValueError("qd contains a non-finite value (NaN or inf)")
-        with np.errstate(over="ignore"):
-            tau = self.viscous * qd + np.where(qd > 0, self.coulomb, 0.0) - np.where(qd < 0, self.coulomb_negative, 0.0)
-        return finite_result(tau, "friction_torque: tau_f", qd.ndim - 1)
+        """viscous * qd + Coulomb friction (:func:`kinedyn.dynamics.friction_torque`), (n,) or (N, n)."""
+        return dynamics.friction_torque(self, qd)
 
     is_symbolic = _described("is_symbolic")
     symbols = _described("symbols")
@@ -395,45 +377,29 @@ class Robot:
     def _link_frame_ids(self) -> np.ndarray:
         return np.array([self.frame_index(name) for name in self.body_names], dtype=np.int64)
 
-    @staticmethod
-    def _state(x, name: str = "q") -> np.ndarray:
-        # float64 arrays pass through (the core reads any layout); anything else is converted,
-        # complex numbers and text refused (TypeError naming the argument)
-        if type(x) is np.ndarray and x.dtype is _F64:
-            return x
-        return real_array(x, name)
-
     def _reference(self, reference: str) -> int:
         try:
             return _REFERENCES[reference]
         except KeyError:
             raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'") from None
 
-    def _point(self, point) -> np.ndarray | None:
-        if point is None:
-            return None
-        p = real_array(point, "point")
-        if p.shape != (3,) or not np.all(np.isfinite(p)):
-            raise ValueError(f"point must be 3 finite coordinates in the frame's axes, got {point!r}")
-        return p
-
     # kinematics ---------------------------------------------------------------------------
     @batched("q")
     def forward_kinematics(self, q: ArrayLike) -> np.ndarray:
         """Poses of the moving links' frames in the base: (n, 4, 4), or (N, n, 4, 4) for a batch."""
-        return self._model.frame_poses(self._state(q), self._link_frame_ids)
+        return self._model.frame_poses(float64_array(q), self._link_frame_ids)
 
     @batched("q")
     def frame_poses(self, q: ArrayLike, frames: Sequence[str] | None = None) -> np.ndarray:
         """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
         names = self.frame_names if frames is None else list(frames)
         ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
-        return self._model.frame_poses(self._state(q), ids)
+        return self._model.frame_poses(float64_array(q), ids)
 
     @batched("q")
     def pose(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
-        out = self._model.frame_poses(self._state(q), self._frame_id_array(frame or self.tool))
+        out = self._model.frame_poses(float64_array(q), self._frame_id_array(frame or self.tool))
         return out[0] if out.ndim == 3 else out[:, 0]
 
     @cached_property
@@ -460,8 +426,8 @@ class Robot:
         fid = self._frame_ids.get(frame or self.tool)
         ref = _REFERENCES.get(reference)
         if fid is None or ref is None or point is not None:  # the checked path, with its error messages
-            fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
-        return self._model.jacobian(self._state(q), fid, ref, point)
+            fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), point_in_frame(point)
+        return self._model.jacobian(float64_array(q), fid, ref, point)
 
     @batched("q")
     def jacobian_hessian(
@@ -478,7 +444,7 @@ class Robot:
         Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
         """
         fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
-        return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
+        return self._model.jacobian_hessian(float64_array(q), fid, ref, point_in_frame(point))
 
     @batched("q", "qd")
     def frame_velocity(
@@ -491,11 +457,11 @@ class Robot:
     ) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(
-            self._state(q),
-            self._state(qd, "qd"),
+            float64_array(q),
+            float64_array(qd, "qd"),
             self.frame_index(frame or self.tool),
             self._reference(reference),
-            self._point(point),
+            point_in_frame(point),
         )
 
     @batched("q", "qd")
@@ -509,11 +475,11 @@ class Robot:
     ) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
         return self._model.jdot_qd(
-            self._state(q),
-            self._state(qd, "qd"),
+            float64_array(q),
+            float64_array(qd, "qd"),
             self.frame_index(frame or self.tool),
             self._reference(reference),
-            self._point(point),
+            point_in_frame(point),
         )
 
     def inverse_kinematics(
@@ -531,7 +497,7 @@ class Robot:
         if _DASK_ARRAY in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             return lazy_inverse_kinematics(
                 self,
-                target if is_dask_array(target) else _dask_targets(target, q0),
+                target if is_dask_array(target) else dask_targets(target, q0),
                 q0,
                 mask,
                 method,
@@ -541,91 +507,11 @@ class Robot:
         return solve_ik(self, target, q0, mask, method, respect_limits, **kwargs)
 
     # dynamics -----------------------------------------------------------------------------
-    # Equations of motion (DESIGN.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
+    _link_origin_in_body = cached_property(link_origin_in_body)  # (n, 3) or None (kinedyn.native.wrenches)
+
+    # Equations of motion (docs/architecture.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
     # friction = viscous qd + coulomb sign(qd) (direction-dependent levels: friction_torque), M including
     # the reflected rotor inertia r^2 J_m.
-    @cached_property
-    def _link_origin_in_body(self) -> np.ndarray | None:
-        """(n, 3) ``R_bl^T t_bl`` of each link frame in its body (joint) frame, or None if every link
-        frame has its origin at the joint frame's (URDF); DH links sit at ``Tx(a)`` from it."""
-        u = np.zeros((len(self.tree.bodies), 3))
-        for i, name in enumerate(self.body_names):
-            T = to_float_array(self.tree.frames[self.frame_index(name)].placement, (4, 4), f"frame '{name}'")
-            u[i] = T[:3, :3].T @ T[:3, 3]
-        return u if np.any(u) else None
-
-    def _f_ext(self, q, f_ext):
-        """Wrenches about the link-frame origins -> about the body-frame origins the core uses:
-        ``n_body = n_link + (p_link - p_body) x f``, ``p_link - p_body = R_link R_bl^T t_bl``."""
-        if f_ext is None:
-            return None
-        f = real_array(f_ext, "f_ext")
-        links = len(self.tree.bodies)
-        if f.shape == (links, 6) and np.ndim(q) == 2:
-            # one set of wrenches for every state of a batch
-            f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
-        if self._multi_dof:
-            if f.shape[-2:] != (links, 6):
-                raise ValueError(
-                    f"f_ext must have shape ({links}, 6): one wrench per moving link {self.body_names}, got {f.shape}"
-                )
-            u = self._link_origin_in_body
-            if u is not None and f.ndim == np.ndim(q) + 1:
-                R = self.forward_kinematics(q)[..., :3, :3]
-                f = f.copy()
-                f[..., 3:] += np.cross(np.einsum("...ij,...j->...i", R, u), f[..., :3])
-            # the native model has a body per degree of freedom: the link's wrench acts on its last
-            full = np.zeros(f.shape[:-2] + (len(self._dof_body), 6))  # every native body
-            full[..., self._body_last_dof, :] = f
-            return full
-        u = self._link_origin_in_body
-        if u is None or f.shape[-2:] != (links, 6) or f.ndim != np.ndim(q) + 1:
-            return f  # (wrong shapes are reported by the core)
-        R = self.forward_kinematics(q)[..., :3, :3]
-        d = np.einsum("...ij,...j->...i", R, u)
-        f = f.copy()
-        f[..., 3:] += np.cross(d, f[..., :3])
-        return f
-
-    def _singular(self, error: RuntimeError) -> Exception:
-        """The core's singular-mass-matrix error with the joint's name added
-        (:func:`kinedyn.native.singular_mass_matrix_error`); other RuntimeErrors unchanged."""
-        if not isinstance(error, SingularMassMatrixError):
-            return error
-        return singular_mass_matrix_error(
-            error, self.name, self._dof_label, lambda dof: self._nonphysical_note(int(self._dof_body[dof]))
-        )
-
-    def _dof_label(self, dof: int) -> str | None:
-        """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
-        if not 0 <= dof < self.n:
-            return None
-        i = int(self._dof_body[dof])
-        return f"('{self.joint_names[i]}', moving body '{self.body_names[i]}')"
-
-    def _nonphysical_note(self, joint: int) -> str:
-        """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
-        positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
-        subtree, parents = {joint}, self.parents
-        for i in range(joint + 1, len(self.tree.bodies)):  # parent[i] < i
-            if parents[i] in subtree:
-                subtree.add(i)
-        bad = [
-            f"link '{f.name}' ({self.nonphysical[f.name].describe()})"
-            for f in self.tree.frames
-            if f.body in subtree and f.name in self.nonphysical and not self.nonphysical[f.name].positive
-        ]
-        if not bad:
-            return ""
-        return (
-            f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
-            f"{', '.join(bad)}; load the robot with inertia='repair'"
-        )
-
-    @staticmethod
-    def _scalar(x):
-        return float(x) if np.ndim(x) == 0 else x
-
     @batched("q", "qd", "qdd", "f_ext")
     def inverse_dynamics(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: ArrayLike | None = None, out: np.ndarray | None = None
@@ -638,8 +524,8 @@ class Robot:
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
         if f_ext is None:
             return self._model.inverse_dynamics(q, qd, qdd, None, out)
-        q = self._state(q)
-        return self._model.inverse_dynamics(q, qd, qdd, self._f_ext(q, f_ext), out)
+        q = float64_array(q)
+        return self._model.inverse_dynamics(q, qd, qdd, body_wrenches(self, q, f_ext), out)
 
     @batched("q")
     def mass_matrix(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
@@ -654,7 +540,7 @@ class Robot:
         try:
             return self._model.mass_matrix_inverse(q, out)
         except RuntimeError as e:
-            raise self._singular(e) from None
+            raise robot_error(self, e) from None
 
     @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics(
@@ -666,10 +552,10 @@ class Robot:
         try:
             if f_ext is None:
                 return self._model.forward_dynamics(q, qd, tau, None, out)
-            q = self._state(q)
-            return self._model.forward_dynamics(q, qd, tau, self._f_ext(q, f_ext), out)
+            q = float64_array(q)
+            return self._model.forward_dynamics(q, qd, tau, body_wrenches(self, q, f_ext), out)
         except RuntimeError as e:
-            raise self._singular(e) from None
+            raise robot_error(self, e) from None
 
     @batched("q", "qd", "qdd", "f_ext")
     def inverse_dynamics_derivatives(
@@ -683,9 +569,9 @@ class Robot:
         (qd != 0)."""
         if f_ext is None:
             return self._model.inverse_dynamics_derivatives(q, qd, qdd)
-        q = self._state(q)
-        dq, dqd, M = self._model.inverse_dynamics_derivatives(q, qd, qdd, self._f_ext(q, f_ext))
-        shift = self._moment_shift_derivative(q, f_ext)
+        q = float64_array(q)
+        dq, dqd, M = self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self, q, f_ext))
+        shift = moment_shift_derivative(self, q, f_ext)
         return (dq if shift is None else dq + shift), dqd, M
 
     @batched("q", "qd", "tau", "f_ext")
@@ -698,29 +584,12 @@ class Robot:
         try:
             if f_ext is None:
                 return self._model.forward_dynamics_derivatives(q, qd, tau)
-            q = self._state(q)
-            dq, dqd, Minv = self._model.forward_dynamics_derivatives(q, qd, tau, self._f_ext(q, f_ext))
+            q = float64_array(q)
+            dq, dqd, Minv = self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self, q, f_ext))
         except RuntimeError as e:
-            raise self._singular(e) from None
-        shift = self._moment_shift_derivative(q, f_ext)
+            raise robot_error(self, e) from None
+        shift = moment_shift_derivative(self, q, f_ext)
         return (dq if shift is None else dq - Minv @ shift), dqd, Minv
-
-    def _moment_shift_derivative(self, q: ArrayLike, f_ext) -> np.ndarray | None:
-        """The part of dtau/dq the core does not see: :meth:`_f_ext` moves each moment to the body
-        origin with ``d_i(q) x f_i``, and ``d_i = R_i u_i`` turns with the joints supporting body i,
-        ``dd_i/dq_j = w_j x d_i`` (``w_j``: joint j's world axis, column j of body i's angular
-        Jacobian ``Jw_i``); tau has ``-Jw_i^T n_i``, so this adds ``-sum_i Jw_i^T ((w_j x d_i) x f_i)``
-        to column j. None when every link frame sits at its body origin (URDF) or without f_ext."""
-        if f_ext is None or self._link_origin_in_body is None:
-            return None
-        u = self._link_origin_in_body
-        f = np.asarray(f_ext, dtype=np.float64)
-        R = self.forward_kinematics(q)[..., :3, :3]
-        d = np.einsum("...bij,bj->...bi", R, u)
-        Jw = np.stack([self.jacobian(q, frame=name)[..., 3:, :] for name in self.body_names], axis=-3)  # (..., b, 3, n)
-        dd = np.cross(np.swapaxes(Jw, -1, -2), d[..., :, None, :])  # (..., b, j, 3): w_j x d_b
-        dm = np.cross(dd, f[..., :, None, :3])  # (w_j x d_b) x f_b
-        return -np.einsum("...bkr,...bjk->...rj", Jw, dm)
 
     @batched("q", "qd")
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
@@ -746,12 +615,12 @@ class Robot:
     @batched("q", "qd")
     def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> FloatOrArray:
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
-        return self._scalar(self._model.kinetic_energy(q, qd))
+        return scalar_or_array(self._model.kinetic_energy(q, qd))
 
     @batched("q")
     def potential_energy(self, q: ArrayLike) -> FloatOrArray:
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
-        return self._scalar(self._model.potential_energy(q))
+        return scalar_or_array(self._model.potential_energy(q))
 
     @batched("q")
     def center_of_mass(self, q: ArrayLike) -> np.ndarray:

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from .._core import NonFiniteResultError, SingularMassMatrixError
 
-__all__ = ["SingularMassMatrixError", "singular_mass_matrix_error"]
+if TYPE_CHECKING:
+    from ..robot import Robot
+
+__all__ = ["SingularMassMatrixError", "dof_label", "nonphysical_note", "robot_error", "singular_mass_matrix_error"]
 
 
 def _name_first(message: str, joint: int, label: str) -> str:
@@ -37,3 +41,44 @@ def singular_mass_matrix_error(
     if named is not None:
         message += note(error.joint)
     return RuntimeError(f"robot '{robot}': {message}")
+
+
+def robot_error(robot: Robot, error: RuntimeError) -> Exception:
+    """The core's singular-mass-matrix error with the joint's name added
+    (:func:`kinedyn.native.singular_mass_matrix_error`); other RuntimeErrors unchanged."""
+    if not isinstance(error, SingularMassMatrixError):
+        return error
+    return singular_mass_matrix_error(
+        error,
+        robot.name,
+        lambda dof: dof_label(robot, dof),
+        lambda dof: nonphysical_note(robot, int(robot._dof_body[dof])),
+    )
+
+
+def dof_label(robot: Robot, dof: int) -> str | None:
+    """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
+    if not 0 <= dof < robot.n:
+        return None
+    i = int(robot._dof_body[dof])
+    return f"('{robot.joint_names[i]}', moving body '{robot.body_names[i]}')"
+
+
+def nonphysical_note(robot: Robot, joint: int) -> str:
+    """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
+    positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
+    subtree, parents = {joint}, robot.parents
+    for i in range(joint + 1, len(robot.tree.bodies)):  # parent[i] < i
+        if parents[i] in subtree:
+            subtree.add(i)
+    bad = [
+        f"link '{f.name}' ({robot.nonphysical[f.name].describe()})"
+        for f in robot.tree.frames
+        if f.body in subtree and f.name in robot.nonphysical and not robot.nonphysical[f.name].positive
+    ]
+    if not bad:
+        return ""
+    return (
+        f"; the bodies it moves include inertias no rigid body has, kept by inertia='warn': "
+        f"{', '.join(bad)}; load the robot with inertia='repair'"
+    )

@@ -9,6 +9,7 @@ integrator reports (``kinedyn._core.integrate_fixed``)."""
 from __future__ import annotations
 
 from .._core import NonFiniteResultError
+from ..native.errors import nonphysical_note
 
 __all__ = [
     "SimulationError",
@@ -85,8 +86,8 @@ def raise_failure(system, names, failures, steps_done, traj_factory, steps):
             cls, message = failure_message(
                 getattr(system, "name", "system"), names, f, index if len(failures) > 1 else None, steps
             )
-            if f["kind"] == "singular" and isinstance(f.get("joint"), int) and hasattr(system, "_nonphysical_note"):
-                message += system._nonphysical_note(f["joint"])  # a kept non-physical inertia can make M singular
+            if f["kind"] == "singular" and isinstance(f.get("joint"), int) and hasattr(system, "description"):
+                message += nonphysical_note(system, f["joint"])  # a kept non-physical inertia can make M singular
             partial = traj_factory(index, int(steps_done[index]))
             raise cls(
                 message,
