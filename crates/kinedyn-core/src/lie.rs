@@ -27,7 +27,7 @@ pub type Quat = [f64; 4];
 /// there multiplies θ²; the first omitted series term is below 1e-17 at 1e-2.
 const SERIES_BELOW: f64 = 1e-2;
 
-/// The kind of a joint's block of q and v (the lead's `Model` maps its joint kinds onto these).
+/// The kind of a joint's block of q and v ([`crate::model::Coordinates::Head`] has the multi-DOF ones).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Block {
     /// Revolute or prismatic: nq = nv = 1.
@@ -341,17 +341,6 @@ pub fn normalize_block(block: Block, q: &mut [f64]) {
     let n = part.iter().map(|x| x * x).sum::<f64>().sqrt();
     for x in part.iter_mut() {
         *x /= n;
-    }
-}
-
-/// The block kind of a model's multi-DOF joint ([`crate::model::Block`], which has no `Scalar`).
-impl From<crate::model::Block> for Block {
-    fn from(block: crate::model::Block) -> Self {
-        match block {
-            crate::model::Block::FreeFlyer => Block::FreeFlyer,
-            crate::model::Block::Spherical => Block::Spherical,
-            crate::model::Block::Planar => Block::Planar,
-        }
     }
 }
 

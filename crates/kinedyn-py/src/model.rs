@@ -5,7 +5,8 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
-use kinedyn_core::model::{Block, Coordinates};
+use kinedyn_core::lie::Block;
+use kinedyn_core::model::Coordinates;
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};

@@ -2,7 +2,8 @@
 //! unit (a quaternion, or the (cos, sin) pair of a planar joint), since the algorithms read it as a
 //! rotation and any other numbers would give a silently wrong result.
 
-use super::{Block, Coordinates, Model};
+use super::{Coordinates, Model};
+use crate::lie::Block;
 
 /// Largest distance from 1 of the norm of a quaternion or (cos, sin) pair that the algorithms and
 /// the inverse-kinematics solver accept (float64 round-off of a normalised block is ~1e-16; a user's
@@ -10,12 +11,14 @@ use super::{Block, Coordinates, Model};
 pub const UNIT_TOLERANCE: f64 = 1e-6;
 
 impl Block {
-    /// The unit part of a q block, relative to its start, and what it is called in messages.
-    pub fn unit_range(self) -> (std::ops::Range<usize>, &'static str) {
+    /// The unit part of a q block, relative to its start, and what it is called in messages
+    /// (`None`: a scalar block has none).
+    pub fn unit_range(self) -> Option<(std::ops::Range<usize>, &'static str)> {
         match self {
-            Block::FreeFlyer => (3..7, "quaternion (qx, qy, qz, qw)"),
-            Block::Spherical => (0..4, "quaternion (qx, qy, qz, qw)"),
-            Block::Planar => (2..4, "(cos, sin) pair"),
+            Block::FreeFlyer => Some((3..7, "quaternion (qx, qy, qz, qw)")),
+            Block::Spherical => Some((0..4, "quaternion (qx, qy, qz, qw)")),
+            Block::Planar => Some((2..4, "(cos, sin) pair")),
+            Block::Scalar => None,
         }
     }
 }
@@ -30,7 +33,9 @@ impl Model {
         }
         for (i, c) in self.coordinates.iter().enumerate() {
             let Coordinates::Head { block, at } = *c else { continue };
-            let (unit, what) = block.unit_range();
+            let Some((unit, what)) = block.unit_range() else {
+                continue;
+            };
             let norm = q[at + unit.start..at + unit.end]
                 .iter()
                 .map(|x| x * x)
