@@ -29,7 +29,6 @@ from .description.link import Frame, Link
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
-from .native.compile import REFERENCES as _REFERENCES
 from .native.compile import compile_model, locked_block
 from .native.errors import SingularMassMatrixError, singular_mass_matrix_error
 
@@ -403,12 +402,6 @@ class Robot:
             return x
         return real_array(x, name)
 
-    def _reference(self, reference: str) -> int:
-        try:
-            return _REFERENCES[reference]
-        except KeyError:
-            raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'") from None
-
     def _point(self, point) -> np.ndarray | None:
         if point is None:
             return None
@@ -458,10 +451,9 @@ class Robot:
         ``"spatial"``: the spatial Jacobian (velocity of the body point at the base origin).
         """
         fid = self._frame_ids.get(frame or self.tool)
-        ref = _REFERENCES.get(reference)
-        if fid is None or ref is None or point is not None:  # the checked path, with its error messages
-            fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), self._point(point)
-        return self._model.jacobian(self._state(q), fid, ref, point)
+        if fid is None or point is not None:  # the checked path, with its error messages
+            fid, point = self.frame_index(frame or self.tool), self._point(point)
+        return self._model.jacobian(self._state(q), fid, reference, point)
 
     @batched("q")
     def jacobian_hessian(
@@ -477,8 +469,8 @@ class Robot:
         :func:`kinedyn.kinematics.hessian_in_frame_axes`. Computed in the native core from the
         Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
         """
-        fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
-        return self._model.jacobian_hessian(self._state(q), fid, ref, self._point(point))
+        fid = self.frame_index(frame or self.tool)
+        return self._model.jacobian_hessian(self._state(q), fid, reference, self._point(point))
 
     @batched("q", "qd")
     def frame_velocity(
@@ -494,7 +486,7 @@ class Robot:
             self._state(q),
             self._state(qd, "qd"),
             self.frame_index(frame or self.tool),
-            self._reference(reference),
+            reference,
             self._point(point),
         )
 
@@ -512,7 +504,7 @@ class Robot:
             self._state(q),
             self._state(qd, "qd"),
             self.frame_index(frame or self.tool),
-            self._reference(reference),
+            reference,
             self._point(point),
         )
 

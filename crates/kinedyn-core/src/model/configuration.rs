@@ -114,4 +114,25 @@ mod tests {
             "{e}"
         );
     }
+
+    #[test]
+    fn names_at_the_border_decode_into_the_spherical_layout() {
+        let names = ["spherical", "", "", ""];
+        let blocks: Vec<Block> = names.iter().map(|n| Block::from_name(n).unwrap()).collect();
+        let coordinates = Coordinates::from_blocks(&blocks).unwrap();
+        assert_eq!(&coordinates[..3], &spherical().coordinates[..]);
+        assert_eq!(coordinates[3], Coordinates::Scalar { at: 4 });
+        let bad = Coordinates::from_blocks(&[Block::Spherical, Block::Planar]).unwrap_err();
+        assert!(bad.to_string().contains("body 1"), "{bad}");
+        let e = Block::from_name("helical").unwrap_err().to_string();
+        assert!(e.contains("'helical'"), "{e}");
+        let e = crate::joint::JointKind::from_name("continuous")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'continuous'"), "{e}");
+        let e = crate::algorithms::jacobian::Reference::from_name("base")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'base'"), "{e}");
+    }
 }

@@ -42,6 +42,36 @@ pub enum Coordinates {
     Member,
 }
 
+impl Coordinates {
+    /// The coordinates of `n = blocks.len()` bodies from the block each body's joint starts
+    /// ([`Block::Scalar`] for a 1-DOF joint): a multi-DOF head is followed by its `nv - 1` members,
+    /// whose entries must be [`Block::Scalar`]; q blocks follow in body order. The layout itself is
+    /// checked by [`Model::with_coordinates`].
+    pub fn from_blocks(blocks: &[Block]) -> Result<Vec<Coordinates>> {
+        let (mut out, mut at, mut i) = (Vec::with_capacity(blocks.len()), 0, 0);
+        while i < blocks.len() {
+            let block = blocks[i];
+            if block == Block::Scalar {
+                out.push(Coordinates::Scalar { at });
+                (at, i) = (at + 1, i + 1);
+                continue;
+            }
+            out.push(Coordinates::Head { block, at });
+            let end = (i + block.nv()).min(blocks.len());
+            for (k, member) in blocks.iter().enumerate().take(end).skip(i + 1) {
+                if *member != Block::Scalar {
+                    return Err(Error::InvalidModel(format!(
+                        "body {k}: a member of the {block:?} joint starting at body {i} cannot start a {member:?} joint"
+                    )));
+                }
+                out.push(Coordinates::Member);
+            }
+            (at, i) = (at + block.nq(), end);
+        }
+        Ok(out)
+    }
+}
+
 /// A named frame rigidly attached to a body (`None`: the base).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
