@@ -97,7 +97,7 @@ def test_native_model_rejects_bad_negative_levels():
     eye = np.eye(4)
     args = dict(
         parent=np.array([-1]),
-        kind=np.array([0]),
+        kind=["revolute"],
         axis=np.array([[0, 0, 1.0]]),
         offset=np.zeros(1),
         placement=eye[None].copy(),

@@ -269,7 +269,7 @@ def test_native_model_rejects_bad_arrays_without_panicking():
     eye = np.eye(4)[None]
     good = dict(
         parent=np.array([-1]),
-        kind=np.array([0]),
+        kind=["revolute"],
         axis=np.array([[0, 0, 1.0]]),
         offset=np.zeros(1),
         placement=eye.copy(),
@@ -285,7 +285,7 @@ def test_native_model_rejects_bad_arrays_without_panicking():
     cases = {
         "axis": (dict(axis=np.array([[0, 0, 2.0]])), "unit vector"),
         "parent": (dict(parent=np.array([0])), "parent"),
-        "kind": (dict(kind=np.array([7])), "unknown kind"),
+        "kind": (dict(kind=["helical"]), "unknown joint kind .helical."),
         "shape": (dict(placement=np.eye(4)), "placement must have shape"),
         "frame": (dict(frame_body=np.array([3])), "out of range"),
         "mass": (dict(inertia=np.array([[-1.0] + [0] * 9])), "negative mass"),

@@ -65,7 +65,7 @@ def _calls(robot, q, v, a):
         "potential_energy": (lambda *x: model.potential_energy(*x), (q,)),
         "frame_poses": (lambda q: model.frame_poses(q, np.arange(model.n_frames)), (q,)),
     }
-    for reference in range(3):  # world, local, spatial
+    for reference in ("world", "local", "spatial"):
         calls[f"jacobian {reference}"] = (lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r), (q,))
         calls[f"jacobian {reference} at a point"] = (
             lambda q, r=reference: model.jacobian(q, model.n_frames - 1, r, np.array([0.1, -0.2, 0.3])),

@@ -7,7 +7,7 @@ TypeError). Finite inputs with a non-finite result raise NonFiniteResultError na
 the state of a batch); a result that cannot be allocated raises MemoryError naming its bytes; a panic
 of the native code (a bug) raises RuntimeError naming the binding, never pyo3's PanicException.
 Batches run in a thread pool rebuilt in a forked child, so they work after ``fork``.
-``reference``: 0 = "world" (LOCAL_WORLD_ALIGNED), 1 = "local", 2 = "spatial" (WORLD).
+``reference``: "world" (LOCAL_WORLD_ALIGNED), "local" or "spatial" (WORLD).
 """
 
 from collections.abc import Callable, Sequence
@@ -23,7 +23,7 @@ class Model:
     def __init__(
         self,
         parent: I64,  # (n,) parent body index, -1 = base, parent[i] < i
-        kind: I64,  # (n,) 0 = revolute, 1 = prismatic
+        kind: Sequence[str],  # (n,) "revolute" or "prismatic"
         axis: F64,  # (n, 3) unit joint axis in the joint frame
         offset: F64,  # (n,) joint offset added to q
         placement: F64,  # (n, 4, 4) parent body frame -> joint frame at q = 0
@@ -35,8 +35,9 @@ class Model:
         frame_body: I64,  # (nf,) body of each named frame, -1 = base
         frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
         coulomb_negative: F64 | None = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
-        blocks: I64
-        | None = None,  # (n,) 0 a 1-DOF joint; 1/2/3 head of a free-flyer/spherical/planar joint; -1 its further bodies
+        # (n,) the block each body's joint starts: "floating", "spherical", "planar"; "" or None for a
+        # 1-DOF joint and for a multi-DOF joint's further bodies
+        blocks: Sequence[str | None] | None = None,
     ) -> None: ...
     @property
     def n(self) -> int: ...  # bodies = degrees of freedom (nv)
@@ -46,15 +47,15 @@ class Model:
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
-    def jacobian(self, q: F64, frame: int, reference: int, point: F64 | None = None) -> F64: ...  # (6, n) | (N, 6, n)
+    def jacobian(self, q: F64, frame: int, reference: str, point: F64 | None = None) -> F64: ...  # (6, n) | (N, 6, n)
     def jacobian_hessian(
-        self, q: F64, frame: int, reference: int, point: F64 | None = None
+        self, q: F64, frame: int, reference: str, point: F64 | None = None
     ) -> F64: ...  # (n, 6, n) | (N, n, 6, n), H[i, r, j] = dJ[r, j]/dq_i
     def frame_velocity(
-        self, q: F64, qd: F64, frame: int, reference: int, point: F64 | None = None
+        self, q: F64, qd: F64, frame: int, reference: str, point: F64 | None = None
     ) -> F64: ...  # (6,) | (N, 6)
     def jdot_qd(
-        self, q: F64, qd: F64, frame: int, reference: int, point: F64 | None = None
+        self, q: F64, qd: F64, frame: int, reference: str, point: F64 | None = None
     ) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----
     # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the body origin.

@@ -29,7 +29,6 @@ from .description.link import Frame, Link
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
-from .native.compile import REFERENCES as _REFERENCES
 from .native.compile import compile_model, locked_block
 from .native.errors import robot_error
 from .native.wrenches import body_wrenches, link_origin_in_body, moment_shift_derivative
@@ -377,12 +376,6 @@ class Robot:
     def _link_frame_ids(self) -> np.ndarray:
         return np.array([self.frame_index(name) for name in self.body_names], dtype=np.int64)
 
-    def _reference(self, reference: str) -> int:
-        try:
-            return _REFERENCES[reference]
-        except KeyError:
-            raise ValueError(f"reference must be one of {list(_REFERENCES)}, got '{reference}'") from None
-
     # kinematics ---------------------------------------------------------------------------
     @batched("q")
     def forward_kinematics(self, q: ArrayLike) -> np.ndarray:
@@ -424,10 +417,9 @@ class Robot:
         ``"spatial"``: the spatial Jacobian (velocity of the body point at the base origin).
         """
         fid = self._frame_ids.get(frame or self.tool)
-        ref = _REFERENCES.get(reference)
-        if fid is None or ref is None or point is not None:  # the checked path, with its error messages
-            fid, ref, point = self.frame_index(frame or self.tool), self._reference(reference), point_in_frame(point)
-        return self._model.jacobian(float64_array(q), fid, ref, point)
+        if fid is None or point is not None:  # the checked path, with its error messages
+            fid, point = self.frame_index(frame or self.tool), point_in_frame(point)
+        return self._model.jacobian(float64_array(q), fid, reference, point)
 
     @batched("q")
     def jacobian_hessian(
@@ -443,8 +435,8 @@ class Robot:
         :func:`kinedyn.kinematics.hessian_in_frame_axes`. Computed in the native core from the
         Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
         """
-        fid, ref = self.frame_index(frame or self.tool), self._reference(reference)
-        return self._model.jacobian_hessian(float64_array(q), fid, ref, point_in_frame(point))
+        fid = self.frame_index(frame or self.tool)
+        return self._model.jacobian_hessian(float64_array(q), fid, reference, point_in_frame(point))
 
     @batched("q", "qd")
     def frame_velocity(
@@ -460,7 +452,7 @@ class Robot:
             float64_array(q),
             float64_array(qd, "qd"),
             self.frame_index(frame or self.tool),
-            self._reference(reference),
+            reference,
             point_in_frame(point),
         )
 
@@ -478,7 +470,7 @@ class Robot:
             float64_array(q),
             float64_array(qd, "qd"),
             self.frame_index(frame or self.tool),
-            self._reference(reference),
+            reference,
             point_in_frame(point),
         )
 

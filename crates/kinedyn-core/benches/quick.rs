@@ -250,7 +250,8 @@ fn bench_tree(tree: &models::TreeFile, filter: &str) {
 /// The same calls as crba_blocks, on the model's own data, without the rest of the algorithm.
 fn free_flyer_crba_share(model: &kinedyn_core::Model, data: &mut Data, tree: &models::TreeFile, filter: &str) {
     use kinedyn_core::algorithms::kinematics::{inertia_to_parent, joint_trig, parent_from_body_trig};
-    use kinedyn_core::model::{Block, Coordinates};
+    use kinedyn_core::lie::Block;
+    use kinedyn_core::model::Coordinates;
     use kinedyn_core::spatial::{Force, Inertia, Vec3};
     if !matches!(
         model.coordinates.first(),

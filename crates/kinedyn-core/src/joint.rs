@@ -1,5 +1,6 @@
 //! Joint kinds and the one function that decodes them, `jcalc` (RBDA §4.4, Table 4.1).
 
+use crate::error::{Error, Result};
 use crate::spatial::{cross, mm, mv, splat3, Force, Inertia, Mat3, Motion, Real, Transform, Vec3};
 
 /// The closed set of joint kinds of the compiled model (fixed joints are merged at build time).
@@ -9,6 +10,19 @@ pub enum JointKind {
     Revolute,
     /// Translation along `axis` by the joint coordinate.
     Prismatic,
+}
+
+impl JointKind {
+    /// The kind named "revolute" or "prismatic" (the one place the border's names become kinds).
+    pub fn from_name(name: &str) -> Result<JointKind> {
+        match name {
+            "revolute" => Ok(JointKind::Revolute),
+            "prismatic" => Ok(JointKind::Prismatic),
+            _ => Err(Error::InvalidModel(format!(
+                "unknown joint kind '{name}' (expected 'revolute' or 'prismatic')"
+            ))),
+        }
+    }
 }
 
 /// A one-degree-of-freedom joint: its kind and unit axis in the joint frame.

@@ -18,6 +18,7 @@
 //! Symbols: `omega` ω rotation vector (rad), `theta` θ = |ω|, `rho` ρ linear part of a twist, `quat`
 //! a quaternion stored (x, y, z, w), `p` a translation.
 
+use crate::error::{Error, Result};
 use crate::spatial::{Mat3, Real};
 
 /// A quaternion (x, y, z, w), w the scalar part (Pinocchio's and Eigen's storage order).
@@ -27,7 +28,7 @@ pub type Quat = [f64; 4];
 /// there multiplies θ²; the first omitted series term is below 1e-17 at 1e-2.
 const SERIES_BELOW: f64 = 1e-2;
 
-/// The kind of a joint's block of q and v (the lead's `Model` maps its joint kinds onto these).
+/// The kind of a joint's block of q and v ([`crate::model::Coordinates::Head`] has the multi-DOF ones).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Block {
     /// Revolute or prismatic: nq = nv = 1.
@@ -41,6 +42,20 @@ pub enum Block {
 }
 
 impl Block {
+    /// The block of a joint named by its description kind: "floating", "spherical", "planar", or
+    /// "" for a 1-DOF joint (the one place the border's names become blocks).
+    pub fn from_name(name: &str) -> Result<Block> {
+        match name {
+            "" => Ok(Block::Scalar),
+            "floating" => Ok(Block::FreeFlyer),
+            "spherical" => Ok(Block::Spherical),
+            "planar" => Ok(Block::Planar),
+            _ => Err(Error::InvalidModel(format!(
+                "unknown joint block kind '{name}' (expected 'floating', 'spherical', 'planar' or '' for a 1-DOF joint)"
+            ))),
+        }
+    }
+
     /// Length of the block in q.
     pub const fn nq(self) -> usize {
         match self {
@@ -341,17 +356,6 @@ pub fn normalize_block(block: Block, q: &mut [f64]) {
     let n = part.iter().map(|x| x * x).sum::<f64>().sqrt();
     for x in part.iter_mut() {
         *x /= n;
-    }
-}
-
-/// The block kind of a model's multi-DOF joint ([`crate::model::Block`], which has no `Scalar`).
-impl From<crate::model::Block> for Block {
-    fn from(block: crate::model::Block) -> Self {
-        match block {
-            crate::model::Block::FreeFlyer => Block::FreeFlyer,
-            crate::model::Block::Spherical => Block::Spherical,
-            crate::model::Block::Planar => Block::Planar,
-        }
     }
 }
 

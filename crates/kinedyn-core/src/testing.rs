@@ -186,7 +186,8 @@ pub const UR5_DH: [(f64, f64, f64); 6] = [
 /// angular x, y, z, the last carrying a random inertia), with a spherical joint in place of its
 /// second body when `n >= 2`: the multi-DOF layout of `Model::with_coordinates`.
 pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
-    use crate::model::{Block, Coordinates};
+    use crate::lie::Block;
+    use crate::model::Coordinates;
     let tail = random_model(seed, n, branching);
     let mut rng = Rng::new(seed ^ 0x5eed);
     let unit = |k: usize| Vec3::ith(k % 3, 1.0);
@@ -296,7 +297,8 @@ pub fn random_floating_model(seed: u64, n: usize, branching: bool) -> Model {
 /// A random configuration of `model` (nq numbers): joint coordinates in `[-3, 3]`, unit quaternions
 /// for free-flyer and spherical joints, `(cos, sin)` of a random angle for planar ones.
 pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
-    use crate::model::{Block, Coordinates};
+    use crate::lie::Block;
+    use crate::model::Coordinates;
     let mut q = vec![0.0; model.nq];
     for c in &model.coordinates {
         match *c {
@@ -306,6 +308,7 @@ pub fn random_configuration(model: &Model, rng: &mut Rng) -> Vec<f64> {
                     Block::FreeFlyer => (at + 3, true),
                     Block::Spherical => (at, true),
                     Block::Planar => (at + 2, false),
+                    Block::Scalar => unreachable!("a multi-DOF head is never a scalar block"),
                 };
                 for x in &mut q[at..start] {
                     *x = rng.uniform(-1.0, 1.0);

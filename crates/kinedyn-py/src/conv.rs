@@ -206,15 +206,8 @@ pub(crate) fn vec_of(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[usize]) -
     Ok(a.as_array().iter().copied().collect())
 }
 
-pub(crate) fn reference(code: i64) -> PyResult<Reference> {
-    match code {
-        0 => Ok(Reference::World),
-        1 => Ok(Reference::Local),
-        2 => Ok(Reference::Spatial),
-        _ => Err(PyValueError::new_err(format!(
-            "reference code must be 0 (world), 1 (local) or 2 (spatial), got {code}"
-        ))),
-    }
+pub(crate) fn reference(name: &str) -> PyResult<Reference> {
+    Reference::from_name(name).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// A frame index of a model with `nf` frames.

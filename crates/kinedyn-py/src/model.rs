@@ -5,7 +5,8 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
-use kinedyn_core::model::{Block, Coordinates};
+use kinedyn_core::lie::Block;
+use kinedyn_core::model::Coordinates;
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::{Data, Frame, Joint, JointKind, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
@@ -150,7 +151,7 @@ model_methods! {
         #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None, blocks=None))]
         fn new(
             parent: Vec<i64>,
-            kind: Vec<i64>,
+            kind: Vec<String>,
             axis: PyReadonlyArrayDyn<f64>,
             offset: Vec<f64>,
             placement: PyReadonlyArrayDyn<f64>,
@@ -162,7 +163,7 @@ model_methods! {
             frame_body: Vec<i64>,
             frame_placement: PyReadonlyArrayDyn<f64>,
             coulomb_negative: Option<Vec<f64>>,
-            blocks: Option<Vec<i64>>,
+            blocks: Option<Vec<Option<String>>>,
         ) -> PyResult<Self> {
             guarded("Model.__new__", || {
                 let n = parent.len();
@@ -200,12 +201,10 @@ model_methods! {
                 let joints = kind
                     .iter()
                     .enumerate()
-                    .map(|(i, &k)| {
-                        let kind = match k {
-                            0 => JointKind::Revolute,
-                            1 => JointKind::Prismatic,
-                            _ => return Err(PyValueError::new_err(format!("joint {i}: unknown kind code {k}"))),
-                        };
+                    .map(|(i, k)| {
+                        let kind = JointKind::from_name(k).map_err(|e| {
+                            PyValueError::new_err(format!("joint {i}: {e}"))
+                        })?;
                         Ok(Joint {
                             kind,
                             axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]),
@@ -240,42 +239,24 @@ model_methods! {
                 if let Some(levels) = coulomb_negative {
                     model = model.with_coulomb_negative(levels).map_err(core_err)?;
                 }
-                if let Some(codes) = blocks {
-                    // per body: 0 a 1-DOF joint, 1 / 2 / 3 the head of a free-flyer / spherical / planar
-                    // joint, -1 a further member of the multi-DOF joint before it
-                    if codes.len() != n {
+                if let Some(names) = blocks {
+                    // per body: the block its joint starts ("floating", "spherical", "planar"; "" or
+                    // None for a 1-DOF joint and for a multi-DOF joint's further bodies)
+                    if names.len() != n {
                         return Err(PyValueError::new_err(format!(
                             "blocks has {} entries for {n} bodies",
-                            codes.len()
+                            names.len()
                         )));
                     }
-                    let mut at = 0;
-                    let mut coordinates = Vec::with_capacity(n);
-                    for (i, &code) in codes.iter().enumerate() {
-                        let c = match code {
-                            0 => Coordinates::Scalar { at },
-                            1 => Coordinates::Head {
-                                block: Block::FreeFlyer,
-                                at,
-                            },
-                            2 => Coordinates::Head {
-                                block: Block::Spherical,
-                                at,
-                            },
-                            3 => Coordinates::Head {
-                                block: Block::Planar,
-                                at,
-                            },
-                            -1 => Coordinates::Member,
-                            _ => return Err(PyValueError::new_err(format!("body {i}: unknown block code {code}"))),
-                        };
-                        at += match c {
-                            Coordinates::Scalar { .. } => 1,
-                            Coordinates::Head { block, .. } => block.nq(),
-                            Coordinates::Member => 0,
-                        };
-                        coordinates.push(c);
-                    }
+                    let blocks = names
+                        .iter()
+                        .enumerate()
+                        .map(|(i, name)| {
+                            Block::from_name(name.as_deref().unwrap_or(""))
+                                .map_err(|e| PyValueError::new_err(format!("body {i}: {e}")))
+                        })
+                        .collect::<PyResult<Vec<_>>>()?;
+                    let coordinates = Coordinates::from_blocks(&blocks).map_err(core_err)?;
                     model = model.with_coordinates(coordinates).map_err(core_err)?;
                 }
                 let data = Mutex::new(Data::new(&model));
@@ -332,7 +313,7 @@ model_methods! {
             py: Python<'py>,
             q: Bound<'py, PyArrayDyn<f64>>,
             frame: i64,
-            reference: i64,
+            reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian", || {
@@ -361,7 +342,7 @@ model_methods! {
             py: Python<'py>,
             q: Bound<'py, PyArrayDyn<f64>>,
             frame: i64,
-            reference: i64,
+            reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian_hessian", || {
@@ -389,7 +370,7 @@ model_methods! {
             q: Bound<'py, PyArrayDyn<f64>>,
             qd: Bound<'py, PyArrayDyn<f64>>,
             frame: i64,
-            reference: i64,
+            reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.frame_velocity", || {
@@ -411,7 +392,7 @@ model_methods! {
             q: Bound<'py, PyArrayDyn<f64>>,
             qd: Bound<'py, PyArrayDyn<f64>>,
             frame: i64,
-            reference: i64,
+            reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jdot_qd", || {

@@ -3,12 +3,11 @@
 the messages users read (:mod:`kinedyn.native.errors`), and the native model of a robot with mimic
 joints in its reduced coordinates (:mod:`kinedyn.native.mimic`)."""
 
-from .compile import REFERENCES, compile_model, joint_columns, locked_block, planar_basis
+from .compile import compile_model, joint_columns, locked_block, planar_basis
 from .errors import SingularMassMatrixError, singular_mass_matrix_error
 from .mimic import ReducedModel
 
 __all__ = [
-    "REFERENCES",
     "ReducedModel",
     "SingularMassMatrixError",
     "compile_model",

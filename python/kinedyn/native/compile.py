@@ -18,13 +18,10 @@ from .mimic import ReducedModel
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["REFERENCES", "compile_model", "joint_columns", "locked_block", "planar_basis"]
+__all__ = ["compile_model", "joint_columns", "locked_block", "planar_basis"]
 
-# the native model's code of a Jacobian reference (crates/kinedyn-py/src/conv.rs, `reference`)
-REFERENCES = {"world": 0, "local": 1, "spatial": 2}
-
-# the native model's code for the first body of each multi-DOF joint (crates/kinedyn-py/src/model.rs, `new`)
-_BLOCK_CODES = {"floating": 1, "spherical": 2, "planar": 3}
+# the joint kinds the core decodes into multi-DOF blocks (lie::Block::from_name)
+MULTI_DOF_KINDS = ("floating", "spherical", "planar")
 
 
 def locked_block(joint, block) -> np.ndarray:
@@ -56,19 +53,19 @@ def locked_block(joint, block) -> np.ndarray:
 
 
 def joint_columns(joint) -> list:
-    """The native bodies' (kind code, unit axis) of a joint's motion subspace, in its child's frame:
-    1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z; spherical: angular x, y, z;
-    planar: linear e1, e2, angular normal (0 revolute, 1 prismatic)."""
+    """The native bodies' (kind, unit axis) of a joint's motion subspace, in its child's frame, kind
+    "revolute" or "prismatic": 1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z;
+    spherical: angular x, y, z; planar: linear e1, e2, angular normal."""
     e = np.eye(3)
     if joint.kind == "floating":
-        return [(1, e[k]) for k in range(3)] + [(0, e[k]) for k in range(3)]
+        return [("prismatic", e[k]) for k in range(3)] + [("revolute", e[k]) for k in range(3)]
     if joint.kind == "spherical":
-        return [(0, e[k]) for k in range(3)]
+        return [("revolute", e[k]) for k in range(3)]
     axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
     if joint.kind == "planar":
         e1, e2 = planar_basis(axis)
-        return [(1, e1), (1, e2), (0, np.cross(e1, e2))]
-    return [(0 if joint.kind == "revolute" else 1, axis)]
+        return [("prismatic", e1), ("prismatic", e2), ("revolute", np.cross(e1, e2))]
+    return [("revolute" if joint.kind == "revolute" else "prismatic", axis)]
 
 
 def compile_model(robot: Robot):
@@ -106,7 +103,7 @@ def compile_model(robot: Robot):
                 offset.append(0.0)
             kind.append(k)
             axis.append(a)
-        blocks.extend([_BLOCK_CODES.get(joint.kind, 0)] + [-1] * (len(columns) - 1))
+        blocks.extend([joint.kind if joint.kind in MULTI_DOF_KINDS else ""] + [""] * (len(columns) - 1))
         inertia[last[b]] = link_inertia[b]
 
     # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
@@ -127,7 +124,7 @@ def compile_model(robot: Robot):
     asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
     native = Model(
         np.array(parent, dtype=np.int64),
-        np.array(kind, dtype=np.int64),
+        kind,
         np.array(axis, dtype=float).reshape(-1, 3),
         np.array(offset),
         np.array(placement).reshape(-1, 4, 4),
@@ -139,7 +136,7 @@ def compile_model(robot: Robot):
         frame_body,
         frame_placement,
         coulomb_negative=asymmetric,
-        blocks=np.array(blocks, dtype=np.int64) if robot.has_multi_dof_joints else None,
+        blocks=blocks if robot.has_multi_dof_joints else None,
     )
     if robot._mimic is None:
         return native

@@ -156,7 +156,8 @@ fn parse_numbers(path: &str, line: &str, words: &mut std::str::SplitWhitespace, 
 /// link), as `python/kinedyn/robot.py`'s `_model` compiles it; revolute and prismatic joints one each.
 #[allow(dead_code)]
 pub fn read_tree(path: &str) -> TreeFile {
-    use kinedyn_core::model::{Block, Coordinates};
+    use kinedyn_core::lie::Block;
+    use kinedyn_core::model::Coordinates;
     use kinedyn_core::JointKind::{Prismatic, Revolute};
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
     let mut lines = text.lines();

@@ -12,6 +12,7 @@
 
 use super::kinematics::{forward_acceleration, forward_kinematics, forward_velocity, frame_pose};
 use crate::data::Data;
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::{cross, mtv, Mat3, Motion, Real, Transform, Vec3};
 
@@ -21,6 +22,20 @@ pub enum Reference {
     World,
     Local,
     Spatial,
+}
+
+impl Reference {
+    /// "world" (Pinocchio's LOCAL_WORLD_ALIGNED), "local" or "spatial" (Pinocchio's WORLD).
+    pub fn from_name(name: &str) -> Result<Reference> {
+        match name {
+            "world" => Ok(Reference::World),
+            "local" => Ok(Reference::Local),
+            "spatial" => Ok(Reference::Spatial),
+            _ => Err(Error::InvalidInput(format!(
+                "reference must be one of ['world', 'local', 'spatial'], got '{name}'"
+            ))),
+        }
+    }
 }
 
 /// `body_from_frame` of a frame, moved to a point given in the frame's axes.

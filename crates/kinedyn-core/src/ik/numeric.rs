@@ -108,7 +108,7 @@ impl<'a> Space<'a> {
             .iter()
             .enumerate()
             .filter_map(|(i, c)| match *c {
-                Coordinates::Head { block, at } => solver_q(at).map(|k| ((lie::Block::from(block), k), i)),
+                Coordinates::Head { block, at } => solver_q(at).map(|k| ((block, k), i)),
                 _ => None,
             })
             .unzip();
@@ -489,7 +489,8 @@ mod tests {
     /// nq = 12, nv = 10.
     fn floating_model() -> Model {
         use crate::joint::Joint;
-        use crate::model::{Block, Frame};
+        use crate::lie::Block;
+        use crate::model::Frame;
         use crate::spatial::Inertia;
         let mut rng = Rng::new(4);
         let unit = |k: usize| Vec3::ith(k, 1.0);

@@ -2,7 +2,8 @@
 //! unit (a quaternion, or the (cos, sin) pair of a planar joint), since the algorithms read it as a
 //! rotation and any other numbers would give a silently wrong result.
 
-use super::{Block, Coordinates, Model};
+use super::{Coordinates, Model};
+use crate::lie::Block;
 
 /// Largest distance from 1 of the norm of a quaternion or (cos, sin) pair that the algorithms and
 /// the inverse-kinematics solver accept (float64 round-off of a normalised block is ~1e-16; a user's
@@ -10,12 +11,14 @@ use super::{Block, Coordinates, Model};
 pub const UNIT_TOLERANCE: f64 = 1e-6;
 
 impl Block {
-    /// The unit part of a q block, relative to its start, and what it is called in messages.
-    pub fn unit_range(self) -> (std::ops::Range<usize>, &'static str) {
+    /// The unit part of a q block, relative to its start, and what it is called in messages
+    /// (`None`: a scalar block has none).
+    pub fn unit_range(self) -> Option<(std::ops::Range<usize>, &'static str)> {
         match self {
-            Block::FreeFlyer => (3..7, "quaternion (qx, qy, qz, qw)"),
-            Block::Spherical => (0..4, "quaternion (qx, qy, qz, qw)"),
-            Block::Planar => (2..4, "(cos, sin) pair"),
+            Block::FreeFlyer => Some((3..7, "quaternion (qx, qy, qz, qw)")),
+            Block::Spherical => Some((0..4, "quaternion (qx, qy, qz, qw)")),
+            Block::Planar => Some((2..4, "(cos, sin) pair")),
+            Block::Scalar => None,
         }
     }
 }
@@ -30,7 +33,9 @@ impl Model {
         }
         for (i, c) in self.coordinates.iter().enumerate() {
             let Coordinates::Head { block, at } = *c else { continue };
-            let (unit, what) = block.unit_range();
+            let Some((unit, what)) = block.unit_range() else {
+                continue;
+            };
             let norm = q[at + unit.start..at + unit.end]
                 .iter()
                 .map(|x| x * x)
@@ -108,5 +113,26 @@ mod tests {
             e.starts_with("q[0..4] of state 3, the quaternion (qx, qy, qz, qw) of the Spherical joint at body 0"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn names_at_the_border_decode_into_the_spherical_layout() {
+        let names = ["spherical", "", "", ""];
+        let blocks: Vec<Block> = names.iter().map(|n| Block::from_name(n).unwrap()).collect();
+        let coordinates = Coordinates::from_blocks(&blocks).unwrap();
+        assert_eq!(&coordinates[..3], &spherical().coordinates[..]);
+        assert_eq!(coordinates[3], Coordinates::Scalar { at: 4 });
+        let bad = Coordinates::from_blocks(&[Block::Spherical, Block::Planar]).unwrap_err();
+        assert!(bad.to_string().contains("body 1"), "{bad}");
+        let e = Block::from_name("helical").unwrap_err().to_string();
+        assert!(e.contains("'helical'"), "{e}");
+        let e = crate::joint::JointKind::from_name("continuous")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'continuous'"), "{e}");
+        let e = crate::algorithms::jacobian::Reference::from_name("base")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'base'"), "{e}");
     }
 }

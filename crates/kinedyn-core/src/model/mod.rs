@@ -22,44 +22,54 @@ pub use configuration::UNIT_TOLERANCE;
 
 use crate::error::{Error, Result};
 use crate::joint::Joint;
+use crate::lie::Block;
 use crate::spatial::{splat3, AxisRotation, Inertia, Mat3, Motion, Real, Transform, Vec3};
-
-/// The multi-DOF joint kinds (their columns and q blocks, Pinocchio's conventions).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Block {
-    /// q = (x, y, z, qx, qy, qz, qw), columns: linear x, y, z then angular x, y, z of the child frame.
-    FreeFlyer,
-    /// q = (qx, qy, qz, qw), columns: angular x, y, z of the child frame.
-    Spherical,
-    /// q = (x, y, cos th, sin th), columns: linear e1, e2 and angular n (the members' axes, with
-    /// (e1, e2, n) right-handed): translation x e1 + y e2, rotation th about n.
-    Planar,
-}
-
-impl Block {
-    pub fn nq(self) -> usize {
-        match self {
-            Block::FreeFlyer => 7,
-            Block::Spherical | Block::Planar => 4,
-        }
-    }
-    pub fn nv(self) -> usize {
-        match self {
-            Block::FreeFlyer => 6,
-            Block::Spherical | Block::Planar => 3,
-        }
-    }
-}
 
 /// Where body i's joint transform comes from in the configuration q.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Coordinates {
     /// A 1-DOF joint with coordinate `q[at]`.
     Scalar { at: usize },
-    /// The first body of a multi-DOF joint, whose transform is read from `q[at..at + block.nq()]`.
+    /// The first body of a multi-DOF joint, whose transform is read from `q[at..at + block.nq()]`
+    /// (never [`Block::Scalar`]: [`Model::with_coordinates`] refuses it). Columns and q blocks follow
+    /// Pinocchio's conventions: a free-flyer's q = (x, y, z, qx, qy, qz, qw) with columns linear x, y,
+    /// z then angular x, y, z of the child frame; a spherical joint's q = (qx, qy, qz, qw) with
+    /// columns angular x, y, z; a planar joint's q = (x, y, cos th, sin th) with columns linear e1, e2
+    /// and angular n (the members' axes, (e1, e2, n) right-handed): translation x e1 + y e2, rotation
+    /// th about n.
     Head { block: Block, at: usize },
     /// A further degree of freedom of the multi-DOF joint of the body before (identity transform).
     Member,
+}
+
+impl Coordinates {
+    /// The coordinates of `n = blocks.len()` bodies from the block each body's joint starts
+    /// ([`Block::Scalar`] for a 1-DOF joint): a multi-DOF head is followed by its `nv - 1` members,
+    /// whose entries must be [`Block::Scalar`]; q blocks follow in body order. The layout itself is
+    /// checked by [`Model::with_coordinates`].
+    pub fn from_blocks(blocks: &[Block]) -> Result<Vec<Coordinates>> {
+        let (mut out, mut at, mut i) = (Vec::with_capacity(blocks.len()), 0, 0);
+        while i < blocks.len() {
+            let block = blocks[i];
+            if block == Block::Scalar {
+                out.push(Coordinates::Scalar { at });
+                (at, i) = (at + 1, i + 1);
+                continue;
+            }
+            out.push(Coordinates::Head { block, at });
+            let end = (i + block.nv()).min(blocks.len());
+            for (k, member) in blocks.iter().enumerate().take(end).skip(i + 1) {
+                if *member != Block::Scalar {
+                    return Err(Error::InvalidModel(format!(
+                        "body {k}: a member of the {block:?} joint starting at body {i} cannot start a {member:?} joint"
+                    )));
+                }
+                out.push(Coordinates::Member);
+            }
+            (at, i) = (at + block.nq(), end);
+        }
+        Ok(out)
+    }
 }
 
 /// A named frame rigidly attached to a body (`None`: the base).
@@ -266,6 +276,14 @@ impl Model {
                     nq += 1;
                     i += 1;
                 }
+                Coordinates::Head {
+                    block: Block::Scalar, ..
+                } => {
+                    return bad(
+                        i,
+                        "a multi-DOF head with a scalar block (use Coordinates::Scalar)".into(),
+                    )
+                }
                 Coordinates::Head { block, at } => {
                     if at != nq {
                         return bad(i, format!("reads q[{at}..], expected q[{nq}..] (blocks in body order)"));
@@ -329,6 +347,7 @@ impl Model {
                 let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
                 vec![(Prismatic, e1), (Prismatic, e2), (Revolute, e1.cross(&e2))]
             }
+            Block::Scalar => vec![],
         };
         let bad = |k: usize, why: &str| {
             Err(Error::InvalidModel(format!(
@@ -381,6 +400,7 @@ impl Model {
                 let rot = Mat3::identity() * c + skew_n * s + nn * (T::one() - c);
                 Transform::new(rot, splat3::<T>(&e1) * qb[0] + splat3::<T>(&e2) * qb[1])
             }
+            Block::Scalar => unreachable!("a multi-DOF head is never a scalar block (with_coordinates)"),
         }
     }
 
@@ -398,13 +418,7 @@ impl Model {
                 Coordinates::Scalar { at } => out[at] = q[at] + v[i] * dt,
                 Coordinates::Head { block, at } => {
                     let end = at + block.nq();
-                    crate::lie::integrate_block(
-                        block.into(),
-                        &q[at..end],
-                        &v[i..i + block.nv()],
-                        dt,
-                        &mut out[at..end],
-                    );
+                    crate::lie::integrate_block(block, &q[at..end], &v[i..i + block.nv()], dt, &mut out[at..end]);
                 }
                 Coordinates::Member => {}
             }
@@ -424,7 +438,7 @@ impl Model {
             if let Coordinates::Head { block, .. } = *c {
                 let k = block.nv();
                 let (w, x) = (&omega[i..i + k], &v[i..i + k]);
-                let bracket = |a: &[f64], b: &[f64]| -> [f64; 6] { crate::lie::lie_bracket(block.into(), a, b) };
+                let bracket = |a: &[f64], b: &[f64]| -> [f64; 6] { crate::lie::lie_bracket(block, a, b) };
                 let wx = bracket(w, x);
                 let wwx = bracket(w, &wx[..k]);
                 for j in 0..k {
