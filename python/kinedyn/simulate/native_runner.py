@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _core
+from .._core import integrate_callback, integrate_fixed
 
 __all__ = ["run_native"]
 
@@ -54,18 +54,18 @@ def run_native(
                     tau = u_data
                 else:
                     tau = np.ascontiguousarray(u_data[..., k0 : k0 + m + (1 if linear else 0), :])
-            res = _core.integrate_fixed(
+            res = integrate_fixed(
                 model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper
             )
         else:
             if batch is None:
                 cb = _offset(torque_for(0), k0)
-                res = _core.integrate_callback(
+                res = integrate_callback(
                     model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper
                 )
             else:
                 results: list[tuple[Any, ...]] = [
-                    _core.integrate_callback(
+                    integrate_callback(
                         model,
                         method,
                         q[i],
