@@ -245,7 +245,7 @@ def _equations(eom) -> dict:
     else:
         out["plain"] = [
             _equation(eom, lhs, value)
-            for lhs, value in [(of_q("D"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]
+            for lhs, value in [(of_q("M"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]
         ]
         # one line per joint: the torques are long
         out["plain"] += [

@@ -20,6 +20,7 @@ from .backends import c_numpy, casadi
 from .derive import cse, proofs, regressor
 from .render import latex
 from .render.mathml import equation_mathml, name, of_q, rate_symbols, text_of
+from .render.text import equation_text
 from .steps import Step, op_counts
 
 __all__ = ["EquationsOfMotion", "Step"]
@@ -53,6 +54,7 @@ class EquationsOfMotion:
         closed_form: Callable[[], Any] | None = None,
         derivation: Callable[[], dict[str, Any]] | None = None,
         robot: Any = None,
+        notes: Sequence[str] = (),
     ):
         self.q = sp.Matrix(q)
         self.qd = sp.Matrix(qd)
@@ -82,6 +84,9 @@ class EquationsOfMotion:
         #: the kinedyn.Robot these equations were derived from (None for a LagrangianSystem); to_casadi
         #: takes the tool pose and Jacobian from it
         self.robot = robot
+        #: sentences every rendering prints before the equations (e.g. the angles made exact, see
+        #: :func:`kinedyn.description.snap.snap_right_angles`)
+        self.notes = list(notes)
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod
@@ -90,7 +95,7 @@ class EquationsOfMotion:
 
     @property
     def M(self) -> sp.Matrix:
-        """The inertia matrix D(q) (Spong 9.47), reflected rotor inertia on the diagonal."""
+        """The inertia matrix M(q) (Spong's D(q), eq. 9.47), reflected rotor inertia on the diagonal."""
         self._M = self._get(self._M)
         return self._M
 
@@ -280,13 +285,28 @@ class EquationsOfMotion:
         return op_counts(exprs)
 
     # ------------------------------------------------------------------ rendering
+    def legend(self, style: str = "text") -> str:
+        """Which joint each printed q_k is, where the joints' names are printed as q_1..q_n because they
+        do not read well as symbols (``shoulder_pan_joint``; "" otherwise). ``style``: "text"
+        (``q_1: shoulder_pan_joint``), "markdown" or "latex" (the names as code, the q_k as math)."""
+        renamed = [(k, s) for k, s in enumerate(self.q, start=1) if self.latex_names.get(s) == f"q_{{{k}}}"]
+        if not renamed or all(s.name == f"q{k}" for k, s in renamed):
+            return ""
+        if style == "latex":
+            pairs = [f"$q_{{{k}}}$: \\texttt{{{latex.escape(s.name)}}}" for k, s in renamed]
+        elif style == "markdown":
+            pairs = [f"$q_{{{k}}}$: `{s.name}`" for k, s in renamed]
+        else:
+            pairs = [f"q_{k}: {s.name}" for k, s in renamed]
+        return "Joint variables: " + ", ".join(pairs) + "."
+
     def result_equations(self) -> list[tuple]:
         """The result as (left-hand side, value) pairs: D, C, g, tau, or in CSE form the entry names
         (defined in the last steps)."""
         if self.final_equations is not None:  # CSE form: entry names, defined in the last steps
             return self.final_equations()
         return [
-            (of_q("D"), self.M),
+            (of_q("M"), self.M),
             (of_q("C", rates=True), self.C),
             (of_q("g"), self.g),
             (name(r"\tau", "tau", "tau"), self.tau),
@@ -304,7 +324,14 @@ class EquationsOfMotion:
         """A complete LaTeX document (article, amsmath only) that ``pdflatex`` compiles: a section per
         step with its prose and equations, then the result; see :mod:`kinedyn.symbolic.latex`."""
         title = f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method.replace('_', '-')})"
-        return latex.document(title, self.steps if steps else [], self.result_equations(), self.latex_names)
+        return latex.document(
+            title,
+            self.steps if steps else [],
+            self.result_equations(),
+            self.latex_names,
+            intro="\n\n".join(self.notes),
+            legend=self.legend("latex"),
+        )
 
     def to_markdown(self) -> str:
         """Markdown with LaTeX math (``$$ ... $$``, long equations as ``aligned`` blocks broken over
@@ -319,13 +346,15 @@ class EquationsOfMotion:
             return ["$$", r"\begin{aligned}", *rows, r"\end{aligned}", "$$", ""]
 
         out = [f"# Equations of motion{': ' + self.name if self.name else ''} ({self.method})", ""]
+        for sentence in [*self.notes, self.legend("markdown")]:
+            out += [sentence, ""] if sentence else []
         for k, step in enumerate(self.steps, start=1):
             out += [f"## Step {k}: {step.title}", ""]
             if step.text:
                 out += [step.text, ""]
             for lhs, value in step.equations:
                 out += block(lhs, value)
-        out += ["## Result: $D(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
+        out += ["## Result: $M(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
         for lhs, value in self.result_equations():
             out += block(lhs, value)
         return "\n".join(out)
@@ -357,12 +386,15 @@ class EquationsOfMotion:
         out = [
             f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
         ]
+        out += self.notes + ([self.legend()] if self.legend() else [])
+        rates = [*self.qdd, *self.qd]
         for k, step in enumerate(self.steps, start=1):
             out.append(f"\nStep {k}: {step.title}")
             for lhs, value in step.equations:
-                out.append(f"  {text_of(lhs)} = {value}")
+                out += ["  " + line for line in equation_text(text_of(lhs), value, rates)]
+        out.append("\nResult:")
         for lhs, value in self.result_equations():
-            out.append(f"{text_of(lhs)} = {value}")
+            out += equation_text(text_of(lhs), value, rates)
         return "\n".join(out)
 
     def __repr__(self) -> str:

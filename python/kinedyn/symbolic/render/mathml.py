@@ -224,6 +224,27 @@ def mathml_of(lhs) -> str:
 
 
 # ------------------------------------------------------------------ expressions
+_COM_NAME = re.compile(r"([A-Za-z])(c)_?(\d+)")
+
+
+def compound_name(sym) -> tuple[str, str] | None:
+    """(LaTeX, MathML) of a parameter named for a centre of mass, ``lc2`` or ``lc_2`` (Spong's l_c2, the
+    distance to link 2's centre of mass): one symbol l with the subscript c2, where SymPy would print
+    the product-looking ``lc_{2}``; None for any other name."""
+    m = _COM_NAME.fullmatch(getattr(sym, "name", ""))
+    if m is None:
+        return None
+    base, c, k = m.groups()
+    return f"{base}_{{{c}{k}}}", f"<msub>{mi(base)}<mrow>{mi(c)}<mn>{k}</mn></mrow></msub>"
+
+
+def compound_latex_names(expr) -> dict:
+    """``{symbol: LaTeX}`` for the symbols of ``expr`` that :func:`compound_name` renames (for
+    ``sympy.latex(..., symbol_names=...)``)."""
+    free = expr.free_symbols if hasattr(expr, "free_symbols") else set()
+    return {s: n[0] for s in free if (n := compound_name(s)) is not None}
+
+
 class _Printer(MathMLPresentationPrinter):
     """SymPy's presentation printer, drawing chosen symbols (the rates q̇_k, q̈_k) with given MathML."""
 
@@ -236,6 +257,10 @@ class _Printer(MathMLPresentationPrinter):
             root = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement
             assert root is not None  # a parsed document always has its root element
             return root.firstChild
+        compound = compound_name(sym)
+        if compound is not None:
+            self._given[sym] = compound[1]
+            return self._print_Symbol(sym, style)
         return super()._print_Symbol(sym, style)
 
 
