@@ -19,7 +19,7 @@ from .._math import by_name
 from .backends import c_numpy, casadi
 from .derive import cse, proofs, regressor
 from .render import latex
-from .render.mathml import equation_mathml, name, of_q, rate_symbols, text_of
+from .render.mathml import broken_equation_mathml, equation_mathml, name, of_q, rate_symbols, text_of
 from .render.text import equation_text
 from .steps import Step, op_counts
 
@@ -359,12 +359,18 @@ class EquationsOfMotion:
             out += block(lhs, value)
         return "\n".join(out)
 
-    def equation_mathml(self, lhs, value, display: str = "block") -> str:
+    def equation_mathml(self, lhs, value, display: str = "block", width: float | None = None) -> str:
         """One ``<math>`` element ``lhs = value`` in presentation MathML (SymPy's printer; q̇, q̈ with
-        dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
+        dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string. ``width``
+        (points of 10 pt type, as :func:`kinedyn.symbolic.render.latex.width` estimates them): a sum
+        wider than this is laid out over several lines, broken between its terms."""
         rates = self.__dict__.get("_rate_symbols")
         if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
             rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
+        if width is not None and not isinstance(value, sp.MatrixBase):
+            pieces = latex.sum_pieces(sp.sympify(value), width)
+            if len(pieces) > 1:
+                return broken_equation_mathml(lhs, pieces, rates, display=display)
         return equation_mathml(lhs, value, rates, display=display)
 
     def to_mathml(self, steps: bool = True) -> str:

@@ -26,7 +26,17 @@ from sympy.printing.conventions import split_super_sub
 
 from .mathml import compound_latex_names
 
-__all__ = ["escape", "latex_text", "width", "expression_lines", "equation_rows", "fragment", "document", "LINE_PT"]
+__all__ = [
+    "escape",
+    "sum_pieces",
+    "latex_text",
+    "width",
+    "expression_lines",
+    "equation_rows",
+    "fragment",
+    "document",
+    "LINE_PT",
+]
 
 #: the text width in points (A4 less 2 cm margins) and the width given to a right-hand side when the
 #: left-hand sides are short (the text width less the left-hand column, the relation and a margin)
@@ -327,6 +337,24 @@ def expression_lines(expr, limit: float = LINE_PT, names: dict | None = None) ->
                 (inner[-1][0] + r"\Bigr)^{" + str(expr.exp) + "}", inner[-1][1] + 10),
             ]
     return [(_tex(expr, names), w)]
+
+
+def sum_pieces(expr, limit: float = LINE_PT) -> list:
+    """A sum wider than ``limit`` points cut between its terms into consecutive partial sums each at
+    most ``limit`` wide (a single wider term stands alone); ``sum(pieces) == expr``. Anything else:
+    ``[expr]``."""
+    if not expr.is_Add or width(expr) <= limit:
+        return [expr]
+    pieces, current, used = [], [], 0.0
+    for term in expr.as_ordered_terms():
+        w = width(term) + _OP
+        if current and used + w > limit:
+            pieces.append(sp.Add(*current))
+            current, used = [], 0.0
+        current.append(term)
+        used += w
+    pieces.append(sp.Add(*current))
+    return pieces
 
 
 def _entry_name(lhs: str, i: int, j: int | None) -> str:

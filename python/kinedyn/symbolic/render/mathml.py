@@ -291,6 +291,24 @@ def value_mathml(value, rates: dict[sp.Symbol, str] | None = None) -> str:
     return re.sub(r"<mo>([()\[\]])</mo>", r'<mo stretchy="true">\1</mo>', m)
 
 
+def broken_equation_mathml(lhs, pieces, rates=None, display: str = "block") -> str:
+    """``lhs = pieces[0] + pieces[1] + ...`` as one ``<math>`` element laid out on several lines (an
+    ``<mtable>``, one row per piece, the later rows starting with their sign), so that a long sum wraps
+    on the page instead of scrolling sideways (browsers' MathML does not break lines itself)."""
+    rows = []
+    for k, piece in enumerate(pieces):
+        neg = k > 0 and piece.could_extract_minus_sign()
+        body = value_mathml(-piece if neg else piece, rates)
+        sign = "" if k == 0 else f"<mo>{'−' if neg else '+'}</mo>"
+        left = mathml_of(lhs) if k == 0 else ""
+        rows.append(f"<mtr><mtd>{left}</mtd><mtd><mo>{'=' if k == 0 else ''}</mo></mtd><mtd>{sign}{body}</mtd></mtr>")
+    return (
+        f'<math xmlns="{MATHML_NS}" display="{display}"><mtable columnalign="right center left">'
+        + "".join(rows)
+        + "</mtable></math>"
+    )
+
+
 def equation_mathml(lhs, value, rates=None, display: str = "block") -> str:
     """One ``<math>`` element: ``lhs = value``."""
     return (

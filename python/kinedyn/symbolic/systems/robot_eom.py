@@ -94,7 +94,7 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
     steps.append(
         Step(
             "Kinetic energy K = qd^T M(q) qd / 2",
-            "M(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47, where it is called D(q)).",
+            "M(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
             [(of_q("M"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
         )
     )
