@@ -366,7 +366,13 @@ class EquationsOfMotion:
         wider than this is laid out over several lines, broken between its terms."""
         rates = self.__dict__.get("_rate_symbols")
         if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
-            rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
+            if self.legend():  # joints printed as q_1..q_n (see legend): their MathML too
+                proxies = [sp.Symbol(f"q{k}") for k in range(1, self.n + 1)]
+                rates = rate_symbols(proxies, self.qd, self.qdd)
+                rates.update({q: rates.pop(p) for q, p in zip(self.q, proxies)})
+            else:
+                rates = rate_symbols(self.q, self.qd, self.qdd)
+            self.__dict__["_rate_symbols"] = rates
         if width is not None and not isinstance(value, sp.MatrixBase):
             pieces = latex.sum_pieces(sp.sympify(value), width)
             if len(pieces) > 1:
@@ -377,6 +383,7 @@ class EquationsOfMotion:
         """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per
         equation) and the result, inside one ``<div>`` (well-formed XML, embeddable in HTML)."""
         parts = ['<div class="kinedyn-eom">']
+        parts += [f"<p>{escape(sentence)}</p>" for sentence in [*self.notes, self.legend()] if sentence]
         for k, step in enumerate(self.steps if steps else [], start=1):
             parts.append(f"<section><h3>Step {k}: {escape(step.title)}</h3>")
             if step.text:

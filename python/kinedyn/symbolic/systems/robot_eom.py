@@ -229,7 +229,7 @@ def lagrange_eom(
                 "Lagrange's steps omitted (too large to read)",
                 f"K, P, L and their derivatives of this {robot.n}-joint model run to thousands of terms. M, C and g below are the "
                 "same unique inertia matrix, Christoffel Coriolis matrix and gravity vector, formed from the customised "
-                "Newton-Euler model and printed with named intermediate variables; eom.M, eom.C, eom.g give them expanded.",
+                "Newton-Euler model and printed with named intermediate variables; in Python the result's attributes M, C and g hold them expanded.",
             )
             assert closed is not None
             return [note] + closed_form_steps(closed())
