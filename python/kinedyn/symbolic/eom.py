@@ -399,7 +399,7 @@ class EquationsOfMotion:
         out = [
             f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
         ]
-        out += self.notes + ([self.legend()] if self.legend() else [])
+        out += self.notes  # no legend: plain text writes the joints' own names
         rates = [*self.qdd, *self.qd]
         for k, step in enumerate(self.steps, start=1):
             out.append(f"\nStep {k}: {step.title}")
