@@ -246,3 +246,13 @@ def test_long_sums_wrap_in_the_report():
     assert html.count("<mtr>") == len(pieces) and "columnalign" in html
     short = eom.equation_mathml("g", eom.g[1], width=EQUATION_WIDTH)
     assert "<mtr>" not in short
+
+
+def test_the_report_snaps_and_says_so(tmp_path):
+    """The report's equations section derives with the same snapping as `kinedyn derive`, and its note
+    says so."""
+    from kinedyn.report.data import symbolic_equations
+
+    robot = kd.load(_urdf(tmp_path))
+    eom, note = symbolic_equations(robot, "arm", max_joints=robot.n)
+    assert eom.notes and "multiple of pi/2" in note and note.startswith("with this robot's numbers (")
