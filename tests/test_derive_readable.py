@@ -20,6 +20,7 @@ from reference import UR5, erd
 import kinedyn as kd
 from kinedyn.cli import main
 from kinedyn.description.snap import snap_right_angles, snap_rotation
+from kinedyn.report.data import symbolic_equations
 from kinedyn.symbolic.cse import evaluate_block
 from kinedyn.symbolic.render.latex import sum_pieces
 from kinedyn.symbolic.render.text import equation_text, tidy, whole_numbers
@@ -102,9 +103,15 @@ def test_the_snapped_model_equals_the_files_to_the_tolerance(tmp_path):
 def test_snap_rotation_at_gimbal_lock_keeps_the_free_combination():
     """pitch within the tolerance of pi/2: only roll - yaw is defined; an arbitrary one is kept, and the
     result still equals the input to the tolerance."""
-    from kinedyn._math import rpy_to_matrix
 
-    R = np.asarray(rpy_to_matrix(0.9, math.pi / 2 - 2e-9, 0.25))[:3, :3]
+    def rot(axis, a):  # URDF's fixed-axis rotations, written out here
+        c, s = math.cos(a), math.sin(a)
+        i, j = [(1, 2), (2, 0), (0, 1)][axis]
+        R = np.eye(3)
+        R[i, i], R[i, j], R[j, i], R[j, j] = c, -s, s, c
+        return R
+
+    R = rot(2, 0.25) @ rot(1, math.pi / 2 - 2e-9) @ rot(0, 0.9)
     out, moved = snap_rotation(R, 1e-6)
     assert [a for a, _, _ in moved] == ["pitch"]
     assert np.max(np.abs(out - R)) <= 3e-6
@@ -251,8 +258,6 @@ def test_long_sums_wrap_in_the_report():
 def test_the_report_snaps_and_says_so(tmp_path):
     """The report's equations section derives with the same snapping as `kinedyn derive`, and its note
     says so."""
-    from kinedyn.report.data import symbolic_equations
-
     robot = kd.load(_urdf(tmp_path))
     eom, note = symbolic_equations(robot, "arm", max_joints=robot.n)
     assert eom.notes and "multiple of pi/2" in note and note.startswith("with this robot's numbers (")
