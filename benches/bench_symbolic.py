@@ -7,6 +7,12 @@ description, in the same run; operation counts before and after common-subexpres
 
     PYTHONPATH=python python benches/bench_symbolic.py [--puma-lagranges] [--repeat N]
     PYTHONPATH=python python benches/bench_symbolic.py --cse-only [--expanded]   # issue 12 §5 cases alone
+    PYTHONPATH=python python benches/bench_symbolic.py --derive-only   # issue 23: documents a person reads
+
+Issue 23 cases (section "derive for a reader"): `kinedyn derive puma560 --format latex` (numeric
+parameters, the default) beside the same with `--general`, in the same run: time and size ratios
+(target: at most 2 each); `derive ur5` and example-robot-data's `ur5_robot.urdf` (near-right angles
+snapped) likewise.
 
 Issue 12 §5 cases (section "CSE form"): `kinedyn derive puma560 --general --method newton_euler` in
 every --format and `derive ur5 --general`, CLI wall time in a child process; M, C, g in CSE form
@@ -187,7 +193,7 @@ def cli_seconds(args, timeout=600):
 
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    out = subprocess.run([sys.executable, "-m", "kinedyn.cli", *args], capture_output=True, text=True, timeout=timeout)
+    out = subprocess.run([sys.executable, "-m", "kinedyn", *args], capture_output=True, text=True, timeout=timeout)
     sec = _Seconds(time.perf_counter() - t)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     sec.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -238,6 +244,30 @@ def cse_section(expanded=False):
     print(f"{'puma560 general inertias: M, C, g in CSE form':58s} {sec:8.2f} s ({ops} ops)", flush=True)
 
 
+def derive_section():
+    """Issue 23: the default derive documents against the --general one, wall time and bytes."""
+    import os
+    import tempfile
+
+    from kinedyn.testing import example_robot_data_dir
+
+    print("\n== derive for a reader (issue 23); compare the ratios, not the seconds ==", flush=True)
+    root = example_robot_data_dir()
+    cases = [["puma560"], ["puma560", "--general"], ["ur5"]]
+    if root is not None:
+        cases.append([os.path.join(root, "ur_description", "urdf", "ur5_robot.urdf")])
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, case in enumerate(cases):
+            out = f"{tmp}/{k}.tex"
+            sec = cli_seconds(["derive", *case, "--format", "latex", "-o", out])
+            results[" ".join(case)] = (float(sec), os.path.getsize(out))
+            label = "derive " + " ".join(os.path.basename(c) for c in case) + " --format latex"
+            print(f"{label:58s} {fmt(sec)} {os.path.getsize(out) / 1000:8.1f} kB", flush=True)
+    (t_n, b_n), (t_g, b_g) = results["puma560"], results["puma560 --general"]
+    print(f"{'puma560 numeric / --general':58s} time {t_n / t_g:5.2f}  size {b_n / b_g:5.2f}  (targets <= 2)")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument(
@@ -247,6 +277,7 @@ def main(argv=None):
     ap.add_argument(
         "--cse-only", action="store_true", help="only the issue 12 §5 cases (CSE form, CLI wall times, Panda)"
     )
+    ap.add_argument("--derive-only", action="store_true", help="only the issue 23 cases (derive documents)")
     ap.add_argument(
         "--expanded",
         action="store_true",
@@ -258,6 +289,9 @@ def main(argv=None):
         return
     if args.cse_only:
         cse_section(args.expanded)
+        return
+    if args.derive_only:
+        derive_section()
         return
     if args.child == "puma-lagranges":
         sec, eqs = lagranges(kd.robots.puma560())

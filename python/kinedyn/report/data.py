@@ -28,6 +28,7 @@ from ..coordinates import (  # noqa: F401 (the report's names for them)
     in_multi_dof_block,
     velocity_labels,
 )
+from ..description.snap import SNAP_TOLERANCE
 from ..kinematics import singularity_report
 from ..simulate import SimulationError, SimulationTruncatedWarning, simulate
 
@@ -171,8 +172,10 @@ def symbolic_equations(robot, name: str | None, max_joints: int):
         except (TypeError, ValueError, AttributeError):
             subject = robot
     # above 3 joints the results are shown in CSE form (kinedyn.symbolic.cse): readable, and seconds
-    eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto")
-    return eom, ("with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers")
+    # a file's right angles written with a few digits made exact, as `kinedyn derive` does (and said)
+    eom = subject.equations_of_motion(form="cse" if subject.n > 3 else "auto", snap_angles=SNAP_TOLERANCE)
+    note = "with the catalogue's parameters as symbols" if subject is not robot else "with this robot's numbers"
+    return eom, note + (" (" + " ".join(eom.notes).rstrip(".") + ")" if eom.notes else "")
 
 
 def joint_rows(robot) -> list[dict]:

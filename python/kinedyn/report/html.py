@@ -214,10 +214,15 @@ def motion_plots(robot, t, qs, labels) -> list[str]:
 
 
 # ------------------------------------------------------------------ MathML
+#: the widest line of an equation, in points of 10 pt type (latex.width's estimate): at the page's
+#: 18 px mathematics about 850 px, the width of the report's column
+EQUATION_WIDTH = 360.0
+
+
 def _equation(eom, lhs, value) -> Markup:
     """One equation as display MathML from the symbolic engine (EquationsOfMotion.equation_mathml:
     SymPy's presentation printer, names built as MathML)."""
-    m = eom.equation_mathml(lhs, value)
+    m = eom.equation_mathml(lhs, value, width=EQUATION_WIDTH)  # a long sum wraps over several lines
     # matrices: brackets drawn by CSS (class bm), which needs no stretchy glyphs in the reader's fonts
     m = re.sub(r"<mrow><mo>\[</mo><mtable>(.*?)</mtable><mo>\]</mo></mrow>", r'<mtable class="bm">\1</mtable>', m)
     return Markup(f'<div class="eq">{m}</div>')
@@ -245,7 +250,7 @@ def _equations(eom) -> dict:
     else:
         out["plain"] = [
             _equation(eom, lhs, value)
-            for lhs, value in [(of_q("D"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]
+            for lhs, value in [(of_q("M"), eom.M), (of_q("C", rates=True), eom.C), (of_q("g"), eom.g)]
         ]
         # one line per joint: the torques are long
         out["plain"] += [

@@ -19,7 +19,8 @@ from .._math import by_name
 from .backends import c_numpy, casadi
 from .derive import cse, proofs, regressor
 from .render import latex
-from .render.mathml import equation_mathml, name, of_q, rate_symbols, text_of
+from .render.mathml import broken_equation_mathml, equation_mathml, name, of_q, rate_symbols, text_of
+from .render.text import equation_text
 from .steps import Step, op_counts
 
 __all__ = ["EquationsOfMotion", "Step"]
@@ -53,6 +54,7 @@ class EquationsOfMotion:
         closed_form: Callable[[], Any] | None = None,
         derivation: Callable[[], dict[str, Any]] | None = None,
         robot: Any = None,
+        notes: Sequence[str] = (),
     ):
         self.q = sp.Matrix(q)
         self.qd = sp.Matrix(qd)
@@ -82,6 +84,9 @@ class EquationsOfMotion:
         #: the kinedyn.Robot these equations were derived from (None for a LagrangianSystem); to_casadi
         #: takes the tool pose and Jacobian from it
         self.robot = robot
+        #: sentences every rendering prints before the equations (e.g. the angles made exact, see
+        #: :func:`kinedyn.description.snap.snap_right_angles`)
+        self.notes = list(notes)
 
     # ------------------------------------------------------------------ lazily computed parts
     @staticmethod
@@ -90,7 +95,7 @@ class EquationsOfMotion:
 
     @property
     def M(self) -> sp.Matrix:
-        """The inertia matrix D(q) (Spong 9.47), reflected rotor inertia on the diagonal."""
+        """The inertia matrix M(q) (Spong's D(q), eq. 9.47), reflected rotor inertia on the diagonal."""
         self._M = self._get(self._M)
         return self._M
 
@@ -280,13 +285,28 @@ class EquationsOfMotion:
         return op_counts(exprs)
 
     # ------------------------------------------------------------------ rendering
+    def legend(self, style: str = "text") -> str:
+        """Which joint each printed q_k is, where the joints' names are printed as q_1..q_n because they
+        do not read well as symbols (``shoulder_pan_joint``; "" otherwise). ``style``: "text"
+        (``q_1: shoulder_pan_joint``), "markdown" or "latex" (the names as code, the q_k as math)."""
+        renamed = [(k, s) for k, s in enumerate(self.q, start=1) if self.latex_names.get(s) == f"q_{{{k}}}"]
+        if not renamed or all(s.name == f"q{k}" for k, s in renamed):
+            return ""
+        if style == "latex":
+            pairs = [f"$q_{{{k}}}$: \\texttt{{{latex.escape(s.name)}}}" for k, s in renamed]
+        elif style == "markdown":
+            pairs = [f"$q_{{{k}}}$: `{s.name}`" for k, s in renamed]
+        else:
+            pairs = [f"q_{k}: {s.name}" for k, s in renamed]
+        return "Joint variables: " + ", ".join(pairs) + "."
+
     def result_equations(self) -> list[tuple]:
         """The result as (left-hand side, value) pairs: D, C, g, tau, or in CSE form the entry names
         (defined in the last steps)."""
         if self.final_equations is not None:  # CSE form: entry names, defined in the last steps
             return self.final_equations()
         return [
-            (of_q("D"), self.M),
+            (of_q("M"), self.M),
             (of_q("C", rates=True), self.C),
             (of_q("g"), self.g),
             (name(r"\tau", "tau", "tau"), self.tau),
@@ -304,7 +324,14 @@ class EquationsOfMotion:
         """A complete LaTeX document (article, amsmath only) that ``pdflatex`` compiles: a section per
         step with its prose and equations, then the result; see :mod:`kinedyn.symbolic.latex`."""
         title = f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method.replace('_', '-')})"
-        return latex.document(title, self.steps if steps else [], self.result_equations(), self.latex_names)
+        return latex.document(
+            title,
+            self.steps if steps else [],
+            self.result_equations(),
+            self.latex_names,
+            intro="\n\n".join(self.notes),
+            legend=self.legend("latex"),
+        )
 
     def to_markdown(self) -> str:
         """Markdown with LaTeX math (``$$ ... $$``, long equations as ``aligned`` blocks broken over
@@ -319,29 +346,44 @@ class EquationsOfMotion:
             return ["$$", r"\begin{aligned}", *rows, r"\end{aligned}", "$$", ""]
 
         out = [f"# Equations of motion{': ' + self.name if self.name else ''} ({self.method})", ""]
+        for sentence in [*self.notes, self.legend("markdown")]:
+            out += [sentence, ""] if sentence else []
         for k, step in enumerate(self.steps, start=1):
             out += [f"## Step {k}: {step.title}", ""]
             if step.text:
                 out += [step.text, ""]
             for lhs, value in step.equations:
                 out += block(lhs, value)
-        out += ["## Result: $D(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
+        out += ["## Result: $M(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
         for lhs, value in self.result_equations():
             out += block(lhs, value)
         return "\n".join(out)
 
-    def equation_mathml(self, lhs, value, display: str = "block") -> str:
+    def equation_mathml(self, lhs, value, display: str = "block", width: float | None = None) -> str:
         """One ``<math>`` element ``lhs = value`` in presentation MathML (SymPy's printer; q̇, q̈ with
-        dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string."""
+        dots); ``lhs`` a :class:`kinedyn.symbolic.render.Name` or a small LaTeX string. ``width``
+        (points of 10 pt type, as :func:`kinedyn.symbolic.render.latex.width` estimates them): a sum
+        wider than this is laid out over several lines, broken between its terms."""
         rates = self.__dict__.get("_rate_symbols")
         if rates is None:  # once per model, not per equation (a CSE-form model has a thousand)
-            rates = self.__dict__["_rate_symbols"] = rate_symbols(self.q, self.qd, self.qdd)
+            if self.legend():  # joints printed as q_1..q_n (see legend): their MathML too
+                proxies = [sp.Symbol(f"q{k}") for k in range(1, self.n + 1)]
+                rates = rate_symbols(proxies, self.qd, self.qdd)
+                rates.update({q: rates.pop(p) for q, p in zip(self.q, proxies)})
+            else:
+                rates = rate_symbols(self.q, self.qd, self.qdd)
+            self.__dict__["_rate_symbols"] = rates
+        if width is not None and not isinstance(value, sp.MatrixBase):
+            pieces = latex.sum_pieces(sp.sympify(value), width)
+            if len(pieces) > 1:
+                return broken_equation_mathml(lhs, pieces, rates, display=display)
         return equation_mathml(lhs, value, rates, display=display)
 
     def to_mathml(self, steps: bool = True) -> str:
         """Presentation MathML: one ``<section>`` per step (title, sentence, one ``<math>`` element per
         equation) and the result, inside one ``<div>`` (well-formed XML, embeddable in HTML)."""
         parts = ['<div class="kinedyn-eom">']
+        parts += [f"<p>{escape(sentence)}</p>" for sentence in [*self.notes, self.legend()] if sentence]
         for k, step in enumerate(self.steps if steps else [], start=1):
             parts.append(f"<section><h3>Step {k}: {escape(step.title)}</h3>")
             if step.text:
@@ -357,12 +399,15 @@ class EquationsOfMotion:
         out = [
             f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
         ]
+        out += self.notes  # no legend: plain text writes the joints' own names
+        rates = [*self.qdd, *self.qd]
         for k, step in enumerate(self.steps, start=1):
             out.append(f"\nStep {k}: {step.title}")
             for lhs, value in step.equations:
-                out.append(f"  {text_of(lhs)} = {value}")
+                out += ["  " + line for line in equation_text(text_of(lhs), value, rates)]
+        out.append("\nResult:")
         for lhs, value in self.result_equations():
-            out.append(f"{text_of(lhs)} = {value}")
+            out += equation_text(text_of(lhs), value, rates)
         return "\n".join(out)
 
     def __repr__(self) -> str:

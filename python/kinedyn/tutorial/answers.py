@@ -13,6 +13,7 @@ import sympy as sp
 
 from .. import robots
 from .. import symbolic as ks
+from ..symbolic.render.text import whole_numbers
 from .printed import th1, th2, thd1, thd2, thdd1, thdd2
 
 
@@ -116,6 +117,7 @@ def tutorial_display(expr, tutorial_symbols: bool = True):
         thdd2: "thetaddot2",
     }
     reps = {s: sp.Symbol(n, real=True) for s, n in names.items()}
+    expr = whole_numbers(expr)  # 1.0*L3 -> L3, -1.0*cos(theta1) -> -cos(theta1): a float axis' 1.0
     e = ks.abbreviate(expr, [th1, th2, sp.Symbol("th3", real=True)], prefix=("C", "S")) if tutorial_symbols else expr
     return e.xreplace(reps) if isinstance(e, sp.Basic) else e.applyfunc(lambda x: x.xreplace(reps))
 

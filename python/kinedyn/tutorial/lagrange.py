@@ -128,7 +128,9 @@ def question_3() -> Answer:
     for k, step in enumerate(eom.steps, start=1):
         if step.title.startswith("Christoffel"):
             continue
-        a.text(f"Step {k}: {step.title}" + (f" - {step.text}" if step.text else ""))
+        a.text(f"Step {k}: {step.title}")  # its sentence on a line of its own: " - " would read as a minus
+        if step.text:
+            a.text(step.text)
         for lhs, value in step.equations:
             v = value.applyfunc(T) if isinstance(value, sp.MatrixBase) else _pretty_collect(T(value))
             a.eq(_plain_lhs(lhs), v)

@@ -12,6 +12,7 @@ import sympy as sp
 from .. import robots
 from .. import symbolic as ks
 from ..kinematics import singularity_report
+from ..symbolic.render.text import inline
 from .answers import (
     Answer,
     Comparison,
@@ -98,9 +99,7 @@ def _q1b() -> Answer:
     a.eq("J^-1", sp.MatMul(1 / det, adj, evaluate=False))
     prod = (J * Jinv).applyfunc(lambda e: sp.simplify(sp.expand_trig(e)))
     check_ok = same_function(J * Jinv, sp.eye(2), [th1, th2, l1, l2])
-    check = (
-        f"J J^-1 = I at random (theta, l1, l2): {'yes' if check_ok else 'NO'}; symbolically J J^-1 = {sp.sstr(prod)}"
-    )
+    check = f"J J^-1 = I at random (theta, l1, l2): {'yes' if check_ok else 'NO'}; symbolically J J^-1 = {inline(prod)}"
     a.text("Check: " + check + ".")
     # kinedyn's singularity report at a stretched arm
     rep = singularity_report(robots.planar_2r(), [0.4, 0.0], task="planar")

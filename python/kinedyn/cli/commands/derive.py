@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from ... import robots
 from ..._ui import progress
+from ...description.snap import SNAP_TOLERANCE
 from .. import app
 from ..app import console, emit, esc
 from ..options import OutputPath
@@ -27,6 +29,13 @@ def add_arguments(p) -> None:
         default="auto",
         choices=["auto", "cse", "expanded"],
         help="M, C, g with named intermediate variables (cse), written out (expanded), or cse for a large model (auto)",
+    )
+    p.add_argument(
+        "--snap-angles",
+        type=float,
+        default=SNAP_TOLERANCE,
+        metavar="TOL",
+        help=f"make rotation angles within TOL rad of a multiple of pi/2 exact (default {SNAP_TOLERANCE:g}; 0: off)",
     )
     p.add_argument("-o", "--output", action=OutputPath, help="write to this file instead of the terminal")
     p.add_argument("--json", action="store_true", help="print M, C, g, tau and op counts as JSON")
@@ -56,6 +65,7 @@ def run(args) -> int:
             simplify=not args.no_simplify,
             parameters="general" if args.general else None,
             form=args.form,
+            snap_angles=args.snap_angles,
         )
         fmt = args.format
         if fmt == "latex":
@@ -71,6 +81,9 @@ def run(args) -> int:
         payload = _payload(args, robot, eom, text) if args.json else {}
     if args.output:
         Path(args.output).write_text(text)
+    if not args.json:
+        for note in eom.notes:  # on stderr: the equations on stdout stay clean for a pipe
+            print(f"note: {note}", file=sys.stderr)
 
     def render():
         if args.output:
@@ -85,7 +98,13 @@ def run(args) -> int:
 def _payload(args, robot, eom, text) -> dict:
     """The --json document: M, C, g, tau as strings; in CSE form (a large model) each block's
     intermediate variables as [name, expression] pairs beside its entries, in terms of them."""
-    payload = {"robot": robot.name, "method": args.method, "format": args.format, "q": [str(s) for s in eom.q]}
+    payload = {
+        "robot": robot.name,
+        "method": args.method,
+        "format": args.format,
+        "q": [str(s) for s in eom.q],
+        "notes": eom.notes,
+    }
     if eom.closed_form is not None:
         cf = eom.closed_form()
         n = eom.n

@@ -347,6 +347,9 @@ def evaluate_block(block: Block, values: dict) -> list:
 #: the customised model is shown in CSE form above this many operations (tau of the PUMA 560 with its
 #: numeric inertias has 354 and stays expanded; with general inertias 577)
 CSE_THRESHOLD = 400
+#: ... and for any model of more coordinates than this (the PUMA 560 with numeric inertias: expanded,
+#: its Lagrange steps filled 800 kB of LaTeX; in CSE form about 50 kB, like its general-inertia model)
+CSE_JOINTS = 3
 
 
 def _lhs(sym):
@@ -389,4 +392,4 @@ def final_equations(cf: ClosedForm, friction) -> list:
     tau = M qdd + C qd + g + friction in those names."""
     M, C, g = cf["M"].symbol_matrix(), cf["C"].symbol_matrix(), cf["g"].symbol_matrix()
     tau = M * sp.Matrix(cf.qdd) + C * sp.Matrix(cf.qd) + g + sp.Matrix(friction)
-    return [(of_q("D"), M), (of_q("C", rates=True), C), (of_q("g"), g), (name(r"\tau", "tau", "tau"), tau)]
+    return [(of_q("M"), M), (of_q("C", rates=True), C), (of_q("g"), g), (name(r"\tau", "tau", "tau"), tau)]

@@ -33,6 +33,7 @@ from __future__ import annotations
 import re
 
 import sympy as sp
+from sympy.printing.conventions import split_super_sub
 
 from ..render.mathml import rate_names
 from ..values import exact, matrix, rational
@@ -97,11 +98,37 @@ def body_states(robot, q, qd, qdd) -> tuple:
     return qb, qdb, qddb
 
 
+def readable_name(name: str) -> bool:
+    """Whether SymPy's LaTeX of a joint variable named ``name`` reads as that name: ``q1``, ``theta_2``,
+    ``x_a``, ``shoulder`` do; ``shoulder_pan_joint`` (typeset shoulder_{pan joint}) and
+    ``panda_joint1`` (panda_{joint1}) do not."""
+    base, sups, subs = split_super_sub(name)
+    if sups or len(subs) > 1:
+        return False
+    if not subs:
+        return True
+    return len(base) == 1 or base.lower() in _GREEK or subs[0].isdigit()
+
+
+_GREEK = {"alpha", "beta", "gamma", "delta", "theta", "phi", "psi", "chi", "eta", "mu", "nu", "rho", "sigma", "tau"}
+
+
+def joint_symbols_renamed(q) -> bool:
+    """Whether the joint variables are printed as q_1, ..., q_n (with a legend) because some joint's
+    name does not read well as a symbol (:func:`readable_name`)."""
+    return not all(readable_name(a.name) for a in q)
+
+
 def latex_names(q, qd, qdd) -> dict:
-    """LaTeX names for the velocity/acceleration symbols (\\dot q_1, \\ddot q_1)."""
+    """LaTeX names for the velocity/acceleration symbols (\\dot q_1, \\ddot q_1); when a joint's name
+    does not read well as a symbol (``shoulder_pan_joint``), every joint variable is printed as
+    q_1, ..., q_n instead (the documents print which joint each is)."""
     out = {}
-    for a, b, c in zip(q, qd, qdd):
-        base = sp.latex(a)
+    renamed = joint_symbols_renamed(q)
+    for k, (a, b, c) in enumerate(zip(q, qd, qdd), start=1):
+        if renamed:
+            out[a] = f"q_{{{k}}}"
+        base = out.get(a) or sp.latex(a)
         m = re.fullmatch(r"(.+?)_\{(.+)\}", base)
         head, tail = (m.group(1), "_{" + m.group(2) + "}") if m else (base, "")
         out[b] = r"\dot{" + head + "}" + tail

@@ -24,7 +24,19 @@ from collections.abc import Sequence
 import sympy as sp
 from sympy.printing.conventions import split_super_sub
 
-__all__ = ["latex_text", "width", "expression_lines", "equation_rows", "fragment", "document", "LINE_PT"]
+from .mathml import compound_latex_names
+
+__all__ = [
+    "escape",
+    "sum_pieces",
+    "latex_text",
+    "width",
+    "expression_lines",
+    "equation_rows",
+    "fragment",
+    "document",
+    "LINE_PT",
+]
 
 #: the text width in points (A4 less 2 cm margins) and the width given to a right-hand side when the
 #: left-hand sides are short (the text width less the left-hand column, the relation and a margin)
@@ -69,8 +81,12 @@ _MATH_WORD = re.compile(
 )
 
 
-def _escape(s: str) -> str:
+def escape(s: str) -> str:
+    """``s`` for LaTeX text mode, TeX's special characters escaped and nothing else changed."""
     return "".join(_SPECIAL.get(c, c) for c in s)
+
+
+_escape = escape
 
 
 def _math_base(base: str) -> str:
@@ -219,7 +235,8 @@ Line = tuple[str, float]
 
 
 def _tex(expr, names) -> str:
-    return sp.latex(expr, symbol_names=names)
+    compound = compound_latex_names(expr)  # lc2 -> l_{c2}
+    return sp.latex(expr, symbol_names={**compound, **names} if compound else names)
 
 
 def expression_lines(expr, limit: float = LINE_PT, names: dict | None = None) -> list[Line]:
@@ -322,6 +339,24 @@ def expression_lines(expr, limit: float = LINE_PT, names: dict | None = None) ->
     return [(_tex(expr, names), w)]
 
 
+def sum_pieces(expr, limit: float = LINE_PT) -> list:
+    """A sum wider than ``limit`` points cut between its terms into consecutive partial sums each at
+    most ``limit`` wide (a single wider term stands alone); ``sum(pieces) == expr``. Anything else:
+    ``[expr]``."""
+    if not expr.is_Add or width(expr) <= limit:
+        return [expr]
+    pieces, current, used = [], [], 0.0
+    for term in expr.as_ordered_terms():
+        w = width(term) + _OP
+        if current and used + w > limit:
+            pieces.append(sp.Add(*current))
+            current, used = [], 0.0
+        current.append(term)
+        used += w
+    pieces.append(sp.Add(*current))
+    return pieces
+
+
 def _entry_name(lhs: str, i: int, j: int | None) -> str:
     """``D(q)`` -> ``D_{12}``; ``\\tau`` -> ``\\tau_{1}``; anything else -> ``\\left[lhs\\right]_{12}``."""
     idx = f"{i + 1}" if j is None else f"{i + 1}{j + 1}"
@@ -364,7 +399,7 @@ def equation_rows(lhs, value, limit: float = LINE_PT, names: dict | None = None)
 
 
 # ------------------------------------------------------------------ the two outputs
-RESULT_TITLE = r"D(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau"
+RESULT_TITLE = r"M(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau"
 
 
 def fragment(steps: Sequence, final: Sequence[tuple], names: dict | None = None, limit: float | None = None) -> str:
@@ -407,12 +442,15 @@ def document(
     names: dict | None = None,
     intro: str = "",
     limit: float | None = None,
+    legend: str = "",
 ) -> str:
     """A complete LaTeX document (``pdflatex`` compiles it): a section per step with its prose and its
-    equations, and the result."""
+    equations, and the result; ``intro`` is prose (through :func:`latex_text`), ``legend`` LaTeX."""
     parts = [PREAMBLE, r"\title{" + _escape(title) + "}", r"\date{}", r"\begin{document}", r"\maketitle"]
     if intro:
         parts.append(latex_text(intro) + "\n")
+    if legend:  # already LaTeX
+        parts.append(legend + "\n")
     for k, step in enumerate(steps, start=1):
         parts.append(r"\section*{Step " + str(k) + ": " + latex_text(step.title) + "}")
         if getattr(step, "text", ""):

@@ -224,6 +224,27 @@ def mathml_of(lhs) -> str:
 
 
 # ------------------------------------------------------------------ expressions
+_COM_NAME = re.compile(r"([A-Za-z])(c)_?(\d+)")
+
+
+def compound_name(sym) -> tuple[str, str] | None:
+    """(LaTeX, MathML) of a parameter named for a centre of mass, ``lc2`` or ``lc_2`` (Spong's l_c2, the
+    distance to link 2's centre of mass): one symbol l with the subscript c2, where SymPy would print
+    the product-looking ``lc_{2}``; None for any other name."""
+    m = _COM_NAME.fullmatch(getattr(sym, "name", ""))
+    if m is None:
+        return None
+    base, c, k = m.groups()
+    return f"{base}_{{{c}{k}}}", f"<msub>{mi(base)}<mrow>{mi(c)}<mn>{k}</mn></mrow></msub>"
+
+
+def compound_latex_names(expr) -> dict:
+    """``{symbol: LaTeX}`` for the symbols of ``expr`` that :func:`compound_name` renames (for
+    ``sympy.latex(..., symbol_names=...)``)."""
+    free = expr.free_symbols if hasattr(expr, "free_symbols") else set()
+    return {s: n[0] for s in free if (n := compound_name(s)) is not None}
+
+
 class _Printer(MathMLPresentationPrinter):
     """SymPy's presentation printer, drawing chosen symbols (the rates q̇_k, q̈_k) with given MathML."""
 
@@ -236,6 +257,10 @@ class _Printer(MathMLPresentationPrinter):
             root = parseString(f'<wrap xmlns="{MATHML_NS}">{self._given[sym]}</wrap>').documentElement
             assert root is not None  # a parsed document always has its root element
             return root.firstChild
+        compound = compound_name(sym)
+        if compound is not None:
+            self._given[sym] = compound[1]
+            return self._print_Symbol(sym, style)
         return super()._print_Symbol(sym, style)
 
 
@@ -264,6 +289,24 @@ def value_mathml(value, rates: dict[sp.Symbol, str] | None = None) -> str:
     printer = _Printer(rates or {})
     m = _xml_entities(printer.doprint(sp.sympify(value)))
     return re.sub(r"<mo>([()\[\]])</mo>", r'<mo stretchy="true">\1</mo>', m)
+
+
+def broken_equation_mathml(lhs, pieces, rates=None, display: str = "block") -> str:
+    """``lhs = pieces[0] + pieces[1] + ...`` as one ``<math>`` element laid out on several lines (an
+    ``<mtable>``, one row per piece, the later rows starting with their sign), so that a long sum wraps
+    on the page instead of scrolling sideways (browsers' MathML does not break lines itself)."""
+    rows = []
+    for k, piece in enumerate(pieces):
+        neg = k > 0 and piece.could_extract_minus_sign()
+        body = value_mathml(-piece if neg else piece, rates)
+        sign = "" if k == 0 else f"<mo>{'−' if neg else '+'}</mo>"
+        left = mathml_of(lhs) if k == 0 else ""
+        rows.append(f"<mtr><mtd>{left}</mtd><mtd><mo>{'=' if k == 0 else ''}</mo></mtd><mtd>{sign}{body}</mtd></mtr>")
+    return (
+        f'<math xmlns="{MATHML_NS}" display="{display}"><mtable columnalign="right center left">'
+        + "".join(rows)
+        + "</mtable></math>"
+    )
 
 
 def equation_mathml(lhs, value, rates=None, display: str = "block") -> str:

@@ -145,8 +145,8 @@ def change_coordinates(eom: EquationsOfMotion, A, coordinates=None, name: str | 
     steps = [
         Step(
             "Change of coordinates q = A p",
-            "qd = A pd; D_p = A^T D_q A, g_p = A^T g_q, tau_p = A^T tau_q (virtual work)",
-            [("A", A), (r"D(p)", D), (r"g(p)", g)],
+            "qd = A pd; M_p = A^T M_q A, g_p = A^T g_q, tau_p = A^T tau_q (virtual work)",
+            [("A", A), (r"M(p)", D), (r"g(p)", g)],
         )
     ]
     return _from_inertia(
@@ -295,8 +295,8 @@ def closed_chain(trees, closure, independent, solution: dict, name: str = "close
         ),
         Step(
             "Reduced dynamics",
-            "J = dTheta/dq, D = J^T D_tree J, g = J^T g_tree, C from the Christoffel symbols of D",
-            [("J", J), ("D(q)", D), ("g(q)", g)],
+            "J = dTheta/dq, M = J^T M_tree J, g = J^T g_tree, C from the Christoffel symbols of M",
+            [("J", J), ("M(q)", D), ("g(q)", g)],
         ),
     ]
     return _from_inertia(

@@ -9,7 +9,8 @@ from typing import Any
 import sympy as sp
 
 from ...description.parametrise import euler_parametrised
-from ..derive.cse import CSE_THRESHOLD, closed_form_of_program, closed_form_steps
+from ...description.snap import snap_note, snap_right_angles
+from ..derive.cse import CSE_JOINTS, CSE_THRESHOLD, closed_form_of_program, closed_form_steps
 from ..derive.lagrange import (
     RingModel,
     body_coordinates,
@@ -92,9 +93,9 @@ def _steps(robot, model, d, conv, mat, vec, q, qd):
         pass
     steps.append(
         Step(
-            "Kinetic energy K = qd^T D(q) qd / 2",
-            "D(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
-            [(of_q("D"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
+            "Kinetic energy K = qd^T M(q) qd / 2",
+            "M(q) = sum_i m_i J_vci^T J_vci + J_wi^T R_i I_i R_i^T J_wi, plus reflected rotor inertia r^2 J_m on the diagonal (Spong eqs. 9.46-9.47).",
+            [(of_q("M"), mat(d["D"])), (name("K", "K", "K"), conv(d["K"]))],
         )
     )
     steps.append(
@@ -161,12 +162,14 @@ def _christoffel_sympy(c, conv):
     return [[[conv(c[i][j][k]) for k in range(n)] for j in range(n)] for i in range(n)]
 
 
-def _use_cse(form: str, prog) -> bool:
-    """Whether the results are shown in CSE form: ``form`` "cse", "expanded" or "auto" (CSE above
-    :data:`kinedyn.symbolic.cse.CSE_THRESHOLD` operations of the customised model)."""
+def _use_cse(form: str, prog, n: int) -> bool:
+    """Whether the results are shown in CSE form: ``form`` "cse", "expanded" or "auto": CSE above
+    :data:`kinedyn.symbolic.cse.CSE_THRESHOLD` operations of the customised model or above
+    :data:`kinedyn.symbolic.cse.CSE_JOINTS` coordinates, numeric parameters or not (a 6-joint arm's
+    expanded Lagrange steps run to hundreds of pages either way)."""
     if form not in ("auto", "cse", "expanded"):
         raise ValueError(f"form must be 'auto', 'cse' or 'expanded', got {form!r}")
-    return form == "cse" or (form == "auto" and prog.op_count()["total"] > CSE_THRESHOLD)
+    return form == "cse" or (form == "auto" and (n > CSE_JOINTS or prog.op_count()["total"] > CSE_THRESHOLD))
 
 
 def _closed_form_getter(prog, q, qd, qdd) -> Callable[[], Any]:
@@ -216,7 +219,7 @@ def lagrange_eom(
         except Exception:  # noqa: BLE001 - a model the recursion cannot take is shown expanded, as before
             if form == "cse":
                 raise
-    cse = prog is not None and _use_cse(form, prog)
+    cse = prog is not None and _use_cse(form, prog, len(q))
     closed = _closed_form_getter(prog, q, qd, qdd) if cse else None
     steps: Any = None
     if with_steps and cse:
@@ -226,7 +229,7 @@ def lagrange_eom(
                 "Lagrange's steps omitted (too large to read)",
                 f"K, P, L and their derivatives of this {robot.n}-joint model run to thousands of terms. M, C and g below are the "
                 "same unique inertia matrix, Christoffel Coriolis matrix and gravity vector, formed from the customised "
-                "Newton-Euler model and printed with named intermediate variables; eom.M, eom.C, eom.g give them expanded.",
+                "Newton-Euler model and printed with named intermediate variables; in Python the result's attributes M, C and g hold them expanded.",
             )
             assert closed is not None
             return [note] + closed_form_steps(closed())
@@ -307,7 +310,7 @@ def newton_euler_eom(
     symbols), P and K from the kinematics."""
     q, qd, qdd = state_symbols(robot)
     prog = newton_euler_program(robot, q, qd, qdd, parameters=parameters, friction=False)
-    closed = _closed_form_getter(prog, q, qd, qdd) if _use_cse(form, prog) else None
+    closed = _closed_form_getter(prog, q, qd, qdd) if _use_cse(form, prog, len(q)) else None
     friction = _friction(robot, qd)
     inertias = [_Inertias(p) for p in parameters] if parameters is not None else None
     cache: dict[str, Any] = {}
@@ -363,7 +366,13 @@ def newton_euler_eom(
 
 
 def equations_of_motion(
-    robot, method: str = "lagrange", simplify: bool = True, steps: bool = True, parameters=None, form: str = "auto"
+    robot,
+    method: str = "lagrange",
+    simplify: bool = True,
+    steps: bool = True,
+    parameters=None,
+    form: str = "auto",
+    snap_angles: float | None = None,
 ) -> EquationsOfMotion:
     """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
 
@@ -383,7 +392,18 @@ def equations_of_motion(
     velocities (:mod:`kinedyn.description.parametrise`; ``eom.robot`` is that robot). Reduced mimic
     joints stay reduced: a follower's joint variable is ``m q_leader + o`` (docs/symbolic.md, "Mimic
     joints"; :mod:`kinedyn.symbolic.lagrange`).
+
+    ``snap_angles``: a tolerance in radians; the robot's rotation angles within it of a multiple of
+    pi/2 (a file's ``1.570796325``) are made exact first, so that cos(pi/2) terms vanish instead of
+    printing as 1e-12 (:func:`kinedyn.description.snap.snap_right_angles`); ``eom.notes`` says what
+    moved and ``eom.robot`` is the snapped robot. ``kinedyn derive`` snaps within 1e-6 rad by default.
     """
+    notes = []
+    if snap_angles:
+        snapped, moved = snap_right_angles(robot.description, snap_angles)
+        if moved:
+            robot = robot.replace(links=snapped.links, frames=snapped.frames)
+            notes.append(snap_note(moved, snap_angles))
     robot = euler_parametrised(robot)
     if isinstance(parameters, str):
         if parameters != "general":
@@ -393,7 +413,10 @@ def equations_of_motion(
     if parameters is not None and (len(parameters) != bodies or any(len(p) != 10 for p in parameters)):
         raise ValueError(f"parameters must hold {bodies} vectors of 10 inertial parameters (one per moving body)")
     if method == "lagrange":
-        return lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
+        eom = lagrange_eom(robot, simplify=simplify, with_steps=steps, parameters=parameters, form=form)
     elif method in ("newton_euler", "newton-euler", "rnea"):
-        return newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
-    raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
+        eom = newton_euler_eom(robot, simplify=simplify, parameters=parameters, with_steps=steps, form=form)
+    else:
+        raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
+    eom.notes = notes
+    return eom
