@@ -192,3 +192,7 @@ def integrate_callback(
     # external wrenches per body: None, (n, 6) constant, or (t, q, qd) -> (n, 6) at every stage
     f_ext: F64 | Callable[[float, F64, F64], F64] | None = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
+
+# the core's Lie-group operations per joint block ("floating", "spherical", "planar", "" for 1-DOF):
+def lie_integrate(names: Sequence[str], q: F64, v: F64) -> F64: ...  # q (..., nq), v (..., nv) -> q ⊕ v
+def lie_difference(names: Sequence[str], q0: F64, q1: F64) -> F64: ...  # (..., nq) x2 -> v with q0 ⊕ v = q1
