@@ -279,3 +279,24 @@ def test_f_ext_on_a_floating_tree_changes_its_momentum_as_newton_and_euler_say()
     # trapezoidal rule over the samples: O(dt^2)
     L = h[0, 3:] + np.concatenate([[np.zeros(3)], np.cumsum((rate_L[1:] + rate_L[:-1]) / 2 * dt, axis=0)])
     close(h[:, 3:], L, 1e-5, "angular momentum")
+
+
+def test_constant_f_ext_with_a_controller_and_a_bad_f_ext_function():
+    """A controller sends the run through the core's callback loop, where a constant f_ext travels as
+    data: the same run as the same wrench given as a function; a function returning the wrong shape
+    is an error naming it."""
+    robot = kd.robots.puma560()
+    rng = np.random.default_rng(11)
+    x0 = np.r_[rng.uniform(-1, 1, 6), np.zeros(6)]
+    F = 2 * rng.normal(size=(6, 6))
+
+    def controller(t, q, qd):
+        return -5.0 * qd
+
+    as_data = kd.simulate(robot, 0.1, x0, dt=1e-3, controller=controller, f_ext=F)
+    as_function = kd.simulate(robot, 0.1, x0, dt=1e-3, controller=controller, f_ext=lambda t, q, qd: F)
+    assert as_data.info["native"] and as_function.info["native"]
+    close(as_data.q, as_function.q, 1e-14, "q")
+    assert np.abs(as_data.q - kd.simulate(robot, 0.1, x0, dt=1e-3, controller=controller).q).max() > 1e-4
+    with pytest.raises(ValueError, match=r"f_ext returned wrenches of shape \[5, 6\]"):
+        kd.simulate(robot, 0.1, x0, dt=1e-3, f_ext=lambda t, q, qd: np.zeros((5, 6)))
