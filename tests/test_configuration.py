@@ -397,8 +397,9 @@ def test_length_and_non_finite_numbers_are_refused():
 
 # ---------------------------------------------------------------- the Rust core's shared vectors
 def test_python_reproduces_the_vectors_shared_with_the_rust_core():
-    """crates/kinedyn-core/src/lie.rs tests its SO(3)/SE(3)/SE(2) functions on vectors written by this
-    module; reading them back here keeps the two implementations pinned to the same numbers."""
+    """crates/kinedyn-core/src/lie.rs tests its SO(3)/SE(3)/SE(2) functions on vectors written by the
+    NumPy module it replaced (tests/lie_oracle.py); the configuration space, now on the core's
+    operations, reads them back through the bindings (tests/test_lie_core.py holds the two together)."""
     import re
     from pathlib import Path
 

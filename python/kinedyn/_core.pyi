@@ -39,6 +39,9 @@ class Model:
         # 1-DOF joint and for a multi-DOF joint's further bodies
         blocks: Sequence[str | None] | None = None,
     ) -> None: ...
+    # the model with f_ext's moments taken about link-frame origins: (n, 3), each body's link-frame
+    # origin in its body frame (zero: the body origin)
+    def with_link_origins(self, origins: F64) -> Model: ...
     @property
     def n(self) -> int: ...  # bodies = degrees of freedom (nv)
     @property
@@ -58,7 +61,7 @@ class Model:
         self, q: F64, qd: F64, frame: int, reference: str, point: F64 | None = None
     ) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----
-    # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the body origin.
+    # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the link-frame origin (with_link_origins; the body origin by default).
     # A singular mass matrix (forward_dynamics, mass_matrix_inverse) raises RuntimeError naming the joint.
     def inverse_dynamics(
         self, q: F64, qd: F64, qdd: F64, f_ext: F64 | None = None, out: F64 | None = None
@@ -168,6 +171,7 @@ def integrate_fixed(
     max_speed: float = 1e6,
     lower: F64 | None = None,  # (n,) joint position limits: inelastic stops when given
     upper: F64 | None = None,
+    f_ext: F64 | None = None,  # (n, 6) constant external wrenches per body (as Model.inverse_dynamics)
 ) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
 def integrate_callback(
     model: Model,
@@ -185,4 +189,10 @@ def integrate_callback(
     | None = None,  # (step, t, q, qd) -> (dtau/dq, dtau/dqd) (n, n) each, or None
     lower: F64 | None = None,
     upper: F64 | None = None,
+    # external wrenches per body: None, (n, 6) constant, or (t, q, qd) -> (n, 6) at every stage
+    f_ext: F64 | Callable[[float, F64, F64], F64] | None = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
+
+# the core's Lie-group operations per joint block ("floating", "spherical", "planar", "" for 1-DOF):
+def lie_integrate(names: Sequence[str], q: F64, v: F64) -> F64: ...  # q (..., nq), v (..., nv) -> q ⊕ v
+def lie_difference(names: Sequence[str], q0: F64, q1: F64) -> F64: ...  # (..., nq) x2 -> v with q0 ⊕ v = q1

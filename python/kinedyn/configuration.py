@@ -22,28 +22,26 @@ Manipulation* (1994), §2.3 eq. 2.36 (the exponential of a twist) and Prop. 2.9;
 random rotations", *Graphics Gems III* (1992) for random quaternions.
 
 Everything here is NumPy and vectorised: ``q`` may be (nq,) or a batch (..., nq), ``v`` (nv,) or
-(..., nv), broadcast against each other. Nothing needs the native core.
+(..., nv), broadcast against each other. ``integrate`` and ``difference`` are the core's
+(``kinedyn._core.lie_integrate`` / ``lie_difference``, which need no model); their Jacobians and the
+quaternion helpers are NumPy (:mod:`kinedyn.lie`).
 """
 
 from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._core import lie_difference, lie_integrate
 from .description.joint import Joint
 from .lie import (
     block_jacobians,
-    difference_floating,
-    difference_planar,
     exp3,
-    integrate_floating,
-    integrate_planar,
-    integrate_rotation,
     log3,
     quaternion_multiply,
     quaternion_rotate,
@@ -120,6 +118,10 @@ class ConfigurationSpace:
             iq, iv = iq + joint.nq, iv + joint.nv
         self.blocks: tuple = tuple(blocks)
         self.nq, self.nv = iq, iv
+        # each joint's block as the core names it (lie::Block::from_name): "" for a 1-DOF joint
+        self._block_names = [
+            b.joint.kind if b.joint.kind in ("floating", "spherical", "planar") else "" for b in blocks
+        ]
         self._scalar_q = np.array([b.iq for b in blocks if b.joint.nq == 1], dtype=np.intp)
         self._scalar_v = np.array([b.iv for b in blocks if b.joint.nv == 1], dtype=np.intp)
         self._kinds = {}  # kind -> (q indices (k, nq), v indices (k, nv)) for the multi-DOF kinds present
@@ -226,17 +228,8 @@ class ConfigurationSpace:
         shape = np.broadcast_shapes(q.shape[:-1], vdt.shape[:-1])
         q = np.broadcast_to(q, shape + (self.nq,))
         vdt = np.broadcast_to(vdt, shape + (self.nv,))
-        out = np.array(q, dtype=float)
-        # 1-DOF joints: q + v dt
-        out[..., self._scalar_q] = q[..., self._scalar_q] + vdt[..., self._scalar_v]
-        step: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
-            "floating": integrate_floating,
-            "spherical": integrate_rotation,
-            "planar": integrate_planar,
-        }
-        for kind, (qi, vi) in self._kinds.items():
-            out[..., qi] = step[kind](q[..., qi], vdt[..., vi])
-        return out
+        # the core's q ⊕ v per joint block (crates/kinedyn-core/src/lie.rs)
+        return lie_integrate(self._block_names, np.ascontiguousarray(q), np.ascontiguousarray(vdt))
 
     def difference(self, q0, q1) -> np.ndarray:
         """v with q0 ⊕ v = q1: Log(M(q0)⁻¹ M(q1)) per joint, q1 - q0 for 1-DOF joints; rotations the
@@ -245,18 +238,8 @@ class ConfigurationSpace:
         shape = np.broadcast_shapes(q0.shape[:-1], q1.shape[:-1])
         q0 = np.broadcast_to(q0, shape + (self.nq,))
         q1 = np.broadcast_to(q1, shape + (self.nq,))
-        out = np.empty(shape + (self.nv,))
-        out[..., self._scalar_v] = q1[..., self._scalar_q] - q0[..., self._scalar_q]
-        for kind, (qi, vi) in self._kinds.items():
-            a, b = q0[..., qi], q1[..., qi]
-            if kind == "floating":
-                out[..., vi] = difference_floating(a, b)
-            elif kind == "spherical":
-                conj = a * np.array([-1.0, -1.0, -1.0, 1.0])
-                out[..., vi] = log3(quaternion_multiply(conj, b))
-            else:
-                out[..., vi] = difference_planar(a, b)
-        return out
+        # the core's Log(M0⁻¹ M1) per joint block (crates/kinedyn-core/src/lie.rs)
+        return lie_difference(self._block_names, np.ascontiguousarray(q0), np.ascontiguousarray(q1))
 
     def interpolate(self, q0, q1, t) -> np.ndarray:
         """q0 ⊕ t · difference(q0, q1): the geodesic from q0 (t = 0) to q1 (t = 1) in each joint's group;

@@ -29,9 +29,8 @@ from .description.link import Frame, Link
 from .description.mjcf import description_from_mjcf
 from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
-from .native.compile import compile_model, locked_block
+from .native.compile import body_wrenches, compile_model, locked_block
 from .native.errors import robot_error
-from .native.wrenches import body_wrenches, link_origin_in_body, moment_shift_derivative
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -499,8 +498,6 @@ class Robot:
         return solve_ik(self, target, q0, mask, method, respect_limits, **kwargs)
 
     # dynamics -----------------------------------------------------------------------------
-    _link_origin_in_body = cached_property(link_origin_in_body)  # (n, 3) or None (kinedyn.native.wrenches)
-
     # Equations of motion (docs/architecture.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
     # friction = viscous qd + coulomb sign(qd) (direction-dependent levels: friction_torque), M including
     # the reflected rotor inertia r^2 J_m.
@@ -562,9 +559,7 @@ class Robot:
         if f_ext is None:
             return self._model.inverse_dynamics_derivatives(q, qd, qdd)
         q = float64_array(q)
-        dq, dqd, M = self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self, q, f_ext))
-        shift = moment_shift_derivative(self, q, f_ext)
-        return (dq if shift is None else dq + shift), dqd, M
+        return self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self, q, f_ext))
 
     @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics_derivatives(
@@ -577,11 +572,9 @@ class Robot:
             if f_ext is None:
                 return self._model.forward_dynamics_derivatives(q, qd, tau)
             q = float64_array(q)
-            dq, dqd, Minv = self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self, q, f_ext))
+            return self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self, q, f_ext))
         except RuntimeError as e:
             raise robot_error(self, e) from None
-        shift = moment_shift_derivative(self, q, f_ext)
-        return (dq if shift is None else dq - Minv @ shift), dqd, Minv
 
     @batched("q", "qd")
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:

@@ -506,6 +506,14 @@ mod tests {
             ("tree", random_model(3, 9, true)),
             ("floating", random_floating_model(4, 5, false)),
             ("floating tree", random_floating_model(5, 6, true)),
+            // external wrenches about link-frame origins off the body origins
+            ("floating tree, link origins", {
+                let model = random_floating_model(5, 6, true);
+                let origins = (0..model.n)
+                    .map(|k| crate::spatial::Vec3::new(0.1 * k as f64, -0.2, 0.3))
+                    .collect();
+                model.with_link_origins(origins).unwrap()
+            }),
             // direction-dependent Coulomb levels (the lanes' compare-and-blend friction)
             (
                 "asymmetric friction",

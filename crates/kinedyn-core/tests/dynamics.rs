@@ -153,12 +153,16 @@ fn forward_dynamics_inverts_inverse_dynamics_with_external_forces() {
         let n = model.n;
         let mut data = Data::new(&model);
         let mut rng = Rng::new(9);
+        let origins = (0..n)
+            .map(|_| Vec3::from_column_slice(&vector(&mut rng, 3, 0.7)))
+            .collect();
+        let moved = model.clone().with_link_origins(origins).unwrap();
         for (q, qd, qdd) in states(&model, 10) {
-            for with_f in [false, true] {
+            for (model, with_f) in [(&model, false), (&model, true), (&moved, true)] {
                 let f = vector(&mut rng, 6 * n, 5.0);
                 let f_ext = if with_f { Some(&f[..]) } else { None };
-                let tau = alg::rnea(&model, &mut data, &q, &qd, &qdd, f_ext).to_vec();
-                let back = alg::aba(&model, &mut data, &q, &qd, &tau, f_ext).unwrap().to_vec();
+                let tau = alg::rnea(model, &mut data, &q, &qd, &qdd, f_ext).to_vec();
+                let back = alg::aba(model, &mut data, &q, &qd, &tau, f_ext).unwrap().to_vec();
                 assert_close(&format!("{name}: aba(rnea(qdd)) (f_ext {with_f})"), &back, &qdd, 1e-10);
             }
         }
@@ -167,10 +171,15 @@ fn forward_dynamics_inverts_inverse_dynamics_with_external_forces() {
 
 #[test]
 fn external_wrench_enters_as_minus_jacobian_transpose() {
-    for (name, model) in models() {
-        let n = model.n;
-        let mut data = Data::new(&model);
+    for (name, plain) in models() {
+        let n = plain.n;
         let mut rng = Rng::new(11);
+        // wrenches about link-frame origins off the body origins (as DH links)
+        let origins: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::from_column_slice(&vector(&mut rng, 3, 0.7)))
+            .collect();
+        let model = plain.with_link_origins(origins.clone()).unwrap();
+        let mut data = Data::new(&model);
         let (q, qd, qdd) = states(&model, 12).remove(0);
         let f = vector(&mut rng, 6 * n, 5.0);
         let with = alg::rnea(&model, &mut data, &q, &qd, &qdd, Some(&f)).to_vec();
@@ -179,8 +188,8 @@ fn external_wrench_enters_as_minus_jacobian_transpose() {
         let mut want = vec![0.0; n];
         let mut jac = vec![0.0; 6 * n];
         for i in 0..n {
-            // frame i sits on body i; its Jacobian at body i's origin (a point fixed in the frame)
-            let origin = model.frames[i].body_from_frame.inverse().trans;
+            // frame i sits on body i; its Jacobian at body i's link origin (a point fixed in the frame)
+            let origin = model.frames[i].body_from_frame.inverse().act_point(&origins[i]);
             alg::frame_jacobian(&model, &mut data, &q, i, Reference::World, Some(&origin), &mut jac);
             for k in 0..n {
                 want[k] -= (0..6).map(|r| jac[r * n + k] * f[6 * i + r]).sum::<f64>();

@@ -9,6 +9,7 @@
 mod conv;
 mod guard;
 mod ik;
+mod lie;
 mod model;
 mod run;
 mod simulate;
@@ -46,6 +47,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     guard::register(m)?;
     ik::register(m)?;
+    lie::register(m)?;
     simulate::register(m)?;
     Ok(())
 }

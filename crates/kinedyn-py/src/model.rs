@@ -264,6 +264,21 @@ model_methods! {
             })
         }
 
+        /// This model with external wrenches taken about link-frame origins: `origins` (n, 3), body
+        /// i's link-frame origin in body i's frame (the core's `Model::with_link_origins`).
+        fn with_link_origins(&self, origins: PyReadonlyArrayDyn<f64>) -> PyResult<Self> {
+            guarded("Model.with_link_origins", || {
+                let u = vec_of("origins", &origins, &[self.n(), 3])?;
+                let model = self
+                    .model
+                    .clone()
+                    .with_link_origins(u.chunks(3).map(Vec3::from_column_slice).collect())
+                    .map_err(core_err)?;
+                let data = Mutex::new(Data::new(&model));
+                Ok(Self { model, data })
+            })
+        }
+
         #[getter(n)]
         fn get_n(&self) -> usize {
             self.model.n

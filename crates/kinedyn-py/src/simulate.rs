@@ -8,7 +8,9 @@
 
 use std::cell::RefCell;
 
-use kinedyn_core::sim::{self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn};
+use kinedyn_core::sim::{
+    self, Failure, FailureKind, Limits, Method, Outcome, Record, Sampled, Settings, TorqueFn, WithWrenches,
+};
 use kinedyn_core::Data;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -75,6 +77,19 @@ fn flat(name: &str, a: &PyReadonlyArrayDyn<f64>) -> PyResult<Vec<f64>> {
         )));
     }
     Ok(v)
+}
+
+/// Constant external wrenches `f_ext` ((n, 6), per body as `Model.inverse_dynamics` takes them),
+/// checked and flattened.
+fn constant_wrenches(n: usize, f_ext: Option<&PyReadonlyArrayDyn<f64>>) -> PyResult<Option<Vec<f64>>> {
+    let Some(f) = f_ext else { return Ok(None) };
+    if f.shape() != [n, 6] {
+        return Err(PyValueError::new_err(format!(
+            "f_ext must have shape ({n}, 6): one wrench per body, got {:?}",
+            f.shape()
+        )));
+    }
+    flat("f_ext", f).map(Some)
 }
 
 fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict>> {
@@ -182,8 +197,9 @@ fn initial_states(
 /// samples `tau`: None (zero), `(S, n)` shared by every trajectory or `(N, S, n)` one per trajectory;
 /// S = 1 is a constant, else samples at `t0 + k dt` held over each step (`linear=False`, S >= steps)
 /// or interpolated (`linear=True`, S >= steps + 1). A batch runs in parallel without the GIL.
+/// `f_ext`: constant external wrenches (n, 6) per body (as `Model.inverse_dynamics` takes them), or None.
 #[pyfunction]
-#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6, lower=None, upper=None))]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6, lower=None, upper=None, f_ext=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_fixed<'py>(
     py: Python<'py>,
@@ -200,10 +216,12 @@ pub fn integrate_fixed<'py>(
     max_speed: f64,
     lower: Option<PyReadonlyArrayDyn<'py, f64>>,
     upper: Option<PyReadonlyArrayDyn<'py, f64>>,
+    f_ext: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_fixed", || {
         let m = model.get();
         let (n, nq) = (m.model.n, m.model.nq);
+        let f_ext = constant_wrenches(n, f_ext.as_ref())?;
         let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
         let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
         let settings = Settings {
@@ -278,12 +296,23 @@ pub fn integrate_fixed<'py>(
             } else {
                 &tau[i * rows * n..(i + 1) * rows * n]
             };
-            let mut source = Sampled {
+            let samples = Sampled {
                 values,
                 n,
                 t0,
                 dt,
                 linear,
+            };
+            let (mut plain, mut pushed);
+            let source: &mut dyn TorqueFn = match f_ext.as_deref() {
+                None => {
+                    plain = samples;
+                    &mut plain
+                }
+                Some(f_ext) => {
+                    pushed = WithWrenches { source: samples, f_ext };
+                    &mut pushed
+                }
             };
             let mut data = Data::new(model_ref);
             sim::integrate(
@@ -292,7 +321,7 @@ pub fn integrate_fixed<'py>(
                 &settings,
                 &q0[i * nq..(i + 1) * nq],
                 &qd0[i * n..(i + 1) * n],
-                &mut source,
+                source,
                 Record { q, qd, qdd, tau: t },
             )
         };
@@ -318,16 +347,21 @@ pub fn integrate_fixed<'py>(
 
 /// A torque source made of Python callables: `torque(k, t, q, qd, out)` and, for the implicit
 /// method, `jacobian(k, t, q, qd, dtau_dq, dtau_dqd) -> known`.
-struct CallbackSource<T, J> {
+struct CallbackSource<T, J, W> {
     torque: T,
     jacobian: J,
+    wrenches: W,
 }
 
-impl<T, J> TorqueFn for CallbackSource<T, J>
+impl<T, J, W> TorqueFn for CallbackSource<T, J, W>
 where
     T: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> Result<(), String>,
     J: FnMut(usize, f64, &[f64], &[f64], &mut [f64], &mut [f64]) -> Result<bool, String>,
+    W: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> Result<bool, String>,
 {
+    fn wrenches(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<bool, String> {
+        (self.wrenches)(step, t, q, qd, out)
+    }
     fn torque(&mut self, step: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<(), String> {
         (self.torque)(step, t, q, qd, out)
     }
@@ -361,9 +395,10 @@ fn matrix_into(value: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut [f64]) 
 /// numbers; `step` is the index k of the step [t_k, t_k + dt] being taken), called by the core's loop at every stage (`hold=False`) or once per step, held
 /// (`hold=True`). A batch (N, n) runs its trajectories one after the other. An exception raised by
 /// the callback propagates unchanged. `jacobian(step, t, q, qd) -> (dtau_dq, dtau_dqd)` ((n, n)
-/// each) or None: the torque's derivatives, used by the implicit method.
+/// each) or None: the torque's derivatives, used by the implicit method. `f_ext`: None, constant
+/// wrenches (n, 6) or a callable `f_ext(t, q, qd) -> (n, 6)` evaluated at every stage.
 #[pyfunction]
-#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6, jacobian=None, lower=None, upper=None))]
+#[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6, jacobian=None, lower=None, upper=None, f_ext=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_callback<'py>(
     py: Python<'py>,
@@ -381,6 +416,7 @@ pub fn integrate_callback<'py>(
     jacobian: Option<Bound<'py, PyAny>>,
     lower: Option<PyReadonlyArrayDyn<'py, f64>>,
     upper: Option<PyReadonlyArrayDyn<'py, f64>>,
+    f_ext: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     guarded("integrate_callback", || {
         let m = model.get();
@@ -467,9 +503,39 @@ pub fn integrate_callback<'py>(
                     message
                 })
             };
+        // external wrenches: None, a constant (n, 6) array, or a callable f_ext(t, q, qd) -> (n, 6)
+        let constant = match f_ext.as_ref() {
+            Some(f) if !f.is_callable() => constant_wrenches(n, Some(&f.extract::<PyReadonlyArrayDyn<f64>>()?))?,
+            _ => None,
+        };
+        let wrenches = |_k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<bool, String> {
+            if let Some(c) = constant.as_deref() {
+                out.copy_from_slice(c);
+                return Ok(true);
+            }
+            let Some(f) = f_ext.as_ref() else { return Ok(false) };
+            let mut call = || -> PyResult<bool> {
+                let value = f.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)))?;
+                let a: PyReadonlyArrayDyn<f64> = value.extract()?;
+                if a.shape() != [n, 6] {
+                    return Err(PyValueError::new_err(format!(
+                        "f_ext returned wrenches of shape {:?} at t = {t}; the model has {n} bodies: ({n}, 6)",
+                        a.shape()
+                    )));
+                }
+                out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
+                Ok(true)
+            };
+            call().map_err(|e| {
+                let message = e.to_string();
+                *error.borrow_mut() = Some(e);
+                message
+            })
+        };
         let mut source = CallbackSource {
             torque,
             jacobian: derivatives,
+            wrenches,
         };
         let mut outcomes = Vec::with_capacity(count);
         let mut data = Data::new(&m.model);

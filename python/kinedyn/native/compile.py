@@ -18,7 +18,7 @@ from .mimic import ReducedModel
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["compile_model", "joint_columns", "locked_block", "planar_basis"]
+__all__ = ["body_wrenches", "compile_model", "joint_columns", "link_origins", "locked_block", "planar_basis"]
 
 # the joint kinds the core decodes into multi-DOF blocks (lie::Block::from_name)
 MULTI_DOF_KINDS = ("floating", "spherical", "planar")
@@ -138,7 +138,45 @@ def compile_model(robot: Robot):
         coulomb_negative=asymmetric,
         blocks=blocks if robot.has_multi_dof_joints else None,
     )
+    origins = link_origins(robot)
+    if np.any(origins):
+        native = native.with_link_origins(origins)
     if robot._mimic is None:
         return native
 
     return ReducedModel(native, robot._mimic, robot.name)
+
+
+def link_origins(robot: Robot) -> np.ndarray:
+    """(n, 3) per native body: the origin of its link frame in its body frame, about which the core
+    takes an external wrench's moment (``_core.Model.with_link_origins``). A standard-DH link frame
+    sits at ``Tx(a)`` from its joint frame; a URDF link frame is its joint frame (zero). A multi-DOF
+    joint's link is on its last body; the bodies before it carry no link (zero)."""
+    u = np.zeros((len(robot._dof_body), 3))
+    for b, name in enumerate(robot.body_names):
+        T = to_float_array(robot.tree.frames[robot.frame_index(name)].placement, (4, 4), f"frame '{name}'")
+        u[robot._body_last_dof[b]] = T[:3, 3]
+    return u
+
+
+def body_wrenches(robot: Robot, q, f_ext):
+    """``f_ext`` (one wrench per moving link, ``robot.body_names``; or (N, links, 6)) laid out as the
+    native model's bodies: one set for a batch of states is repeated for each, and the wrench of a
+    multi-DOF joint's link acts on the joint's last body. The core moves each moment from the link
+    frame's origin to the body's (:func:`link_origins`)."""
+    if f_ext is None:
+        return None
+    f = real_array(f_ext, "f_ext")
+    links = len(robot.tree.bodies)
+    if f.shape == (links, 6) and np.ndim(q) == 2:
+        # one set of wrenches for every state of a batch
+        f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
+    if not robot.has_multi_dof_joints:
+        return f  # (wrong shapes are reported by the core)
+    if f.shape[-2:] != (links, 6):
+        raise ValueError(
+            f"f_ext must have shape ({links}, 6): one wrench per moving link {robot.body_names}, got {f.shape}"
+        )
+    full = np.zeros(f.shape[:-2] + (len(robot._dof_body), 6))  # every native body
+    full[..., robot._body_last_dof, :] = f
+    return full

@@ -59,6 +59,11 @@ class ReducedModel:
     def n_frames(self) -> int:
         return self.native.n_frames
 
+    def with_link_origins(self, origins) -> ReducedModel:
+        """The full model's link origins (per body of the full model: they place wrenches, which act
+        on every link, mimic followers' too)."""
+        return ReducedModel(self.native.with_link_origins(origins), self.map, self.robot)
+
     def __getattr__(self, name: str):
         # a method of the native model this wrapper does not map (added to the core after it): an
         # error naming it, never the full model's answer in the wrong coordinates

@@ -18,9 +18,11 @@ Where the work happens (docs/architecture.md: Rust does every hot loop):
   algorithm, so a Python controller sets the speed (~20-40 us per RK4 step instead of ~5-10 us);
   precompute open-loop torques as arrays where possible. A batch with a controller runs its states
   one after the other.
-- External wrenches ``f_ext`` (they are given about the link frames, which move with q) and every
-  :class:`~kinedyn.simulate.systems.MechanicalSystem` / ``LagrangianSystem`` integrate in Python
-  with the same schemes, calling the compiled dynamics once per stage (:mod:`.fixed_step`).
+- External wrenches ``f_ext`` (about the link frames' origins, which move with q) are the core's: a
+  constant array goes with the run as data, a function ``f_ext(t, q, qd)`` is called back at every
+  stage. Every :class:`~kinedyn.simulate.systems.MechanicalSystem` / ``LagrangianSystem`` (and a robot
+  with reduced mimic joints) integrates in Python with the same schemes, calling the compiled
+  dynamics once per stage (:mod:`.fixed_step`).
 - Adaptive methods (``rk45``, ``rk23``, ``dop853``, ``radau``, ``bdf``, ``lsoda``) use
   ``scipy.integrate.solve_ivp`` with ``rtol``/``atol``; the samples are at multiples of ``dt``
   (:mod:`.adaptive`).
@@ -201,22 +203,23 @@ def simulate(
     else:
         u_fn = None
         u_data, linear = sampled_u(u, n, steps, batch)
-    fext_fn = external_wrenches(f_ext, n, robot)
+    # one wrench per moving link (a multi-DOF joint's link counts once)
+    fext_fn = external_wrenches(f_ext, len(cast("Robot", system).body_names) if robot else n, robot)
+    native_wrenches = f_ext if callable(f_ext) or f_ext is None else np.asarray(f_ext, dtype=float)
     count = batch or 1
     work = steps * count * (4 if method == "rk4" else 1)
-    # The one place that sends a robot to the Python fixed-step loop (:mod:`.fixed_step`): wrenches
-    # about link frames (f_ext) are applied in Python (Robot.forward_dynamics), and a robot with reduced
-    # mimic joints runs on its reduced methods (the native integrators take the full model). Once the
-    # core takes both, this is `robot and method in FIXED_METHODS`, and the Python loop serves
-    # MechanicalSystem / LagrangianSystem alone.
-    native = robot and method in FIXED_METHODS and fext_fn is None and not getattr(system, "mimic_joints", None)
+    # The one place that sends a robot to the Python fixed-step loop (:mod:`.fixed_step`): a robot
+    # with reduced mimic joints runs on its reduced methods (the native integrators take the full
+    # model). Wrenches about link frames (f_ext) are the core's (Model.with_link_origins).
+    native = robot and method in FIXED_METHODS and not getattr(system, "mimic_joints", None)
     if multi_dof and not native:
-        why = f"the method '{method}'" if method not in FIXED_METHODS else "f_ext or mimic joints"
+        why = f"the method '{method}'" if method not in FIXED_METHODS else "mimic joints"
         raise ValueError(
             f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
-            f"integrators only ({', '.join(FIXED_METHODS)}, without f_ext or mimic joints); {why} needs the Python loop, which steps q + h qd"
+            f"integrators only ({', '.join(FIXED_METHODS)}, without mimic joints); {why} needs the Python loop, which steps q + h qd"
         )
-    pure_native = native and u_fn is None and controller is None
+    # constant wrenches go to the core as data (a batch in parallel); a function of (t, q, qd) is called back
+    pure_native = native and u_fn is None and controller is None and not callable(f_ext)
     delay = 0.0
     if progress is None:
         # on a terminal, a bar appears once a run has taken a second (runs over ~2 s show progress)
@@ -256,6 +259,7 @@ def simulate(
                 jac,
                 limits,
                 deadline,
+                native_wrenches,
             )
         elif method in FIXED_METHODS:  # a MechanicalSystem, or a robot the core cannot run (see `native`)
             out = run_fixed_step(

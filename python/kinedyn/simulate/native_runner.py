@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._core import integrate_callback, integrate_fixed
+from ..native.compile import body_wrenches
 
 __all__ = ["run_native"]
 
@@ -32,10 +33,19 @@ def run_native(
     jac=None,
     limits=None,
     deadline=None,
+    f_ext=None,
 ):
     """The core's integrator, in chunks when a progress bar is shown or a time budget is set
-    (chunk boundaries on recorded steps, so the samples are the same as in one call)."""
+    (chunk boundaries on recorded steps, so the samples are the same as in one call). ``f_ext``:
+    None, constant link wrenches (links, 6) or a function ``(t, q, qd) -> (links, 6)``, laid out
+    as the native model's bodies (:func:`kinedyn.native.compile.body_wrenches`)."""
     model = robot._model
+    wrenches: Any = None if f_ext is None or callable(f_ext) else body_wrenches(robot, None, f_ext)
+    if callable(f_ext):
+
+        def wrenches(t, q, qd):
+            return body_wrenches(robot, None, f_ext(t, q, qd))
+
     bounded = deadline is not None and deadline.end is not None
     chunks = 1 if (not bar.enabled and not bounded) else min(200 if bounded else 50, max(1, steps // every))
     per = -(-(steps // every) // chunks) * every if chunks > 1 else steps
@@ -55,13 +65,27 @@ def run_native(
                 else:
                     tau = np.ascontiguousarray(u_data[..., k0 : k0 + m + (1 if linear else 0), :])
             res = integrate_fixed(
-                model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper
+                model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper, wrenches
             )
         else:
             if batch is None:
                 cb = _offset(torque_for(0), k0)
                 res = integrate_callback(
-                    model, method, q, qd, t0 + k0 * dt, dt, m, cb, hold, every, max_speed, jacobian, lower, upper
+                    model,
+                    method,
+                    q,
+                    qd,
+                    t0 + k0 * dt,
+                    dt,
+                    m,
+                    cb,
+                    hold,
+                    every,
+                    max_speed,
+                    jacobian,
+                    lower,
+                    upper,
+                    wrenches,
                 )
             else:
                 results: list[tuple[Any, ...]] = [
@@ -80,6 +104,7 @@ def run_native(
                         jacobian,
                         lower,
                         upper,
+                        wrenches,
                     )
                     for i in range(batch)
                 ]

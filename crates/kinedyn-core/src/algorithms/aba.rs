@@ -22,7 +22,7 @@ use super::rnea::friction;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::{mtv, splat3, ArticulatedInertia, Force, Motion, Real, Vec3};
+use crate::spatial::{splat3, ArticulatedInertia, Motion, Real, Vec3};
 
 /// Relative size under which `D_i` counts as zero (`D_i <= EPS_D * trace(IA_i)`).
 const EPS_D: f64 = 1e-13;
@@ -66,12 +66,8 @@ pub fn aba<'d, T: Real>(
         data.ia[i] = ArticulatedInertia::from(inertia);
         let mut pa = v.cross_force(&inertia.mul_motion(&v));
         if let Some(fx) = f_ext {
-            let r = &data.world_from_body[i].rot;
-            let fw = Force::new(
-                Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
-                Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
-            );
-            pa -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
+            // ^iX_0^* f^x_i, the moment moved from the link-frame origin to the body origin
+            pa -= model.body_wrench(i, &data.world_from_body[i].rot, fx);
         }
         data.pa[i] = pa;
     }

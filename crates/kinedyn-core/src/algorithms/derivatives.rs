@@ -137,9 +137,10 @@ pub fn rnea_derivatives_tangent(
 /// `sigma_k = S_k x* h^c_k`, each entry below j is three dot products:
 /// `dtau_k/dq_j = alpha_k . w + u . (sigma_k - beta_k)`, `dtau_k/dqd_j = 2 alpha_k . dS_j/dt + S_j . (beta_k - sigma_k)`.
 ///
-/// External wrenches `(f_i, n_i)` (base axes, moment about body i's origin `p_i`) are the world
-/// force `(f_i, n_i + p_i x f_i)`, subtracted from `f_i`. They do not turn with the subtree; only
-/// their point moves, `dp_i/dq_j = S_j,lin + w_j x p_i`. Removing the rigid turn `S_j x* F^x` that
+/// External wrenches `(f_i, n_i)` (base axes, moment about body i's link-frame origin `p_i`, a
+/// point fixed in body i: [`Model::link_origin`]) are the world force `(f_i, n_i + p_i x f_i)`,
+/// subtracted from `f_i`. They do not turn with the subtree; only their point moves,
+/// `dp_i/dq_j = S_j,lin + w_j x p_i`. Removing the rigid turn `S_j x* F^x` that
 /// the formula above applies to them, and adding the true change `(0, dp_i x f_i)`, adds
 /// `E_k(w_j) = (w_j x sum f_i, w_j x sum n_i + w_j tr(P_k) - P_k w_j)`, `P_k = sum f_i p_i^T` over
 /// subtree k, to `dF_k/dq_j` (Jacobi: `w x (p x f) - (w x p) x f = p x (w x f)`).
@@ -212,7 +213,8 @@ fn world_pass<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd
                 Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
                 Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
             );
-            let p = x.trans;
+            // the point of application: body i's link-frame origin, fixed in the body like its origin
+            let p = x.act_point(&splat3::<T>(&model.link_origin[i]));
             fc[i] -= Force::new(f, m + cross(&p, &f));
             (data.ext_f[i], data.ext_n[i], data.ext_p[i]) = (f, m, outer(&f, &p));
         }
@@ -407,12 +409,14 @@ fn tangent_sweeps(
             t.dfc = inertia.mul_motion(&t.da) + t.dv.cross_force(&iv[i]) + v[i].cross_force(&inertia.mul_motion(&t.dv));
         }
         if let Some(fx) = f_ext {
-            // - d(R_i^T f^x_i)/dq_j = -(R^T f^x) x w, w = psi_i's angular part
+            // the body-axes wrench (R^T f, R^T n + u x R^T f) of `Model::body_wrench`, along q_j:
+            // d(R_i^T x)/dq_j = (R^T x) x w (w = psi_i's angular part), u fixed in the body
             let r = &data.world_from_body[i].rot;
-            let w = &psi_i.ang;
+            let (w, u) = (&psi_i.ang, &model.link_origin[i]);
             let fw = Force::from_slice(&fx[6 * i..6 * i + 6]);
             let (lin, ang) = (r.tr_mul(&fw.lin), r.tr_mul(&fw.ang));
-            q_i.dfc -= Force::new(lin.cross(w), ang.cross(w));
+            let dlin = lin.cross(w);
+            q_i.dfc -= Force::new(dlin, ang.cross(w) + u.cross(&dlin));
         }
         (tq[i], tqd[i], psi[i]) = (q_i, qd_i, psi_i);
     }
@@ -516,6 +520,11 @@ mod tests {
         for model in models {
             let n = model.n;
             let mut rng = Rng::new(5);
+            // wrenches about link-frame origins off the body origins
+            let origins = (0..n)
+                .map(|_| Vec3::from_column_slice(&rng.vector(3, -0.8, 0.8)))
+                .collect();
+            let model = model.with_link_origins(origins).unwrap();
             let q = random_configuration(&model, &mut rng);
             let (qd, qdd) = (rng.vector(n, -2.0, 2.0), rng.vector(n, -2.0, 2.0));
             let fx = rng.vector(6 * n, -3.0, 3.0);
@@ -641,7 +650,16 @@ mod tests {
                 rng.vector(n, -2.0, 2.0),
             );
             let fx = rng.vector(6 * n, -3.0, 3.0);
-            for f_ext in [None, Some(&fx[..])] {
+            // wrenches about the body origins, and about link origins off them (as DH links)
+            let origins = (0..n)
+                .map(|_| Vec3::from_column_slice(&rng.vector(3, -0.8, 0.8)))
+                .collect();
+            let moved = model.clone().with_link_origins(origins).unwrap();
+            for (model, f_ext) in [
+                (model.clone(), None),
+                (model.clone(), Some(&fx[..])),
+                (moved, Some(&fx[..])),
+            ] {
                 let mut data = Data::new(&model);
                 let (mut dq, mut dqd) = (vec![0.0; n * n], vec![0.0; n * n]);
                 let mut m = vec![0.0; n * n];

@@ -11,13 +11,13 @@
 //! | `v_i, a_i`  | `data.v[i], data.a[i]`     | body twist / acceleration (gravity included)       |
 //! | `f_i`       | `data.f[i]`                | force transmitted by joint i onto body i           |
 //! | `I_i`       | `model.inertia[i]`         | body inertia about its origin                      |
-//! | `f^x_i`     | `f_ext` (base axes, body origin) | external wrench on body i                    |
+//! | `f^x_i`     | `f_ext` (base axes, link origin) | external wrench on body i (`Model::body_wrench`) |
 //! | `J_m r^2`   | `model.armature[i]`        | reflected rotor inertia, adds `armature qdd`       |
 
 use super::kinematics::{forward_kinematics, joint_transforms};
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::{mtv, splat3, Force, Motion, Real, Vec3};
+use crate::spatial::{splat3, Motion, Real, Vec3};
 
 /// Joint friction `viscous qd + coulomb sign(qd)` of joint i (with direction-dependent Coulomb
 /// levels: [`Model::coulomb_torque`]).
@@ -48,7 +48,8 @@ impl RneaTerms {
 
 /// `tau = rnea(q, qd, qdd, f_ext)` with gravity, friction and armature (written to `data.tau`).
 ///
-/// `f_ext`: `n * 6` numbers, per body `[force; moment]` in base axes about the body-frame origin.
+/// `f_ext`: `n * 6` numbers, per body `[force; moment]` in base axes, the moment about the body's
+/// link-frame origin ([`Model::link_origin`]; the body-frame origin unless the model sets one).
 #[inline(always)]
 pub fn rnea<'d, T: Real>(
     model: &Model,
@@ -109,12 +110,8 @@ pub fn rnea_with<'d, T: Real>(
         let body = &inertia[i].splat::<T>();
         let mut fi = body.mul_motion(&ai) + vi.cross_force(&body.mul_motion(&vi));
         if let Some(fx) = f_ext {
-            let r = &data.world_from_body[i].rot;
-            let fw = Force::new(
-                Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]),
-                Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]),
-            );
-            fi -= Force::new(mtv(r, &fw.lin), mtv(r, &fw.ang));
+            // ^iX_0^* f^x_i, the moment moved from the link-frame origin to the body origin
+            fi -= model.body_wrench(i, &data.world_from_body[i].rot, fx);
         }
         v[i] = vi;
         a[i] = ai;

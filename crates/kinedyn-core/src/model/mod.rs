@@ -116,6 +116,11 @@ pub struct Model {
     /// Gravity acceleration in base coordinates (e.g. `[0, 0, -9.81]`).
     pub gravity: Vec3,
     pub frames: Vec<Frame>,
+    /// The origin of each body's link frame in the body frame (body axes; zero by default): the
+    /// point about which the moment of an external wrench `f_ext` on that body is given. A
+    /// standard-DH link frame sits at `Tx(a)` from its joint frame, a URDF link frame at the joint
+    /// frame (zero). Set by [`Model::with_link_origins`]; see `rnea.rs` for how a wrench is moved.
+    pub link_origin: Vec<Vec3>,
     /// `support[i]`: body i and its ancestors, ascending (the joints that move body i).
     pub support: Vec<Vec<usize>>,
     /// `subtree_end[i]`: one past the largest index in body i's subtree (i and its descendants).
@@ -247,6 +252,7 @@ impl Model {
             coulomb_negative: None,
             gravity,
             frames,
+            link_origin: vec![Vec3::zeros(); n],
             support,
             subtree_end,
             subtrees_contiguous,
@@ -476,6 +482,35 @@ impl Model {
             }
             v.cross_motion(&vj)
         }
+    }
+
+    /// The model with external wrenches given about link-frame origins: `origins[i]` is body i's
+    /// link-frame origin in body i's frame (see [`Model::link_origin`]).
+    pub fn with_link_origins(mut self, origins: Vec<Vec3>) -> Result<Self> {
+        if origins.len() != self.n {
+            return Err(Error::InvalidModel(format!(
+                "link origins has {} entries for {} bodies",
+                origins.len(),
+                self.n
+            )));
+        }
+        for (i, u) in origins.iter().enumerate() {
+            finite(&format!("link origin of body {i}"), u.as_slice())?;
+        }
+        self.link_origin = origins;
+        Ok(self)
+    }
+
+    /// An external wrench `(f, n)` (base axes, moment about body i's link-frame origin) in body
+    /// i's axes with the moment about the body origin, given `rot` = body i's `world_from_body`
+    /// rotation: `f_b = R^T f`, `n_b = R^T n + u_i x f_b` (`n_p = n_l + (l - p) x f`, and
+    /// `l - p = R u_i`; a rotation preserves the cross product).
+    #[inline(always)]
+    pub fn body_wrench<T: Real>(&self, i: usize, rot: &Mat3<T>, fx: &[T]) -> crate::spatial::Force<T> {
+        use crate::spatial::{cross, mtv};
+        let f = mtv(rot, &Vec3::new(fx[6 * i], fx[6 * i + 1], fx[6 * i + 2]));
+        let n = mtv(rot, &Vec3::new(fx[6 * i + 3], fx[6 * i + 4], fx[6 * i + 5]));
+        crate::spatial::Force::new(f, n + cross(&splat3::<T>(&self.link_origin[i]), &f))
     }
 
     /// The model with direction-dependent Coulomb friction: `levels[i]` (>= 0) acts against

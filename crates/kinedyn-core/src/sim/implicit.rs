@@ -131,11 +131,12 @@ pub(super) fn implicit_step(
     qd: &mut [f64],
     qdd: &[f64],
     tau: &[f64],
+    f_ext: Option<&[f64]>,
 ) -> std::result::Result<(), Failure> {
     let n = model.n;
     let fail = |joint, kind| Failure { step, t, joint, kind };
-    // A_q = dqdd/dq, A_v = dqdd/dqd, M^-1 at (q, qd, tau)
-    aba_derivatives(model, data, q, qd, tau, None, &mut s.a_q, &mut s.a_v, &mut s.minv)
+    // A_q = dqdd/dq, A_v = dqdd/dqd, M^-1 at (q, qd, tau, f_ext), the wrenches held in base axes
+    aba_derivatives(model, data, q, qd, tau, f_ext, &mut s.a_q, &mut s.a_v, &mut s.minv)
         .map_err(|e| fail(singular_joint(&e), FailureKind::Singular(e.to_string())))?;
     // the torque's own dependence on the state: A_q += M^-1 dtau/dq ; A_v += M^-1 dtau/dqd
     let known = source

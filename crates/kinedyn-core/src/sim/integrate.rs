@@ -17,6 +17,8 @@ use crate::model::Model;
 
 /// Scratch of one run (allocated once per trajectory).
 struct Stage {
+    /// The source's external wrenches at the last state evaluated (6 n).
+    f_ext: Vec<f64>,
     /// RK4's weighted mean velocity (k1 + 2 k2 + 2 k3 + k4) / 6.
     mean: Vec<f64>,
     q: Vec<f64>,
@@ -47,7 +49,8 @@ fn apply_limits(model: &Model, limits: &Limits<'_>, q: &mut [f64], qd: &mut [f64
     }
 }
 
-/// `qdd = aba(q, qd, tau(t, q, qd))` into `kv`, with the torque into `tau` unless `hold`.
+/// `qdd = aba(q, qd, tau(t, q, qd), f_ext(t, q, qd))` into `kv`, with the torque into `tau` unless
+/// `hold` and the source's external wrenches into `f_ext`; returns whether there are any.
 #[allow(clippy::too_many_arguments)]
 fn derivative(
     model: &Model,
@@ -59,8 +62,9 @@ fn derivative(
     qd: &[f64],
     tau: &mut [f64],
     evaluate_torque: bool,
+    f_ext: &mut [f64],
     kv: &mut [f64],
-) -> std::result::Result<(), Failure> {
+) -> std::result::Result<bool, Failure> {
     let fail = |joint, kind| Failure { step, t, joint, kind };
     if evaluate_torque {
         source
@@ -70,10 +74,19 @@ fn derivative(
             return Err(fail(Some(j), FailureKind::Torque(tau[j])));
         }
     }
-    match aba(model, data, q, qd, tau, None) {
+    let wrenches = source
+        .wrenches(step, t, q, qd, f_ext)
+        .map_err(|m| fail(None, FailureKind::Source(m)))?;
+    if let Some(k) = f_ext.iter().position(|x| !x.is_finite()).filter(|_| wrenches) {
+        return Err(fail(
+            None,
+            FailureKind::Source(format!("the external wrench on body {} is not finite", k / 6)),
+        ));
+    }
+    match aba(model, data, q, qd, tau, wrenches.then_some(&*f_ext)) {
         Ok(qdd) => {
             kv.copy_from_slice(qdd);
-            Ok(())
+            Ok(wrenches)
         }
         Err(e) => Err(fail(singular_joint(&e), FailureKind::Singular(e.to_string()))),
     }
@@ -173,6 +186,7 @@ pub fn integrate(
     let mut qd = qd0.to_vec();
     let zeros = || vec![0.0; n];
     let mut s = Stage {
+        f_ext: vec![0.0; 6 * n],
         mean: zeros(),
         q: vec![0.0; nq],
         qd: zeros(),
@@ -205,13 +219,28 @@ pub fn integrate(
         let t = t_of(k);
         // k1 = f(t_k, x_k): also the recorded qdd_k and tau_k
         let (kv0, rest) = s.kv.split_at_mut(1);
-        if let Err(f) = derivative(model, data, source, k, t, &q, &qd, &mut s.tau, true, &mut kv0[0]) {
-            return Ok(Outcome {
-                steps: k,
-                samples,
-                failure: Some(f),
-            });
-        }
+        let wrenches = match derivative(
+            model,
+            data,
+            source,
+            k,
+            t,
+            &q,
+            &qd,
+            &mut s.tau,
+            true,
+            &mut s.f_ext,
+            &mut kv0[0],
+        ) {
+            Ok(w) => w,
+            Err(f) => {
+                return Ok(Outcome {
+                    steps: k,
+                    samples,
+                    failure: Some(f),
+                })
+            }
+        };
         if k % every == 0 || k == settings.steps {
             record(&mut samples, &q, &qd, &kv0[0], &s.tau);
         }
@@ -238,7 +267,11 @@ pub fn integrate(
             }
             Method::Implicit => {
                 let scratch = implicit.as_mut().expect("allocated for the implicit method");
-                implicit_step(model, data, source, scratch, k, t, h, &mut q, &mut qd, &kv0[0], &s.tau)
+                // the wrenches at (t_k, x_k), from k1
+                let f_ext = wrenches.then_some(&s.f_ext[..]);
+                implicit_step(
+                    model, data, source, scratch, k, t, h, &mut q, &mut qd, &kv0[0], &s.tau, f_ext,
+                )
             }
             Method::Rk4 => (|| {
                 let kq = &mut s.kq;
@@ -268,6 +301,7 @@ pub fn integrate(
                         &s.qd,
                         &mut s.tau,
                         evaluate,
+                        &mut s.f_ext,
                         &mut rest[stage],
                     )?;
                 }
@@ -781,5 +815,151 @@ mod tests {
             },
         );
         assert!(matches!(r, Err(Error::InvalidInput(_))));
+    }
+
+    /// The joint torque `J^T f = rnea(q, 0, 0) - rnea(q, 0, 0, f)` of external wrenches `f` held in
+    /// base axes, and its derivative for the implicit step (`-d rnea(q, 0, 0, f)/dq` plus the same
+    /// without f), evaluated at each state.
+    struct Pushed<'a> {
+        model: &'a Model,
+        f: &'a [f64],
+        data: Data,
+    }
+
+    impl TorqueFn for Pushed<'_> {
+        fn torque(
+            &mut self,
+            _k: usize,
+            _t: f64,
+            q: &[f64],
+            _qd: &[f64],
+            out: &mut [f64],
+        ) -> std::result::Result<(), String> {
+            use crate::algorithms::rnea::{rnea_with, RneaTerms};
+            let zeros = vec![0.0; self.model.n];
+            let free = rnea_with(self.model, &mut self.data, q, &zeros, &zeros, None, RneaTerms::RIGID).to_vec();
+            let pushed = rnea_with(
+                self.model,
+                &mut self.data,
+                q,
+                &zeros,
+                &zeros,
+                Some(self.f),
+                RneaTerms::RIGID,
+            );
+            for (o, (a, b)) in out.iter_mut().zip(free.iter().zip(pushed)) {
+                *o = a - b;
+            }
+            Ok(())
+        }
+
+        fn jacobian(
+            &mut self,
+            _k: usize,
+            _t: f64,
+            q: &[f64],
+            _qd: &[f64],
+            dq: &mut [f64],
+            dqd: &mut [f64],
+        ) -> std::result::Result<bool, String> {
+            use crate::algorithms::derivatives::rnea_derivatives;
+            let n = self.model.n;
+            let zeros = vec![0.0; n];
+            let (mut with_f, mut scratch) = (vec![0.0; n * n], vec![0.0; n * n]);
+            rnea_derivatives(
+                self.model,
+                &mut self.data,
+                q,
+                &zeros,
+                &zeros,
+                None,
+                dq,
+                &mut scratch,
+                None,
+            );
+            rnea_derivatives(
+                self.model,
+                &mut self.data,
+                q,
+                &zeros,
+                &zeros,
+                Some(self.f),
+                &mut with_f,
+                &mut scratch,
+                None,
+            );
+            for (a, b) in dq.iter_mut().zip(&with_f) {
+                *a -= b;
+            }
+            dqd.fill(0.0);
+            Ok(true)
+        }
+    }
+
+    /// Constant external wrenches (about link origins off the body origins) give the run that their
+    /// joint torque ([`Pushed`]) gives: both routes through the same schemes.
+    #[test]
+    fn constant_wrenches_act_as_their_joint_torques() {
+        let model = random_model(21, 5, true);
+        let n = model.n;
+        let mut rng = crate::testing::Rng::new(3);
+        let origins = (0..n)
+            .map(|_| crate::spatial::Vec3::from_column_slice(&rng.vector(3, -0.5, 0.5)))
+            .collect();
+        let model = model.with_link_origins(origins).unwrap();
+        let f = rng.vector(6 * n, -2.0, 2.0);
+        let (q0, qd0) = (rng.vector(n, -1.0, 1.0), rng.vector(n, -1.0, 1.0));
+        for method in [Method::Rk4, Method::Implicit, Method::SemiImplicitEuler] {
+            let settings = Settings {
+                method,
+                dt: 1e-3,
+                steps: 200,
+                t0: 0.0,
+                record_every: 10,
+                hold: false,
+                max_speed: 1e6,
+                limits: None,
+            };
+            let m = settings.samples() * n;
+            let mut runs = Vec::new();
+            for native in [true, false] {
+                let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+                let zero = Sampled {
+                    values: &[],
+                    n,
+                    t0: 0.0,
+                    dt: settings.dt,
+                    linear: false,
+                };
+                let mut with = crate::sim::WithWrenches {
+                    source: zero,
+                    f_ext: &f,
+                };
+                let mut pushed = Pushed {
+                    model: &model,
+                    f: &f,
+                    data: Data::new(&model),
+                };
+                let source: &mut dyn TorqueFn = if native { &mut with } else { &mut pushed };
+                let record = Record {
+                    q: &mut q,
+                    qd: &mut qd,
+                    qdd: &mut qdd,
+                    tau: &mut tau,
+                };
+                let out = integrate(&model, &mut Data::new(&model), &settings, &q0, &qd0, source, record).unwrap();
+                assert!(out.failure.is_none(), "{method:?}: {:?}", out.failure);
+                runs.push((q, qd));
+            }
+            let tol = 1e-11;
+            for (a, b) in runs[0]
+                .0
+                .iter()
+                .chain(&runs[0].1)
+                .zip(runs[1].0.iter().chain(&runs[1].1))
+            {
+                assert!((a - b).abs() <= tol * (1.0 + b.abs()), "{method:?}: {a} vs {b}");
+            }
+        }
     }
 }

@@ -1,9 +1,10 @@
 //! Fixed-step integration of the equations of motion over a whole trajectory.
 //!
-//! State `x = (q, qd)`, `dx/dt = (qd, qdd)`, `qdd = aba(q, qd, tau(t, q, qd))` (LaValle eq. 13.148,
-//! the phase form of `M qdd + C qd + g + friction = tau`). The torque comes from a [`TorqueFn`]:
-//! zero, a constant, samples held or interpolated over each step, or any closure (the Python
-//! binding passes a controller through one).
+//! State `x = (q, qd)`, `dx/dt = (qd, qdd)`, `qdd = aba(q, qd, tau(t, q, qd), f_ext(t, q, qd))`
+//! (LaValle eq. 13.148, the phase form of `M qdd + C qd + g + friction = tau + J^T f_ext`). The torque
+//! comes from a [`TorqueFn`]: zero, a constant, samples held or interpolated over each step, or any
+//! closure (the Python binding passes a controller through one); the external wrenches, if any, from
+//! the same source ([`TorqueFn::wrenches`], evaluated at every stage even when the torque is held).
 //!
 //! Methods (step `h`, `t_k = t0 + k h`):
 //! - `Rk4`, classical Runge-Kutta (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.1, Table 1.2):
@@ -53,7 +54,7 @@ mod integrate;
 mod torque;
 
 pub use integrate::integrate;
-pub use torque::{Sampled, TorqueFn};
+pub use torque::{Sampled, TorqueFn, WithWrenches};
 
 /// The fixed-step schemes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

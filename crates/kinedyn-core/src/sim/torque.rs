@@ -31,6 +31,63 @@ pub trait TorqueFn {
     ) -> std::result::Result<bool, String> {
         Ok(false)
     }
+
+    /// External wrenches at a state into `out` (`n * 6`: per body `[force; moment]` in base axes,
+    /// the moment about the body's link-frame origin, as [`crate::algorithms::rnea`] takes them),
+    /// evaluated at every stage; `Ok(false)` (the default): none.
+    fn wrenches(
+        &mut self,
+        _step: usize,
+        _t: f64,
+        _q: &[f64],
+        _qd: &[f64],
+        _out: &mut [f64],
+    ) -> std::result::Result<bool, String> {
+        Ok(false)
+    }
+}
+
+/// A torque source with constant external wrenches `f_ext` (`n * 6`, as [`TorqueFn::wrenches`]).
+pub struct WithWrenches<'a, S> {
+    pub source: S,
+    pub f_ext: &'a [f64],
+}
+
+impl<S: TorqueFn> TorqueFn for WithWrenches<'_, S> {
+    fn torque(
+        &mut self,
+        step: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<(), String> {
+        self.source.torque(step, t, q, qd, out)
+    }
+
+    fn jacobian(
+        &mut self,
+        step: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        dtau_dq: &mut [f64],
+        dtau_dqd: &mut [f64],
+    ) -> std::result::Result<bool, String> {
+        self.source.jacobian(step, t, q, qd, dtau_dq, dtau_dqd)
+    }
+
+    fn wrenches(
+        &mut self,
+        _step: usize,
+        _t: f64,
+        _q: &[f64],
+        _qd: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<bool, String> {
+        out.copy_from_slice(self.f_ext);
+        Ok(true)
+    }
 }
 
 impl<F: FnMut(usize, f64, &[f64], &[f64], &mut [f64]) -> std::result::Result<(), String>> TorqueFn for F {
