@@ -329,8 +329,10 @@ class Robot:
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
+        # a robot without moving joints (a drone's body on a fixed base) has no parameters: shape (0,)
         return np.concatenate(
-            [to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies]
+            [np.zeros(0)]
+            + [to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies]
         )
 
     @cached_property
