@@ -67,7 +67,7 @@ from .link import Link
 from .tool import default_tool
 from .xacro import expand_xacro, is_xacro
 
-__all__ = ["description_from_urdf", "MAX_DEPTH"]
+__all__ = ["description_from_urdf", "read_urdf_xml", "MAX_DEPTH"]
 
 _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 #: the name Pinocchio gives the free-flyer joint that ``floating_base=True`` adds above the root link
@@ -216,6 +216,13 @@ class _Source:
 
     def error(self, element, message: str) -> ValueError:
         return ValueError(f"{self.at(self.line(element))}: {message}")
+
+
+def read_urdf_xml(path_or_string, source_path: str | None = None):
+    """(source, root element) of a URDF's XML, read as the loader reads it (bounded, no entities),
+    for readers of the raw file (:mod:`kinedyn.description.audit`): ``source.label`` is the file,
+    ``source.at(source.line(element))`` the "file:line" of an element."""
+    return _parse(path_or_string, source_path)
 
 
 def _parse(path_or_string, source_path: str | None = None):

@@ -235,6 +235,8 @@ class ReportData(Mapping):
     properties: list[dict]
     simulation: dict[str, Any]
     eom_note: str | None = None
+    #: the audit of the robot's file (kinedyn.description.audit: source, counts, findings), or None
+    audit: dict | None = None
     #: the symbolic equations of motion typeset on the page (a kinedyn.symbolic EquationsOfMotion), or
     #: None where they are not derived (``eom_note`` says why); not part of the JSON
     eom: Any = field(default=None, repr=False)
@@ -248,6 +250,7 @@ class ReportData(Mapping):
             out[key] = out.pop(key)  # the order of earlier versions: after "dynamics"
         out["simulation"] = out.pop("simulation")
         out["eom_note"] = self.eom_note
+        out["audit"] = out.pop("audit")
         return out
 
     def __getitem__(self, key: str):
@@ -358,6 +361,8 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         )
     steps.step("equations of motion")
     eom, note = _equations_and_note(robot, name, eom_joints)
+    # what is wrong with the file (docs/audit.md); a robot built in Python is audited from its description
+    audit = robot.audit().to_dict()
     return ReportData(
         **kinematics,
         mass_matrix=M.tolist(),
@@ -367,6 +372,7 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         properties=properties,
         simulation=simulation,
         eom_note=note,
+        audit=audit,
         eom=eom,
     )
 
