@@ -226,6 +226,21 @@ def test_mjcf_names_are_kept_per_element_kind_as_mujoco_keeps_them(world):
     np.testing.assert_allclose(robot.pose([0.4], "site:x")[:3, 3], data.site("x").xpos, atol=1e-12)
 
 
+@pytest.mark.parametrize("kind", ["mesh", "material"])
+def test_asset_names_are_scoped_per_kind_too(kind):
+    twice = f'<{kind} name="m" {"vertex" if kind == "mesh" else "rgba"}="{"0 0 0 1 0 0 0 1 0 0 0 1" if kind == "mesh" else "1 0 0 1"}"/>'
+    xml = (
+        f"<mujoco><asset>{twice}{twice}</asset><worldbody><body name='m'><joint name='m'/>"
+        "<geom name='m' size='0.1'/></body></worldbody></mujoco>"
+    )
+    with pytest.raises(ValueError, match="repeated name"):
+        mujoco.MjModel.from_xml_string(xml)
+    with pytest.raises(ValueError, match=rf"<{kind}> the name 'm' is given to two <{kind}> elements"):
+        kd.Robot.from_mjcf(xml)
+    once = xml.replace(twice + twice, twice)  # a mesh, a material, a body, a joint and a geom all named m
+    assert mujoco.MjModel.from_xml_string(once).nq == kd.Robot.from_mjcf(once).nq == 1
+
+
 @pytest.mark.parametrize("kind", ["body", "joint", "geom", "site"])
 def test_a_name_given_twice_within_one_kind_is_refused_as_mujoco_refuses_it(kind):
     names = {"body": ("x", "y", "j", "k", "g", "h"), "joint": ("a", "b", "j", "j", "g", "h")}

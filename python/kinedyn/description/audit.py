@@ -434,7 +434,7 @@ def _check_inertia(facts: Facts, link: LinkFacts, what: str) -> None:
             what,
             link.file,
             link.line,
-            f"its inertial frame is rotated (rpy {' '.join(f'{a:g}' for a in link.rpy)}): MuJoCo's URDF import dropped the rotation (mujoco#3559) and other tools read it differently",
+            f"its inertial frame is rotated (rpy {' '.join(f'{a:g}' for a in link.rpy)}): MuJoCo's URDF import dropped the rotation until mujoco#3559 was fixed, and tools differ on it",
             fix,
         )
     inertia = Inertia(link.mass, link.com, 0.5 * (link.tensor + link.tensor.T))

@@ -155,10 +155,10 @@ class _Reader(ModelSettings):
         self.gravity = self.option()
         for section in root.iterfind("default"):
             self.read_defaults(section, "main", {t: {} for t in DEFAULTED}, top=True)
+        # MuJoCo keeps one name scope per element kind (a site and a body may share a name)
+        self.scopes: dict = {"body": {}, "joint": {}, "geom": {}, "site": {}, "mesh": {}, "material": {}}
         self.materials, self.meshes = self.assets()
         self.names: set = {"world"}  # kinedyn's frames: bodies, the links of a body's joints, sites
-        # MuJoCo keeps one name scope per element kind (a site and a body may share a name)
-        self.scopes: dict = {"body": {}, "joint": {}, "geom": {}, "site": {}}
         # a site whose name a body has, before or after it in the file, is the frame 'site:NAME'
         self.body_names = {b.get("name") for b in root.iter("body") if b.get("name")}
         self.site_names: list = []
@@ -169,9 +169,11 @@ class _Reader(ModelSettings):
         materials, meshes = {}, {}
         for asset in self.root.iterfind("asset"):
             for m in asset.iterfind("material"):
+                self.unique("material", m)
                 if m.get("name") and m.get("rgba"):
                     materials[m.get("name")] = self.rgba(m, m.get("rgba"))
             for mesh in asset.iterfind("mesh"):
+                self.unique("mesh", mesh)
                 a = self.attributes(mesh, "main")
                 file = a.get("file")
                 name = a.get("name") or (os.path.splitext(os.path.basename(file))[0] if file else None)
