@@ -66,6 +66,7 @@ CASES = {
     ),
     "rotated-inertia": (_robot(_box_link("a", rpy="0 0.3 0"), _joint("j", "base", "a")), "link 'a'", '<link name="a">'),
     "massless": (_robot('<link name="a"/>\n', _joint("j", "base", "a")), "link 'a'", '<link name="a"/>'),
+    "point-mass": (_robot(_box_link("a", moments=[0, 0, 0]), _joint("j", "base", "a")), "link 'a'", '<link name="a">'),
     "density": (_robot(_box_link("a", mass=100.0), _joint("j", "base", "a")), "link 'a'", '<link name="a">'),
     "com-outside": (_robot(_box_link("a", com="0.5 0 0"), _joint("j", "base", "a")), "link 'a'", '<link name="a">'),
     "inertia-vs-shape": (
@@ -180,6 +181,7 @@ CASES = {
 SEVERITY = {
     "rotated-inertia": "warning",
     "massless": "warning",
+    "point-mass": "warning",
     "density": "warning",
     "com-outside": "warning",
     "inertia-vs-shape": "warning",
@@ -332,6 +334,18 @@ def test_mjcf_findings_name_the_body_line(tmp_path):
     empty = next(f for f in result.findings if f.code == "limits-empty")
     assert (empty.line, empty.element) == (4, "joint 'j'")
     assert not any(f.code == "limits-missing" for f in result.findings)  # MJCF joints need no range
+
+
+def test_mjcf_links_between_the_joints_of_one_body_are_not_massless_links(tmp_path):
+    path = tmp_path / "two_joints.xml"
+    path.write_text(
+        '<mujoco>\n<worldbody>\n<body name="a">\n<joint axis="1 0 0"/>\n<joint name="k" axis="0 1 0"/>\n'
+        '<geom type="box" size="0.05 0.05 0.05" density="2700"/>\n</body>\n<body>\n<joint/>\n</body>\n</worldbody>\n</mujoco>\n'
+    )
+    result = audit(path)
+    (massless,) = [f for f in result.findings if f.code == "massless"]  # the second, unnamed body
+    assert (massless.element, massless.line) == ("link 'body2'", 8)
+    assert kd.load(path).joint_names[0] == "joint0"  # the unnamed joint's name, as the audit numbers it
 
 
 def test_a_robot_built_in_python_is_audited_from_its_description():

@@ -103,7 +103,10 @@ def audit(source, *, geometry: bool = True) -> Audit:
     meshes and measure shapes."""
     if isinstance(source, Description):
         facts = description_facts(source)
-        if source.source and os.path.isfile(source.source):
+        # the file it was read from says more (lines, what the loader drops); a xacro file is
+        # expanded only on trust, so its description is audited as it is
+        readable = os.path.splitext(source.source)[1].lower() in (".urdf", ".xml", ".mjcf")
+        if readable and os.path.isfile(source.source):
             return audit(source.source, geometry=geometry)
     else:
         text = os.fspath(source) if isinstance(source, os.PathLike) else source
@@ -398,7 +401,25 @@ def _check_links(facts: Facts, geometry: bool) -> None:
                 "give the link's mass",
             )
             continue
-        if link.name in moving and moving[link.name] < NEAR_MASSLESS:
+        if link.part_of_body:
+            pass  # a massless link kinedyn makes between the joints of one MJCF body: MuJoCo's one body
+        elif (
+            link.name in moving
+            and link.mass >= NEAR_MASSLESS
+            and moving[link.name] == link.mass
+            and not np.any(np.abs(link.tensor) > 1e-12 * link.mass)
+        ):
+            facts.add(
+                "warning",
+                "point-mass",
+                what,
+                link.file,
+                link.line,
+                f"moves on a joint with mass {link.mass:g} kg but no rotational inertia (a point mass): MuJoCo "
+                "refuses it ('mass and inertia of moving bodies must be larger than mjMINVAL')",
+                "give the link the inertia of its shape (a solid of its mass), or at least a small one",
+            )
+        elif link.name in moving and moving[link.name] < NEAR_MASSLESS:
             near = "massless" if moving[link.name] == 0 else f"near-massless ({moving[link.name]:.3g} kg)"
             facts.add(
                 "warning",

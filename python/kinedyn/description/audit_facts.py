@@ -75,6 +75,7 @@ class LinkFacts:
     rpy: tuple = (0.0, 0.0, 0.0)
     has_inertial: bool = False
     shapes: list = field(default_factory=list)  # (role, shape, origin 4x4, "file:line")
+    part_of_body: bool = False  # a link kinedyn makes between the joints of one MJCF body
 
 
 @dataclass
@@ -288,10 +289,20 @@ def mjcf_facts(path_or_string) -> Facts:
         description = description_from_mjcf(path_or_string, inertia="warn")
     src, root = parse_model(path_or_string)
     lines = {}
-    for kind in ("body", "joint"):
-        for k, e in enumerate(root.iter(kind)):
-            label, line = src.where.get(id(e), (src.label, None))
-            lines[(kind, e.get("name") or f"{kind}{k + 1}")] = (label, line)
+    bodies = joints = 0  # MuJoCo's numbering of unnamed elements, as the reader gives it: body{1..}, joint{0..}
+    for world in root.iterfind("worldbody"):
+        for e in world.iter():
+            if e.tag == "body":
+                bodies += 1
+                key = ("body", e.get("name") or f"body{bodies}")
+            elif e.tag in ("joint", "freejoint"):
+                key = ("joint", e.get("name") or f"joint{joints}")
+                joints += 1
+            else:
+                continue
+            lines[key] = src.where.get(id(e), (src.label, None))
     facts = description_facts(description, lines)
     facts.source = src.label
+    for link in facts.links:
+        link.part_of_body = ("body", link.name) not in lines
     return facts
