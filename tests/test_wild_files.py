@@ -169,6 +169,12 @@ def test_the_cli_and_the_checks_answer_for_a_robot_with_no_degrees_of_freedom(tm
         assert main(command) == 0, capsys.readouterr().err
     assert main(["check", str(path)]) != 0
     assert "no degrees of freedom" in capsys.readouterr().err
+    assert main(["ik", str(path), "--xyz", "0.1", "0", "0"]) == 1
+    assert "has no moving joint" in capsys.readouterr().err  # not the native core's panic
+    assert main(["convert", str(path), str(tmp_path / "drone.xml")]) == 0, capsys.readouterr().err
+    assert mujoco.MjModel.from_xml_path(str(tmp_path / "drone.xml")).nq == 0
+    assert main(["report", str(path), "-o", str(tmp_path / "drone.html"), "--t", "0.05"]) == 0, capsys.readouterr().err
+    assert "Audit of the robot file" in (tmp_path / "drone.html").read_text()
 
 
 EXAMPLE_ROBOTS = Path(pin.__file__).parents[4] / "share" / "example-robot-data" / "robots"

@@ -105,10 +105,12 @@ def property_checks(robot, q, qd, rng) -> list[dict]:
     """The textbook's properties at (q, qd), each with its measured residual."""
     out = []
     n = robot.n
+    if n == 0:
+        return out  # no moving joint: the equations of motion are empty, with no property to measure
     M = robot.mass_matrix(q)
     eig = np.linalg.eigvalsh((M + M.T) / 2)
-    scale = max(1.0, float(np.max(np.abs(M))))
-    asym = float(np.max(np.abs(M - M.T)))
+    scale = max(1.0, float(np.max(np.abs(M), initial=0.0)))  # initial: a robot with no joint has an empty M
+    asym = float(np.max(np.abs(M - M.T), initial=0.0))
     out.append({"property": "M(q) symmetric", "measure": "max |M - M^T|", "value": asym, "ok": asym <= 1e-12 * scale})
     out.append(
         {
