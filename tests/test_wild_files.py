@@ -319,6 +319,37 @@ def test_mujocos_fluid_forces_are_named_as_not_modelled(option, named):
         assert abs(data.qfrc_passive[0]) > 0
 
 
+PYBULLET_SWIMMER = None
+try:
+    import pybullet_data
+
+    PYBULLET_SWIMMER = Path(pybullet_data.getDataPath()) / "mjcf" / "swimmer.xml"
+except ImportError:  # pragma: no cover - the peers extra
+    pass
+
+
+@pytest.mark.skipif(PYBULLET_SWIMMER is None or not PYBULLET_SWIMMER.is_file(), reason="pybullet_data is not installed")
+def test_the_gym_swimmer_says_its_fluid_forces_are_not_modelled():
+    with pytest.warns(UserWarning, match=r"fluid forces \(<option density='4000', viscosity='0.1'>"):
+        robot = kd.load(PYBULLET_SWIMMER)
+    # MuJoCo 3+ refuses this old file's <option collision>; its joints are hinges and slides, one coordinate each
+    text = PYBULLET_SWIMMER.read_text()
+    assert robot.nq == text.count("<joint") - text.count("<joint ", text.index("<default"), text.index("</default>"))
+
+
+@pytest.mark.parametrize(
+    "xml",
+    [
+        '<mujoco><compiler alignfree="true"/><worldbody><body><freejoint/><geom size="0.1" pos="0.1 0 0"/></body></worldbody></mujoco>',
+        '<mujoco><worldbody><body><freejoint align="true"/><geom size="0.1" pos="0.1 0 0"/></body></worldbody></mujoco>',
+    ],
+)
+def test_aligned_free_bodies_are_named_as_read_differently(xml):
+    with pytest.warns(UserWarning, match="aligned qpos"):
+        kd.Robot.from_mjcf(xml)
+    mujoco.MjModel.from_xml_string(xml)  # MuJoCo reads both forms
+
+
 def test_no_fluid_warning_when_the_fluid_is_off():
     with warnings.catch_warnings():
         warnings.simplefilter("error")

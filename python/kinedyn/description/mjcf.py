@@ -397,6 +397,10 @@ class _Reader(ModelSettings):
             raise self.src.error(
                 element, f"{what}: attribute 'type' is '{short(kind)}', expected one of {', '.join(_JOINT_KINDS)}"
             )
+        if kind == "free" and a.get("align") == "true":
+            self.ignored.add(
+                f"align='true' of the free {what} (kinedyn's q is its body frame's pose, not MuJoCo's aligned qpos)"
+            )
         if kind == "free" and not (top_level and count == 1):
             raise self.src.error(
                 element, f"{what}: a free joint must be the only joint of a body whose parent is the world body"

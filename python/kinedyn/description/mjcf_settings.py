@@ -76,6 +76,12 @@ class ModelSettings:
                     setattr(self, attribute, numbers(c, attribute, self.src, 1)[0])
                 elif attribute == "balanceinertia":
                     self.balanceinertia = self.boolean(c, attribute, value)
+                elif attribute == "alignfree" and self.boolean(c, attribute, value):
+                    # MuJoCo then moves a free body's frame to its inertial frame, so its qpos is that
+                    # frame's pose; kinedyn keeps the body frame the file writes
+                    self.ignored.add(
+                        "<compiler alignfree='true'> (kinedyn's q of a free body is its body frame's pose, not MuJoCo's aligned qpos)"
+                    )
 
     @staticmethod
     def boolean_value(value: str) -> bool | None:
