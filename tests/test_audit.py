@@ -472,3 +472,31 @@ def test_a_file_a_peer_refuses_is_a_row_saying_why(tmp_path, capsys):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert main(["audit", str(path), "--compare", "--strict", "--samples", "2"]) == 2
+
+
+def test_a_damaged_file_is_audited_not_crashed_on():
+    """Attribute values replaced by words, NaN, huge or empty numbers (seeded): the audit reports
+    them as findings; only XML that is not well-formed stops it, with a ValueError naming the place."""
+    import random
+    import re
+
+    base = _robot(
+        _box_link("a", rpy="0 0.1 0"),
+        _box_link("b"),
+        _joint("j", "base", "a"),
+        _joint("k", "a", "b", inner=LIMIT + '<mimic joint="j"/>'),
+    )
+    rng = random.Random(0)
+    for _ in range(150):
+        text = base
+        for _ in range(3):
+            m = rng.choice(list(re.finditer(r'"[^"]*"', text)))
+            text = (
+                text[: m.start()]
+                + rng.choice(['""', '"nan"', '"x y z"', '"1e308"', '"-1"', '"0"', '"0 0"', '"inf"'])
+                + text[m.end() :]
+            )
+        result = audit(text)
+        assert all(f.severity in ("error", "warning", "info") and f.element for f in result.findings)
+    with pytest.raises(ValueError, match="malformed XML"):
+        audit(base.replace("<robot", "<robot <"))

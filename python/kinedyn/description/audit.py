@@ -458,7 +458,11 @@ def _check_inertia(facts: Facts, link: LinkFacts, what: str) -> None:
             f"its inertial frame is rotated (rpy {' '.join(f'{a:g}' for a in link.rpy)}): MuJoCo's URDF import dropped the rotation until mujoco#3559 was fixed, and tools differ on it",
             fix,
         )
-    inertia = Inertia(link.mass, link.com, 0.5 * (link.tensor + link.tensor.T))
+    try:
+        inertia = Inertia(link.mass, link.com, 0.5 * (link.tensor + link.tensor.T))
+    except ValueError as e:  # a number beyond what a description may hold (the loader refuses it too)
+        facts.add("error", "unreadable", what, link.file, link.line, f"its <inertial> cannot be read: {e}")
+        return
     check = inertia.consistency()
     if check is None or check.ok:
         return
@@ -504,6 +508,8 @@ def _check_geometry(facts: Facts, link: LinkFacts, what: str, cache: dict) -> No
     if len(unread):
         return  # a link measured in part would read too light a shape
     shape = combined(solids)
+    if not (math.isfinite(shape.volume) and shape.volume > 0 and np.all(np.isfinite(shape.points))):
+        return  # sizes beyond measure (1e308 m): nothing to compare a mass with
     for s, where in placed:
         if isinstance(s, Solid) and s.extent > 0 and np.ptp(s.points, axis=0).max() > 20.0:
             file, _, line = where.rpartition(":")

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._math import rpy_to_matrix
+from .checks import LARGEST
 from .description import Description
 from .geometry import Box, Cylinder, Mesh, Sphere
 from .inertia import Inertia
@@ -120,14 +121,15 @@ def urdf_facts(path_or_string) -> Facts:
             values = tuple(float(v) for v in text.split())
         except ValueError:
             values = ()
-        if len(values) != n or not all(math.isfinite(v) for v in values):
+        # finite and at most LARGEST in magnitude, as the loader reads numbers
+        if len(values) != n or not all(math.isfinite(v) and abs(v) <= LARGEST for v in values):
             facts.add(
                 "error",
                 "unreadable",
                 element,
                 src.label,
                 line(e),
-                f"'{attribute}' must be {n} finite numbers, got '{text[:40]}'",
+                f"'{attribute}' must be {n} finite numbers of magnitude at most {LARGEST:g}, got '{text[:40]}'",
             )
             return default
         return values
