@@ -120,7 +120,7 @@ def compare_loaders(path, samples: int = 4, seed: int = 0) -> LoaderDiff:
 
 # ------------------------------------------------------------------------------- the peers
 def _pinocchio(path: str, robot: Robot):
-    import pinocchio as pin  # the peers extra: imported only when the diff runs
+    import pinocchio as pin  # type: ignore[import-untyped]  # the peers extra: imported only when the diff runs
 
     model = pin.buildModelFromUrdf(path)
     data = model.createData()
@@ -151,7 +151,7 @@ def _pinocchio(path: str, robot: Robot):
 
 
 def _mujoco(path: str, robot: Robot):
-    import mujoco  # the peers extra: imported only when the diff runs
+    import mujoco  # type: ignore[import-untyped]  # the peers extra: imported only when the diff runs
 
     text = open(path, encoding="utf-8").read()
     # MuJoCo cannot resolve package:// paths: the file without its meshes (primitives kept)
@@ -221,13 +221,13 @@ def _compare(tool: str, robot: Robot, evaluate, Q, facts) -> list:
                     break
         rows.append(Difference(tool, quantity, d, where, cause))
     # the frames both know
-    worst_frame, worst = "", 0.0
+    worst_frame, largest = "", 0.0
     for q, (_, _, frames) in zip(Q, theirs):
         for name, T in frames.items():
             diff = float(np.abs(robot.pose(q, name) - T).max())
-            if diff > worst:
-                worst_frame, worst = name, diff
-    rows.append(Difference(tool, "frames", worst, f"link '{worst_frame}'" if worst > TOLERANCE else ""))
+            if diff > largest:
+                worst_frame, largest = name, diff
+    rows.append(Difference(tool, "frames", largest, f"link '{worst_frame}'" if largest > TOLERANCE else ""))
     return rows
 
 

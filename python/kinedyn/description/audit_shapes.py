@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -100,7 +101,7 @@ def _read_mesh(shape: Mesh):
     except ImportError:
         return "not read (install trimesh, the viz extra, to measure meshes)"
     try:
-        mesh = trimesh.load(str(path), force="mesh")
+        mesh: Any = trimesh.load(str(path), force="mesh")
     except Exception as e:  # trimesh raises many kinds for a broken file  # noqa: BLE001
         return f"not read by trimesh ({type(e).__name__}: {e})"
     if not hasattr(mesh, "vertices") or len(mesh.vertices) == 0 or len(getattr(mesh, "faces", ())) == 0:

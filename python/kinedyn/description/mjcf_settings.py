@@ -17,6 +17,7 @@ contacts, which change no term of the equations of motion kinedyn computes, and 
 from __future__ import annotations
 
 import os
+from typing import Any
 
 from .mjcf_xml import Sources, numbers, short
 
@@ -32,7 +33,7 @@ class ModelSettings:
     """The compiler settings, the option's gravity and flags, and the default classes of a model."""
 
     src: Sources
-    root: object
+    root: Any  # the model's root element (xml.etree)
     ignored: set
     defaults: dict
 

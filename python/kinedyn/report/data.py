@@ -103,7 +103,7 @@ def simulate_free_motion(
 
 def property_checks(robot, q, qd, rng) -> list[dict]:
     """The textbook's properties at (q, qd), each with its measured residual."""
-    out = []
+    out: list[dict] = []
     n = robot.n
     if n == 0:
         return out  # no moving joint: the equations of motion are empty, with no property to measure
