@@ -500,3 +500,21 @@ def test_a_damaged_file_is_audited_not_crashed_on():
         assert all(f.severity in ("error", "warning", "info") and f.element for f in result.findings)
     with pytest.raises(ValueError, match="malformed XML"):
         audit(base.replace("<robot", "<robot <"))
+
+
+def test_an_mjcf_file_is_compared_as_mujoco_and_pinocchio_read_it(tmp_path):
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("mujoco")
+    from kinedyn.analysis.loaders import compare_loaders
+
+    path = tmp_path / "arm.xml"
+    path.write_text(
+        '<mujoco><option gravity="0.5 0 -9"/><worldbody><body name="a"><joint name="j1" axis="0 1 0" armature="0.1" ref="10"/>'
+        '<geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.04"/><body name="b" pos="0.3 0 0"><joint name="j2" axis="1 0 1"/>'
+        '<geom type="box" size="0.1 0.02 0.03" pos="0.1 0 0"/></body></body></worldbody></mujoco>'
+    )
+    rows = {(r.tool, r.quantity): r for r in compare_loaders(path, samples=3).rows}
+    assert all(rows[("MuJoCo", q)].agrees for q in ("M(q)", "g(q)", "frames"))
+    assert rows[("Pinocchio", "M(q)")].agrees and rows[("Pinocchio", "frames")].agrees
+    gravity = rows[("Pinocchio", "g(q)")]
+    assert not gravity.agrees and "ignores <option gravity> (0.5 0 -9)" in gravity.cause

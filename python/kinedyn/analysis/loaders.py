@@ -15,7 +15,8 @@ import behaviour; the variant that removes the difference names the cause):
 - MuJoCo gives a link without ``<inertial>`` the inertia of its collision shapes at 1000 kg/m^3
   (its compiler's ``inertiafromgeom="auto"``);
 - MuJoCo's URDF import dropped the rotation of ``<inertial><origin rpy>`` (mujoco#3559), so a
-  rotated inertial frame read without its rotation.
+  rotated inertial frame read without its rotation;
+- Pinocchio's MJCF reader keeps its own gravity whatever ``<option gravity>`` says.
 """
 
 from __future__ import annotations
@@ -92,10 +93,12 @@ class LoaderDiff:
 
 
 def compare_loaders(path, samples: int = 4, seed: int = 0) -> LoaderDiff:
-    """Load the URDF ``path`` with kinedyn, Pinocchio and MuJoCo and compare M(q), g(q) and the link
-    frames at ``samples`` seeded configurations (see the module docstring)."""
+    """Load the URDF or MJCF ``path`` with kinedyn, Pinocchio and MuJoCo and compare M(q), g(q) and
+    the link frames at ``samples`` seeded configurations (see the module docstring; an MJCF file is
+    read by MuJoCo as it is, and by Pinocchio's MJCF reader)."""
     path = os.fspath(path)
-    robot = load(path, mimic="independent")
+    mjcf = os.path.splitext(path)[1].lower() in (".xml", ".mjcf")
+    robot = load(path) if mjcf else load(path, mimic="independent")
     rng = np.random.default_rng(seed)
     lo = np.where(np.isfinite(robot.lower_limits), robot.lower_limits, -np.pi)
     hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
@@ -104,10 +107,10 @@ def compare_loaders(path, samples: int = 4, seed: int = 0) -> LoaderDiff:
     if robot.has_multi_dof_joints:
         result.skipped["all"] = "the file has multi-DOF joints; the diff compares 1-DOF joints"
         return result
-    facts = urdf_facts(path)
+    facts = None if mjcf else urdf_facts(path)
     for tool, peer in (("Pinocchio", _pinocchio), ("MuJoCo", _mujoco)):
         try:
-            evaluate = peer(path, robot)
+            evaluate = peer(path, robot, mjcf)
         except ImportError as e:
             result.skipped[tool] = f"not installed ({e.name})"
             continue
@@ -119,10 +122,10 @@ def compare_loaders(path, samples: int = 4, seed: int = 0) -> LoaderDiff:
 
 
 # ------------------------------------------------------------------------------- the peers
-def _pinocchio(path: str, robot: Robot):
+def _pinocchio(path: str, robot: Robot, mjcf: bool):
     import pinocchio as pin  # type: ignore[import-untyped]  # the peers extra: imported only when the diff runs
 
-    model = pin.buildModelFromUrdf(path)
+    model = pin.buildModelFromMJCF(path) if mjcf else pin.buildModelFromUrdf(path)
     data = model.createData()
     ids = [model.getJointId(name) for name in robot.joint_names]
     if any(i >= model.njoints for i in ids):
@@ -150,25 +153,30 @@ def _pinocchio(path: str, robot: Robot):
     return evaluate
 
 
-def _mujoco(path: str, robot: Robot):
+def _mujoco(path: str, robot: Robot, mjcf: bool):
     import mujoco  # type: ignore[import-untyped]  # the peers extra: imported only when the diff runs
 
-    text = open(path, encoding="utf-8").read()
-    # MuJoCo cannot resolve package:// paths: the file without its meshes (primitives kept)
-    text = re.sub(r"<(visual|collision)\b[^>]*>(?:(?!</\1>).)*?<mesh\b.*?</\1>", "", text, flags=re.S)
-    with tempfile.TemporaryDirectory() as folder:
-        copy = os.path.join(folder, os.path.basename(path))
-        with open(copy, "w", encoding="utf-8") as f:
-            f.write(text)
-        model = mujoco.MjModel.from_xml_path(copy)
+    if mjcf:
+        model = mujoco.MjModel.from_xml_path(path)
+    else:
+        text = open(path, encoding="utf-8").read()
+        # MuJoCo cannot resolve package:// paths: the file without its meshes (primitives kept)
+        text = re.sub(r"<(visual|collision)\b[^>]*>(?:(?!</\1>).)*?<mesh\b.*?</\1>", "", text, flags=re.S)
+        with tempfile.TemporaryDirectory() as folder:
+            copy = os.path.join(folder, os.path.basename(path))
+            with open(copy, "w", encoding="utf-8") as f:
+                f.write(text)
+            model = mujoco.MjModel.from_xml_path(copy)
     data = mujoco.MjData(model)
     joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in robot.joint_names]
     if min(joints, default=0) < 0:
-        raise ValueError("its joints are not named as kinedyn's")
+        if not mjcf or model.njnt != robot.n:
+            raise ValueError("its joints are not named as kinedyn's")
+        joints = list(range(model.njnt))  # unnamed MJCF joints: kinedyn keeps MuJoCo's order
     qadr, vadr = [int(model.jnt_qposadr[j]) for j in joints], [int(model.jnt_dofadr[j]) for j in joints]
 
     def evaluate(q):
-        data.qpos[:] = 0
+        data.qpos[:] = model.qpos0
         data.qpos[qadr] = q
         data.qvel[:] = 0
         mujoco.mj_forward(model, data)
@@ -177,7 +185,8 @@ def _mujoco(path: str, robot: Robot):
             mujoco.mj_fullM(model, data, M)  # MuJoCo >= 3.4
         except TypeError:
             mujoco.mj_fullM(model, M, data.qM)
-        M -= np.diag(model.dof_armature)  # URDF has no armature; kinedyn's M would not hold it
+        if not mjcf:
+            M -= np.diag(model.dof_armature)  # MuJoCo's URDF import may add armature; URDF has none
         frames = {}
         for name in robot.frame_names:
             b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
@@ -204,7 +213,10 @@ def _compare(tool: str, robot: Robot, evaluate, Q, facts) -> list:
     theirs = [evaluate(q) for q in Q]
     ours = _mass_props(robot, Q)
     rows = []
-    variants = _variants(robot, facts, tool) if tool == "MuJoCo" else []
+    if facts is None:  # an MJCF file
+        variants = _mjcf_variants(robot) if tool == "Pinocchio" else []
+    else:
+        variants = _variants(robot, facts, tool) if tool == "MuJoCo" else []
     for k, quantity in enumerate(("M(q)", "g(q)")):
         diffs = [_relative(o[k], t[k]) for o, t in zip(ours, theirs)]
         worst = int(np.argmax(diffs))
@@ -264,6 +276,20 @@ def _variants(robot: Robot, facts, tool: str) -> list:
                 )
             )
     return out
+
+
+def _mjcf_variants(robot: Robot) -> list:
+    """(cause, kinedyn robot imitating it) for Pinocchio's MJCF reader: it keeps its own gravity,
+    (0, 0, -9.81), whatever ``<option gravity>`` says."""
+    default = (0.0, 0.0, -9.81)
+    if tuple(float(g) for g in robot.gravity) == default:
+        return []
+    return [
+        (
+            f"Pinocchio's MJCF reader ignores <option gravity> ({' '.join(f'{g:g}' for g in robot.gravity)}) and keeps 0 0 -9.81",
+            Robot(dataclasses.replace(robot.description, gravity=default)),
+        )
+    ]
 
 
 def _with(robot: Robot, links: list, k: int, inertia: Inertia) -> Robot:

@@ -40,8 +40,8 @@ def run(args) -> int:
     result = audit(args.file, geometry=args.geometry)
     loaders = None
     if args.compare:
-        if not args.file.lower().endswith(".urdf"):
-            raise ValueError(f"{args.file}: --compare reads a URDF (.urdf) file")
+        if not args.file.lower().endswith((".urdf", ".xml", ".mjcf")):
+            raise ValueError(f"{args.file}: --compare reads a URDF (.urdf) or MJCF (.xml, .mjcf) file")
         from ...analysis.loaders import compare_loaders  # builds robots and loads the peers: only when asked
 
         loaders = compare_loaders(args.file, samples=args.samples)
