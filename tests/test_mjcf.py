@@ -480,9 +480,11 @@ def test_errors_from_a_file_name_the_file(tmp_path):
         kd.load(tmp_path / "missing.xml")
 
 
-def test_a_model_without_joints_or_worldbody_is_refused():
-    with pytest.raises(ValueError, match="has no joint"):
-        robot_from_mjcf('<mujoco><worldbody><body><geom size="1"/></body></worldbody></mujoco>')
+def test_a_model_without_joints_loads_as_mujoco_loads_it_and_one_without_worldbody_is_refused():
+    xml = '<mujoco><worldbody><body><geom size="1"/></body></worldbody></mujoco>'
+    robot = robot_from_mjcf(xml)
+    assert robot.nq == robot.nv == mujoco.MjModel.from_xml_string(xml).nq == 0
+    assert robot.mass_matrix(np.zeros(0)).shape == (0, 0)
     with pytest.raises(ValueError, match=r"<mujoco> has no <worldbody>"):
         robot_from_mjcf("<mujoco></mujoco>")
     with pytest.raises(ValueError, match=r"the root element is <robot>, expected <mujoco>"):

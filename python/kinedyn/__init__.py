@@ -10,6 +10,7 @@ from ._core import (
     simd,  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
 )
 from .description import DHRow, Frame, Inertia, Joint, Link
+from .description.audit import audit  # what is wrong with a robot file (docs/audit.md)
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 from .robot_files import load as _load
@@ -54,6 +55,7 @@ __all__ = [
     "Frame",
     "DHRow",
     "load",
+    "audit",
     "robots",
     "LagrangianSystem",
     "simulate",

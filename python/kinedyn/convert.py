@@ -168,17 +168,24 @@ def check_conversion(
         frames = [n for n in frames if not (n == "tool" or (n.startswith("link") and n[4:].isdigit()))]
     result.frames_compared = frames
     for q, qd, qdd in _random_states(source, states, seed):
-        e_fk = float(np.abs(source.pose(q) - back.pose(q, back.tool)).max()) if fmt == "dh" else 0.0
+        e_fk = float(np.abs(source.pose(q) - back.pose(q, back.tool)).max(initial=0.0)) if fmt == "dh" else 0.0
         if frames:
-            e_fk = max(e_fk, float(np.abs(source.frame_poses(q, frames) - back.frame_poses(q, frames)).max()))
+            e_fk = max(
+                e_fk, float(np.abs(source.frame_poses(q, frames) - back.frame_poses(q, frames)).max(initial=0.0))
+            )
         result.max_frame_error = max(result.max_frame_error, e_fk)
         result.max_mass_matrix_error = max(
-            result.max_mass_matrix_error, float(np.abs(source.mass_matrix(q) - back.mass_matrix(q) - armature).max())
+            result.max_mass_matrix_error,
+            float(np.abs(source.mass_matrix(q) - back.mass_matrix(q) - armature).max(initial=0.0)),
         )
         tau_extra = source.armature * qdd if fmt == "urdf" else 0.0
         result.max_torque_error = max(
             result.max_torque_error,
-            float(np.abs(source.inverse_dynamics(q, qd, qdd) - back.inverse_dynamics(q, qd, qdd) - tau_extra).max()),
+            float(
+                np.abs(source.inverse_dynamics(q, qd, qdd) - back.inverse_dynamics(q, qd, qdd) - tau_extra).max(
+                    initial=0.0
+                )
+            ),
         )
     if fmt == "dh":
         result.frames_compared = ["tool (the source's tool)"] + frames
@@ -210,13 +217,15 @@ def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int
         mujoco.mj_fullM(model, data, M)
         poses = source.frame_poses(q, names)
         e_fk = max(
-            float(np.abs(data.xpos[ids] - poses[:, :3, 3]).max()),
-            float(np.abs(data.xmat[ids].reshape(-1, 3, 3) - poses[:, :3, :3]).max()),
+            float(np.abs(data.xpos[ids] - poses[:, :3, 3]).max(initial=0.0)),
+            float(np.abs(data.xmat[ids].reshape(-1, 3, 3) - poses[:, :3, :3]).max(initial=0.0)),
         )
         result.max_frame_error = max(result.max_frame_error, e_fk)
-        result.max_mass_matrix_error = max(result.max_mass_matrix_error, float(np.abs(M - source.mass_matrix(q)).max()))
+        result.max_mass_matrix_error = max(
+            result.max_mass_matrix_error, float(np.abs(M - source.mass_matrix(q)).max(initial=0.0))
+        )
         bias = source.coriolis_matrix(q, qd) @ qd + source.gravity_torque(q)
-        result.max_torque_error = max(result.max_torque_error, float(np.abs(data.qfrc_bias - bias).max()))
+        result.max_torque_error = max(result.max_torque_error, float(np.abs(data.qfrc_bias - bias).max(initial=0.0)))
     result.notes.append(
         "read back by MuJoCo: M = mj_fullM, and qfrc_bias against C qd + g (MuJoCo keeps friction out of the bias)"
     )

@@ -358,7 +358,7 @@ def spanned_rows(robot: Robot, frame: str | None = None, reference: str = "world
     hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
     Js = np.array([robot.jacobian(lo + (hi - lo) * rng.random(robot.n), frame, reference) for _ in range(samples)])
     scale = max(1.0, float(np.abs(Js).max(initial=0.0)))
-    moving = [r for r in range(6) if np.abs(Js[:, r, :]).max() > 1e-9 * scale]
+    moving = [r for r in range(6) if np.abs(Js[:, r, :]).max(initial=0.0) > 1e-9 * scale]
     linear, angular = [r for r in moving if r < 3], [r for r in moving if r >= 3]
     rows = linear if len(linear) >= robot.n else linear + angular
     if not rows or len(rows) > robot.n:

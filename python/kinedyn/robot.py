@@ -20,6 +20,7 @@ from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from .description import export
+from .description.audit import Audit, audit
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
 from .description.edit import lock_joints, substitute
@@ -320,6 +321,10 @@ class Robot:
         ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
         return export.to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
+    def audit(self, *, geometry: bool = True) -> Audit:
+        """What is wrong with the robot's file (its description where it has none): docs/audit.md."""
+        return audit(self.description, geometry=geometry)
+
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
         """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
         :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
@@ -328,8 +333,10 @@ class Robot:
     def inertial_parameters(self) -> np.ndarray:
         """The 10 standard parameters of every body, stacked (10 n,): about each body-frame origin
         (the joint frame), order [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
+        # a robot without moving joints (a drone's body on a fixed base) has no parameters: shape (0,)
         return np.concatenate(
-            [to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies]
+            [np.zeros(0)]
+            + [to_float_array(b.inertia.parameters(), what=f"inertia of '{b.name}'") for b in self.tree.bodies]
         )
 
     @cached_property

@@ -49,8 +49,9 @@ def svg_plot(
     many rows as it needs (the plot grows taller to keep its area); colours repeat dashed after seven."""
     x = np.asarray(x, dtype=float)
     ys = [np.asarray(y, dtype=float) for _, y in series]
-    ylo = min(float(np.min(y)) for y in ys)
-    yhi = max(float(np.max(y)) for y in ys)
+    # no series (a robot with no moving joint has no coordinate to plot): an empty plot on [-1, 1]
+    ylo = min((float(np.min(y)) for y in ys), default=0.0)
+    yhi = max((float(np.max(y)) for y in ys), default=0.0)
     if yhi - ylo < 1e-9 * max(1.0, abs(yhi)):
         ylo, yhi = ylo - 1.0, yhi + 1.0
     pad = 0.06 * (yhi - ylo)

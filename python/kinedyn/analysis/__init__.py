@@ -17,6 +17,7 @@ from .identification import (
     simulate_measurements,
     with_inertial_parameters,
 )
+from .loaders import LoaderDiff, compare_loaders
 from .logs import Log, LogError, load_log
 from .properties import (
     Check,
@@ -29,6 +30,8 @@ from .properties import (
 from .system_properties import check_system_properties
 
 __all__ = [
+    "compare_loaders",
+    "LoaderDiff",
     "check_properties",
     "check_system_properties",
     "prove_properties",

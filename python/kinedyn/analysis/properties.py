@@ -102,6 +102,11 @@ def check_properties(
     configurations drawn from the seed). The trajectory depends on ``seed`` only, not on ``samples``."""
     rng = np.random.default_rng(seed)
     n = robot.n
+    if n == 0:
+        raise ValueError(
+            f"robot '{robot.name}' has no degrees of freedom (no moving joint): its equations of motion are "
+            "empty and have no property to check (floating_base=True makes a lone body a free flyer)"
+        )
     Q = robot.random_configuration(rng, size=samples)
     QD = rng.uniform(-2.0, 2.0, size=(samples, n))
     QDD = rng.uniform(-4.0, 4.0, size=(samples, n))

@@ -87,6 +87,10 @@ COMMANDS = {
         "one self-contained HTML report of a robot: 3-D view, Jacobian, equations of motion, properties, simulation",
     ),
     "view": ("view", "open a live 3-D view of a robot in the browser (meshes, joint sliders); Ctrl-C stops it"),
+    "audit": (
+        "audit",
+        "what is wrong with a robot file: inertias, masses for their shapes, limits, mimics, names, tree",
+    ),
 }
 
 

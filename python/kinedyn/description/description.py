@@ -71,8 +71,6 @@ class Description:
         put(self, "gravity", vector(self.gravity, 3, "gravity"))
         put(self, "dh", tuple(self.dh) if self.dh is not None else None)
         tree = build_tree(links, self.frames, self.base)
-        if tree.n == 0:
-            raise ValueError(f"robot '{self.name}' has no moving joint")
         put(self, "tree", tree)
         # mimic joints (Joint.mimic): None when no joint follows another
         put(

@@ -8,13 +8,15 @@ mesh files is :mod:`kinedyn.visual.meshes`, drawing them :mod:`kinedyn.visual`.
 
 Mesh file names are resolved by :func:`resolve_mesh`, in this order (the first file found wins):
 
-1. ``package://PKG/rest``: ``PKG`` looked up as ``DIR/PKG`` for each ``DIR`` of ``ROS_PACKAGE_PATH``;
+1. ``package://PKG/rest`` (also written ``package:///PKG/rest``, as example-robot-data's Talos does:
+   ROS's resource_retriever and Pinocchio read the package as the first segment after the slashes): ``PKG`` looked up as ``DIR/PKG`` for each ``DIR`` of ``ROS_PACKAGE_PATH``;
    then as a folder named ``PKG`` among the robot file's folder and its parents, or ``ANCESTOR/PKG``
    for each of those; then in installed description packages: ``cmeel.prefix/share/PKG`` and
    ``cmeel.prefix/share/example-robot-data/robots/PKG`` of every site-packages folder (where
    example-robot-data installs its robots). ``rest`` may not hold ``..``: a package path stays
    inside its package.
-2. ``file:///abs/path`` and absolute paths: that file, as written in the robot file.
+2. ``file:///abs/path`` and absolute paths: that file, as written in the robot file (``file://rel/path``
+   is a relative path, as ROS's resource_retriever reads it).
 3. A relative path: against the robot file's folder, then each of its parents.
 
 Whatever the route, the file must have a mesh extension (``.stl``, ``.obj``, ``.dae``; the file a
@@ -159,7 +161,8 @@ def resolve_mesh(filename: str, base_dir: str | None = None) -> Path:
         raise ValueError(f"mesh '{filename}': not a mesh file name (kinedyn reads {', '.join(MESH_EXTENSIONS)})")
     tried: list[Path] = []
     if name.startswith("package://"):
-        package, _, rest = name[len("package://") :].partition("/")
+        # package:///PKG/rest (an empty authority) names the same file as package://PKG/rest
+        package, _, rest = name[len("package://") :].lstrip("/").partition("/")
         parts = Path(rest).parts
         if not package or not rest or ".." in parts or Path(rest).is_absolute() or ".." == package:
             raise ValueError(

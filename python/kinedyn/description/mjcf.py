@@ -6,7 +6,8 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
   inertiafromgeom inertiagrouprange boundmass boundinertia balanceinertia settotalmass>`` (MuJoCo's
   defaults: degrees, ``xyz``, autolimits on, inertia from geoms when a body has no ``<inertial>``); ``<option gravity>`` and
   ``<option><flag gravity="disable">``.
-- ``<default>`` classes (the top one is ``main``; nested classes inherit; an element's ``class``, else
+- ``<default>`` classes (the top one is ``main``, and several top-level ``<default>`` blocks all add
+  to it, as MuJoCo merges them; nested classes inherit; an element's ``class``, else
   the ``childclass`` of the nearest enclosing body or frame, else ``main``) for ``joint``, ``geom``,
   ``site`` and ``mesh``.
 - ``<worldbody>`` and nested ``<body name pos quat|axisangle|euler|xyaxes|zaxis childclass>``
@@ -33,14 +34,18 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
   most ``MAX_INCLUDE_DEPTH`` deep.
 
 Not modelled, and named in one warning when present: actuators, tendons, equality constraints,
-contact pairs and exclusions, sensors, keyframes, joint springs (``stiffness``), ``gravcomp``,
-friction and armature of ball and free joints, a ball joint's range (a cone). Lights, cameras, textures and the ``<visual>``
+contact pairs and exclusions, sensors, keyframes, plugins (``<extension>``, a body's ``<plugin>``),
+fluid forces (``<option density viscosity wind>``), joint springs (``stiffness``, ``springdamper``),
+``gravcomp``, friction and armature of ball and free joints, a ball joint's range (a cone); every
+``<option>`` attribute is listed in :mod:`kinedyn.description.mjcf_settings`. Lights, cameras, textures and the ``<visual>``
 settings are presentation and are skipped silently. ``<replicate>``, ``<attach>``, ``<composite>``,
 ``<flexcomp>``, mocap bodies, ``shellinertia`` and ``<compiler coordinate="global">`` are refused (they make bodies kinedyn cannot
 read here).
 
 The base of the robot is MuJoCo's world body, named ``world``; bodies without a joint are welded to
-their parent (fixed joints). Unnamed bodies and joints get MuJoCo's numbering: ``body{id}``,
+their parent (fixed joints); a model without any joint loads with nq = 0, as MuJoCo loads it.
+Names are kept per element kind, as MuJoCo keeps them: two bodies (or joints, geoms, sites) of one
+name are refused, a site and a body may share one (the site's frame is then ``site:NAME``). Unnamed bodies and joints get MuJoCo's numbering: ``body{id}``,
 ``joint{id}``.
 
 Security, as the URDF loader: the XML may not declare entities; nesting, file size and includes are
@@ -65,6 +70,7 @@ from .link import Frame, Link
 
 __all__ = ["description_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
 
+from .mjcf_settings import DEFAULTED, ModelSettings
 from .mjcf_xml import (
     MAX_DEPTH,
     MAX_FILE_BYTES,
@@ -84,11 +90,10 @@ from .mjcf_xml import (
 
 _JOINT_KINDS = {"hinge": "revolute", "slide": "prismatic", "ball": "spherical", "free": "floating"}
 _SHAPES = ("sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "plane", "hfield", "sdf")
-_DEFAULTED = ("joint", "geom", "site", "mesh")
 # top-level sections with dynamics kinedyn does not model (named in the warning)
-_UNMODELLED = ("actuator", "tendon", "equality", "contact", "sensor", "keyframe", "deformable")
+_UNMODELLED = ("actuator", "tendon", "equality", "contact", "sensor", "keyframe", "deformable", "extension")
 # sections or elements kinedyn skips silently (presentation, bookkeeping)
-_PRESENTATION = ("visual", "statistic", "size", "custom", "extension", "light", "camera", "asset")
+_PRESENTATION = ("visual", "statistic", "size", "custom", "light", "camera", "asset")
 
 
 # ============================================================================== entry point
@@ -117,8 +122,6 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
             UserWarning,
             stacklevel=caller_level(),
         )
-    if not any(link.joint.is_moving for link in links):
-        raise ValueError(f"{src.label}: model '{name}' has no joint (kinedyn needs at least one moving joint)")
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysicalConsistencyWarning)
@@ -142,7 +145,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
 
 
 # ============================================================================== the reader
-class _Reader:
+class _Reader(ModelSettings):
     def __init__(self, src: Sources, root):
         self.src = src
         self.root = root
@@ -151,116 +154,26 @@ class _Reader:
         self.defaults: dict = {}  # class name -> {element tag: {attribute: value}}
         self.gravity = self.option()
         for section in root.iterfind("default"):
-            self.read_defaults(section, "main", {t: {} for t in _DEFAULTED})
+            self.read_defaults(section, "main", {t: {} for t in DEFAULTED}, top=True)
+        # MuJoCo keeps one name scope per element kind (a site and a body may share a name)
+        self.scopes: dict = {"body": {}, "joint": {}, "geom": {}, "site": {}, "mesh": {}, "material": {}}
         self.materials, self.meshes = self.assets()
-        self.names: set = {"world"}
+        self.names: set = {"world"}  # kinedyn's frames: bodies, the links of a body's joints, sites
+        # a site whose name a body has, before or after it in the file, is the frame 'site:NAME'
+        self.body_names = {b.get("name") for b in root.iter("body") if b.get("name")}
         self.site_names: list = []
         self.body_count = 0
         self.joint_count = 0
-
-    # --------------------------------------------------------------------- model-wide settings
-    def compiler(self) -> None:
-        self.degrees, self.eulerseq, self.autolimits = True, "xyz", True
-        self.inertiafromgeom, self.groups = "auto", (0, 5)
-        # MuJoCo's compiler adjustments of body inertias (off by default)
-        self.boundmass, self.boundinertia, self.settotalmass, self.balanceinertia = 0.0, 0.0, -1.0, False
-        self.meshdir = self.src.base_dir
-        for c in self.root.iter("compiler"):
-            for attribute, value in c.attrib.items():
-                if attribute == "angle":
-                    if value not in ("degree", "radian"):
-                        raise self.src.error(c, f"attribute 'angle' must be 'degree' or 'radian', got '{short(value)}'")
-                    self.degrees = value == "degree"
-                elif attribute == "eulerseq":
-                    if len(value) != 3 or any(ch not in "xyzXYZ" for ch in value):
-                        raise self.src.error(
-                            c, f"attribute 'eulerseq' must be 3 letters of xyz or XYZ, got '{short(value)}'"
-                        )
-                    self.eulerseq = value
-                elif attribute == "autolimits":
-                    self.autolimits = self.boolean(c, attribute, value)
-                elif attribute == "inertiafromgeom":
-                    if value not in ("true", "false", "auto"):
-                        raise self.src.error(
-                            c, f"attribute 'inertiafromgeom' must be true, false or auto, got '{short(value)}'"
-                        )
-                    self.inertiafromgeom = value
-                elif attribute == "inertiagrouprange":
-                    lo, hi = numbers(c, attribute, self.src, 2)
-                    self.groups = (int(lo), int(hi))
-                elif attribute in ("meshdir", "assetdir"):
-                    if self.src.base_dir is not None and (attribute == "meshdir" or c.get("meshdir") is None):
-                        self.meshdir = os.path.join(self.src.base_dir, value)
-                elif attribute == "coordinate" and value != "local":
-                    raise self.src.error(
-                        c, f"coordinate='{value}': only local coordinates are read (MuJoCo removed global ones)"
-                    )
-                elif attribute in ("boundmass", "boundinertia", "settotalmass"):
-                    setattr(self, attribute, numbers(c, attribute, self.src, 1)[0])
-                elif attribute == "balanceinertia":
-                    self.balanceinertia = self.boolean(c, attribute, value)
-
-    @staticmethod
-    def boolean_value(value: str) -> bool | None:
-        return {"true": True, "false": False}.get(value)
-
-    def boolean(self, element, attribute: str, value: str) -> bool:
-        b = self.boolean_value(value)
-        if b is None:
-            raise self.src.error(element, f"attribute '{attribute}' must be true or false, got '{short(value)}'")
-        return b
-
-    def option(self) -> tuple:
-        gravity = (0.0, 0.0, -9.81)
-        for o in self.root.iter("option"):
-            if o.get("gravity") is not None:
-                gravity = numbers(o, "gravity", self.src, 3)
-            for flag in o.iterfind("flag"):
-                if flag.get("gravity") == "disable":
-                    gravity = (0.0, 0.0, 0.0)
-        return gravity
-
-    def read_defaults(self, element, name: str, inherited: dict) -> None:
-        cls = element.get("class") or name
-        if cls in self.defaults:
-            raise self.src.error(element, f"class '{cls}' is defined twice")
-        own = {t: dict(a) for t, a in inherited.items()}
-        for child in element:
-            if child.tag in _DEFAULTED:
-                own[child.tag].update(child.attrib)
-        self.defaults[cls] = own
-        for child in element:
-            if child.tag == "default":
-                if not child.get("class"):
-                    raise self.src.error(child, "a nested <default> needs a 'class' attribute")
-                self.read_defaults(child, child.get("class"), own)
-
-    def attributes(self, element, childclass: str) -> dict:
-        """The element's attributes over its default class's."""
-        cls = element.get("class") or childclass
-        if cls not in self.defaults:
-            if cls == "main":
-                return dict(element.attrib)
-            raise self.src.error(element, f"class='{cls}' names no <default> class")
-        out = dict(self.defaults[cls].get(element.tag, {}))
-        if element.tag == "geom" and "size" in out and "size" in element.attrib:
-            # MuJoCo reads the numbers given over the default's (a sphere's size="r" keeps the rest)
-            given = element.get("size").split()
-            rest = out["size"].split()[len(given) :]
-            out["size"] = " ".join(given + rest)
-            element = {k: v for k, v in element.attrib.items() if k != "size"}
-            out.update(element)
-            return out
-        out.update(element.attrib)
-        return out
 
     def assets(self) -> tuple:
         materials, meshes = {}, {}
         for asset in self.root.iterfind("asset"):
             for m in asset.iterfind("material"):
+                self.unique("material", m)
                 if m.get("name") and m.get("rgba"):
                     materials[m.get("name")] = self.rgba(m, m.get("rgba"))
             for mesh in asset.iterfind("mesh"):
+                self.unique("mesh", mesh)
                 a = self.attributes(mesh, "main")
                 file = a.get("file")
                 name = a.get("name") or (os.path.splitext(os.path.basename(file))[0] if file else None)
@@ -397,6 +310,10 @@ class _Reader:
                 geoms.append(self.geom(child, link, link_from_here, childclass))
             elif tag == "site":
                 self.site(child, link, link_from_here, childclass)
+            elif tag == "plugin":
+                self.ignored.add(
+                    f"the plugin '{child.get('plugin') or child.get('instance', '')}' of '{link}' (its forces)"
+                )
             elif tag in REFUSED:
                 raise self.src.error(
                     child,
@@ -414,6 +331,7 @@ class _Reader:
         if childclass not in self.defaults and childclass != "main":
             raise self.src.error(element, f"childclass='{childclass}' names no <default> class")
         what = f"body '{name}'"
+        self.unique("body", element)
         self.claim(name, element, what)
         if a.get("gravcomp") not in (None, "0"):
             self.ignored.add(f"gravcomp of {what}")
@@ -448,6 +366,20 @@ class _Reader:
         last = self.links[index]
         self.links[index] = Link(last.name, last.parent, last.joint, last.placement, last.post, body_inertia)
 
+    def unique(self, kind: str, element) -> None:
+        """A name given twice to elements of one kind is refused, as MuJoCo refuses it ("repeated
+        name"); elements of different kinds may share a name."""
+        name = element.get("name")
+        if not name:
+            return
+        first = self.scopes[kind].get(name)
+        if first is not None:
+            raise self.src.error(
+                element,
+                f"the name '{name}' is given to two <{kind}> elements (the first at {self.src.at(first)}); MuJoCo refuses it too",
+            )
+        self.scopes[kind][name] = element
+
     def claim(self, name: str, element, what: str) -> None:
         if name in self.names:
             raise self.src.error(element, f"{what}: the name '{name}' is used twice")
@@ -455,6 +387,7 @@ class _Reader:
 
     def joint(self, element, childclass: str, body: str, count: int, top_level: bool):
         self.joint_count += 1
+        self.unique("joint", element)
         # <freejoint> takes no default class (MuJoCo's reference); <joint> does
         a = dict(element.attrib) if element.tag == "freejoint" else self.attributes(element, childclass)
         name = a.get("name") or f"joint{self.joint_count - 1}"
@@ -463,6 +396,10 @@ class _Reader:
         if kind not in _JOINT_KINDS:
             raise self.src.error(
                 element, f"{what}: attribute 'type' is '{short(kind)}', expected one of {', '.join(_JOINT_KINDS)}"
+            )
+        if kind == "free" and a.get("align") == "true":
+            self.ignored.add(
+                f"align='true' of the free {what} (kinedyn's q is its body frame's pose, not MuJoCo's aligned qpos)"
             )
         if kind == "free" and not (top_level and count == 1):
             raise self.src.error(
@@ -477,13 +414,17 @@ class _Reader:
             )
         if scalars["stiffness"] != 0:
             self.ignored.add(f"the spring (stiffness) of {what}")
+        if any(v > 0 for v in numbers(element, "springdamper", self.src, 2, text=a.get("springdamper", "0 0"))):
+            # MuJoCo's compiler turns (time constant, damping ratio) into a stiffness and a damping
+            self.ignored.add(f"the spring and damper (springdamper) of {what}")
         angular = kind == "hinge"
         options: dict = {}
         if kind in ("hinge", "slide"):
             options["offset"] = -(self.angle(scalars["ref"]) if angular else scalars["ref"])
             options["rotor_inertia"] = scalars["armature"]
-            options["viscous"] = scalars["damping"]
-            options["coulomb"] = scalars["frictionloss"]
+            # <option><flag damper|frictionloss="disable"> drop these forces in MuJoCo
+            options["viscous"] = scalars["damping"] if self.damping_on else 0.0
+            options["coulomb"] = scalars["frictionloss"] if self.frictionloss_on else 0.0
             limited = a.get("limited", "auto")
             if limited not in ("true", "false", "auto"):
                 raise self.src.error(
@@ -522,8 +463,9 @@ class _Reader:
         name = a.get("name")
         if not name:
             return
+        self.unique("site", element)
         self.site_names.append(name)
-        frame_name = name if name not in self.names else f"site:{name}"
+        frame_name = name if name not in self.names and name not in self.body_names else f"site:{name}"
         self.claim(frame_name, element, f"site '{name}'")
         pose = self.frame(element, a)
         if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
@@ -548,6 +490,7 @@ class _Reader:
     def geom(self, element, link: str, link_from_here: np.ndarray, childclass: str) -> dict:
         """The geom's shape, pose (in the link) and mass properties; its visual/collision is recorded."""
         a = self.attributes(element, childclass)
+        self.unique("geom", element)
         kind = a.get("type", "sphere")
         what = f"geom '{a['name']}'" if a.get("name") else "geom"
         if kind not in _SHAPES:

@@ -20,7 +20,20 @@ Reads the kinematic and inertial parts of a URDF (ROS wiki, "urdf/XML/joint" and
   are not read here: they are found and read when the robot is drawn.
 
 Ignored: ``<texture>``, ``<transmission>``, ``<gazebo>``, ``<calibration>``,
-``<safety_controller>``. Floating and planar joints are rejected.
+``<safety_controller>``.
+
+What urdfdom (the reference reader, which Pinocchio and ROS use) accepts is loaded, and where the
+file says something kinedyn cannot use, a warning names the file, line and element:
+
+- a degenerate shape (a ``<sphere>``, ``<cylinder>`` or ``<box>`` with a size that is zero or
+  negative, a ``<mesh>`` scaled by 0 on an axis) is no shape;
+- ``<limit lower upper>`` with lower above upper (``lower="2"`` alone, upper defaulting to 0) gives
+  the joint no position limits (kinedyn cannot honour an empty interval; ``kinedyn audit`` flags it);
+- ``<mimic multiplier="0">`` leaves the joint independent, as Pinocchio's default reader does;
+- a URDF whose joints are all fixed is a robot with no degrees of freedom (nq = 0) on a fixed base,
+  as Pinocchio builds it, or a free-flying body with ``floating_base=True``.
+
+A zero joint axis is refused (MuJoCo refuses it too: the joint would move nothing).
 
 - ``<joint><mimic joint multiplier offset>`` (multiplier default 1, offset 0): the joint follows
   ``joint`` with ``q = multiplier * q_joint + offset`` (-> ``Joint.mimic``). ``mimic="reduce"``
@@ -54,7 +67,7 @@ from .link import Link
 from .tool import default_tool
 from .xacro import expand_xacro, is_xacro
 
-__all__ = ["description_from_urdf", "MAX_DEPTH"]
+__all__ = ["description_from_urdf", "read_urdf_xml", "MAX_DEPTH"]
 
 _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 #: the name Pinocchio gives the free-flyer joint that ``floating_base=True`` adds above the root link
@@ -144,6 +157,8 @@ def description_from_urdf(
     name = root.get("name") or "urdf_robot"
     source = src.label if not src.label.startswith("<") else "URDF string"
     visuals, collisions = _geometry(root, list(link_elements.items()), src)
+    for note in src.notes:
+        warnings.warn(note, UserWarning, stacklevel=caller_level())
     # the Description judges the inertias (policy) and checks the tree: its errors and warnings name a
     # link or joint, to which the file and line are added here, once
     lines = {
@@ -188,6 +203,10 @@ class _Source:
     def __init__(self, label: str):
         self.label = label
         self.lines: dict = {}  # id(element) -> line of its start tag
+        self.notes: list = []  # "file:line: what was read differently" (warned once the file is read)
+
+    def note(self, element, message: str) -> None:
+        self.notes.append(f"{self.at(self.line(element))}: {message}")
 
     def line(self, element) -> int | None:
         return self.lines.get(id(element))
@@ -197,6 +216,13 @@ class _Source:
 
     def error(self, element, message: str) -> ValueError:
         return ValueError(f"{self.at(self.line(element))}: {message}")
+
+
+def read_urdf_xml(path_or_string, source_path: str | None = None):
+    """(source, root element) of a URDF's XML, read as the loader reads it (bounded, no entities),
+    for readers of the raw file (:mod:`kinedyn.description.audit`): ``source.label`` is the file,
+    ``source.at(source.line(element))`` the "file:line" of an element."""
+    return _parse(path_or_string, source_path)
 
 
 def _parse(path_or_string, source_path: str | None = None):
@@ -330,6 +356,11 @@ def _mimic(element, what: str, src: _Source) -> Mimic | None:
         _float(element, "multiplier", 1.0, f"{what} <mimic>", src),
         _float(element, "offset", 0.0, f"{what} <mimic>", src),
     )
+    if multiplier == 0:
+        # a follower with multiplier 0 would be locked at the offset; urdfdom accepts it and
+        # Pinocchio's default reader keeps the joint a coordinate of its own, as kinedyn does here
+        src.note(element, f"{what}: <mimic> multiplier 0 follows nothing: the joint is read as an independent joint")
+        return None
     try:
         return Mimic(leader, multiplier, offset)
     except ValueError as e:
@@ -344,8 +375,18 @@ def _limits(limit, kind: str, what: str, src: _Source) -> dict:
         "effort_limit": _float(limit, "effort", math.inf, f"{what} <limit>", src),
     }
     if kind != "continuous":
-        out["lower"] = _float(limit, "lower", 0.0, f"{what} <limit>", src)
-        out["upper"] = _float(limit, "upper", 0.0, f"{what} <limit>", src)
+        lower = _float(limit, "lower", 0.0, f"{what} <limit>", src)
+        upper = _float(limit, "upper", 0.0, f"{what} <limit>", src)
+        if lower > upper:
+            # urdfdom and Pinocchio keep the empty interval; no position satisfies it, so kinedyn
+            # reads no position limits (URDF spec: an absent lower or upper is 0)
+            src.note(
+                limit,
+                f"{what}: <limit> lower {lower:g} is above upper {upper:g} (an absent one is 0): "
+                "the joint is read without position limits",
+            )
+        else:
+            out["lower"], out["upper"] = lower, upper
     return out
 
 
@@ -400,24 +441,34 @@ def _materials(root, src: _Source) -> dict:
     return out
 
 
+def _degenerate(child, what: str, src: _Source, detail: str) -> None:
+    """A shape with no volume: urdfdom (and so Pinocchio and ROS) accepts it (ARMAR-4 ships a
+    ``<sphere radius="0"/>``); kinedyn keeps no shape for it and says so."""
+    src.note(child, f"{what} <{child.tag}> is degenerate ({detail}): no shape is kept for it")
+
+
 def _shape(geometry, what: str, src: _Source, base_dir):
+    """The shape ``<geometry>`` holds, or None for a degenerate one (noted)."""
     for child in geometry:
         tag = child.tag
         if tag == "box":
             size = _floats(child.get("size") or "", 3, (), f"{what} <box> size", child, src)
             if any(v <= 0 for v in size):
-                raise src.error(child, f"{what} <box> needs size with 3 positive numbers")
+                _degenerate(child, what, src, f"size '{_short(child.get('size') or '')}' is not 3 positive numbers")
+                return None
             return Box(size)
         if tag == "cylinder":
             radius = _float(child, "radius", None, f"{what} <cylinder>", src)
             length = _float(child, "length", None, f"{what} <cylinder>", src)
             if radius <= 0 or length <= 0:
-                raise src.error(child, f"{what} <cylinder> needs a positive radius and length")
+                _degenerate(child, what, src, f"radius {radius:g} and length {length:g} are not both positive")
+                return None
             return Cylinder(radius, length)
         if tag == "sphere":
             radius = _float(child, "radius", None, f"{what} <sphere>", src)
             if radius <= 0:
-                raise src.error(child, f"{what} <sphere> needs a positive radius")
+                _degenerate(child, what, src, f"radius {radius:g} is not positive")
+                return None
             return Sphere(radius)
         if tag == "mesh":
             filename = child.get("filename")
@@ -425,7 +476,8 @@ def _shape(geometry, what: str, src: _Source, base_dir):
                 raise src.error(child, f"{what} <mesh> needs a filename (of at most {MAX_MESH_NAME} characters)")
             scale = _floats(child.get("scale"), 3, (1.0, 1.0, 1.0), f"{what} <mesh> scale", child, src)
             if any(v == 0 for v in scale):
-                raise src.error(child, f"{what} <mesh> scale may not hold 0")
+                _degenerate(child, what, src, f"scale '{_short(child.get('scale') or '')}' holds 0")
+                return None
             return Mesh(filename, scale, base_dir)
     raise src.error(geometry, f"{what} <geometry> holds none of <box>, <cylinder>, <sphere>, <mesh>")
 
@@ -444,6 +496,8 @@ def _geometry(root, links: list, src: _Source) -> tuple:
                 if geometry is None:
                     raise src.error(item, f"{what} has no <geometry>")
                 shape = _shape(geometry, what, src, base_dir)
+                if shape is None:
+                    continue
                 rgba, material = None, None
                 m = item.find("material") if kind == "visual" else None
                 if m is not None:

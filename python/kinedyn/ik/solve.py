@@ -316,6 +316,11 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
+    if robot.nv == 0:
+        raise ValueError(
+            f"robot '{robot.name}' has no moving joint: no joint value can move its frames "
+            "(floating_base=True makes a lone body a free flyer)"
+        )
     if (
         type(max_iterations) is not int
         or type(restarts) is not int

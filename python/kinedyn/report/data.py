@@ -104,12 +104,14 @@ def simulate_free_motion(
 
 def property_checks(robot, q, qd, rng) -> list[dict]:
     """The textbook's properties at (q, qd), each with its measured residual."""
-    out = []
+    out: list[dict] = []
     n = robot.n
+    if n == 0:
+        return out  # no moving joint: the equations of motion are empty, with no property to measure
     M = robot.mass_matrix(q)
     eig = np.linalg.eigvalsh((M + M.T) / 2)
-    scale = max(1.0, float(np.max(np.abs(M))))
-    asym = float(np.max(np.abs(M - M.T)))
+    scale = max(1.0, float(np.max(np.abs(M), initial=0.0)))  # initial: a robot with no joint has an empty M
+    asym = float(np.max(np.abs(M - M.T), initial=0.0))
     out.append({"property": "M(q) symmetric", "measure": "max |M - M^T|", "value": asym, "ok": asym <= 1e-12 * scale})
     out.append(
         {
@@ -238,6 +240,8 @@ class ReportData(Mapping):
     properties: list[dict]
     simulation: dict[str, Any]
     eom_note: str | None = None
+    #: the audit of the robot's file (kinedyn.description.audit: source, counts, findings), or None
+    audit: dict | None = None
     #: the symbolic equations of motion typeset on the page (a kinedyn.symbolic EquationsOfMotion), or
     #: None where they are not derived (``eom_note`` says why); not part of the JSON
     eom: Any = field(default=None, repr=False)
@@ -251,6 +255,7 @@ class ReportData(Mapping):
             out[key] = out.pop(key)  # the order of earlier versions: after "dynamics"
         out["simulation"] = out.pop("simulation")
         out["eom_note"] = self.eom_note
+        out["audit"] = out.pop("audit")
         return out
 
     def __getitem__(self, key: str):
@@ -361,6 +366,8 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         )
     steps.step("equations of motion")
     eom, note = _equations_and_note(robot, name, eom_joints)
+    # what is wrong with the file (docs/audit.md); a robot built in Python is audited from its description
+    audit = robot.audit().to_dict()
     return ReportData(
         **kinematics,
         mass_matrix=M.tolist(),
@@ -370,6 +377,7 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
         properties=properties,
         simulation=simulation,
         eom_note=note,
+        audit=audit,
         eom=eom,
     )
 

@@ -362,6 +362,10 @@ def _render(robot, d: ReportData, tutorial: bool, steps, geometry: str) -> str:
         joint_rows=joint_rows,
         dh_rows=_dh_rows(d),
         mass_rows=[[b["link"], fmt(b["mass"]), " ".join(fmt(c) for c in b["com"])] for b in d["bodies"]],
+        audit_rows=[
+            [f["severity"], f["line"] or "", f["element"], f["message"], f["fix"]]
+            for f in (d.audit or {}).get("findings", [])
+        ],
         sigma_names=[f"σ{k + 1}" for k in range(len(d["singular_values"]))],
         configuration_rows=_configuration_rows(q, d) if multi else None,
         rotations=[j["name"] for j in d["joints"] if j["type"] in ("floating", "spherical", "planar")],

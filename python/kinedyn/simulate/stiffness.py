@@ -21,6 +21,8 @@ def choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
     step. Returns (method, reason)."""
     states = [(q0, qd0)] if q0.ndim == 1 else list(zip(q0[:16], qd0[:16]))
     n = qd0.shape[-1]
+    if n == 0:
+        return "rk4", "auto: rk4 (the robot has no degrees of freedom)"
     worst, joint = 0.0, None
     for q, qd in states:
         try:

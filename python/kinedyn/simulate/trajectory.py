@@ -114,7 +114,8 @@ class Trajectory:
 
     # ------------------------------------------------------------------ energies
     def _flat(self, a):
-        return a.reshape(-1, a.shape[-1])
+        # (samples..., n) -> (all samples, n); explicit so that n = 0 (a robot with no moving joint) works
+        return a.reshape(int(np.prod(a.shape[:-1])), a.shape[-1])
 
     def _per_sample(self, fn_batch, fn_single, *arrays):
         shape = arrays[0].shape[:-1]

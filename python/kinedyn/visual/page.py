@@ -87,7 +87,8 @@ def view_model(robot, q, geometry: str = "visual", budget: int | None = None) ->
     up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
     axes = np.array([np.asarray(robot.pose(q, name)[:3, 2]) for name in robot.body_names])
     planar = (
-        all(j.kind == "revolute" for j in robot.joints)
+        len(axes) > 0  # a robot with no moving joint has no joint axis to look along
+        and all(j.kind == "revolute" for j in robot.joints)
         and np.allclose(np.abs(axes @ axes[0]), 1.0, atol=1e-9)
         and abs(axes[0] @ up) < 1e-9
     )
