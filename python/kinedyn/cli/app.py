@@ -22,6 +22,7 @@ from rich.table import Table
 from .. import robot_files, robots
 from .._ui import terminal
 from .._ui.json import jsonable
+from ..coordinates import coordinate_labels, coordinate_units, velocity_labels
 from .options import ROBOT_FILE_EXTENSIONS, SYMBOLIC_COMMANDS, set_values
 
 
@@ -204,6 +205,40 @@ def parse_q(
     return q
 
 
+# ------------------------------------------------------------------ labels of q and qd
+def dof_labels(robot) -> list[str]:
+    """One label per degree of freedom (nv): rows of M, C, g, tau, columns of a Jacobian; a
+    free-flyer's six are ``root.vx`` ... ``root.ωz`` (kinedyn.coordinates, the report's names)."""
+    return velocity_labels(robot)
+
+
+def q_labels(robot) -> list[str]:
+    """One label per entry of q (nq): a free-flyer's seven are ``root.x`` ... ``root.qw``."""
+    return coordinate_labels(robot)
+
+
+def q_units(robot, degrees: bool = False) -> str:
+    """The units of a configuration's entries in words: "rad", "m", "rad/m", or for a robot with
+    multi-DOF joints what each kind of entry is (a quaternion's entries have no unit)."""
+    units = set(coordinate_units(robot))
+    angle = "deg" if degrees else "rad"
+    plain = "/".join(angle if u == "rad" else u for u in ("rad", "m") if u in units) or angle
+    if "" not in units:
+        return plain
+    kinds = {j.kind for j in robot.joints}
+    parts = [f"{plain} but"]
+    if kinds & {"floating", "spherical"}:
+        parts.append("quaternions (qx qy qz qw) unitless")
+    if "planar" in kinds:
+        parts.append("(cos θ, sin θ) unitless")
+    return parts[0] + " " + ", ".join(parts[1:])
+
+
+def q_text(robot, q, degrees: bool = False, precision: int = 6) -> str:
+    """``q`` for a one-line header, with its units (``[0.1 0.2] rad``)."""
+    return f"{np.array2string(np.asarray(q), precision=precision)} ({q_units(robot, degrees)})"
+
+
 def esc(text) -> str:
     """``text`` (a name from a robot file, a path, a library message) safe inside rich markup: a
     ``[`` that would open a tag (``[/bold]``, ``[red]``) is escaped, so the terminal shows it as it
@@ -230,8 +265,18 @@ def matrix_table(title: str, M: np.ndarray, rows: Sequence[str], cols: Sequence[
     for c in cols:
         table.add_column(esc(c), justify="right")
     for name, row in zip(rows, np.atleast_2d(M)):
-        table.add_row(esc(name), *(f"{v: .{digits}g}" for v in row))
+        table.add_row(esc(name), *(f"{v + 0.0: .{digits}g}" for v in row))  # + 0.0: no "-0"
     return table
+
+
+def fixed(values, digits: int = 4) -> str:
+    """Numbers in fixed notation with ``digits`` decimals, rounding-level values shown as 0
+    (``[180.0000 0.0000 1.3071]``, never ``-9.0101e-15`` or ``-0.0000``)."""
+    out = []
+    for v in np.atleast_1d(np.asarray(values, dtype=float)):
+        r = round(float(v), digits)
+        out.append(f"{(0.0 if r == 0 else r):.{digits}f}")
+    return "[" + " ".join(out) + "]"
 
 
 def fmt(v) -> str:
