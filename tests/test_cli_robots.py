@@ -114,3 +114,84 @@ def test_fk_pose_table_is_labelled_and_rpy_is_fixed_notation(capsys):
     # R = Rz(yaw) Ry(pitch) Rx(roll) (SciPy's intrinsic z-y'-x'' angles) rebuilds the pose's rotation
     R = Rotation.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_matrix()
     np.testing.assert_allclose(R, kd.load(path).pose(np.zeros(6))[:3, :3], atol=1e-5)
+
+
+# ------------------------------------------------------------------ kinedyn convert
+# a gripper whose second finger mimics the first (as the Panda's): nq = 2, MuJoCo keeps 3
+GRIPPER = """<robot name="gripper">
+  <link name="base"/>
+  <link name="palm"><inertial><mass value="1.0"/><origin xyz="0 0 0.05"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="left"><inertial><mass value="0.1"/><origin xyz="0 0 0.02"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="right"><inertial><mass value="0.1"/><origin xyz="0 0 0.02"/>
+    <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="wrist" type="revolute"><parent link="base"/><child link="palm"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="10" velocity="10"/></joint>
+  <joint name="finger1" type="prismatic"><parent link="palm"/><child link="left"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/></joint>
+  <joint name="finger2" type="prismatic"><parent link="palm"/><child link="right"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 -1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/>
+    <mimic joint="finger1" multiplier="1" offset="0"/></joint>
+</robot>
+"""
+
+
+def test_convert_a_floating_base_to_mjcf_passes_its_check(capsys, legged, tmp_path):
+    pytest.importorskip("mujoco")
+    out = tmp_path / "legged.xml"
+    code, text, err = run(capsys, "convert", legged, str(out), "--floating-base")
+    assert code == 0, err
+    assert "checked by reading it back" in text and out.exists()
+
+
+def test_convert_writes_mimic_joints_as_mjcf_equalities(capsys, tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    src = tmp_path / "gripper.urdf"
+    src.write_text(GRIPPER)
+    out = tmp_path / "gripper.xml"
+    code, text, err = run(capsys, "convert", str(src), str(out))
+    assert code == 0, err
+    assert "checked by reading it back" in text
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.nq == kd.load(src).nq + 1 and model.neq == 1
+    # MuJoCo holds the follower to its leader: at rest with gravity off, the constraint solver
+    # pulls finger2 to finger1's value
+    model.opt.gravity[:] = 0
+    data = mujoco.MjData(model)
+    f1 = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "finger1")]
+    f2 = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "finger2")]
+    data.qpos[f1] = 0.03
+    for _ in range(2000):
+        data.qpos[f1] = 0.03
+        mujoco.mj_step(model, data)
+    assert data.qpos[f2] == pytest.approx(0.03, abs=2e-3)
+
+
+def test_convert_leaves_no_file_that_failed_its_check(capsys, tmp_path, monkeypatch):
+    pytest.importorskip("mujoco")
+    written = kd.Robot.to_mjcf
+
+    def wrong_gravity(self, path=None, **kw):  # a writer bug: the file's gravity differs from the robot's
+        text = written(self, None, **kw).replace('gravity="0 0 -9.81"', 'gravity="0 0 -5"')
+        with open(path, "w") as f:
+            f.write(text)
+        return text
+
+    monkeypatch.setattr(kd.Robot, "to_mjcf", wrong_gravity)
+    out = tmp_path / "ur5.xml"
+    code, text, err = run(capsys, "convert", "ur5", str(out))
+    assert code == 1 and "nothing was written" in err and "did not write" in text
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+    out.write_text("an older file")
+    assert run(capsys, "convert", "ur5", str(out))[0] == 1
+    assert out.read_text() == "an older file"
+
+
+def test_convert_without_mujoco_says_the_check_did_not_run(capsys, tmp_path, monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "mujoco", None)  # import mujoco raises ImportError
+    out = tmp_path / "ur5.xml"
+    code, text, err = run(capsys, "convert", "ur5", str(out))
+    assert code == 0 and out.exists()
+    assert "checked by reading it back" not in text
+    assert "warning: not checked: MuJoCo is not installed" in err

@@ -480,7 +480,8 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
     Nested ``<body>`` elements, one per link and extra frame, each at its link frame; joints:
     revolute -> hinge, prismatic -> slide (with ``pos`` and ``axis`` in the body frame, so a link's
     ``post`` and joint offset need no extra body), floating -> free (top-level bodies only, as
-    MuJoCo requires), spherical -> ball, planar (about z) -> two slides and a hinge. ``<inertial>``
+    MuJoCo requires), spherical -> ball, planar (about z) -> two slides and a hinge; a mimic follower
+    is a joint tied to its leader by an ``<equality><joint>`` (MuJoCo keeps its coordinate). ``<inertial>``
     with ``fullinertia`` about the centre of mass; armature = r² J_m, damping = viscous friction,
     frictionloss = Coulomb friction (one level); ``range`` from finite position limits;
     ``<option gravity>``. Geoms come from the visuals (``contype``/``conaffinity`` 0, group 1) and
@@ -578,6 +579,19 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
         body = ET.SubElement(bodies[frame.link or robot.base], "body", name=frame.name)
         bodies[frame.name] = body
         _mj_pose(body, _np(frame.placement))
+    if robot.mimic_joints:
+        # MuJoCo's joint equality (MJCF reference, equality/joint): y - y0 = a0 + a1 (x - x0) + ...,
+        # y = joint1 (the follower), x = joint2 (the leader); both written with reference 0 (the
+        # offsets are in the body poses), so polycoef = (offset, multiplier, 0, 0, 0)
+        equality = ET.SubElement(root, "equality")
+        for follower, relation in robot.mimic_joints.items():
+            ET.SubElement(
+                equality,
+                "joint",
+                joint1=follower,
+                joint2=relation.leader,
+                polycoef=_fs((float(relation.offset), float(relation.multiplier), 0.0, 0.0, 0.0)),
+            )
     for group, items in ((1, visuals), (3, collisions)):
         for _k, v in enumerate(items):
             if v.frame not in bodies:
