@@ -195,3 +195,56 @@ def test_convert_without_mujoco_says_the_check_did_not_run(capsys, tmp_path, mon
     assert code == 0 and out.exists()
     assert "checked by reading it back" not in text
     assert "warning: not checked: MuJoCo is not installed" in err
+
+
+# ------------------------------------------------------------------ meshes: the viz extra, relative paths
+def binary_stl(path) -> None:
+    """A tetrahedron as a binary STL (MuJoCo reads binary STL only, of at least 4 vertices)."""
+    import struct
+
+    v = [(0, 0, 0), (0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)]
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    with open(path, "wb") as f:
+        f.write(b"\0" * 80 + struct.pack("<I", len(faces)))
+        for a, b, c in faces:
+            f.write(struct.pack("<12fH", 0, 0, 0, *v[a], *v[b], *v[c], 0))
+
+
+MESHY = """<robot name="meshy">
+  <link name="base"/>
+  <link name="l1"><inertial><mass value="1.0"/><origin xyz="0.1 0 0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="meshes/tri.stl"/></geometry></visual></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" effort="10" velocity="10"/></joint>
+</robot>
+"""
+
+
+@pytest.fixture
+def meshy(tmp_path):
+    (tmp_path / "robot" / "meshes").mkdir(parents=True)
+    binary_stl(tmp_path / "robot" / "meshes" / "tri.stl")
+    path = tmp_path / "robot" / "meshy.urdf"
+    path.write_text(MESHY)
+    return path
+
+
+def test_report_without_the_viz_extra_says_so_on_the_terminal(capsys, meshy, tmp_path, monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "trimesh", None)  # as after pip install . without [viz]
+    out = tmp_path / "report.html"
+    code, text, err = run(capsys, "report", str(meshy), "-o", str(out), "--no-tutorial")
+    assert code == 0 and out.exists()
+    assert "draws 0 of the 1 visual shapes" in err and "pip install 'kinedyn[viz]'" in err
+
+
+def test_converted_mjcf_holds_relative_mesh_paths(capsys, meshy, tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    (tmp_path / "out").mkdir()
+    out = tmp_path / "out" / "meshy.xml"
+    code, text, err = run(capsys, "convert", str(meshy), str(out))
+    assert code == 0, err
+    xml = out.read_text()
+    assert str(tmp_path) not in xml and 'file="../robot/meshes/tri.stl"' in xml
+    model = mujoco.MjModel.from_xml_path(str(out))  # MuJoCo finds the mesh from the file's folder
+    assert model.nmesh == 1
