@@ -248,3 +248,19 @@ def test_converted_mjcf_holds_relative_mesh_paths(capsys, meshy, tmp_path):
     assert str(tmp_path) not in xml and 'file="../robot/meshes/tri.stl"' in xml
     model = mujoco.MjModel.from_xml_path(str(out))  # MuJoCo finds the mesh from the file's folder
     assert model.nmesh == 1
+
+
+# ------------------------------------------------------------------ info, units, names
+def test_info_counts_degrees_of_freedom_and_marks_mimic_joints(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # the table on one line per joint
+    src = tmp_path / "gripper.urdf"
+    src.write_text(GRIPPER)
+    code, out, err = run(capsys, "info", str(src))
+    assert code == 0, err
+    first = out.splitlines()[0]
+    assert "2 degrees of freedom" in first and "3 moving joints" in first and "1 of them mimic" in first
+    row = next(line for line in out.splitlines() if "finger2" in line)
+    assert "mimics finger1" in row
+    doc = __import__("json").loads(run(capsys, "info", str(src), "--json")[1])
+    mimic = {j["name"]: j["mimics"] for j in doc["joints"]}
+    assert mimic["finger2"] == {"leader": "finger1", "multiplier": 1.0, "offset": 0.0} and mimic["finger1"] is None
