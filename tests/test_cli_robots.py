@@ -264,3 +264,41 @@ def test_info_counts_degrees_of_freedom_and_marks_mimic_joints(capsys, tmp_path,
     doc = __import__("json").loads(run(capsys, "info", str(src), "--json")[1])
     mimic = {j["name"]: j["mimics"] for j in doc["joints"]}
     assert mimic["finger2"] == {"leader": "finger1", "multiplier": 1.0, "offset": 0.0} and mimic["finger1"] is None
+
+
+@pytest.mark.parametrize(
+    "argv, flag",
+    [
+        (["ik", "ur5", "--xyz", "0.3", "0.2", "0.4", "--rpy", "180", "0", "0"], "--rpy roll is 180 rad"),
+        (["fk", "ur5", "--q", "90", "0", "0", "0", "0", "0"], "--q value 1 (shoulder_pan_joint) is 90 rad"),
+        (["fk", "puma560", "--q", "0", "0", "0", "0", "100", "0"], "--q value 5 (q5) is 100 rad"),
+    ],
+)
+def test_angles_that_look_like_degrees_warn_and_name_deg(capsys, argv, flag):
+    code, out, err = run(capsys, *argv)
+    assert flag in err and "--deg" in err and "did you mean degrees" in err
+    code, out, err = run(capsys, *argv, "--deg")
+    assert "did you mean degrees" not in err
+
+
+def test_plausible_radians_do_not_warn(capsys):
+    code, out, err = run(capsys, "fk", "ur5", "--q", "3.1", "-1.5", "6.2", "0", "0", "0")
+    assert code == 0 and "warning" not in err
+    # a prismatic joint's metres are not angles
+    code, out, err = run(capsys, "fk", "cartesian_2p", "--q", "50", "40")
+    assert code == 0 and "did you mean degrees" not in err
+
+
+@pytest.mark.parametrize(
+    "argv, suggestion",
+    [
+        (["fk", "ur5", "--frame", "linkk3"], "did you mean 'link3'"),
+        (["fk", "ur6"], "did you mean 'ur5'"),
+        (["fk", "planar_2r", "--set", "l_1=2"], "did you mean 'l1'"),
+        (["convert", "ur5", "OUT.yaml", "--lock", "wrist_3"], "did you mean 'wrist_3_joint'"),
+    ],
+)
+def test_misspelt_names_get_a_suggestion(capsys, tmp_path, argv, suggestion):
+    argv = [str(tmp_path / a) if a == "OUT.yaml" else a for a in argv]
+    code, out, err = run(capsys, *argv)
+    assert code == 1 and suggestion in err

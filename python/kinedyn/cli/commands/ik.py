@@ -14,7 +14,7 @@ from rich.table import Table
 from ..._math import rpy_to_matrix
 from ...ik.solve import METHODS, inverse_kinematics
 from .. import app
-from ..app import console, emit, esc, parse_q, q_labels
+from ..app import console, emit, esc, parse_q, q_labels, warn_degrees
 from ..options import EXIT_NO, EXIT_OK, finite_float, in_cli_terms
 
 # the solver's messages name its Python arguments; on the command line they are these flags
@@ -73,6 +73,8 @@ def target_from_args(xyz, rpy=None, degrees: bool = False) -> np.ndarray:
 
 def run(args) -> int:
     robot = app.robot(args)
+    if args.rpy is not None and not args.deg:
+        warn_degrees("--rpy", [(name, v, None) for name, v in zip(("roll", "pitch", "yaw"), args.rpy)])
     target = target_from_args(args.xyz, args.rpy, args.deg)
     q0 = None
     if args.q0 is not None:
