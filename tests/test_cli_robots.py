@@ -302,3 +302,28 @@ def test_misspelt_names_get_a_suggestion(capsys, tmp_path, argv, suggestion):
     argv = [str(tmp_path / a) if a == "OUT.yaml" else a for a in argv]
     code, out, err = run(capsys, *argv)
     assert code == 1 and suggestion in err
+
+
+# ------------------------------------------------------------------ simulate --plot, --csv
+def test_simulate_plot_keeps_its_legends_in_the_figure_and_labels_every_column(capsys, legged, tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    robot = kd.load(legged, floating_base=True)
+    png, csv = tmp_path / "run.png", tmp_path / "run.csv"
+    code, out, err = run(
+        capsys, "simulate", legged, "--floating-base", "--t", "0.05", "--plot", str(png), "--csv", str(csv)
+    )
+    assert code == 0, err
+    assert png.stat().st_size > 0
+    header = csv.read_text().splitlines()[0].split(",")
+    assert [h for h in header if h.startswith("q[")] == [f"q[{n}]" for n in coordinate_labels(robot)]
+    assert [h for h in header if h.startswith("tau[")] == [f"tau[{n}]" for n in velocity_labels(robot)]
+    traj = kd.simulate(robot, 0.05, np.concatenate([robot.neutral(), np.zeros(robot.nv)]), dt=1e-3)
+    fig = traj.plot(tmp_path / "again.png")  # saving lays the figure out, as the command does
+    legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None]
+    assert [t.get_text() for t in legends[0].get_texts()] == coordinate_labels(robot)
+    assert [t.get_text() for t in legends[1].get_texts()] == velocity_labels(robot)
+    for legend in legends:  # nothing cut off at the figure's edges
+        box = legend.get_window_extent()
+        assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1 + 0.5 and box.y1 <= fig.bbox.y1 + 0.5
