@@ -236,6 +236,9 @@ def test_report_without_the_viz_extra_says_so_on_the_terminal(capsys, meshy, tmp
     code, text, err = run(capsys, "report", str(meshy), "-o", str(out), "--no-tutorial")
     assert code == 0 and out.exists()
     assert "draws 0 of the 1 visual shapes" in err and "pip install 'kinedyn[viz]'" in err
+    # the page names the mesh as the robot file does, not by this machine's absolute path
+    page = out.read_text()
+    assert "'meshes/tri.stl'" in page and str(meshy.parent / "meshes") not in page
 
 
 def test_converted_mjcf_holds_relative_mesh_paths(capsys, meshy, tmp_path):
