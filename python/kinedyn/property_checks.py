@@ -210,14 +210,14 @@ def global_inertia_bounds(
     lo_s, hi_s = eig[:, 0], eig[:, -1]
     bounds = [(None, None) if p else (a, b) for a, b, p in zip(lower, upper, periodic)]
 
-    def picks(sign: float, column: int) -> tuple:
+    def picks(sign: float, column: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
         values = sign * (lo_s if column == 0 else hi_s)
         order = np.argsort(values)
         chosen = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
         return values, order, list(dict.fromkeys(int(i) for i in chosen))
 
-    plans = [(sign, column, *picks(sign, column)) for sign, column in ((1.0, 0), (-1.0, -1))]
-    planned = sum(len(p[-1]) for p in plans)
+    low, high = picks(1.0, 0), picks(-1.0, -1)
+    planned = len(low[2]) + len(high[2])
     start_time, done = time.perf_counter(), 0
     bar = Delayed(
         wanted(progress),
@@ -272,8 +272,8 @@ def global_inertia_bounds(
     # the budget is shared: the least eigenvalue's searches end at half of it, the greatest's at all of it
     deadlines = (None, None) if time_budget is None else (start_time + time_budget / 2, start_time + time_budget)
     try:
-        lmin, qmin = extreme(*plans[0], deadlines[0])
-        lmax, qmax = extreme(*plans[1], deadlines[1])
+        lmin, qmin = extreme(1.0, 0, *low, deadlines[0])
+        lmax, qmax = extreme(-1.0, -1, *high, deadlines[1])
     finally:
         bar.close()
     return InertiaBounds(

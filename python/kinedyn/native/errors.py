@@ -29,7 +29,10 @@ def _name_joints(message: str, joint: int, name: str, body: str | None) -> str:
 
 
 def singular_mass_matrix_error(
-    error: SingularMassMatrixError, robot: str, label: Callable[[int], str | None], note: Callable[[int], str]
+    error: SingularMassMatrixError,
+    robot: str,
+    label: Callable[[int], tuple[str, str] | None],
+    note: Callable[[int], str],
 ) -> Exception:
     """The user's error for the core's ``SingularMassMatrixError``: the joint named (``label(joint)``,
     its name and moving body ``('elbow', 'forearm')``, None when it has none) and the robot's note on it
@@ -59,7 +62,7 @@ def robot_error(robot: Robot, error: RuntimeError) -> Exception:
     )
 
 
-def dof_label(robot: Robot, dof: int) -> tuple | None:
+def dof_label(robot: Robot, dof: int) -> tuple[str, str] | None:
     """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
     if not 0 <= dof < robot.n:
         return None
