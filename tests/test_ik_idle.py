@@ -57,3 +57,16 @@ def test_a_batch_keeps_idle_joints_at_q0():
     others = [k for k, n in enumerate(robot.joint_names) if not n.startswith("left_")]
     rest = np.clip(robot.neutral(), robot.lower_limits, robot.upper_limits)
     np.testing.assert_array_equal(batch.q[:, others], np.broadcast_to(rest[others], (2, len(others))))
+
+
+def test_cli_ik_on_baxter_moves_only_the_left_arm(capsys):
+    import json
+
+    from kinedyn.cli import main
+
+    path = erd(*BAXTER)
+    code = main(["ik", path, "--xyz", "0.7", "0.3", "0.2", "--frame", "left_gripper", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0
+    moved = {n for n, v in zip(doc["coordinate_labels"], doc["solutions"][0]) if v != 0.0}
+    assert moved and all(n.startswith("left_") for n in moved)
