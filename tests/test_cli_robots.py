@@ -330,3 +330,13 @@ def test_simulate_plot_keeps_its_legends_in_the_figure_and_labels_every_column(c
     for legend in legends:  # nothing cut off at the figure's edges
         box = legend.get_window_extent()
         assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1 + 0.5 and box.y1 <= fig.bbox.y1 + 0.5
+
+
+def test_convert_to_a_device_checks_then_writes_into_it(capsys):
+    import os
+    import stat
+
+    code, text, err = run(capsys, "convert", "ur5", os.devnull, "--to", "urdf")
+    assert code == 0, err
+    assert "checked by reading it back" in text
+    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)  # still the device, not a file renamed over it

@@ -114,12 +114,16 @@ class ConversionError(ValueError):
         self.result = result
 
 
-def _temporary_beside(path: str) -> str:
+_EXTENSION = {"urdf": ".urdf", "mjcf": ".xml", "yaml": ".yaml", "toml": ".toml", "dh": ".yaml"}
+
+
+def _temporary_beside(path: str, fmt: str) -> str:
     """A new empty file for writing ``path``'s content before its check: in the same folder, with
-    the same extension (readers dispatch on it, and relative mesh paths stay right); in the system's
+    the same extension (the format's when it has none: readers dispatch on it), so relative mesh paths
+    stay right; in the system's
     temporary folder when ``path`` is a device such as /dev/null."""
     folder, name = os.path.split(os.path.abspath(path))
-    ext = os.path.splitext(name)[1]
+    ext = os.path.splitext(name)[1] or _EXTENSION[fmt]  # /dev/null --to urdf: the reader needs an extension
     regular = not os.path.exists(path) or os.path.isfile(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=ext, dir=folder if regular else None)
     os.close(fd)
@@ -153,7 +157,7 @@ def convert(
     more (else :class:`ConversionError`, and ``path`` is left as it was)."""
     fmt = format_of(path, to)
     path = os.fspath(path)
-    tmp = _temporary_beside(path)
+    tmp = _temporary_beside(path, fmt)
     try:
         result = _write(robot, path, tmp, fmt, convention)
         if check:
