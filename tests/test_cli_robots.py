@@ -340,3 +340,38 @@ def test_convert_to_a_device_checks_then_writes_into_it(capsys):
     assert code == 0, err
     assert "checked by reading it back" in text
     assert stat.S_ISCHR(os.stat(os.devnull).st_mode)  # still the device, not a file renamed over it
+
+
+def test_kinedyn_reads_the_mjcf_joint_equalities_it_writes_as_mimic_joints(capsys, tmp_path):
+    src = tmp_path / "gripper.urdf"
+    src.write_text(GRIPPER)
+    out = tmp_path / "gripper.xml"
+    assert run(capsys, "convert", str(src), str(out), "--no-check")[0] == 0
+    urdf, mjcf = kd.load(src), kd.load(out)
+    assert mjcf.nq == urdf.nq == 2 and set(mjcf.mimic_joints) == {"finger2"}
+    q = urdf.random_configuration(3)
+    np.testing.assert_allclose(mjcf.mass_matrix(q), urdf.mass_matrix(q), atol=1e-12)
+    np.testing.assert_allclose(mjcf.frame_poses(q, ["right"]), urdf.frame_poses(q, ["right"]), atol=1e-12)
+    # an equality that is not linear in its joint stays unmodelled, and says so
+    text = out.read_text().replace('polycoef="0 1 0 0 0"', 'polycoef="0 1 0.5 0 0"')
+    assert 'polycoef="0 1 0.5 0 0"' in text
+    with pytest.warns(UserWarning, match="not a linear joint equality"):
+        assert kd.Robot.from_mjcf(text).nq == 3
+
+
+def test_a_joint_equality_with_reference_positions_reads_as_mujoco_holds_it():
+    mujoco = pytest.importorskip("mujoco")
+    xml = """<mujoco><option gravity="0 0 0"/><worldbody>
+      <body name="a"><joint name="x" type="slide" axis="1 0 0" ref="0.2"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+        <body name="b"><joint name="y" type="slide" axis="0 1 0" ref="-0.1"/>
+          <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/></body></body>
+      </worldbody><equality><joint joint1="y" joint2="x" polycoef="0.05 2 0 0 0"/></equality></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    for _ in range(3000):  # MuJoCo's constraint solver pulls y to where the equality holds x
+        data.qpos[0], data.qvel[0] = 0.7, 0.0
+        mujoco.mj_step(model, data)
+    relation = kd.Robot.from_mjcf(xml).mimic_joints["y"]
+    assert relation.leader == "x"
+    assert relation.multiplier * 0.7 + relation.offset == pytest.approx(data.qpos[1], abs=1e-6)
