@@ -143,7 +143,7 @@ def test_cli_check_and_identify(capsys):
 
     code = main(["check", "planar_2r", "--samples", "20", "--t", "0.5", "--json"])
     doc = json.loads(capsys.readouterr().out)
-    assert code == 0 and doc["passed"] and len(doc["checks"]) == 7
+    assert code == 0 and doc["passed"] and len(doc["checks"]) == 8  # with "friction dissipates"
     code = main(["identify", "planar_2r", "--json"])
     doc = json.loads(capsys.readouterr().out)
     assert code == 0 and doc["max_abs_error"] < 1e-8

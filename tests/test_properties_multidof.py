@@ -124,6 +124,7 @@ def test_check_properties_on_multi_dof_robots_and_a_lone_floating_body():
         "sampled",
         "sampled",
         "sampled",
+        "sampled",  # friction dissipates
         "simulated",
     ]
     assert "along q ⊕ t qd" in report["dM/dt - 2C"].detail
@@ -155,7 +156,7 @@ def test_kinedyn_check_floating_base_on_solo12(capsys):
     path = os.path.join(root, "solo_description", "robots", "solo12.urdf")
     assert main(["check", path, "--floating-base", "--samples", "16", "--t", "0.3", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["passed"] and len(doc["checks"]) == 7
+    assert doc["passed"] and len(doc["checks"]) == 8  # with "friction dissipates"
     bounds = next(c for c in doc["checks"] if c["name"].startswith("inertia bounds"))
     assert len(bounds["q_lambda_min"]) == 19 and bounds["lambda_min"] > 0
     assert main(["check", path, "--floating-base", "--prove"]) != 0

@@ -384,7 +384,7 @@ def test_non_finite_controller_torque_is_reported(puma):
 
     for method in ("rk4", "rk45"):
         with pytest.raises(
-            NonFiniteTorqueError, match=r"non-finite torque \(nan\) at joint 2 \('q3'\) at t = 0\.0[5-9]"
+            NonFiniteTorqueError, match=r"non-finite torque \(nan\) at joint 'q3' at t = 0\.0[5-9]"
         ) as info:
             kd.simulate(puma, 0.2, X0_PUMA, controller=bad, method=method)
         assert isinstance(info.value, ValueError)
@@ -395,9 +395,7 @@ def test_non_finite_controller_torque_is_reported(puma):
 def test_blow_up_stops_with_when_and_where(puma):
     # a destabilising "controller" (positive velocity feedback) drives joint speeds past max_speed
     ctl = lambda t, q, qd: 500.0 * qd  # noqa: E731
-    with pytest.raises(
-        SimulationError, match=r"blew up at t = [0-9.]+ s \(step \d+ of 3000\).*joint \d \('q\d'\)"
-    ) as info:
+    with pytest.raises(SimulationError, match=r"blew up at t = [0-9.]+ s \(step \d+ of 3000\).*joint 'q\d'") as info:
         kd.simulate(puma, 3.0, X0_PUMA, controller=ctl, max_speed=1e3)
     err = info.value
     partial = err.trajectory

@@ -560,7 +560,7 @@ def test_forward_dynamics_names_the_nonphysical_link():
     for call in (lambda: robot.forward_dynamics([0.0], [0.0], [1.0]), lambda: robot.mass_matrix_inverse([0.0])):
         with pytest.raises(
             RuntimeError,
-            match=r"joint 0 \('j'.*(negative inertia about the axis|negative pivot, so M is indefinite).*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'",
+            match=r"joint 'j'.*(negative inertia about the axis|negative pivot, so M is indefinite).*link 'a' \(inertia tensor is not positive semi-definite.*inertia='repair'",
         ):
             call()
     # repaired: second moments (1.05, -0.05, -0.05) clipped to (1.05, 0, 0): principal moments (0, 1.05, 1.05)

@@ -8,12 +8,18 @@ the written file back and compares it with the source at random states (:func:`c
 the pose of every frame both have, the mass matrix and inverse dynamics. URDF files are read back by
 kinedyn's URDF reader (URDF keeps no rotor inertia for it: the source's ``r² J_m`` is added back to
 the result's M and tau, and said so); MJCF files by MuJoCo itself (``mj_fullM``, ``qfrc_bias``
-against ``C qd + g``, body poses).
+against ``C qd + g``, body poses), through the map between MuJoCo's coordinates and the source's
+(:func:`mujoco_coordinates`: scalar-first quaternions, a free joint's linear velocity in world axes,
+mimic followers kept by MuJoCo and tied by equalities). The states are drawn by the source's
+``random_configuration`` (unit quaternions), and the file is written to a temporary file beside
+``path`` and renamed only once its check has passed, so a file that failed its check is never left.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
 import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -28,7 +34,7 @@ if TYPE_CHECKING:
     from ._typing import PathLike
     from .robot import Robot
 
-__all__ = ["convert", "check_conversion", "Conversion", "FORMATS", "format_of"]
+__all__ = ["convert", "check_conversion", "Conversion", "ConversionError", "FORMATS", "format_of"]
 
 FORMATS = ("urdf", "mjcf", "yaml", "toml", "dh")
 _BY_EXTENSION = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".yaml": "yaml", ".yml": "yaml", ".toml": "toml"}
@@ -92,11 +98,45 @@ class Conversion:
 
 
 def _random_states(robot: Robot, states: int, seed: int):
+    """Valid states: configurations from the robot's own sampler (unit quaternions, within finite
+    limits), velocities and accelerations of nv entries."""
     rng = np.random.default_rng(seed)
-    lo = np.where(np.isfinite(robot.lower_limits), robot.lower_limits, -np.pi)
-    hi = np.where(np.isfinite(robot.upper_limits), robot.upper_limits, np.pi)
     for _ in range(states):
-        yield rng.uniform(lo, hi), rng.uniform(-1, 1, robot.n), rng.uniform(-1, 1, robot.n)
+        yield robot.random_configuration(rng), rng.uniform(-1, 1, robot.nv), rng.uniform(-1, 1, robot.nv)
+
+
+class ConversionError(ValueError):
+    """The written file failed its check (``convert(..., tolerance=...)``): nothing was written;
+    ``result`` holds the differences found."""
+
+    def __init__(self, message: str, result: Conversion):
+        super().__init__(message)
+        self.result = result
+
+
+_EXTENSION = {"urdf": ".urdf", "mjcf": ".xml", "yaml": ".yaml", "toml": ".toml", "dh": ".yaml"}
+
+
+def _temporary_beside(path: str, fmt: str) -> str:
+    """A new empty file for writing ``path``'s content before its check: in the same folder, with
+    the same extension (the format's when it has none: readers dispatch on it), so relative mesh paths
+    stay right; in the system's
+    temporary folder when ``path`` is a device such as /dev/null."""
+    folder, name = os.path.split(os.path.abspath(path))
+    ext = os.path.splitext(name)[1] or _EXTENSION[fmt]  # /dev/null --to urdf: the reader needs an extension
+    regular = not os.path.exists(path) or os.path.isfile(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=ext, dir=folder if regular else None)
+    os.close(fd)
+    return tmp
+
+
+def _put_in_place(tmp: str, path: str) -> None:
+    if not os.path.exists(path) or os.path.isfile(path):
+        os.replace(tmp, path)  # atomic on one file system: readers see the old file or the checked one
+    else:  # a device (/dev/null, /dev/stdout): copy the content into it
+        with open(tmp, "rb") as src, open(path, "wb") as dst:
+            shutil.copyfileobj(src, dst)
+        os.remove(tmp)
 
 
 def convert(
@@ -108,16 +148,44 @@ def convert(
     check: bool = True,
     states: int = 5,
     seed: int = 0,
+    tolerance: float | None = None,
 ) -> Conversion:
     """Write ``robot`` to ``path`` in format ``to`` (default: by extension; see the module docstring)
     and, with ``check``, read it back and compare (:func:`check_conversion`). ``convention``: of the
-    DH table for ``to="dh"``."""
+    DH table for ``to="dh"``. The file is written beside ``path`` first and moved there only when
+    its check ran without error and, with ``tolerance``, found no difference of ``tolerance`` or
+    more (else :class:`ConversionError`, and ``path`` is left as it was)."""
     fmt = format_of(path, to)
     path = os.fspath(path)
+    tmp = _temporary_beside(path, fmt)
+    try:
+        result = _write(robot, path, tmp, fmt, convention)
+        if check:
+            if robot.is_symbolic:
+                result.notes.append(f"not checked: the robot has symbolic parameters {sorted(map(str, robot.symbols))}")
+            else:
+                check_conversion(robot, tmp, fmt, result, states=states, seed=seed)
+        if tolerance is not None and result.checked and not result.max_error < tolerance:
+            raise ConversionError(
+                f"the file written for {path} differs from robot '{robot.name}' by {result.max_error:.3g} "
+                f"(more than {tolerance:g}); nothing was written",
+                result,
+            )
+        _put_in_place(tmp, path)
+    except BaseException as e:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        if isinstance(e, ValueError) and not isinstance(e, ConversionError) and path not in str(e):
+            raise ValueError(f"{e} (converting to {path}: nothing was written)") from e
+        raise
+    return result
+
+
+def _write(robot: Robot, path: str, target: str, fmt: str, convention: str) -> Conversion:
+    """Write ``robot`` to the file ``target`` in format ``fmt``; the Conversion names ``path``."""
     notes: list[str] = []
-    source = robot
     if fmt == "urdf":
-        robot.to_urdf(path)
+        robot.to_urdf(target)
         if np.any(robot.armature) and not robot.is_symbolic:
             notes.append(
                 "URDF has no rotor inertia: gear ratios and rotor inertias are in Drake's <transmission> extension, "
@@ -126,10 +194,10 @@ def convert(
         if not robot.is_symbolic and not np.allclose(np.asarray(robot.gravity, dtype=float), (0.0, 0.0, -9.81)):
             notes.append(f"URDF holds no gravity: give gravity={list(map(float, robot.gravity))} when loading it")
     elif fmt == "mjcf":
-        robot.to_mjcf(path)
+        robot.to_mjcf(target)
     elif fmt == "dh":
         found = dh_from_robot(robot, convention)
-        found.robot.save(path)
+        found.robot.save(target)
         dh_names = {f"link{i + 1}" for i in range(robot.n)} | {"tool"}
         clashing = [n for n in found.source_frames if n in dh_names]
         if clashing:
@@ -137,15 +205,8 @@ def convert(
                 f"in the DH file, {', '.join(clashing)} are the DH table's own frames (the source's frames of those names are not kept)"
             )
     else:
-        robot.save(path)
-    result = Conversion(path, "DH " + convention if fmt == "dh" else fmt, source.n, source.name, notes=notes)
-    if not check:
-        return result
-    if source.is_symbolic:
-        result.notes.append(f"not checked: the robot has symbolic parameters {sorted(map(str, source.symbols))}")
-        return result
-    check_conversion(source, path, fmt, result, states=states, seed=seed)
-    return result
+        robot.save(target)
+    return Conversion(path, "DH " + convention if fmt == "dh" else fmt, robot.n, robot.name, notes=notes)
 
 
 def check_conversion(
@@ -193,26 +254,112 @@ def check_conversion(
     return result
 
 
+def mujoco_coordinates(source: Robot, model) -> tuple | None:
+    """How the MuJoCo model ``model`` of a file written by ``to_mjcf`` moves with ``source``:
+    ``(qpos, A, a_bias)`` with ``qpos(q)`` MuJoCo's configuration at the source's ``q``,
+    ``A(q)`` the (model.nv, source.nv) matrix with ``qvel = A v``, and ``a_bias(q, v)`` = ``dA/dt v``,
+    so that the source's ``M = A^T M_mj A`` and ``C v + g = A^T (qfrc_bias + M_mj dA/dt v)``
+    (the kinetic energy and the power of a force are the same in both coordinates). None when a
+    joint has no such map here (a planar joint, written as two slides and a hinge).
+
+    MuJoCo's conventions (MJCF reference, joint and freejoint): quaternions scalar first
+    (w, x, y, z); a free joint's linear velocity in world axes and its angular velocity in the
+    body's; a ball joint's angular velocity in the body's (as kinedyn's, docs/conventions.md). A
+    mimic follower keeps its coordinate in MuJoCo: the full coordinates are ``q_full = expand(q)``
+    and ``v_full = G v`` (kinedyn.description.mimic)."""
+    import importlib
+
+    mujoco = importlib.import_module("mujoco")
+    mimic = source.description.mimic_map
+    joints = [b.joint for b in source.tree.bodies if b.joint.is_moving]
+    if any(j.kind == "planar" for j in joints):
+        return None
+    layout = []  # (kind, full q index, full v index, MuJoCo qpos address, MuJoCo dof address)
+    iq = iv = 0
+    for j in joints:
+        k = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)
+        if k < 0:
+            raise ValueError(f"MuJoCo's model of the written file has no joint '{j.name}'")
+        layout.append((j.kind, iq, iv, int(model.jnt_qposadr[k]), int(model.jnt_dofadr[k])))
+        iq, iv = iq + j.nq, iv + j.nv
+    G = mimic.G if mimic is not None else np.eye(source.nv)
+
+    def full_q(q):
+        return mimic.expand_q(np.asarray(q, dtype=float)) if mimic is not None else np.asarray(q, dtype=float)
+
+    def qpos(q):
+        qf, out = full_q(q), np.zeros(model.nq)
+        for kind, i, _, a, _ in layout:
+            if kind in ("revolute", "prismatic"):
+                out[a] = qf[i]
+            elif kind == "spherical":
+                out[a : a + 4] = np.roll(qf[i : i + 4], 1)  # (x, y, z, w) -> (w, x, y, z)
+            else:  # floating
+                out[a : a + 3] = qf[i : i + 3]
+                out[a + 3 : a + 7] = np.roll(qf[i + 3 : i + 7], 1)
+        return out
+
+    def rotation(qf, i):  # the free-flyer's rotation from its unit quaternion (x, y, z, w)
+        x, y, z, w = qf[i + 3 : i + 7]
+        return np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+
+    def A(q):
+        qf, T = full_q(q), np.zeros((model.nv, G.shape[0]))
+        for kind, i, v, _, d in layout:
+            n = {"revolute": 1, "prismatic": 1, "spherical": 3, "floating": 6}[kind]
+            T[d : d + n, v : v + n] = np.eye(n)
+            if kind == "floating":  # linear velocity: body axes (kinedyn) -> world axes (MuJoCo)
+                T[d : d + 3, v : v + 3] = rotation(qf, i)
+        return T @ G
+
+    def a_bias(q, v):
+        qf, vf, out = full_q(q), G @ np.asarray(v, dtype=float), np.zeros(model.nv)
+        for kind, i, iv_, _, d in layout:
+            if kind == "floating":  # d/dt (R v_lin) at fixed v_lin = R (ω × v_lin), ω in body axes
+                out[d : d + 3] = rotation(qf, i) @ np.cross(vf[iv_ + 3 : iv_ + 6], vf[iv_ : iv_ + 3])
+        return out
+
+    return qpos, A, a_bias
+
+
 def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int, seed: int) -> Conversion:
     import importlib
 
     try:  # (through importlib: MuJoCo ships no type stubs, and the type checker need not know it)
         mujoco = importlib.import_module("mujoco")
     except ImportError:
-        result.notes.append("not checked: MuJoCo is not installed (pip install mujoco)")
+        result.notes.append(
+            "not checked: MuJoCo is not installed, so the file was not read back "
+            "(pip install mujoco, or kinedyn's 'peers' extra, then run the conversion again)"
+        )
         return result
     model = mujoco.MjModel.from_xml_path(path)
     data = mujoco.MjData(model)
-    if model.nv != source.n or model.nq != source.nq:
+    mimic = source.description.mimic_map
+    nq, nv = (mimic.nq_full, mimic.nv_full) if mimic is not None else (source.nq, source.nv)
+    if model.nv != nv or model.nq != nq:  # a free joint and a ball have kinedyn's sizes (7, 6 and 4, 3)
         raise ValueError(
-            f"MuJoCo reads the written file with nq={model.nq}, nv={model.nv}; the source has nq={source.nq}, nv={source.n}"
+            f"MuJoCo reads the written file with nq={model.nq}, nv={model.nv}; the source has nq={nq}, nv={nv}"
+            + (" with its mimic followers" if mimic is not None else "")
         )
+    maps = mujoco_coordinates(source, model)
+    if maps is None:
+        result.notes.append("not checked: MuJoCo writes a planar joint as two slides and a hinge (no map here)")
+        return result
+    qpos, A, a_bias = maps
     names = [l.name for l in source.links] + [f.name for f in source.frames]
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
     result.frames_compared = names
     M = np.zeros((model.nv, model.nv))
     for q, qd, _ in _random_states(source, states, seed):
-        data.qpos[:], data.qvel[:] = q, qd
+        Aq = A(q)
+        data.qpos[:], data.qvel[:] = qpos(q), Aq @ qd
         mujoco.mj_forward(model, data)
         mujoco.mj_fullM(model, data, M)
         poses = source.frame_poses(q, names)
@@ -222,12 +369,14 @@ def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int
         )
         result.max_frame_error = max(result.max_frame_error, e_fk)
         result.max_mass_matrix_error = max(
-            result.max_mass_matrix_error, float(np.abs(M - source.mass_matrix(q)).max(initial=0.0))
+            result.max_mass_matrix_error, float(np.abs(Aq.T @ M @ Aq - source.mass_matrix(q)).max(initial=0.0))
         )
         bias = source.coriolis_matrix(q, qd) @ qd + source.gravity_torque(q)
-        result.max_torque_error = max(result.max_torque_error, float(np.abs(data.qfrc_bias - bias).max(initial=0.0)))
+        bias_mj = Aq.T @ (data.qfrc_bias + M @ a_bias(q, qd))
+        result.max_torque_error = max(result.max_torque_error, float(np.abs(bias_mj - bias).max(initial=0.0)))
     result.notes.append(
         "read back by MuJoCo: M = mj_fullM, and qfrc_bias against C qd + g (MuJoCo keeps friction out of the bias)"
+        + ("; mimic followers compared on the independent coordinates (G^T M G)" if mimic is not None else "")
     )
     result.checked, result.states = True, states
     return result

@@ -6,12 +6,14 @@ robot (:mod:`kinedyn.analysis.properties`) and the exact proofs on symbolic equa
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import display
+from ._ui.progress import SHOW_AFTER, Delayed, wanted
 
 __all__ = ["STATUSES", "Check", "PropertiesReport", "InertiaBounds", "global_inertia_bounds"]
 
@@ -112,6 +114,16 @@ class InertiaBounds:
     #: how the configurations were searched, when not the box ``lower``/``upper`` of the coordinates
     #: themselves (a robot with multi-DOF joints: the chart of :class:`_ManifoldChart`)
     space: str = ""
+    #: local searches run and planned: fewer run when the time budget ran out, and the bounds are
+    #: then the extremes of the sample and of the searches that ran (an estimate, flagged as such)
+    searched: int = 0
+    planned: int = 0
+    time_budget: float | None = None
+
+    @property
+    def complete(self) -> bool:
+        """Every planned local search ran (the time budget, if any, did not cut the search short)."""
+        return self.searched >= self.planned
 
     def describe(self) -> str:
         box = self.space or ", ".join(
@@ -119,12 +131,25 @@ class InertiaBounds:
         )
         if self.starts == 0 and self.space:  # nothing to search (M constant)
             return f"lambda_min = {self.lambda_min:.8g}, lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)} ({self.space})"
+        how = (
+            f"global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
+            f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box}"
+        )
+        if not self.complete:
+            how = (
+                f"a sampled bound, not a searched one: the time budget of {self.time_budget:g} s ran out with "
+                f"{self.searched} of {self.planned} local searches finished, so these are the extremes of {self.samples} random "
+                f"configurations and the searches that ran (the true lambda_min may be lower, lambda_max higher; "
+                f"a larger budget searches further); q in {box}"
+            )
         return (
             f"lambda_min = {self.lambda_min:.8g} at q = {np.array2string(self.q_lambda_min, precision=4)}, "
-            f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} "
-            f"(global search: {self.starts} truncated-Newton starts with the analytic eigenvalue gradient from the best of "
-            f"{self.samples} random configurations, whose extremes were {self.sampled_min:.8g} and {self.sampled_max:.8g}; q in {box})"
+            f"lambda_max = {self.lambda_max:.8g} at q = {np.array2string(self.q_lambda_max, precision=4)} ({how})"
         )
+
+
+class _OutOfTime(Exception):
+    """Raised inside a local search when the inertia-bound search's time budget is spent."""
 
 
 def _wrap(q: np.ndarray, periodic: np.ndarray) -> np.ndarray:
@@ -143,6 +168,8 @@ def global_inertia_bounds(
     starts: int = 12,
     seed: int = 0,
     wrap: Callable[[np.ndarray], np.ndarray] | None = None,
+    time_budget: float | None = None,
+    progress: bool | None = False,
 ) -> InertiaBounds:
     """The least and greatest eigenvalue of M(q) over the box ``lower <= q <= upper`` (coordinates
     marked ``periodic`` are searched without bounds, M being 2 pi-periodic in them, and reported in
@@ -154,7 +181,11 @@ def global_inertia_bounds(
     ``mass_matrix_gradient(q)``: (n_q, n, n), dM/dq_k stacked. ``wrap(q)``: the representative of a
     searched point to report (default: periodic coordinates into [-pi, pi)); the box of the periodic
     coordinates is where the samples are drawn. A search, not a proof: the reported bounds are
-    attained (at the returned configurations) and no worse than every sample."""
+    attained (at the returned configurations) and no worse than every sample. ``time_budget``
+    (seconds, default none): half of it for the least eigenvalue's searches, the rest for the
+    greatest's; a search running when its share is spent stops at the best point it reached, and the
+    result says how many searches finished (:attr:`InertiaBounds.complete`); ``progress``: a bar on stderr over the local searches
+    (None: when stderr is a terminal and the search runs over a second)."""
     from scipy.optimize import minimize  # scipy loads only when bounds are searched
 
     lower = np.asarray(lower, dtype=float)
@@ -179,36 +210,72 @@ def global_inertia_bounds(
     lo_s, hi_s = eig[:, 0], eig[:, -1]
     bounds = [(None, None) if p else (a, b) for a, b, p in zip(lower, upper, periodic)]
 
-    def extreme(sign: float, column: int):
+    def picks(sign: float, column: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+        values = sign * (lo_s if column == 0 else hi_s)
+        order = np.argsort(values)
+        chosen = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
+        return values, order, list(dict.fromkeys(int(i) for i in chosen))
+
+    low, high = picks(1.0, 0), picks(-1.0, -1)
+    planned = len(low[2]) + len(high[2])
+    start_time, done = time.perf_counter(), 0
+    bar = Delayed(
+        wanted(progress),
+        planned,
+        "inertia bounds",
+        "{task.completed:.0f} / {task.total:.0f} searches",
+        SHOW_AFTER if progress is None else 0.0,
+    )
+
+    def extreme(sign: float, column: int, values, order, chosen, deadline):
+        nonlocal done
+        seen: list = [np.inf, None]  # the best point a search has evaluated (kept when time runs out)
+
         def f(q):
+            if deadline is not None and time.perf_counter() > deadline:
+                raise _OutOfTime
             w, V = np.linalg.eigh(np.asarray(mass_matrix(q), dtype=float))
             v = V[:, column]
             dM = np.asarray(mass_matrix_gradient(q), dtype=float)
+            if sign * w[column] < seen[0]:
+                seen[:] = [sign * w[column], np.array(q, dtype=float)]
             return sign * w[column], sign * np.einsum("i,kij,j->k", v, dM, v)
 
-        values = sign * (lo_s if column == 0 else hi_s)
-        order = np.argsort(values)
-        picks = list(order[:starts]) + list(rng.choice(samples, size=min(starts, samples), replace=False))
         best_q, best = Q[order[0]].copy(), values[order[0]]
-        for k in dict.fromkeys(int(i) for i in picks):
-            res = minimize(
-                f,
-                Q[k],
-                jac=True,
-                method="TNC",
-                bounds=bounds,
-                options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12),
-            )
-            x = np.array(res.x, dtype=float)
+        for k in chosen:
+            seen[:] = [np.inf, None]
+            try:
+                res = minimize(
+                    f,
+                    Q[k],
+                    jac=True,
+                    method="TNC",
+                    bounds=bounds,
+                    options=dict(maxfun=400, ftol=1e-15, xtol=1e-12, gtol=1e-12),
+                )
+                x, finished = np.array(res.x, dtype=float), True
+            except _OutOfTime:  # the budget ran out inside this search: keep the best point it reached
+                if seen[1] is None:
+                    break
+                x, finished = seen[1], False
             x[~periodic] = np.clip(x[~periodic], lower[~periodic], upper[~periodic])
             x = _wrap(x, periodic) if wrap is None else wrap(x)
             val = sign * np.linalg.eigvalsh(np.asarray(mass_matrix(x), dtype=float))[column]
             if val < best:
                 best, best_q = val, x
+            if not finished:
+                break
+            done += 1
+            bar.update(done)
         return sign * best, best_q
 
-    lmin, qmin = extreme(1.0, 0)
-    lmax, qmax = extreme(-1.0, -1)
+    # the budget is shared: the least eigenvalue's searches end at half of it, the greatest's at all of it
+    deadlines = (None, None) if time_budget is None else (start_time + time_budget / 2, start_time + time_budget)
+    try:
+        lmin, qmin = extreme(1.0, 0, *low, deadlines[0])
+        lmax, qmax = extreme(-1.0, -1, *high, deadlines[1])
+    finally:
+        bar.close()
     return InertiaBounds(
         float(lmin),
         qmin,
@@ -221,4 +288,7 @@ def global_inertia_bounds(
         lower,
         upper,
         periodic,
+        searched=done,
+        planned=planned,
+        time_budget=time_budget,
     )

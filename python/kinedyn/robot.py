@@ -19,6 +19,7 @@ from . import configuration, display, dynamics, symbolic
 from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
+from ._ui.names import did_you_mean
 from .description import export
 from .description.audit import Audit, audit
 from .description.description import Description
@@ -347,7 +348,9 @@ class Robot:
         try:
             return self._frame_ids[frame]
         except KeyError:
-            raise ValueError(f"unknown frame '{frame}' (frames of robot '{self.name}': {self.frame_names})") from None
+            raise ValueError(
+                f"unknown frame '{frame}'{did_you_mean(frame, self.frame_names)} (frames of robot '{self.name}': {self.frame_names})"
+            ) from None
 
     def show(self, q: ArrayLike | None = None, *, block: bool | None = None, **kwargs):
         """Open a live 3-D view of the robot at ``q`` in the browser (a viser server on localhost; its

@@ -193,11 +193,19 @@ class ManifoldChart:
         )
 
 
-def robot_inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> InertiaBounds:
+def robot_inertia_bounds(
+    robot: Robot,
+    samples: int,
+    starts: int,
+    seed: int,
+    time_budget: float | None = None,
+    progress: bool | None = False,
+) -> InertiaBounds:
     """:func:`global_inertia_bounds` over the robot's configurations: over the box of its coordinates
     for 1-DOF joints, over the coordinates of :class:`ManifoldChart` with multi-DOF joints (whose
     configurations are then reported as q, nq numbers). dM/dq_i = c_i + c_i^T from the engine's
-    Christoffel symbols (c[i, j, k] + c[i, k, j] = dM_kj/dq_i, Spong eq. 9.58; along q ⊕ t e_i)."""
+    Christoffel symbols (c[i, j, k] + c[i, k, j] = dM_kj/dq_i, Spong eq. 9.58; along q ⊕ t e_i).
+    ``time_budget``, ``progress``: of the search (:func:`global_inertia_bounds`)."""
 
     def tangent_dM(q):
         c = np.asarray(robot.christoffel(q), dtype=float)
@@ -206,7 +214,16 @@ def robot_inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> 
     if not robot.has_multi_dof_joints:
         box_lo, box_hi, periodic = configuration_box(robot)
         return global_inertia_bounds(
-            robot.mass_matrix, tangent_dM, box_lo, box_hi, periodic, samples=samples, starts=starts, seed=seed
+            robot.mass_matrix,
+            tangent_dM,
+            box_lo,
+            box_hi,
+            periodic,
+            samples=samples,
+            starts=starts,
+            seed=seed,
+            time_budget=time_budget,
+            progress=progress,
         )
     chart = ManifoldChart(robot)
     if chart.nx == 0:  # a floating body alone (a drone): M is one constant matrix
@@ -240,6 +257,8 @@ def robot_inertia_bounds(robot: Robot, samples: int, starts: int, seed: int) -> 
         starts=starts,
         seed=seed,
         wrap=chart.wrap,
+        time_budget=time_budget,
+        progress=progress,
     )
     b.q_lambda_min = chart.configuration(b.q_lambda_min)
     b.q_lambda_max = chart.configuration(b.q_lambda_max)

@@ -10,6 +10,7 @@ import argparse
 import inspect
 import json
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +23,8 @@ from rich.table import Table
 from .. import robot_files, robots
 from .._ui import terminal
 from .._ui.json import jsonable
+from .._ui.names import did_you_mean
+from ..coordinates import coordinate_labels, coordinate_units, velocity_labels
 from .options import ROBOT_FILE_EXTENSIONS, SYMBOLIC_COMMANDS, set_values
 
 
@@ -98,7 +101,9 @@ def robot_file(spec: str, options: RobotOptions):
     ext = path.suffix.lower()
     if ext not in ROBOT_FILE_EXTENSIONS:
         why = f"robot files end in {', '.join(ROBOT_FILE_EXTENSIONS)}" + (f", not '{ext}'" if ext else "")
-        raise ValueError(f"'{spec}' is neither a built-in robot ({', '.join(robots.names())}) nor a robot file ({why})")
+        raise ValueError(
+            f"'{spec}' is neither a built-in robot ({', '.join(robots.names())}) nor a robot file ({why}){did_you_mean(spec, robots.names())}"
+        )
     if not path.exists():
         raise ValueError(f"robot file '{spec}' does not exist")
     if path.is_dir():
@@ -149,7 +154,7 @@ def builtin_robot(name: str, values: dict[str, float]):
     unknown = [k for k in values if k not in numeric]
     if unknown:
         raise ValueError(
-            f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}' (its parameters: {', '.join(numeric)})"
+            f"--set {unknown[0]}: the built-in robot '{name}' has no parameter '{unknown[0]}'{did_you_mean(unknown[0], numeric)} (its parameters: {', '.join(numeric)})"
         )
     return robots.get(name, **values)
 
@@ -164,7 +169,9 @@ def substitute(robot, values: dict[str, float], spec: str):
         has = (
             f"its parameters: {', '.join(known)}" if known else "it has no symbolic parameters: every value is a number"
         )
-        raise ValueError(f"--set {unknown[0]}: robot '{spec}' has no parameter '{unknown[0]}' ({has})")
+        raise ValueError(
+            f"--set {unknown[0]}: robot '{spec}' has no parameter '{unknown[0]}'{did_you_mean(unknown[0], known)} ({has})"
+        )
     return robot.subs(values)
 
 
@@ -201,7 +208,74 @@ def parse_q(
         )
     if degrees:
         q = np.array([math.radians(v) if j is not None and j.kind == "revolute" else v for v, j in zip(q, owners)])
+    elif not rates:
+        warn_degrees(flag, [(f"value {k + 1} ({j.name})", v, j) for k, (v, j) in enumerate(zip(q, owners)) if j])
     return q
+
+
+def looks_like_degrees(value: float, joint=None) -> bool:
+    """An angle in radians that is more likely degrees: beyond 2 pi, or (a revolute joint with finite
+    limits) further outside its limits than their span (90 where the limits are [-2.9, 2.9])."""
+    if abs(value) > 2 * math.pi:
+        return True
+    if joint is None or not (math.isfinite(joint.lower) and math.isfinite(joint.upper)):
+        return False
+    span = max(joint.upper - joint.lower, 1e-9)
+    return value < joint.lower - span or value > joint.upper + span
+
+
+def warn_degrees(flag: str, entries) -> None:
+    """Warn (one line on stderr, kinedyn.cli's warning format) when revolute angles given in radians
+    look like degrees; ``entries``: (what, value, joint or None) with the joint None for an angle
+    that is not a joint's (``--rpy``)."""
+    slips = [(what, v, j) for what, v, j in entries if (j is None or j.kind == "revolute") and looks_like_degrees(v, j)]
+    if not slips:
+        return
+    what, v, j = slips[0]
+    limits = (
+        f", outside its limits [{j.lower:.4g}, {j.upper:.4g}] rad" if j is not None and math.isfinite(j.lower) else ""
+    )
+    more = f" (and {len(slips) - 1} more)" if len(slips) > 1 else ""
+    warnings.warn(
+        f"{flag} {what} is {v:g} rad = {math.degrees(v):.4g} deg{limits}{more}: angles are radians unless you add --deg; "
+        "did you mean degrees?",
+        UserWarning,
+        stacklevel=3,
+    )
+
+
+# ------------------------------------------------------------------ labels of q and qd
+def dof_labels(robot) -> list[str]:
+    """One label per degree of freedom (nv): rows of M, C, g, tau, columns of a Jacobian; a
+    free-flyer's six are ``root.vx`` ... ``root.ωz`` (kinedyn.coordinates, the report's names)."""
+    return velocity_labels(robot)
+
+
+def q_labels(robot) -> list[str]:
+    """One label per entry of q (nq): a free-flyer's seven are ``root.x`` ... ``root.qw``."""
+    return coordinate_labels(robot)
+
+
+def q_units(robot, degrees: bool = False) -> str:
+    """The units of a configuration's entries in words: "rad", "m", "rad/m", or for a robot with
+    multi-DOF joints what each kind of entry is (a quaternion's entries have no unit)."""
+    units = set(coordinate_units(robot))
+    angle = "deg" if degrees else "rad"
+    plain = "/".join(angle if u == "rad" else u for u in ("rad", "m") if u in units) or angle
+    if "" not in units:
+        return plain
+    kinds = {j.kind for j in robot.joints}
+    parts = [f"{plain} but"]
+    if kinds & {"floating", "spherical"}:
+        parts.append("quaternions (qx qy qz qw) unitless")
+    if "planar" in kinds:
+        parts.append("(cos θ, sin θ) unitless")
+    return parts[0] + " " + ", ".join(parts[1:])
+
+
+def q_text(robot, q, degrees: bool = False, precision: int = 6) -> str:
+    """``q`` for a one-line header, with its units (``[0.1 0.2] rad``)."""
+    return f"{np.array2string(np.asarray(q), precision=precision)} ({q_units(robot, degrees)})"
 
 
 def esc(text) -> str:
@@ -230,8 +304,18 @@ def matrix_table(title: str, M: np.ndarray, rows: Sequence[str], cols: Sequence[
     for c in cols:
         table.add_column(esc(c), justify="right")
     for name, row in zip(rows, np.atleast_2d(M)):
-        table.add_row(esc(name), *(f"{v: .{digits}g}" for v in row))
+        table.add_row(esc(name), *(f"{v + 0.0: .{digits}g}" for v in row))  # + 0.0: no "-0"
     return table
+
+
+def fixed(values, digits: int = 4) -> str:
+    """Numbers in fixed notation with ``digits`` decimals, rounding-level values shown as 0
+    (``[180.0000 0.0000 1.3071]``, never ``-9.0101e-15`` or ``-0.0000``)."""
+    out = []
+    for v in np.atleast_1d(np.asarray(values, dtype=float)):
+        r = round(float(v), digits)
+        out.append(f"{(0.0 if r == 0 else r):.{digits}f}")
+    return "[" + " ".join(out) + "]"
 
 
 def fmt(v) -> str:

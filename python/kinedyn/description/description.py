@@ -24,6 +24,7 @@ import numpy as np
 import sympy as sp
 
 from .._math import is_symbolic
+from .._ui.names import did_you_mean
 from .checks import vector
 from .link import KinematicTree, build_tree, judge_inertias
 from .mimic import MimicMap, mimic_map, reduced_coefficient
@@ -83,7 +84,9 @@ class Description:
         if tool is None:
             tool = "tool" if "tool" in names else default_tool(links, self.base)
         if tool not in names:
-            raise ValueError(f"tool frame '{tool}' is not a frame of robot '{self.name}' (frames: {names})")
+            raise ValueError(
+                f"tool frame '{tool}' is not a frame of robot '{self.name}'{did_you_mean(tool, names)} (frames: {names})"
+            )
         put(self, "tool", tool)
 
     # ------------------------------------------------------------------ joints and frames

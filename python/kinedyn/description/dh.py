@@ -12,6 +12,7 @@ For a revolute joint ``theta`` is the joint offset (joint angle = q + theta); fo
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
@@ -25,7 +26,30 @@ from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
 
-__all__ = ["DHRow", "links_from_dh", "description_from_dh", "dh_from_robot", "DHExtraction"]
+__all__ = ["DHRow", "links_from_dh", "description_from_dh", "dh_from_robot", "DHExtraction", "MasslessRobotWarning"]
+
+
+class MasslessRobotWarning(UserWarning):
+    """A DH table whose rows carry no mass, inertia or rotor inertia: M(q) = 0, so the robot serves
+    kinematics (FK, Jacobians, IK) but not dynamics; said when it is built, not at the first
+    forward-dynamics error."""
+
+
+def _is_zero(value) -> bool:
+    try:
+        return float(value) == 0.0
+    except TypeError:  # a symbolic parameter: not known to be zero
+        return False
+
+
+def _massless(links) -> bool:
+    """No link has mass, rotational inertia or rotor inertia (numerically zero)."""
+    return all(
+        _is_zero(link.inertia.mass)
+        and all(_is_zero(x) for row in np.asarray(link.inertia.inertia, dtype=object) for x in row)
+        and _is_zero(link.joint.rotor_inertia)
+        for link in links
+    )
 
 
 @dataclass(frozen=True)
@@ -165,6 +189,14 @@ def description_from_dh(
         first = links[0]
         links[0] = Link(first.name, None, first.joint, matmul(base_pose, first.placement), first.post, first.inertia)
     frames = (Frame("tool", links[-1].name, identity() if tool is None else tool),)
+    if links and _massless(links):
+        warnings.warn(
+            f"robot '{name}': no DH row gives a mass, an inertia or a rotor inertia, so M(q) = 0: fine for "
+            "kinematics (FK, Jacobians, IK), but the dynamics (forward dynamics, simulation) need them: give each "
+            "row an inertia, e.g. DHRow(a=0.5, inertia=kd.Inertia.rod(2.0, 0.5)) or {'a': 0.5, 'inertia': ...}",
+            MasslessRobotWarning,
+            stacklevel=3,
+        )
     return Description(
         tuple(links),
         frames,

@@ -16,6 +16,7 @@ import sympy as sp
 
 from .._arrays import real_array
 from .._math import as_value, is_symbolic, matmul, rot_axis, translation
+from .._ui.names import did_you_mean
 from .description import Description
 from .joint import Joint
 from .mimic import lock_followers
@@ -124,7 +125,10 @@ def lock_joints(description: Description, joints, at, block_motion) -> Descripti
     )  # reduced mimic followers: locked with their leader (description/mimic.py)
     unknown = sorted(str(key) for key, _ in items if isinstance(key, str) and key not in names and key not in followers)
     if unknown:
-        raise ValueError(f"lock_joints: unknown joints {unknown} (moving joints: {names + list(followers)})")
+        raise ValueError(
+            f"lock_joints: unknown joints {unknown}{did_you_mean(unknown[0], names + list(followers))} "
+            f"(moving joints: {names + list(followers)})"
+        )
     values: dict = {}
     follower_values: dict = {}
     for key, value in items:

@@ -136,6 +136,16 @@ def _coulomb(joint, fmt: str) -> float:
     return float(positive)
 
 
+def _relative_to(file: str, written: str) -> str:
+    """``file`` relative to the folder of the file being ``written`` (a written model then holds no
+    absolute path of the machine that wrote it); absolute when no relative path exists (another
+    drive)."""
+    try:
+        return os.path.relpath(file, os.path.dirname(os.path.abspath(written)))
+    except ValueError:
+        return file
+
+
 def _mesh_file(shape: Mesh) -> str:
     name = shape.filename
     if shape.base_dir is None or "://" in name or os.path.isabs(name):
@@ -480,11 +490,13 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
     Nested ``<body>`` elements, one per link and extra frame, each at its link frame; joints:
     revolute -> hinge, prismatic -> slide (with ``pos`` and ``axis`` in the body frame, so a link's
     ``post`` and joint offset need no extra body), floating -> free (top-level bodies only, as
-    MuJoCo requires), spherical -> ball, planar (about z) -> two slides and a hinge. ``<inertial>``
+    MuJoCo requires), spherical -> ball, planar (about z) -> two slides and a hinge; a mimic follower
+    is a joint tied to its leader by an ``<equality><joint>`` (MuJoCo keeps its coordinate). ``<inertial>``
     with ``fullinertia`` about the centre of mass; armature = r² J_m, damping = viscous friction,
     frictionloss = Coulomb friction (one level); ``range`` from finite position limits;
     ``<option gravity>``. Geoms come from the visuals (``contype``/``conaffinity`` 0, group 1) and
-    collisions (group 3); mesh files MuJoCo cannot read (``.dae``) are left out with a warning.
+    collisions (group 3); mesh files MuJoCo cannot read (``.dae``) are left out with a warning, and
+    the others are written relative to ``path``'s folder when a path is given.
     ``<compiler inertiafromgeom="false">``: the inertials are the robot's, never the geoms'.
     ``geometry``: cylinders of :func:`default_visuals` for a robot without visuals;
     ``default_inertia``: MuJoCo refuses a moving body that carries no mass; a link whose whole
@@ -578,6 +590,19 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
         body = ET.SubElement(bodies[frame.link or robot.base], "body", name=frame.name)
         bodies[frame.name] = body
         _mj_pose(body, _np(frame.placement))
+    if robot.mimic_joints:
+        # MuJoCo's joint equality (MJCF reference, equality/joint): y - y0 = a0 + a1 (x - x0) + ...,
+        # y = joint1 (the follower), x = joint2 (the leader); both written with reference 0 (the
+        # offsets are in the body poses), so polycoef = (offset, multiplier, 0, 0, 0)
+        equality = ET.SubElement(root, "equality")
+        for follower, relation in robot.mimic_joints.items():
+            ET.SubElement(
+                equality,
+                "joint",
+                joint1=follower,
+                joint2=relation.leader,
+                polycoef=_fs((float(relation.offset), float(relation.multiplier), 0.0, 0.0, 0.0)),
+            )
     for group, items in ((1, visuals), (3, collisions)):
         for _k, v in enumerate(items):
             if v.frame not in bodies:
@@ -605,6 +630,8 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
                     continue
                 if file.startswith("package://"):
                     file = str(resolve_mesh(file, shape.base_dir))
+                if path is not None and os.path.isabs(file):  # MuJoCo reads it relative to the MJCF's folder
+                    file = _relative_to(file, os.fspath(path))
                 mesh_name = _unique(f"{v.frame}_mesh", names)
                 mesh = ET.SubElement(asset, "mesh", name=mesh_name, file=file)
                 if tuple(shape.scale) != (1.0, 1.0, 1.0):

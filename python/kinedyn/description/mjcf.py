@@ -33,7 +33,8 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
 - ``<include file>``: relative to the including file's folder, which it may not leave; nested at
   most ``MAX_INCLUDE_DEPTH`` deep.
 
-Not modelled, and named in one warning when present: actuators, tendons, equality constraints,
+Not modelled, and named in one warning when present: actuators, tendons, equality constraints
+other than a linear joint equality (read as a mimic joint: ``mjcf_xml.with_joint_equalities``),
 contact pairs and exclusions, sensors, keyframes, plugins (``<extension>``, a body's ``<plugin>``),
 fluid forces (``<option density viscosity wind>``), joint springs (``stiffness``, ``springdamper``),
 ``gravcomp``, friction and armature of ball and free joints, a ball joint's range (a cone); every
@@ -85,6 +86,7 @@ from .mjcf_xml import (
     short,
     solid_volume_and_moments,
     translation_of,
+    with_joint_equalities,
     z_to,
 )
 
@@ -110,6 +112,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
         raise src.error(root, f"the root element is <{root.tag}>, expected <mujoco>")
     reader = _Reader(src, root)
     links, frames, visuals, collisions = reader.read()
+    links = with_joint_equalities(root, src, links, reader.ignored)  # mimic joints, as to_mjcf writes them
     name = root.get("model") or "mjcf_robot"
     source = src.label if src.base_dir is not None else "MJCF string"
     if gravity is None:

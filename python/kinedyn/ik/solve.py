@@ -21,6 +21,7 @@ from .._core import AnalyticIk, solve_ik
 from .._ui.progress import SHOW_AFTER, Delayed, wanted
 from ..configuration import space
 from ..display import ik_html, ik_markdown
+from .idle import settle
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -314,6 +315,9 @@ def inverse_kinematics(
     ``progress``: a bar on stderr for a numeric batch that runs over a second (default: when stderr
     is a terminal); the answers are the same with or without it.
 
+    Joints that cannot move the frame's target rows (outside its chain, or not needed by a
+    position target) stay at ``q0`` (:mod:`kinedyn.ik.idle`).
+
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
     if robot.nv == 0:
@@ -321,6 +325,13 @@ def inverse_kinematics(
             f"robot '{robot.name}' has no moving joint: no joint value can move its frames "
             "(floating_base=True makes a lone body a free flyer)"
         )
+    result = _solve(
+        robot, target, q0, mask, method, respect_limits, frame, tolerance, max_iterations, restarts, seed, progress
+    )
+    return settle(robot, frame, target, mask, q0, result)
+
+
+def _solve(robot, target, q0, mask, method, respect_limits, frame, tolerance, max_iterations, restarts, seed, progress):
     if (
         type(max_iterations) is not int
         or type(restarts) is not int

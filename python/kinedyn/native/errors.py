@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from .._core import NonFiniteResultError, SingularMassMatrixError
 
@@ -13,29 +16,32 @@ if TYPE_CHECKING:
 __all__ = ["SingularMassMatrixError", "dof_label", "nonphysical_note", "robot_error", "singular_mass_matrix_error"]
 
 
-def _name_first(message: str, joint: int, label: str) -> str:
-    """``message`` with ``label`` after its first ``joint <joint>`` (not ``joint <joint>0``)."""
-    token = f"joint {joint}"
-    start = 0
-    while (at := message.find(token, start)) >= 0:
-        end = at + len(token)
-        if (at == 0 or not message[at - 1].isalnum()) and (end == len(message) or not message[end].isdigit()):
-            return f"{message[:end]} {label}{message[end:]}"
-        start = end
-    return message
+def _name_joints(message: str, joint: int, name: str, body: str | None) -> str:
+    """``message`` (the core's, which counts joints from 0) with every ``joint <joint>`` (not
+    ``joint <joint>0``) replaced by the joint's name, the first followed by its moving body: a
+    0-based number beside a 1-based name ("joint 2 ('q3')") reads as two different joints."""
+    pattern = re.compile(rf"(?<![\w]){re.escape(f'joint {joint}')}(?!\d)")
+    first = f"joint '{name}'" + (f" (moving body '{body}')" if body is not None else "")
+    message, count = pattern.subn(first, message, count=1)
+    if not count:  # the message does not name the joint: say which it is
+        return f"{first}: {message}"
+    return pattern.sub(f"joint '{name}'", message)
 
 
 def singular_mass_matrix_error(
-    error: SingularMassMatrixError, robot: str, label: Callable[[int], str | None], note: Callable[[int], str]
+    error: SingularMassMatrixError,
+    robot: str,
+    label: Callable[[int], tuple[str, str] | None],
+    note: Callable[[int], str],
 ) -> Exception:
     """The user's error for the core's ``SingularMassMatrixError``: the joint named (``label(joint)``,
-    e.g. ``('elbow', moving body 'forearm')``, None when it has no name) and the robot's note on it
+    its name and moving body ``('elbow', 'forearm')``, None when it has none) and the robot's note on it
     (``note(joint)``, '' when none); a NonFiniteResultError (a ValueError) when the core found
     numbers too large for float64 (finite inputs that overflowed on the way), else a RuntimeError."""
     message = str(error)
     named = label(error.joint)
     if named is not None:
-        message = _name_first(message, error.joint, named)
+        message = _name_joints(message, error.joint, *named)
     if error.overflow:
         return NonFiniteResultError(f"robot '{robot}': {message}")
     if named is not None:
@@ -56,17 +62,22 @@ def robot_error(robot: Robot, error: RuntimeError) -> Exception:
     )
 
 
-def dof_label(robot: Robot, dof: int) -> str | None:
+def dof_label(robot: Robot, dof: int) -> tuple[str, str] | None:
     """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
     if not 0 <= dof < robot.n:
         return None
     i = int(robot._dof_body[dof])
-    return f"('{robot.joint_names[i]}', moving body '{robot.body_names[i]}')"
+    return robot.joint_names[i], robot.body_names[i]
 
 
 def nonphysical_note(robot: Robot, joint: int) -> str:
     """For a singular-mass-matrix error at ``joint``: the links it moves whose inertia is not
     positive semi-definite (kept by inertia='warn'), which can make its D <= 0; else ''."""
+    if not np.any(robot.inertial_parameters()) and not np.any(robot.armature):
+        return (
+            f"; robot '{robot.name}' has no mass or inertia on any link (M = 0): give its links inertias "
+            "(Robot.from_dh: DHRow(..., inertia=kd.Inertia(...)))"
+        )
     subtree, parents = {joint}, robot.parents
     for i in range(joint + 1, len(robot.tree.bodies)):  # parent[i] < i
         if parents[i] in subtree:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -39,6 +40,7 @@ from ..symbolic.render import latex_to_mathml, of_q
 from ..symbolic.render import name as mathml_name
 from ..tutorial import QUESTIONS, answer, render_html
 from ..visual.page import asset, json_script, script_json, view_model
+from ..visual.scene import MissingMeshWarning
 from ..visual.web import plotly_script
 from .data import (
     SIMULATION_BUDGET,
@@ -312,6 +314,17 @@ def render_report(robot, data: ReportData, *, tutorial: bool = False, steps=None
             steps.close()
 
 
+def missing_shapes_summary(name: str, model: dict, geometry: str) -> str:
+    """One line for the terminal: how many shapes the report left out and why (the extra to install
+    when the reason is a missing mesh reader, else the first reason)."""
+    missing = model["missing"]
+    head = f"the report draws {model['shapes_drawn']} of the {model['shapes']} {geometry} shapes of robot '{name}'"
+    if any("needs trimesh" in m for m in missing):
+        return f"{head}: reading mesh files needs the viz extra (pip install 'kinedyn[viz]'); the links are drawn as a stick figure"
+    more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+    return f"{head}: {missing[0]}{more}"
+
+
 def _render(robot, d: ReportData, tutorial: bool, steps, geometry: str) -> str:
     steps.step("3-D view and tables")
     q = np.asarray(d["q"])
@@ -323,6 +336,8 @@ def _render(robot, d: ReportData, tutorial: bool, steps, geometry: str) -> str:
         looks = "No visual geometry is described, so the links are drawn as solids along the kinematics (joints orange when revolute, violet when prismatic)."
     else:
         looks = f"{model['shapes_drawn']} of the {model['shapes']} {geometry} shapes of the description are drawn."
+        if model["missing"]:  # said where the user looks first (the terminal): kinedyn.visual.scene's reasons
+            warnings.warn(missing_shapes_summary(robot.name, model, geometry), MissingMeshWarning, stacklevel=3)
     joint_headers, joint_rows = _joint_table(d, multi)
 
     steps.step("equations (MathML)")

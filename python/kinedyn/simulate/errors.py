@@ -55,7 +55,8 @@ class StopRun(Exception):
 
 def failure_message(system_name, names, f: dict, index, steps, unit_speed="rad/s or m/s") -> tuple:
     j = f.get("joint")
-    where = f" at joint {j} ('{names[j]}')" if j is not None and j < len(names) else ""
+    # the joint by name only: the core counts from 0, the default names from 1 ("joint 2 ('q3')")
+    where = f" at joint '{names[j]}'" if j is not None and j < len(names) else ""
     at = f"t = {f['t']:.6g} s (step {f['step']} of {steps})"
     which = f" (trajectory {index} of the batch)" if index is not None else ""
     kind = f["kind"]

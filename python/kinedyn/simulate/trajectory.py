@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ..coordinates import coordinate_labels, velocity_labels
 from ..display import trajectory_html
 from ..visual.page import animation_page
 from ..visual.viewer import show as show_in_viewer
@@ -104,6 +105,15 @@ class Trajectory:
         if hasattr(s, "joint_names"):
             return list(s.joint_names)
         return list(getattr(s, "names", [f"q{i + 1}" for i in range(self.n)]))
+
+    def labels(self) -> tuple[list, list]:
+        """The names of q's columns (nq) and of qd's, qdd's and tau's (nv): a robot's from
+        :mod:`kinedyn.coordinates` (a free-flyer's seven coordinates and six velocities each named),
+        another system's ``names`` for both."""
+        s = self.system
+        if hasattr(s, "joints") and hasattr(s, "nq"):
+            return coordinate_labels(s), velocity_labels(s)
+        return self.names, self.names
 
     def __repr__(self) -> str:
         b = f", batch={self.batch}" if self.batch is not None else ""
@@ -200,9 +210,14 @@ class Trajectory:
 
     # ------------------------------------------------------------------ export
     def _columns(self) -> tuple:
-        names = self.names
+        q_names, v_names = self.labels()
         cols = {"t": self.t}
-        for key, arr in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd), ("tau", self.tau)):
+        for key, arr, names in (
+            ("q", self.q, q_names),
+            ("qd", self.qd, v_names),
+            ("qdd", self.qdd, v_names),
+            ("tau", self.tau, v_names),
+        ):
             for i, nm in enumerate(names):
                 cols[f"{key}[{nm}]"] = arr[:, i]
         try:
@@ -246,16 +261,29 @@ class Trajectory:
 
         if self.batch is not None:
             raise TypeError("plot() draws one trajectory: use traj[i].plot()")
-        fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
-        names = self.names
-        for ax, arr, label in zip(
-            axes[:3], (self.q, self.qd, self.tau), ("q [rad | m]", "qd [rad/s | m/s]", "tau [N m | N]")
+        # the joints' legend goes beside the plots, in a layout that makes room for it (constrained
+        # layout counts an axes' legend in its extent): inside the axes, many joints' names ran past
+        # the figure's edge and were cut off
+        q_names, v_names = self.labels()
+        rows = max(len(q_names), len(v_names))
+        columns = 1 if rows <= 14 else 2 if rows <= 28 else 3
+        fig, axes = plt.subplots(4, 1, figsize=(8 + 1.6 * columns, 9), sharex=True, layout="constrained")
+        for ax, arr, label, names in zip(
+            axes[:3],
+            (self.q, self.qd, self.tau),
+            ("q [rad | m]", "qd [rad/s | m/s]", "tau [N m | N]"),
+            (q_names, v_names, v_names),
         ):
-            for i in range(self.n):
-                ax.plot(self.t, arr[:, i], label=names[i])
+            for i, name in enumerate(names):
+                ax.plot(self.t, arr[:, i], label=name)
             ax.set_ylabel(label)
             ax.grid(True, alpha=0.3)
-        axes[0].legend(loc="upper right", fontsize="small", ncol=min(self.n, 6))
+        # a legend beside the q plot (the same colours in qd and tau, a line per joint); with multi-DOF
+        # joints (nq != nv) the qd plot's entries are others, so it gets its own
+        legend = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", ncols=columns)
+        axes[0].legend(**legend)
+        if q_names != v_names:
+            axes[1].legend(**legend)
         ax = axes[3]
         for key in ("K", "P", "H"):
             try:
@@ -267,7 +295,6 @@ class Trajectory:
         ax.legend(loc="upper right", fontsize="small")
         ax.grid(True, alpha=0.3)
         fig.suptitle(f"{getattr(self.system, 'name', '')} ({self.method})")
-        fig.tight_layout()
         if path is not None:
             fig.savefig(path, dpi=100)
         if show:

@@ -4,11 +4,13 @@ inverse kinematics (:func:`elbow_ik`) and its Jacobian."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import sympy as sp
 
 from .. import robots
+from ..description.dh import MasslessRobotWarning
 from ..robot import Robot
 from .answers import Answer, fmt_number, matrix_rows, same_function, symbolic_frame_pose, symbolic_jacobian
 from .printed import QUESTION_DATA
@@ -82,7 +84,11 @@ def challenge() -> Answer:
     # symbolic FK and Jacobian from the symbolic robot
     # the same DH table with the lengths as symbols
     Ls = sp.symbols("L1 L2 L3", positive=True)
-    sym = Robot.from_dh([(r.theta, Ls[0] if i == 0 else r.d, Ls[i] if i else r.a, r.alpha) for i, r in enumerate(dh)])
+    with warnings.catch_warnings():  # kinematics only: the symbolic table needs no masses
+        warnings.simplefilter("ignore", MasslessRobotWarning)
+        sym = Robot.from_dh(
+            [(r.theta, Ls[0] if i == 0 else r.d, Ls[i] if i else r.a, r.alpha) for i, r in enumerate(dh)]
+        )
     t1, t2, t3 = sp.symbols("theta1 theta2 theta3", real=True)
     q = [t1, t2, t3]
     T = symbolic_frame_pose(sym, q)

@@ -61,7 +61,11 @@ class Scene:
 def _shape_parts(visual: Visual) -> list[Part]:
     s = visual.shape
     if isinstance(s, Mesh):
-        parts = read_mesh(resolve_mesh(s.filename, s.base_dir))
+        found = resolve_mesh(s.filename, s.base_dir)
+        try:
+            parts = read_mesh(found)
+        except ValueError as e:  # named as the description names it (a page holds no path of this machine)
+            raise ValueError(str(e).replace(f"'{found}'", f"'{s.filename}'")) from None
         return [p.transformed(visual.origin, s.scale) for p in parts]
     if isinstance(s, Box):
         return [box(s.size).transformed(visual.origin)]

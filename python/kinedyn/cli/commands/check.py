@@ -12,6 +12,8 @@ from .. import app
 from ..app import console, emit, esc
 from ..options import EXIT_NO, EXIT_OK, nonnegative_int, positive_float, positive_int, robot_argument
 
+SEARCH_BUDGET = 30.0  # seconds: the inertia-bound search of a 32-joint humanoid took 3.5 minutes unbounded
+
 
 def add_arguments(p) -> None:
     robot_argument(p)
@@ -20,6 +22,14 @@ def add_arguments(p) -> None:
         "--t", type=positive_float, default=2.0, help="length of the passivity trajectory in seconds (default 2)"
     )
     p.add_argument("--seed", type=nonnegative_int, default=0)
+    p.add_argument(
+        "--budget",
+        type=positive_float,
+        default=SEARCH_BUDGET,
+        metavar="SECONDS",
+        help=f"time for the global search of the inertia bounds (default {SEARCH_BUDGET:g} s); when it runs out, "
+        "the bounds found so far are reported as sampled, not searched",
+    )
     p.add_argument(
         "--prove",
         action="store_true",
@@ -37,7 +47,14 @@ def run(args) -> int:
             f"bounds exist in them, and a floating base's derivation is large. Run 'kinedyn check' without --prove (the numeric "
             f"checks handle multi-DOF joints), or call robot.equations_of_motion().check_properties() in Python for the identities"
         )
-    report = check_properties(robot, samples=args.samples, seed=args.seed, T=args.t)
+    report = check_properties(
+        robot,
+        samples=args.samples,
+        seed=args.seed,
+        T=args.t,
+        time_budget=args.budget,
+        progress=None if not getattr(args, "json", False) else False,
+    )
     if getattr(args, "prove", False):
         proof = prove_properties(robot.equations_of_motion(steps=False), samples=args.samples, seed=args.seed)
         report.checks += [replace(c, name="symbolic model: " + c.name) for c in proof.checks]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from ...convert import convert
+from ...convert import ConversionError, convert
 from .. import app
 from ..options import EXIT_ERROR, EXIT_OK, OutputPath, one_line
 
@@ -54,17 +54,29 @@ def run(args) -> int:
         robot = robot.lock_joints(args.lock)
     if args.states < 1:
         raise ValueError(f"--states must be at least 1, got {args.states}")
-    result = convert(
-        robot, args.output, args.to, convention=args.convention, check=not args.no_check, states=args.states
-    )
-    print(result.summary())
-    if result.checked and not result.max_error < CONVERT_TOLERANCE:
+    try:
+        result = convert(
+            robot,
+            args.output,
+            args.to,
+            convention=args.convention,
+            check=not args.no_check,
+            states=args.states,
+            tolerance=CONVERT_TOLERANCE,
+        )
+    except ConversionError as e:  # the check found a difference: nothing written; show what it found
+        print(e.result.summary().replace("wrote ", "did not write ", 1))
         print(
             one_line(
-                f"kinedyn convert: error: the written file differs from {args.robot} by {result.max_error:.3g} "
-                f"(more than {CONVERT_TOLERANCE:g}); this is a bug in kinedyn's writer, please report it"
+                f"kinedyn convert: error: the written file differs from {args.robot} by {e.result.max_error:.3g} "
+                f"(more than {CONVERT_TOLERANCE:g}); nothing was written to {args.output}; "
+                "this is a bug in kinedyn's writer, please report it"
             ),
             file=sys.stderr,
         )
         return EXIT_ERROR
+    print(result.summary())
+    for note in result.notes:
+        if note.startswith("not checked"):  # said on stderr too: the conversion is unverified
+            print(f"kinedyn convert: warning: {one_line(note)}", file=sys.stderr)
     return EXIT_OK

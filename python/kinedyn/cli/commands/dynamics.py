@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import app
-from ..app import console, emit, esc, matrix_table, parse_q
+from ..app import console, dof_labels, emit, esc, matrix_table, parse_q, q_labels, q_text
 from ..options import robot_argument, state_arguments
 
 
@@ -31,6 +31,8 @@ def run(args) -> int:
         "q": q,
         "qd": qd,
         "qdd": qdd,
+        "coordinate_labels": q_labels(robot),
+        "velocity_labels": dof_labels(robot),
         "mass_matrix": M,
         "coriolis_matrix": C,
         "gravity_torque": g,
@@ -47,9 +49,9 @@ def run(args) -> int:
 
     def render():
         c = console()
-        names = robot.joint_names
+        names = dof_labels(robot)
         c.print(
-            f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}"
+            f"[bold]{esc(robot.name)}[/bold] at q = {q_text(robot, q)}, qd = {np.array2string(qd, precision=6)}, qdd = {np.array2string(qdd, precision=6)}"
         )
         c.print(matrix_table("M(q), mass matrix", M, names, names))
         c.print(matrix_table("C(q, qd), Coriolis matrix (Christoffel symbols)", C, names, names))

@@ -7,9 +7,13 @@ import numpy as np
 
 from ..._math import rpy_from_matrix
 from .. import app
-from ..app import console, emit, esc, matrix_table, parse_q
+from ..app import console, emit, esc, fixed, matrix_table, parse_q, q_labels, q_text
 from ..options import robot_argument, state_arguments
 from . import formulas
+
+# the rows and columns of a homogeneous transform: the frame's axes and origin in base coordinates
+POSE_ROWS = ["x", "y", "z", "(homogeneous)"]
+POSE_COLUMNS = ["x axis", "y axis", "z axis", "origin"]
 
 
 def add_arguments(p) -> None:
@@ -30,6 +34,7 @@ def run(args) -> int:
     payload = {
         "robot": robot.name,
         "q": q,
+        "coordinate_labels": q_labels(robot),
         "frames": {
             f: {"pose": T, "position": T[:3, 3], "rpy": list(rpy_from_matrix(T))} for f, T in zip(frames, poses)
         },
@@ -37,13 +42,15 @@ def run(args) -> int:
 
     def render():
         c = console()
-        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)} rad/m")
+        c.print(f"[bold]{esc(robot.name)}[/bold] at q = {q_text(robot, q)}")
         for f, T in zip(frames, poses):
-            c.print(matrix_table(f"pose of '{f}' in '{robot.base}'", T, ["", "", "", ""], ["", "", "", ""]))
-            rpy = list(rpy_from_matrix(T))
             c.print(
-                f"  position {np.array2string(T[:3, 3], precision=6)} m, rpy {np.array2string(np.degrees(rpy), precision=4)} deg"
+                matrix_table(
+                    f"pose of '{f}' in '{robot.base}' (4x4: rotation, position in m)", T, POSE_ROWS, POSE_COLUMNS
+                )
             )
+            rpy = list(rpy_from_matrix(T))
+            c.print(f"  position {fixed(T[:3, 3], 6)} m, rpy {fixed(np.degrees(rpy), 4)} deg")
 
     emit(args, payload, render)
     return 0

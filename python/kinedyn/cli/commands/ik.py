@@ -12,10 +12,9 @@ import numpy as np
 from rich.table import Table
 
 from ..._math import rpy_to_matrix
-from ...configuration import COORDINATE_NAMES
 from ...ik.solve import METHODS, inverse_kinematics
 from .. import app
-from ..app import console, emit, esc, parse_q
+from ..app import console, emit, esc, parse_q, q_labels, warn_degrees
 from ..options import EXIT_NO, EXIT_OK, finite_float, in_cli_terms
 
 # the solver's messages name its Python arguments; on the command line they are these flags
@@ -74,6 +73,8 @@ def target_from_args(xyz, rpy=None, degrees: bool = False) -> np.ndarray:
 
 def run(args) -> int:
     robot = app.robot(args)
+    if args.rpy is not None and not args.deg:
+        warn_degrees("--rpy", [(name, v, None) for name, v in zip(("roll", "pitch", "yaw"), args.rpy)])
     target = target_from_args(args.xyz, args.rpy, args.deg)
     q0 = None
     if args.q0 is not None:
@@ -83,9 +84,9 @@ def run(args) -> int:
     )
     shown = result.solutions if args.all else result.solutions[:1]
     # per q coordinate: revolute angles (--deg) and the column names (a multi-DOF joint's block:
-    # q1.x, q1.y, q1.z, q1.qx, ..., q1.qw for a free-flyer that is joint q1)
+    # root.x, root.y, root.z, root.qx, ..., root.qw for a free-flyer; kinedyn.coordinates)
     revolute = np.array([j.kind == "revolute" for j in robot.joints for _ in range(j.nq)], dtype=bool)
-    labels = _coordinate_labels(robot)
+    labels = q_labels(robot)
 
     def angles(q):
         return np.where(revolute, np.degrees(q), q) if args.deg else q
@@ -95,6 +96,7 @@ def run(args) -> int:
         "frame": args.frame or robot.tool,
         "target": target,
         "units": "deg/m" if args.deg else "rad/m",
+        "coordinate_labels": labels,
         **result.to_dict(),
         "solutions": [angles(q) for q in shown],
         "position_error": result.position_error[: len(shown)],
@@ -116,7 +118,6 @@ def run(args) -> int:
         c.print(f"[bold]{esc(robot.name)}[/bold]: '{esc(payload['frame'])}' to {what}; solver {result.solver}")
         if len(shown):
             unit = "deg" if args.deg else "rad"
-            c.width = max(c.width, 12 * (robot.nq + 3))  # never truncate the numbers
             table = Table(
                 title=f"{len(result.solutions)} solution(s) ({unit}, m), nearest q0 first"
                 + ("" if args.all else " (--all lists every one)"),
@@ -124,7 +125,7 @@ def run(args) -> int:
             )
             table.add_column("#", justify="right")
             for label in labels:
-                table.add_column(label, justify="right")
+                table.add_column(esc(label), justify="right")
             table.add_column("|dp| m", justify="right")
             table.add_column("|dR| rad", justify="right")
             for k, q in enumerate(shown):
@@ -135,26 +136,8 @@ def run(args) -> int:
                     f"{result.orientation_error[k]:.0e}",
                 )
             c.print(table)
-            if robot.joint_names != [f"q{k + 1}" for k in range(len(robot.joints))]:
-                c.print("joints: " + ", ".join(f"q{k + 1} = {esc(name)}" for k, name in enumerate(robot.joint_names)))
         style = "green" if result.success else "bold red"
         c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
 
     emit(args, payload, render)
     return EXIT_OK if result.success else EXIT_NO
-
-
-def _coordinate_labels(robot) -> list:
-    """A column name per q coordinate: ``q<k>`` for the k-th joint, ``q<k>.<part>`` inside a floating,
-    spherical or planar joint's block (``q1.x`` ... ``q1.qw``; docs/conventions.md)."""
-    labels = []
-    for k, j in enumerate(robot.joints):
-        labels.extend(
-            [
-                f"q{k + 1}.{part.replace('cos theta', 'cos').replace('sin theta', 'sin')}"
-                for part in COORDINATE_NAMES[j.kind]
-            ]
-            if j.is_multi_dof
-            else [f"q{k + 1}"]
-        )
-    return labels

@@ -26,6 +26,33 @@ def _value(v):
         return str(v)
 
 
+def _mimic(robot, joint: str):
+    """A reduced mimic follower's relation to its leader (``q = multiplier * q_leader + offset``), else None."""
+    relation = robot.mimic_joints.get(joint)
+    if relation is None:
+        return None
+    return {"leader": relation.leader, "multiplier": float(relation.multiplier), "offset": float(relation.offset)}
+
+
+def _headline(robot) -> str:
+    """How many degrees of freedom and joints: a mimic follower is a joint without a coordinate of its
+    own, a multi-DOF joint has several coordinates."""
+    moving = len(robot.tree.bodies)
+    followers = len(robot.mimic_joints)
+    if not followers and not robot.has_multi_dof_joints:
+        return f"{robot.n} joints"
+    parts = [
+        f"{robot.n} degrees of freedom (nv), {robot.nq} coordinates (nq)"
+        if robot.nq != robot.n
+        else f"{robot.n} degrees of freedom"
+    ]
+    parts.append(
+        f"{moving} moving joints"
+        + (f", {followers} of them mimic joints (no coordinate of their own)" if followers else "")
+    )
+    return ", ".join(parts)
+
+
 def run(args) -> int:
     robot = app.robot(args)
     joints = []
@@ -48,6 +75,7 @@ def run(args) -> int:
                 "viscous": _value(j.viscous),
                 "coulomb": _value(j.coulomb),
                 "coulomb_negative": _value(j.coulomb_levels[1]),  # the level for qd < 0 (= coulomb if symmetric)
+                "mimics": _mimic(robot, j.name),
             }
         )
     bodies = [
@@ -85,7 +113,7 @@ def run(args) -> int:
     def render():
         c = console()
         c.print(
-            f"[bold]{esc(robot.name)}[/bold]: {robot.n} joints, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2"
+            f"[bold]{esc(robot.name)}[/bold]: {_headline(robot)}, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2"
         )
         if robot.source:
             c.print(f"source: {esc(robot.source)}")
@@ -94,10 +122,18 @@ def run(args) -> int:
             t.add_column(col)
         for i, j in enumerate(joints, 1):
             unit = "rad" if j["type"] == "revolute" else "m"
+            mimic = j["mimics"]
+            kind = j["type"]
+            if mimic is not None:  # q = multiplier q_leader + offset: no coordinate of its own
+                m, o = mimic["multiplier"], mimic["offset"]
+                if m == 1 and o == 0:
+                    kind += f", mimics {mimic['leader']}"
+                else:
+                    kind += f", mimic: q = {fmt(m)} q({mimic['leader']})" + (f" + {fmt(o)}" if o else "")
             t.add_row(
                 str(i),
                 esc(j["name"]),
-                j["type"],
+                esc(kind),
                 esc(f"{j['parent']} -> {j['link']}"),
                 esc(" ".join(fmt(a) for a in j["axis"])),
                 esc(fmt(j["offset"])),

@@ -7,7 +7,7 @@ import numpy as np
 
 from ... import kinematics as kin
 from .. import app
-from ..app import console, emit, esc, matrix_table, parse_q
+from ..app import console, dof_labels, emit, esc, matrix_table, parse_q, q_labels, q_text
 from ..options import robot_argument, state_arguments
 from . import formulas
 
@@ -62,6 +62,8 @@ def run(args) -> int:
         "frame": args.frame or robot.tool,
         "reference": args.reference,
         "rows": names,
+        "coordinate_labels": q_labels(robot),
+        "velocity_labels": dof_labels(robot),
         "jacobian": J,
         "singular_values": report.singular_values,
         "rank": report.rank,
@@ -76,9 +78,9 @@ def run(args) -> int:
     def render():
         c = console()
         c.print(
-            f"[bold]{esc(robot.name)}[/bold] at q = {np.array2string(q, precision=6)}; frame '{esc(payload['frame'])}', reference '{args.reference}'"
+            f"[bold]{esc(robot.name)}[/bold] at q = {q_text(robot, q)}; frame '{esc(payload['frame'])}', reference '{args.reference}'"
         )
-        c.print(matrix_table("Jacobian", J, names, robot.joint_names))
+        c.print(matrix_table("Jacobian", J, names, dof_labels(robot)))
         c.print(f"rank, singular values and manipulability over rows {', '.join(w_rows)} ({basis})")
         c.print(f"singular values: {np.array2string(report.singular_values, precision=6)}")
         c.print(f"manipulability sqrt(det J J^T): {w:.6g}")
