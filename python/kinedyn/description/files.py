@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 import tomli_w
 import yaml
 
+from .._ui.files import write_text
 from .description import Description
 from .file_reader import MAX_FILE_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
 from .file_writer import robot_to_mapping
@@ -70,8 +71,7 @@ def save(robot: Robot | Description, path: PathLike) -> None:
         text = tomli_w.dumps(data)
     else:
         raise ValueError(f"{path}: can only save robots as .yaml, .yml or .toml, not '{ext}'")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+    write_text(path, text)  # atomic: a failed run leaves the old file (kinedyn._ui.files)
 
 
 def __getattr__(name: str):

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from ... import robots
 from ..._ui import progress
+from ..._ui.files import write_text
 from .. import app
 from ..app import console, emit, esc
 from ..options import OutputPath
@@ -70,7 +69,7 @@ def run(args) -> int:
             text = eom.to_code(fmt)
         payload = _payload(args, robot, eom, text) if args.json else {}
     if args.output:
-        Path(args.output).write_text(text)
+        write_text(args.output, text)  # atomic: a failed run leaves the old file
 
     def render():
         if args.output:
