@@ -26,6 +26,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 import yaml
 
 from .._math import matmul, rpy_to_matrix, translation
+from .._ui.files import open_regular
 from ..expressions import parse_expression
 from .description import Description
 from .dh import DHRow, description_from_dh
@@ -99,7 +100,7 @@ _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 
 def read_text(path: str) -> str:
     """The file's text, refusing files too large to be a robot description before reading them."""
     try:
-        with open(path, "rb") as f:
+        with open_regular(path, "robot file") as f:  # a FIFO or /dev/zero: refused, never waited on
             raw = f.read(MAX_FILE_BYTES + 1)
     except OSError as e:
         raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import tomli_w
 import yaml
 
-from .._ui.files import write_text
+from .._ui.files import require_regular, write_text
 from .description import Description
 from .file_reader import MAX_FILE_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
 from .file_writer import robot_to_mapping
@@ -46,6 +46,8 @@ def read_description(path: PathLike, inertia: str = "warn", **kwargs) -> Descrip
     nearest consistent tensor) or "strict" (raise); see docs/model-files.md."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
+    if os.path.exists(path):  # a FIFO or a device would block the reader (xacro's too): refused first
+        require_regular(path, "robot file")
     if ext in (".urdf", ".xacro"):  # robot.urdf.xacro; kwargs: xacro_args, trust_xacro, package_dirs, gravity, tool
         return description_from_urdf(path, inertia=inertia, **kwargs)
     if ext in (".xml", ".mjcf"):

@@ -12,6 +12,7 @@ import os
 
 import numpy as np
 
+from .._ui.files import open_regular
 from .bounded_xml import parse_bounded
 from .checks import LARGEST
 
@@ -82,12 +83,14 @@ def parse_model(path_or_string):
 
 
 def read_file(path: str, src: Sources, element=None) -> bytes:
+    where = f"{src.at(element)}: <include> " if element is not None else ""
     try:
-        with open(path, "rb") as f:
+        with open_regular(path, "MJCF file") as f:  # a FIFO or a device: refused, never waited on
             data = f.read(MAX_FILE_BYTES + 1)
     except OSError as e:
-        where = f"{src.at(element)}: <include> " if element is not None else f"{path}: "
-        raise ValueError(f"{where}cannot read MJCF file '{path}' ({e.strerror or e})") from None
+        raise ValueError(f"{where or path + ': '}cannot read MJCF file '{path}' ({e.strerror or e})") from None
+    except ValueError as e:
+        raise ValueError(f"{where}{e}") from None
     src.total_bytes += len(data)
     if len(data) > MAX_FILE_BYTES or src.total_bytes > MAX_FILE_BYTES:
         raise ValueError(

@@ -44,6 +44,7 @@ import warnings
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
+from .._ui.files import open_regular
 from .bounded_xml import parse_bounded
 from .checks import LARGEST, caller_level
 from .description import Description
@@ -213,7 +214,7 @@ def _parse(path_or_string, source_path: str | None = None):
     else:
         src = _Source(text)
         try:
-            with open(text, "rb") as f:
+            with open_regular(text, "URDF file") as f:  # a FIFO or a device: refused, never waited on
                 data = f.read()  # bytes: expat honours the file's encoding declaration
         except OSError as e:
             raise ValueError(f"{text}: cannot read URDF file ({e.strerror or e})") from None
