@@ -235,6 +235,23 @@ def test_broken_and_strange_logs_name_the_problem(tmp_path):
         load_log(tmp_path / "latin.csv", n=2)
 
 
+def test_a_line_with_a_different_count_of_values_is_named(tmp_path):
+    path = tmp_path / "short.csv"
+    path.write_text("t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.01,0,0,0,0\n0.02,1,1,1\n0.03,0,0,0,0\n")
+    with pytest.raises(LogError, match=r"short\.csv: line 4: 4 values, where the lines before have 5"):
+        load_log(path, n=2)
+
+
+def test_a_large_yaml_file_is_refused_on_its_size_before_parsing(tmp_path, monkeypatch):
+    from kinedyn.description import file_reader, files
+
+    path = tmp_path / "big.yaml"
+    path.write_text("joints:\n" + "  - {a: 1}\n" * (file_reader.MAX_TEXT_BYTES // 10 + 1))
+    monkeypatch.setattr(files, "parse_yaml", lambda *a: pytest.fail("parsed before the size was checked"))
+    with pytest.raises(ValueError, match=r"big\.yaml: the file is larger than 1 MiB"):
+        kd.load(path)
+
+
 @pytest.mark.parametrize(
     "options, words",
     [

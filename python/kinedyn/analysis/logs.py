@@ -197,6 +197,14 @@ def _read_csv(path: str, stream) -> dict:
     try:
         data = np.loadtxt(f, delimiter=",", ndmin=2)
     except ValueError as e:
+        # NumPy counts the rows after the header from 0 in a conversion error and from 1 in a change of
+        # the column count (numpy.loadtxt, NumPy 1.23+): line = row + 2 and row + 1 of the file
+        changed = re.search(r"number of columns changed from (\d+) to (\d+) at row (\d+)", str(e))
+        if changed:
+            raise LogError(
+                f"{path}: line {int(changed.group(3)) + 1}: {changed.group(2)} values, where the lines before "
+                f"have {changed.group(1)}"
+            ) from None
         m = re.search(r"at row (\d+)", str(e))
         where = f" line {int(m.group(1)) + 2}:" if m else ""
         raise LogError(f"{path}:{where} not a number ({e})") from None

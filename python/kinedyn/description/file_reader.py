@@ -41,6 +41,7 @@ __all__ = [
     "parse_yaml",
     "parse_toml",
     "MAX_FILE_BYTES",
+    "MAX_TEXT_BYTES",
     "MAX_NESTING",
     "MAX_NODES",
     "MAX_TEXT",
@@ -93,6 +94,9 @@ MAX_FILE_BYTES = 16 * 2**20  # a robot file is text a person writes: 16 MiB is f
 MAX_NESTING = 32  # mappings and lists inside each other (a robot file needs 5)
 MAX_NODES = 1_000_000  # YAML nodes composed, counting every use of an alias as the nodes it repeats
 MAX_TEXT = 1000  # characters of a name or other text field
+# a YAML/TOML robot file: a 100-joint robot is ~20 KiB; the YAML parser reads ~0.1-1 MiB/s, so a larger
+# file is refused on its size before parsing, not after seconds of it
+MAX_TEXT_BYTES = 2**20
 _REPR = reprlib.Repr()
 _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 40, 40, 4, 4
 
@@ -101,11 +105,16 @@ def read_text(path: str) -> str:
     """The file's text, refusing files too large to be a robot description before reading them."""
     try:
         with open_regular(path, "robot file") as f:  # a FIFO or /dev/zero: refused, never waited on
-            raw = f.read(MAX_FILE_BYTES + 1)
+            size = os.fstat(f.fileno()).st_size
+            if size > MAX_TEXT_BYTES:  # on its size, before a byte is read
+                raise ValueError(
+                    f"{path}: the file is larger than {MAX_TEXT_BYTES // 2**20} MiB, too large for a robot file"
+                )
+            raw = f.read(MAX_TEXT_BYTES + 1)
     except OSError as e:
         raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ValueError(f"{path}: the file is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot file")
+    if len(raw) > MAX_TEXT_BYTES:
+        raise ValueError(f"{path}: the file is larger than {MAX_TEXT_BYTES // 2**20} MiB, too large for a robot file")
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as e:

@@ -25,7 +25,7 @@ import yaml
 
 from .._ui.files import require_regular, write_text
 from .description import Description
-from .file_reader import MAX_FILE_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
+from .file_reader import MAX_FILE_BYTES, MAX_TEXT_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
 from .file_writer import robot_to_mapping
 from .mjcf import description_from_mjcf
 from .urdf import description_from_urdf
@@ -34,7 +34,14 @@ if TYPE_CHECKING:
     from .._typing import PathLike
     from ..robot import Robot
 
-__all__ = ["read_description", "save", "description_from_mapping", "robot_to_mapping", "MAX_FILE_BYTES"]
+__all__ = [
+    "read_description",
+    "save",
+    "description_from_mapping",
+    "robot_to_mapping",
+    "MAX_FILE_BYTES",
+    "MAX_TEXT_BYTES",
+]
 
 
 def read_description(path: PathLike, inertia: str = "warn", **kwargs) -> Description:
