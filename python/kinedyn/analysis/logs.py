@@ -335,11 +335,18 @@ def load_log(
         cutoff = choose_cutoff(q, rate)
     if not 0 < cutoff < rate / 2:
         raise LogError(f"{name}: cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
-    qf = _lowpass(q, cutoff, rate, order)
-    h = 1.0 / rate
-    qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
-    qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
-    tau_f = _lowpass(tau, cutoff, rate, order)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked just below, with a message
+        qf = _lowpass(q, cutoff, rate, order)
+        h = 1.0 / rate
+        qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
+        qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
+        tau_f = _lowpass(tau, cutoff, rate, order)
+    for what, x in (("velocities", qd_f), ("accelerations", qdd_f), ("torques", tau_f)):
+        if not np.all(np.isfinite(x)):  # e.g. a step of 1e-302 s: differences over it overflow
+            raise LogError(
+                f"{name}: the filtered {what} are not finite numbers (a time step of {float(np.median(dt)):g} s "
+                "is too small to differentiate over; give t in seconds)"
+            )
     if trim is None:
         trim = 3.0 / cutoff
     edge = int(np.ceil(trim * rate))

@@ -223,6 +223,23 @@ def _refuse_tag(loader, node):
 # constructor can also fail on with an AttributeError, binary, sets, ordered pairs) are refused
 for _tag in ("timestamp", "binary", "set", "omap", "pairs"):
     _BoundedLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
+# digits of a YAML integer the parser converts at all: below Python's own limit (4300, whose message
+# speaks of sys.set_int_max_str_digits); the field's reader then refuses anything over ~300 digits by name
+MAX_INT_DIGITS = 4000
+
+
+def _bounded_int(loader, node):
+    """A YAML integer, its digits counted before Python converts it (whose own limit, 4300 digits,
+    speaks of sys.set_int_max_str_digits, not of the file)."""
+    digits = sum(c.isalnum() for c in str(node.value))
+    if digits > MAX_INT_DIGITS:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"the integer has {digits} digits, too large for a robot's parameter", node.start_mark
+        )
+    return loader.construct_yaml_int(node)
+
+
+_BoundedLoader.add_constructor("tag:yaml.org,2002:int", _bounded_int)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:map", _BoundedLoader.construct_line_mapping)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct_line_sequence)
 
