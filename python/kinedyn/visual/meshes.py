@@ -246,8 +246,10 @@ def read_mesh(path) -> list[Part]:
         raise ValueError(f"mesh '{path}': reading mesh files needs trimesh (pip install 'kinedyn[viz]')") from None
     try:
         return list(_read(str(path.resolve()), st.st_mtime_ns, st.st_size))
-    except ValueError:
-        raise
+    except ValueError as e:  # kinedyn's own name the mesh; trimesh's ("could not be read to its end") do not
+        if str(path) in str(e) or str(path.resolve()) in str(e):
+            raise
+        raise ValueError(f"mesh '{path}' could not be read: {e}") from None
     except MemoryError:
         raise ValueError(f"mesh '{path}' needs more memory than this machine has") from None
     except Exception as e:  # whatever trimesh or pycollada raise on a broken file
