@@ -266,3 +266,12 @@ def test_a_large_yaml_file_is_refused_on_its_size_before_parsing(tmp_path, monke
 def test_log_settings_are_checked_first(tmp_path, options, words):
     with pytest.raises(LogError, match=words):
         load_log(tmp_path / "never-read.csv", n=2, **options)
+
+
+def test_a_urdf_over_16_mib_is_refused_without_reading_it_whole(tmp_path):
+    from kinedyn.description.urdf import MAX_FILE_BYTES
+
+    path = tmp_path / "big.urdf"
+    path.write_bytes(b'<robot name="r">' + b" " * MAX_FILE_BYTES + b"</robot>")
+    with pytest.raises(ValueError, match=r"big\.urdf: the file is larger than 16 MiB"):
+        kd.load(path)

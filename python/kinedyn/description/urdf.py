@@ -62,6 +62,7 @@ _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "plana
 ROOT_JOINT = "root_joint"
 #: the fixed frame a floating base moves in (Pinocchio's name for it)
 FLOATING_BASE_FRAME = "universe"
+MAX_FILE_BYTES = 16 * 2**20  # a URDF is text a person (or xacro) writes: read no more (docs/model-files.md)
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
@@ -215,7 +216,9 @@ def _parse(path_or_string, source_path: str | None = None):
         src = _Source(text)
         try:
             with open_regular(text, "URDF file") as f:  # a FIFO or a device: refused, never waited on
-                data = f.read()  # bytes: expat honours the file's encoding declaration
+                data = f.read(MAX_FILE_BYTES + 1)  # bytes: expat honours the file's encoding declaration
+            if len(data) > MAX_FILE_BYTES:
+                raise ValueError(f"{text}: the file is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a URDF")
         except OSError as e:
             raise ValueError(f"{text}: cannot read URDF file ({e.strerror or e})") from None
 
