@@ -83,3 +83,15 @@ def test_forward_dynamics_with_mimic_joints_never_returns_nan():
     with pytest.raises(kd.NonFiniteResultError, match=r"forward_dynamics: qdd\[\d\] is nan"):
         r.forward_dynamics(np.zeros(r.nq), np.zeros(r.n), np.full(r.n, 1.7e308))
     assert np.all(np.isfinite(r.forward_dynamics(np.zeros(r.nq), np.zeros(r.n), np.ones(r.n))))
+
+
+def test_a_bad_inertial_pos_names_the_file_once(tmp_path):
+    """Found by the fuzz suite's MJCF cases: the pose's own error was wrapped in a second prefix."""
+    path = tmp_path / "arm.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="l1"><joint name="j1" axis="0 0 1"/>\n'
+        '<inertial pos="0.15 0 0x1F" mass="0.7" diaginertia="0.001 0.004 0.004"/></body></worldbody></mujoco>'
+    )
+    with pytest.raises(ValueError, match=r"arm\.xml:2: <inertial> attribute 'pos' must be numbers") as e:
+        kd.load(path)
+    assert str(e.value).count(str(path)) == 1

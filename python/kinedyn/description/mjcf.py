@@ -652,8 +652,9 @@ class _Reader:
             ixy = ixz = iyz = 0.0
         else:
             raise self.src.error(element, f"of body '{body}' has neither 'diaginertia' nor 'fullinertia'")
+        pose = self.frame(element, a)  # its errors name the file and line already
         try:
-            return Inertia.from_urdf(mass, ixx, ixy, ixz, iyy, iyz, izz).transformed(self.frame(element, a))
+            return Inertia.from_urdf(mass, ixx, ixy, ixz, iyy, iyz, izz).transformed(pose)
         except ValueError as e:
             raise self.src.error(element, f"of body '{body}': {e}") from None
 
