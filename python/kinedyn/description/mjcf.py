@@ -669,14 +669,8 @@ class _Reader:
             )
         try:
             volume, unit = solid_volume_and_moments(kind, s0, s1, s2)
-        except (ZeroDivisionError, OverflowError):  # a capsule of radius 1e-300: its volume underflows to 0
-            volume, unit = math.nan, (math.nan,)
-        if not (math.isfinite(volume) and all(math.isfinite(u) for u in unit)):
-            raise self.src.error(
-                element,
-                f"{what}: its size ({s0:g}, {s1:g}, {s2:g}) gives a volume or moments of inertia that are not "
-                "finite numbers; give sizes a robot has, or the body an <inertial>",
-            )
+        except ValueError as e:  # a capsule of radius 1e-300: its volume underflows to 0
+            raise self.src.error(element, f"{what}: {e}; give sizes a robot has, or the body an <inertial>") from None
         if "mass" in a:
             mass = numbers(element, "mass", self.src, 1, text=a["mass"])[0]
         else:

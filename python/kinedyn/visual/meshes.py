@@ -131,7 +131,7 @@ MAX_MESH_COORDINATE = 1e6  # |x|, |y|, |z| in the file's units: a robot in milli
 def _side_files(path: str, refused: list):
     """trimesh's resolver for the files a mesh names, kept to kinedyn's rules (above); each file it
     does not read is a message in ``refused`` (trimesh then draws the mesh without it)."""
-    from trimesh.resolvers import FilePathResolver
+    from trimesh.resolvers import FilePathResolver  # trimesh (optional, heavy) loads only to read a mesh
 
     class SideFiles(FilePathResolver):
         def namespaced(self, namespace: str):
