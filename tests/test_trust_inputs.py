@@ -235,6 +235,15 @@ def test_broken_and_strange_logs_name_the_problem(tmp_path):
         load_log(tmp_path / "latin.csv", n=2)
 
 
+def test_a_log_too_short_to_filter_is_named(tmp_path):
+    """Found by the fuzz suite's log cases: scipy's padding error named no file."""
+    t, q, tau = _log(rows=12)  # more than identification needs (10), fewer than the filter (15)
+    rows = "\n".join(",".join(f"{v:.17g}" for v in (t[i], *q[i], *tau[i])) for i in range(len(t)))
+    (tmp_path / "short.csv").write_text("t,q1,q2,tau1,tau2\n" + rows + "\n")
+    with pytest.raises(LogError, match=r"short\.csv: 12 samples are too few to filter"):
+        load_log(tmp_path / "short.csv", n=2, cutoff=10.0, trim=0)
+
+
 def test_a_line_with_a_different_count_of_values_is_named(tmp_path):
     path = tmp_path / "short.csv"
     path.write_text("t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.01,0,0,0,0\n0.02,1,1,1\n0.03,0,0,0,0\n")

@@ -335,12 +335,15 @@ def load_log(
         cutoff = choose_cutoff(q, rate)
     if not 0 < cutoff < rate / 2:
         raise LogError(f"{name}: cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked just below, with a message
-        qf = _lowpass(q, cutoff, rate, order)
-        h = 1.0 / rate
-        qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
-        qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
-        tau_f = _lowpass(tau, cutoff, rate, order)
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked just below, with a message
+            qf = _lowpass(q, cutoff, rate, order)
+            h = 1.0 / rate
+            qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
+            qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
+            tau_f = _lowpass(tau, cutoff, rate, order)
+    except ValueError as e:  # scipy's filtfilt needs more samples than its padding (15 at order 4)
+        raise LogError(f"{name}: {S} samples are too few to filter (scipy: {e})") from None
     for what, x in (("velocities", qd_f), ("accelerations", qdd_f), ("torques", tau_f)):
         if not np.all(np.isfinite(x)):  # e.g. a step of 1e-302 s: differences over it overflow
             raise LogError(
