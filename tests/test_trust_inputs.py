@@ -284,3 +284,28 @@ def test_a_urdf_over_16_mib_is_refused_without_reading_it_whole(tmp_path):
     path.write_bytes(b'<robot name="r">' + b" " * MAX_FILE_BYTES + b"</robot>")
     with pytest.raises(ValueError, match=r"big\.urdf: the file is larger than 16 MiB"):
         kd.load(path)
+
+
+def test_a_binary_stl_is_read_in_its_own_layout_as_trimesh_reads_it(tmp_path):
+    """The NumPy reader of binary STL (a fraction of trimesh's memory) gives trimesh's triangles and
+    merged vertices; a length that disagrees with the count goes to trimesh, which refuses it."""
+    import trimesh
+
+    from kinedyn.visual.meshes import read_mesh
+
+    rng = np.random.default_rng(3)
+    corners = rng.random((40, 3, 3)).astype(np.float32)
+    corners[20:] = corners[:20]  # shared corners, to merge
+    corners[5, 0] = -0.0
+    corners[6, 1] = [0.0, 0.0, 0.0]
+    rec = np.zeros(40, dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = corners
+    path = tmp_path / "part.stl"
+    path.write_bytes(b"\0" * 80 + (40).to_bytes(4, "little") + rec.tobytes())
+    (part,) = read_mesh(path)
+    m = trimesh.Trimesh(**trimesh.exchange.stl.load_stl(open(path, "rb")), process=True)
+    assert len(part.vertices) == len(m.vertices) and len(part.faces) == len(m.faces) == 40
+    np.testing.assert_array_equal(part.vertices[part.faces], corners)
+    path.write_bytes(path.read_bytes()[:-7])  # a count that disagrees with the length
+    with pytest.raises(ValueError, match=r"part\.stl"):
+        read_mesh(path)
