@@ -204,8 +204,8 @@ def test_a_file_too_large_is_refused_before_reading(tmp_path):
 
     path = tmp_path / "big.yaml"
     with open(path, "w") as f:
-        f.write("joints: [{a: 1}]\n" + "#" * (files.MAX_FILE_BYTES + 10) + "\n")
-    with pytest.raises(ValueError, match=r"big\.yaml: the file is larger than 16 MiB"):
+        f.write("joints: [{a: 1}]\n" + "#" * (files.MAX_TEXT_BYTES + 10) + "\n")
+    with pytest.raises(ValueError, match=r"big\.yaml: the file is larger than 1 MiB"):
         kd.load(path)
 
 

@@ -229,7 +229,14 @@ class ConfigurationSpace:
         q = np.broadcast_to(q, shape + (self.nq,))
         vdt = np.broadcast_to(vdt, shape + (self.nv,))
         # the core's q ⊕ v per joint block (crates/kinedyn-core/src/lie.rs)
-        return lie_integrate(self._block_names, np.ascontiguousarray(q), np.ascontiguousarray(vdt))
+        out = lie_integrate(self._block_names, np.ascontiguousarray(q), np.ascontiguousarray(vdt))
+        if not np.all(np.isfinite(out)):  # a step of 1e300: its norm overflows, the exponential is NaN
+            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(out))[0])
+            raise ValueError(
+                f"q ⊕ v dt is not finite at {self._describe(bad[-1])}{self._at(bad[:-1])}: the step v dt "
+                f"(largest |v dt| {float(np.max(np.abs(vdt))):.3g}) is beyond what float64 holds"
+            )
+        return out
 
     def difference(self, q0, q1) -> np.ndarray:
         """v with q0 ⊕ v = q1: Log(M(q0)⁻¹ M(q1)) per joint, q1 - q0 for 1-DOF joints; rotations the
@@ -244,7 +251,10 @@ class ConfigurationSpace:
     def interpolate(self, q0, q1, t) -> np.ndarray:
         """q0 ⊕ t · difference(q0, q1): the geodesic from q0 (t = 0) to q1 (t = 1) in each joint's group;
         ``t`` a number or an array of them (one configuration each). t = 1 returns q1 itself."""
-        t = np.asarray(t, dtype=float)
+        t = np.asarray(t)
+        if t.dtype.kind not in "fiub":  # a complex t would lose its imaginary part, text is no number
+            raise TypeError(f"t must be real numbers, got an array of dtype {t.dtype}")
+        t = t.astype(float)
         if not np.all(np.isfinite(t)):
             raise ValueError(f"t must be finite, got {t}")
         q0, q1 = self.check(q0, "q0"), self.check(q1, "q1")
@@ -296,6 +306,9 @@ class ConfigurationSpace:
     def normalize(self, q) -> np.ndarray:
         """``q`` with each quaternion and planar (cos, sin) pair divided by its norm (a copy)."""
         a = self._array(q, self.nq, "q", "nq")
+        if not np.all(np.isfinite(a)):  # NaN, inf, and None (which NumPy reads as NaN)
+            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+            raise ValueError(f"q{list(bad)} ({self._describe(bad[-1])}) is {a[bad]}: a configuration must be finite")
         out = np.array(a, dtype=float)
         for block, columns, what in self._unit_parts:
             norm = vector_norm(out[..., columns])

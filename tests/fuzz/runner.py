@@ -31,7 +31,17 @@ from .worker import CODE_EXEC, CRASH, DEFECTS, HANG, MEMORY, read_frame, write_f
 
 PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # share of each kind in --kind all
-SHARES = {"urdf": 0.35, "yaml": 0.25, "toml": 0.15, "arrays": 0.25}
+SHARES = {
+    "urdf": 0.25,
+    "yaml": 0.18,
+    "toml": 0.10,
+    "arrays": 0.20,
+    "mjcf": 0.07,
+    "mesh": 0.06,
+    "log": 0.06,
+    "viewer": 0.04,
+    "output": 0.04,
+}
 
 
 # ============================================================================ generating
@@ -235,6 +245,7 @@ ROWS = (
     ("errors deferred past load", "deferred"),
     ("bad input accepted (complex, NaN, dup. keys)", "bad_input_accepted"),
     ("valid input rejected", "valid_rejected"),
+    ("outputs over an input (data loss)", "data_loss"),
 )
 
 

@@ -56,7 +56,7 @@ class Case:
 
     @property
     def ext(self) -> str:
-        return {"urdf": ".urdf", "yaml": ".yaml", "toml": ".toml"}.get(self.kind, ".pkl")
+        return {"urdf": ".urdf", "yaml": ".yaml", "toml": ".toml", "mjcf": ".xml"}.get(self.kind, ".pkl")
 
 
 def _canary(function: str = "exec") -> str:
@@ -1028,11 +1028,16 @@ def array_cases(draw) -> Case:
     return Case(kind="arrays", seed=spec, ops=tuple(ops), call=(spec, method, tuple(args), kwargs), valid=valid)
 
 
-KINDS = ("urdf", "yaml", "toml", "arrays")
+# the surfaces of issue 25 (fuzz.surfaces): MJCF with includes, meshes, logs, the viewer's address, outputs
+KINDS = ("urdf", "yaml", "toml", "arrays", "mjcf", "mesh", "log", "viewer", "output")
 
 
 def cases(kind: str):
     """The strategy for one kind of case."""
+    if kind in ("mjcf", "mesh", "log", "viewer", "output"):
+        from .surfaces import surface_cases  # (it builds on this module's mutations)
+
+        return surface_cases(kind)
     return array_cases() if kind == "arrays" else file_cases(kind)
 
 

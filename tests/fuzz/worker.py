@@ -42,6 +42,7 @@ BAD_INPUT_ACCEPTED = (
     "bad_input_accepted"  # complex (non-zero imaginary part) or NaN/inf input, or duplicate YAML keys, accepted
 )
 VALID_REJECTED = "valid_rejected"  # an input valid as documented (an unmutated seed, a valid call) raised an error
+DATA_LOSS = "data_loss"  # an output overwrote, or was allowed to be, a file the command reads (fuzz.surfaces)
 
 CLASSES = (
     CLEAN,
@@ -58,6 +59,7 @@ CLASSES = (
     DEFERRED,
     BAD_INPUT_ACCEPTED,
     VALID_REJECTED,
+    DATA_LOSS,
 )
 DEFECTS = CLASSES[2:]
 FILE_NAME = "fuzzcase"  # basename (without extension) of the file each file case is written to
@@ -266,7 +268,12 @@ def run_case(case: Case, folder: str, marker: str):
         except MemoryError as e:
             outcome, detail = MEMORY, _describe(e)
     else:
-        outcome, detail = run_file(case, folder) if case.kind != "arrays" else run_call(case)
+        if case.kind in ("mjcf", "mesh", "log", "viewer", "output"):
+            from .surfaces import run_surface  # issue 25's surfaces
+
+            outcome, detail = run_surface(case, folder)
+        else:
+            outcome, detail = run_file(case, folder) if case.kind != "arrays" else run_call(case)
     if case.valid and outcome == CLEAN:
         outcome, detail = VALID_REJECTED, f"a valid input was rejected: {detail}"
     if os.environ.pop(CANARY_ENV, None) is not None or os.path.exists(marker):

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._ui.files import replacing
 from ..simulate.control import Fourier
 
 if TYPE_CHECKING:
@@ -153,6 +154,5 @@ def write_trajectory_csv(reference, path, rate: float = 1000.0, periods: float =
     q, qd, qdd = reference(t)
     n = q.shape[1]
     header = ",".join(["t"] + [f"{p}{j + 1}" for p in ("q", "qd", "qdd") for j in range(n)])
-    np.savetxt(
-        os.fspath(path), np.column_stack([t, q, qd, qdd]), delimiter=",", header=header, comments="", fmt="%.10g"
-    )
+    with replacing(os.fspath(path)) as tmp:  # atomic: a failed run leaves the old file (kinedyn._ui.files)
+        np.savetxt(tmp, np.column_stack([t, q, qd, qdd]), delimiter=",", header=header, comments="", fmt="%.10g")

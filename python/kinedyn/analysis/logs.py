@@ -31,15 +31,25 @@ spread over the whole band.
 
 from __future__ import annotations
 
+import io
+import math
 import os
 import re
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from .._ui.files import open_regular
+
 __all__ = ["Log", "LogError", "load_log", "motion_bandwidth", "choose_cutoff"]
+
+
+# A log file, or what an .npz archive inflates to, larger than this is refused before it is read:
+# an hour at 1 kHz of 30 float64 columns is 0.9 GB of numbers, 2-3 GB as CSV text
+MAX_LOG_BYTES = 4 * 2**30
 
 
 class LogError(ValueError):
@@ -124,31 +134,83 @@ def _read(source: Any) -> tuple[dict, str]:
     path = os.fspath(source)
     if not os.path.exists(path):
         raise LogError(f"{path}: no such file")
-    if path.lower().endswith(".npz"):
-        with np.load(path) as z:
-            cols = {}
+    try:  # a FIFO, /dev/zero or a folder: refused, never waited on (kinedyn._ui.files)
+        stream = open_regular(path, "log")
+    except ValueError as e:
+        raise LogError(str(e)) from None
+    with stream:
+        size = os.fstat(stream.fileno()).st_size
+        if size > MAX_LOG_BYTES:
+            raise LogError(
+                f"{path}: the log is {size / 2**20:.0f} MiB, more than the {MAX_LOG_BYTES // 2**20} MiB kinedyn reads"
+            )
+        if path.lower().endswith(".npz"):
+            return _read_npz(path, stream), path
+        return _read_csv(path, stream), path
+
+
+def _read_npz(path: str, stream) -> dict:
+    """The arrays of an .npz archive, their sizes checked from the archive's headers before any is
+    inflated (a small archive can hold gigabytes of zeros)."""
+    try:
+        with zipfile.ZipFile(stream) as archive:
+            inflated = sum(info.file_size for info in archive.infolist())
+    except (zipfile.BadZipFile, OSError, ValueError) as e:
+        raise LogError(f"{path}: not a NumPy .npz archive ({e})") from None
+    if inflated > MAX_LOG_BYTES:
+        raise LogError(
+            f"{path}: the archive inflates to {inflated / 2**20:.0f} MiB, more than the {MAX_LOG_BYTES // 2**20} MiB kinedyn reads"
+        )
+    stream.seek(0)
+    cols = {}
+    try:
+        with np.load(stream, allow_pickle=False) as z:
             for k in z.files:
-                a = np.asarray(z[k], dtype=float)
+                raw = z[k]
+                if raw.dtype.kind not in "biuf":  # complex, strings, objects: not a measured signal
+                    raise LogError(f"{path}: array '{k}' holds {raw.dtype} values, not real numbers")
+                a = np.asarray(raw, dtype=float)
                 if a.ndim == 2 and k in ("q", "qd", "qdd", "tau", "i"):  # whole (S, n) arrays
                     for j in range(a.shape[1]):
                         cols[f"{k}{j + 1}"] = a[:, j]
                 else:
                     cols[k] = a.reshape(-1) if a.ndim <= 1 else a
-        return cols, path
-    with open(path, encoding="utf-8") as f:
-        header = f.readline()
+    except LogError:
+        raise
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as e:
+        raise LogError(f"{path}: not a readable NumPy .npz archive ({e})") from None
+    return cols
+
+
+def _read_csv(path: str, stream) -> dict:
+    raw = stream.read()
+    try:
+        text = raw.decode("utf-8-sig")  # a UTF-8 byte-order mark is not part of the first column's name
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise LogError(f"{path}: line {line}: the log is not UTF-8 text (byte {e.start})") from None
+    f = io.StringIO(text)
+    header = f.readline()
     names = [h.strip() for h in header.strip().split(",")]
     if not names or not any(names):
         raise LogError(f"{path}: line 1 should be a header of column names (t, q1..qn, tau1..taun)")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        data = np.loadtxt(f, delimiter=",", ndmin=2)
     except ValueError as e:
+        # NumPy counts the rows after the header from 0 in a conversion error and from 1 in a change of
+        # the column count (numpy.loadtxt, NumPy 1.23+): line = row + 2 and row + 1 of the file
+        changed = re.search(r"number of columns changed from (\d+) to (\d+) at row (\d+)", str(e))
+        if changed:
+            raise LogError(
+                f"{path}: line {int(changed.group(3)) + 1}: {changed.group(2)} values, where the lines before "
+                f"have {changed.group(1)}"
+            ) from None
         m = re.search(r"at row (\d+)", str(e))
         where = f" line {int(m.group(1)) + 2}:" if m else ""
         raise LogError(f"{path}:{where} not a number ({e})") from None
     if data.shape[1] != len(names):
         raise LogError(f"{path}: the header names {len(names)} columns but the rows have {data.shape[1]}")
-    return _columns_from_table(names, data), path
+    return _columns_from_table(names, data)
 
 
 def _numbered(cols: dict, prefix: str) -> list:
@@ -187,6 +249,18 @@ def load_log(
     inconsistent column."""
     if isinstance(source, Log):
         return source
+    # the settings first, before a byte is read: a decimation of 0 or -1 (a log reversed), a negative trim
+    if decimate is not None and (
+        isinstance(decimate, bool) or not isinstance(decimate, (int, np.integer)) or decimate < 1
+    ):
+        raise LogError(f"decimate must be a whole number >= 1 (keep every k-th sample), got {decimate!r}")
+    for setting, value in (("trim", trim), ("cutoff", cutoff)):
+        if value is not None and not (
+            isinstance(value, (int, float, np.number)) and math.isfinite(value) and value >= 0
+        ):
+            raise LogError(f"{setting} must be a finite number >= 0, got {value!r}")
+    if cutoff is not None and not cutoff > 0:
+        raise LogError(f"cutoff must be a positive frequency in Hz, got {cutoff!r}")
     cols, name = _read(source)
     if "t" not in cols:
         raise LogError(f"{name}: missing column 't' (time, s); columns: {sorted(cols)}")
@@ -261,11 +335,21 @@ def load_log(
         cutoff = choose_cutoff(q, rate)
     if not 0 < cutoff < rate / 2:
         raise LogError(f"{name}: cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
-    qf = _lowpass(q, cutoff, rate, order)
-    h = 1.0 / rate
-    qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
-    qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
-    tau_f = _lowpass(tau, cutoff, rate, order)
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked just below, with a message
+            qf = _lowpass(q, cutoff, rate, order)
+            h = 1.0 / rate
+            qd_f = np.gradient(qf, h, axis=0) if qd is None else _lowpass(qd, cutoff, rate, order)
+            qdd_f = np.gradient(qd_f, h, axis=0) if qdd is None else _lowpass(qdd, cutoff, rate, order)
+            tau_f = _lowpass(tau, cutoff, rate, order)
+    except ValueError as e:  # scipy's filtfilt needs more samples than its padding (15 at order 4)
+        raise LogError(f"{name}: {S} samples are too few to filter (scipy: {e})") from None
+    for what, x in (("velocities", qd_f), ("accelerations", qdd_f), ("torques", tau_f)):
+        if not np.all(np.isfinite(x)):  # e.g. a step of 1e-302 s: differences over it overflow
+            raise LogError(
+                f"{name}: the filtered {what} are not finite numbers (a time step of {float(np.median(dt)):g} s "
+                "is too small to differentiate over; give t in seconds)"
+            )
     if trim is None:
         trim = 3.0 / cutoff
     edge = int(np.ceil(trim * rate))

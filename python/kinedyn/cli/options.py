@@ -10,6 +10,7 @@ import os
 import re
 from pathlib import Path
 
+from .._ui.files import same_file
 from ..expressions import parse_number
 
 EXIT_OK = 0
@@ -99,32 +100,50 @@ def check_output_path(path, flag: str = "output") -> Path:
     return Path(text)
 
 
+class InputPath(argparse.Action):
+    """argparse action for an option that names a file the command reads (a log): no output of the
+    command may be that file (:func:`check_outputs`)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+
+
+def _flag(action) -> str:
+    return "/".join(action.option_strings) or str(action.metavar or action.dest)  # a positional names itself
+
+
 def check_outputs(args) -> None:
-    """Every OutputPath option of the command, checked before the work starts; an output that would
-    overwrite the robot file it reads is refused too."""
+    """Every OutputPath option of the command, checked before the work starts. An output that is a
+    file the command reads (the robot file, an InputPath option's file) is refused, and so are two
+    outputs that are one file: files are compared by device and inode, so a hard link or a symbolic
+    link to the robot file is the robot file (kinedyn._ui.files.same_file)."""
     parser = getattr(args, "_command_parser", None)
     if parser is None:
         return
+    inputs: list[tuple[str, str]] = []
     robot = getattr(args, "robot", None)
-    robot_file = (
-        Path(robot).resolve()
-        if robot and Path(robot).suffix.lower() in ROBOT_FILE_EXTENSIONS and Path(robot).exists()
-        else None
-    )
-    seen: dict[Path, str] = {}
+    if isinstance(robot, str) and robot and os.path.exists(robot):
+        inputs.append((robot, "the robot file this command reads"))
+    for action in parser._actions:
+        value = getattr(args, action.dest, None)
+        if isinstance(action, InputPath) and isinstance(value, str) and value:
+            inputs.append((value, f"the file {_flag(action)} reads"))
+    seen: list[tuple[Path, str]] = []
     for action in parser._actions:
         if not isinstance(action, OutputPath):
             continue
         value = getattr(args, action.dest, None)
         if value is None:
             continue
-        flag = "/".join(action.option_strings) or str(action.metavar or action.dest)  # a positional OUT names itself
-        path = check_output_path(value, flag).resolve()
-        if robot_file is not None and path == robot_file:
-            raise ValueError(f"{flag}: '{value}' is the robot file this command reads; write somewhere else")
-        if path in seen:
-            raise ValueError(f"{flag}: '{value}' is also the file of {seen[path]}; give each output its own file")
-        seen[path] = flag
+        flag = _flag(action)
+        path = check_output_path(value, flag)
+        for source, what in inputs:
+            if Path(os.path.abspath(value)) == Path(os.path.abspath(source)) or same_file(value, source):
+                raise ValueError(f"{flag}: '{value}' is {what} ('{source}'); write somewhere else")
+        for other, other_flag in seen:
+            if path.resolve() == other.resolve() or same_file(path, other):
+                raise ValueError(f"{flag}: '{value}' is also the file of {other_flag}; give each output its own file")
+        seen.append((path, flag))
 
 
 # ------------------------------------------------------------------ argument values

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._math import pose_inverse, rot_axis, rpy_from_matrix, translation
+from .._ui.files import write_text
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual, resolve_mesh
 from .inertia import Inertia
 from .link import Link
@@ -471,8 +472,7 @@ def to_urdf(
         + "\n"
     )
     if path is not None:
-        with open(os.fspath(path), "w", encoding="utf-8") as f:
-            f.write(text)
+        write_text(os.fspath(path), text)  # atomic (kinedyn._ui.files)
     return text
 
 
@@ -647,6 +647,5 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
     ET.indent(root)
     text = f"<!-- written by kinedyn from robot '{robot.name}' -->\n" + ET.tostring(root, encoding="unicode") + "\n"
     if path is not None:
-        with open(os.fspath(path), "w", encoding="utf-8") as f:
-            f.write(text)
+        write_text(os.fspath(path), text)  # atomic (kinedyn._ui.files)
     return text

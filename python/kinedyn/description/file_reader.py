@@ -26,6 +26,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 import yaml
 
 from .._math import matmul, rpy_to_matrix, translation
+from .._ui.files import open_regular
 from ..expressions import parse_expression
 from .description import Description
 from .dh import DHRow, description_from_dh
@@ -40,6 +41,7 @@ __all__ = [
     "parse_yaml",
     "parse_toml",
     "MAX_FILE_BYTES",
+    "MAX_TEXT_BYTES",
     "MAX_NESTING",
     "MAX_NODES",
     "MAX_TEXT",
@@ -92,6 +94,9 @@ MAX_FILE_BYTES = 16 * 2**20  # a robot file is text a person writes: 16 MiB is f
 MAX_NESTING = 32  # mappings and lists inside each other (a robot file needs 5)
 MAX_NODES = 1_000_000  # YAML nodes composed, counting every use of an alias as the nodes it repeats
 MAX_TEXT = 1000  # characters of a name or other text field
+# a YAML/TOML robot file: a 100-joint robot is ~20 KiB; the YAML parser reads ~0.1-1 MiB/s, so a larger
+# file is refused on its size before parsing, not after seconds of it
+MAX_TEXT_BYTES = 2**20
 _REPR = reprlib.Repr()
 _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 40, 40, 4, 4
 
@@ -99,12 +104,17 @@ _REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 
 def read_text(path: str) -> str:
     """The file's text, refusing files too large to be a robot description before reading them."""
     try:
-        with open(path, "rb") as f:
-            raw = f.read(MAX_FILE_BYTES + 1)
+        with open_regular(path, "robot file") as f:  # a FIFO or /dev/zero: refused, never waited on
+            size = os.fstat(f.fileno()).st_size
+            if size > MAX_TEXT_BYTES:  # on its size, before a byte is read
+                raise ValueError(
+                    f"{path}: the file is larger than {MAX_TEXT_BYTES // 2**20} MiB, too large for a robot file"
+                )
+            raw = f.read(MAX_TEXT_BYTES + 1)
     except OSError as e:
         raise ValueError(f"{path}: cannot read robot file ({e.strerror or e})") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ValueError(f"{path}: the file is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a robot file")
+    if len(raw) > MAX_TEXT_BYTES:
+        raise ValueError(f"{path}: the file is larger than {MAX_TEXT_BYTES // 2**20} MiB, too large for a robot file")
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -213,6 +223,23 @@ def _refuse_tag(loader, node):
 # constructor can also fail on with an AttributeError, binary, sets, ordered pairs) are refused
 for _tag in ("timestamp", "binary", "set", "omap", "pairs"):
     _BoundedLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
+# digits of a YAML integer the parser converts at all: below Python's own limit (4300, whose message
+# speaks of sys.set_int_max_str_digits); the field's reader then refuses anything over ~300 digits by name
+MAX_INT_DIGITS = 4000
+
+
+def _bounded_int(loader, node):
+    """A YAML integer, its digits counted before Python converts it (whose own limit, 4300 digits,
+    speaks of sys.set_int_max_str_digits, not of the file)."""
+    digits = sum(c.isalnum() for c in str(node.value))
+    if digits > MAX_INT_DIGITS:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"the integer has {digits} digits, too large for a robot's parameter", node.start_mark
+        )
+    return loader.construct_yaml_int(node)
+
+
+_BoundedLoader.add_constructor("tag:yaml.org,2002:int", _bounded_int)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:map", _BoundedLoader.construct_line_mapping)
 _BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct_line_sequence)
 

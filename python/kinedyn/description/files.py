@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING
 import tomli_w
 import yaml
 
+from .._ui.files import require_regular, write_text
 from .description import Description
-from .file_reader import MAX_FILE_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
+from .file_reader import MAX_FILE_BYTES, MAX_TEXT_BYTES, description_from_mapping, parse_toml, parse_yaml, read_text
 from .file_writer import robot_to_mapping
 from .mjcf import description_from_mjcf
 from .urdf import description_from_urdf
@@ -33,7 +34,14 @@ if TYPE_CHECKING:
     from .._typing import PathLike
     from ..robot import Robot
 
-__all__ = ["read_description", "save", "description_from_mapping", "robot_to_mapping", "MAX_FILE_BYTES"]
+__all__ = [
+    "read_description",
+    "save",
+    "description_from_mapping",
+    "robot_to_mapping",
+    "MAX_FILE_BYTES",
+    "MAX_TEXT_BYTES",
+]
 
 
 def read_description(path: PathLike, inertia: str = "warn", **kwargs) -> Description:
@@ -45,6 +53,8 @@ def read_description(path: PathLike, inertia: str = "warn", **kwargs) -> Descrip
     nearest consistent tensor) or "strict" (raise); see docs/model-files.md."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
+    if os.path.exists(path):  # a FIFO or a device would block the reader (xacro's too): refused first
+        require_regular(path, "robot file")
     if ext in (".urdf", ".xacro"):  # robot.urdf.xacro; kwargs: xacro_args, trust_xacro, package_dirs, gravity, tool
         return description_from_urdf(path, inertia=inertia, **kwargs)
     if ext in (".xml", ".mjcf"):
@@ -70,8 +80,7 @@ def save(robot: Robot | Description, path: PathLike) -> None:
         text = tomli_w.dumps(data)
     else:
         raise ValueError(f"{path}: can only save robots as .yaml, .yml or .toml, not '{ext}'")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+    write_text(path, text)  # atomic: a failed run leaves the old file (kinedyn._ui.files)
 
 
 def __getattr__(name: str):

@@ -188,6 +188,9 @@ def resolve_mesh(filename: str, base_dir: str | None = None) -> Path:
                 if _is_mesh_file(candidate):
                     return candidate
     shown = ", ".join(str(p) for p in tried[:6]) + (f" and {len(tried) - 6} more places" if len(tried) > 6 else "")
+    odd = [p for p in tried if p.exists() and not p.is_file()]  # a FIFO, a device, a folder: never opened
+    if odd:
+        raise MeshNotFound(f"mesh '{filename}': {odd[0]} is not a regular file; kinedyn reads only regular files")
     raise MeshNotFound(
         f"mesh '{filename}' was not found (looked in {shown or 'no folder'}; set ROS_PACKAGE_PATH to the folder holding its package)"
     )

@@ -598,8 +598,9 @@ class _Reader(ModelSettings):
             ixy = ixz = iyz = 0.0
         else:
             raise self.src.error(element, f"of body '{body}' has neither 'diaginertia' nor 'fullinertia'")
+        pose = self.frame(element, a)  # its errors name the file and line already
         try:
-            return Inertia.from_urdf(mass, ixx, ixy, ixz, iyy, iyz, izz).transformed(self.frame(element, a))
+            return Inertia.from_urdf(mass, ixx, ixy, ixz, iyy, iyz, izz).transformed(pose)
         except ValueError as e:
             raise self.src.error(element, f"of body '{body}': {e}") from None
 
@@ -612,7 +613,10 @@ class _Reader(ModelSettings):
                 element,
                 f"{what}: kinedyn does not compute a mesh's inertia; give body '{body}' an <inertial> (MuJoCo's compiled model shows it: model.body_inertia)",
             )
-        volume, unit = solid_volume_and_moments(kind, s0, s1, s2)
+        try:
+            volume, unit = solid_volume_and_moments(kind, s0, s1, s2)
+        except ValueError as e:  # a capsule of radius 1e-300: its volume underflows to 0
+            raise self.src.error(element, f"{what}: {e}; give sizes a robot has, or the body an <inertial>") from None
         if "mass" in a:
             mass = numbers(element, "mass", self.src, 1, text=a["mass"])[0]
         else:

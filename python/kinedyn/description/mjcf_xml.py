@@ -13,6 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .._ui.files import open_regular
 from .bounded_xml import parse_bounded
 from .checks import LARGEST
 from .joint import Mimic
@@ -85,12 +86,14 @@ def parse_model(path_or_string):
 
 
 def read_file(path: str, src: Sources, element=None) -> bytes:
+    where = f"{src.at(element)}: <include> " if element is not None else ""
     try:
-        with open(path, "rb") as f:
+        with open_regular(path, "MJCF file") as f:  # a FIFO or a device: refused, never waited on
             data = f.read(MAX_FILE_BYTES + 1)
     except OSError as e:
-        where = f"{src.at(element)}: <include> " if element is not None else f"{path}: "
-        raise ValueError(f"{where}cannot read MJCF file '{path}' ({e.strerror or e})") from None
+        raise ValueError(f"{where or path + ': '}cannot read MJCF file '{path}' ({e.strerror or e})") from None
+    except ValueError as e:
+        raise ValueError(f"{where}{e}") from None
     src.total_bytes += len(data)
     if len(data) > MAX_FILE_BYTES or src.total_bytes > MAX_FILE_BYTES:
         raise ValueError(
@@ -222,7 +225,20 @@ def translation_of(p) -> np.ndarray:
 def solid_volume_and_moments(kind: str, s0: float, s1: float, s2: float) -> tuple:
     """(volume, principal moments per unit mass about the centre) of a solid MuJoCo geom of ``kind``
     with MuJoCo's half-sizes ``(s0, s1, s2)`` (radius / half-lengths; a cylinder's and a capsule's
-    axis is z, s1 its half-length), as MuJoCo's inertiafromgeom computes them for a uniform density."""
+    axis is z, s1 its half-length), as MuJoCo's inertiafromgeom computes them for a uniform density.
+    ValueError when they are not finite numbers (sizes that underflow or overflow float64)."""
+    try:
+        volume, unit = _volume_and_moments(kind, s0, s1, s2)
+    except (ZeroDivisionError, OverflowError):
+        volume, unit = math.nan, (math.nan,)
+    if not (math.isfinite(volume) and all(math.isfinite(u) for u in unit)):
+        raise ValueError(
+            f"its size ({s0:g}, {s1:g}, {s2:g}) gives a volume or moments of inertia that are not finite numbers"
+        )
+    return volume, unit
+
+
+def _volume_and_moments(kind: str, s0: float, s1: float, s2: float) -> tuple:
     if kind == "sphere":
         volume = 4 / 3 * math.pi * s0**3
         unit = (2 / 5 * s0**2,) * 3  # moments per unit mass

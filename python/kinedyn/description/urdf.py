@@ -57,6 +57,7 @@ import warnings
 import numpy as np
 
 from .._math import matmul, rpy_to_matrix, translation
+from .._ui.files import open_regular
 from .bounded_xml import parse_bounded
 from .checks import LARGEST, caller_level
 from .description import Description
@@ -74,6 +75,7 @@ _SUPPORTED = ("revolute", "continuous", "prismatic", "fixed", "floating", "plana
 ROOT_JOINT = "root_joint"
 #: the fixed frame a floating base moves in (Pinocchio's name for it)
 FLOATING_BASE_FRAME = "universe"
+MAX_FILE_BYTES = 16 * 2**20  # a URDF is text a person (or xacro) writes: read no more (docs/model-files.md)
 MAX_DEPTH = 100  # deepest element nesting accepted (a URDF needs about 6; guards the parser's memory)
 
 
@@ -239,8 +241,10 @@ def _parse(path_or_string, source_path: str | None = None):
     else:
         src = _Source(text)
         try:
-            with open(text, "rb") as f:
-                data = f.read()  # bytes: expat honours the file's encoding declaration
+            with open_regular(text, "URDF file") as f:  # a FIFO or a device: refused, never waited on
+                data = f.read(MAX_FILE_BYTES + 1)  # bytes: expat honours the file's encoding declaration
+            if len(data) > MAX_FILE_BYTES:
+                raise ValueError(f"{text}: the file is larger than {MAX_FILE_BYTES // 2**20} MiB, too large for a URDF")
         except OSError as e:
             raise ValueError(f"{text}: cannot read URDF file ({e.strerror or e})") from None
 

@@ -189,7 +189,10 @@ class ReducedModel:
         qd_full = self._v(qd, "qd", q)
         drift = self._left(self.native.inverse_dynamics(qf, qd_full, np.zeros_like(qd_full), f_ext))
         M = self._both(self.native.mass_matrix(qf))
-        return self._out(self._solve(M, tau - drift), out)
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below, as the core checks its own
+            qdd = self._solve(M, tau - drift)
+        qdd = finite_result(qdd, "forward_dynamics: qdd", batch_axes=qdd.ndim - 1)
+        return self._out(qdd, out)
 
     def coriolis_matrix(self, q, qd, out=None):
         q, qf = self._q(q)

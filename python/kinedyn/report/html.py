@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 from markupsafe import Markup
 
+from .._ui.files import write_text
 from .._ui.json import jsonable
 from .._ui.progress import Steps
 from .._ui.svg import svg_plot
@@ -395,5 +396,5 @@ def _render(robot, d: ReportData, tutorial: bool, steps, geometry: str) -> str:
 def write_report(robot, path="report.html", q=None, qd=None, **kwargs) -> Path:
     """Write the report to ``path``; returns the path."""
     path = Path(path)
-    path.write_text(build_report(robot, q, qd, **kwargs), encoding="utf-8")
+    write_text(path, build_report(robot, q, qd, **kwargs))  # atomic (kinedyn._ui.files)
     return path

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from markupsafe import Markup
 
+from .._ui.files import write_text
 from .._ui.json import jsonable
 from .._version import __version__
 from ..visual.page import asset, json_script
@@ -224,7 +225,7 @@ def write_identification_report(
 ) -> Path:
     """Write :func:`identification_report` to ``path``; returns the path."""
     path = Path(path)
-    path.write_text(identification_report(result, validate, **load_options), encoding="utf-8")
+    write_text(path, identification_report(result, validate, **load_options))  # atomic (kinedyn._ui.files)
     return path
 
 

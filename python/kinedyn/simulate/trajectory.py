@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._ui.files import replacing, write_text
 from ..coordinates import coordinate_labels, velocity_labels
 from ..display import trajectory_html
 from ..visual.page import animation_page
@@ -236,7 +237,8 @@ class Trajectory:
             raise TypeError("to_csv writes one trajectory: use traj[i].to_csv(...) or to_npz for a batch")
         header, data = self._columns()
         path = Path(path)
-        np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+        with replacing(path) as tmp:  # atomic: a failed run leaves the old file (kinedyn._ui.files)
+            np.savetxt(tmp, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
         return path
 
     def to_npz(self, path) -> Path:
@@ -250,7 +252,10 @@ class Trajectory:
                 arrays[key] = getattr(self, key)
             except AttributeError:
                 pass
-        np.savez_compressed(path, **arrays)
+        if path.suffix != ".npz":  # NumPy's own rule: the name gets .npz
+            path = path.with_name(path.name + ".npz")
+        with replacing(path) as tmp, open(tmp, "wb") as f:  # atomic (kinedyn._ui.files)
+            np.savez_compressed(f, **arrays)
         return path
 
     # ------------------------------------------------------------------ plots
@@ -296,7 +301,8 @@ class Trajectory:
         ax.grid(True, alpha=0.3)
         fig.suptitle(f"{getattr(self.system, 'name', '')} ({self.method})")
         if path is not None:
-            fig.savefig(path, dpi=100)
+            with replacing(path) as tmp:  # atomic (kinedyn._ui.files); the same extension, so the same format
+                fig.savefig(tmp, dpi=100)
         if show:
             plt.show()
         else:
@@ -347,9 +353,7 @@ class Trajectory:
         idx = np.unique(np.round(np.linspace(0, len(self) - 1, frames)).astype(int))
         if suffix == ".html" and hasattr(self.system, "frame_poses"):
             # a robot: its meshes in the report's 3-D view, sent once, then joint values per frame
-            path.write_text(
-                animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]), encoding="utf-8"
-            )
+            write_text(path, animation_page(self.system, np.asarray(self.t)[idx], np.asarray(self.q)[idx]))
             return path
         P = self._points()
         planar = np.ptp(P[..., 2]) < 1e-9
@@ -400,13 +404,15 @@ class Trajectory:
         anim = animation.FuncAnimation(fig, draw, frames=len(idx), interval=1000 / fps, blit=False)
         try:
             if suffix == ".gif":
-                anim.save(path, writer=animation.PillowWriter(fps=fps))
+                with replacing(path) as tmp:  # atomic (kinedyn._ui.files)
+                    anim.save(tmp, writer=animation.PillowWriter(fps=fps))
             elif suffix == ".html":
-                path.write_text(_offline_jshtml(anim.to_jshtml(fps=fps)))
+                write_text(path, _offline_jshtml(anim.to_jshtml(fps=fps)))
             else:
                 if not animation.FFMpegWriter.isAvailable():
                     raise RuntimeError("writing .mp4 needs ffmpeg on the PATH; write a .gif or .html instead")
-                anim.save(path, writer=animation.FFMpegWriter(fps=fps))
+                with replacing(path) as tmp:  # atomic (kinedyn._ui.files)
+                    anim.save(tmp, writer=animation.FFMpegWriter(fps=fps))
         finally:
             plt.close(fig)
         return path

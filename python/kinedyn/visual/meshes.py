@@ -9,14 +9,19 @@ A :class:`Part` is one colour's triangles: ``vertices`` (V, 3) float32 in the sh
 
 from __future__ import annotations
 
+import io
 import math
 import os
+import re
+import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .._ui.files import open_regular
 
 __all__ = ["Part", "MAX_MESH_BYTES", "MAX_MESH_TRIANGLES", "read_mesh", "decimate", "box", "cylinder", "sphere"]
 
@@ -117,11 +122,111 @@ def _colour(geometry) -> tuple[float, float, float, float] | None:
         return None
 
 
+# the files a mesh may name beside itself (an OBJ's mtllib, its textures, a DAE's images): read under
+# the mesh's own rules (its folder, a regular file, MAX_MESH_BYTES), any other kind of file is not read
+SIDE_FILE_EXTENSIONS = (".mtl", ".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tga", ".tif", ".tiff", ".webp")
+MAX_MESH_COORDINATE = 1e6  # |x|, |y|, |z| in the file's units: a robot in millimetres spans 1e4
+
+
+def _side_files(path: str, refused: list):
+    """trimesh's resolver for the files a mesh names, kept to kinedyn's rules (above); each file it
+    does not read is a message in ``refused`` (trimesh then draws the mesh without it)."""
+    from trimesh.resolvers import FilePathResolver  # trimesh (optional, heavy) loads only to read a mesh
+
+    class SideFiles(FilePathResolver):
+        def namespaced(self, namespace: str):
+            return SideFiles(os.path.join(self.parent, namespace))
+
+        def get(self, name: str):
+            try:
+                return self._get(name)
+            except (OSError, ValueError) as e:
+                refused.append(f"mesh '{path}': '{name}' not read: {getattr(e, 'strerror', None) or e}")
+                raise
+
+        def _get(self, name: str) -> bytes:
+            if os.path.splitext(name.strip())[1].lower() not in SIDE_FILE_EXTENSIONS:
+                raise ValueError(f"not a material or an image ({', '.join(SIDE_FILE_EXTENSIONS)})")
+            target = self.absolute(name)  # trimesh's own rule: inside the mesh's folder
+            with open_regular(target, "file") as f:
+                data = f.read(MAX_MESH_BYTES + 1)
+            if len(data) > MAX_MESH_BYTES:
+                raise ValueError(f"more than the {MAX_MESH_BYTES // 2**20} MiB kinedyn reads")
+            return data
+
+    return SideFiles(path)
+
+
+def counted_triangles(data: bytes, ext: str) -> int:
+    """The triangles a mesh file declares, counted without parsing it: a binary STL's header count,
+    an ASCII STL's facets, an OBJ's face lines (a polygon of k corners is k - 2 triangles or more),
+    a DAE's primitive counts. A lower bound where it cannot be exact, so a refusal is never wrong."""
+    if ext == ".stl":
+        if data[:5].lower() == b"solid" and b"facet" in data[:4096]:
+            return data.count(b"endfacet")
+        return int.from_bytes(data[80:84], "little") if len(data) >= 84 else 0
+    if ext == ".obj":
+        return data.count(b"\nf ") + data.startswith(b"f ")
+    if ext == ".dae":
+        return sum(int(m) for m in re.findall(rb"<(?:triangles|polylist|polygons)\b[^>]*?\bcount=\"(\d{1,12})\"", data))
+    return 0
+
+
+_STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+
+
+def _binary_stl(data: bytes, path: str) -> Part | None:
+    """A binary STL read with NumPy in the format's own layout (an 80-byte header, a triangle count,
+    then 50 bytes a triangle: normal, three corners, an attribute), its corners merged into shared
+    vertices by value: a few times the file's size in memory, where trimesh's general reader takes
+    ~700 bytes a triangle (1.7 GB for a 119 MiB file). None for an ASCII STL or one whose length
+    disagrees with its count (trimesh's reader then decides)."""
+    if len(data) < 84 or (data[:5].lower() == b"solid" and b"facet" in data[:4096]):
+        return None
+    count = int.from_bytes(data[80:84], "little")
+    if count == 0 or len(data) != 84 + _STL_RECORD.itemsize * count:
+        return None
+    corners = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)["corners"].reshape(-1, 3)
+    if not np.all(np.isfinite(corners)):
+        raise ValueError(f"mesh '{path}' has vertices that are not finite numbers")
+    if np.max(np.abs(corners)) > MAX_MESH_COORDINATE:
+        raise ValueError(
+            f"mesh '{path}' has a vertex at {np.max(np.abs(corners)):.3g}, beyond the {MAX_MESH_COORDINATE:g} kinedyn draws"
+        )
+    # one vertex per position, positions equal to 8 decimals as trimesh's merge_vertices takes them
+    # (tol.merge = 1e-8; + 0.0 makes -0.0 and 0.0 one position)
+    keys = np.round(corners.astype(np.float64), 8) + 0.0
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    del keys
+    return Part(np.ascontiguousarray(corners[first]), inverse.reshape(-1, 3).astype(np.int32), None)
+
+
 @lru_cache(maxsize=256)
 def _read(path: str, mtime_ns: int, size: int) -> tuple[Part, ...]:
     import trimesh
 
-    loaded = trimesh.load(path, force="scene", process=False)
+    ext = os.path.splitext(path)[1].lower()
+    with open_regular(path, "mesh") as f:  # a FIFO or a device: refused, never waited on
+        data = f.read(MAX_MESH_BYTES + 1)
+    if len(data) > MAX_MESH_BYTES:
+        raise ValueError(f"mesh '{path}' is more than the {MAX_MESH_BYTES // 2**20} MiB kinedyn reads")
+    declared = counted_triangles(data, ext)
+    if declared > MAX_MESH_TRIANGLES:  # refused before trimesh builds it (gigabytes for a large file)
+        raise ValueError(
+            f"mesh '{path}' declares {declared:,} triangles, more than the {MAX_MESH_TRIANGLES:,} kinedyn reads "
+            "(kinedyn draws robots, not scans)"
+        )
+    if ext == ".stl":
+        part = _binary_stl(data, path)
+        if part is not None:
+            return (part,)
+    refused: list[str] = []
+    loaded = trimesh.load(
+        io.BytesIO(data), file_type=ext.lstrip("."), force="scene", process=False, resolver=_side_files(path, refused)
+    )
+    del data
+    for message in dict.fromkeys(refused):
+        warnings.warn(message, stacklevel=2)
     meshes = loaded.dump(concatenate=False) if hasattr(loaded, "dump") else [loaded]
     by_colour: dict = {}
     total = 0
@@ -132,6 +237,13 @@ def _read(path: str, mtime_ns: int, size: int) -> tuple[Part, ...]:
         if total > MAX_MESH_TRIANGLES:
             raise ValueError(
                 f"mesh '{path}' has more than {MAX_MESH_TRIANGLES:,} triangles (kinedyn draws robots, not scans)"
+            )
+        raw = np.asarray(m.vertices, dtype=np.float64)
+        if not np.all(np.isfinite(raw)):
+            raise ValueError(f"mesh '{path}' has vertices that are not finite numbers")
+        if raw.size and np.max(np.abs(raw)) > MAX_MESH_COORDINATE:  # 1e308 overflows float32 and the report's JSON
+            raise ValueError(
+                f"mesh '{path}' has a vertex at {np.max(np.abs(raw)):.3g}, beyond the {MAX_MESH_COORDINATE:g} kinedyn draws"
             )
         by_colour.setdefault(_colour(m), []).append(m)
     parts = []
@@ -167,8 +279,12 @@ def read_mesh(path) -> list[Part]:
         raise ValueError(f"mesh '{path}': reading mesh files needs trimesh (pip install 'kinedyn[viz]')") from None
     try:
         return list(_read(str(path.resolve()), st.st_mtime_ns, st.st_size))
-    except ValueError:
-        raise
+    except ValueError as e:  # kinedyn's own name the mesh; trimesh's ("could not be read to its end") do not
+        if str(path) in str(e) or str(path.resolve()) in str(e):
+            raise
+        raise ValueError(f"mesh '{path}' could not be read: {e}") from None
+    except MemoryError:
+        raise ValueError(f"mesh '{path}' needs more memory than this machine has") from None
     except Exception as e:  # whatever trimesh or pycollada raise on a broken file
         raise ValueError(f"mesh '{path}' could not be read: {type(e).__name__}: {e}") from None
 

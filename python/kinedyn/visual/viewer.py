@@ -12,16 +12,21 @@ http://localhost:8080 here (docs/visualisation.md).
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import io
 import math
 import sys
 import threading
 import time
+import warnings
 from typing import Any
 
 import numpy as np
 
 from ..configuration import default_configuration
 from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
+from .serving import HandshakeGuard, guarded_viser, listen_address
 
 __all__ = ["Viewer", "show"]
 
@@ -70,8 +75,11 @@ class Viewer:
     """A running viewer of ``robot`` at ``q`` (default: the report's configuration), optionally
     playing back ``trajectory`` (a :class:`kinedyn.simulate.Trajectory` of this robot).
 
-    ``host``/``port``: where the server listens (``127.0.0.1``: this machine only; viser takes the
-    next free port if ``port`` is busy). ``geometry``: "visual" or "collision" shapes. Attributes:
+    ``host``/``port``: where the server listens (``127.0.0.1``: this machine only; the next free port
+    if ``port`` is busy, any free one for 0); a bad port, a host that does not resolve or an address
+    this machine does not have is a ValueError, and listening beyond loopback warns. The viewer
+    answers only requests that name it by a loopback Host and WebSockets from its own page;
+    ``allow_remote=True`` accepts any Host (docs/viewer-security.md: an ssh tunnel is the safe route). ``geometry``: "visual" or "collision" shapes. Attributes:
     ``url``, ``server`` (the viser server), ``q``. ``set_q(q)`` moves the robot, ``close()`` stops."""
 
     def __init__(
@@ -85,6 +93,7 @@ class Viewer:
         geometry: str = "visual",
         budget: int = DEFAULT_BUDGET,
         verbose: bool = True,
+        allow_remote: bool = False,
     ):
         try:
             import viser
@@ -101,8 +110,25 @@ class Viewer:
             if tq.ndim != 2 or tq.shape[1] != robot.nq:
                 raise ValueError(f"the trajectory's q must have shape (N, {robot.nq}), got {tq.shape}")
         self.scene = robot_scene(robot, geometry, budget)
-        self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        self.url = f"http://{'localhost' if host in ('127.0.0.1', '0.0.0.0', '::') else host}:{self.server.get_port()}"
+        # host and port checked (and a free port found) before viser's thread starts, and each handshake
+        # checked for a loopback Host and the viewer's own Origin (kinedyn.visual.serving)
+        address = listen_address(host, port)
+        if not address.loopback:
+            warnings.warn(address.exposure(), stacklevel=2)
+        with guarded_viser(HandshakeGuard(beyond_loopback=not address.loopback, allow_remote=allow_remote)) as state:
+            # viser prints its own panel of URLs (``http://:PORT`` for host ""); the viewer prints the right one
+            with contextlib.redirect_stdout(io.StringIO()):
+                self.server = viser.ViserServer(host=host, port=address.port, verbose=False)
+        if not state["guarded"]:  # a viser that builds its server otherwise: refuse to serve unchecked
+            self.server.stop()
+            raise RuntimeError(
+                f"the live viewer could not install its handshake check in viser {viser.__version__}; "
+                "please report it (docs/viewer-security.md)"
+            )
+        self.address = dataclasses.replace(address, port=self.server.get_port())
+        self.url = self.address.url
+        # viser's share button opens a public tunnel to the viewer: not from a viewer that answers only this machine
+        self.server.gui.configure_theme(show_share_button=False)
         poses = robot.frame_poses(self.q)
         reach = max(float(np.max(np.linalg.norm(poses[:, :3, 3], axis=-1))), 0.05)
         self._reach = reach
@@ -294,13 +320,14 @@ class Viewer:
         self._playing = False
 
     # ------------------------------------------------------------------ lifetime
-    def wait(self) -> None:
-        """Block until Ctrl-C (what ``kinedyn view`` and a script's ``show()`` do), then stop."""
+    def wait(self) -> bool:
+        """Block until Ctrl-C (what ``kinedyn view`` and a script's ``show()`` do), then stop; True
+        when Ctrl-C ended it (``kinedyn view`` then exits 130)."""
         try:
             while True:
                 time.sleep(0.5)
         except KeyboardInterrupt:
-            pass
+            return True
         finally:
             self.close()
 

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from ... import robots
 from ..._ui import progress
+from ..._ui.files import write_text
 from ...description.snap import SNAP_TOLERANCE
 from .. import app
 from ..app import console, emit, esc
@@ -80,7 +80,7 @@ def run(args) -> int:
             text = eom.to_code(fmt)
         payload = _payload(args, robot, eom, text) if args.json else {}
     if args.output:
-        Path(args.output).write_text(text)
+        write_text(args.output, text)  # atomic: a failed run leaves the old file
     if not args.json:
         for note in eom.notes:  # on stderr: the equations on stdout stay clean for a pipe
             print(f"note: {note}", file=sys.stderr)

@@ -5,13 +5,22 @@ from __future__ import annotations
 
 from rich.table import Table
 
+from ..._ui.files import replacing
 from ...analysis.excitation import excitation_condition, optimize_excitation, write_trajectory_csv
 from ...analysis.identification import excitation, identify, simulate_measurements
 from ...analysis.logs import load_log
 from ...report.identification import write_identification_html
 from .. import app
 from ..app import console, emit, esc
-from ..options import OutputPath, nonnegative_float, nonnegative_int, positive_float, positive_int, robot_argument
+from ..options import (
+    InputPath,
+    OutputPath,
+    nonnegative_float,
+    nonnegative_int,
+    positive_float,
+    positive_int,
+    robot_argument,
+)
 
 
 def add_arguments(p) -> None:
@@ -29,6 +38,7 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--data",
         metavar="LOG",
+        action=InputPath,
         help="identify from a log (CSV or NPZ: t, q1..qn, tau1..taun) instead of a simulated excitation",
     )
     p.add_argument(
@@ -45,7 +55,10 @@ def add_arguments(p) -> None:
         help="physically consistent parameters (pseudo-inertias positive definite; an SDP through cvxpy)",
     )
     p.add_argument(
-        "--validate", metavar="LOG", help="a second log: torque RMS and R^2 per joint of the identified model"
+        "--validate",
+        metavar="LOG",
+        action=InputPath,
+        help="a second log: torque RMS and R^2 per joint of the identified model",
     )
     p.add_argument(
         "--cutoff", type=positive_float, default=None, help="low-pass cut-off, Hz (default: 5 x the motion's bandwidth)"
@@ -163,7 +176,8 @@ def _identify_from_log(robot, args) -> int:
         payload["validation"] = check.to_dict()
     if args.plot:
         fig = result.plot(args.validate or log)
-        fig.savefig(args.plot)
+        with replacing(args.plot) as tmp:  # atomic; the same extension, so the same format
+            fig.savefig(tmp)
         payload["plot"] = str(args.plot)
     if args.output:
         payload["report"] = str(write_identification_html(result, args.output, args.validate, **options))

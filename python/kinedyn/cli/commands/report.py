@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import robots
+from ..._ui.files import write_text
 from ...report.html import SIMULATION_BUDGET, build_report, collect, default_configuration
 from .. import app
 from ..app import console, emit, esc, parse_q
@@ -97,7 +98,7 @@ def run(args) -> int:
         time_budget=budget,
         geometry="collision" if args.collision else "visual",
     )
-    out.write_text(page, encoding="utf-8")
+    write_text(out, page)  # atomic: a failed run leaves the old file
     payload = {"path": str(out.resolve()), **public}
     payload.pop("simulation", None)
     if "simulation" in data:

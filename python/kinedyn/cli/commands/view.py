@@ -5,7 +5,7 @@ from __future__ import annotations
 from ...visual.viewer import Viewer
 from .. import app
 from ..app import parse_q
-from ..options import state_arguments
+from ..options import EXIT_INTERRUPTED, EXIT_OK, state_arguments
 
 
 def add_arguments(p) -> None:
@@ -18,7 +18,15 @@ def add_arguments(p) -> None:
         default="127.0.0.1",
         help="address to listen on (default 127.0.0.1: this machine only; over ssh use ssh -L PORT:localhost:PORT)",
     )
-    p.add_argument("--port", type=int, default=8080, help="port (default 8080; the next free one if it is taken)")
+    p.add_argument(
+        "--port", type=int, default=8080, help="port (default 8080; the next free one if it is taken; 0: any free one)"
+    )
+    p.add_argument(
+        "--allow-remote",
+        action="store_true",
+        help="answer requests that name the viewer by any host name, not only localhost (a reverse proxy); "
+        "the page's WebSocket must still come from the viewer's own page (docs/viewer-security.md)",
+    )
     p.add_argument("--collision", action="store_true", help="draw the collision shapes instead of the visual ones")
     p.add_argument("--no-wait", action="store_true", help="start the server, print its URL and stop (a check)")
 
@@ -26,10 +34,16 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     robot = app.robot(args)
     q = None if args.q is None else parse_q(args.q, robot, args.deg)
-    viewer = Viewer(robot, q, host=args.host, port=args.port, geometry="collision" if args.collision else "visual")
+    viewer = Viewer(
+        robot,
+        q,
+        host=args.host,
+        port=args.port,
+        geometry="collision" if args.collision else "visual",
+        allow_remote=args.allow_remote,
+    )
     if args.no_wait:  # for tests and scripts that only want the server checked
         viewer.close()
         return 0
     print("Ctrl-C stops the viewer.", flush=True)
-    viewer.wait()
-    return 0
+    return EXIT_INTERRUPTED if viewer.wait() else EXIT_OK
