@@ -109,6 +109,22 @@ def test_armature_stribeck_and_offset_are_recovered(prior):
     assert plain.residual_rms.max() > 3 * result.residual_rms.max()
 
 
+def test_stribeck_and_delay_on_a_filtered_log(prior):
+    """Positions and torques only: the Stribeck column goes through the log's low-pass as the
+    torques did (parallel filtering), so its level, its velocity and the delay come out right."""
+    true = arm(symmetric=True)
+    data = log(true, delay=0.004, noise=0.01, derivatives=False)
+    assert data.cutoff is not None and data.decimation > 1
+    result = an.identify(prior, data, friction="stribeck", offset=True, armature=True, delay="estimate")
+    assert result.delay == pytest.approx(0.004, abs=0.2 / RATE)
+    for j in range(2):
+        assert friction_of(result, j, "stribeck") == pytest.approx(STRIBECK[j], rel=0.1)
+        assert result.stribeck[j]["velocity"] == pytest.approx(VST[j], rel=0.1)
+        assert friction_of(result, j, "coulomb") == pytest.approx(COULOMB[j].mean(), rel=0.03)
+    check = result.validate(log(true, seed=5, delay=0.004, noise=0.01, derivatives=False))
+    assert check.rms.max() < 0.01
+
+
 def test_asymmetric_coulomb_levels_are_recovered(prior):
     data = log(arm(), noise=0.01, stribeck=False, offset=False)
     result = an.identify(prior, data, friction="viscous+asymmetric", armature=True)

@@ -67,9 +67,11 @@ class FrictionModel:
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.sign(qd) if self.smoothing is None else np.tanh(qd / self.smoothing)
 
-    def regressor(self, qd: np.ndarray, sign: np.ndarray | None = None) -> np.ndarray:
+    def regressor(self, qd: np.ndarray, sign: np.ndarray | None = None, parallel=None) -> np.ndarray:
         """(S, n, n k) for qd (S, n): column block j holds joint j's columns (zero in other rows).
-        ``sign``: a filtered sign(qd) to use for the Coulomb columns (ignored with smoothing)."""
+        ``sign``: a filtered sign(qd) to use for the Coulomb columns (ignored with smoothing);
+        ``parallel``: a filtered log's :meth:`~kinedyn.analysis.Log.parallel`, through which the
+        Stribeck column passes as the torques did."""
         qd = np.asarray(qd, dtype=float)
         S, n = qd.shape
         cols = self.columns()
@@ -82,6 +84,13 @@ class FrictionModel:
         # filtering the constant 1 of a moving joint leaves 1, so (moving +- s) / 2 are the filtered
         # direction indicators when s is the filtered sign
         moving = (np.abs(qd) > 1e-9 * np.maximum(np.abs(qd).max(axis=0), 1e-300)).astype(float)
+        stribeck = None
+        if "stribeck" in self.terms:
+            v = np.asarray(self.velocities, dtype=float)
+            if parallel is not None and self.smoothing is None:
+                stribeck = parallel(lambda raw: stribeck_shape(raw, v) * np.sign(raw))
+            if stribeck is None:
+                stribeck = stribeck_shape(qd, v) * s
         for j in range(n):
             for c, name in enumerate(cols):
                 col = out[:, j, j * k + c]
@@ -94,8 +103,8 @@ class FrictionModel:
                 elif name == "coulomb-":
                     col[:] = -(moving[:, j] - s[:, j]) / 2
                 elif name == "stribeck":
-                    assert self.velocities is not None
-                    col[:] = stribeck_shape(qd[:, j], self.velocities[j]) * s[:, j]
+                    assert stribeck is not None
+                    col[:] = stribeck[:, j]
                 else:
                     col[:] = 1.0
         return out

@@ -308,7 +308,8 @@ class Identification:
         sign = getattr(data, "filtered_sign", None)
         if sign is not None and self.friction.terms:  # the log's torques went through its filter
             predicted = predicted - self.friction.torque(data.qd, self.friction_estimates)
-            predicted = predicted + (self.friction.regressor(np.asarray(data.qd), sign) @ self.friction_estimates)
+            F = self.friction.regressor(np.asarray(data.qd), sign, data.parallel)
+            predicted = predicted + F @ self.friction_estimates
         return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
 
     def plot(self, log=None, **load_options):
@@ -424,6 +425,7 @@ def aligned(data, delay: float, edge: int | None = None):
         changes["tau_true"] = np.asarray(data.tau_true)[sl]
     elif data.filtered_sign is not None:
         changes["filtered_sign"] = data.filtered_sign[sl]
+        changes["window"] = data.subset(sl.start, sl.stop)
     return dc_replace(data, **changes)
 
 
@@ -517,12 +519,12 @@ def identify(
     known_armature = robot.armature.copy()
     known_armature[list(rotor_joints)] = 0.0
 
-    def columns(q, qd, qdd, sign, model=model):
+    def columns(q, qd, qdd, sign, model=model, parallel=None):
         """(S, n, nb + nf): the base regressor (links and estimated armatures), the friction columns."""
         Y = robot.regressor(q, qd, qdd)
         if nr:  # the armatures' columns after the links' (S, n, 10 n + nr)
             Y = np.concatenate([Y, rotor_regressor(qdd, rotor_joints, n)], axis=2)
-        return np.concatenate([Y[..., base.indices], model.regressor(qd, sign)], axis=2)
+        return np.concatenate([Y[..., base.indices], model.regressor(qd, sign, parallel)], axis=2)
 
     def known(q, qd, qdd):
         """The torques of the known drive terms, subtracted from the measured ones."""
@@ -530,9 +532,9 @@ def identify(
 
     def arrays(data):
         q, qd, qdd, tau = (np.ascontiguousarray(a, dtype=float) for a in (data.q, data.qd, data.qdd, data.tau))
-        return q, qd, qdd, tau, getattr(data, "filtered_sign", None)
+        return q, qd, qdd, tau, getattr(data, "filtered_sign", None), getattr(data, "parallel", None)
 
-    q, qd, qdd, tau, sign = arrays(data)
+    q, qd, qdd, tau, sign, parallel = arrays(data)
     if isinstance(delay, str):
         if delay.strip().lower() != "estimate":
             raise ValueError(f"delay must be a number of seconds, None or 'estimate', got {delay!r}")
@@ -542,7 +544,7 @@ def identify(
         edge = int(np.ceil(max_delay / float(np.median(np.diff(t))))) + 1
         keep = np.zeros(len(t), dtype=bool)
         keep[edge : len(t) - edge] = True
-        W0 = columns(q, qd, qdd, sign).reshape(len(t) * n, -1)
+        W0 = columns(q, qd, qdd, sign, model, parallel).reshape(len(t) * n, -1)
         W0 = W0[:, np.linalg.norm(W0, axis=0) > 0]
         delay_s, *_ = estimate_delay(t, tau, W0, known(q, qd, qdd), keep, max_delay)
         data = aligned(data, delay_s, edge)
@@ -553,7 +555,7 @@ def identify(
         data = aligned(data, delay_s)
     else:
         delay_s = 0.0
-    q, qd, qdd, tau, sign = arrays(data)
+    q, qd, qdd, tau, sign, parallel = arrays(data)
     S = q.shape[0]
     y = tau - known(q, qd, qdd)
     yv = y.reshape(S * n)
@@ -567,13 +569,13 @@ def identify(
         index = [nb + j * k + model.columns().index("stribeck") for j in range(n)]
         ranges = [(1e-3 * v, 0.5 * v) for v in qd_max]
         velocities = stribeck_search(
-            lambda v: columns(q, qd, qdd, sign, dc_replace(model, velocities=tuple(v))).reshape(S * n, -1),
+            lambda v: columns(q, qd, qdd, sign, dc_replace(model, velocities=tuple(v)), parallel).reshape(S * n, -1),
             yv,
             index,
             ranges,
         )
         model = dc_replace(model, velocities=tuple(float(v) for v in velocities))
-    W = columns(q, qd, qdd, sign, model).reshape(S * n, nb + nf)
+    W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)
     # a column that is round-off noise on the data carries no information: leave it out
     norms = np.linalg.norm(W, axis=0)
     keep = norms > 1e-9 * norms.max()
@@ -599,14 +601,14 @@ def identify(
         rest = data.t[0], q[0], qd[0]
 
         def model_torque(qs, qds, qdds, theta=None):
-            return columns(qs, qds, qdds, None)[..., keep] @ theta + known(qs, qds, qdds)
+            return columns(qs, qds, qdds, None, model)[..., keep] @ theta + known(qs, qds, qdds)
 
         def instruments(theta):
             def torque(a, b, c):
                 return model_torque(a, b, c, theta)
 
             qs, qds, qdds = simulate_model(torque, controller, data.t, rest[1], rest[2], control_period)
-            return columns(qs, qds, qdds, None)[..., keep].reshape(S * n, -1)
+            return columns(qs, qds, qdds, None, model)[..., keep].reshape(S * n, -1)
 
         est, cov, iterations, _ = instrumental_fit(method, W, yv, w, est, instruments)
         r = (yv - W @ est).reshape(S, n)
@@ -658,7 +660,7 @@ def identify(
     Yfull = robot.regressor(q, qd, qdd)
     if nr:
         Yfull = np.concatenate([Yfull, rotor_regressor(qdd, rotor_joints, n)], axis=2)
-    F = model.regressor(qd, sign)
+    F = model.regressor(qd, sign, parallel)
     full = np.concatenate([Yfull.reshape(S * n, 10 * n + nr), F.reshape(S * n, nf)], axis=1)
     standard, armature_est, fric = consistent_fit(
         robot, full * w[:, None], yv * w, nf, rotor_joints, regularization, margin, solver
