@@ -261,3 +261,32 @@ def test_cli_fits_the_drive_train_and_the_delay(tmp_path, prior, capsys):
     text = capsys.readouterr().out
     assert "method ols" in text and "4 ms behind the positions" in text
     assert "not separable by the data" in text and "joint1.coulomb+, joint1.coulomb-, joint1.offset" in text
+
+
+def test_excitation_optimised_for_the_drive_train_within_torque_limits():
+    """Issue 29 §4: the armature and friction columns join Swevers' criterion; the torque limits
+    hold at the sampled instants."""
+    robot = kd.robots.planar_2r(l1=0.5, l2=0.4, m1=3.0, m2=2.0)
+    drive = dict(armature=True, friction="viscous+coulomb+offset")
+    options = dict(period=6.0, harmonics=4, samples=60, maxiter=40)
+    fitted = an.optimize_excitation(robot, **options, **drive)
+    rigid = an.optimize_excitation(robot, **options)
+    random = an.excitation(robot, harmonics=4, period=6.0, amplitude=1.0, seed=0)
+    cond = {
+        k: an.excitation_condition(robot, r, samples=60, **drive)
+        for k, r in dict(fitted=fitted, rigid=rigid, random=random).items()
+    }
+    assert cond["fitted"] < 0.5 * cond["random"]
+    assert cond["fitted"] < cond["rigid"]  # the rigid-body criterion alone sees the drive train worse
+    # about the upright pose (gravity small at the centre, so the limits can be met)
+    t = np.arange(60) * 6.0 / 60
+    upright = dict(q=([0.6, -1.0], [2.5, 1.0]))
+    free = an.optimize_excitation(robot, limits=upright, **options, **drive)
+    limits = dict(upright, tau=[10.0, 5.0])
+    held = an.optimize_excitation(robot, limits=limits, **options, **drive)
+    assert np.abs(robot.inverse_dynamics(*free(t))[:, 0]).max() > 15.0  # the limit binds
+    tau = np.abs(robot.inverse_dynamics(*held(t))).max(axis=0)
+    assert np.all(tau <= np.array(limits["tau"]) * (1 + 1e-6))
+    assert an.excitation_condition(robot, held, samples=60, **drive) < 100
+    with pytest.raises(ValueError, match="torque limits must be positive"):
+        an.optimize_excitation(robot, limits=dict(tau=[0.0, 4.0]), **options)
