@@ -60,7 +60,13 @@ def experiment():
         )
         for m in ("ols", "iv", "didim")
     }
-    return truth, fits, controller, log, prior
+    late = 3  # samples (ms): the current sensor's torques arrive after the encoder's positions
+    delayed = an.load_log(
+        {"t": traj.t[late:], "q1": q[late:, 0], "q2": q[late:, 1], "tau1": tau[:-late, 0], "tau2": tau[:-late, 1]},
+        n=2,
+        cutoff=CUTOFF,
+    )
+    return truth, fits, controller, log, prior, delayed
 
 
 def inertias(result):
@@ -92,7 +98,7 @@ def test_iv_and_didim_recover_the_parameters(experiment, method):
 
 
 def test_auto_picks_iv_when_the_controller_is_given(experiment, capsys):
-    _, fits, controller, log, prior = experiment
+    _, fits, controller, log, prior, _ = experiment
     assert an.identify(prior, log, friction="viscous+coulomb", armature=True).method == "ols"
     auto = an.identify(prior, log, friction="viscous+coulomb", armature=True, controller=controller)
     assert auto.method == "iv" and np.allclose(auto.estimates, fits["iv"].estimates)
@@ -104,10 +110,22 @@ def test_a_model_that_cannot_be_simulated_is_named(experiment):
     """IV simulates its estimate: one with a negative inertia diverges, and says so."""
     from kinedyn.analysis.closed_loop import simulate_model
 
-    _, _, controller, log, _ = experiment
+    _, _, controller, log, _, _ = experiment
 
     def negative(q, qd, qdd):  # M = -I
         return -qdd
 
     with pytest.raises(ValueError, match=r"the identified model diverges under the controller at t = "):
         simulate_model(negative, controller, log.t, log.q[0], log.qd[0])
+
+
+def test_iv_estimates_the_delay_against_the_simulated_loop(experiment):
+    """The least-squares profile of the delay is pulled by the noise the regressor and the
+    controller's torque share; IV estimates it again against the noise-free simulated regressor."""
+    truth, _, controller, _, prior, delayed = experiment
+    options = dict(friction="viscous+coulomb", armature=True, delay="estimate")
+    ols = an.identify(prior, delayed, method="ols", **options)
+    iv = an.identify(prior, delayed, method="iv", controller=controller, **options)
+    assert abs(ols.delay - 0.003) > 1e-3  # off by more than a millisecond
+    assert iv.delay == pytest.approx(0.003, abs=3e-4)
+    assert np.all(np.abs(inertias(iv) / inertias(truth) - 1) < 0.06)

@@ -535,6 +535,7 @@ def identify(
         return q, qd, qdd, tau, getattr(data, "filtered_sign", None), getattr(data, "parallel", None)
 
     q, qd, qdd, tau, sign, parallel = arrays(data)
+    raw, edge, window = data, 0, np.zeros(0, dtype=bool)
     if isinstance(delay, str):
         if delay.strip().lower() != "estimate":
             raise ValueError(f"delay must be a number of seconds, None or 'estimate', got {delay!r}")
@@ -542,11 +543,11 @@ def identify(
             raise ValueError(f"max_delay must be >= 0 s, got {max_delay}")
         t = np.asarray(data.t, dtype=float)
         edge = int(np.ceil(max_delay / float(np.median(np.diff(t))))) + 1
-        keep = np.zeros(len(t), dtype=bool)
-        keep[edge : len(t) - edge] = True
+        window = np.zeros(len(t), dtype=bool)
+        window[edge : len(t) - edge] = True
         W0 = columns(q, qd, qdd, sign, model, parallel).reshape(len(t) * n, -1)
         W0 = W0[:, np.linalg.norm(W0, axis=0) > 0]
-        delay_s, *_ = estimate_delay(t, tau, W0, known(q, qd, qdd), keep, max_delay)
+        delay_s, *_ = estimate_delay(t, tau, W0, known(q, qd, qdd), window, max_delay)
         data = aligned(data, delay_s, edge)
     elif delay is not None and float(delay) != 0.0:
         delay_s = float(delay)
@@ -598,19 +599,32 @@ def identify(
     if method == "irls":
         est, cov, r, w, iterations = irls(W, yv, n)
     elif method in ("iv", "didim"):
-        rest = data.t[0], q[0], qd[0]
 
-        def model_torque(qs, qds, qdds, theta=None):
-            return columns(qs, qds, qdds, None, model)[..., keep] @ theta + known(qs, qds, qdds)
+        def simulated(theta, times, q0, qd0):
+            """The regressor of the model ``theta`` simulated under the controller at ``times``."""
 
-        def instruments(theta):
             def torque(a, b, c):
-                return model_torque(a, b, c, theta)
+                return columns(a, b, c, None, model)[..., keep] @ theta + known(a, b, c)
 
-            qs, qds, qdds = simulate_model(torque, controller, data.t, rest[1], rest[2], control_period)
-            return columns(qs, qds, qdds, None, model)[..., keep].reshape(S * n, -1)
+            qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period)
+            return columns(qs, qds, qdds, None, model)[..., keep].reshape(len(times) * n, -1)
 
-        est, cov, iterations, _ = instrumental_fit(method, W, yv, w, est, instruments)
+        if window.any():
+            # the delay again, against the simulated loop's regressor: the measured W carries the
+            # encoder noise the controller's torque also carries, and that correlation pulls the
+            # least-squares profile's minimum away from the true delay
+            rq, rqd, rqdd, rtau, *_ = arrays(raw)
+            Z0 = simulated(est, np.asarray(raw.t), rq[0], rqd[0])
+            delay_s, *_ = estimate_delay(np.asarray(raw.t), rtau, Z0, known(rq, rqd, rqdd), window, max_delay)
+            data = aligned(raw, delay_s, edge)
+            q, qd, qdd, tau, sign, parallel = arrays(data)
+            yv = (tau - known(q, qd, qdd)).reshape(S * n)
+            W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)[:, keep]
+            seen = identifiability(W, names)
+            est, cov, r = least_squares(W, yv, n, w)
+        est, cov, iterations, _ = instrumental_fit(
+            method, W, yv, w, est, lambda theta: simulated(theta, data.t, q[0], qd[0])
+        )
         r = (yv - W @ est).reshape(S, n)
     cond = float(np.linalg.cond(W * w[:, None]))
     std = np.sqrt(np.maximum(np.diag(cov), 0.0))
