@@ -290,3 +290,22 @@ def test_excitation_optimised_for_the_drive_train_within_torque_limits():
     assert an.excitation_condition(robot, held, samples=60, **drive) < 100
     with pytest.raises(ValueError, match="torque limits must be positive"):
         an.optimize_excitation(robot, limits=dict(tau=[0.0, 4.0]), **options)
+
+
+def test_report_and_consistent_fit_carry_the_drive_train(prior, tmp_path):
+    from kinedyn.report import identification_html
+    from kinedyn.report.identification import identification_data
+
+    pytest.importorskip("cvxpy")
+    data = log(arm(symmetric=True), delay=0.003, noise=0.01, stribeck=True, offset=True)
+    result = an.identify(prior, data, friction="stribeck", offset=True, armature=True, delay="estimate", method="irls")
+    d = identification_data(result)
+    assert d["method"] == "irls" and d["delay"] == pytest.approx(0.003, abs=2e-4)
+    assert [s["velocity"] for s in d["stribeck"]] == pytest.approx(VST, rel=0.05)
+    page = identification_html(result)
+    assert "iteratively reweighted least squares" in page and "ms behind the positions" in page
+    assert "static - Coulomb [N m]" in page
+    consistent = an.identify(prior, data, friction="stribeck", offset=True, armature=True, delay=0.003, consistent=True)
+    assert np.linalg.eigvalsh(consistent.mass_matrix(data.q[::100])).min() > 0
+    for j in range(2):
+        assert friction_of(consistent, j, "stribeck") == pytest.approx(STRIBECK[j], rel=0.1)
