@@ -129,3 +129,37 @@ def test_iv_estimates_the_delay_against_the_simulated_loop(experiment):
     assert abs(ols.delay - 0.003) > 1e-3  # off by more than a millisecond
     assert iv.delay == pytest.approx(0.003, abs=3e-4)
     assert np.all(np.abs(inertias(iv) / inertias(truth) - 1) < 0.06)
+
+
+def test_iv_falls_back_on_the_prior_when_the_start_cannot_be_simulated():
+    """Any simulable model gives valid instruments: a least-squares start that diverges is replaced
+    by the prior's; a later iterate that diverges ends the iterations on the last instruments."""
+    from kinedyn.analysis.closed_loop import instrumental_fit
+
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(20000, 3))  # the noise-free regressor
+    theta = np.array([1.0, -2.0, 0.5])
+    W = X + 0.3 * rng.normal(size=X.shape)  # measured with noise: OLS attenuated
+    y = X @ theta + 0.01 * rng.normal(size=len(X))
+
+    def instruments(t):
+        if t[0] < 0:  # "diverges"
+            raise ValueError("the identified model diverges under the controller at t = 1 s")
+        return X
+
+    est, _, it, _, note = instrumental_fit("iv", W, y, np.ones(len(X)), -theta, instruments, fallback=theta)
+    assert "the first instruments are the prior model's" in note
+    ols = np.linalg.lstsq(W, y, rcond=None)[0]
+    assert np.all(np.abs(ols) < 0.95 * np.abs(theta))  # attenuated by the noise in W
+    assert np.allclose(est, theta, atol=0.02) and it >= 1
+    with pytest.raises(ValueError, match="diverges"):
+        instrumental_fit("iv", W, y, np.ones(len(X)), -theta, instruments)
+    flips = iter([False, True, True])
+
+    def later(t):
+        if next(flips):
+            raise ValueError("diverges at t = 2 s")
+        return X
+
+    est, _, it, _, note = instrumental_fit("iv", W, y, np.ones(len(X)), theta, later, tol=0.0)
+    assert it == 1 and "iteration 2 could not be simulated" in note and np.allclose(est, theta, atol=0.02)

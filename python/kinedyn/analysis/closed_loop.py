@@ -100,21 +100,41 @@ def instrumental_fit(
     instruments: Callable,
     iterations: int = 6,
     tol: float = 0.02,
+    fallback: np.ndarray | None = None,
 ):
     """IDIM-IV (``kind='iv'``) or DIDIM (``'didim'``) from ``start``; ``instruments(theta)`` returns
     the stacked regressor of the model simulated with ``theta``. It stops when the estimate moves by
     less than ``tol`` (relative) or after ``iterations``: any noise-free model's motion gives valid
     instruments, so iterating only sharpens them, and IV's estimate keeps moving within its own
-    standard deviation from one simulation to the next (Janot et al. stop on a few per cent). Returns (estimate, covariance,
-    iterations, relative change of the last iteration)."""
+    standard deviation from one simulation to the next (Janot et al. stop on a few per cent).
+    An estimate that cannot be simulated (a mass matrix not positive definite along the motion, as
+    a least-squares start on poorly excited data may have): the first simulation falls back on
+    ``fallback`` (the prior model's parameters: any simulable model gives valid instruments), a later
+    one ends the iterations on the last instruments. Returns (estimate, covariance, iterations,
+    relative change of the last iteration, a note of a fallback or None)."""
     w = weights
     Ww, yw = W * w[:, None], y * w
     est = start
     change = np.inf
     it = 0
+    note = None
+    Zw = None
     while it < iterations:
         it += 1
-        Zw = instruments(est) * w[:, None]
+        try:
+            Zw = instruments(est) * w[:, None]
+        except ValueError as e:
+            if Zw is None and fallback is not None:
+                note = (
+                    f"the least-squares start could not be simulated ({e}); the first instruments are the prior model's"
+                )
+                Zw = instruments(fallback) * w[:, None]
+            elif Zw is None:
+                raise
+            else:
+                note = f"iteration {it} could not be simulated ({e}); stopped on the instruments of iteration {it - 1}"
+                it -= 1
+                break
         if kind == "iv":
             new = np.linalg.lstsq(Zw.T @ Ww, Zw.T @ yw, rcond=None)[0]
         else:
@@ -133,4 +153,4 @@ def instrumental_fit(
         r = yw - Zw @ est
         s2 = float(r @ r) / dof
         cov = s2 * np.linalg.pinv(Zw.T @ Zw)
-    return est, cov, it, change
+    return est, cov, it, change, note

@@ -51,13 +51,12 @@ from .estimators import (
     irls,
     joint_noise,
     least_squares,
-    shift_torques,
     stribeck_search,
     unseparable_mask,
 )
 from .friction import FrictionModel, parse_friction
 from .logs import Log, load_log
-from .measurements import Measurements, Validation, excitation, simulate_measurements
+from .measurements import Measurements, Validation, aligned, excitation, simulate_measurements
 from .parameters import (
     RotorEstimate,
     base_parameters_with_rotors,
@@ -139,6 +138,8 @@ class Identification:
     identifiability: Identifiability | None = field(default=None, repr=False)
     #: standard deviation of each joint's Stribeck velocity (Gauss-Newton, with the linear parameters)
     stribeck_velocity_std: np.ndarray | None = None
+    #: what the estimator had to do differently (e.g. IV's fallback on the prior model's instruments)
+    notes: tuple = ()
 
     @property
     def consistent(self) -> bool:
@@ -359,6 +360,8 @@ class Identification:
         )
         if self.iterations:
             d.update(iterations=self.iterations)
+        if self.notes:
+            d.update(notes=list(self.notes))
         if self.identifiability is not None:
             d.update(identifiability=self.identifiability.to_dict())
         if self.stribeck:
@@ -407,26 +410,6 @@ class Identification:
         for k, nm in enumerate(self.friction_names):
             lines.append(f"  {nm:<22} {self.friction_estimates[k]: .8g} +- {self.friction_std[k]:.2g}")
         return "\n".join(lines)
-
-
-def aligned(data, delay: float, edge: int | None = None):
-    """A copy of ``data`` (Log or Measurements) with its torques read at ``t + delay`` and ``edge``
-    samples (default: those the shift reads past) dropped at each end."""
-    t = np.asarray(data.t, dtype=float)
-    if edge is None:
-        edge = int(np.ceil(abs(delay) / float(np.median(np.diff(t))))) + 1
-    if 2 * edge >= len(t) - 10:
-        raise ValueError(f"a delay of {delay:g} s leaves too few samples of the {len(t)} in the data")
-    sl = slice(edge, len(t) - edge)
-    tau = shift_torques(t, np.asarray(data.tau, dtype=float), delay)
-    changes: dict = {k: np.asarray(getattr(data, k))[sl] for k in ("t", "q", "qd", "qdd")}
-    changes["tau"] = tau[sl]
-    if isinstance(data, Measurements):
-        changes["tau_true"] = np.asarray(data.tau_true)[sl]
-    elif data.filtered_sign is not None:
-        changes["filtered_sign"] = data.filtered_sign[sl]
-        changes["window"] = data.subset(sl.start, sl.stop)
-    return dc_replace(data, **changes)
 
 
 def _resolve_method(method: str, weighted: bool, controller) -> str:
@@ -594,6 +577,7 @@ def identify(
     sig = joint_noise(r, W.shape[1])
     w = np.ones(S * n) if method == "ols" else np.tile(1.0 / sig, S)
     iterations = 0
+    note = None
     if method in ("wls", "iv", "didim"):
         est, cov, r = least_squares(W, yv, n, w)
     if method == "irls":
@@ -609,12 +593,17 @@ def identify(
             qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period)
             return columns(qs, qds, qdds, None, model)[..., keep].reshape(len(times) * n, -1)
 
+        # the prior model's parameters (the friction from the fit): simulable, so valid instruments
+        prior = np.concatenate([np.asarray(base.values, dtype=float)[used], est[int(used.sum()) :]])
         if window.any():
             # the delay again, against the simulated loop's regressor: the measured W carries the
             # encoder noise the controller's torque also carries, and that correlation pulls the
             # least-squares profile's minimum away from the true delay
             rq, rqd, rqdd, rtau, *_ = arrays(raw)
-            Z0 = simulated(est, np.asarray(raw.t), rq[0], rqd[0])
+            try:
+                Z0 = simulated(est, np.asarray(raw.t), rq[0], rqd[0])
+            except ValueError:  # a least-squares start that cannot be simulated: the prior's instruments
+                Z0 = simulated(prior, np.asarray(raw.t), rq[0], rqd[0])
             delay_s, *_ = estimate_delay(np.asarray(raw.t), rtau, Z0, known(rq, rqd, rqdd), window, max_delay)
             data = aligned(raw, delay_s, edge)
             q, qd, qdd, tau, sign, parallel = arrays(data)
@@ -622,8 +611,8 @@ def identify(
             W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)[:, keep]
             seen = identifiability(W, names)
             est, cov, r = least_squares(W, yv, n, w)
-        est, cov, iterations, _ = instrumental_fit(
-            method, W, yv, w, est, lambda theta: simulated(theta, data.t, q[0], qd[0])
+        est, cov, iterations, _, note = instrumental_fit(
+            method, W, yv, w, est, lambda theta: simulated(theta, data.t, q[0], qd[0]), fallback=prior
         )
         r = (yv - W @ est).reshape(S, n)
     cond = float(np.linalg.cond(W * w[:, None]))
@@ -665,6 +654,7 @@ def identify(
             iterations=iterations,
             identifiability=seen,
             stribeck_velocity_std=vstd,
+            notes=() if note is None else (note,),
             **extra,
         )
 

@@ -5,22 +5,24 @@ identified model on a log (measured against predicted torques).
   so data can be taken over whole periods (:func:`excitation`).
 - Measurements: q, qd, qdd sampled along the reference and ``tau = rnea(q, qd, qdd)`` plus Gaussian
   noise of standard deviation ``noise`` per joint (:func:`simulate_measurements`).
+- A log's torques aligned with its positions by a delay (:func:`aligned`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..simulate.control import Fourier
+from .estimators import shift_torques
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..robot import Robot
 
-__all__ = ["Measurements", "Validation", "excitation", "simulate_measurements"]
+__all__ = ["Measurements", "Validation", "excitation", "simulate_measurements", "aligned"]
 
 
 @dataclass
@@ -119,3 +121,23 @@ def simulate_measurements(
     rng = np.random.default_rng(seed)
     tau = tau_true + rng.normal(size=tau_true.shape) * sigma
     return Measurements(t, q, qd, qdd, tau, tau_true, sigma)
+
+
+def aligned(data, delay: float, edge: int | None = None):
+    """A copy of ``data`` (Log or Measurements) with its torques read at ``t + delay`` and ``edge``
+    samples (default: those the shift reads past) dropped at each end."""
+    t = np.asarray(data.t, dtype=float)
+    if edge is None:
+        edge = int(np.ceil(abs(delay) / float(np.median(np.diff(t))))) + 1
+    if 2 * edge >= len(t) - 10:
+        raise ValueError(f"a delay of {delay:g} s leaves too few samples of the {len(t)} in the data")
+    sl = slice(edge, len(t) - edge)
+    tau = shift_torques(t, np.asarray(data.tau, dtype=float), delay)
+    changes: dict = {k: np.asarray(getattr(data, k))[sl] for k in ("t", "q", "qd", "qdd")}
+    changes["tau"] = tau[sl]
+    if isinstance(data, Measurements):
+        changes["tau_true"] = np.asarray(data.tau_true)[sl]
+    elif data.filtered_sign is not None:
+        changes["filtered_sign"] = data.filtered_sign[sl]
+        changes["window"] = data.subset(sl.start, sl.stop)
+    return replace(data, **changes)
