@@ -126,6 +126,7 @@ def _fit_lines(d: dict) -> list[str]:
     ]
     if d.get("delay"):
         lines.append(f"torques {fmt(1e3 * d['delay'], 4)} ms behind the positions (aligned before the fit)")
+    lines.extend(d.get("notes", []))
     for group in d.get("identifiability", {}).get("unseparable", []):
         lines.append(f"not separable by the data (only a combination is identified): {', '.join(group)}")
     if d.get("consistent"):
