@@ -108,7 +108,9 @@ def main() -> None:
     ap.add_argument("--cutoff", type=float, default=10.0)
     ap.add_argument("--methods", nargs="+", default=["ols", "wls", "irls", "iv", "didim"])
     args = ap.parse_args()
-    print("| arm | data | encoder noise (rad) | method | parameter error (median) | held-out torque error (median) | time / fit |")
+    print(
+        "| arm | data | encoder noise (rad) | method | parameter error (median) | held-out torque error (median) | time / fit |"
+    )
     print("|---|---|---|---|---|---|---|")
     for arm in args.arms:
         true, prior, ref, controller = ARMS[arm]()
