@@ -126,8 +126,8 @@ def test_iv_estimates_the_delay_against_the_simulated_loop(experiment):
     options = dict(friction="viscous+coulomb", armature=True, delay="estimate")
     ols = an.identify(prior, delayed, method="ols", **options)
     iv = an.identify(prior, delayed, method="iv", controller=controller, **options)
-    assert abs(ols.delay - 0.003) > 1e-3  # off by more than a millisecond
-    assert iv.delay == pytest.approx(0.003, abs=3e-4)
+    assert abs(ols.delay - 0.003) > 3e-3  # off by more than 3 ms (the sample period is 19 ms)
+    assert iv.delay == pytest.approx(0.003, abs=1e-3)
     assert np.all(np.abs(inertias(iv) / inertias(truth) - 1) < 0.06)
 
 

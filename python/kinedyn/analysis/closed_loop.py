@@ -21,6 +21,9 @@ acceleration follows ``v``: the estimated inertias come out too small.
   Gauss-Newton step with that regressor is the linear least squares ``theta = argmin |Z theta - y|``,
   iterated with a new simulation until it stops moving. Covariance ``s^2 (Z^T Z)^-1``.
 
+On a filtered log the simulated regressor goes through the log's low-pass at the control rate
+before it is read at the log's samples (the parallel filtering its torques saw: a Coulomb column's
+jump smeared alike), and the filter's start-up at either end of the simulated span gets no weight.
 Both weight each joint's rows by its noise level from the first fit (Gautier & Poignet 2001), as
 Janot et al. do. The simulation (:func:`simulate_model`) runs the model's inverse dynamics only (the
 estimate need not be a physical robot, only have a positive-definite M along the motion): the
@@ -49,12 +52,20 @@ def _forward(torque: Callable, q: np.ndarray, qd: np.ndarray, u: np.ndarray) -> 
 
 
 def simulate_model(
-    torque: Callable, controller: Callable, t: np.ndarray, q0, qd0, period: float = 1e-3, max_speed: float = 1e3
+    torque: Callable,
+    controller: Callable,
+    t: np.ndarray,
+    q0,
+    qd0,
+    period: float = 1e-3,
+    max_speed: float = 1e3,
+    dense: bool = False,
 ):
     """The model ``torque(q, qd, qdd)`` (batched (S, n) -> (S, n)) under ``controller(t, q, qd)``, from
     ``(q0, qd0)`` at ``t[0]`` to ``t[-1]``, the controller held over each ``period``; q, qd, qdd at the
     times ``t``. ValueError naming the time where the motion diverges or M stops being invertible
-    (an estimate that cannot be simulated)."""
+    (an estimate that cannot be simulated). ``dense``: (grid, q, qd, qdd) at every control period
+    instead."""
     t = np.asarray(t, dtype=float)
     steps = int(np.ceil((t[-1] - t[0]) / period - 1e-9))
     grid = t[0] + period * np.arange(steps + 1)
@@ -85,6 +96,8 @@ def simulate_model(
                 f"{max_speed:g}): its mass matrix is not positive definite along the motion, or the controller cannot "
                 "hold it; try consistent=True or method='ols'"
             )
+    if dense:
+        return grid, Qs, Vs, As
     out = []
     for X in (Qs, Vs, As):
         out.append(np.column_stack([np.interp(t, grid, X[:, j]) for j in range(n)]))

@@ -590,29 +590,44 @@ def identify(
             def torque(a, b, c):
                 return columns(a, b, c, None, model)[..., keep] @ theta + known(a, b, c)
 
-            qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period)
-            return columns(qs, qds, qdds, None, model)[..., keep].reshape(len(times) * n, -1)
+            if getattr(raw, "cutoff", None) is None:
+                qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period)
+                return columns(qs, qds, qdds, None, model)[..., keep].reshape(len(times) * n, -1)
+            # a filtered log: the simulated regressor through the log's low-pass, as its torques
+            # went (the Coulomb columns' jumps smeared alike), then read at the log's samples
+            grid, qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period, dense=True)
+            Z = raw.lowpass(columns(qs, qds, qdds, None, model)[..., keep], 1.0 / control_period)
+            Z = Z.reshape(len(grid), -1)
+            return np.column_stack([np.interp(times, grid, z) for z in Z.T]).reshape(len(times) * n, -1)
 
         # the prior model's parameters (the friction from the fit): simulable, so valid instruments
         prior = np.concatenate([np.asarray(base.values, dtype=float)[used], est[int(used.sum()) :]])
+        settle = 3.0 / raw.cutoff if getattr(raw, "cutoff", None) else 0.0
+
+        def settled(times):
+            """Samples past the filter's start-up at either end of a simulated span (weight 0 else)."""
+            return (times >= times[0] + settle) & (times <= times[-1] - settle)
+
+        # the delay again, against the simulated loop's regressor: the measured W carries the encoder
+        # noise the controller's torque also carries, and that correlation pulls the least-squares
+        # profile's minimum away from the true delay (the simulated motion's phase follows the model
+        # simulated, so what is left is of the order of the start's tracking lag error)
+        rq, rqd, rqdd, rtau, *_ = arrays(raw)
+        rt = np.asarray(raw.t)
         if window.any():
-            # the delay again, against the simulated loop's regressor: the measured W carries the
-            # encoder noise the controller's torque also carries, and that correlation pulls the
-            # least-squares profile's minimum away from the true delay
-            rq, rqd, rqdd, rtau, *_ = arrays(raw)
             try:
-                Z0 = simulated(est, np.asarray(raw.t), rq[0], rqd[0])
-            except ValueError:  # a least-squares start that cannot be simulated: the prior's instruments
-                Z0 = simulated(prior, np.asarray(raw.t), rq[0], rqd[0])
-            delay_s, *_ = estimate_delay(np.asarray(raw.t), rtau, Z0, known(rq, rqd, rqdd), window, max_delay)
+                Z0 = simulated(est, rt, rq[0], rqd[0])
+            except ValueError:  # a start that cannot be simulated: the prior's instruments
+                Z0 = simulated(prior, rt, rq[0], rqd[0])
+            delay_s, *_ = estimate_delay(rt, rtau, Z0, known(rq, rqd, rqdd), window & settled(rt), max_delay)
             data = aligned(raw, delay_s, edge)
             q, qd, qdd, tau, sign, parallel = arrays(data)
             yv = (tau - known(q, qd, qdd)).reshape(S * n)
             W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)[:, keep]
             seen = identifiability(W, names)
-            est, cov, r = least_squares(W, yv, n, w)
+        wz = w * np.repeat(settled(np.asarray(data.t)), n)
         est, cov, iterations, _, note = instrumental_fit(
-            method, W, yv, w, est, lambda theta: simulated(theta, data.t, q[0], qd[0]), fallback=prior
+            method, W, yv, wz, est, lambda theta: simulated(theta, data.t, q[0], qd[0]), fallback=prior
         )
         r = (yv - W @ est).reshape(S, n)
     cond = float(np.linalg.cond(W * w[:, None]))

@@ -81,6 +81,14 @@ class Log:
         raw_rate = self.rate * self.decimation
         return _lowpass(column(self.raw_qd), self.cutoff, raw_rate, self.order)[start:stop:step]
 
+    def lowpass(self, x: np.ndarray, rate: float) -> np.ndarray:
+        """``x`` sampled at ``rate`` Hz (along axis 0) through this log's zero-phase low-pass (the
+        unchanged ``x`` for a log that was not filtered): to filter a simulated regressor as the
+        log's torques were."""
+        if self.cutoff is None:
+            return x
+        return _lowpass(x, self.cutoff, rate, self.order)
+
     def subset(self, start: int, stop: int) -> tuple | None:
         """The window of the samples ``start:stop`` of this log (for a copy holding only those)."""
         if self.window is None:
