@@ -165,6 +165,7 @@ def instrumental_fit(
         est = new
         if change < tol:
             break
+    assert Zw is not None  # at least one iteration ran (iterations >= 1)
     dof = max(len(y) - W.shape[1], 1)
     if kind == "iv":
         r = yw - Ww @ est

@@ -309,7 +309,7 @@ class Identification:
         sign = getattr(data, "filtered_sign", None)
         if sign is not None and self.friction.terms:  # the log's torques went through its filter
             predicted = predicted - self.friction.torque(data.qd, self.friction_estimates)
-            F = self.friction.regressor(np.asarray(data.qd), sign, data.parallel)
+            F = self.friction.regressor(np.asarray(data.qd), sign, getattr(data, "parallel", None))
             predicted = predicted + F @ self.friction_estimates
         return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
 
@@ -584,7 +584,7 @@ def identify(
         est, cov, r, w, iterations = irls(W, yv, n)
     elif method in ("iv", "didim"):
 
-        def simulated(theta, times, q0, qd0):
+        def simulated_regressor(theta, times, q0, qd0):
             """The regressor of the model ``theta`` simulated under the controller at ``times``."""
 
             def torque(a, b, c):
@@ -616,9 +616,9 @@ def identify(
         rt = np.asarray(raw.t)
         if window.any():
             try:
-                Z0 = simulated(est, rt, rq[0], rqd[0])
+                Z0 = simulated_regressor(est, rt, rq[0], rqd[0])
             except ValueError:  # a start that cannot be simulated: the prior's instruments
-                Z0 = simulated(prior, rt, rq[0], rqd[0])
+                Z0 = simulated_regressor(prior, rt, rq[0], rqd[0])
             delay_s, *_ = estimate_delay(rt, rtau, Z0, known(rq, rqd, rqdd), window & settled(rt), max_delay)
             data = aligned(raw, delay_s, edge)
             q, qd, qdd, tau, sign, parallel = arrays(data)
@@ -627,7 +627,7 @@ def identify(
             seen = identifiability(W, names)
         wz = w * np.repeat(settled(np.asarray(data.t)), n)
         est, cov, iterations, _, note = instrumental_fit(
-            method, W, yv, wz, est, lambda theta: simulated(theta, data.t, q[0], qd[0]), fallback=prior
+            method, W, yv, wz, est, lambda theta: simulated_regressor(theta, data.t, q[0], qd[0]), fallback=prior
         )
         r = (yv - W @ est).reshape(S, n)
     cond = float(np.linalg.cond(W * w[:, None]))
