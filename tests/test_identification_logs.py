@@ -205,8 +205,8 @@ def test_pseudo_inertia_matches_the_mass_distribution():
 
 def test_identify_errors(true_robot, logs):
     (cols, _), _ = logs
-    with pytest.raises(ValueError, match=r"unknown friction term 'stribeck'"):
-        an.identify(kd.robots.get("ur5"), cols, friction="viscous+stribeck")
+    with pytest.raises(ValueError, match=r"unknown friction term 'dahl'"):
+        an.identify(kd.robots.get("ur5"), cols, friction="viscous+dahl")
     with pytest.raises(an.LogError, match=r"robot has 3 joints"):
         an.identify(kd.robots.get("elbow_3r"), cols)
     with pytest.raises(ValueError, match=r"the log has 6 joints but robot 'elbow_3r' has 3"):

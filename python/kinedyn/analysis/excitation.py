@@ -12,19 +12,28 @@ periods and the trajectory starts where it ends; it starts (and ends) at rest wh
 a_il = 0`` and ``qdd(0) = wf sum_l l b_il = 0``, which this module builds in by solving for the
 first harmonic's ``a_i1`` and ``b_i1``. The free coefficients are chosen by SLSQP
 (``scipy.optimize.minimize``) to minimise the condition number of the base regressor stacked over
-the period, subject to the position, velocity and acceleration limits at the sampled instants
-(Swevers' criterion; the noise in the estimates grows with cond(W)).
+the period, subject to the position, velocity, acceleration and torque limits at the sampled
+instants (Swevers' criterion; the noise in the estimates grows with cond(W)).
+
+The drive train joins the criterion when it is estimated (``armature=True``, ``friction=...``): the
+armatures' columns ``qdd_j`` and the friction columns (:mod:`.friction`; the Coulomb sign smoothed
+as ``tanh(qd / 0.05 rad/s)`` so that the objective stays smooth for SLSQP) stand beside the rigid
+body's, the base parameters found for them together (:func:`~.parameters.base_parameters_with_rotors`),
+and each column is scaled to unit norm so that the units of the parameters do not weigh.
 """
 
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._ui.files import replacing
 from ..simulate.control import Fourier
+from .friction import parse_friction
+from .parameters import base_parameters_with_rotors, rotor_regressor
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -43,13 +52,42 @@ def _from_free(x: np.ndarray, n: int, L: int) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
-def excitation_condition(robot: Robot, reference, samples: int = 100, base=None) -> float:
-    """cond(W_base) of ``reference`` sampled at ``samples`` instants over one period."""
-    base = robot.base_parameters() if base is None else base
+def _criterion(robot: Robot, armature: bool, friction):
+    """W(q, qd, qdd) (S n, p) of the parameters estimated: the base columns (with every joint's
+    armature when ``armature``), then the friction columns; scaled by the caller."""
+    n = robot.n
+    joints = tuple(range(n)) if armature else ()
+    base = base_parameters_with_rotors(robot, joints) if armature else robot.base_parameters()
+    model = parse_friction(friction, smoothing=0.05) if friction else None
+    if model is not None and "stribeck" in model.terms:
+        model = replace(model, velocities=(0.1,) * n)
+
+    def W(q, qd, qdd):
+        Y = robot.regressor(q, qd, qdd)
+        if joints:
+            Y = np.concatenate([Y, rotor_regressor(qdd, joints, n)], axis=2)
+        Y = Y[..., base.indices]
+        if model is not None and model.terms:
+            Y = np.concatenate([Y, model.regressor(qd)], axis=2)
+        return Y.reshape(-1, Y.shape[2])
+
+    return W
+
+
+def excitation_condition(
+    robot: Robot, reference, samples: int = 100, base=None, armature: bool = False, friction=None
+) -> float:
+    """cond(W) of ``reference`` sampled at ``samples`` instants over one period: the base regressor
+    (``base``: given base parameters), or with ``armature``/``friction`` the drive-train columns beside
+    it, each column scaled to unit norm (see the module docstring)."""
     t = np.arange(samples) * reference.period / samples
     q, qd, qdd = (np.ascontiguousarray(v) for v in reference(t))
-    W = robot.regressor(q, qd, qdd)[..., base.indices].reshape(-1, base.count)
-    return float(np.linalg.cond(W))
+    if not armature and not friction:
+        base = robot.base_parameters() if base is None else base
+        W = robot.regressor(q, qd, qdd)[..., base.indices].reshape(-1, base.count)
+        return float(np.linalg.cond(W))
+    W = _criterion(robot, armature, friction)(q, qd, qdd)
+    return float(np.linalg.cond(W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)))
 
 
 def optimize_excitation(
@@ -60,11 +98,16 @@ def optimize_excitation(
     samples: int = 100,
     seed: int = 0,
     maxiter: int = 200,
+    armature: bool = False,
+    friction=None,
 ) -> Fourier:
     """A Fourier excitation at rest at t = 0 (and so at every period's end) minimising cond(Y_base)
     within ``limits``: a dict with ``q`` ((lower, upper) arrays; default the robot's finite joint
-    limits, else +-pi about 0), ``qd`` and ``qdd`` (per joint maxima; default 1.5 rad/s and 5 rad/s^2).
-    The start is the SLSQP optimisation from a random (seeded) trajectory scaled into the limits."""
+    limits, else +-pi about 0), ``qd`` and ``qdd`` (per joint maxima; default 1.5 rad/s and 5 rad/s^2)
+    and ``tau`` (per joint maxima of the robot's inverse-dynamics torque; default its finite effort
+    limits, else none). ``armature``, ``friction``: the drive-train columns estimated with it join the
+    criterion (module docstring). The start is the SLSQP optimisation from a random (seeded)
+    trajectory scaled into the limits."""
     from scipy.optimize import minimize  # scipy loads only when an excitation is optimised
 
     if harmonics < 2:
@@ -82,6 +125,11 @@ def optimize_excitation(
         raise ValueError(f"position limits: every lower limit must lie below its upper limit, got {lo} and {hi}")
     qd_max = np.broadcast_to(np.asarray(limits.get("qd", 1.5), dtype=float), (n,))
     qdd_max = np.broadcast_to(np.asarray(limits.get("qdd", 5.0), dtype=float), (n,))
+    effort = np.array([float(j.effort_limit) for j in robot.joints])
+    tau_max = np.broadcast_to(np.asarray(limits.get("tau", effort), dtype=float), (n,))
+    torque_limited = bool(np.any(np.isfinite(tau_max)))
+    if np.any(~(tau_max > 0)):
+        raise ValueError(f"torque limits must be positive (inf: none), got {tau_max}")
     q0 = (lo + hi) / 2
     half = 0.95 * (hi - lo) / 2  # a small margin inside the position limits
     wf = 2 * np.pi / period
@@ -99,12 +147,16 @@ def optimize_excitation(
         qdd = -(S * w) @ a.T + (C * w) @ b.T
         return q, qd, qdd
 
+    drive = _criterion(robot, armature, friction) if (armature or friction) else None
+
     def objective(x):
         q, qd, qdd = motion(x)
-        W = robot.regressor(np.ascontiguousarray(q), np.ascontiguousarray(qd), np.ascontiguousarray(qdd))[
-            ..., base.indices
-        ]
-        W = W.reshape(-1, base.count)
+        q, qd, qdd = (np.ascontiguousarray(v) for v in (q, qd, qdd))
+        if drive is not None:
+            W = drive(q, qd, qdd)
+            W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
+        else:
+            W = robot.regressor(q, qd, qdd)[..., base.indices].reshape(-1, base.count)
         # cond(W)^2 = cond(W^T W): the eigenvalues of the small Gram matrix cost a fraction of an SVD of
         # the tall W (which also ran 30x slower than this under a multi-threaded BLAS on a busy
         # machine); they are accurate while cond(W) is well below 1/sqrt(eps) ~ 1e8, else the SVD decides
@@ -114,15 +166,20 @@ def optimize_excitation(
         sv = np.linalg.svd(W, compute_uv=False)
         return float(np.log(sv[0] / max(sv[-1], 1e-300)))
 
+    finite_tau = np.where(np.isfinite(tau_max), tau_max, 1.0)
+
     def margins(x):
         q, qd, qdd = motion(x)
-        return np.concatenate(
-            [
-                (half - np.abs(q - q0)).ravel() / half.max(),
-                (qd_max - np.abs(qd)).ravel() / qd_max.max(),
-                (qdd_max - np.abs(qdd)).ravel() / qdd_max.max(),
-            ]
-        )
+        parts = [
+            (half - np.abs(q - q0)).ravel() / half.max(),
+            (qd_max - np.abs(qd)).ravel() / qd_max.max(),
+            (qdd_max - np.abs(qdd)).ravel() / qdd_max.max(),
+        ]
+        if torque_limited:  # the prior model's torque along the trajectory, joint by joint
+            tau = robot.inverse_dynamics(*(np.ascontiguousarray(v) for v in (q, qd, qdd)))
+            slack = np.where(np.isfinite(tau_max), (finite_tau - np.abs(tau)) / finite_tau, 1.0)
+            parts.append(slack.ravel())
+        return np.concatenate(parts)
 
     rng = np.random.default_rng(seed)
     x0 = rng.normal(size=2 * n * (L - 1))
@@ -133,6 +190,8 @@ def optimize_excitation(
         float((qdd_max / np.maximum(np.abs(qdd).max(axis=0), 1e-12)).min()),
     )
     x0 = 0.9 * shrink * x0
+    while torque_limited and np.min(margins(x0)) < 0 and shrink > 1e-6:  # slower until within the torques
+        x0, shrink = 0.7 * x0, 0.7 * shrink
     result = minimize(
         objective,
         x0,

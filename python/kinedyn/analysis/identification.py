@@ -36,14 +36,27 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from dataclasses import replace as dc_replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..display import identification_html
-from ..simulate.control import Fourier
+from .closed_loop import instrumental_fit, simulate_model
+from .estimators import (
+    METHODS,
+    Identifiability,
+    estimate_delay,
+    identifiability,
+    irls,
+    joint_noise,
+    least_squares,
+    stribeck_search,
+    unseparable_mask,
+)
 from .friction import FrictionModel, parse_friction
 from .logs import Log, load_log
+from .measurements import Measurements, Validation, aligned, excitation, simulate_measurements
 from .parameters import (
     RotorEstimate,
     base_parameters_with_rotors,
@@ -73,20 +86,9 @@ __all__ = [
     "with_inertial_parameters",
     "base_parameters_with_rotors",
     "geared_joints",
+    "Identifiability",
+    "METHODS",
 ]
-
-
-@dataclass
-class Measurements:
-    """Samples (S,) / (S, n): t, q, qd, qdd, measured torques ``tau`` and the noise-free ``tau_true``."""
-
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    tau: np.ndarray
-    tau_true: np.ndarray
-    noise: np.ndarray
 
 
 @dataclass
@@ -124,8 +126,20 @@ class Identification:
     standard_armature: np.ndarray | None = field(default=None, repr=False)
     #: consistent estimate: the unconstrained (ordinary or weighted least-squares) fit of the same data
     unconstrained: Identification | None = field(default=None, repr=False)
-    #: the samples fitted (a Log or Measurements), for plots and reports
+    #: the samples fitted (a Log or Measurements, its torques aligned by ``delay``), for plots and reports
     data: Any = field(default=None, repr=False)
+    #: the estimator used (:data:`METHODS`, ``auto`` resolved)
+    method: str = "ols"
+    #: seconds the torques lag the positions (estimated or given; the fit reads them at t + delay)
+    delay: float = 0.0
+    #: iterations of an iterative estimator (irls, iv, didim)
+    iterations: int = 0
+    #: what the data can see: scaled cond(W), the groups of parameters it cannot separate
+    identifiability: Identifiability | None = field(default=None, repr=False)
+    #: standard deviation of each joint's Stribeck velocity (Gauss-Newton, with the linear parameters)
+    stribeck_velocity_std: np.ndarray | None = None
+    #: what the estimator had to do differently (e.g. IV's fallback on the prior model's instruments)
+    notes: tuple = ()
 
     @property
     def consistent(self) -> bool:
@@ -154,10 +168,46 @@ class Identification:
             np.abs(self.true_values), 1e-12 * max(1.0, np.abs(self.true_values).max())
         )
 
-    def predict_torque(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
+    @property
+    def exact(self) -> bool:
+        """The fit reproduces the torques to round-off (noise-free data): the standard deviations are
+        then round-off too, and an error divided by one measures nothing."""
+        if self.data is None:
+            return False
+        scale = float(np.sqrt(np.mean(np.asarray(self.data.tau) ** 2)))
+        return bool(np.all(self.residual_rms <= 1e-9 * max(scale, 1e-300)))
+
+    @property
+    def stribeck(self) -> list:
+        """Per joint with a Stribeck term: velocity (and its std), the excess ``Fs - Fc`` and the
+        static level(s) ``Fs`` (one per direction with asymmetric Coulomb friction)."""
+        model = self.friction
+        if "stribeck" not in model.terms or model.velocities is None:
+            return []
+        cols = model.columns()
+        k = len(cols)
+        out = []
+        for j in range(self.nominal.n):
+            c = dict(zip(cols, self.friction_estimates[j * k : (j + 1) * k]))
+            levels = [c["coulomb"]] if "coulomb" in c else [c["coulomb+"], c["coulomb-"]]
+            vstd = None if self.stribeck_velocity_std is None else float(self.stribeck_velocity_std[j])
+            out.append(
+                dict(
+                    joint=self.nominal.joints[j].name,
+                    velocity=float(model.velocities[j]),
+                    velocity_std=vstd,
+                    excess=float(c["stribeck"]),
+                    static=[float(v + c["stribeck"]) for v in levels],
+                )
+            )
+        return out
+
+    def predict_torque(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, offset: bool = True) -> np.ndarray:
         """Torques of the identified model, (n,) or (S, n): rigid body (base regressor times the
         estimates, or the full regressor times the consistent standard parameters) plus the drive
-        terms (the nominal rotor inertia, and the identified or the nominal friction)."""
+        terms (the nominal rotor inertia, and the identified or the nominal friction). The delay is
+        not in it (it is the arm's torque at the given state); ``offset=False`` leaves out the
+        identified torque offsets (a sensor's, not the arm's)."""
         q, qd, qdd = (np.asarray(a, dtype=float) for a in (q, qd, qdd))
         armature = self.nominal.armature.copy()
         armature[list(self.rotor_joints)] = 0.0  # estimated: in the regressor (or standard_armature)
@@ -167,10 +217,9 @@ class Identification:
                 armature[list(self.rotor_joints)] = self.standard_armature
         else:
             rigid = self._regressor(q, qd, qdd)[..., self.base.indices[self._rows()]] @ self.estimates
+        fric = self.friction.torque(qd, self.friction_estimates, offset) if self.friction.terms else 0.0
         if self.friction.known:
-            fric = self.nominal.friction_torque(qd)
-        else:
-            fric = self.friction.torque(qd, self.friction_estimates)
+            fric = fric + self.nominal.friction_torque(qd)
         return rigid + armature * qdd + fric
 
     def _regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -245,19 +294,23 @@ class Identification:
         robot = with_inertial_parameters(self.nominal, pi)
         if rotor:
             robot = with_armatures(robot, dict(zip(rotor, armature)))
-        if self.friction.known or not ({"viscous", "coulomb"} & set(self.friction.terms)):
+        if self.friction.known or not ({"viscous", "coulomb", "asymmetric"} & set(self.friction.terms)):
             return robot
         return with_friction(robot, self.friction, self.friction_estimates)
 
     def validate(self, log, **load_options) -> Validation:
         """Torque prediction on another log (a :class:`Log`, or anything :func:`load_log` reads,
-        processed with ``load_options``): RMS error and R^2 per joint."""
+        processed with ``load_options``): RMS error and R^2 per joint. Its torques are read at
+        ``t + delay`` (the identified delay: the same sensors lag alike), except on the fitted data."""
         data = log if isinstance(log, Measurements) else load_log(log, n=self.nominal.n, **load_options)
+        if self.delay and log is not self.data:
+            data = aligned(data, self.delay)
         predicted = self.predict_torque(data.q, data.qd, data.qdd)
         sign = getattr(data, "filtered_sign", None)
-        if sign is not None and not self.friction.known:  # the log's torques went through its filter
+        if sign is not None and self.friction.terms:  # the log's torques went through its filter
             predicted = predicted - self.friction.torque(data.qd, self.friction_estimates)
-            predicted = predicted + (self.friction.regressor(np.asarray(data.qd), sign) @ self.friction_estimates)
+            F = self.friction.regressor(np.asarray(data.qd), sign, getattr(data, "parallel", None))
+            predicted = predicted + F @ self.friction_estimates
         return Validation(np.asarray(data.t), np.asarray(data.tau), predicted, getattr(data, "source", "<data>"))
 
     def plot(self, log=None, **load_options):
@@ -302,7 +355,17 @@ class Identification:
             residual_rms=self.residual_rms,
             weighted=self.weighted,
             dropped=list(self.dropped),
+            method=self.method,
+            delay=self.delay,
         )
+        if self.iterations:
+            d.update(iterations=self.iterations)
+        if self.notes:
+            d.update(notes=list(self.notes))
+        if self.identifiability is not None:
+            d.update(identifiability=self.identifiability.to_dict())
+        if self.stribeck:
+            d.update(stribeck=self.stribeck)
         if not self.friction.known:
             d.update(
                 relative_std_percent=self.relative_std,
@@ -324,7 +387,10 @@ class Identification:
                 true_values=self.true_values,
                 errors=errors,
                 max_abs_error=float(np.abs(errors).max()),
-                max_error_in_std=float(np.abs(errors / self.std).max()) if np.all(self.std > 0) else None,
+                # on noise-free data the std is round-off, and an error over it measures nothing
+                max_error_in_std=(
+                    float(np.abs(errors / self.std).max()) if np.all(self.std > 0) and not self.exact else None
+                ),
             )
         return d
 
@@ -333,7 +399,8 @@ class Identification:
 
     def __str__(self) -> str:
         lines = [
-            f"{len(self.names)} base parameters, cond(W) = {self.condition_number:.4g}, {'weighted' if self.weighted else 'ordinary'} least squares"
+            f"{len(self.names)} base parameters, cond(W) = {self.condition_number:.4g}, method {self.method}"
+            + (f", torques {1e3 * self.delay:.3g} ms late" if self.delay else "")
         ]
         for k, nm in enumerate(self.names):
             s = f"  {nm:<22} {self.estimates[k]: .8g} +- {self.std[k]:.2g}"
@@ -345,89 +412,18 @@ class Identification:
         return "\n".join(lines)
 
 
-@dataclass
-class Validation:
-    """Measured and predicted torques on a log, with the RMS error and R^2 per joint."""
-
-    t: np.ndarray
-    measured: np.ndarray
-    predicted: np.ndarray
-    source: str = "<data>"
-
-    @property
-    def residuals(self) -> np.ndarray:
-        return self.measured - self.predicted
-
-    @property
-    def rms(self) -> np.ndarray:
-        return np.sqrt(np.mean(self.residuals**2, axis=0))
-
-    @property
-    def r2(self) -> np.ndarray:
-        """1 - SS_res / SS_tot per joint (1: perfect; 0: no better than the mean torque)."""
-        centred = self.measured - self.measured.mean(axis=0)
-        total = np.sum(centred**2, axis=0)
-        return 1.0 - np.sum(self.residuals**2, axis=0) / np.maximum(total, 1e-300)
-
-    def to_dict(self) -> dict:
-        return dict(source=self.source, samples=int(len(self.t)), rms=self.rms, r2=self.r2)
-
-    def plot(self):
-        """A matplotlib Figure: per joint, measured and predicted torque over time, and the residual."""
-        from matplotlib.figure import Figure  # matplotlib loads only when a figure is drawn
-
-        n = self.measured.shape[1]
-        fig = Figure(figsize=(9, 1.8 * n + 0.5))
-        axes = fig.subplots(n, 2, squeeze=False, sharex=True)
-        for j in range(n):
-            ax, rx = axes[j]
-            ax.plot(self.t, self.measured[:, j], lw=0.8, label="measured")
-            ax.plot(self.t, self.predicted[:, j], lw=0.8, ls="--", label="predicted")
-            ax.set_ylabel(f"tau{j + 1}")
-            ax.set_title(f"joint {j + 1}: RMS {self.rms[j]:.3g}, R² {self.r2[j]:.4f}", fontsize=8)
-            rx.plot(self.t, self.residuals[:, j], lw=0.6, color="C3")
-            rx.set_ylabel("residual")
-        axes[0, 0].legend(fontsize=7)
-        axes[-1, 0].set_xlabel("t (s)")
-        axes[-1, 1].set_xlabel("t (s)")
-        fig.tight_layout()
-        return fig
-
-
-def excitation(
-    robot: Robot, harmonics: int = 5, period: float = 10.0, amplitude=0.6, q0: ArrayLike | None = None, seed: int = 0
-) -> Fourier:
-    """A random Fourier excitation for ``robot`` (Swevers et al. 1997): ``harmonics`` harmonics of
-    the base frequency 2 pi / period, each joint's excursion ``amplitude`` about ``q0`` (default: the
-    middle of finite joint limits, else 0)."""
-    robot.require_one_dof_joints("an excitation trajectory (one Fourier series per joint coordinate)")
-    if q0 is None:
-        lo, hi = robot.lower_limits, robot.upper_limits
-        finite = np.isfinite(lo) & np.isfinite(hi)
-        q0 = np.zeros(robot.n)
-        q0[finite] = (lo[finite] + hi[finite]) / 2  # (-inf + inf) would be NaN
-    return Fourier.random(robot.n, harmonics=harmonics, wf=2 * np.pi / period, amplitude=amplitude, q0=q0, seed=seed)
-
-
-def simulate_measurements(
-    robot: Robot, reference, T: float | None = None, rate: float = 100.0, noise=0.0, seed: int = 0
-) -> Measurements:
-    """Sample ``reference`` at ``rate`` Hz over ``T`` seconds (default: two periods of a Fourier
-    reference) and measure torques by inverse dynamics (one native batch call) plus Gaussian noise of
-    standard deviation ``noise`` (scalar or per joint, N m / N)."""
-    if T is None:
-        T = 2 * getattr(reference, "period", 10.0)
-    if not rate > 0 or not T > 0:
-        raise ValueError(f"rate and T must be positive, got rate={rate}, T={T}")
-    t = np.arange(int(round(T * rate))) / rate
-    q, qd, qdd = (np.ascontiguousarray(a) for a in reference(t))
-    tau_true = robot.inverse_dynamics(q, qd, qdd)
-    sigma = np.broadcast_to(np.asarray(noise, dtype=float), (robot.n,)).copy()
-    if np.any(sigma < 0):
-        raise ValueError(f"noise standard deviations must be >= 0, got {noise}")
-    rng = np.random.default_rng(seed)
-    tau = tau_true + rng.normal(size=tau_true.shape) * sigma
-    return Measurements(t, q, qd, qdd, tau, tau_true, sigma)
+def _resolve_method(method: str, weighted: bool, controller) -> str:
+    method = str(method).lower()
+    if method not in METHODS:
+        raise ValueError(f"unknown identification method '{method}': use one of {', '.join(METHODS)}")
+    if method == "auto":
+        return "iv" if controller is not None else ("wls" if weighted else "ols")
+    if method in ("iv", "didim") and controller is None:
+        raise ValueError(
+            f"method '{method}' simulates the identified model under the arm's controller: give controller=(t, q, qd) -> tau "
+            "(the one that ran the experiment, with its reference)"
+        )
+    return method
 
 
 def identify(
@@ -439,69 +435,131 @@ def identify(
     friction=None,
     consistent: bool = False,
     rotor: bool | None = None,
+    armature: bool | None = None,
+    offset: bool = False,
+    delay: float | str | None = None,
+    max_delay: float = 0.02,
+    method: str = "auto",
+    controller=None,
+    control_period: float = 1e-3,
     smoothing: float | None = None,
     regularization: float = 1e-4,
     margin: float = 1e-8,
     solver: str | None = None,
     **load_options,
 ) -> Identification:
-    """Least-squares estimates of ``robot``'s base parameters (and friction) from ``data``.
+    """Estimates of ``robot``'s base parameters and its drive train (armature, friction, offsets, the
+    torque delay) from ``data`` (docs/identification.md).
 
     ``data``: simulated :class:`Measurements`, a :class:`~kinedyn.analysis.logs.Log`, or anything
     :func:`~kinedyn.analysis.load_log` reads (CSV / NPZ path, DataFrame; ``load_options`` go to it).
     ``robot`` gives the kinematics, the rotor inertia (taken as known) and the prior parameters.
-    ``friction``: the terms estimated per joint (``"viscous+coulomb"``, ``"+offset"``, ``"none"``) or
-    ``"known"`` (the robot's own friction subtracted); default ``"known"`` for Measurements,
-    ``"viscous+coulomb"`` for a log. ``smoothing``: Coulomb sign smoothed as tanh(qd / smoothing).
-    ``weighted``: weighted least squares, each joint's rows divided by its noise level estimated from
-    the ordinary fit's residuals. ``consistent``: the physically consistent estimate (see the module
-    docstring: an SDP with every body's pseudo-inertia ``>= margin I``, ``regularization`` the weight
-    of the pull toward ``robot``'s parameters relative to the data term, the armatures kept ``>= 0``).
+    ``friction``: the terms estimated per joint (:mod:`.friction`: ``"viscous+coulomb"``,
+    ``"stribeck"``, ``"viscous+asymmetric"``, ...; ``"none"``) or ``"known"`` (the robot's own friction
+    subtracted); default ``"known"`` for Measurements, ``"viscous+coulomb"`` for a log; ``offset``: add
+    a torque offset per joint. ``smoothing``: Coulomb sign smoothed as tanh(qd / smoothing).
     ``rotor``: estimate the armature ``r^2 J_m`` of every joint whose model has a gear ratio or a
-    rotor inertia (:func:`geared_joints`; see the module docstring), or take it as known (False);
-    default: estimated for a log, known for Measurements."""
+    rotor inertia (:func:`geared_joints`), or take it as known (False); default: estimated for a log,
+    known for Measurements. ``armature=True``: estimate every joint's armature (False: none).
+    ``delay``: None (none), seconds, or ``"estimate"`` (within +-``max_delay``, :mod:`.estimators`).
+    ``method``: ``ols``, ``wls`` (also ``weighted=True``), ``irls``, ``iv`` or ``didim``
+    (:mod:`.closed_loop`: they need the ``controller`` that ran the experiment, run at
+    ``control_period``); ``auto``: ``iv`` when a controller is given, else ``ols`` (``wls`` with
+    ``weighted=True``). ``consistent``: the physically consistent estimate (an SDP with every body's
+    pseudo-inertia ``>= margin I``, ``regularization`` the weight of the pull toward ``robot``'s
+    parameters, the armatures kept ``>= 0``; a least-squares data term, so with ols or wls)."""
     # joint logs hold one number per coordinate and a fixed base; a floating base needs its pose
     # and the contact wrenches in the log, which this workflow does not read
     robot.require_one_dof_joints("identification from joint logs")
     n = robot.n
+    method = _resolve_method(method, weighted, controller)
+    if consistent and method not in ("ols", "wls"):
+        raise ValueError(f"consistent=True fits a least-squares data term: use method 'ols' or 'wls', not '{method}'")
     simulated = isinstance(data, Measurements)
     if not simulated:
         data = data if isinstance(data, Log) else load_log(data, n=n, **load_options)
         if data.n != n:
             raise ValueError(f"the log has {data.n} joints but robot '{robot.name}' has {n}")
-    rotor_joints = geared_joints(robot) if (not simulated if rotor is None else rotor) else ()
+    if armature is not None:
+        rotor_joints = tuple(range(n)) if armature else ()
+    else:
+        rotor_joints = geared_joints(robot) if (not simulated if rotor is None else rotor) else ()
     if base is None:
         base = base_parameters_with_rotors(robot, rotor_joints)
     elif rotor_joints and base.grouping.shape[1] != 10 * n + len(rotor_joints):
         raise ValueError(
-            f"base: {base.grouping.shape[1]} parameters, but the link parameters and the armatures of the geared joints "
+            f"base: {base.grouping.shape[1]} parameters, but the link parameters and the armatures of the joints "
             f"{[robot.joints[j].name for j in rotor_joints]} are {10 * n + len(rotor_joints)} (see base_parameters_with_rotors, or rotor=False)"
         )
-    true_values: np.ndarray | None = None
-    if simulated:
-        model = parse_friction("known" if friction is None else friction, smoothing)
-        true_values = np.asarray(base.values, dtype=float)
-    else:
-        model = parse_friction("viscous+coulomb" if friction is None else friction, smoothing)
-    q, qd, qdd, tau = (np.ascontiguousarray(a, dtype=float) for a in (data.q, data.qd, data.qdd, data.tau))
-    S = q.shape[0]
+    true_values = np.asarray(base.values, dtype=float) if simulated else None
+    model = parse_friction(("known" if simulated else "viscous+coulomb") if friction is None else friction, smoothing)
+    if offset and "offset" not in model.terms:
+        model = dc_replace(model, terms=(*model.terms, "offset"))
+    qd_max = np.maximum(np.abs(np.asarray(data.qd, dtype=float)).max(axis=0), 1e-9)
+    if "stribeck" in model.terms:
+        model = dc_replace(model, velocities=tuple(0.05 * qd_max))
     nr = len(rotor_joints)
-    Yfull = robot.regressor(q, qd, qdd)  # (S, n, 10 n)
-    if nr:  # the armatures' columns after the links' (S, n, 10 n + nr)
-        Yfull = np.concatenate([Yfull, rotor_regressor(qdd, rotor_joints, n)], axis=2)
-    F = model.regressor(qd, getattr(data, "filtered_sign", None))  # (S, n, f)
     known_armature = robot.armature.copy()
     known_armature[list(rotor_joints)] = 0.0
-    y = tau - known_armature * qdd
-    if model.known:
-        y = y - robot.friction_torque(qd)
-    nb, nf = base.count, F.shape[2]
+
+    def columns(q, qd, qdd, sign, model=model, parallel=None):
+        """(S, n, nb + nf): the base regressor (links and estimated armatures), the friction columns."""
+        Y = robot.regressor(q, qd, qdd)
+        if nr:  # the armatures' columns after the links' (S, n, 10 n + nr)
+            Y = np.concatenate([Y, rotor_regressor(qdd, rotor_joints, n)], axis=2)
+        return np.concatenate([Y[..., base.indices], model.regressor(qd, sign, parallel)], axis=2)
+
+    def known(q, qd, qdd):
+        """The torques of the known drive terms, subtracted from the measured ones."""
+        return known_armature * qdd + (robot.friction_torque(qd) if model.known else 0.0)
+
+    def arrays(data):
+        q, qd, qdd, tau = (np.ascontiguousarray(a, dtype=float) for a in (data.q, data.qd, data.qdd, data.tau))
+        return q, qd, qdd, tau, getattr(data, "filtered_sign", None), getattr(data, "parallel", None)
+
+    q, qd, qdd, tau, sign, parallel = arrays(data)
+    raw, edge, window = data, 0, np.zeros(0, dtype=bool)
+    if isinstance(delay, str):
+        if delay.strip().lower() != "estimate":
+            raise ValueError(f"delay must be a number of seconds, None or 'estimate', got {delay!r}")
+        if not max_delay >= 0:
+            raise ValueError(f"max_delay must be >= 0 s, got {max_delay}")
+        t = np.asarray(data.t, dtype=float)
+        edge = int(np.ceil(max_delay / float(np.median(np.diff(t))))) + 1
+        window = np.zeros(len(t), dtype=bool)
+        window[edge : len(t) - edge] = True
+        W0 = columns(q, qd, qdd, sign, model, parallel).reshape(len(t) * n, -1)
+        W0 = W0[:, np.linalg.norm(W0, axis=0) > 0]
+        delay_s, *_ = estimate_delay(t, tau, W0, known(q, qd, qdd), window, max_delay)
+        data = aligned(data, delay_s, edge)
+    elif delay is not None and float(delay) != 0.0:
+        delay_s = float(delay)
+        if not np.isfinite(delay_s):
+            raise ValueError(f"delay must be finite, got {delay}")
+        data = aligned(data, delay_s)
+    else:
+        delay_s = 0.0
+    q, qd, qdd, tau, sign, parallel = arrays(data)
+    S = q.shape[0]
+    y = tau - known(q, qd, qdd)
+    yv = y.reshape(S * n)
+    nb, nf = base.count, n * len(model.columns())
     if S * n <= nb + nf:
         raise ValueError(
             f"{S} samples x {n} joints = {S * n} equations cannot determine {nb} base parameters and {nf} friction coefficients"
         )
-    W = np.concatenate([Yfull[..., base.indices], F], axis=2).reshape(S * n, nb + nf)
-    yv = y.reshape(S * n)
+    if "stribeck" in model.terms:
+        k = len(model.columns())
+        index = [nb + j * k + model.columns().index("stribeck") for j in range(n)]
+        ranges = [(1e-3 * v, 0.5 * v) for v in qd_max]
+        velocities = stribeck_search(
+            lambda v: columns(q, qd, qdd, sign, dc_replace(model, velocities=tuple(v)), parallel).reshape(S * n, -1),
+            yv,
+            index,
+            ranges,
+        )
+        model = dc_replace(model, velocities=tuple(float(v) for v in velocities))
+    W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)
     # a column that is round-off noise on the data carries no information: leave it out
     norms = np.linalg.norm(W, axis=0)
     keep = norms > 1e-9 * norms.max()
@@ -513,40 +571,87 @@ def identify(
     used = keep[:nb]
     dropped = tuple(nm for nm, u in zip(base.names, used) if not u)
     W = W[:, keep]
-    p = W.shape[1]
-    dof = S * n - p
-    est, *_ = np.linalg.lstsq(W, yv, rcond=None)
-    r = (yv - W @ est).reshape(S, n)
-    # per-joint noise (Gautier & Poignet 2001): residual variance of each joint's S equations
-    sig = np.sqrt((r**2).sum(axis=0) / max(S - p / n, 1.0))
-    sig = np.where(sig > 0, sig, max(float(sig.max()), 1e-300))
-    if weighted:
-        w = np.tile(1.0 / sig, S)
-        Ww = W * w[:, None]
-        est, *_ = np.linalg.lstsq(Ww, yv * w, rcond=None)
+    names = tuple(nm for nm, u in zip(base.names, used) if u) + model.names(n)
+    seen = identifiability(W, names)
+    est, cov, r = least_squares(W, yv, n)
+    sig = joint_noise(r, W.shape[1])
+    w = np.ones(S * n) if method == "ols" else np.tile(1.0 / sig, S)
+    iterations = 0
+    note = None
+    if method in ("wls", "iv", "didim"):
+        est, cov, r = least_squares(W, yv, n, w)
+    if method == "irls":
+        est, cov, r, w, iterations = irls(W, yv, n)
+    elif method in ("iv", "didim"):
+
+        def simulated_regressor(theta, times, q0, qd0):
+            """The regressor of the model ``theta`` simulated under the controller at ``times``."""
+
+            def torque(a, b, c):
+                return columns(a, b, c, None, model)[..., keep] @ theta + known(a, b, c)
+
+            if getattr(raw, "cutoff", None) is None:
+                qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period)
+                return columns(qs, qds, qdds, None, model)[..., keep].reshape(len(times) * n, -1)
+            # a filtered log: the simulated regressor through the log's low-pass, as its torques
+            # went (the Coulomb columns' jumps smeared alike), then read at the log's samples
+            grid, qs, qds, qdds = simulate_model(torque, controller, times, q0, qd0, control_period, dense=True)
+            Z = raw.lowpass(columns(qs, qds, qdds, None, model)[..., keep], 1.0 / control_period)
+            Z = Z.reshape(len(grid), -1)
+            return np.column_stack([np.interp(times, grid, z) for z in Z.T]).reshape(len(times) * n, -1)
+
+        # the prior model's parameters (the friction from the fit): simulable, so valid instruments
+        prior = np.concatenate([np.asarray(base.values, dtype=float)[used], est[int(used.sum()) :]])
+        settle = 3.0 / raw.cutoff if getattr(raw, "cutoff", None) else 0.0
+
+        def settled(times):
+            """Samples past the filter's start-up at either end of a simulated span (weight 0 else)."""
+            return (times >= times[0] + settle) & (times <= times[-1] - settle)
+
+        # the delay again, against the simulated loop's regressor: the measured W carries the encoder
+        # noise the controller's torque also carries, and that correlation pulls the least-squares
+        # profile's minimum away from the true delay (the simulated motion's phase follows the model
+        # simulated, so what is left is of the order of the start's tracking lag error)
+        rq, rqd, rqdd, rtau, *_ = arrays(raw)
+        rt = np.asarray(raw.t)
+        if window.any():
+            try:
+                Z0 = simulated_regressor(est, rt, rq[0], rqd[0])
+            except ValueError:  # a start that cannot be simulated: the prior's instruments
+                Z0 = simulated_regressor(prior, rt, rq[0], rqd[0])
+            delay_s, *_ = estimate_delay(rt, rtau, Z0, known(rq, rqd, rqdd), window & settled(rt), max_delay)
+            data = aligned(raw, delay_s, edge)
+            q, qd, qdd, tau, sign, parallel = arrays(data)
+            yv = (tau - known(q, qd, qdd)).reshape(S * n)
+            W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)[:, keep]
+            seen = identifiability(W, names)
+        wz = w * np.repeat(settled(np.asarray(data.t)), n)
+        est, cov, iterations, _, note = instrumental_fit(
+            method, W, yv, wz, est, lambda theta: simulated_regressor(theta, data.t, q[0], qd[0]), fallback=prior
+        )
         r = (yv - W @ est).reshape(S, n)
-        rw = (r / sig).reshape(-1)
-        s2 = float(rw @ rw) / dof
-        cov = s2 * np.linalg.pinv(Ww.T @ Ww)
-        cond = float(np.linalg.cond(Ww))
-    else:
-        w = np.ones(S * n)
-        s2 = float((r**2).sum()) / dof
-        cov = s2 * np.linalg.pinv(W.T @ W)
-        cond = float(np.linalg.cond(W))
+    cond = float(np.linalg.cond(W * w[:, None]))
     std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    std[unseparable_mask(seen, names)] = np.inf
+    vstd = None
+    if "stribeck" in model.terms:  # Gauss-Newton: the velocities' columns beside the linear ones
+        fk = est[int(used.sum()) :]
+        D = model.stribeck_derivative(qd, sign, fk).reshape(S * n, n)
+        J = np.concatenate([W, D], axis=1) * w[:, None]
+        s2 = float(((r.reshape(-1) * w) ** 2).sum()) / max(S * n - J.shape[1], 1)
+        vstd = np.sqrt(np.maximum(np.diag(s2 * np.linalg.pinv(J.T @ J))[-n:], 0.0))
     kb = int(used.sum())
 
     def result(est, r, **extra) -> Identification:
         return Identification(
-            names=tuple(nm for nm, u in zip(base.names, used) if u),
+            names=names[:kb],
             estimates=est[:kb],
             std=std[:kb],
             covariance=cov[:kb, :kb],
             true_values=None if true_values is None else true_values[used],
             condition_number=cond,
             residual_rms=np.sqrt((r**2).mean(axis=0)),
-            weighted=weighted,
+            weighted=method != "ols",
             base=base,
             nominal=robot,
             dropped=dropped,
@@ -555,26 +660,36 @@ def identify(
             friction_names=model.names(n),
             friction_estimates=est[kb:],
             friction_std=std[kb:],
-            noise=sig,
+            noise=joint_noise(r, W.shape[1]),
             samples=S,
             rotor_joints=rotor_joints,
             data=data,
+            method=method,
+            delay=delay_s,
+            iterations=iterations,
+            identifiability=seen,
+            stribeck_velocity_std=vstd,
+            notes=() if note is None else (note,),
             **extra,
         )
 
     free = result(est, r)
     if not consistent:
         return free
+    Yfull = robot.regressor(q, qd, qdd)
+    if nr:
+        Yfull = np.concatenate([Yfull, rotor_regressor(qdd, rotor_joints, n)], axis=2)
+    F = model.regressor(qd, sign, parallel)
     full = np.concatenate([Yfull.reshape(S * n, 10 * n + nr), F.reshape(S * n, nf)], axis=1)
-    standard, armature, fric = consistent_fit(
+    standard, armature_est, fric = consistent_fit(
         robot, full * w[:, None], yv * w, nf, rotor_joints, regularization, margin, solver
     )
-    x = np.concatenate([standard, armature])
+    x = np.concatenate([standard, armature_est])
     r = (yv - full @ np.concatenate([x, fric])).reshape(S, n)
     return result(
         np.concatenate([base.grouping[used] @ x, fric]),
         r,
         standard=standard,
-        standard_armature=armature if nr else None,
+        standard_armature=armature_est if nr else None,
         unconstrained=free,
     )

@@ -37,7 +37,7 @@ import os
 import re
 import zipfile
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -74,6 +74,37 @@ class Log:
     #: sign(qd) passed through the same low-pass filter as the torques (None when not filtered): the
     #: Coulomb column of the friction regressor, so that it sees the filter the torque's Coulomb part saw
     filtered_sign: np.ndarray | None = None
+    #: the filtered velocities at the log's own rate, before trimming and decimation (None when not
+    #: filtered), and the Butterworth order: :meth:`parallel` filters other columns of qd with them
+    raw_qd: np.ndarray | None = field(default=None, repr=False)
+    order: int = 4
+    #: (start, stop, step) of the kept samples in the raw ones
+    window: tuple | None = None
+
+    def parallel(self, column) -> np.ndarray | None:
+        """``column(qd)`` (a function of the velocities, (S, n) -> (S, n), e.g. a friction column)
+        computed at the log's own rate, passed through the log's low-pass and kept at its samples:
+        the parallel filtering the torques saw (module docstring, step 2). None for an unfiltered log."""
+        if self.raw_qd is None or self.cutoff is None or self.window is None:
+            return None
+        start, stop, step = self.window
+        raw_rate = self.rate * self.decimation
+        return _lowpass(column(self.raw_qd), self.cutoff, raw_rate, self.order)[start:stop:step]
+
+    def lowpass(self, x: np.ndarray, rate: float) -> np.ndarray:
+        """``x`` sampled at ``rate`` Hz (along axis 0) through this log's zero-phase low-pass (the
+        unchanged ``x`` for a log that was not filtered): to filter a simulated regressor as the
+        log's torques were."""
+        if self.cutoff is None:
+            return x
+        return _lowpass(x, self.cutoff, rate, self.order)
+
+    def subset(self, start: int, stop: int) -> tuple | None:
+        """The window of the samples ``start:stop`` of this log (for a copy holding only those)."""
+        if self.window is None:
+            return None
+        s0, _, step = self.window
+        return (s0 + start * step, s0 + stop * step, step)
 
     @property
     def n(self) -> int:
@@ -363,4 +394,18 @@ def load_log(
     # Coulomb column of +-1 noise: velocities below 1e-9 of the log's largest count as rest
     rest = np.abs(qd_f) <= 1e-9 * max(float(np.abs(qd_f).max()), 1e-300)
     sign_f = _lowpass(np.where(rest, 0.0, np.sign(qd_f)), cutoff, rate, order)
-    return Log(t[sl], qf[sl], qd_f[sl], qdd_f[sl], tau_f[sl], rate / k, float(cutoff), k, name, sign_f[sl])
+    return Log(
+        t[sl],
+        qf[sl],
+        qd_f[sl],
+        qdd_f[sl],
+        tau_f[sl],
+        rate / k,
+        float(cutoff),
+        k,
+        name,
+        sign_f[sl],
+        raw_qd=qd_f,
+        order=order,
+        window=(edge, S - edge, k),
+    )

@@ -122,19 +122,27 @@ def consistent_fit(
 
 
 def with_friction(robot: Robot, model: FrictionModel, coefficients: np.ndarray) -> Robot:
-    """``robot`` with the identified viscous and (symmetric) Coulomb coefficients in its joints."""
-    k = len(model.terms)
+    """``robot`` with the identified viscous and Coulomb coefficients in its joints (asymmetric
+    Coulomb levels as the joint's two levels; the Stribeck and offset terms have no place in a joint
+    and are left out)."""
+    cols = model.columns()
+    k = len(cols)
     index = {j.name: i for i, j in enumerate(robot.joints)}
     links = []
     for link in robot.links:
         i = index.get(link.joint.name) if link.joint.is_moving else None
         if i is not None:
-            c = dict(zip(model.terms, coefficients[i * k : (i + 1) * k]))
+            c = dict(zip(cols, coefficients[i * k : (i + 1) * k]))
+            if "coulomb+" in c:
+                levels = (float(max(c["coulomb+"], 0.0)), float(max(c["coulomb-"], 0.0)))
+                coulomb, negative = levels if levels[0] != levels[1] else (levels[0], None)
+            else:
+                coulomb, negative = float(abs(c.get("coulomb", link.joint.coulomb))), None
             joint = dc_replace(
                 link.joint,
                 viscous=float(c.get("viscous", link.joint.viscous)),
-                coulomb=float(abs(c.get("coulomb", link.joint.coulomb))),
-                coulomb_negative=None,
+                coulomb=coulomb,
+                coulomb_negative=negative,
             )
             link = Link(link.name, link.parent, joint, link.placement, link.post, link.inertia)
         links.append(link)

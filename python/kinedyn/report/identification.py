@@ -45,6 +45,15 @@ __all__ = [
 #: at most this many samples of each log are plotted (evenly spaced; the tables use them all)
 PLOT_POINTS = 1500
 
+#: the estimators as a sentence names them
+METHOD_NAMES = {
+    "ols": "ordinary least squares",
+    "wls": "weighted least squares",
+    "irls": "iteratively reweighted least squares (Huber)",
+    "iv": "instrumental variables (IDIM-IV)",
+    "didim": "closed-loop output error (DIDIM)",
+}
+
 #: states of the log at which the mass matrices are checked (evenly spaced)
 CHECK_STATES = 200
 
@@ -77,7 +86,7 @@ def identification_data(result: Identification, validate=None, **load_options) -
     data = result.data
     d: dict = {"robot": robot.name, "joint_names": list(robot.joint_names), **jsonable(result.to_dict())}
     d["relative_std_percent"] = jsonable(result.relative_std)
-    d["friction_terms"] = list(result.friction.terms)
+    d["friction_terms"] = list(result.friction.columns())
     d["friction_known"] = bool(result.friction.known)
     d["rotors"] = [r.to_dict() for r in result.rotors]
     if data is not None:
@@ -111,11 +120,16 @@ def _joint_of(name: str) -> int:
 def _fit_lines(d: dict) -> list[str]:
     """What was fitted, one line each: the estimator and cond(W), consistency, the log and its filtering."""
     log = d.get("log")
-    how = "weighted" if d["weighted"] else "ordinary"
+    how = METHOD_NAMES.get(d.get("method", ""), "weighted least squares" if d["weighted"] else "ordinary least squares")
     lines = [
-        f"{len(d['names'])} base parameters and {len(d.get('friction_names', []))} friction coefficients by {how} least squares",
+        f"{len(d['names'])} base parameters and {len(d.get('friction_names', []))} friction coefficients by {how}",
         f"cond(W) = {fmt(d['condition_number'], 4)}",
     ]
+    if d.get("delay"):
+        lines.append(f"torques {fmt(1e3 * d['delay'], 4)} ms behind the positions (aligned before the fit)")
+    lines.extend(d.get("notes", []))
+    for group in d.get("identifiability", {}).get("unseparable", []):
+        lines.append(f"not separable by the data (only a combination is identified): {', '.join(group)}")
     if d.get("consistent"):
         lines.append("physically consistent: every body's pseudo-inertia positive definite (an SDP through cvxpy)")
     if log is not None:
@@ -156,7 +170,14 @@ def _friction(d: dict) -> tuple[list[str], list[list[str]] | None]:
         [d["joint_names"][j], *(f"{fmt(by_joint[j][t][0], 5)} ± {fmt(by_joint[j][t][1], 2)}" for t in terms)]
         for j in sorted(by_joint)
     ]
-    units = {"viscous": "viscous [N m s/rad]", "coulomb": "Coulomb [N m]", "offset": "offset [N m]"}
+    units = {
+        "viscous": "viscous [N m s/rad]",
+        "coulomb": "Coulomb [N m]",
+        "coulomb+": "Coulomb, qd > 0 [N m]",
+        "coulomb-": "Coulomb, qd < 0 [N m]",
+        "stribeck": "static - Coulomb [N m]",
+        "offset": "offset [N m]",
+    }
     return ["joint", *(units[t] for t in terms)], rows
 
 

@@ -44,7 +44,27 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--friction",
         default="viscous+coulomb",
-        help="friction terms estimated with --data: viscous, coulomb, offset joined by '+', or none / known (default viscous+coulomb)",
+        help="friction terms estimated with --data: viscous, coulomb, asymmetric (a Coulomb level per direction), "
+        "stribeck, offset joined by '+'; stribeck alone (viscous+coulomb+stribeck); none / known (default viscous+coulomb)",
+    )
+    p.add_argument("--offset", action="store_true", help="estimate a torque offset per joint (with --data)")
+    p.add_argument(
+        "--armature",
+        action="store_true",
+        help="estimate every joint's armature (reflected rotor inertia; by default only the geared joints')",
+    )
+    p.add_argument(
+        "--delay",
+        default=None,
+        metavar="SECONDS|estimate",
+        help="the torques' delay behind the positions: a number of seconds, or 'estimate' (within +-20 ms)",
+    )
+    p.add_argument(
+        "--method",
+        default="auto",
+        choices=("auto", "ols", "wls", "irls"),
+        help="estimator: ordinary, weighted or iteratively reweighted (robust) least squares (default: ols, "
+        "wls with --weighted); the closed-loop methods iv and didim need the controller: kinedyn.analysis.identify",
     )
     p.add_argument(
         "--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s"
@@ -115,6 +135,9 @@ def run(args) -> int:
             t.add_column(col, justify="right")
         true = result.true_values
         assert true is not None  # identify() on a known robot always has the true values
+        # noise-free data: the fit is exact to round-off, so the std is round-off as well and an error
+        # over it is a ratio of two rounding noises (it read 40 like a 40-sigma failure)
+        exact = result.exact
         for k, nm in enumerate(result.names):
             e = result.estimates[k] - true[k]
             t.add_row(
@@ -123,9 +146,14 @@ def run(args) -> int:
                 f"{result.std[k]:.2g}",
                 f"{true[k]:.8g}",
                 f"{e:.2g}",
-                f"{e / result.std[k]:.2f}" if result.std[k] > 0 else "-",
+                f"{e / result.std[k]:.2f}" if result.std[k] > 0 and not exact else "-",
             )
         c.print(t)
+        if exact:
+            c.print(
+                "noise-free data: the fit reproduces the torques to round-off, so the errors and std are round-off "
+                "and error / std is not shown (give --noise to see the estimator's statistics)"
+            )
         if result.dropped:
             c.print(f"not excited (zero regressor columns on the data): {esc(', '.join(result.dropped))}")
 
@@ -166,8 +194,23 @@ def _identify_from_log(robot, args) -> int:
     """``kinedyn identify ROBOT --data log.csv``: a real robot's log (see docs/analysis.md)."""
     options = dict(cutoff=args.cutoff, decimate=args.decimate)
     log = load_log(args.data, n=robot.n, **options)
+    delay = args.delay
+    if delay is not None and delay.strip().lower() != "estimate":
+        try:
+            delay = float(delay)
+        except ValueError:
+            raise ValueError(f"--delay: a number of seconds or 'estimate', got {delay!r}") from None
     result = identify(
-        robot, log, weighted=args.weighted, friction=args.friction, consistent=args.consistent, smoothing=args.smoothing
+        robot,
+        log,
+        weighted=args.weighted,
+        friction=args.friction,
+        consistent=args.consistent,
+        smoothing=args.smoothing,
+        offset=args.offset,
+        armature=True if args.armature else None,
+        delay=delay,
+        method=args.method,
     )
     payload = dict(robot=robot.name, data=str(args.data), cutoff_hz=log.cutoff, rate_hz=log.rate, **result.to_dict())
     check = None
@@ -187,8 +230,9 @@ def _identify_from_log(robot, args) -> int:
         c.print(
             f"[bold]{esc(robot.name)}[/bold]: {len(result.names)} base parameters and {len(result.friction_names)} friction coefficients "
             f"from {len(log)} samples of {esc(str(args.data))} (cut-off {log.cutoff or 0:.3g} Hz, {log.rate:.4g} Hz after decimation); "
-            f"cond(W) = {result.condition_number:.4g}, {'weighted' if args.weighted else 'ordinary'} least squares"
+            f"cond(W) = {result.condition_number:.4g}, method {result.method}"
             + (", physically consistent (SDP)" if result.consistent else "")
+            + (f"; torques {1e3 * result.delay:.3g} ms behind the positions" if result.delay else "")
         )
         t = Table(title_justify="left")
         for col in ("parameter", "estimate", "std", "std %"):
@@ -198,6 +242,14 @@ def _identify_from_log(robot, args) -> int:
         for nm, e, sd in zip(result.friction_names, result.friction_estimates, result.friction_std):
             t.add_row(esc(nm), f"{e:.6g}", f"{sd:.2g}", f"{100 * sd / max(abs(e), 1e-300):.3g}")
         c.print(t)
+        for s in result.stribeck:
+            c.print(
+                f"{esc(s['joint'])}: Stribeck velocity {s['velocity']:.4g} rad/s (std {s['velocity_std']:.2g}), "
+                f"static friction {', '.join(f'{v:.4g}' for v in s['static'])} N m"
+            )
+        assert result.identifiability is not None
+        for group in result.identifiability.groups:
+            c.print(f"not separable by the data (only a combination is identified): {esc(', '.join(group))}")
         grouped = [r for r in result.rotors if r.armature is None]
         if grouped:
             c.print(
