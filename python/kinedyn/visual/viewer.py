@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .._ui import interrupts
 from ..configuration import default_configuration
 from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
 
@@ -300,7 +301,7 @@ class Viewer:
             while True:
                 time.sleep(0.5)
         except KeyboardInterrupt:
-            pass
+            interrupts.taken()  # Ctrl-C is how this ends: the close below is not interrupted again
         finally:
             self.close()
 
