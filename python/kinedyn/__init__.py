@@ -21,21 +21,26 @@ if TYPE_CHECKING:
     from . import analysis, configuration, dynamics, ik, kinematics, symbolic, testing  # noqa: F401
     from ._typing import PathLike
     from .simulate._callable import simulate
+    from .symbolic import LagrangianSystem
 else:
     from . import simulate  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
 from ._version import __version__
 from .simulate import Trajectory
-from .symbolic import LagrangianSystem
 
 _SUBMODULES = ("analysis", "configuration", "dynamics", "ik", "kinematics", "symbolic", "testing")
 
 
 def __getattr__(name):
-    """Submodules load on first use (kd.ik, kd.kinematics, kd.analysis, ...), keeping import fast."""
+    """Submodules load on first use (kd.ik, kd.kinematics, kd.analysis, ...), and so does
+    kd.LagrangianSystem (SymPy), keeping import fast."""
     if name in _SUBMODULES:
         import importlib
 
         return importlib.import_module(f"{__name__}.{name}")
+    if name == "LagrangianSystem":  # the symbolic engine (SymPy) loads on first use
+        from .symbolic import LagrangianSystem
+
+        return LagrangianSystem
     raise AttributeError(f"module 'kinedyn' has no attribute '{name}'")
 
 

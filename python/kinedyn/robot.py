@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from . import configuration, display, dynamics, symbolic
+from . import configuration, display, dynamics
 from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
@@ -662,6 +662,8 @@ class Robot:
     # symbolic engine ----------------------------------------------------------------------
     def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs) -> EquationsOfMotion:
         """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
+        from . import symbolic  # SymPy's engine loads only for symbolic work (kinedyn._lazy)
+
         return symbolic.equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
     # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------

@@ -14,10 +14,9 @@ import re
 import reprlib
 import sys
 from dataclasses import replace
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
-import sympy as sp
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -25,6 +24,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
     import tomli as tomllib
 import yaml
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import matmul, rpy_to_matrix, translation
 from ..expressions import parse_expression
 from .description import Description
@@ -33,6 +33,11 @@ from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia
 from .joint import Joint, Mimic
 from .link import Frame, Link
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = [
     "description_from_mapping",
@@ -371,7 +376,7 @@ class _Reader:
 
     def number(self, raw, ctx: str, infinite: bool = False) -> float:
         v = self.value(raw, ctx, infinite)
-        if isinstance(v, sp.Basic):
+        if sympy_instance(v, "Basic"):
             self.fail(ctx, f"must be a number, got the expression '{_REPR.repr(raw)[1:-1]}'")
         return v
 
@@ -379,7 +384,7 @@ class _Reader:
         v = self.value(raw, ctx)
         if not self.deg:
             return v
-        return v * sp.pi / 180 if isinstance(v, sp.Basic) else v * math.pi / 180
+        return v * sp.pi / 180 if sympy_instance(v, "Basic") else v * math.pi / 180
 
     def vector(self, raw, ctx: str, n: int = 3, angles: bool = False) -> tuple:
         if not isinstance(raw, (list, tuple)) or len(raw) != n:
@@ -439,7 +444,7 @@ class _Reader:
                 )
             levels = tuple(self.value(v, f"{ctx}.coulomb[{i}]") for i, v in enumerate(c))
             for i, v in enumerate(levels):
-                if not isinstance(v, sp.Basic) and v < 0:
+                if not sympy_instance(v, "Basic") and v < 0:
                     self.fail(
                         f"{ctx}.coulomb[{i}]",
                         f"a Coulomb level is a magnitude >= 0, got {v} (Corke's Tc = [Tc+, Tc-] with Tc- < 0 is written [Tc+, -Tc-])",
