@@ -13,7 +13,7 @@ from pathlib import Path
 
 import kinedyn as kd
 
-HEAVY = ("sympy", "scipy", "plotly", "trimesh", "matplotlib", "pandas", "jinja2")
+HEAVY = ("sympy", "scipy", "plotly", "trimesh", "matplotlib", "pandas", "jinja2", "yaml")
 
 
 def loaded_after(code: str) -> list[str]:
