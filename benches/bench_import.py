@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -31,11 +32,16 @@ COMMANDS = {
 }
 
 
-def wall(command: list[str], env: dict[str, str]) -> float | None:
+def timed(command: list[str], env: dict[str, str]) -> tuple[float, float] | None:
+    """(wall, CPU) seconds of the command; CPU (user + system of the child) depends far less on what
+    else the machine runs than wall time does."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(command, env=env, capture_output=True)
     elapsed = time.perf_counter() - start
-    return elapsed if done.returncode == 0 else None
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return (elapsed, cpu) if done.returncode == 0 else None
 
 
 def main() -> None:
@@ -43,20 +49,25 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(PYTHON_DIR), os.environ.get("PYTHONPATH", "")]))
-    times: dict[str, list[float]] = {name: [] for name in COMMANDS}
+    times: dict[str, list[tuple[float, float]]] = {name: [] for name in COMMANDS}
     for _ in range(args.repeat):
         for name, command in COMMANDS.items():
-            t = wall(command, env)
+            t = timed(command, env)
             if t is not None:
                 times[name].append(t)
-    best = {name: min(ts) for name, ts in times.items() if ts}
-    print(f"best of {args.repeat} (s), a fresh interpreter each:")
+    best = {name: (min(w for w, _ in ts), min(c for _, c in ts)) for name, ts in times.items() if ts}
+    print(f"best of {args.repeat}, a fresh interpreter each: wall s, CPU s")
     for name in COMMANDS:
-        print(f"  {name:18s} {best[name]:.3f}" if name in best else f"  {name:18s} failed (not installed?)")
+        if name in best:
+            print(f"  {name:18s} {best[name][0]:.3f}  {best[name][1]:.3f}")
+        else:
+            print(f"  {name:18s} failed (not installed?)")
     if "import pinocchio" in best:
         peer = best["import pinocchio"]
         for name in ("import kinedyn", "kinedyn fk ur5"):
-            print(f"  {name} / import pinocchio = {best[name] / peer:.2f}")
+            if name in best:
+                wall, cpu = best[name][0] / peer[0], best[name][1] / peer[1]
+                print(f"  {name} / import pinocchio: wall {wall:.2f}, CPU {cpu:.2f}")
     loaded = subprocess.run(
         [sys.executable, "-c", f"import sys, kinedyn; print(' '.join(m for m in {HEAVY!r} if m in sys.modules))"],
         env=env,

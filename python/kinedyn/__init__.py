@@ -12,7 +12,6 @@ from ._core import (
 from .description import DHRow, Frame, Inertia, Joint, Link
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
-from .robot_files import load as _load
 
 if TYPE_CHECKING:
     # what type checkers and IDEs see: kd.simulate is the function and still holds the package's
@@ -58,7 +57,9 @@ def load(path: PathLike, **kwargs) -> Robot:
     """Load a robot from a URDF (.urdf), YAML (.yaml/.yml) or TOML (.toml) file, by extension.
     ``inertia="warn"|"repair"|"strict"``: the policy for an inertia no rigid body can have
     (docs/model-files.md); other keywords as :meth:`Robot.from_urdf` or the Robot constructor."""
-    return _load(path, **kwargs)
+    from .robot_files import load as load_file  # the file readers (XML, TOML) load when a file is read
+
+    return load_file(path, **kwargs)
 
 
 __all__ = [

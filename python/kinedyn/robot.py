@@ -19,15 +19,11 @@ from . import configuration, display, dynamics
 from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
-from .description import export
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
 from .description.edit import lock_joints, substitute
-from .description.files import save as save_robot_file
 from .description.geometry import Visual
 from .description.link import Frame, Link
-from .description.mjcf import description_from_mjcf
-from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
 from .native.compile import compile_model, locked_block
 from .native.errors import robot_error
@@ -191,6 +187,8 @@ class Robot:
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
         Python expressions from the file, so it needs ``trust_xacro=True``
         (:mod:`kinedyn.description.xacro`)."""
+        from .description.urdf import description_from_urdf  # file formats load on use
+
         return cls(
             description_from_urdf(
                 path_or_string,
@@ -217,6 +215,8 @@ class Robot:
         """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
         and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
         ``tool`` and ``inertia`` as :meth:`from_urdf`."""
+        from .description.mjcf import description_from_mjcf  # file formats load on use
+
         return cls(description_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia))
 
     def replace(self, **changes) -> Robot:
@@ -310,6 +310,8 @@ class Robot:
 
     def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
+        from .description.files import save as save_robot_file  # file formats load on use
+
         save_robot_file(self, path)
 
     def to_urdf(
@@ -319,11 +321,15 @@ class Robot:
         origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
         robots"). ``geometry``: cylinders along the links of a robot without visuals;
         ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
+        from .description import export  # file formats load on use
+
         return export.to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
         """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
         :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
+        from .description import export  # file formats load on use
+
         return export.to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
 
     def inertial_parameters(self) -> np.ndarray:
