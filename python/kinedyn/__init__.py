@@ -34,10 +34,10 @@ def __getattr__(name):
         import importlib
 
         return importlib.import_module(f"{__name__}.{name}")
-    if name == "simulate":  # callable: kd.simulate(system, t_span, x0, ...) (see kinedyn.simulate)
+    if name in ("simulate", "robot_files", "scale"):  # kd.simulate is callable (see kinedyn.simulate)
         import importlib
 
-        return importlib.import_module(f"{__name__}.simulate")
+        return importlib.import_module(f"{__name__}.{name}")
     if name == "Trajectory":
         from .simulate import Trajectory
 

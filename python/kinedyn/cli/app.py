@@ -19,7 +19,7 @@ import numpy as np
 from rich.markup import escape
 from rich.table import Table
 
-from .. import robot_files, robots
+from .. import robots
 from .._ui import terminal
 from .._ui.json import jsonable
 from .options import ROBOT_FILE_EXTENSIONS, SYMBOLIC_COMMANDS, set_values
@@ -114,6 +114,8 @@ def robot_file(spec: str, options: RobotOptions):
         loader_options["floating_base"] = True
     try:
         try:
+            from .. import robot_files  # the file readers load only for a robot file
+
             return robot_files.load(path, **loader_options)
         except ValueError as e:
             if ext == ".xacro" and "trust_xacro=True" in str(e):
