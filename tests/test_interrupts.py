@@ -70,8 +70,8 @@ SWALLOWING_COMMAND = """
     from kinedyn.cli import main
 
     def run(args):
-        print("running", flush=True)
         try:
+            print("running", flush=True)  # inside the try: the test interrupts as soon as it reads this
             while True:
                 time.sleep(0.02)
         except KeyboardInterrupt:
@@ -124,8 +124,8 @@ def test_a_command_that_ends_on_ctrl_c_is_not_interrupted_again_while_it_closes(
         from kinedyn.cli import main
 
         def run(args):
-            print("running", flush=True)
             try:
+                print("running", flush=True)  # inside the try, as above
                 while True:
                     time.sleep(0.02)
             except KeyboardInterrupt:
