@@ -15,7 +15,6 @@ description and builds the native model once, whatever the number of chunks or c
 from __future__ import annotations
 
 import functools
-import hashlib
 import inspect
 import os
 import pickle
@@ -87,6 +86,8 @@ class _RobotByContent:
 
     @classmethod
     def of(cls, robot: Robot) -> _RobotByContent:
+        import hashlib  # OpenSSL's hashes load only when a robot goes to dask
+
         payload = pickle.dumps(robot, protocol=pickle.HIGHEST_PROTOCOL)
         return cls(robot, hashlib.sha256(payload).hexdigest(), payload)
 

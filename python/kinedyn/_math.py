@@ -9,12 +9,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from ._lazy import LazyModule, sympy_instance
 from .expressions import parse_expression
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = [
     "is_symbolic",
@@ -38,10 +43,10 @@ __all__ = [
 def is_symbolic(*values: Any) -> bool:
     """True if any value (scalar, sequence, array or matrix) contains a non-numeric SymPy expression."""
     for v in values:
-        if isinstance(v, sp.MatrixBase):
+        if sympy_instance(v, "MatrixBase"):
             if any(not e.is_number for e in v):
                 return True
-        elif isinstance(v, sp.Basic):
+        elif sympy_instance(v, "Basic"):
             if not v.is_number:
                 return True
         elif isinstance(v, np.ndarray):
@@ -55,7 +60,7 @@ def is_symbolic(*values: Any) -> bool:
 
 def as_value(x: Any) -> Any:
     """A scalar as a float when it is a plain number, else as a SymPy expression."""
-    if isinstance(x, sp.Basic):
+    if sympy_instance(x, "Basic"):
         return float(x) if x.is_number and x.is_real is not False and not x.free_symbols else x
     if isinstance(x, str):  # read as data by kinedyn's own parser, never evaluated as Python
         return parse_expression(x)
@@ -63,7 +68,7 @@ def as_value(x: Any) -> Any:
 
 
 def _has_sympy(v: Any) -> bool:
-    if isinstance(v, (sp.Basic, sp.MatrixBase)):
+    if sympy_instance(v):
         return True
     if isinstance(v, (list, tuple)):
         return any(_has_sympy(e) for e in v)
@@ -188,14 +193,14 @@ def to_float_array(value, shape=None, what: str = "value") -> np.ndarray:
     """Convert numbers / numeric SymPy matrices to a float array; explain when symbols remain."""
     if is_symbolic(value):
         free = set()
-        for e in value if isinstance(value, sp.MatrixBase) else np.asarray(value, dtype=object).flat:
-            if isinstance(e, sp.Basic):
+        for e in value if sympy_instance(value, "MatrixBase") else np.asarray(value, dtype=object).flat:
+            if sympy_instance(e, "Basic"):
                 free |= e.free_symbols
         raise ValueError(
             f"{what} contains SymPy symbols {sorted(map(str, free))}; substitute numbers first "
             f"(robot.subs({{...}})) before numeric computation"
         )
-    if isinstance(value, sp.MatrixBase):
+    if sympy_instance(value, "MatrixBase"):
         value = np.array(value.tolist(), dtype=float)
     arr = np.asarray(value, dtype=float)
     if shape is not None and arr.shape != tuple(shape):
@@ -209,7 +214,7 @@ def by_name(mapping, symbols) -> dict:
     ``Symbol("m1", positive=True)``, which ``Symbol("m1")`` would not equal); other names become plain
     symbols. A value given as text is read by kinedyn's expression parser (SymPy's ``subs`` would
     hand it to ``eval``)."""
-    named = {s.name: s for s in symbols if isinstance(s, sp.Symbol)}
+    named = {s.name: s for s in symbols if sympy_instance(s, "Symbol")}
     return {
         (named.get(k, sp.Symbol(k)) if isinstance(k, str) else k): (as_value(v) if isinstance(v, str) else v)
         for k, v in dict(mapping).items()

@@ -20,31 +20,58 @@ from __future__ import annotations
 
 import ast
 import math
+import re
 from collections.abc import Mapping
-from typing import Union
+from typing import TYPE_CHECKING, Union
 
-import sympy as sp
+from ._lazy import LazyModule, sympy_instance
 
-__all__ = ["FUNCTIONS", "CONSTANTS", "parse_expression", "parse_number", "MAX_LENGTH", "MAX_DEPTH", "MAX_EXPONENT"]
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
-# the functions a file may call: name -> (SymPy function, number of arguments)
-FUNCTIONS: dict = {
-    "sin": (sp.sin, 1),
-    "cos": (sp.cos, 1),
-    "tan": (sp.tan, 1),
-    "asin": (sp.asin, 1),
-    "acos": (sp.acos, 1),
-    "atan": (sp.atan, 1),
-    "atan2": (sp.atan2, 2),
-    "sinh": (sp.sinh, 1),
-    "cosh": (sp.cosh, 1),
-    "tanh": (sp.tanh, 1),
-    "sqrt": (sp.sqrt, 1),
-    "exp": (sp.exp, 1),
-    "log": (sp.log, 1),
-    "abs": (sp.Abs, 1),
+
+__all__ = [  # noqa: F822 - FUNCTIONS and CONSTANTS come from the module __getattr__
+    "FUNCTIONS",
+    "CONSTANTS",
+    "parse_expression",
+    "parse_number",
+    "MAX_LENGTH",
+    "MAX_DEPTH",
+    "MAX_EXPONENT",
+]
+
+# the functions a file may call: name -> (SymPy function's name, number of arguments); FUNCTIONS and
+# CONSTANTS, with the SymPy objects themselves, are made on first use (module __getattr__ below)
+_FUNCTION_NAMES: dict = {
+    "sin": ("sin", 1),
+    "cos": ("cos", 1),
+    "tan": ("tan", 1),
+    "asin": ("asin", 1),
+    "acos": ("acos", 1),
+    "atan": ("atan", 1),
+    "atan2": ("atan2", 2),
+    "sinh": ("sinh", 1),
+    "cosh": ("cosh", 1),
+    "tanh": ("tanh", 1),
+    "sqrt": ("sqrt", 1),
+    "exp": ("exp", 1),
+    "log": ("log", 1),
+    "abs": ("Abs", 1),
 }
-CONSTANTS: dict = {"pi": sp.pi}
+_CONSTANT_NAMES = ("pi",)
+
+
+def __getattr__(name: str):
+    """FUNCTIONS (name -> (SymPy function, arity)) and CONSTANTS (name -> SymPy constant), built when
+    first read: building them imports SymPy (kinedyn._lazy)."""
+    if name == "FUNCTIONS":
+        return {k: (getattr(sp, f), arity) for k, (f, arity) in _FUNCTION_NAMES.items()}
+    if name == "CONSTANTS":
+        return {k: getattr(sp, k) for k in _CONSTANT_NAMES}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 MAX_LENGTH = 1000  # characters of one expression
 MAX_DEPTH = 32  # nesting of the syntax tree (parentheses, operators, calls)
@@ -85,8 +112,15 @@ def parse_expression(
     return expr
 
 
+_PLAIN_NUMBER = re.compile(r"[+-]?((0|[1-9]\d*)(\.\d*)?|\.\d+)([eE][+-]?\d+)?")  # as Python writes a literal
+
+
 def parse_number(text: str) -> float:
     """A finite real number written as text (``"2.5"``, ``"pi/2"``, ``"sqrt(2)/2"``): no names allowed."""
+    if isinstance(text, str) and len(text) <= MAX_LENGTH and _PLAIN_NUMBER.fullmatch(text.strip()):
+        value = float(text)  # a plain decimal (most command lines): no SymPy needed
+        if abs(value) <= MAX_FLOAT:
+            return value
     value = parse_expression(text, allow_symbols=False)
     return float(value)
 
@@ -132,17 +166,17 @@ class _Walker:
         if isinstance(node, ast.Call):
             return self.call(node, depth)
         raise _Refused(
-            f"{_describe(node)} is not allowed (only numbers, names, + - * / **, parentheses and {', '.join(FUNCTIONS)})"
+            f"{_describe(node)} is not allowed (only numbers, names, + - * / **, parentheses and {', '.join(_FUNCTION_NAMES)})"
         )
 
     def name(self, name: str) -> sp.Basic:
         if name in self.symbols:
             return self.symbols[name]
-        if name in CONSTANTS:
-            return CONSTANTS[name]
+        if name in _CONSTANT_NAMES:
+            return getattr(sp, name)
         if name.lower() in ("nan", "inf", "infinity"):
             raise _Refused(f"'{name}' is not a finite number (and not allowed as a name)")
-        if name in FUNCTIONS:
+        if name in _FUNCTION_NAMES:
             raise _Refused(f"'{name}' is a function: call it, e.g. {name}(x)")
         if not self.allow_symbols:
             raise _Refused(f"'{name}' is a name, but a number is needed here")
@@ -153,10 +187,11 @@ class _Walker:
         return sp.Symbol(name)
 
     def call(self, node: ast.Call, depth: int) -> sp.Basic:
-        if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
+        if not isinstance(node.func, ast.Name) or node.func.id not in _FUNCTION_NAMES:
             called = node.func.id if isinstance(node.func, ast.Name) else _describe(node.func)
-            raise _Refused(f"'{called}' is not a known function (known: {', '.join(FUNCTIONS)})")
-        function, arity = FUNCTIONS[node.func.id]
+            raise _Refused(f"'{called}' is not a known function (known: {', '.join(_FUNCTION_NAMES)})")
+        name, arity = _FUNCTION_NAMES[node.func.id]
+        function = getattr(sp, name)
         if node.keywords or len(node.args) != arity or any(isinstance(a, ast.Starred) for a in node.args):
             raise _Refused(f"{node.func.id} takes {arity} positional argument{'s' if arity > 1 else ''}")
         args = [self.visit(a, depth + 1) for a in node.args]
@@ -187,7 +222,7 @@ def _binary(op: ast.operator, a: sp.Basic, b: sp.Basic) -> sp.Basic:
             raise _Refused("division by zero")
         return a / b
     # ast.Pow: the exponent is a number of bounded size, so that no step can ask for unbounded work
-    if not (isinstance(b, sp.Number) and abs(float(b)) <= MAX_EXPONENT):
+    if not (sympy_instance(b, "Number") and abs(float(b)) <= MAX_EXPONENT):
         raise _Refused(f"an exponent must be a number between -{MAX_EXPONENT} and {MAX_EXPONENT}, got {_short(b)}")
     if a == 0 and b < 0:
         raise _Refused("division by zero (0 to a negative power)")
@@ -198,7 +233,7 @@ def _bounded(e: sp.Basic) -> sp.Basic:
     """Refuse a value met on the way that is not a finite real number or is too large to be a robot's
     parameter; checking every step bounds the work of the next one (``exp(exp(exp(10)))`` stops at
     the second ``exp``)."""
-    if isinstance(e, sp.Rational):
+    if sympy_instance(e, "Rational"):
         if e.p.bit_length() > MAX_BITS or e.q.bit_length() > MAX_BITS:
             raise _Refused(f"a number on the way is too large (more than {MAX_BITS} bits)")
         return e
@@ -223,7 +258,7 @@ def _numeric_value(e: sp.Basic) -> float:
 
 
 def _finish(e: sp.Basic) -> Union[float, sp.Expr]:
-    if not isinstance(e, sp.Expr):
+    if not sympy_instance(e, "Expr"):
         raise _Refused(f"the result is a {type(e).__name__}, not an expression")
     if e.has(sp.I):
         raise _Refused("the result is not a real number")
@@ -255,5 +290,5 @@ def _describe(node: ast.AST) -> str:
 
 
 def _short(e) -> str:
-    text = str(e) if isinstance(e, sp.Symbol) or (isinstance(e, sp.Rational) and e.p.bit_length() < 100) else ""
+    text = str(e) if sympy_instance(e, "Symbol") or (sympy_instance(e, "Rational") and e.p.bit_length() < 100) else ""
     return text[:40] if text and len(text) <= 40 else f"a {type(e).__name__}"

@@ -15,21 +15,17 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from . import configuration, display, dynamics, symbolic
+from . import configuration, display, dynamics
 from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from ._ui.names import did_you_mean
-from .description import export
 from .description.audit import Audit, audit
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
 from .description.edit import lock_joints, substitute
-from .description.files import save as save_robot_file
 from .description.geometry import Visual
 from .description.link import Frame, Link
-from .description.mjcf import description_from_mjcf
-from .description.urdf import description_from_urdf
 from .ik.dispatch import inverse_kinematics as solve_ik
 from .native.compile import body_wrenches, compile_model, locked_block
 from .native.errors import robot_error
@@ -192,6 +188,8 @@ class Robot:
         (its ``<xacro:arg>`` values) and ``package_dirs`` (where ``$(find PKG)`` looks); xacro runs
         Python expressions from the file, so it needs ``trust_xacro=True``
         (:mod:`kinedyn.description.xacro`)."""
+        from .description.urdf import description_from_urdf  # file formats load on use
+
         return cls(
             description_from_urdf(
                 path_or_string,
@@ -218,6 +216,8 @@ class Robot:
         """A robot from a MuJoCo MJCF file path or XML string (see :mod:`kinedyn.description.mjcf`
         and docs/model-files.md). ``gravity``: overrides the model's ``<option gravity>``;
         ``tool`` and ``inertia`` as :meth:`from_urdf`."""
+        from .description.mjcf import description_from_mjcf  # file formats load on use
+
         return cls(description_from_mjcf(path_or_string, gravity=gravity, tool=tool, inertia=inertia))
 
     def replace(self, **changes) -> Robot:
@@ -311,15 +311,17 @@ class Robot:
 
     def save(self, path: PathLike) -> None:
         """Write the robot to a YAML or TOML robot file (by extension); see docs/model-files.md."""
+        from .description.files import save as save_robot_file  # file formats load on use
+
         save_robot_file(self, path)
 
     def to_urdf(
         self, path: PathLike | None = None, *, geometry: bool = True, floating_base_as_root: bool = True
     ) -> str:
-        """The robot as URDF text, written to ``path`` when given (joint offsets folded into the joint
-        origins; see :func:`kinedyn.description.export.to_urdf` and docs/model-files.md, "Converting
-        robots"). ``geometry``: cylinders along the links of a robot without visuals;
-        ``floating_base_as_root``: a free-flying trunk is written as the URDF root."""
+        """The robot as URDF text, written to ``path`` when given (:func:`kinedyn.description.export.to_urdf`,
+        docs/model-files.md, "Converting robots")."""
+        from .description import export  # file formats load on use
+
         return export.to_urdf(self, path, geometry=geometry, floating_base_as_root=floating_base_as_root)
 
     def audit(self, *, geometry: bool = True) -> Audit:
@@ -327,8 +329,9 @@ class Robot:
         return audit(self.description, geometry=geometry)
 
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:
-        """The robot as MuJoCo XML (MJCF), written to ``path`` when given (see
-        :func:`kinedyn.description.export.to_mjcf` and docs/model-files.md, "Converting robots")."""
+        """The robot as MuJoCo XML (MJCF), written to ``path`` when given (:func:`kinedyn.description.export.to_mjcf`)."""
+        from .description import export  # file formats load on use
+
         return export.to_mjcf(self, path, geometry=geometry, default_inertia=default_inertia)
 
     def inertial_parameters(self) -> np.ndarray:
@@ -665,6 +668,8 @@ class Robot:
     # symbolic engine ----------------------------------------------------------------------
     def equations_of_motion(self, method: str = "lagrange", simplify: bool = True, **kwargs) -> EquationsOfMotion:
         """Symbolic equations of motion (SymPy): see :func:`kinedyn.symbolic.equations_of_motion`."""
+        from . import symbolic  # SymPy's engine loads only for symbolic work (kinedyn._lazy)
+
         return symbolic.equations_of_motion(self, method=method, simplify=simplify, **kwargs)
 
     # configurations (kinedyn.configuration: Pinocchio's conventions, docs/conventions.md) ---------

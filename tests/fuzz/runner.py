@@ -83,6 +83,15 @@ def case_id(case: Case) -> str:
 
 
 # ============================================================================ running
+def load_factor() -> float:
+    """How many times over the machine's CPUs are busy (1 when it has CPUs to spare): the 1-minute
+    load average per CPU, at least 1 (1 where the load average is unknown)."""
+    try:
+        return max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
+    except (AttributeError, OSError):
+        return 1.0
+
+
 class Worker:
     """One worker subprocess; restarted after a hang or a crash."""
 
@@ -158,6 +167,10 @@ class Worker:
         if self.proc is None:
             self._start()
         start = time.perf_counter()
+        # the limit is in the seconds of an idle machine: on a machine running more work than it has
+        # CPUs (parallel test workers, other jobs), a case gets proportionally more wall time, so that
+        # a slow answer on a loaded machine is not taken for a hang
+        timeout = timeout * load_factor()
         try:
             write_frame(self.proc.stdin, case)
             answer = self._answer(timeout)
@@ -168,7 +181,12 @@ class Worker:
         seconds = time.perf_counter() - start
         if answer == "timeout":
             self.stop()
-            result = {"index": case.index, "outcome": HANG, "detail": f"no answer in {timeout:g} s", "seconds": seconds}
+            result = {
+                "index": case.index,
+                "outcome": HANG,
+                "detail": f"no answer in {timeout:.3g} s",
+                "seconds": seconds,
+            }
         else:
             code = self.proc.wait()
             tail = self._stderr_tail()

@@ -10,6 +10,9 @@
 //! - [`install`]: the thread pool of batch calls, built lazily per process id, so that a child made
 //!   by `fork` (which inherits the pool's bookkeeping but none of its threads) builds its own pool
 //!   instead of queuing work for threads that do not exist and blocking forever.
+//! - [`interruptible`]: long work without the GIL runs on a helper thread while the caller checks
+//!   Python's signals, so Ctrl-C (KeyboardInterrupt) stops a long native run within a poll interval
+//!   instead of when it ends.
 //! - [`non_finite_error`]: `kinedyn.NonFiniteResultError` (a `FloatingPointError` and a
 //!   `ValueError`), raised when finite inputs give a non-finite result.
 
@@ -17,6 +20,7 @@ use std::any::Any;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
 use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
+use std::time::Duration;
 
 use numpy::npyffi::{self, npy_intp, PY_ARRAY_API};
 use numpy::{Element, PyArrayDescrMethods, PyArrayDyn};
@@ -231,6 +235,48 @@ fn pool() -> PyResult<&'static rayon::ThreadPool> {
 /// after a fork).
 pub fn install<R: Send>(work: impl FnOnce() -> R + Send) -> PyResult<R> {
     Ok(pool()?.install(work))
+}
+
+// ------------------------------------------------------------------ interrupts
+
+/// How often the caller of [`interruptible`] work checks Python's signals.
+const SIGNAL_POLL: Duration = Duration::from_millis(20);
+
+/// Run `work` without the GIL and stop it on a signal. Python runs signal handlers only in the main
+/// thread and only while it holds the GIL (Python docs, `signal`: "Python signal handlers are always
+/// executed in the main Python thread"), so a long native call would see Ctrl-C only when it ends.
+/// Here `work` runs on a scoped helper thread and polls the cancellation flag it is given, while the
+/// calling thread checks Python's signals every [`SIGNAL_POLL`]: when a handler raises (Ctrl-C's
+/// `KeyboardInterrupt`), the flag is set, the work stops at its next poll, and that exception is
+/// returned. A panic of `work` is resumed on the calling thread (for [`guarded`]).
+pub fn interruptible<R: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> R + Send) -> PyResult<R> {
+    let cancel = AtomicBool::new(false);
+    let caller = std::thread::current();
+    let (joined, raised) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let helper = scope.spawn(|| {
+                let r = work(&cancel);
+                caller.unpark(); // the caller need not wait out its poll interval
+                r
+            });
+            let mut raised = None;
+            while !helper.is_finished() {
+                std::thread::park_timeout(SIGNAL_POLL);
+                if raised.is_none() && !helper.is_finished() {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        cancel.store(true, Ordering::Relaxed);
+                        raised = Some(e);
+                    }
+                }
+            }
+            (helper.join(), raised)
+        })
+    });
+    let result = joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload));
+    match raised {
+        Some(e) => Err(e),
+        None => Ok(result),
+    }
 }
 
 // ------------------------------------------------------------------ non-finite results

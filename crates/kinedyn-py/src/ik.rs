@@ -171,6 +171,12 @@ pub fn solve_ik<'py>(
         let reduced = reduced.as_ref();
         // configurations have n entries (nq), steps nv
         let (n, _) = ik::solver_sizes(m, reduced);
+        if n == 0 {
+            // no joint value moves a frame: nothing to solve (and no rows to split the batch by)
+            return Err(PyValueError::new_err(
+                "inverse kinematics: the model has no moving joint",
+            ));
+        }
         let frame = model.frame(frame)?;
         let (targets, batch, position) = gather_targets(&targets)?;
         let count = targets.len();

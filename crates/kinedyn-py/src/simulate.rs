@@ -103,6 +103,7 @@ fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict
         FailureKind::Torque(v) => ("torque", Some(*v), String::new()),
         FailureKind::Source(m) => ("source", None, m.clone()),
         FailureKind::Singular(m) => ("singular", None, m.clone()),
+        FailureKind::Cancelled => ("cancelled", None, String::new()),
     };
     d.set_item("kind", kind)?;
     d.set_item("value", value)?;
@@ -193,6 +194,11 @@ fn initial_states(
     Ok((batch, q0, flat("qd0", qd0)?))
 }
 
+/// Runs of at least this many steps (all trajectories of a batch together) take milliseconds or
+/// more and run interruptibly ([`guard::interruptible`]: a helper thread, a few tens of
+/// microseconds); shorter ones run on the calling thread.
+const INTERRUPTIBLE_STEPS: usize = 20_000;
+
 /// Integrate from `q0, qd0` ((n,) or a batch (N, n)) over `steps` steps of `dt`, the torque given by
 /// samples `tau`: None (zero), `(S, n)` shared by every trajectory or `(N, S, n)` one per trajectory;
 /// S = 1 is a constant, else samples at `t0 + k dt` held over each step (`linear=False`, S >= steps)
@@ -233,6 +239,7 @@ pub fn integrate_fixed<'py>(
             hold: false,
             max_speed,
             limits,
+            cancel: None,
         };
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(PyValueError::new_err(format!(
@@ -283,7 +290,8 @@ pub fn integrate_fixed<'py>(
             .map_err(|_| PyValueError::new_err("internal: output views"))?;
         let (per, per_q) = (samples * n, samples * nq);
         let model_ref = &m.model;
-        let run_one = |i: usize,
+        let run_one = |settings: &Settings,
+                       i: usize,
                        q: &mut [f64],
                        qd: &mut [f64],
                        qdd: &mut [f64],
@@ -318,29 +326,47 @@ pub fn integrate_fixed<'py>(
             sim::integrate(
                 model_ref,
                 &mut data,
-                &settings,
+                settings,
                 &q0[i * nq..(i + 1) * nq],
                 &qd0[i * n..(i + 1) * n],
                 source,
                 Record { q, qd, qdd, tau: t },
             )
         };
-        let outcomes: Vec<Outcome> = py
-            .detach(|| {
-                if count == 1 {
-                    return Ok(run_one(0, oq, oqd, oqdd, otau).map(|o| vec![o]));
-                }
-                guard::install(|| {
-                    oq.par_chunks_mut(per_q)
-                        .zip(oqd.par_chunks_mut(per))
-                        .zip(oqdd.par_chunks_mut(per))
-                        .zip(otau.par_chunks_mut(per))
-                        .enumerate()
-                        .map(|(i, (((q, qd), qdd), t))| run_one(i, q, qd, qdd, t))
-                        .collect::<Result<Vec<_>, _>>()
+        // the whole run without the GIL, the trajectories of a batch in parallel
+        let mut run_all = |settings: &Settings| {
+            if count == 1 {
+                return Ok(run_one(settings, 0, oq, oqd, oqdd, otau).map(|o| vec![o]));
+            }
+            if per == 0 || per_q == 0 {
+                // a model without coordinates: no rows to split the outputs by, the runs in turn
+                let empty = || -> &mut [f64] { &mut [] };
+                return Ok((0..count)
+                    .map(|i| run_one(settings, i, empty(), empty(), empty(), empty()))
+                    .collect::<Result<Vec<_>, _>>());
+            }
+            guard::install(|| {
+                oq.par_chunks_mut(per_q)
+                    .zip(oqd.par_chunks_mut(per))
+                    .zip(oqdd.par_chunks_mut(per))
+                    .zip(otau.par_chunks_mut(per))
+                    .enumerate()
+                    .map(|(i, (((q, qd), qdd), t))| run_one(settings, i, q, qd, qdd, t))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+        };
+        let outcomes = if steps.saturating_mul(count) < INTERRUPTIBLE_STEPS {
+            py.detach(|| run_all(&settings))?
+        } else {
+            // long: Ctrl-C stops it (the core polls the flag every step; guard::interruptible)
+            guard::interruptible(py, |cancel| {
+                run_all(&Settings {
+                    cancel: Some(cancel),
+                    ..settings
                 })
-            })?
-            .map_err(core_err)?;
+            })??
+        };
+        let outcomes: Vec<Outcome> = outcomes.map_err(core_err)?;
         result(py, arrays, &outcomes)
     })
 }
@@ -432,6 +458,7 @@ pub fn integrate_callback<'py>(
             hold,
             max_speed,
             limits,
+            cancel: None,
         };
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(PyValueError::new_err(format!(

@@ -24,6 +24,7 @@ import traceback
 import warnings
 from collections.abc import Iterable, Sequence
 
+from .._ui import interrupts
 from .._version import __version__
 from .options import (
     EXIT_ERROR,
@@ -250,25 +251,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
     command, phrases = "", None
     try:
-        parser = build_parser(load=())
-        try:
-            args = parser.parse_args(argv)
-        except _UsageError as e:
-            print(one_line(f"{e.prog}: error: {e}"), file=sys.stderr)
-            return EXIT_ERROR
-        if not getattr(args, "func", None):
-            parser.print_help()
-            return EXIT_OK
-        command = args.command
-        debug = bool(args.debug)
-        phrases = getattr(args, "_flag_phrases", None)
-        # a --set given twice is refused before the work starts, as an unwritable output is
-        set_values((getattr(args, "set_global", None) or []) + (getattr(args, "set", None) or []))
-        with warnings.catch_warnings():
-            if not debug:
-                warnings.showwarning = _warning_line(command)
-            check_outputs(args)
-            return int(args.func(args) or 0)
+        with interrupts.sticky():  # Ctrl-C stops the command even where a library swallows it
+            parser = build_parser(load=())
+            try:
+                args = parser.parse_args(argv)
+            except _UsageError as e:
+                print(one_line(f"{e.prog}: error: {e}"), file=sys.stderr)
+                return EXIT_ERROR
+            if not getattr(args, "func", None):
+                parser.print_help()
+                return EXIT_OK
+            command = args.command
+            debug = bool(args.debug)
+            phrases = getattr(args, "_flag_phrases", None)
+            # a --set given twice is refused before the work starts, as an unwritable output is
+            set_values((getattr(args, "set_global", None) or []) + (getattr(args, "set", None) or []))
+            with warnings.catch_warnings():
+                if not debug:
+                    warnings.showwarning = _warning_line(command)
+                check_outputs(args)
+                return int(args.func(args) or 0)
     except BrokenPipeError:  # e.g. `kinedyn derive | head`: the reader left, nothing to report
         # the interpreter's flush at exit must not fail again (Python docs, signal: SIGPIPE)
         with contextlib.suppress(Exception):

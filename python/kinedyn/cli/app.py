@@ -20,7 +20,7 @@ import numpy as np
 from rich.markup import escape
 from rich.table import Table
 
-from .. import robot_files, robots
+from .. import robots
 from .._ui import terminal
 from .._ui.json import jsonable
 from .._ui.names import did_you_mean
@@ -119,6 +119,8 @@ def robot_file(spec: str, options: RobotOptions):
         loader_options["floating_base"] = True
     try:
         try:
+            from .. import robot_files  # the file readers load only for a robot file
+
             return robot_files.load(path, **loader_options)
         except ValueError as e:
             if ext == ".xacro" and "trust_xacro=True" in str(e):

@@ -15,12 +15,17 @@ import numbers
 import os
 import sys
 import types
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import as_value
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["LARGEST", "number", "real", "real_array", "vector"]
 
@@ -38,9 +43,13 @@ def real(value: Any, what: str, *, infinite: bool = False) -> float:
     TypeError: a 400-digit integer, a complex number or a string is a ValueError too)."""
     if type(value) is float and -LARGEST <= value <= LARGEST:  # the common case, fast (NaN fails it)
         return value
-    if isinstance(value, bool) or not isinstance(value, (numbers.Real, sp.Basic)) and not hasattr(value, "__float__"):
+    if (
+        isinstance(value, bool)
+        or not (isinstance(value, numbers.Real) or sympy_instance(value, "Basic"))
+        and not hasattr(value, "__float__")
+    ):
         raise ValueError(f"{what} must be a real number, got {_describe(value)}")
-    if isinstance(value, sp.Basic) and (not value.is_number or value.is_extended_real is False):
+    if sympy_instance(value, "Basic") and (not value.is_number or value.is_extended_real is False):
         raise ValueError(f"{what} must be a real number, got {_describe(value)}")
     if isinstance(value, numbers.Complex) and not isinstance(value, numbers.Real):
         raise ValueError(f"{what} must be a real number, got {_describe(value)}")
@@ -64,11 +73,11 @@ def real(value: Any, what: str, *, infinite: bool = False) -> float:
 def number(value: Any, what: str) -> Any:
     """A description number: a SymPy expression with free symbols is kept as it is; anything else
     must pass :func:`real` and is returned as a float."""
-    if isinstance(value, sp.Basic) and value.free_symbols:
+    if sympy_instance(value, "Basic") and value.free_symbols:
         return value
     if isinstance(value, str):
         value = as_value(value)  # the expression parser of kinedyn._math
-        if isinstance(value, sp.Basic) and value.free_symbols:
+        if sympy_instance(value, "Basic") and value.free_symbols:
             return value
     return real(value, what)
 

@@ -18,17 +18,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import is_symbolic
 from .._ui.names import did_you_mean
 from .checks import vector
 from .link import KinematicTree, build_tree, judge_inertias
 from .mimic import MimicMap, mimic_map, reduced_coefficient
 from .tool import default_tool
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["Description"]
 
@@ -223,9 +228,9 @@ class Description:
         free: set = set()
 
         def add(v):
-            if isinstance(v, sp.MatrixBase):
+            if sympy_instance(v, "MatrixBase"):
                 free.update(v.free_symbols)
-            elif isinstance(v, sp.Basic):
+            elif sympy_instance(v, "Basic"):
                 free.update(v.free_symbols)
             elif isinstance(v, (tuple, list)):
                 for e in v:

@@ -14,17 +14,22 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field, fields, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import identity, matmul, pose_inverse, rot_axis, rot_x, rot_z, translation
 from .checks import number
 from .description import Description
 from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["DHRow", "links_from_dh", "description_from_dh", "dh_from_robot", "DHExtraction", "MasslessRobotWarning"]
 
@@ -127,7 +132,7 @@ def links_from_dh(rows, convention: str = "standard"):
         # real, finite, sane numbers (or symbols) before they enter the transforms; exact SymPy
         # numbers (pi / 2) stay exact, so symbolic DH robots keep their exact zeros
         checked = {key: number(getattr(r, key), f"DH row {i}: {key}") for key in ("theta", "d", "a", "alpha")}
-        r = replace(r, **{k: v for k, v in checked.items() if not isinstance(getattr(r, k), sp.Basic)})
+        r = replace(r, **{k: v for k, v in checked.items() if not sympy_instance(getattr(r, k), "Basic")})
         revolute = r.kind == "revolute"
         joint = Joint(
             name=r.name or f"q{i}",

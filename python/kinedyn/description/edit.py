@@ -10,16 +10,22 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
 from .._arrays import real_array
+from .._lazy import LazyModule, sympy_instance
 from .._math import as_value, is_symbolic, matmul, rot_axis, translation
 from .._ui.names import did_you_mean
 from .description import Description
 from .joint import Joint
 from .mimic import lock_followers
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["substitute", "lock", "lock_joints"]
 
@@ -30,9 +36,9 @@ def substitute(description: Description, mapping: Mapping) -> Description:
     the DH table. A matrix left without symbols becomes a float array (the numeric engine's input)."""
 
     def f(v):
-        if isinstance(v, (sp.Basic, sp.MatrixBase)):
+        if sympy_instance(v):
             out = v.subs(mapping)
-            if isinstance(out, sp.MatrixBase):
+            if sympy_instance(out, "MatrixBase"):
                 return out if is_symbolic(out) else np.array(out.tolist(), dtype=float)
             return as_value(out)
         return v

@@ -11,31 +11,38 @@ from __future__ import annotations
 import math
 import os
 import re
-import reprlib
 import sys
 from dataclasses import replace
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
-import sympy as sp
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard library since 3.11
     import tomli as tomllib
-import yaml
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import matmul, rpy_to_matrix, translation
 from .._ui.files import open_regular
 from ..expressions import parse_expression
 from .description import Description
 from .dh import DHRow, description_from_dh
+from .file_limits import MAX_NESTING, MAX_NODES, SHORT_REPR, LineDict, LineList
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia
 from .joint import Joint, Mimic
 from .link import Frame, Link
 
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
+
 __all__ = [
+    "LineDict",
+    "LineList",
+    "SHORT_REPR",
     "description_from_mapping",
     "read_text",
     "parse_yaml",
@@ -91,14 +98,10 @@ _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 # Bounds on a robot file, so that a small hostile file cannot ask for unbounded time or memory
 MAX_FILE_BYTES = 16 * 2**20  # a robot file is text a person writes: 16 MiB is far beyond any robot
-MAX_NESTING = 32  # mappings and lists inside each other (a robot file needs 5)
-MAX_NODES = 1_000_000  # YAML nodes composed, counting every use of an alias as the nodes it repeats
 MAX_TEXT = 1000  # characters of a name or other text field
 # a YAML/TOML robot file: a 100-joint robot is ~20 KiB; the YAML parser reads ~0.1-1 MiB/s, so a larger
 # file is refused on its size before parsing, not after seconds of it
 MAX_TEXT_BYTES = 2**20
-_REPR = reprlib.Repr()
-_REPR.maxlevel, _REPR.maxstring, _REPR.maxother, _REPR.maxlist, _REPR.maxdict = 2, 40, 40, 4, 4
 
 
 def read_text(path: str) -> str:
@@ -122,148 +125,11 @@ def read_text(path: str) -> str:
 
 
 # ---------------------------------------------------------------- YAML, bounded
-class _LineDict(dict):
-    """A mapping read from YAML that remembers the line of each key (1-based), for messages."""
-
-    lines: dict
-
-
-class _LineList(list):
-    """A list read from YAML that remembers the line of each item (1-based), for messages."""
-
-    lines: list
-
-
-class _BoundedLoader(yaml.SafeLoader):
-    """PyYAML's safe loader (plain data only: no Python objects) with three changes:
-
-    - nesting deeper than ``MAX_NESTING`` is an error (PyYAML's composer recurses);
-    - the size of the document is bounded with every alias counted as the nodes it repeats, so a
-      small file of aliases to aliases (a "billion laughs") fails at once instead of filling memory;
-    - a key given twice in one mapping is an error (YAML 1.2 forbids it; PyYAML keeps the last).
-    """
-
-    def __init__(self, stream):
-        super().__init__(stream)
-        self._depth = 0
-        self._expanded = 0  # nodes composed so far, aliases counted as what they repeat
-        self._size_of: dict = {}  # id(anchored node) -> its expanded size
-
-    def _refuse(self, problem: str, mark):
-        raise yaml.composer.ComposerError(None, None, problem, mark)
-
-    def compose_node(self, parent, index):
-        event = self.peek_event()
-        if isinstance(event, yaml.AliasEvent):
-            node = self.anchors.get(event.anchor)
-            if node is not None:
-                if id(node) not in self._size_of:
-                    self._refuse(f"the alias *{event.anchor} refers to a node that contains it", event.start_mark)
-                self._count(self._size_of[id(node)], event.start_mark)
-            return super().compose_node(parent, index)
-        self._depth += 1
-        if self._depth > MAX_NESTING:
-            self._refuse(f"mappings and lists are nested more than {MAX_NESTING} deep", event.start_mark)
-        before = self._expanded
-        self._count(1, event.start_mark)
-        node = super().compose_node(parent, index)
-        self._depth -= 1
-        self._size_of[id(node)] = self._expanded - before
-        return node
-
-    def _count(self, nodes: int, mark):
-        self._expanded += nodes
-        if self._expanded > MAX_NODES:
-            self._refuse(
-                f"the document expands to more than {MAX_NODES} values (aliases counted as what they repeat)", mark
-            )
-
-    def construct_line_mapping(self, node):
-        data = _LineDict()
-        data.lines = {}
-        yield data
-        for key_node, _ in node.value:
-            if key_node.tag == "tag:yaml.org,2002:merge":  # "<<: *anchor": merged keys may be overridden
-                continue
-            key = self.construct_object(key_node, deep=True)
-            try:
-                repeated = key in data.lines
-            except TypeError:
-                raise yaml.constructor.ConstructorError(
-                    None, None, "a mapping key must be a plain value", key_node.start_mark
-                ) from None
-            if repeated:
-                raise yaml.constructor.ConstructorError(
-                    None,
-                    None,
-                    f"the key {_REPR.repr(key)} appears twice in one mapping (first on line {data.lines[key]})",
-                    key_node.start_mark,
-                )
-            data.lines[key] = key_node.start_mark.line + 1
-        data.update(self.construct_mapping(node, deep=True))
-
-    def construct_line_sequence(self, node):
-        data = _LineList()
-        data.lines = [item.start_mark.line + 1 for item in node.value]
-        yield data
-        data.extend(self.construct_sequence(node, deep=True))
-
-
-def _refuse_tag(loader, node):
-    raise yaml.constructor.ConstructorError(
-        None,
-        None,
-        f"the YAML type {node.tag.rsplit(':', 1)[-1]} ({_REPR.repr(node.value) if isinstance(node.value, str) else '...'}) "
-        "has no meaning in a robot file (numbers, text, lists and mappings only)",
-        node.start_mark,
-    )
-
-
-# a robot file holds numbers, text, lists and mappings: YAML's other types (dates, which PyYAML's
-# constructor can also fail on with an AttributeError, binary, sets, ordered pairs) are refused
-for _tag in ("timestamp", "binary", "set", "omap", "pairs"):
-    _BoundedLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
-# digits of a YAML integer the parser converts at all: below Python's own limit (4300, whose message
-# speaks of sys.set_int_max_str_digits); the field's reader then refuses anything over ~300 digits by name
-MAX_INT_DIGITS = 4000
-
-
-def _bounded_int(loader, node):
-    """A YAML integer, its digits counted before Python converts it (whose own limit, 4300 digits,
-    speaks of sys.set_int_max_str_digits, not of the file)."""
-    digits = sum(c.isalnum() for c in str(node.value))
-    if digits > MAX_INT_DIGITS:
-        raise yaml.constructor.ConstructorError(
-            None, None, f"the integer has {digits} digits, too large for a robot's parameter", node.start_mark
-        )
-    return loader.construct_yaml_int(node)
-
-
-_BoundedLoader.add_constructor("tag:yaml.org,2002:int", _bounded_int)
-_BoundedLoader.add_constructor("tag:yaml.org,2002:map", _BoundedLoader.construct_line_mapping)
-_BoundedLoader.add_constructor("tag:yaml.org,2002:seq", _BoundedLoader.construct_line_sequence)
-
-
 def parse_yaml(text: str, where: str):
-    loader = None
-    try:
-        loader = _BoundedLoader(text)  # its reader already refuses control characters
-        return loader.get_single_data()
-    except yaml.MarkedYAMLError as e:
-        mark = e.problem_mark or e.context_mark
-        line = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
-        raise ValueError(f"{where}: invalid YAML at {line}: {e.problem or e.context}") from None
-    except yaml.reader.ReaderError as e:  # a character YAML does not allow (NUL, other control characters)
-        line_no = text.count("\n", 0, e.position) + 1
-        shown = chr(e.character) if isinstance(e.character, int) else e.character
-        raise ValueError(
-            f"{where}: invalid YAML at line {line_no}: the character {shown!r} is not allowed in YAML"
-        ) from None
-    except yaml.YAMLError as e:
-        raise ValueError(f"{where}: invalid YAML: {e}") from None
-    finally:
-        if loader is not None:
-            loader.dispose()
+    """The YAML robot file ``text`` as plain data (kinedyn.description.yaml_reader)."""
+    from .yaml_reader import parse_yaml as parse  # PyYAML loads only for YAML robot files
+
+    return parse(text, where)
 
 
 _TOML_STRING_OR_COMMENT = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*')
@@ -337,10 +203,10 @@ class _Reader:
 
     def remember_lines(self, container, ctx: str, keys=None) -> None:
         """Note the lines of a YAML mapping's keys (``ctx.key``) or a list's items (``ctx[i]``)."""
-        if isinstance(container, _LineDict):
+        if isinstance(container, LineDict):
             for key, line in container.lines.items():
                 self.lines.setdefault(f"{ctx}.{key}" if ctx else str(key), line)
-        elif isinstance(container, _LineList):
+        elif isinstance(container, LineList):
             for i, line in enumerate(container.lines):
                 self.lines.setdefault(f"{ctx}[{i}]", line)
                 if keys is not None:
@@ -352,7 +218,7 @@ class _Reader:
         self.remember_lines(mapping, "" if ctx == "top level" else ctx)
         for key in mapping:
             if key not in known:
-                self.fail(ctx, f"unknown key {_REPR.repr(key)} (known keys: {', '.join(sorted(known))})")
+                self.fail(ctx, f"unknown key {SHORT_REPR.repr(key)} (known keys: {', '.join(sorted(known))})")
         return mapping
 
     def items(self, raw, ctx: str, what: str, row_ctx) -> list:
@@ -398,19 +264,19 @@ class _Reader:
 
     def number(self, raw, ctx: str, infinite: bool = False) -> float:
         v = self.value(raw, ctx, infinite)
-        if isinstance(v, sp.Basic):
-            self.fail(ctx, f"must be a number, got the expression '{_REPR.repr(raw)[1:-1]}'")
+        if sympy_instance(v, "Basic"):
+            self.fail(ctx, f"must be a number, got the expression '{SHORT_REPR.repr(raw)[1:-1]}'")
         return v
 
     def angle(self, raw, ctx: str):
         v = self.value(raw, ctx)
         if not self.deg:
             return v
-        return v * sp.pi / 180 if isinstance(v, sp.Basic) else v * math.pi / 180
+        return v * sp.pi / 180 if sympy_instance(v, "Basic") else v * math.pi / 180
 
     def vector(self, raw, ctx: str, n: int = 3, angles: bool = False) -> tuple:
         if not isinstance(raw, (list, tuple)) or len(raw) != n:
-            self.fail(ctx, f"expected a list of {n} values, got {_REPR.repr(raw)}")
+            self.fail(ctx, f"expected a list of {n} values, got {SHORT_REPR.repr(raw)}")
         self.remember_lines(raw, ctx)
         f = self.angle if angles else self.value
         return tuple(f(v, f"{ctx}[{i}]") for i, v in enumerate(raw))
@@ -466,7 +332,7 @@ class _Reader:
                 )
             levels = tuple(self.value(v, f"{ctx}.coulomb[{i}]") for i, v in enumerate(c))
             for i, v in enumerate(levels):
-                if not isinstance(v, sp.Basic) and v < 0:
+                if not sympy_instance(v, "Basic") and v < 0:
                     self.fail(
                         f"{ctx}.coulomb[{i}]",
                         f"a Coulomb level is a magnitude >= 0, got {v} (Corke's Tc = [Tc+, Tc-] with Tc- < 0 is written [Tc+, -Tc-])",
@@ -486,7 +352,7 @@ def description_from_mapping(data, where: str = "<robot mapping>", inertia: str 
     r.check_keys(data, _TOP_DH if dh else _TOP_TREE, "top level")
     units = r.check_keys(data.get("units", {}), {"angle"}, "units")
     if units.get("angle", "rad") not in ("deg", "rad"):
-        r.fail("units.angle", f"must be 'deg' or 'rad', got {_REPR.repr(units['angle'])}")
+        r.fail("units.angle", f"must be 'deg' or 'rad', got {SHORT_REPR.repr(units['angle'])}")
     r.deg = units.get("angle") == "deg"
     common = {
         "gravity": r.vector(data.get("gravity", [0, 0, -9.81]), "gravity"),
@@ -590,7 +456,7 @@ def _visuals(r: _Reader, raw, where: str) -> list:
 def _dh_description(r: _Reader, data: dict, common: dict, frames: list) -> Description:
     convention = data.get("convention", "standard")
     if convention not in ("standard", "modified"):
-        r.fail("convention", f"must be 'standard' or 'modified', got {_REPR.repr(convention)}")
+        r.fail("convention", f"must be 'standard' or 'modified', got {SHORT_REPR.repr(convention)}")
     joints = r.items(data["joints"], "joints", "DH rows", lambda i: f"joints row {i + 1}")
     if not joints:
         r.fail("joints", "expected a non-empty list of DH rows")
@@ -609,7 +475,7 @@ def _dh_row(r: _Reader, row, i: int) -> DHRow:
     row = r.check_keys(row, _ROW_KEYS, ctx)
     kind = row.get("type", "revolute")
     if kind not in ("revolute", "prismatic"):
-        r.fail(f"{ctx}.type", f"must be 'revolute' or 'prismatic', got {_REPR.repr(kind)}")
+        r.fail(f"{ctx}.type", f"must be 'revolute' or 'prismatic', got {SHORT_REPR.repr(kind)}")
     limits = r.limits(row.get("limits", {}), kind == "revolute", f"{ctx}.limits")
     return DHRow(
         theta=r.angle(row.get("theta", 0.0), f"{ctx}.theta"),
@@ -649,7 +515,7 @@ def _tree_link(r: _Reader, raw, i: int) -> Link:
     j = r.check_keys(raw.get("joint", {"type": "fixed"}), _JOINT_KEYS, f"{ctx}.joint")
     kind = j.get("type", "revolute")
     if kind not in ("revolute", "continuous", "prismatic", "fixed"):
-        r.fail(f"{ctx}.joint.type", f"must be revolute, continuous, prismatic or fixed, got {_REPR.repr(kind)}")
+        r.fail(f"{ctx}.joint.type", f"must be revolute, continuous, prismatic or fixed, got {SHORT_REPR.repr(kind)}")
     revolute = kind in ("revolute", "continuous")
     offset_reader = r.angle if revolute else r.value
     joint = Joint(
@@ -683,4 +549,6 @@ def _mimic(r, raw, ctx: str):
 def _kind(raw) -> str:
     """A short description of a value from a file, for messages (never its whole text)."""
     kind = "mapping" if isinstance(raw, dict) else "list" if isinstance(raw, list) else type(raw).__name__
-    return f"{kind} {_REPR.repr(dict(raw) if isinstance(raw, dict) else list(raw) if isinstance(raw, list) else raw)}"
+    return (
+        f"{kind} {SHORT_REPR.repr(dict(raw) if isinstance(raw, dict) else list(raw) if isinstance(raw, list) else raw)}"
+    )

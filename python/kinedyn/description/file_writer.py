@@ -10,17 +10,22 @@ import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
 if sys.version_info >= (3, 11):
     pass
 else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard library since 3.11
     pass
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import is_symbolic, matmul, pose_inverse, rpy_from_matrix
 from .dh import links_from_dh
 from .geometry import Box, Cylinder, Mesh
 from .inertia import Inertia
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -71,7 +76,7 @@ def _visual_mapping(v) -> dict:
 
 
 def _dump(v):
-    if isinstance(v, sp.Basic):
+    if sympy_instance(v, "Basic"):
         return float(v) if not v.free_symbols else str(v)
     return float(v)
 
@@ -86,7 +91,7 @@ def _pose_mapping(T, what: str) -> dict:
     T = sp.Matrix(T) if is_symbolic(T) else np.asarray(T, dtype=float)
     if is_symbolic(T[:3, :3]):
         raise ValueError(f"cannot save {what}: its rotation is symbolic (only translations may hold symbols)")
-    R = np.array(sp.Matrix(T[:3, :3]).tolist(), dtype=float) if isinstance(T, sp.MatrixBase) else T[:3, :3]
+    R = np.array(sp.Matrix(T[:3, :3]).tolist(), dtype=float) if sympy_instance(T, "MatrixBase") else T[:3, :3]
     return {"xyz": [_dump(T[i, 3]) for i in range(3)], "rpy": list(rpy_from_matrix(R))}
 
 

@@ -21,7 +21,6 @@ import warnings
 from typing import TYPE_CHECKING
 
 import tomli_w
-import yaml
 
 from .._ui.files import require_regular, write_text
 from .description import Description
@@ -75,6 +74,8 @@ def save(robot: Robot | Description, path: PathLike) -> None:
     ext = os.path.splitext(path)[1].lower()
     data = robot_to_mapping(robot)
     if ext in (".yaml", ".yml"):
+        import yaml  # PyYAML loads only to write a YAML file
+
         text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=120)
     elif ext == ".toml":
         text = tomli_w.dumps(data)

@@ -16,13 +16,18 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import is_symbolic
 from .checks import number, real_array, vector
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["Inertia", "Consistency", "PhysicalConsistencyWarning", "INERTIA_POLICIES", "judge", "skew"]
 
@@ -279,7 +284,7 @@ class Inertia:
         return Inertia(m, c, Ic)
 
     def subs(self, mapping) -> Inertia:
-        f = lambda e: e.subs(mapping) if isinstance(e, sp.Basic) else e
+        f = lambda e: e.subs(mapping) if sympy_instance(e, "Basic") else e
         return Inertia(f(self.mass), tuple(f(c) for c in self.com), tuple(tuple(f(e) for e in r) for r in self.inertia))
 
 

@@ -20,15 +20,20 @@ order, so ``parent[i] < i``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import sympy as sp
 
+from .._lazy import LazyModule, sympy_instance
 from .._math import identity, is_symbolic, matmul
 from .checks import LARGEST
 from .inertia import Inertia, judge
 from .joint import Joint
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["Link", "Frame", "Body", "NamedFrame", "KinematicTree", "build_tree", "judge_inertias"]
 
@@ -37,7 +42,7 @@ def _pose(value, what: str):
     if is_symbolic(value):
         T = sp.Matrix(value)
     else:
-        raw = np.asarray(value.tolist() if isinstance(value, sp.MatrixBase) else value)
+        raw = np.asarray(value.tolist() if sympy_instance(value, "MatrixBase") else value)
         if (
             raw.dtype.kind == "c"
             or raw.dtype == object

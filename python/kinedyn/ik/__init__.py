@@ -8,10 +8,24 @@ See docs/ik.md. ``symbolic_elbow_solution()`` gives the tutorial elbow arm's sol
 expressions of x, y, z and the link lengths.
 """
 
-from .solve import METHODS, IKBatchResult, IKResult, analytic_structure, inverse_kinematics
-from .symbolic import ElbowSolution, symbolic_elbow_solution
+from typing import TYPE_CHECKING
 
-__all__ = [
+from .solve import METHODS, IKBatchResult, IKResult, analytic_structure, inverse_kinematics
+
+if TYPE_CHECKING:
+    from .symbolic import ElbowSolution, symbolic_elbow_solution
+
+
+def __getattr__(name: str):
+    """The symbolic solution's names load SymPy, on first use (kinedyn._lazy)."""
+    if name in ("ElbowSolution", "symbolic_elbow_solution"):
+        from . import symbolic
+
+        return getattr(symbolic, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = [  # noqa: F822 - the symbolic names come from __getattr__
     "inverse_kinematics",
     "IKResult",
     "IKBatchResult",

@@ -10,13 +10,17 @@ import functools
 import inspect
 import math
 from collections.abc import Callable
-from typing import TypeVar, cast
+from typing import TYPE_CHECKING, TypeVar, cast
 
-import sympy as sp
-
+from .._lazy import LazyModule
 from ..description.dh import DHRow
 from ..description.inertia import Inertia
 from ..robot import Robot
+
+if TYPE_CHECKING:
+    import sympy as sp
+else:
+    sp = LazyModule("sympy")  # SymPy loads on first use, not with kinedyn (kinedyn._lazy)
 
 __all__ = ["planar_2r", "planar_3r", "elbow_3r", "cartesian_2p"]
 

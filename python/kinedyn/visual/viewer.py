@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from .._ui import interrupts
 from ..configuration import default_configuration
 from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
 from .serving import HandshakeGuard, guarded_viser, listen_address
@@ -327,6 +328,7 @@ class Viewer:
             while True:
                 time.sleep(0.5)
         except KeyboardInterrupt:
+            interrupts.taken()  # Ctrl-C is how this ends: the close below is not interrupted again
             return True
         finally:
             self.close()

@@ -9,6 +9,8 @@
 //! | `tau`       | `tau`                 | joint torque at a stage, length `n`              |
 
 use super::implicit::{implicit_step, ImplicitScratch};
+use std::sync::atomic::Ordering;
+
 use super::{Failure, FailureKind, Limits, Method, Outcome, Record, Settings, TorqueFn};
 use crate::algorithms::aba::aba;
 use crate::data::Data;
@@ -217,6 +219,19 @@ pub fn integrate(
     }
     for k in 0..=settings.steps {
         let t = t_of(k);
+        // another thread asked the run to stop (one relaxed load per step: no measurable cost)
+        if settings.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return Ok(Outcome {
+                steps: k,
+                samples,
+                failure: Some(Failure {
+                    step: k,
+                    t,
+                    joint: None,
+                    kind: FailureKind::Cancelled,
+                }),
+            });
+        }
         // k1 = f(t_k, x_k): also the recorded qdd_k and tau_k
         let (kv0, rest) = s.kv.split_at_mut(1);
         let wrenches = match derivative(
@@ -358,6 +373,7 @@ mod tests {
             hold: false,
             max_speed: 1e6,
             limits: None,
+            cancel: None,
         };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
@@ -484,6 +500,7 @@ mod tests {
             hold: false,
             max_speed: 1e6,
             limits: None,
+            cancel: None,
         };
         let m = settings.samples() * n;
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
@@ -548,6 +565,7 @@ mod tests {
             hold: false,
             max_speed: 1e6,
             limits: None,
+            cancel: None,
         };
         let mut v = vec![0.0; 11];
         let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
@@ -642,6 +660,7 @@ mod tests {
             hold: false,
             max_speed: 1e6,
             limits,
+            cancel: None,
         };
         let m = settings.samples();
         let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
@@ -797,6 +816,7 @@ mod tests {
                 lower: &[1.0],
                 upper: &[0.0],
             }),
+            cancel: None,
         };
         let mut v = vec![0.0; 2];
         let (mut a, mut b, mut c) = (v.clone(), v.clone(), v.clone());
@@ -919,6 +939,7 @@ mod tests {
                 hold: false,
                 max_speed: 1e6,
                 limits: None,
+                cancel: None,
             };
             let m = settings.samples() * n;
             let mut runs = Vec::new();
@@ -961,5 +982,55 @@ mod tests {
                 assert!((a - b).abs() <= tol * (1.0 + b.abs()), "{method:?}: {a} vs {b}");
             }
         }
+    }
+
+    /// A cancellation flag set while the run goes (here by the torque source at step 10, as
+    /// another thread would on Ctrl-C) stops it before the next step, samples so far kept.
+    #[test]
+    fn a_set_cancel_flag_stops_the_run_before_the_next_step() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let model = random_model(2, 7, true);
+        let flag = AtomicBool::new(false);
+        let mut source = |k: usize, _t: f64, _q: &[f64], _qd: &[f64], out: &mut [f64]| {
+            out.fill(0.0);
+            if k == 10 {
+                flag.store(true, Ordering::Relaxed);
+            }
+            Ok(())
+        };
+        let steps = 1_000_000;
+        let settings = Settings {
+            method: Method::Rk4,
+            dt: 1e-3,
+            steps,
+            t0: 0.0,
+            record_every: steps,
+            hold: false,
+            max_speed: 1e6,
+            limits: None,
+            cancel: Some(&flag),
+        };
+        let n = model.n;
+        let m = settings.samples() * n;
+        let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        let out = integrate(
+            &model,
+            &mut Data::new(&model),
+            &settings,
+            &vec![0.1; model.nq],
+            &vec![0.0; n],
+            &mut source,
+            Record {
+                q: &mut q,
+                qd: &mut qd,
+                qdd: &mut qdd,
+                tau: &mut tau,
+            },
+        )
+        .unwrap();
+        let failure = out.failure.expect("the run was cancelled");
+        assert_eq!(failure.kind, FailureKind::Cancelled);
+        assert_eq!((out.steps, failure.step), (11, 11));
+        assert_eq!(out.samples, 1, "the first sample is kept");
     }
 }

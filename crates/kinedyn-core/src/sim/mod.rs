@@ -37,7 +37,8 @@
 //! Recorded per sample `k` (every `record_every` steps, and the last): `q_k`, `qd_k`, the torque
 //! applied at `t_k` and `qdd_k = aba(q_k, qd_k, tau_k)`. A step that produces a non-finite state or a
 //! joint speed above `max_speed`, a torque that is not finite, or a singular mass matrix stops the
-//! run: the samples before it are kept and a [`Failure`] says when and where.
+//! run: the samples before it are kept and a [`Failure`] says when and where. So does a set
+//! cancellation flag (`settings.cancel`, polled before every step): long runs can be interrupted.
 //!
 //! Files: the types of a run are here; `integrate.rs` (the runner: checks, stages, limits, samples),
 //! `implicit.rs` (the linearly implicit step), `torque.rs` (torque sources).
@@ -48,6 +49,8 @@
 //! | `x_k`       | `q`, `qd`             | state at `t_k`, each length `n`                  |
 //! | `k1..k4`    | `kq[s]`, `kv[s]`      | stage derivatives of `q` and `qd`                |
 //! | `tau`       | `tau`                 | joint torque at a stage, length `n`              |
+
+use std::sync::atomic::AtomicBool;
 
 mod implicit;
 mod integrate;
@@ -102,6 +105,9 @@ pub struct Settings<'a> {
     pub max_speed: f64,
     /// Joint position limits to honour (inelastic stops), or None: free motion passes through.
     pub limits: Option<Limits<'a>>,
+    /// A cancellation flag polled before every step, or None: once it is set (by another thread,
+    /// e.g. the Python binding's caller on Ctrl-C) the run stops with [`FailureKind::Cancelled`].
+    pub cancel: Option<&'a AtomicBool>,
 }
 
 impl Settings<'_> {
@@ -123,6 +129,8 @@ pub enum FailureKind {
     Source(String),
     /// The mass matrix was singular (message from the articulated-body algorithm).
     Singular(String),
+    /// [`Settings::cancel`] was set: the caller asked the run to stop.
+    Cancelled,
 }
 
 /// When and where a run stopped: during step `step` (from `t` to `t + dt`), at joint `joint`.

@@ -5,10 +5,7 @@ from __future__ import annotations
 
 import json
 
-import sympy as sp
-
 from ... import robots
-from ... import symbolic as ks
 from .. import app
 
 
@@ -43,6 +40,11 @@ def add_arguments(p) -> None:
 
 def run(args, what: str) -> int:
     """``kinedyn fk|jacobian ROBOT --symbolic``: the pose or the Jacobian as formulas (kinedyn.symbolic)."""
+    # the symbolic engine and SymPy load only when --symbolic asks for formulas (kinedyn._lazy)
+    import sympy as sp
+
+    from ... import symbolic as ks
+
     robot = symbolic_robot(args)
     frame = args.frame or robot.tool
     q = ks.joint_symbols(robot)
