@@ -26,6 +26,9 @@ __all__ = ["Solid", "solid_of", "combined", "MAX_MESH_BYTES"]
 
 MAX_MESH_BYTES = 64 * 2**20  # a mesh file larger than this is not read by the audit
 
+# |x|, |y|, |z| of a mesh the audit measures, in the file's units (a robot in millimetres spans 1e4);
+# beyond it the products of the volume integrals overflow
+MAX_MEASURED_COORDINATE = 1e6
 # directions for a sphere's hull points: the 26 of a cube's faces, edges and corners, normalised
 _DIRECTIONS = np.array(
     [(x, y, z) for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)]
@@ -106,6 +109,16 @@ def _read_mesh(shape: Mesh):
         return f"not read by trimesh ({type(e).__name__}: {e})"
     if not hasattr(mesh, "vertices") or len(mesh.vertices) == 0 or len(getattr(mesh, "faces", ())) == 0:
         return "not read (no triangles)"
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    if not np.all(np.isfinite(vertices)) or np.max(np.abs(vertices)) > MAX_MEASURED_COORDINATE:
+        return f"not measured (a vertex beyond {MAX_MEASURED_COORDINATE:g} in the file's units)"
+    try:
+        return _measure(mesh, shape)
+    except Exception as e:  # qhull and trimesh raise many kinds on a degenerate mesh  # noqa: BLE001
+        return f"not measured ({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})"
+
+
+def _measure(mesh: Any, shape: Mesh):
     extent = float(np.max(mesh.extents)) if len(mesh.vertices) else 0.0  # as written in the file, before scale
     mesh.apply_transform(np.diag([*shape.scale, 1.0]))
     note = ""
