@@ -160,7 +160,6 @@ def test_a_urdf_without_moving_joints_is_a_robot_with_no_degrees_of_freedom(tmp_
     np.testing.assert_allclose(flying.mass_matrix(q7), pin.crba(model, data, q7), atol=1e-12)
 
 
-
 def test_batches_and_the_native_solver_answer_for_a_model_with_no_degrees_of_freedom(tmp_path):
     """A batch of runs splits its outputs into rows of zero numbers, and the core's IK has nothing to
     move: each gives an answer or a ValueError, never the binding's internal error."""
@@ -173,7 +172,10 @@ def test_batches_and_the_native_solver_answer_for_a_model_with_no_degrees_of_fre
     assert runs.q.shape[0] == 3 and runs.q.shape[-1] == 0
     targets = np.tile(np.eye(4), (8, 1, 1))
     with pytest.raises(ValueError, match="no moving joint"):
-        _core.solve_ik(robot._model, 0, targets, np.zeros((8, 0)), np.zeros(0), np.zeros(0), np.ones(6), 10, 1, 1e-6, 1e-6)
+        _core.solve_ik(
+            robot._model, 0, targets, np.zeros((8, 0)), np.zeros(0), np.zeros(0), np.ones(6), 10, 1, 1e-6, 1e-6
+        )
+
 
 def test_the_cli_and_the_checks_answer_for_a_robot_with_no_degrees_of_freedom(tmp_path, capsys):
     from kinedyn.cli import main
