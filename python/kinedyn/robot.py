@@ -366,7 +366,7 @@ class Robot:
     @cached_property
     def _model(self):
         """The compiled native model (built once; numeric descriptions only): :func:`kinedyn.native.compile_model`."""
-        return compile_model(self)
+        return compile_model(self.description)
 
     @cached_property
     def _multi_dof(self) -> bool:

@@ -10,6 +10,7 @@ mod conv;
 mod guard;
 mod ik;
 mod model;
+mod records;
 mod run;
 mod simulate;
 

@@ -5,17 +5,15 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
-use kinedyn_core::lie::Block;
-use kinedyn_core::model::Coordinates;
-use kinedyn_core::spatial::{Inertia, Transform, Vec3};
-use kinedyn_core::{Data, Frame, Joint, JointKind, Model};
+use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
-use crate::conv::{self, f64_array, optional, vec_of, Batch};
+use crate::conv::{self, f64_array, optional, Batch};
 use crate::guard::guarded;
-use crate::run::{core_err, Arrays3};
+use crate::run::Arrays3;
 
 /// The compiled model plus one cached `Data` for single-state calls.
 #[pyclass(name = "Model", module = "kinedyn._core", frozen)]
@@ -146,119 +144,17 @@ model_methods! {
     fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernels::Regressor;
 
     by_hand {
+        /// The model of a robot's joints, each a mapping taken whole (see `_core.pyi`):
+        /// `records::build` converts them and the core's `ModelBuilder` expands and checks them.
         #[new]
-        #[allow(clippy::too_many_arguments)]
-        #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None, blocks=None))]
+        #[pyo3(signature = (joints, gravity, frames=Vec::new()))]
         fn new(
-            parent: Vec<i64>,
-            kind: Vec<String>,
-            axis: PyReadonlyArrayDyn<f64>,
-            offset: Vec<f64>,
-            placement: PyReadonlyArrayDyn<f64>,
-            inertia: PyReadonlyArrayDyn<f64>,
-            armature: Vec<f64>,
-            viscous: Vec<f64>,
-            coulomb: Vec<f64>,
-            gravity: Vec<f64>,
-            frame_body: Vec<i64>,
-            frame_placement: PyReadonlyArrayDyn<f64>,
-            coulomb_negative: Option<Vec<f64>>,
-            blocks: Option<Vec<Option<String>>>,
+            joints: Vec<Bound<'_, PyDict>>,
+            gravity: Bound<'_, PyAny>,
+            frames: Vec<(i64, Bound<'_, PyAny>)>,
         ) -> PyResult<Self> {
             guarded("Model.__new__", || {
-                let n = parent.len();
-                let nf = frame_body.len();
-                let axis = vec_of("axis", &axis, &[n, 3])?;
-                let placement = vec_of("placement", &placement, &[n, 4, 4])?;
-                let inertia = vec_of("inertia", &inertia, &[n, 10])?;
-                let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
-                if kind.len() != n {
-                    return Err(PyValueError::new_err(format!(
-                        "kind has {} entries for {n} bodies",
-                        kind.len()
-                    )));
-                }
-                if gravity.len() != 3 {
-                    return Err(PyValueError::new_err(format!(
-                        "gravity must have 3 components, got {}",
-                        gravity.len()
-                    )));
-                }
-                let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
-                    match p {
-                        -1 => Ok(None),
-                        p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
-                        p => Err(PyValueError::new_err(format!(
-                            "{what} {k}: body index {p} is out of range (-1..{n})"
-                        ))),
-                    }
-                };
-                let parent = parent
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &p)| body_index("parent of body", i, p))
-                    .collect::<PyResult<Vec<_>>>()?;
-                let joints = kind
-                    .iter()
-                    .enumerate()
-                    .map(|(i, k)| {
-                        let kind = JointKind::from_name(k).map_err(|e| {
-                            PyValueError::new_err(format!("joint {i}: {e}"))
-                        })?;
-                        Ok(Joint {
-                            kind,
-                            axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]),
-                        })
-                    })
-                    .collect::<PyResult<Vec<_>>>()?;
-                let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
-                let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
-                let frames = frame_body
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &b)| {
-                        Ok(Frame {
-                            body: body_index("frame", k, b)?,
-                            body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]),
-                        })
-                    })
-                    .collect::<PyResult<Vec<_>>>()?;
-                let mut model = Model::new(
-                    parent,
-                    joints,
-                    offset,
-                    placements,
-                    inertias,
-                    armature,
-                    viscous,
-                    coulomb,
-                    Vec3::new(gravity[0], gravity[1], gravity[2]),
-                    frames,
-                )
-                .map_err(core_err)?;
-                if let Some(levels) = coulomb_negative {
-                    model = model.with_coulomb_negative(levels).map_err(core_err)?;
-                }
-                if let Some(names) = blocks {
-                    // per body: the block its joint starts ("floating", "spherical", "planar"; "" or
-                    // None for a 1-DOF joint and for a multi-DOF joint's further bodies)
-                    if names.len() != n {
-                        return Err(PyValueError::new_err(format!(
-                            "blocks has {} entries for {n} bodies",
-                            names.len()
-                        )));
-                    }
-                    let blocks = names
-                        .iter()
-                        .enumerate()
-                        .map(|(i, name)| {
-                            Block::from_name(name.as_deref().unwrap_or(""))
-                                .map_err(|e| PyValueError::new_err(format!("body {i}: {e}")))
-                        })
-                        .collect::<PyResult<Vec<_>>>()?;
-                    let coordinates = Coordinates::from_blocks(&blocks).map_err(core_err)?;
-                    model = model.with_coordinates(coordinates).map_err(core_err)?;
-                }
+                let model = crate::records::build(&joints, &gravity, &frames)?;
                 let data = Mutex::new(Data::new(&model));
                 Ok(Self { model, data })
             })

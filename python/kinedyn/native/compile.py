@@ -1,6 +1,6 @@
-"""A robot description compiled into the native ``_core.Model``: one native body per degree of
-freedom (a multi-DOF joint is a head body and members, crates/kinedyn-core/src/model/mod.rs), the
-joint kinds' motion subspaces and the in-plane axes of planar joints."""
+"""A robot description compiled into the native ``_core.Model``: one record per joint of the
+description's tree, taken whole (kind, axis, placement, inertia, drive data); the core's model
+builder expands multi-DOF joints (crates/kinedyn-core/src/model/builder.rs)."""
 
 from __future__ import annotations
 
@@ -16,12 +16,9 @@ from ..description.joint import planar_basis
 from .mimic import ReducedModel
 
 if TYPE_CHECKING:
-    from ..robot import Robot
+    from ..description.description import Description
 
-__all__ = ["compile_model", "joint_columns", "locked_block", "planar_basis"]
-
-# the joint kinds the core decodes into multi-DOF blocks (lie::Block::from_name)
-MULTI_DOF_KINDS = ("floating", "spherical", "planar")
+__all__ = ["compile_model", "joint_record", "locked_block", "planar_basis"]
 
 
 def locked_block(joint, block) -> np.ndarray:
@@ -52,93 +49,47 @@ def locked_block(joint, block) -> np.ndarray:
     return T
 
 
-def joint_columns(joint) -> list:
-    """The native bodies' (kind, unit axis) of a joint's motion subspace, in its child's frame, kind
-    "revolute" or "prismatic": 1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z;
-    spherical: angular x, y, z; planar: linear e1, e2, angular normal."""
-    e = np.eye(3)
-    if joint.kind == "floating":
-        return [("prismatic", e[k]) for k in range(3)] + [("revolute", e[k]) for k in range(3)]
-    if joint.kind == "spherical":
-        return [("revolute", e[k]) for k in range(3)]
-    axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
-    if joint.kind == "planar":
-        e1, e2 = planar_basis(axis)
-        return [("prismatic", e1), ("prismatic", e2), ("revolute", np.cross(e1, e2))]
-    return [("revolute" if joint.kind == "revolute" else "prismatic", axis)]
+def joint_record(body, inertia) -> dict:
+    """The record ``_core.Model`` takes for a moving body of the description's tree: its joint
+    whole (kind, axis, offset, drive and friction data), the parent body's index, the joint's
+    placement and the link's 10 inertial parameters; the core expands a multi-DOF joint."""
+    joint = body.joint
+    levels = joint.coulomb_levels
+    return {
+        "name": joint.name,
+        "kind": joint.kind,
+        "parent": int(body.parent),
+        "placement": to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"),
+        "axis": None
+        if joint.kind in ("floating", "spherical")
+        else to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'"),
+        "inertia": inertia,
+        "offset": float(joint.offset),
+        "armature": float(joint.armature),
+        "viscous": float(joint.viscous),
+        "coulomb": float(levels[0]),
+        # the level for qd < 0 travels only when it differs
+        "coulomb_negative": None if joint.coulomb_is_symmetric else float(levels[1]),
+    }
 
 
-def compile_model(robot: Robot):
-    """The native model of ``robot`` (numeric parameters only): a ``_core.Model``, or a
-    :class:`~kinedyn.native.mimic.ReducedModel` over it when the robot has reduced mimic joints."""
-    if robot.symbols:
+def compile_model(description: Description):
+    """The native model of a robot ``description`` (numeric parameters only): a ``_core.Model`` of its
+    tree's joints, taken whole (the core's model builder lays out multi-DOF joints,
+    docs/architecture.md "The joint seam"), or a :class:`~kinedyn.native.mimic.ReducedModel` over it
+    when the robot has reduced mimic joints."""
+    if description.symbols:
         raise ValueError(
-            f"robot '{robot.name}' has symbolic parameters {sorted(map(str, robot.symbols))}: "
+            f"robot '{description.name}' has symbolic parameters {sorted(map(str, description.symbols))}: "
             "use robot.subs({...}) to give them values before numeric computation"
         )
-    bodies = robot.tree.bodies
-    last = robot._body_last_dof
-    # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
-    # transform, read from q) and members at the identity on it, the last carrying the link
-    # (crates/kinedyn-core/src/model/mod.rs); a 1-DOF joint is one body
-    parent: list = []
-    kind: list = []
-    axis: list = []
-    offset: list = []
-    placement: list = []
-    blocks: list = []
-    link_inertia = robot.inertial_parameters().reshape(len(bodies), 10)
-    inertia = np.zeros((len(robot._dof_body), 10))  # every native body (mimic followers' too)
-    for b, body in enumerate(bodies):
-        joint = body.joint
-        first = len(parent)
-        parent.append(-1 if body.parent < 0 else int(last[body.parent]))
-        placement.append(to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"))
-        offset.append(float(joint.offset))
-        columns = joint_columns(joint)
-        for m, (k, a) in enumerate(columns):
-            if m > 0:
-                parent.append(first + m - 1)
-                placement.append(np.eye(4))
-                offset.append(0.0)
-            kind.append(k)
-            axis.append(a)
-        blocks.extend([joint.kind if joint.kind in MULTI_DOF_KINDS else ""] + [""] * (len(columns) - 1))
-        inertia[last[b]] = link_inertia[b]
-
-    # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
-    def per_dof(value):
-        return np.array(
-            [x for body in bodies for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])]
-        )
-
-    armature, viscous, coulomb = (
-        per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb")
-    )
-    gravity = to_float_array(robot.gravity, (3,), "gravity")
-    frames = robot.tree.frames
-    frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
-    frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
-    # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-    coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
-    asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-    native = Model(
-        np.array(parent, dtype=np.int64),
-        kind,
-        np.array(axis, dtype=float).reshape(-1, 3),
-        np.array(offset),
-        np.array(placement).reshape(-1, 4, 4),
-        inertia,
-        armature,
-        viscous,
-        coulomb,
-        gravity,
-        frame_body,
-        frame_placement,
-        coulomb_negative=asymmetric,
-        blocks=blocks if robot.has_multi_dof_joints else None,
-    )
-    if robot._mimic is None:
+    tree = description.tree
+    joints = [
+        joint_record(body, to_float_array(body.inertia.parameters(), (10,), f"inertia of '{body.name}'"))
+        for body in tree.bodies
+    ]
+    frames = [(int(f.body), to_float_array(f.placement, (4, 4), f"frame '{f.name}'")) for f in tree.frames]
+    native = Model(joints, to_float_array(description.gravity, (3,), "gravity"), frames)
+    if description.mimic_map is None:
         return native
-
-    return ReducedModel(native, robot._mimic, robot.name)
+    return ReducedModel(native, description.mimic_map, description.name)
