@@ -60,9 +60,8 @@ def joint_record(body, inertia) -> dict:
         "kind": joint.kind,
         "parent": int(body.parent),
         "placement": to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"),
-        "axis": None
-        if joint.kind in ("floating", "spherical")
-        else to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'"),
+        # the joint's axis (a planar joint's normal); the core does not read it for floating and spherical joints
+        "axis": to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'"),
         "inertia": inertia,
         "offset": float(joint.offset),
         "armature": float(joint.armature),
