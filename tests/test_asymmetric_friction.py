@@ -94,25 +94,18 @@ def test_native_model_rejects_bad_negative_levels():
     from kinedyn import _core
 
     robot = kd.robots.planar_2r()
-    eye = np.eye(4)
-    args = dict(
-        parent=np.array([-1]),
-        kind=["revolute"],
-        axis=np.array([[0, 0, 1.0]]),
-        offset=np.zeros(1),
-        placement=eye[None].copy(),
-        inertia=np.array([[1.0, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1]]),
-        armature=np.zeros(1),
-        viscous=np.zeros(1),
-        coulomb=np.zeros(1),
-        gravity=np.array([0, 0, -9.81]),
-        frame_body=np.array([0]),
-        frame_placement=eye[None].copy(),
+    joint = dict(
+        name="j",
+        kind="revolute",
+        placement=np.eye(4),
+        axis=np.array([0, 0, 1.0]),
+        inertia=np.array([1.0, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1]),
     )
-    with pytest.raises(ValueError, match="coulomb_negative of joint 0 is -1"):
-        _core.Model(**args, coulomb_negative=np.array([-1.0]))
-    with pytest.raises(ValueError, match="coulomb_negative has 2 entries for 1 bodies"):
-        _core.Model(**args, coulomb_negative=np.array([1.0, 2.0]))
+    gravity = np.array([0, 0, -9.81])
+    with pytest.raises(ValueError, match="joint 'j' .joint 0.: coulomb_negative is -1"):
+        _core.Model([{**joint, "coulomb_negative": -1.0}], gravity)
+    with pytest.raises(ValueError, match="joint 'ball' .joint 0.: a spherical joint takes no coulomb_negative"):
+        _core.Model([{**joint, "name": "ball", "kind": "spherical", "coulomb_negative": 1.0}], gravity)
     assert robot.n == 2
 
 

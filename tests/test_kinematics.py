@@ -262,38 +262,43 @@ def test_bad_inputs_give_clear_errors():
         kin.task_jacobian(robot, [0, 0, 0], task="xy")
 
 
-def test_native_model_rejects_bad_arrays_without_panicking():
-    """Errors from the native constructor are ValueErrors with a message, never a Rust panic."""
+def test_native_model_rejects_bad_joint_records_without_panicking():
+    """Errors from the native constructor are ValueErrors naming the joint (or frame) and the
+    problem, never a Rust panic."""
     from kinedyn import _core
 
-    eye = np.eye(4)[None]
-    good = dict(
-        parent=np.array([-1]),
-        kind=["revolute"],
-        axis=np.array([[0, 0, 1.0]]),
-        offset=np.zeros(1),
-        placement=eye.copy(),
-        inertia=np.zeros((1, 10)),
-        armature=np.zeros(1),
-        viscous=np.zeros(1),
-        coulomb=np.zeros(1),
-        gravity=np.array([0, 0, -9.81]),
-        frame_body=np.array([0]),
-        frame_placement=eye.copy(),
+    eye = np.eye(4)
+    base = dict(
+        name="base", kind="floating", placement=eye.copy(), inertia=np.array([1.0, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1])
     )
-    _core.Model(**good)
+    good = dict(
+        name="elbow", kind="revolute", parent=0, placement=eye.copy(), axis=np.array([0, 0, 1.0]), inertia=np.zeros(10)
+    )
+    gravity = np.array([0, 0, -9.81])
+    model = _core.Model([base, good], gravity, [(1, eye.copy())])
+    assert (model.nq, model.n, model.n_frames) == (8, 7, 1)
     cases = {
-        "axis": (dict(axis=np.array([[0, 0, 2.0]])), "unit vector"),
-        "parent": (dict(parent=np.array([0])), "parent"),
-        "kind": (dict(kind=["helical"]), "unknown joint kind .helical."),
-        "shape": (dict(placement=np.eye(4)), "placement must have shape"),
-        "frame": (dict(frame_body=np.array([3])), "out of range"),
-        "mass": (dict(inertia=np.array([[-1.0] + [0] * 9])), "negative mass"),
-        "nan": (dict(offset=np.array([np.nan])), "non-finite"),
+        "axis": (dict(axis=np.array([0, 0, 2.0])), "joint 'elbow' .joint 1.: axis .* is not a unit vector"),
+        "parent": (dict(parent=1), "joint 'elbow' .joint 1.: its parent joint 1 is not an earlier joint"),
+        "negative parent": (dict(parent=-3), "joint 1 'elbow': parent must be an earlier joint's index or -1"),
+        "kind": (dict(kind="helical"), "joint 1 'elbow': .*unknown joint kind .helical."),
+        "no axis": (dict(kind="prismatic", axis=None), "joint 1 'elbow': .*a prismatic joint needs an axis"),
+        "shape": (dict(placement=np.eye(3)), r"joint 1 'elbow': placement must have shape \(4, 4\), got \(3, 3\)"),
+        "mass": (dict(inertia=np.array([-1.0] + [0] * 9)), "joint 'elbow' .joint 1.: its link has negative mass"),
+        "nan": (dict(offset=np.nan), "joint 'elbow' .joint 1.: offset is NaN"),
+        "typo": (dict(axes=np.array([0, 0, 1.0])), "joint 1 'elbow': unknown key 'axes'"),
+        "text": (dict(viscous="wet"), "joint 1 'elbow': viscous must be a number"),
     }
-    for _what, (change, message) in cases.items():
+    for what, (change, message) in cases.items():
         with pytest.raises(ValueError, match=message):
-            _core.Model(**{**good, **change})
+            _core.Model([base, {**good, **change}], gravity, [(1, eye.copy())])
+        assert what
+    with pytest.raises(ValueError, match="placement"):
+        _core.Model([base, {k: v for k, v in good.items() if k != "placement"}], gravity)
+    with pytest.raises(ValueError, match="frame 0 is fixed to joint 3, but there are 2 joints"):
+        _core.Model([base, good], gravity, [(3, eye.copy())])
+    with pytest.raises(ValueError, match="non-finite"):
+        _core.Model([base, good], gravity, [(1, np.full((4, 4), np.nan))])
 
 
 def test_frame_poses_of_no_frames_is_an_empty_array():

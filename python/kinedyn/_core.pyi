@@ -10,7 +10,7 @@ Batches run in a thread pool rebuilt in a forked child, so they work after ``for
 ``reference``: "world" (LOCAL_WORLD_ALIGNED), "local" or "spatial" (WORLD).
 """
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -22,22 +22,18 @@ I64 = NDArray[np.int64]
 class Model:
     def __init__(
         self,
-        parent: I64,  # (n,) parent body index, -1 = base, parent[i] < i
-        kind: Sequence[str],  # (n,) "revolute" or "prismatic"
-        axis: F64,  # (n, 3) unit joint axis in the joint frame
-        offset: F64,  # (n,) joint offset added to q
-        placement: F64,  # (n, 4, 4) parent body frame -> joint frame at q = 0
-        inertia: F64,  # (n, 10) [m, mc, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the body-frame origin
-        armature: F64,  # (n,) reflected rotor inertia r^2 J_m
-        viscous: F64,  # (n,)
-        coulomb: F64,  # (n,) Coulomb level (for qd > 0 when coulomb_negative is given)
+        # one record per joint, parents before children, each a mapping taken whole (the core's
+        # ModelBuilder expands a multi-DOF joint into one body per degree of freedom):
+        #   name: str; kind: "revolute" | "continuous" | "prismatic" | "floating" | "spherical" | "planar";
+        #   placement: (4, 4) parent link frame -> joint frame at q = 0;
+        #   parent: int = -1 (an earlier joint's index, -1 = base);
+        #   axis: (3,) unit axis (the planar joint's normal; not read for floating and spherical);
+        #   inertia: (10,) = 0, [m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] of the link about its frame origin;
+        #   offset, armature (r^2 J_m), viscous, coulomb: float = 0 (1-DOF joints only);
+        #   coulomb_negative: float | None = None, the Coulomb level for qd < 0 when it differs
+        joints: Sequence[Mapping[str, object]],
         gravity: F64,  # (3,) in base coordinates
-        frame_body: I64,  # (nf,) body of each named frame, -1 = base
-        frame_placement: F64,  # (nf, 4, 4) body frame -> named frame
-        coulomb_negative: F64 | None = None,  # (n,) Coulomb level for qd < 0 (>= 0); None: = coulomb
-        # (n,) the block each body's joint starts: "floating", "spherical", "planar"; "" or None for a
-        # 1-DOF joint and for a multi-DOF joint's further bodies
-        blocks: Sequence[str | None] | None = None,
+        frames: Sequence[tuple[int, F64]] = (),  # (joint index, -1 = base; (4, 4) link frame -> named frame)
     ) -> None: ...
     # the model with f_ext's moments taken about link-frame origins: (n, 3), each body's link-frame
     # origin in its body frame (zero: the body origin)

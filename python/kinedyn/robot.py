@@ -378,7 +378,7 @@ class Robot:
     @cached_property
     def _model(self):
         """The compiled native model (built once; numeric descriptions only): :func:`kinedyn.native.compile_model`."""
-        return compile_model(self)
+        return compile_model(self.description)
 
     @cached_property
     def _multi_dof(self) -> bool:
@@ -527,7 +527,7 @@ class Robot:
         if f_ext is None:
             return self._model.inverse_dynamics(q, qd, qdd, None, out)
         q = float64_array(q)
-        return self._model.inverse_dynamics(q, qd, qdd, body_wrenches(self, q, f_ext), out)
+        return self._model.inverse_dynamics(q, qd, qdd, body_wrenches(self.description, q, f_ext), out)
 
     @batched("q")
     def mass_matrix(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
@@ -555,7 +555,7 @@ class Robot:
             if f_ext is None:
                 return self._model.forward_dynamics(q, qd, tau, None, out)
             q = float64_array(q)
-            return self._model.forward_dynamics(q, qd, tau, body_wrenches(self, q, f_ext), out)
+            return self._model.forward_dynamics(q, qd, tau, body_wrenches(self.description, q, f_ext), out)
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
@@ -572,7 +572,7 @@ class Robot:
         if f_ext is None:
             return self._model.inverse_dynamics_derivatives(q, qd, qdd)
         q = float64_array(q)
-        return self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self, q, f_ext))
+        return self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self.description, q, f_ext))
 
     @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics_derivatives(
@@ -585,7 +585,7 @@ class Robot:
             if f_ext is None:
                 return self._model.forward_dynamics_derivatives(q, qd, tau)
             q = float64_array(q)
-            return self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self, q, f_ext))
+            return self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self.description, q, f_ext))
         except RuntimeError as e:
             raise robot_error(self, e) from None
 

@@ -5,6 +5,14 @@
 pub enum Error {
     #[error("invalid model: {0}")]
     InvalidModel(String),
+    /// A joint record given to [`crate::model::ModelBuilder`] is wrong: `joint` is its index in
+    /// the order given, `name` its name, `message` what is wrong with it.
+    #[error("invalid model: joint '{name}' (joint {joint}): {message}")]
+    InvalidJoint {
+        joint: usize,
+        name: String,
+        message: String,
+    },
     #[error("invalid input: {0}")]
     InvalidInput(String),
     /// Forward dynamics or M^-1 is undefined: the pivot of `joint` (a body, a degree of freedom) is

@@ -1,6 +1,11 @@
-//! Joint kinds and the one function that decodes them, `jcalc` (RBDA §4.4, Table 4.1).
+//! Joint kinds and the functions that decode them: a description's joint taken whole
+//! ([`JointType`]: its name, its block of q and the columns of its motion subspace, one 1-DOF
+//! [`Joint`] each) and `jcalc` of a column (RBDA §4.4, Table 4.1). Pinocchio keeps the same
+//! knowledge in `multibody/joint/`; here it is written once, and the model builder
+//! (`model/builder.rs`) expands a joint from it.
 
 use crate::error::{Error, Result};
+use crate::lie::Block;
 use crate::spatial::{cross, mm, mv, splat3, Force, Inertia, Mat3, Motion, Real, Transform, Vec3};
 
 /// The closed set of joint kinds of the compiled model (fixed joints are merged at build time).
@@ -12,16 +17,110 @@ pub enum JointKind {
     Prismatic,
 }
 
-impl JointKind {
-    /// The kind named "revolute" or "prismatic" (the one place the border's names become kinds).
-    pub fn from_name(name: &str) -> Result<JointKind> {
-        match name {
-            "revolute" => Ok(JointKind::Revolute),
-            "prismatic" => Ok(JointKind::Prismatic),
-            _ => Err(Error::InvalidModel(format!(
-                "unknown joint kind '{name}' (expected 'revolute' or 'prismatic')"
-            ))),
+/// A joint taken whole, as a robot description names it (fixed joints are merged before the
+/// model is built). A multi-DOF joint's q block and columns follow Pinocchio's conventions
+/// (`model/mod.rs`, [`crate::model::Coordinates::Head`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointType {
+    /// Rotation about the unit `axis` (a URDF "continuous" joint is one without limits).
+    Revolute { axis: Vec3 },
+    /// Translation along the unit `axis`.
+    Prismatic { axis: Vec3 },
+    /// Six degrees of freedom, SE(3) (a description's "floating" joint).
+    FreeFlyer,
+    /// Three rotational degrees of freedom about the joint frame's origin, SO(3).
+    Spherical,
+    /// Motion in the plane normal to the unit `normal`, SE(2).
+    Planar { normal: Vec3 },
+}
+
+impl JointType {
+    /// The joint a description names ("revolute", "continuous", "prismatic", "floating",
+    /// "spherical", "planar") with its axis (the planar joint's normal; not read for "floating"
+    /// and "spherical"): the one place the border's kind names are decoded.
+    pub fn from_name(name: &str, axis: Option<Vec3>) -> Result<JointType> {
+        let axis = || axis.ok_or_else(|| Error::InvalidModel(format!("a {name} joint needs an axis")));
+        Ok(match name {
+            "revolute" | "continuous" => JointType::Revolute { axis: axis()? },
+            "prismatic" => JointType::Prismatic { axis: axis()? },
+            "floating" => JointType::FreeFlyer,
+            "spherical" => JointType::Spherical,
+            "planar" => JointType::Planar { normal: axis()? },
+            _ => {
+                return Err(Error::InvalidModel(format!(
+                    "unknown joint kind '{name}' (expected 'revolute', 'continuous', 'prismatic', 'floating', \
+                     'spherical' or 'planar')"
+                )))
+            }
+        })
+    }
+
+    /// The description's name of the kind ("floating" for the free-flyer).
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointType::Revolute { .. } => "revolute",
+            JointType::Prismatic { .. } => "prismatic",
+            JointType::FreeFlyer | JointType::Spherical | JointType::Planar { .. } => self.block().kind_name(),
         }
+    }
+
+    /// The joint's block of q and v.
+    pub fn block(&self) -> Block {
+        match self {
+            JointType::Revolute { .. } | JointType::Prismatic { .. } => Block::Scalar,
+            JointType::FreeFlyer => Block::FreeFlyer,
+            JointType::Spherical => Block::Spherical,
+            JointType::Planar { .. } => Block::Planar,
+        }
+    }
+
+    /// The unit axis the joint reads (`None` for the free-flyer and the spherical joint).
+    pub fn axis(&self) -> Option<Vec3> {
+        match *self {
+            JointType::Revolute { axis } | JointType::Prismatic { axis } => Some(axis),
+            JointType::Planar { normal } => Some(normal),
+            JointType::FreeFlyer | JointType::Spherical => None,
+        }
+    }
+
+    /// The columns of the joint's motion subspace `S`, one 1-DOF [`Joint`] per degree of freedom,
+    /// in v's order: the joint itself for a 1-DOF joint, else [`block_columns`] (a planar joint's
+    /// in-plane axes from [`planar_basis`] of its normal).
+    pub fn columns(&self) -> Vec<Joint> {
+        match *self {
+            JointType::Revolute { axis } => vec![Joint {
+                kind: JointKind::Revolute,
+                axis,
+            }],
+            JointType::Prismatic { axis } => vec![Joint {
+                kind: JointKind::Prismatic,
+                axis,
+            }],
+            JointType::Planar { normal } => block_columns(Block::Planar, planar_basis(normal)),
+            JointType::FreeFlyer | JointType::Spherical => block_columns(self.block(), (Vec3::x(), Vec3::y())),
+        }
+    }
+}
+
+/// The columns of a multi-DOF block's motion subspace in the child frame, each a unit linear
+/// (prismatic) or angular (revolute) axis, constant in that frame (RBDA Table 4.1's free-flyer
+/// `S = 1` in `[linear; angular]` order): free-flyer linear x, y, z then angular x, y, z;
+/// spherical angular x, y, z; planar linear `e1`, `e2` and angular `e1 x e2` from the in-plane axes
+/// `in_plane` (read only for the planar block). Empty for [`Block::Scalar`].
+pub fn block_columns(block: Block, in_plane: (Vec3, Vec3)) -> Vec<Joint> {
+    let column = |kind, axis| Joint { kind, axis };
+    let (lin, ang) = (JointKind::Prismatic, JointKind::Revolute);
+    let unit = |k: usize| Vec3::ith(k, 1.0);
+    match block {
+        Block::FreeFlyer => (0..6)
+            .map(|k| column(if k < 3 { lin } else { ang }, unit(k % 3)))
+            .collect(),
+        Block::Spherical => (0..3).map(|k| column(ang, unit(k))).collect(),
+        Block::Planar => {
+            let (e1, e2) = in_plane;
+            vec![column(lin, e1), column(lin, e2), column(ang, e1.cross(&e2))]
+        }
+        Block::Scalar => vec![],
     }
 }
 

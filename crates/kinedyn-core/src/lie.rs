@@ -18,7 +18,6 @@
 //! Symbols: `omega` ω rotation vector (rad), `theta` θ = |ω|, `rho` ρ linear part of a twist, `quat`
 //! a quaternion stored (x, y, z, w), `p` a translation.
 
-use crate::error::{Error, Result};
 use crate::spatial::{Mat3, Real};
 
 /// A quaternion (x, y, z, w), w the scalar part (Pinocchio's and Eigen's storage order).
@@ -42,20 +41,6 @@ pub enum Block {
 }
 
 impl Block {
-    /// The block of a joint named by its description kind: "floating", "spherical", "planar", or
-    /// "" for a 1-DOF joint (the one place the border's names become blocks).
-    pub fn from_name(name: &str) -> Result<Block> {
-        match name {
-            "" => Ok(Block::Scalar),
-            "floating" => Ok(Block::FreeFlyer),
-            "spherical" => Ok(Block::Spherical),
-            "planar" => Ok(Block::Planar),
-            _ => Err(Error::InvalidModel(format!(
-                "unknown joint block kind '{name}' (expected 'floating', 'spherical', 'planar' or '' for a 1-DOF joint)"
-            ))),
-        }
-    }
-
     /// Length of the block in q.
     pub const fn nq(self) -> usize {
         match self {

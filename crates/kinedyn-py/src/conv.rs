@@ -1,6 +1,6 @@
 //! Every conversion of a Python argument into numbers for the core, and every check of its shape,
 //! finiteness and range: one dialect for all bindings (`Batch::gather` for per-state arrays,
-//! `vec_of` for the model's tables, `frame` / `reference` / `point` for the kinematics' options).
+//! `numbers` for the model's joint records, `vec_of` for fixed-shape tables, `frame` / `reference` / `point` for the kinematics' options).
 
 use std::borrow::Cow;
 
@@ -197,6 +197,19 @@ impl<'a> Batch<'a> {
         }
         out
     }
+}
+
+/// `x` as float64 numbers of exactly `shape`.
+pub(crate) fn numbers(what: &str, x: &Bound<'_, PyAny>, shape: &[usize]) -> PyResult<Vec<f64>> {
+    let array = f64_array(what, x)?;
+    if array.shape() != shape {
+        return Err(PyValueError::new_err(format!(
+            "{what} must have shape {}, got {}",
+            shape_text(shape),
+            shape_text(array.shape())
+        )));
+    }
+    Ok(array.readonly().as_array().iter().copied().collect())
 }
 
 pub(crate) fn vec_of(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[usize]) -> PyResult<Vec<f64>> {

@@ -11,6 +11,7 @@ mod guard;
 mod ik;
 mod lie;
 mod model;
+mod records;
 mod run;
 mod simulate;
 

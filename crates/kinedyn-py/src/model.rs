@@ -5,17 +5,15 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
-use kinedyn_core::lie::Block;
-use kinedyn_core::model::Coordinates;
-use kinedyn_core::spatial::{Inertia, Transform, Vec3};
-use kinedyn_core::{Data, Frame, Joint, JointKind, Model};
+use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
-use crate::conv::{self, f64_array, optional, vec_of, Batch};
+use crate::conv::{self, f64_array, optional, Batch};
 use crate::guard::guarded;
-use crate::run::{core_err, Arrays3};
+use crate::run::Arrays3;
 
 /// The compiled model plus one cached `Data` for single-state calls.
 #[pyclass(name = "Model", module = "kinedyn._core", frozen)]
@@ -65,18 +63,20 @@ impl PyModel {
     }
 }
 
-/// Writes `#[pymethods] impl PyModel` from one table of the methods that run one core batch
-/// `Kernel`, each row `fn name(input: width, ..; f_ext) -> "result" [per-state shape], out = kernel;`
+/// Writes `#[pymethods] impl PyModel` from one table of the methods whose arguments are state
+/// arrays, each row `fn name(input: width, ..; f_ext) -> "result" [per-state shape], out = how;`
 /// (`; f_ext` where the call takes external wrenches (n, 6), `, out` where it takes NumPy's
-/// `out=`), followed by the methods written by hand (`by_hand { .. }`). `|n, nq|` names the
-/// model's velocity and configuration sizes for the table.
+/// `out=`), where `how` is `kernel K` (a core batch `Kernel`, over SIMD lanes) or
+/// `per_state |model, data, x, out| ..` (one state at a time), followed by the methods written by
+/// hand (`by_hand { .. }`: those with options or several results). `|n, nq|` names the model's
+/// velocity and configuration sizes for the table.
 macro_rules! model_methods {
     (
         |$n:ident, $nq:ident|
         $(
             $(#[doc = $doc:literal])*
             fn $name:ident ( $($arg:ident : $w:ident),+ $(; $fext:ident)? ) -> $quantity:literal [$($dim:expr),*]
-            $(, $out:ident)? = $kernel:expr;
+            $(, $out:ident)? = $how:ident $kernel:expr;
         )*
         by_hand { $($by_hand:tt)* }
     ) => {
@@ -99,7 +99,7 @@ macro_rules! model_methods {
                         let ($n, $nq) = (self.n(), self.model.nq);
                         let batch = model_methods!(@gather self [$(($arg, $w)),+] $($fext)?);
                         let out = model_methods!(@out $($out)?);
-                        batch.run_kernel(py, self, (stringify!($name), $quantity), &[$($dim),*], out, $kernel)
+                        model_methods!(@run $how batch, py, self, (stringify!($name), $quantity), &[$($dim),*], out, $kernel)
                     })
                 }
             )*
@@ -112,6 +112,14 @@ macro_rules! model_methods {
     (@gather $self:ident [$(($arg:ident, $w:ident)),+] $fext:ident) => {
         $self.gather_dynamics([$((stringify!($arg), &$arg)),+], $fext.as_ref())?
     };
+    (@run kernel $batch:ident, $($args:expr),+) => {
+        $batch.run_kernel($($args),+)
+    };
+    // one state at a time; no `out=` (a row of this form never has one)
+    (@run per_state $batch:ident, $py:expr, $m:expr, $what:expr, $dims:expr, $out:expr, $kernel:expr) => {{
+        let _none: Option<Bound<'_, PyAny>> = $out;
+        $batch.run($py, $m, $what, $dims, $kernel)
+    }};
     (@out) => {
         None
     };
@@ -123,142 +131,55 @@ macro_rules! model_methods {
 model_methods! {
     |n, nq|
     /// tau (n,) | (N, n): recursive Newton-Euler with gravity, friction, armature and f_ext.
-    fn inverse_dynamics(q: nq, qd: n, qdd: n; f_ext) -> "tau" [n], out = kernels::InverseDynamics;
+    fn inverse_dynamics(q: nq, qd: n, qdd: n; f_ext) -> "tau" [n], out = kernel kernels::InverseDynamics;
     /// qdd (n,) | (N, n): articulated-body algorithm; RuntimeError for a singular mass matrix.
-    fn forward_dynamics(q: nq, qd: n, tau: n; f_ext) -> "qdd" [n], out = kernels::ForwardDynamics;
+    fn forward_dynamics(q: nq, qd: n, tau: n; f_ext) -> "qdd" [n], out = kernel kernels::ForwardDynamics;
     /// M (n, n) | (N, n, n): composite-rigid-body algorithm, exactly symmetric.
-    fn mass_matrix(q: nq) -> "M" [n, n], out = kernels::MassMatrix;
+    fn mass_matrix(q: nq) -> "M" [n, n], out = kernel kernels::MassMatrix;
     /// M^-1 (n, n) | (N, n, n).
-    fn mass_matrix_inverse(q: nq) -> "M^-1" [n, n], out = kernels::MassMatrixInverse;
+    fn mass_matrix_inverse(q: nq) -> "M^-1" [n, n], out = kernel kernels::MassMatrixInverse;
     /// C (n, n) | (N, n, n): the Christoffel-consistent Coriolis matrix.
-    fn coriolis_matrix(q: nq, qd: n) -> "C" [n, n], out = kernels::Coriolis;
+    fn coriolis_matrix(q: nq, qd: n) -> "C" [n, n], out = kernel kernels::Coriolis;
     /// c[i, j, k] (n, n, n) | (N, n, n, n): Christoffel symbols of the first kind.
-    fn christoffel(q: nq) -> "c" [n, n, n] = kernels::Christoffel;
+    fn christoffel(q: nq) -> "c" [n, n, n] = kernel kernels::Christoffel;
     /// g (n,) | (N, n).
-    fn gravity_torque(q: nq) -> "g" [n], out = kernels::Gravity;
+    fn gravity_torque(q: nq) -> "g" [n], out = kernel kernels::Gravity;
     /// C qd + g (n,) | (N, n), without friction.
-    fn bias_torque(q: nq, qd: n) -> "bias" [n], out = kernels::Bias;
+    fn bias_torque(q: nq, qd: n) -> "bias" [n], out = kernel kernels::Bias;
     /// K () | (N,).
-    fn kinetic_energy(q: nq, qd: n) -> "K" [] = kernels::KineticEnergy;
+    fn kinetic_energy(q: nq, qd: n) -> "K" [] = kernel kernels::KineticEnergy;
     /// P () | (N,).
-    fn potential_energy(q: nq) -> "P" [] = kernels::PotentialEnergy;
+    fn potential_energy(q: nq) -> "P" [] = kernel kernels::PotentialEnergy;
     /// Y (n, 10 n) | (N, n, 10 n).
-    fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernels::Regressor;
+    fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernel kernels::Regressor;
+    /// Centre of mass (3,) | (N, 3) in base coordinates.
+    fn center_of_mass(q: nq) -> "com" [3] = per_state |model, data, x, out| {
+        out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
+        Ok(())
+    };
+    /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
+    fn centroidal_momentum_matrix(q: nq) -> "A_G" [6, n] = per_state |model, data, x, out| {
+        algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
+        Ok(())
+    };
+    /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
+    fn momentum(q: nq, qd: n) -> "h" [6] = per_state |model, data, x, out| {
+        out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
+        Ok(())
+    };
 
     by_hand {
+        /// The model of a robot's joints, each a mapping taken whole (see `_core.pyi`):
+        /// `records::build` converts them and the core's `ModelBuilder` expands and checks them.
         #[new]
-        #[allow(clippy::too_many_arguments)]
-        #[pyo3(signature = (parent, kind, axis, offset, placement, inertia, armature, viscous, coulomb, gravity, frame_body, frame_placement, coulomb_negative=None, blocks=None))]
+        #[pyo3(signature = (joints, gravity, frames=Vec::new()))]
         fn new(
-            parent: Vec<i64>,
-            kind: Vec<String>,
-            axis: PyReadonlyArrayDyn<f64>,
-            offset: Vec<f64>,
-            placement: PyReadonlyArrayDyn<f64>,
-            inertia: PyReadonlyArrayDyn<f64>,
-            armature: Vec<f64>,
-            viscous: Vec<f64>,
-            coulomb: Vec<f64>,
-            gravity: Vec<f64>,
-            frame_body: Vec<i64>,
-            frame_placement: PyReadonlyArrayDyn<f64>,
-            coulomb_negative: Option<Vec<f64>>,
-            blocks: Option<Vec<Option<String>>>,
+            joints: Vec<Bound<'_, PyDict>>,
+            gravity: Bound<'_, PyAny>,
+            frames: Vec<(i64, Bound<'_, PyAny>)>,
         ) -> PyResult<Self> {
             guarded("Model.__new__", || {
-                let n = parent.len();
-                let nf = frame_body.len();
-                let axis = vec_of("axis", &axis, &[n, 3])?;
-                let placement = vec_of("placement", &placement, &[n, 4, 4])?;
-                let inertia = vec_of("inertia", &inertia, &[n, 10])?;
-                let frame_placement = vec_of("frame_placement", &frame_placement, &[nf, 4, 4])?;
-                if kind.len() != n {
-                    return Err(PyValueError::new_err(format!(
-                        "kind has {} entries for {n} bodies",
-                        kind.len()
-                    )));
-                }
-                if gravity.len() != 3 {
-                    return Err(PyValueError::new_err(format!(
-                        "gravity must have 3 components, got {}",
-                        gravity.len()
-                    )));
-                }
-                let body_index = |what: &str, k: usize, p: i64| -> PyResult<Option<usize>> {
-                    match p {
-                        -1 => Ok(None),
-                        p if p >= 0 && (p as usize) < n => Ok(Some(p as usize)),
-                        p => Err(PyValueError::new_err(format!(
-                            "{what} {k}: body index {p} is out of range (-1..{n})"
-                        ))),
-                    }
-                };
-                let parent = parent
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &p)| body_index("parent of body", i, p))
-                    .collect::<PyResult<Vec<_>>>()?;
-                let joints = kind
-                    .iter()
-                    .enumerate()
-                    .map(|(i, k)| {
-                        let kind = JointKind::from_name(k).map_err(|e| {
-                            PyValueError::new_err(format!("joint {i}: {e}"))
-                        })?;
-                        Ok(Joint {
-                            kind,
-                            axis: Vec3::new(axis[3 * i], axis[3 * i + 1], axis[3 * i + 2]),
-                        })
-                    })
-                    .collect::<PyResult<Vec<_>>>()?;
-                let placements = placement.chunks(16).map(Transform::from_homogeneous).collect();
-                let inertias = inertia.chunks(10).map(Inertia::from_parameters).collect();
-                let frames = frame_body
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &b)| {
-                        Ok(Frame {
-                            body: body_index("frame", k, b)?,
-                            body_from_frame: Transform::from_homogeneous(&frame_placement[16 * k..16 * k + 16]),
-                        })
-                    })
-                    .collect::<PyResult<Vec<_>>>()?;
-                let mut model = Model::new(
-                    parent,
-                    joints,
-                    offset,
-                    placements,
-                    inertias,
-                    armature,
-                    viscous,
-                    coulomb,
-                    Vec3::new(gravity[0], gravity[1], gravity[2]),
-                    frames,
-                )
-                .map_err(core_err)?;
-                if let Some(levels) = coulomb_negative {
-                    model = model.with_coulomb_negative(levels).map_err(core_err)?;
-                }
-                if let Some(names) = blocks {
-                    // per body: the block its joint starts ("floating", "spherical", "planar"; "" or
-                    // None for a 1-DOF joint and for a multi-DOF joint's further bodies)
-                    if names.len() != n {
-                        return Err(PyValueError::new_err(format!(
-                            "blocks has {} entries for {n} bodies",
-                            names.len()
-                        )));
-                    }
-                    let blocks = names
-                        .iter()
-                        .enumerate()
-                        .map(|(i, name)| {
-                            Block::from_name(name.as_deref().unwrap_or(""))
-                                .map_err(|e| PyValueError::new_err(format!("body {i}: {e}")))
-                        })
-                        .collect::<PyResult<Vec<_>>>()?;
-                    let coordinates = Coordinates::from_blocks(&blocks).map_err(core_err)?;
-                    model = model.with_coordinates(coordinates).map_err(core_err)?;
-                }
+                let model = crate::records::build(&joints, &gravity, &frames)?;
                 let data = Mutex::new(Data::new(&model));
                 Ok(Self { model, data })
             })
@@ -487,61 +408,6 @@ model_methods! {
                     },
                 )?;
                 Ok((dq, dqd, dtau))
-            })
-        }
-
-        /// Centre of mass (3,) | (N, 3) in base coordinates.
-        fn center_of_mass<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-            guarded("Model.center_of_mass", || {
-                let q = f64_array("q", &q)?;
-                let nq = self.model.nq;
-                let batch = Batch::gather(&[("q", &q, &[nq])])?;
-                batch.run(py, self, ("center_of_mass", "com"), &[3], |model, data, x, out| {
-                    out.copy_from_slice(algorithms::center_of_mass(model, data, x[0])?.as_slice());
-                    Ok(())
-                })
-            })
-        }
-
-        /// Centroidal momentum matrix A_G (6, n) | (N, 6, n): [linear; angular about the centre of mass], base axes.
-        fn centroidal_momentum_matrix<'py>(
-            &self,
-            py: Python<'py>,
-            q: Bound<'py, PyAny>,
-        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-            guarded("Model.centroidal_momentum_matrix", || {
-                let q = f64_array("q", &q)?;
-                let (n, nq) = (self.n(), self.model.nq);
-                let batch = Batch::gather(&[("q", &q, &[nq])])?;
-                batch.run(
-                    py,
-                    self,
-                    ("centroidal_momentum_matrix", "A_G"),
-                    &[6, n],
-                    |model, data, x, out| {
-                        algorithms::centroidal_momentum_matrix(model, data, x[0], out)?;
-                        Ok(())
-                    },
-                )
-            })
-        }
-
-        /// Spatial momentum [p; L about the base origin] (6,) | (N, 6), base axes.
-        fn momentum<'py>(
-            &self,
-            py: Python<'py>,
-            q: Bound<'py, PyAny>,
-            qd: Bound<'py, PyAny>,
-        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-            guarded("Model.momentum", || {
-                let q = f64_array("q", &q)?;
-                let qd = f64_array("qd", &qd)?;
-                let (n, nq) = (self.n(), self.model.nq);
-                let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
-                batch.run(py, self, ("momentum", "h"), &[6], |model, data, x, out| {
-                    out.copy_from_slice(&algorithms::spatial_momentum(model, data, x[0], x[1]).to_array());
-                    Ok(())
-                })
             })
         }
     }

@@ -3,7 +3,7 @@
 the messages users read (:mod:`kinedyn.native.errors`), and the native model of a robot with mimic
 joints in its reduced coordinates (:mod:`kinedyn.native.mimic`)."""
 
-from .compile import compile_model, joint_columns, locked_block, planar_basis
+from .compile import compile_model, joint_record, locked_block, planar_basis
 from .errors import SingularMassMatrixError, singular_mass_matrix_error
 from .mimic import ReducedModel
 
@@ -11,7 +11,7 @@ __all__ = [
     "ReducedModel",
     "SingularMassMatrixError",
     "compile_model",
-    "joint_columns",
+    "joint_record",
     "locked_block",
     "planar_basis",
     "singular_mass_matrix_error",

@@ -1,6 +1,6 @@
-"""A robot description compiled into the native ``_core.Model``: one native body per degree of
-freedom (a multi-DOF joint is a head body and members, crates/kinedyn-core/src/model/mod.rs), the
-joint kinds' motion subspaces and the in-plane axes of planar joints."""
+"""A robot description compiled into the native ``_core.Model``: one record per joint of the
+description's tree, taken whole (kind, axis, placement, inertia, drive data); the core's model
+builder expands multi-DOF joints (crates/kinedyn-core/src/model/builder.rs)."""
 
 from __future__ import annotations
 
@@ -16,12 +16,17 @@ from ..description.joint import planar_basis
 from .mimic import ReducedModel
 
 if TYPE_CHECKING:
-    from ..robot import Robot
+    from ..description.description import Description
 
-__all__ = ["body_wrenches", "compile_model", "joint_columns", "link_origins", "locked_block", "planar_basis"]
-
-# the joint kinds the core decodes into multi-DOF blocks (lie::Block::from_name)
-MULTI_DOF_KINDS = ("floating", "spherical", "planar")
+__all__ = [
+    "body_wrenches",
+    "compile_model",
+    "joint_record",
+    "link_bodies",
+    "link_origins",
+    "locked_block",
+    "planar_basis",
+]
 
 
 def locked_block(joint, block) -> np.ndarray:
@@ -52,131 +57,94 @@ def locked_block(joint, block) -> np.ndarray:
     return T
 
 
-def joint_columns(joint) -> list:
-    """The native bodies' (kind, unit axis) of a joint's motion subspace, in its child's frame, kind
-    "revolute" or "prismatic": 1-DOF: its own; free-flyer: linear x, y, z then angular x, y, z;
-    spherical: angular x, y, z; planar: linear e1, e2, angular normal."""
-    e = np.eye(3)
-    if joint.kind == "floating":
-        return [("prismatic", e[k]) for k in range(3)] + [("revolute", e[k]) for k in range(3)]
-    if joint.kind == "spherical":
-        return [("revolute", e[k]) for k in range(3)]
-    axis = to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'")
-    if joint.kind == "planar":
-        e1, e2 = planar_basis(axis)
-        return [("prismatic", e1), ("prismatic", e2), ("revolute", np.cross(e1, e2))]
-    return [("revolute" if joint.kind == "revolute" else "prismatic", axis)]
+def joint_record(body, inertia) -> dict:
+    """The record ``_core.Model`` takes for a moving body of the description's tree: its joint
+    whole (kind, axis, offset, drive and friction data), the parent body's index, the joint's
+    placement and the link's 10 inertial parameters; the core expands a multi-DOF joint."""
+    joint = body.joint
+    levels = joint.coulomb_levels
+    return {
+        "name": joint.name,
+        "kind": joint.kind,
+        "parent": int(body.parent),
+        "placement": to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"),
+        # the joint's axis (a planar joint's normal); the core does not read it for floating and spherical joints
+        "axis": to_float_array(joint.axis, (3,), f"axis of joint '{joint.name}'"),
+        "inertia": inertia,
+        "offset": float(joint.offset),
+        "armature": float(joint.armature),
+        "viscous": float(joint.viscous),
+        "coulomb": float(levels[0]),
+        # the level for qd < 0 travels only when it differs
+        "coulomb_negative": None if joint.coulomb_is_symmetric else float(levels[1]),
+    }
 
 
-def compile_model(robot: Robot):
-    """The native model of ``robot`` (numeric parameters only): a ``_core.Model``, or a
-    :class:`~kinedyn.native.mimic.ReducedModel` over it when the robot has reduced mimic joints."""
-    if robot.symbols:
+def compile_model(description: Description):
+    """The native model of a robot ``description`` (numeric parameters only): a ``_core.Model`` of its
+    tree's joints, taken whole (the core's model builder lays out multi-DOF joints,
+    docs/architecture.md "The joint seam"), or a :class:`~kinedyn.native.mimic.ReducedModel` over it
+    when the robot has reduced mimic joints."""
+    if description.symbols:
         raise ValueError(
-            f"robot '{robot.name}' has symbolic parameters {sorted(map(str, robot.symbols))}: "
+            f"robot '{description.name}' has symbolic parameters {sorted(map(str, description.symbols))}: "
             "use robot.subs({...}) to give them values before numeric computation"
         )
-    bodies = robot.tree.bodies
-    last = robot._body_last_dof
-    # one native body per degree of freedom: a multi-DOF joint is its head body (the joint's
-    # transform, read from q) and members at the identity on it, the last carrying the link
-    # (crates/kinedyn-core/src/model/mod.rs); a 1-DOF joint is one body
-    parent: list = []
-    kind: list = []
-    axis: list = []
-    offset: list = []
-    placement: list = []
-    blocks: list = []
-    link_inertia = robot.inertial_parameters().reshape(len(bodies), 10)
-    inertia = np.zeros((len(robot._dof_body), 10))  # every native body (mimic followers' too)
-    for b, body in enumerate(bodies):
-        joint = body.joint
-        first = len(parent)
-        parent.append(-1 if body.parent < 0 else int(last[body.parent]))
-        placement.append(to_float_array(body.placement, (4, 4), f"placement of '{body.name}'"))
-        offset.append(float(joint.offset))
-        columns = joint_columns(joint)
-        for m, (k, a) in enumerate(columns):
-            if m > 0:
-                parent.append(first + m - 1)
-                placement.append(np.eye(4))
-                offset.append(0.0)
-            kind.append(k)
-            axis.append(a)
-        blocks.extend([joint.kind if joint.kind in MULTI_DOF_KINDS else ""] + [""] * (len(columns) - 1))
-        inertia[last[b]] = link_inertia[b]
-
-    # per degree of freedom of every moving joint, mimic followers included (the native model has them all)
-    def per_dof(value):
-        return np.array(
-            [x for body in bodies for x in ([0.0] * body.joint.nv if body.joint.is_multi_dof else [value(body.joint)])]
-        )
-
-    armature, viscous, coulomb = (
-        per_dof(lambda j, k=k: float(getattr(j, k))) for k in ("armature", "viscous", "coulomb")
-    )
-    gravity = to_float_array(robot.gravity, (3,), "gravity")
-    frames = robot.tree.frames
-    frame_body = np.array([-1 if f.body < 0 else last[f.body] for f in frames], dtype=np.int64)
-    frame_placement = np.array([to_float_array(f.placement, (4, 4), f"frame '{f.name}'") for f in frames])
-    # direction-dependent Coulomb friction: the level for qd < 0 travels only when it differs
-    coulomb_negative = per_dof(lambda j: float(j.coulomb_levels[1]))
-    asymmetric = None if np.array_equal(coulomb_negative, coulomb) else coulomb_negative
-    native = Model(
-        np.array(parent, dtype=np.int64),
-        kind,
-        np.array(axis, dtype=float).reshape(-1, 3),
-        np.array(offset),
-        np.array(placement).reshape(-1, 4, 4),
-        inertia,
-        armature,
-        viscous,
-        coulomb,
-        gravity,
-        frame_body,
-        frame_placement,
-        coulomb_negative=asymmetric,
-        blocks=blocks if robot.has_multi_dof_joints else None,
-    )
-    origins = link_origins(robot)
+    tree = description.tree
+    joints = [
+        joint_record(body, to_float_array(body.inertia.parameters(), (10,), f"inertia of '{body.name}'"))
+        for body in tree.bodies
+    ]
+    frames = [(int(f.body), to_float_array(f.placement, (4, 4), f"frame '{f.name}'")) for f in tree.frames]
+    native = Model(joints, to_float_array(description.gravity, (3,), "gravity"), frames)
+    origins = link_origins(description)
     if np.any(origins):
         native = native.with_link_origins(origins)
-    if robot._mimic is None:
+    if description.mimic_map is None:
         return native
+    return ReducedModel(native, description.mimic_map, description.name)
 
-    return ReducedModel(native, robot._mimic, robot.name)
+
+def link_bodies(description: Description) -> np.ndarray:
+    """(links,) the native body that carries each moving link of the tree: the core's builder lays a
+    multi-DOF joint out as one body per degree of freedom with the link on the last
+    (crates/kinedyn-core/src/model/builder.rs), a 1-DOF joint as one body."""
+    return np.cumsum([body.joint.nv for body in description.tree.bodies], dtype=np.int64) - 1
 
 
-def link_origins(robot: Robot) -> np.ndarray:
+def link_origins(description: Description) -> np.ndarray:
     """(n, 3) per native body: the origin of its link frame in its body frame, about which the core
     takes an external wrench's moment (``_core.Model.with_link_origins``). A standard-DH link frame
     sits at ``Tx(a)`` from its joint frame; a URDF link frame is its joint frame (zero). A multi-DOF
     joint's link is on its last body; the bodies before it carry no link (zero)."""
-    u = np.zeros((len(robot._dof_body), 3))
-    for b, name in enumerate(robot.body_names):
-        T = to_float_array(robot.tree.frames[robot.frame_index(name)].placement, (4, 4), f"frame '{name}'")
-        u[robot._body_last_dof[b]] = T[:3, 3]
+    tree = description.tree
+    last = link_bodies(description)
+    u = np.zeros((int(last[-1]) + 1 if len(last) else 0, 3))
+    for b, body in enumerate(tree.bodies):
+        frame = next(f for f in tree.frames if f.name == body.name)
+        u[last[b]] = to_float_array(frame.placement, (4, 4), f"frame '{body.name}'")[:3, 3]
     return u
 
 
-def body_wrenches(robot: Robot, q, f_ext):
-    """``f_ext`` (one wrench per moving link, ``robot.body_names``; or (N, links, 6)) laid out as the
+def body_wrenches(description: Description, q, f_ext):
+    """``f_ext`` (one wrench per moving link, ``body_names``; or (N, links, 6)) laid out as the
     native model's bodies: one set for a batch of states is repeated for each, and the wrench of a
     multi-DOF joint's link acts on the joint's last body. The core moves each moment from the link
     frame's origin to the body's (:func:`link_origins`)."""
     if f_ext is None:
         return None
     f = real_array(f_ext, "f_ext")
-    links = len(robot.tree.bodies)
+    links = len(description.tree.bodies)
     if f.shape == (links, 6) and np.ndim(q) == 2:
         # one set of wrenches for every state of a batch
         f = np.ascontiguousarray(np.broadcast_to(f, (len(q), links, 6)))
-    if not robot.has_multi_dof_joints:
+    if not description.has_multi_dof_joints:
         return f  # (wrong shapes are reported by the core)
     if f.shape[-2:] != (links, 6):
         raise ValueError(
-            f"f_ext must have shape ({links}, 6): one wrench per moving link {robot.body_names}, got {f.shape}"
+            f"f_ext must have shape ({links}, 6): one wrench per moving link {description.body_names}, got {f.shape}"
         )
-    full = np.zeros(f.shape[:-2] + (len(robot._dof_body), 6))  # every native body
-    full[..., robot._body_last_dof, :] = f
+    last = link_bodies(description)
+    full = np.zeros(f.shape[:-2] + (int(last[-1]) + 1, 6))  # every native body
+    full[..., last, :] = f
     return full

@@ -40,11 +40,11 @@ def run_native(
     None, constant link wrenches (links, 6) or a function ``(t, q, qd) -> (links, 6)``, laid out
     as the native model's bodies (:func:`kinedyn.native.compile.body_wrenches`)."""
     model = robot._model
-    wrenches: Any = None if f_ext is None or callable(f_ext) else body_wrenches(robot, None, f_ext)
+    wrenches: Any = None if f_ext is None or callable(f_ext) else body_wrenches(robot.description, None, f_ext)
     if callable(f_ext):
 
         def wrenches(t, q, qd):
-            return body_wrenches(robot, None, f_ext(t, q, qd))
+            return body_wrenches(robot.description, None, f_ext(t, q, qd))
 
     bounded = deadline is not None and deadline.end is not None
     chunks = 1 if (not bar.enabled and not bounded) else min(200 if bounded else 50, max(1, steps // every))

@@ -151,14 +151,13 @@ fn parse_numbers(path: &str, line: &str, words: &mut std::str::SplitWhitespace, 
     out
 }
 
-/// Build the kinedyn-core model of a tree file: a free-flyer body becomes six native bodies (linear
-/// x, y, z then angular x, y, z of the child frame, the head reading q's block, the last carrying the
-/// link), as `python/kinedyn/robot.py`'s `_model` compiles it; revolute and prismatic joints one each.
+/// Build the kinedyn-core model of a tree file: each body's joint taken whole by the core's
+/// `ModelBuilder` (a free-flyer becomes six native bodies), as `python/kinedyn/native/compile.py`
+/// compiles a description.
 #[allow(dead_code)]
 pub fn read_tree(path: &str) -> TreeFile {
-    use kinedyn_core::lie::Block;
-    use kinedyn_core::model::Coordinates;
-    use kinedyn_core::JointKind::{Prismatic, Revolute};
+    use kinedyn_core::joint::JointType;
+    use kinedyn_core::model::{JointRecord, ModelBuilder};
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
     let mut lines = text.lines();
     let mut next = |key: &str| -> (String, Vec<String>) {
@@ -176,10 +175,7 @@ pub fn read_tree(path: &str) -> TreeFile {
     let sizes: Vec<usize> = next("sizes").1.iter().map(|w| w.parse().unwrap()).collect();
     let (nq, nv, nbodies) = (sizes[0], sizes[1], sizes[2]);
     let g: Vec<f64> = next("gravity").1.iter().map(|w| w.parse().unwrap()).collect();
-    let (mut parent, mut joints, mut placements, mut inertias, mut coordinates) =
-        (vec![], vec![], vec![], vec![], vec![]);
-    let mut last_of_body: Vec<usize> = vec![];
-    let mut at = 0usize;
+    let mut builder = ModelBuilder::new(Vec3::new(g[0], g[1], g[2]));
     for b in 0..nbodies {
         let (line, words) = next("body");
         let joined = words.join(" ");
@@ -194,66 +190,29 @@ pub fn read_tree(path: &str) -> TreeFile {
         let i_c = Mat3::new(x[19], x[20], x[21], x[22], x[23], x[24], x[25], x[26], x[27]);
         let sc = kinedyn_core::spatial::skew(&c);
         let inertia = Inertia::new(mass, mass * c, i_c - mass * sc * sc); // about the body origin
-        let parent_body = if p < 0 { None } else { Some(last_of_body[p as usize]) };
-        let first = parent.len();
-        match kind.as_str() {
-            "free" => {
-                for k in 0..6 {
-                    let column = Joint {
-                        kind: if k < 3 { Prismatic } else { Revolute },
-                        axis: Vec3::ith(k % 3, 1.0),
-                    };
-                    joints.push(column);
-                    parent.push(if k == 0 { parent_body } else { Some(first + k - 1) });
-                    placements.push(if k == 0 { placement } else { Transform::identity() });
-                    inertias.push(if k == 5 { inertia } else { Inertia::zero() });
-                    coordinates.push(if k == 0 {
-                        Coordinates::Head {
-                            block: Block::FreeFlyer,
-                            at,
-                        }
-                    } else {
-                        Coordinates::Member
-                    });
-                }
-                at += 7;
-            }
-            "revolute" | "prismatic" => {
-                joints.push(Joint {
-                    kind: if kind == "revolute" { Revolute } else { Prismatic },
-                    axis,
-                });
-                parent.push(parent_body);
-                placements.push(placement);
-                inertias.push(inertia);
-                coordinates.push(Coordinates::Scalar { at });
-                at += 1;
-            }
-            other => panic!("{path}: body {b} has unknown joint kind '{other}'"),
-        }
-        last_of_body.push(parent.len() - 1);
+        let joint = match kind.as_str() {
+            "free" => JointType::FreeFlyer,
+            other => JointType::from_name(other, Some(axis)).unwrap_or_else(|e| panic!("{path}: body {b}: {e}")),
+        };
+        let parent = usize::try_from(p).ok();
+        builder
+            .joint(JointRecord::new(
+                &format!("body {b}"),
+                joint,
+                parent,
+                placement,
+                inertia,
+            ))
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
     }
-    let n = parent.len();
+    let model = builder.build().unwrap_or_else(|e| panic!("{path}: {e}"));
     assert_eq!(
-        (at, n),
+        (model.nq, model.n),
         (nq, nv),
-        "{path}: built nq, nv = {at}, {n}, the file says {nq}, {nv}"
+        "{path}: built nq, nv = {}, {}, the file says {nq}, {nv}",
+        model.nq,
+        model.n
     );
-    let z = vec![0.0; n];
-    let model = Model::new(
-        parent,
-        joints,
-        z.clone(),
-        placements,
-        inertias,
-        z.clone(),
-        z.clone(),
-        z,
-        Vec3::new(g[0], g[1], g[2]),
-        vec![],
-    )
-    .and_then(|m| m.with_coordinates(coordinates))
-    .unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut vector = |key: &str, len: usize| -> Vec<f64> {
         let (line, words) = next(key);
         let joined = words.join(" ");

@@ -275,17 +275,16 @@ pub fn check_start(
     }
     let space = Space::new(model, reduction);
     for (&(block, at), &body) in space.blocks.iter().zip(&space.block_body) {
-        let (name, unit) = match block {
-            lie::Block::FreeFlyer => ("quaternion (qx, qy, qz, qw) of the floating", at + 3..at + 7),
-            lie::Block::Spherical => ("quaternion (qx, qy, qz, qw) of the spherical", at..at + 4),
-            lie::Block::Planar => ("(cos theta, sin theta) pair of the planar", at + 2..at + 4),
-            lie::Block::Scalar => continue,
-        };
-        let norm = q[unit.clone()].iter().map(|x| x * x).sum::<f64>().sqrt();
-        if (norm - 1.0).abs() > UNIT_TOLERANCE {
+        if block == lie::Block::Scalar {
+            continue; // a 1-DOF coordinate: no unit part, and limits of its own
+        }
+        // the model's one unit check (`Block::not_unit`), named in the solver's own terms
+        if let Some((unit, what, norm)) = block.not_unit(&q[at..at + block.nq()]) {
             return Err(format!(
-                "q0[{}:{}], the {name} joint at body {body}, has norm {norm:.9}, not 1 to within {UNIT_TOLERANCE:e}: normalise it",
-                unit.start, unit.end
+                "q0[{}:{}], the {what} of the {} joint at body {body}, has norm {norm:.9}, not 1 to within {UNIT_TOLERANCE:e}: normalise it",
+                at + unit.start,
+                at + unit.end,
+                block.kind_name()
             ));
         }
         if let Some(j) = (at..at + block.nq()).find(|&j| lower[j].is_finite() || upper[j].is_finite()) {

@@ -21,6 +21,27 @@ impl Block {
             Block::Scalar => None,
         }
     }
+
+    /// The one unit check of a q block `qb` (the block's own numbers): `None` when its unit part
+    /// has norm 1 to within [`UNIT_TOLERANCE`] (or it has none), else that part's range in `qb`, its
+    /// name in messages and its norm. [`Model::check_configuration`] and the inverse-kinematics
+    /// solver's start check both ask it.
+    pub fn not_unit(self, qb: &[f64]) -> Option<(std::ops::Range<usize>, &'static str, f64)> {
+        let (unit, what) = self.unit_range()?;
+        let norm = qb[unit.clone()].iter().map(|x| x * x).sum::<f64>().sqrt();
+        ((norm - 1.0).abs() > UNIT_TOLERANCE).then_some((unit, what, norm))
+    }
+
+    /// The description's name of a multi-DOF block's joint kind ("floating", "spherical",
+    /// "planar"; "1-DOF" for the scalar block).
+    pub fn kind_name(self) -> &'static str {
+        match self {
+            Block::FreeFlyer => "floating",
+            Block::Spherical => "spherical",
+            Block::Planar => "planar",
+            Block::Scalar => "1-DOF",
+        }
+    }
 }
 
 impl Model {
@@ -33,23 +54,16 @@ impl Model {
         }
         for (i, c) in self.coordinates.iter().enumerate() {
             let Coordinates::Head { block, at } = *c else { continue };
-            let Some((unit, what)) = block.unit_range() else {
+            let Some((unit, what, norm)) = block.not_unit(&q[at..at + block.nq()]) else {
                 continue;
             };
-            let norm = q[at + unit.start..at + unit.end]
-                .iter()
-                .map(|x| x * x)
-                .sum::<f64>()
-                .sqrt();
-            if (norm - 1.0).abs() > UNIT_TOLERANCE {
-                let of_state = state.map_or(String::new(), |k| format!(" of state {k}"));
-                return Err(format!(
-                    "q[{}..{}]{of_state}, the {what} of the {block:?} joint at body {i}, has norm {norm}, not 1 \
-                     (to {UNIT_TOLERANCE:e}): normalise it (robot.normalize(q))",
-                    at + unit.start,
-                    at + block.nq()
-                ));
-            }
+            let of_state = state.map_or(String::new(), |k| format!(" of state {k}"));
+            return Err(format!(
+                "q[{}..{}]{of_state}, the {what} of the {block:?} joint at body {i}, has norm {norm}, not 1 \
+                 (to {UNIT_TOLERANCE:e}): normalise it (robot.normalize(q))",
+                at + unit.start,
+                at + block.nq()
+            ));
         }
         Ok(())
     }
@@ -117,19 +131,32 @@ mod tests {
 
     #[test]
     fn names_at_the_border_decode_into_the_spherical_layout() {
-        let names = ["spherical", "", "", ""];
-        let blocks: Vec<Block> = names.iter().map(|n| Block::from_name(n).unwrap()).collect();
-        let coordinates = Coordinates::from_blocks(&blocks).unwrap();
-        assert_eq!(&coordinates[..3], &spherical().coordinates[..]);
-        assert_eq!(coordinates[3], Coordinates::Scalar { at: 4 });
-        let bad = Coordinates::from_blocks(&[Block::Spherical, Block::Planar]).unwrap_err();
-        assert!(bad.to_string().contains("body 1"), "{bad}");
-        let e = Block::from_name("helical").unwrap_err().to_string();
+        use crate::joint::JointType;
+        use crate::model::{JointRecord, ModelBuilder};
+        let mut builder = ModelBuilder::new(Vec3::new(0.0, 0.0, -9.81));
+        let inertia = Inertia::from_parameters(&[1.0, 0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.1, 0.0, 0.1]);
+        let ball = JointType::from_name("spherical", None).unwrap();
+        let elbow = JointType::from_name("continuous", Some(Vec3::z())).unwrap();
+        builder
+            .joint(JointRecord::new("ball", ball, None, Transform::identity(), inertia))
+            .unwrap();
+        builder
+            .joint(JointRecord::new(
+                "elbow",
+                elbow,
+                Some(0),
+                Transform::identity(),
+                inertia,
+            ))
+            .unwrap();
+        let model = builder.build().unwrap();
+        assert_eq!(&model.coordinates[..3], &spherical().coordinates[..]);
+        assert_eq!(model.coordinates[3], Coordinates::Scalar { at: 4 });
+        assert_eq!(model.parent[3], Some(2));
+        let e = JointType::from_name("helical", None).unwrap_err().to_string();
         assert!(e.contains("'helical'"), "{e}");
-        let e = crate::joint::JointKind::from_name("continuous")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("'continuous'"), "{e}");
+        let e = JointType::from_name("prismatic", None).unwrap_err().to_string();
+        assert!(e.contains("needs an axis"), "{e}");
         let e = crate::algorithms::jacobian::Reference::from_name("base")
             .unwrap_err()
             .to_string();

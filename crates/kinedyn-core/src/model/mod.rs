@@ -14,7 +14,10 @@
 //! these joints), which must use the whole joint velocity: [`Model::velocity_product`] puts it on
 //! the last member (the members before it are massless, so their accelerations never act).
 
+mod builder;
 mod configuration;
+
+pub use builder::{JointRecord, ModelBuilder};
 
 /// Kept here for the algorithms that read it from the model's module.
 pub use crate::lie::quaternion_matrix;
@@ -40,36 +43,6 @@ pub enum Coordinates {
     Head { block: Block, at: usize },
     /// A further degree of freedom of the multi-DOF joint of the body before (identity transform).
     Member,
-}
-
-impl Coordinates {
-    /// The coordinates of `n = blocks.len()` bodies from the block each body's joint starts
-    /// ([`Block::Scalar`] for a 1-DOF joint): a multi-DOF head is followed by its `nv - 1` members,
-    /// whose entries must be [`Block::Scalar`]; q blocks follow in body order. The layout itself is
-    /// checked by [`Model::with_coordinates`].
-    pub fn from_blocks(blocks: &[Block]) -> Result<Vec<Coordinates>> {
-        let (mut out, mut at, mut i) = (Vec::with_capacity(blocks.len()), 0, 0);
-        while i < blocks.len() {
-            let block = blocks[i];
-            if block == Block::Scalar {
-                out.push(Coordinates::Scalar { at });
-                (at, i) = (at + 1, i + 1);
-                continue;
-            }
-            out.push(Coordinates::Head { block, at });
-            let end = (i + block.nv()).min(blocks.len());
-            for (k, member) in blocks.iter().enumerate().take(end).skip(i + 1) {
-                if *member != Block::Scalar {
-                    return Err(Error::InvalidModel(format!(
-                        "body {k}: a member of the {block:?} joint starting at body {i} cannot start a {member:?} joint"
-                    )));
-                }
-                out.push(Coordinates::Member);
-            }
-            (at, i) = (at + block.nq(), end);
-        }
-        Ok(out)
-    }
 }
 
 /// A named frame rigidly attached to a body (`None`: the base).
@@ -341,20 +314,10 @@ impl Model {
     /// The bodies `i..i + block.nv()` form one multi-DOF joint: columns as [`Block`] says, members at
     /// the identity on the body before, massless except the last, no drive or friction data.
     fn check_block(&self, i: usize, block: Block, coordinates: &[Coordinates]) -> Result<()> {
-        use crate::joint::JointKind::{Prismatic, Revolute};
         let nv = block.nv();
-        let unit = |k: usize| crate::spatial::Vec3::ith(k, 1.0);
-        let expected: Vec<(crate::joint::JointKind, Vec3)> = match block {
-            Block::FreeFlyer => (0..6)
-                .map(|k| (if k < 3 { Prismatic } else { Revolute }, unit(k % 3)))
-                .collect(),
-            Block::Spherical => (0..3).map(|k| (Revolute, unit(k))).collect(),
-            Block::Planar => {
-                let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
-                vec![(Prismatic, e1), (Prismatic, e2), (Revolute, e1.cross(&e2))]
-            }
-            Block::Scalar => vec![],
-        };
+        // the columns the block's kind says (the planar joint's in-plane axes are its first members')
+        let in_plane = (self.joints[i].axis, self.joints[(i + 1).min(self.n - 1)].axis);
+        let expected = crate::joint::block_columns(block, in_plane);
         let bad = |k: usize, why: &str| {
             Err(Error::InvalidModel(format!(
                 "body {k} ({block:?} joint starting at body {i}): {why}"
@@ -363,11 +326,18 @@ impl Model {
         if block == Block::Planar && self.joints[i].axis.dot(&self.joints[i + 1].axis).abs() > 1e-12 {
             return bad(i, "the planar joint's in-plane axes are not orthogonal");
         }
-        for (m, (kind, axis)) in expected.iter().enumerate() {
+        for (m, column) in expected.iter().enumerate() {
             let k = i + m;
             let joint = &self.joints[k];
-            if joint.kind != *kind || (joint.axis - axis).norm() > 1e-12 {
-                return bad(k, &format!("column {m} must be {kind:?} along {:?}", axis.as_slice()));
+            if joint.kind != column.kind || (joint.axis - column.axis).norm() > 1e-12 {
+                return bad(
+                    k,
+                    &format!(
+                        "column {m} must be {:?} along {:?}",
+                        column.kind,
+                        column.axis.as_slice()
+                    ),
+                );
             }
             if m > 0 {
                 if coordinates[k] != Coordinates::Member || self.parent[k] != Some(k - 1) {
