@@ -105,6 +105,7 @@ def replacing(path) -> Iterator[Path]:
         yield target  # /dev/null, a terminal, a pipe: there is nothing to replace, the bytes go through
         return
     folder = target.parent
+    fd = -1
     while True:
         tmp = folder / f".{target.stem[:80]}.{secrets.token_hex(4)}.tmp{target.suffix}"
         try:

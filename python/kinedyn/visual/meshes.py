@@ -238,7 +238,7 @@ def _read(path: str, mtime_ns: int, size: int) -> tuple[Part, ...]:
             raise ValueError(
                 f"mesh '{path}' has more than {MAX_MESH_TRIANGLES:,} triangles (kinedyn draws robots, not scans)"
             )
-        raw = np.asarray(m.vertices, dtype=np.float64)
+        raw = np.asarray(m.vertices, dtype=np.float64)  # type: ignore[union-attr]
         if not np.all(np.isfinite(raw)):
             raise ValueError(f"mesh '{path}' has vertices that are not finite numbers")
         if raw.size and np.max(np.abs(raw)) > MAX_MESH_COORDINATE:  # 1e308 overflows float32 and the report's JSON

@@ -99,7 +99,7 @@ def listen_address(host: str, port: int) -> Address:
     except (socket.gaierror, UnicodeError) as e:
         raise ValueError(f"host {shown}: cannot resolve it ({getattr(e, 'strerror', None) or e})") from None
     addresses = list(dict.fromkeys((family, sockaddr[0]) for family, _, _, _, sockaddr in infos))
-    ips = [_ip(a) for _, a in addresses]
+    ips = [_ip(str(a)) for _, a in addresses]
     loopback = all(ip is not None and ip.is_loopback for ip in ips)
     everywhere = not host or any(ip is not None and ip.is_unspecified for ip in ips)
     last: OSError | None = None
@@ -222,8 +222,8 @@ def guarded_viser(guard: HandshakeGuard) -> Iterator[dict]:
             super().__init__(handler, *args, process_request=process_request, **kwargs)
 
     with _CONSTRUCTION:
-        ws_server.serve = serve
+        ws_server.serve = serve  # type: ignore[misc]
         try:
             yield state
         finally:
-            ws_server.serve = plain
+            ws_server.serve = plain  # type: ignore[misc]

@@ -114,8 +114,9 @@ class Viewer:
         # host and port checked (and a free port found) before viser's thread starts, and each handshake
         # checked for a loopback Host and the viewer's own Origin (kinedyn.visual.serving)
         address = listen_address(host, port)
-        if not address.loopback:
-            warnings.warn(address.exposure(), stacklevel=2)
+        exposure = address.exposure()
+        if exposure is not None:
+            warnings.warn(exposure, stacklevel=2)
         with guarded_viser(HandshakeGuard(beyond_loopback=not address.loopback, allow_remote=allow_remote)) as state:
             # viser prints its own panel of URLs (``http://:PORT`` for host ""); the viewer prints the right one
             with contextlib.redirect_stdout(io.StringIO()):

@@ -345,7 +345,9 @@ def sum_pieces(expr, limit: float = LINE_PT) -> list:
     ``[expr]``."""
     if not expr.is_Add or width(expr) <= limit:
         return [expr]
-    pieces, current, used = [], [], 0.0
+    pieces: list = []
+    current: list = []
+    used = 0.0
     for term in expr.as_ordered_terms():
         w = width(term) + _OP
         if current and used + w > limit:
