@@ -86,5 +86,5 @@ def test_the_core_rejects_bad_shapes_and_names_by_message():
         lie_integrate(["floating"], np.zeros(6), np.zeros(6))
     with pytest.raises(ValueError, match=r"v must have shape \(2, 6\)"):
         lie_integrate(["floating"], np.zeros((2, 7)), np.zeros((3, 6)))
-    with pytest.raises(ValueError, match="joint 1: .*unknown joint block kind 'helical'"):
+    with pytest.raises(ValueError, match="joint 1: .*unknown joint kind 'helical'"):
         lie_difference(["", "helical"], np.zeros(2), np.zeros(2))

@@ -55,6 +55,16 @@ impl JointType {
         })
     }
 
+    /// The configuration block of a kind named as at the border, "" standing for any 1-DOF joint:
+    /// what the Lie-group operations need when no model is built (a symbolic robot's joints). The
+    /// block does not depend on the axis, so the decoding above runs with a placeholder one.
+    pub fn block_of_kind(name: &str) -> Result<Block> {
+        match name {
+            "" => Ok(Block::Scalar),
+            _ => JointType::from_name(name, Some(Vec3::z())).map(|j| j.block()),
+        }
+    }
+
     /// The description's name of the kind ("floating" for the free-flyer).
     pub fn name(&self) -> &'static str {
         match self {

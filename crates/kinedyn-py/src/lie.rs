@@ -1,8 +1,9 @@
 //! The core's Lie-group operations of configurations (`kinedyn_core::lie`) on arrays: `q ⊕ v` and
 //! `difference(q0, q1)` of a sequence of joint blocks, over one state or a batch (leading axes).
 //! Blocks cross as names ("floating", "spherical", "planar", "" for a 1-DOF joint), decoded by
-//! `Block::from_name`; no `Model` is needed (a symbolic robot's joints have blocks too).
+//! `JointType::block_of_kind`; no `Model` is needed (a symbolic robot's joints have blocks too).
 
+use kinedyn_core::joint::JointType;
 use kinedyn_core::lie::{difference_block, integrate_block, Block};
 use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -14,7 +15,7 @@ fn blocks(names: &[String]) -> PyResult<Vec<Block>> {
     names
         .iter()
         .enumerate()
-        .map(|(i, name)| Block::from_name(name).map_err(|e| PyValueError::new_err(format!("joint {i}: {e}"))))
+        .map(|(i, name)| JointType::block_of_kind(name).map_err(|e| PyValueError::new_err(format!("joint {i}: {e}"))))
         .collect()
 }
 

@@ -5,15 +5,16 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
+use kinedyn_core::spatial::Vec3;
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::conv::{self, f64_array, optional, Batch};
+use crate::conv::{self, f64_array, optional, vec_of, Batch};
 use crate::guard::guarded;
-use crate::run::Arrays3;
+use crate::run::{core_err, Arrays3};
 
 /// The compiled model plus one cached `Data` for single-state calls.
 #[pyclass(name = "Model", module = "kinedyn._core", frozen)]
