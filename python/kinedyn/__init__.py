@@ -10,7 +10,6 @@ from ._core import (
     simd,  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
 )
 from .description import DHRow, Frame, Inertia, Joint, Link
-from .description.audit import audit  # what is wrong with a robot file (docs/audit.md)
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 
@@ -19,6 +18,7 @@ if TYPE_CHECKING:
     # names (kd.simulate.PD); the lazily loaded submodules are the modules themselves
     from . import analysis, configuration, dynamics, ik, kinematics, symbolic, testing  # noqa: F401
     from ._typing import PathLike
+    from .description.audit import audit
     from .scale import sweep
     from .simulate import Trajectory
     from .simulate._callable import simulate
@@ -30,7 +30,8 @@ _SUBMODULES = ("analysis", "configuration", "dynamics", "ik", "kinematics", "sym
 
 def __getattr__(name):
     """Submodules load on first use (kd.ik, kd.kinematics, kd.analysis, ...), and so do kd.simulate,
-    kd.Trajectory, kd.sweep and kd.LagrangianSystem (SymPy), keeping import fast."""
+    kd.Trajectory, kd.sweep, kd.audit (the file readers) and kd.LagrangianSystem (SymPy), keeping
+    import fast."""
     if name in _SUBMODULES:
         import importlib
 
@@ -47,6 +48,10 @@ def __getattr__(name):
         from .scale import sweep
 
         return sweep
+    if name == "audit":  # what is wrong with a robot file (docs/audit.md): it reads the file formats
+        from .description.audit import audit
+
+        return audit
     if name == "LagrangianSystem":  # the symbolic engine (SymPy) loads on first use
         from .symbolic import LagrangianSystem
 

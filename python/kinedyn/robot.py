@@ -20,18 +20,18 @@ from ._arrays import float64_array, point_in_frame, scalar_or_array
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from ._ui.names import did_you_mean
-from .description.audit import Audit, audit
 from .description.description import Description
 from .description.dh import DHRow, description_from_dh
 from .description.edit import lock_joints, substitute
 from .description.geometry import Visual
 from .description.link import Frame, Link
 from .ik.dispatch import inverse_kinematics as solve_ik
-from .native.compile import body_wrenches, compile_model, locked_block
+from .native.compile import body_wrenches, compile_model, link_bodies, locked_block
 from .native.errors import robot_error
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
+    from .description.audit import Audit
     from .dynamics import BaseParameters
     from .symbolic.eom import EquationsOfMotion
 
@@ -292,9 +292,8 @@ class Robot:
 
     @cached_property
     def _body_last_dof(self) -> np.ndarray:
-        """(n_links,) the last degree of freedom of each moving link's joint: the native body that
-        carries the link (a multi-DOF joint is one native body per degree of freedom)."""
-        return np.cumsum([b.joint.nv for b in self.tree.bodies]) - 1
+        """(n_links,) the native body (last degree of freedom) carrying each moving link."""
+        return link_bodies(self.description)
 
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
@@ -305,8 +304,7 @@ class Robot:
     symbols = _described("symbols")
 
     def subs(self, mapping: Mapping) -> Robot:
-        """A copy with SymPy symbols replaced (by numbers, giving a robot the numeric engine runs);
-        keys are symbols or their names."""
+        """A copy with SymPy symbols (or their names) replaced, by numbers for the numeric engine."""
         return Robot(substitute(self.description, by_name(mapping, self.symbols)))
 
     def save(self, path: PathLike) -> None:
@@ -326,6 +324,8 @@ class Robot:
 
     def audit(self, *, geometry: bool = True) -> Audit:
         """What is wrong with the robot's file (its description where it has none): docs/audit.md."""
+        from .description.audit import audit  # the file formats load on use
+
         return audit(self.description, geometry=geometry)
 
     def to_mjcf(self, path: PathLike | None = None, *, geometry: bool = True, default_inertia: bool = True) -> str:

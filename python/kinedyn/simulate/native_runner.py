@@ -68,46 +68,17 @@ def run_native(
                 model, method, q, qd, t0 + k0 * dt, dt, m, tau, linear, every, max_speed, lower, upper, wrenches
             )
         else:
+
+            def callback_run(qi, qdi, i):
+                return integrate_callback(
+                    model, method, qi, qdi, t0 + k0 * dt, dt, m, _offset(torque_for(i), k0), hold, every,
+                    max_speed, jacobian, lower, upper, wrenches,
+                )  # fmt: skip
+
             if batch is None:
-                cb = _offset(torque_for(0), k0)
-                res = integrate_callback(
-                    model,
-                    method,
-                    q,
-                    qd,
-                    t0 + k0 * dt,
-                    dt,
-                    m,
-                    cb,
-                    hold,
-                    every,
-                    max_speed,
-                    jacobian,
-                    lower,
-                    upper,
-                    wrenches,
-                )
+                res = callback_run(q, qd, 0)
             else:
-                results: list[tuple[Any, ...]] = [
-                    integrate_callback(
-                        model,
-                        method,
-                        q[i],
-                        qd[i],
-                        t0 + k0 * dt,
-                        dt,
-                        m,
-                        _offset(torque_for(i), k0),
-                        hold,
-                        every,
-                        max_speed,
-                        jacobian,
-                        lower,
-                        upper,
-                        wrenches,
-                    )
-                    for i in range(batch)
-                ]
+                results: list[tuple[Any, ...]] = [callback_run(q[i], qd[i], i) for i in range(batch)]
                 res = tuple(np.stack([r[j] for r in results]) for j in range(4)) + (
                     np.concatenate([r[4] for r in results]),
                     [r[5][0] for r in results],
