@@ -9,7 +9,7 @@ from ._core import (
     NonFiniteResultError,
     simd,  # (kind, states per block) of batches in SIMD lanes (docs/dynamics.md)
 )
-from .description import DHRow, Frame, Inertia, Joint, Link
+from .description import DHRow, Frame, Inertia, Joint, Link, Loop
 from .description.inertia import PhysicalConsistencyWarning
 from .robot import Robot
 
@@ -74,6 +74,7 @@ __all__ = [
     "Joint",
     "Link",
     "Frame",
+    "Loop",
     "DHRow",
     "load",
     "audit",

@@ -25,9 +25,11 @@ from .description.dh import DHRow, description_from_dh
 from .description.edit import lock_joints, substitute
 from .description.geometry import Visual
 from .description.link import Frame, Link
+from .description.loops import Loop
 from .ik.dispatch import inverse_kinematics as solve_ik
 from .native.compile import body_wrenches, compile_model, link_bodies, locked_block
 from .native.errors import robot_error
+from .robot_loops import ClosedLoops
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike, FloatOrArray, PathLike, SeedLike
@@ -45,7 +47,7 @@ def _described(name: str) -> property:
     return property(lambda self: getattr(self.description, name), doc=getattr(Description, name).__doc__)
 
 
-class Robot:
+class Robot(ClosedLoops):
     """A kinematic tree of links connected by revolute, prismatic and fixed joints.
 
     Build one with :meth:`from_dh`, :meth:`from_urdf`, :func:`kinedyn.load`, the built-in catalogue
@@ -70,12 +72,14 @@ class Robot:
         visuals: Sequence[Visual] = (),
         collisions: Sequence[Visual] = (),
         mimic: str = "reduce",
+        loops: Sequence[Loop] = (),
     ):
         """``Robot(description)`` (what the readers return), or ``Robot(links, frames, ...)`` with the
         fields of :class:`~kinedyn.description.description.Description` as keywords. ``inertia``: the
         policy for tensors no rigid body can have (docs/model-files.md); ``mimic``: "reduce" removes
         the followers' coordinates, "independent" keeps them (:mod:`kinedyn.description.mimic`);
-        ``visuals``/``collisions``: what :mod:`kinedyn.visual` draws, by frame name."""
+        ``visuals``/``collisions``: what :mod:`kinedyn.visual` draws, by frame name; ``loops``: closed
+        loops between frames (:class:`~kinedyn.description.loops.Loop`, :meth:`add_loop`)."""
         if isinstance(links, Description):
             description = links
         else:
@@ -93,6 +97,7 @@ class Robot:
                 visuals=tuple(visuals),
                 collisions=tuple(collisions),
                 mimic=mimic,
+                loops=tuple(loops),
             )
         object.__setattr__(self, "description", description)
 
@@ -290,11 +295,6 @@ class Robot:
         """(nv,) the moving link (index into body_names) each degree of freedom belongs to."""
         return np.repeat(np.arange(len(self.tree.bodies)), [b.joint.nv for b in self.tree.bodies])
 
-    @cached_property
-    def _body_last_dof(self) -> np.ndarray:
-        """(n_links,) the native body (last degree of freedom) carrying each moving link."""
-        return link_bodies(self.description)
-
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
         """viscous * qd + Coulomb friction (:func:`kinedyn.dynamics.friction_torque`), (n,) or (N, n)."""
@@ -379,10 +379,6 @@ class Robot:
     def _model(self):
         """The compiled native model (built once; numeric descriptions only): :func:`kinedyn.native.compile_model`."""
         return compile_model(self.description)
-
-    @cached_property
-    def _multi_dof(self) -> bool:
-        return self.has_multi_dof_joints
 
     @cached_property
     def _link_frame_ids(self) -> np.ndarray:
@@ -652,9 +648,9 @@ class Robot:
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         y = self._model.regressor(q, qd, qdd)
-        if self._multi_dof:
+        if self.has_multi_dof_joints:
             # the native model's extra bodies of a multi-DOF joint are massless: keep the links' columns
-            columns = (10 * self._body_last_dof[:, None] + np.arange(10)).ravel()
+            columns = (10 * link_bodies(self.description)[:, None] + np.arange(10)).ravel()
             y = np.ascontiguousarray(y[..., columns])
         return y
 

@@ -6,5 +6,6 @@ from .dh import DHRow
 from .inertia import Inertia
 from .joint import Joint
 from .link import Frame, Link
+from .loops import Loop
 
-__all__ = ["DHRow", "Description", "Inertia", "Joint", "Link", "Frame"]
+__all__ = ["DHRow", "Description", "Inertia", "Joint", "Link", "Frame", "Loop"]

@@ -27,6 +27,7 @@ from .._math import is_symbolic
 from .._ui.names import did_you_mean
 from .checks import vector
 from .link import KinematicTree, build_tree, judge_inertias
+from .loops import check_loops
 from .mimic import MimicMap, mimic_map, reduced_coefficient
 from .tool import default_tool
 
@@ -46,6 +47,7 @@ class Description:
     ``"strict"``; docs/model-files.md); ``links`` holds the judged (repaired) links. ``mimic``:
     ``"reduce"`` or ``"independent"`` (:mod:`kinedyn.description.mimic`). ``tool``: a frame name;
     ``None`` picks one (a frame named "tool", else :func:`kinedyn.description.tool.default_tool`).
+    ``loops``: closed kinematic loops between two frames (:class:`~kinedyn.description.loops.Loop`).
     """
 
     links: tuple
@@ -61,6 +63,7 @@ class Description:
     visuals: tuple = ()
     collisions: tuple = ()
     mimic: str = "reduce"
+    loops: tuple = ()
     # derived on construction
     tree: KinematicTree = field(init=False, repr=False)
     nonphysical: dict = field(init=False, repr=False)
@@ -93,6 +96,7 @@ class Description:
                 f"tool frame '{tool}' is not a frame of robot '{self.name}'{did_you_mean(tool, names)} (frames: {names})"
             )
         put(self, "tool", tool)
+        put(self, "loops", check_loops(self.loops, names, self.name))
 
     # ------------------------------------------------------------------ joints and frames
     @property
