@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import kinedyn as kd
+from kinedyn.convert import convert
 
 MJCF = """<mujoco model="loops"><compiler angle="radian"/>
 <worldbody>
@@ -177,3 +178,164 @@ def test_mjcf_loop_errors_name_the_line_and_element(old, new, message):
     assert old in MJCF
     with pytest.raises(ValueError, match=message):
         load_mjcf(MJCF.replace(old, new))
+
+
+# ------------------------------------------------------------------------------------------ URDF
+FOUR_BAR_URDF = """<?xml version="1.0"?>
+<robot name="four_bar">
+  <link name="ground"/>
+  <link name="crank"><inertial><origin xyz="0.05 0 0"/><mass value="0.2"/>
+    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="2e-4" iyz="0" izz="2e-4"/></inertial></link>
+  <link name="coupler"><inertial><origin xyz="0.175 0 0"/><mass value="0.5"/>
+    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="5e-3" iyz="0" izz="5e-3"/></inertial></link>
+  <link name="rocker"><inertial><origin xyz="0.15 0 0"/><mass value="0.4"/>
+    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="3e-3" iyz="0" izz="3e-3"/></inertial></link>
+  <joint name="crank_joint" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+  <joint name="coupler_joint" type="continuous"><parent link="crank"/><child link="coupler"/>
+    <origin xyz="0.1 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="rocker_joint" type="continuous"><parent link="ground"/><child link="rocker"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 0 1"/></joint>
+  <loop name="pin" type="point">
+    <link1 link="coupler" xyz="0.35 0 0"/>
+    <link2 link="rocker" xyz="0.3 0 0" rpy="0 0 0.1"/>
+  </loop>
+  <loop name="glued" type="weld"><link1 link="rocker"/><link2 link="ground"/></loop>
+</robot>
+"""
+
+
+def test_urdf_loop_extension_reads_frames_on_the_links():
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    assert [(lp.name, lp.frame_a, lp.frame_b, lp.kind) for lp in robot.loops] == [
+        ("pin", "pin_a", "pin_b", "point"),
+        ("glued", "rocker", "ground", "weld"),
+    ]
+    frames = {f.name: f for f in robot.frames}
+    assert frames["pin_a"].link == "coupler" and frames["pin_b"].link == "rocker"
+    np.testing.assert_allclose(np.asarray(frames["pin_a"].placement)[:3, 3], [0.35, 0, 0])
+    R = np.asarray(frames["pin_b"].placement)[:3, :3]
+    np.testing.assert_allclose(R[:2, :2], [[np.cos(0.1), -np.sin(0.1)], [np.sin(0.1), np.cos(0.1)]], atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            '<link2 link="rocker" xyz',
+            '<link2 link="roker" xyz',
+            r"<URDF string>:17: loop 'pin': <link2> names link 'roker'.*did you mean 'rocker'",
+        ),
+        ('type="point">', 'type="pin">', r"<URDF string>:15: loop 'pin' has type 'pin': expected one of point, weld"),
+        ('<link1 link="coupler" xyz="0.35 0 0"/>', "", r":15: loop 'pin' has no <link1 link=...>"),
+        ('xyz="0.35 0 0"', 'xyz="0.35 0"', r":16: loop 'pin' <link1> xyz must be 3 numbers"),
+        ('name="glued"', 'name="pin"', r":19: loop 'pin' is defined twice \(first at line 15\)"),
+        ('<link2 link="ground"/>', '<link2 link="rocker"/>', r":19: loop 'glued' closes frame 'rocker' on itself"),
+    ],
+)
+def test_urdf_loop_errors_name_the_line(old, new, message):
+    assert old in FOUR_BAR_URDF
+    with pytest.raises(ValueError, match=message):
+        kd.Robot.from_urdf(FOUR_BAR_URDF.replace(old, new))
+
+
+def same_loops(a, b, states=4):
+    """The same loops (name, kind) whose frames sit at the same poses at random states."""
+    assert [(lp.name, lp.kind) for lp in a.loops] == [(lp.name, lp.kind) for lp in b.loops]
+    rng = np.random.default_rng(3)
+    for _ in range(states):
+        q = a.random_configuration(rng)
+        for la, lb in zip(a.loops, b.loops):
+            np.testing.assert_allclose(
+                a.frame_poses(q, [la.frame_a, la.frame_b]), b.frame_poses(q, [lb.frame_a, lb.frame_b]), atol=1e-12
+            )
+
+
+@pytest.mark.parametrize("fmt", ["urdf", "mjcf", "yaml", "toml"])
+def test_every_writer_keeps_the_loops(fmt, tmp_path):
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    path = tmp_path / f"four_bar.{'xml' if fmt == 'mjcf' else fmt}"
+    if fmt == "urdf":
+        robot.to_urdf(path)
+    elif fmt == "mjcf":
+        robot.to_mjcf(path)
+    else:
+        robot.save(path)
+    back = load_mjcf(str(path)) if fmt == "mjcf" else kd.load(path)
+    same_loops(robot, back)
+    if fmt != "mjcf":  # every frame is a link of the written URDF, or a frame of the robot file
+        assert back.loops == robot.loops
+    else:  # a loop end that is a link gets a site of its own
+        assert [(lp.frame_a, lp.frame_b) for lp in back.loops] == [("pin_a", "pin_b"), ("glued_a", "glued_b")]
+
+
+def test_mjcf_written_loops_are_what_mujoco_holds(tmp_path):
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the oracle of the MJCF writing")
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    model = mujoco.MjModel.from_xml_string(robot.to_mjcf())
+    data = mujoco.MjData(model)
+    q = robot.random_configuration(np.random.default_rng(5))
+    data.qpos[:] = q
+    mujoco.mj_forward(model, data)
+    ours = np.concatenate([residual(robot, q, lp) for lp in robot.loops])
+    theirs = data.efc_pos[: data.ne]
+    if not np.allclose(ours[3:], theirs[3:], atol=1e-9):
+        theirs = np.r_[theirs[:6], -theirs[6:]]
+    np.testing.assert_allclose(ours, theirs, atol=1e-9)
+
+
+def test_kinedyn_convert_keeps_the_loops_and_checks_them(tmp_path):
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    for ext in ("urdf", "xml", "yaml"):
+        result = convert(robot, tmp_path / f"fb.{ext}")
+        assert "loops" in result.summary(), result.summary()
+        same_loops(robot, load_mjcf(str(tmp_path / "fb.xml")) if ext == "xml" else kd.load(tmp_path / f"fb.{ext}"))
+
+
+# ------------------------------------------------------------------------------------------ YAML
+YAML = """name: two_pins
+links:
+  - {name: a, joint: {name: ja, type: revolute}}
+  - {name: b, parent: a, joint: {name: jb, type: revolute, origin: {xyz: [1, 0, 0]}}}
+frames:
+  - {name: tip, link: b, origin: {xyz: [1, 0, 0]}}
+  - {name: pivot, origin: {xyz: [1.5, 0, 0]}}
+loops:
+  - {name: closure, frame_a: tip, frame_b: pivot, kind: point}
+  - {name: held, frame_a: a, frame_b: base}
+"""
+
+
+def test_yaml_loops_section(tmp_path):
+    path = tmp_path / "r.yaml"
+    path.write_text(YAML)
+    robot = kd.load(path)
+    assert [(lp.name, lp.frame_a, lp.frame_b, lp.kind) for lp in robot.loops] == [
+        ("closure", "tip", "pivot", "point"),
+        ("held", "a", "base", "point"),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "frame_b: pivot",
+            "frame_b: pivto",
+            r"line 9: loops\[0\].frame_b: names no frame 'pivto'; did you mean 'pivot'",
+        ),
+        ("kind: point}", "kind: ball}", r"line 9: loops\[0\]: loop 'closure': kind must be one of"),
+        (
+            "{name: held, frame_a: a, frame_b: base}",
+            "{name: held, frame_a: a}",
+            r"line 10: loops\[1\]: a loop needs 'frame_b'",
+        ),
+        ("name: held", "name: closure", r"line 10: loops\[1\].name: two loops are named 'closure'"),
+        ("frame_b: base}", "frame_b: base, rows: 3}", r"line 10: loops\[1\]: unknown key 'rows'"),
+    ],
+)
+def test_yaml_loop_errors_name_the_line(tmp_path, old, new, message):
+    assert old in YAML
+    path = tmp_path / "r.yaml"
+    path.write_text(YAML.replace(old, new))
+    with pytest.raises(ValueError, match=message):
+        kd.load(path)
