@@ -339,3 +339,26 @@ def test_yaml_loop_errors_name_the_line(tmp_path, old, new, message):
     path.write_text(YAML.replace(old, new))
     with pytest.raises(ValueError, match=message):
         kd.load(path)
+
+
+# ------------------------------------------------------------------------------------------ info
+def test_kinedyn_info_prints_the_loops(capsys, tmp_path, monkeypatch):
+    from kinedyn.cli import main
+
+    monkeypatch.setenv("COLUMNS", "200")
+    path = tmp_path / "four_bar.urdf"
+    path.write_text(FOUR_BAR_URDF)
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    rows = [line for line in out.splitlines() if "pin_a" in line or "glued" in line]
+    assert len(rows) == 2 and "pin_b" in rows[0] and "point" in rows[0] and "3" in rows[0]
+    assert "rocker" in rows[1] and "ground" in rows[1] and "weld" in rows[1] and "6" in rows[1]
+    assert main(["info", str(path), "--json"]) == 0
+    doc = __import__("json").loads(capsys.readouterr().out)
+    assert doc["loops"][1] == {"name": "glued", "frame_a": "rocker", "frame_b": "ground", "kind": "weld", "rows": 6}
+
+
+def test_loops_read_as_a_table():
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    assert repr(robot.loops[0]) == "Loop('pin': pin_a meets pin_b, point, 3 rows)"
+    assert str(robot.loops[1]) == "Loop('glued': rocker meets ground, weld, 6 rows)"
