@@ -5,7 +5,11 @@ errors that name file, line and element."""
 
 from __future__ import annotations
 
+import ast
+import re
 import warnings
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -362,3 +366,90 @@ def test_loops_read_as_a_table():
     robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
     assert repr(robot.loops[0]) == "Loop('pin': pin_a meets pin_b, point, 3 rows)"
     assert str(robot.loops[1]) == "Loop('glued': rocker meets ground, weld, 6 rows)"
+
+
+# ------------------------------------------------------------------------------------------ examples
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "robots"
+# file -> degrees of freedom the closed mechanism keeps (nv less the rank of the loops' Jacobian)
+MOBILITY = {
+    "four_bar.yaml": 1,
+    "five_bar.yaml": 2,
+    "parallelogram_arm.urdf": 3,
+    "pushrod_leg.urdf": 8,  # 6 of the trunk, hip, knee
+    "delta.xml": 9,  # 3 translations of the platform, the spins of the 6 ball-jointed rods
+}
+
+
+def closed_configuration(path, robot) -> np.ndarray:
+    """The configuration the file's comment says its loops close at."""
+    found = re.search(r"Closed at q = (neutral|\[[^\]]*\])", path.read_text())
+    assert found, f"{path.name} gives no 'Closed at q = ...' in a comment"
+    return robot.neutral() if found.group(1) == "neutral" else np.array(ast.literal_eval(found.group(1)), dtype=float)
+
+
+def loop_jacobian(robot, q) -> np.ndarray:
+    """d(origin of frame_a - origin of frame_b)/dt = J qd, stacked over the (point) loops."""
+    rows = []
+    for lp in robot.loops:
+        assert lp.kind == "point"
+        rows.append(robot.jacobian(q, lp.frame_a)[:3] - robot.jacobian(q, lp.frame_b)[:3])
+    return np.vstack(rows)
+
+
+@pytest.mark.parametrize("name", sorted(MOBILITY))
+def test_example_loops_close_where_the_file_says_and_keep_the_mechanisms_mobility(name):
+    path = EXAMPLES / name
+    robot = load_mjcf(str(path)) if name.endswith(".xml") else kd.load(path)
+    assert robot.loops, f"{name} declares no loop"
+    q = closed_configuration(path, robot)
+    assert q.shape == (robot.nq,)
+    worst = max(np.abs(residual(robot, q, lp)).max() for lp in robot.loops)
+    assert worst < 1e-12, f"{name}: the loops are open by {worst:.3g} at the configuration its comment gives"
+    J = loop_jacobian(robot, q)
+    assert robot.nv - np.linalg.matrix_rank(J, tol=1e-9) == MOBILITY[name]
+    # a random configuration opens them: the check above is not empty
+    assert max(np.abs(residual(robot, robot.random_configuration(1), lp)).max() for lp in robot.loops) > 1e-3
+
+
+def test_five_bar_is_decoupled_as_spong_says_when_m3_l2_lc3_equals_m4_l1_lc4():
+    """On the parallelogram's manifold (q3 = q1 - q2, q4 = q2 - q1) the kinetic energy in (q1, q2),
+    G^T M G with qd = G (qd1, qd2), is diagonal and constant, and gravity's torque on q1 depends on q1
+    alone (Spong 9.4, eq. 9.105-9.108); here checked numerically on the file's robot."""
+    robot = kd.load(EXAMPLES / "five_bar.yaml")
+    assert robot.joint_names == ["q1", "q4", "q2", "q3"]
+    G = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0], [1.0, -1.0]])  # q = [q1, q4, q2, q3]
+    reduced = []
+    for q1, q2 in np.random.default_rng(11).uniform(-3, 3, size=(5, 2)):
+        q = np.array([q1, q2 - q1, q2, q1 - q2])
+        assert np.abs(residual(robot, q, robot.loops[0])).max() < 1e-12
+        D = G.T @ robot.mass_matrix(q) @ G
+        assert abs(D[0, 1]) < 1e-12
+        reduced.append(np.diag(D))
+        g = G.T @ robot.gravity_torque(q)
+        shifted = G.T @ robot.gravity_torque(np.array([q1, q2 + 0.4 - q1, q2 + 0.4, q1 - q2 - 0.4]))
+        assert abs(g[0] - shifted[0]) < 1e-12  # phi_1 depends on q1 only
+    np.testing.assert_allclose(reduced, [reduced[0]] * 5, atol=1e-12)
+    # and it is not decoupled once the condition breaks (a lighter counterweight)
+    links = [
+        replace(link, inertia=kd.Inertia(2.0, link.inertia.com, link.inertia.inertia)) if link.name == "link4" else link
+        for link in robot.links
+    ]
+    lighter = robot.replace(links=links)
+    q = np.array([0.3, 0.9, 1.2, -0.9])
+    assert abs((G.T @ lighter.mass_matrix(q) @ G)[0, 1]) > 1e-3
+
+
+def test_delta_platform_points_are_the_designed_parallelograms():
+    """The anchors MuJoCo's compiler puts on the platform (where each rod's end is at qpos0) lie in
+    the platform's plane, in pairs 6 cm apart about points 5 cm from its centre, 120 degrees apart."""
+    robot = load_mjcf(str(EXAMPLES / "delta.xml"))
+    frames = {f.name: f for f in robot.frames}
+    points = {lp.name[:5]: np.asarray(frames[lp.frame_b].placement)[:3, 3] for lp in robot.loops}
+    assert all(frames[lp.frame_b].link == "platform" for lp in robot.loops)
+    ball = next(link for link in robot.links if link.name == "platform")  # rod 1a's end: the ball joint
+    points["rod1a"] = np.asarray(ball.post, dtype=float)[:3, 3] * -1
+    for i, phi in ((1, 0.0), (2, 2 * np.pi / 3), (3, 4 * np.pi / 3)):
+        a, b = points[f"rod{i}a"], points[f"rod{i}b"]
+        np.testing.assert_allclose([a[2], b[2]], 0.0, atol=1e-12)
+        np.testing.assert_allclose(np.linalg.norm(a - b), 0.06, atol=1e-9)
+        np.testing.assert_allclose((a + b) / 2, 0.05 * np.array([np.cos(phi), np.sin(phi), 0.0]), atol=1e-9)
