@@ -453,3 +453,28 @@ def test_delta_platform_points_are_the_designed_parallelograms():
         np.testing.assert_allclose([a[2], b[2]], 0.0, atol=1e-12)
         np.testing.assert_allclose(np.linalg.norm(a - b), 0.06, atol=1e-9)
         np.testing.assert_allclose((a + b) / 2, 0.05 * np.array([np.cos(phi), np.sin(phi), 0.0]), atol=1e-9)
+
+
+def test_a_site_named_as_a_body_is_the_loop_end_site_colon_name():
+    text = MJCF.replace('<site name="r_end"', '<site name="rocker"').replace('site2="r_end"', 'site2="rocker"')
+    robot = load_mjcf(text)
+    assert {lp.name: lp.frame_b for lp in robot.loops}["site_pin"] == "site:rocker"
+
+
+def test_convert_check_refuses_a_file_that_lost_the_loops(tmp_path):
+    from kinedyn.convert import Conversion, check_conversion
+
+    robot = kd.Robot.from_urdf(FOUR_BAR_URDF)
+    path = tmp_path / "lost.urdf"
+    robot.replace(loops=()).to_urdf(path)
+    with pytest.raises(ValueError, match=r"reads back with loops \[\], not the source's \[\('pin', 'point'\)"):
+        check_conversion(robot, str(path), "urdf", Conversion(str(path), "urdf", robot.n))
+
+
+def test_a_loop_on_the_base_of_a_floating_robot_keeps_the_base_in_the_urdf(tmp_path):
+    robot = kd.load(EXAMPLES / "pushrod_leg.urdf").add_loop("foot", "world", name="planted")
+    path = tmp_path / "planted.urdf"
+    robot.to_urdf(path)  # not written trunk-as-root: the loop needs the fixed frame 'world'
+    back = kd.load(path)
+    assert back.base == "world" and back.joint_names == robot.joint_names
+    same_loops(robot, back)
