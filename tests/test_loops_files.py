@@ -472,9 +472,14 @@ def test_convert_check_refuses_a_file_that_lost_the_loops(tmp_path):
 
 
 def test_a_loop_on_the_base_of_a_floating_robot_keeps_the_base_in_the_urdf(tmp_path):
-    robot = kd.load(EXAMPLES / "pushrod_leg.urdf").add_loop("foot", "world", name="planted")
+    text = (EXAMPLES / "pushrod_leg.urdf").read_text()
+    text = text.replace('<link name="world"/>', "").replace(
+        '<joint name="root" type="floating"><parent link="world"/><child link="trunk"/></joint>', ""
+    )
+    free = kd.Robot.from_urdf(text, floating_base=True)  # the trunk on Pinocchio's free-flyer from 'universe'
+    robot = free.add_loop("foot", "universe", name="planted")
     path = tmp_path / "planted.urdf"
-    robot.to_urdf(path)  # not written trunk-as-root: the loop needs the fixed frame 'world'
+    robot.to_urdf(path)  # not written trunk-as-root: the loop needs the fixed frame 'universe'
     back = kd.load(path)
-    assert back.base == "world" and back.joint_names == robot.joint_names
+    assert back.base == "universe" and back.joint_names == robot.joint_names
     same_loops(robot, back)
