@@ -33,8 +33,11 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
 - ``<include file>``: relative to the including file's folder, which it may not leave; nested at
   most ``MAX_INCLUDE_DEPTH`` deep.
 
+``<equality><connect>`` and ``<weld>`` are closed loops (:mod:`kinedyn.description.mjcf_loops`).
+
 Not modelled, and named in one warning when present: actuators, tendons, equality constraints
-other than a linear joint equality (read as a mimic joint: ``mjcf_xml.with_joint_equalities``),
+other than a linear joint equality (read as a mimic joint: ``mjcf_xml.with_joint_equalities``), a
+weld or connect, and the softness of these,
 contact pairs and exclusions, sensors, keyframes, plugins (``<extension>``, a body's ``<plugin>``),
 fluid forces (``<option density viscosity wind>``), joint springs (``stiffness``, ``springdamper``),
 ``gravcomp``, friction and armature of ball and free joints, a ball joint's range (a cone); every

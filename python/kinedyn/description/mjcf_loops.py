@@ -34,6 +34,7 @@ import numpy as np
 from .._math import pose_inverse
 from .._ui.names import did_you_mean
 from .link import Frame
+from .loop_files import unique_name
 from .loops import Loop
 from .mjcf_xml import numbers, pose, quat_matrix, short, translation_of
 
@@ -79,7 +80,7 @@ def equality_loops(reader) -> tuple:
                 frame_a, frame_b = _site_frames(reader, element, a, what)
             else:
                 placed = _body_frames(reader, element, a, what)
-                frame_a, frame_b = (_unique(f"{name}_{end}", taken) for end in "ab")
+                frame_a, frame_b = (unique_name(f"{name}_{end}", taken) for end in "ab")
                 frames += [Frame(frame_a, placed[0][0], placed[0][1]), Frame(frame_b, placed[1][0], placed[1][1])]
             try:
                 loops.append(Loop(name, frame_a, frame_b, kind))
@@ -102,14 +103,6 @@ def _attributes(reader, element) -> dict:
         raise reader.src.error(element, f"class='{cls}' names no <default> class")
     out = dict(reader.defaults.get(cls, {}).get("equality", {}))
     out.update(element.attrib)
-    return out
-
-
-def _unique(name: str, taken: set) -> str:
-    out, k = name, 2
-    while out in taken:
-        out, k = f"{name}_{k}", k + 1
-    taken.add(out)
     return out
 
 
