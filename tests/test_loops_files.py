@@ -483,3 +483,25 @@ def test_a_loop_on_the_base_of_a_floating_robot_keeps_the_base_in_the_urdf(tmp_p
     back = kd.load(path)
     assert back.base == "universe" and back.joint_names == robot.joint_names
     same_loops(robot, back)
+
+
+def test_symbolic_five_bar_is_the_numeric_one_with_its_numbers():
+    """five_bar_symbolic.yaml (for the equations) and five_bar.yaml (numbers) are one mechanism: with
+    the numeric file's lengths, masses and inertias about z, the same closure and the same reduced
+    dynamics in (q1, q2)."""
+    symbolic = kd.load(EXAMPLES / "five_bar_symbolic.yaml")
+    numeric = kd.load(EXAMPLES / "five_bar.yaml")
+    values = {"l1": 0.2, "l2": 0.5, "lc1": 0.1, "lc2": 0.25, "lc3": 0.35, "lc4": 0.5, "g": 9.81}
+    values |= {"m1": 1.0, "m2": 2.5, "m3": 2.0, "m4": 3.5}
+    values |= {f"I{k + 1}": numeric.links[k].inertia.inertia[2][2] for k in range(4)}  # about z, file order
+    assert [link.name for link in numeric.links] == ["link1", "link2", "link3", "link4"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # I about z alone: no rigid body, but a planar one's
+        robot = symbolic.subs({s: values[s.name] for s in symbolic.symbols})
+    q = closed_configuration(EXAMPLES / "five_bar_symbolic.yaml", robot)
+    assert np.abs(residual(robot, q, robot.loops[0])).max() < 1e-12
+    G = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0], [1.0, -1.0]])
+    for q1, q2 in np.random.default_rng(2).uniform(-3, 3, size=(3, 2)):
+        q = np.array([q1, q2 - q1, q2, q1 - q2])
+        np.testing.assert_allclose(G.T @ robot.mass_matrix(q) @ G, G.T @ numeric.mass_matrix(q) @ G, atol=1e-12)
+        np.testing.assert_allclose(G.T @ robot.gravity_torque(q), G.T @ numeric.gravity_torque(q), atol=1e-12)
