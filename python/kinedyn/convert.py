@@ -91,7 +91,7 @@ class Conversion:
         if self.checked:
             lines.append(
                 f"checked by reading it back: {len(self.frames_compared)} frames, "
-                + (f"{self.loops_compared} loops, " if self.loops_compared else "")
+                + (f"{self.loops_compared} loop{'s' * (self.loops_compared > 1)}, " if self.loops_compared else "")
                 + f"M and inverse dynamics at {self.states} random states: "
                 f"max |FK error| {self.max_frame_error:.2e}, max |M error| {self.max_mass_matrix_error:.2e}, "
                 f"max |tau error| {self.max_torque_error:.2e}"
