@@ -505,3 +505,31 @@ def test_symbolic_five_bar_is_the_numeric_one_with_its_numbers():
         q = np.array([q1, q2 - q1, q2, q1 - q2])
         np.testing.assert_allclose(G.T @ robot.mass_matrix(q) @ G, G.T @ numeric.mass_matrix(q) @ G, atol=1e-12)
         np.testing.assert_allclose(G.T @ robot.gravity_torque(q), G.T @ numeric.gravity_torque(q), atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------ audit
+def test_audit_names_the_loops_open_at_the_files_reference_as_mujoco_finds_them():
+    """MJCF: the loops the audit finds open at qpos0 are those MuJoCo's constraint residuals say
+    are, by the same distance; a URDF's loop open at q = 0 is an info finding with its line."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the oracle")
+    text = MJCF.replace('<freejoint name="f"/>', '<joint name="f" type="ball"/>')  # no free body: checked
+    model = mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    robot = load_mjcf(text)
+    rows = np.cumsum([0] + [lp.rows for lp in robot.loops])
+    gaps = {lp.name: float(np.linalg.norm(data.efc_pos[rows[k] : rows[k] + 3])) for k, lp in enumerate(robot.loops)}
+    found = {f.element: f for f in kd.audit(text, geometry=False).findings if f.code == "loop-open"}
+    assert set(found) == {f"loop '{name}'" for name, gap in gaps.items() if gap > 1e-9}
+    for name, gap in gaps.items():
+        if gap > 1e-9:
+            finding = found[f"loop '{name}'"]
+            assert finding.severity == "warning" and finding.line is not None
+            np.testing.assert_allclose(finding.data["gap"], gap, rtol=1e-12)
+    urdf = {f.element: f for f in kd.audit(FOUR_BAR_URDF, geometry=False).findings if f.code == "loop-open"}
+    assert urdf["loop 'pin'"].severity == "info" and urdf["loop 'pin'"].line == 15
+    np.testing.assert_allclose(
+        urdf["loop 'pin'"].data["gap"], (0.4 + 0.3) - (0.1 + 0.35), rtol=1e-12
+    )  # pin_b, pin_a along x
+    closed = kd.audit(str(EXAMPLES / "parallelogram_arm.urdf"), geometry=False)
+    assert not [f for f in closed.findings if f.code == "loop-open"]
