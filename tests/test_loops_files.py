@@ -533,3 +533,45 @@ def test_audit_names_the_loops_open_at_the_files_reference_as_mujoco_finds_them(
     )  # pin_b, pin_a along x
     closed = kd.audit(str(EXAMPLES / "parallelogram_arm.urdf"), geometry=False)
     assert not [f for f in closed.findings if f.code == "loop-open"]
+
+
+def test_mjcf_anchor_frames_are_mujocos_compiled_anchors():
+    """Each loop's two frames sit where MuJoCo's compiled model puts the equality's two ends
+    (eq_data, filled by mj_setConst at qpos0; site_xpos/site_xmat for the site form), at a random state."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the oracle of the MJCF reading")
+    robot = load_mjcf(MJCF)
+    model = mujoco.MjModel.from_xml_string(MJCF)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(4)
+    qpos = model.qpos0.copy()
+    qpos[[model.jnt_qposadr[j] for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]] += 0.7
+    ball = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "j3")]
+    qpos[ball : ball + 4] = (v := rng.normal(size=4)) / np.linalg.norm(v)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    q = q_from_qpos(robot, model, qpos, mujoco)
+
+    def quat_matrix(w):
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, w)
+        return R.reshape(3, 3)
+
+    for k, lp in enumerate(robot.loops):
+        A, B = robot.frame_poses(q, [lp.frame_a, lp.frame_b])
+        e = model.eq_data[k]
+        b1, b2 = model.eq_obj1id[k], model.eq_obj2id[k]
+        if model.eq_objtype[k] == mujoco.mjtObj.mjOBJ_SITE:
+            ends = [(data.site_xpos[b], data.site_xmat[b].reshape(3, 3)) for b in (b1, b2)]
+        else:
+            X = [(data.xpos[b], data.xmat[b].reshape(3, 3)) for b in (b1, b2)]
+            if model.eq_type[k] == mujoco.mjtEq.mjEQ_CONNECT:
+                ends = [(X[0][0] + X[0][1] @ e[0:3], None), (X[1][0] + X[1][1] @ e[3:6], None)]
+            else:  # weld: body1's point and axes from relpose (eq_data[3:10]), body2's point eq_data[0:3]
+                ends = [
+                    (X[0][0] + X[0][1] @ e[3:6], X[0][1] @ quat_matrix(e[6:10])),
+                    (X[1][0] + X[1][1] @ e[0:3], X[1][1]),
+                ]
+        for T, (p, R) in zip((A, B), ends):
+            np.testing.assert_allclose(T[:3, 3], p, atol=1e-12, err_msg=lp.name)
+            if lp.kind == "weld" and model.eq_type[k] == mujoco.mjtEq.mjEQ_WELD:
+                np.testing.assert_allclose(T[:3, :3], R, atol=1e-12, err_msg=lp.name)
