@@ -511,8 +511,8 @@ class Robot(ClosedLoops):
     ) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
-        ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
-        (``robot.body_names``), acting on the link, in base axes, the moment taken about the origin of
+        ``f_ext``: (links, 6) (or (N, links, 6); links = ``len(robot.body_names)``, = n without
+        multi-DOF joints), one wrench ``[force; moment]`` per moving link, acting on the link, in base axes, the moment taken about the origin of
         the link's frame (``robot.forward_kinematics(q)[i]``), so that it maps to joint torques by
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
         return self._model.inverse_dynamics(q, qd, qdd, f_ext, out)
