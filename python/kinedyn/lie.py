@@ -31,7 +31,7 @@ __all__ = [
 ]
 
 
-def _core(op: str, *arrays: ArrayLike, widths: tuple) -> np.ndarray:
+def _quaternion(op: str, *arrays: ArrayLike, widths: tuple) -> np.ndarray:
     """``lie_quaternion(op, ...)`` of float arrays broadcast over their leading axes."""
     a = [np.asarray(x, dtype=float) for x in arrays]
     for x, w in zip(a, widths):
@@ -44,17 +44,17 @@ def _core(op: str, *arrays: ArrayLike, widths: tuple) -> np.ndarray:
 
 def quaternion_multiply(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """Hamilton product a ⊗ b of quaternions (x, y, z, w): R(a ⊗ b) = R(a) R(b) (Solà et al. eq. 107)."""
-    return _core("multiply", a, b, widths=(4, 4))
+    return _quaternion("multiply", a, b, widths=(4, 4))
 
 
 def quaternion_rotate(quat: ArrayLike, p: ArrayLike) -> np.ndarray:
     """R(quat) p for a unit quaternion (x, y, z, w): p + 2w (u × p) + 2 u × (u × p), u the vector part."""
-    return _core("rotate", quat, p, widths=(4, 3))
+    return _quaternion("rotate", quat, p, widths=(4, 3))
 
 
 def quaternion_to_matrix(quat: ArrayLike) -> np.ndarray:
     """The rotation matrix (..., 3, 3) of unit quaternions (..., 4) in (x, y, z, w) order."""
-    return _core("matrix", quat, widths=(4,))
+    return _quaternion("matrix", quat, widths=(4,))
 
 
 def vector_norm(x: np.ndarray) -> np.ndarray:
@@ -64,13 +64,13 @@ def vector_norm(x: np.ndarray) -> np.ndarray:
 def exp3(omega: ArrayLike) -> np.ndarray:
     """The unit quaternion of the rotation vector ω: (sin(θ/2) ω/θ, cos(θ/2)), θ = |ω| (Solà et al.
     eq. 101), exact at θ = 0."""
-    return _core("exp", omega, widths=(3,))
+    return _quaternion("exp", omega, widths=(3,))
 
 
 def log3(quat: ArrayLike) -> np.ndarray:
     """The rotation vector ω in [0, π] of a quaternion (x, y, z, w), the inverse of :func:`exp3`
     (Solà et al. eq. 105, taking w >= 0 so that q and -q give the same, short, rotation)."""
-    return _core("log", quat, widths=(4,))
+    return _quaternion("log", quat, widths=(4,))
 
 
 def block_jacobians(kind: str, v: np.ndarray) -> tuple:
