@@ -141,6 +141,7 @@ def instrumental_fit(
     it = 0
     note = None
     Zw = None
+    previous = None  # the last estimate whose model could be simulated
     while it < iterations:
         it += 1
         try:
@@ -151,12 +152,31 @@ def instrumental_fit(
                     f"the least-squares start could not be simulated ({e}); the first instruments are the prior model's"
                 )
                 Zw = instruments(fallback) * w[:, None]
+                est = fallback
             elif Zw is None:
                 raise
             else:
-                note = f"iteration {it} could not be simulated ({e}); stopped on the instruments of iteration {it - 1}"
-                it -= 1
-                break
+                # a step of the iteration (a Gauss-Newton step for DIDIM) that overshoots into a model
+                # that cannot be simulated: halved toward the last simulable estimate (step control,
+                # Dennis & Schnabel, Numerical Methods for Unconstrained Optimization, §6.3)
+                Zh, full = None, est
+                for _ in range(4):
+                    est = previous + 0.5 * (est - previous)
+                    try:
+                        Zh = instruments(est) * w[:, None]
+                        break
+                    except ValueError:
+                        continue
+                if Zh is None:
+                    est = full  # the estimate of the last instruments that could be simulated
+                    note = (
+                        f"iteration {it} could not be simulated ({e}); stopped on the instruments of iteration {it - 1}"
+                    )
+                    it -= 1
+                    break
+                note = f"iteration {it}'s step was halved: the full step's model could not be simulated ({e})"
+                Zw = Zh
+        previous = est
         if kind == "iv":
             new = np.linalg.lstsq(Zw.T @ Ww, Zw.T @ yw, rcond=None)[0]
         else:
