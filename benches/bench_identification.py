@@ -16,7 +16,7 @@ Arms (``--arms``):
   ``TX40.m``: modified DH geometry, masses, first moments and inertias about each DH frame, the
   armatures ``Ia``, gear ratios, viscous ``Fv`` and Coulomb ``Fc`` friction from Gautier, Janot &
   Vandanjon's identifications of the real TX40), without its joint 5-6 friction coupling (no kinedyn
-  term for it); computed torque with a prior 15 % light;
+  term for it); BIRDy's PD gains, a prior 15 % light;
 - ``panda``: example-robot-data's Franka Panda URDF (7 DOF, fingers locked) with a drive train of
   our choosing (armature 0.1-0.3 kg m^2, viscous 0.5-1 N m s, Coulomb 0.6-1.2 N m per direction);
   computed torque with a prior 15 % light.
@@ -177,7 +177,12 @@ def tx40():
             )
         )  # fmt: skip
     true = kd.Robot.from_dh(rows, convention="modified", name="tx40")
-    return lighter(true)
+    true, prior, ref, _ = lighter(true)
+    # BIRDy's TX40 PD gains (TX40.m, controlParameters.Kp and Kd): no gravity compensation, stiff
+    # enough for the wrist's Coulomb levels (a computed torque at wn = 10 rad/s left joint 6 stuck)
+    kp = 0.75 * np.array([455.8254, 500.0, 253.7919, 200.2182, 244.3226, 478.4783])
+    kd_ = np.array([2.5361, 4.1174, 1.1793, 0.5462, 0.5714, 0.1954])
+    return true, prior, ref, PD(np.diag(kp), np.diag(kd_), ref)
 
 
 def panda():

@@ -143,8 +143,8 @@ class Identification:
     stribeck_velocity_std: np.ndarray | None = None
     #: what the estimator had to do differently (e.g. IV's fallback on the prior model's instruments)
     notes: tuple = ()
-    #: iv / didim: the last iteration's relative change, the tolerance, and the OLS and WLS estimates
-    #: of the same rows (the start) for comparison (the report's closed-loop section)
+    #: iv / didim: the last iteration's relative change, the tolerance, and the OLS and WLS (the start)
+    #: estimates of the same rows, ``names`` then ``friction_names`` (the report's closed-loop section)
     closed_loop: dict | None = field(default=None, repr=False)
 
     @property
