@@ -113,8 +113,8 @@ def speed_rows(qd: np.ndarray, min_speed: float, spread: int = 0) -> np.ndarray:
     """1 for the rows (sample, joint) whose joint moves at ``|qd_j| >= min_speed``, else 0, flattened
     as the stacked rows. Near zero speed Coulomb friction is not ``Fc sign(qd)``: a joint sticks, or
     its speed chatters about zero within one sample, and the friction there is any torque within the
-    static levels. Those rows are left out of the fit, as IDIM practice does (Gautier & Khalil, IEEE
-    T-RA 8(3), 1992, data where the velocity is small removed; Janot, Vandanjon & Gautier 2014, §V).
+    static levels. Those rows are left out of the fit (the usual practice of identification with a
+    Coulomb model: it holds away from zero speed, Armstrong-Helouvry, Dupont & Canudas de Wit 1994).
     ``spread``: samples left out on either side of a slow stretch too (a filtered log's torques carry
     the stick's torque as far as its low-pass reaches)."""
     if not (np.isfinite(min_speed) and min_speed >= 0):
