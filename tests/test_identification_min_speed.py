@@ -69,3 +69,19 @@ def test_bad_min_speed_is_named(case):
         an.identify(truth.nominal, log, min_speed=-1.0)
     with pytest.raises(ValueError, match="leaves .* of joint"):
         an.identify(truth.nominal, log, min_speed=100.0)
+
+
+def test_the_consistent_fit_with_the_drive_train_stays_feasible_on_the_rows_kept(case):
+    """The semidefinite fit with armature and friction columns, on the rows min_speed keeps: every
+    body's pseudo-inertia positive definite, the armatures >= 0, and as close to the truth as the
+    unconstrained fit (the truth is physical, so the constraints cost nothing here)."""
+    pytest.importorskip("cvxpy")
+    from kinedyn.analysis.parameters import pseudo_inertia
+
+    cols, truth = case
+    log = an.load_log(cols, n=2, cutoff=15.0)
+    fit = an.identify(truth.nominal, log, friction="viscous+coulomb", armature=True, min_speed=SLOW, consistent=True)
+    for body in np.asarray(fit.standard).reshape(-1, 10):
+        assert np.linalg.eigvalsh(pseudo_inertia(body)).min() > 0
+    assert np.all(fit.standard_armature >= 0)
+    assert error(fit, truth) < 0.01 and error(fit.unconstrained, truth) < 0.01
