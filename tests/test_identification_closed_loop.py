@@ -198,3 +198,29 @@ def test_a_step_into_a_model_that_cannot_be_simulated_is_halved():
     assert "step was halved" in note
     assert np.allclose(tried[2], start + 0.5 * (tried[1] - start))  # halfway toward the last simulable one
     assert np.allclose(est, theta, atol=1e-3) and it >= 2
+
+
+def test_iv_keeps_the_instruments_of_smallest_covariance():
+    """Every noise-free simulation gives consistent instruments, not equally good ones: when an
+    iteration's instruments are nearly uncorrelated with one column of W, its estimate is far off and
+    its covariance says so; IV keeps the iterate whose covariance has the smallest log det."""
+    from kinedyn.analysis.closed_loop import instrumental_fit
+
+    rng = np.random.default_rng(2)
+    X = rng.normal(size=(20000, 3))
+    theta = np.array([1.0, -2.0, 0.5])
+    W = X + 0.3 * rng.normal(size=X.shape)
+    y = X @ theta + 0.05 * rng.normal(size=len(X))
+    weak = X.copy()
+    weak[:, 2] = 0.02 * X[:, 2] + rng.normal(size=len(X))  # a poor instrument for the third column
+    calls = []
+
+    def instruments(t):  # good, then poor ones: the iterations do not settle
+        calls.append(t)
+        return X if len(calls) == 1 else weak
+
+    est, cov, it, _, note = instrumental_fit("iv", W, y, np.ones(len(X)), theta + 0.3, instruments, tol=0.0)
+    assert it == 6 and "kept iteration 1's estimate" in note
+    good = np.linalg.solve(X.T @ W, X.T @ y)
+    assert np.allclose(est, good) and np.allclose(est, theta, atol=0.02)
+    assert np.all(np.sqrt(np.diag(cov)) < 0.05)
