@@ -134,3 +134,6 @@ def test_cli_didim_with_the_controller_matches_the_api(experiment, capsys):
     assert "Closed-loop estimator" in page and "closed-loop output error (DIDIM)" in page
     assert ("converged: the last iteration" in page) == out["closed_loop"]["converged"]
     assert page.count("<tr") >= 2 * len(out["names"])  # parameters' table and the comparison's
+    assert main([a for a in args if a not in ("--json", "-o", str(html))]) == 0  # the text output says it too
+    text = capsys.readouterr().out
+    assert "method didim" in text and "simulation(s) under the experiment's controller" in text

@@ -278,6 +278,15 @@ def _identify_from_log(robot, args) -> int:
                 f"{esc(s['joint'])}: Stribeck velocity {s['velocity']:.4g} rad/s (std {s['velocity_std']:.2g}), "
                 f"static friction {', '.join(f'{v:.4g}' for v in s['static'])} N m"
             )
+        loop = result.closed_loop
+        if loop is not None:
+            c.print(
+                f"{result.method}: {result.iterations} simulation(s) under the experiment's controller, "
+                + ("converged" if loop["converged"] else "not converged")
+                + f" (last change {100 * loop['last_change']:.3g} %, tolerance {100 * loop['tolerance']:.3g} %)"
+            )
+        for note in result.notes:
+            c.print(esc(note))
         assert result.identifiability is not None
         for group in result.identifiability.groups:
             c.print(f"not separable by the data (only a combination is identified): {esc(', '.join(group))}")
