@@ -326,7 +326,7 @@ def test_info_counts_degrees_of_freedom_and_marks_mimic_joints(capsys, tmp_path,
     code, out, err = run(capsys, "info", str(src))
     assert code == 0, err
     first = out.splitlines()[0]
-    assert "2 degrees of freedom" in first and "3 moving joints" in first and "1 of them mimic" in first
+    assert "2 degrees of freedom" in first and "3 moving joints" in first and "1 of them a mimic joint" in first
     row = next(line for line in out.splitlines() if "finger2" in line)
     assert "mimics finger1" in row
     doc = __import__("json").loads(run(capsys, "info", str(src), "--json")[1])

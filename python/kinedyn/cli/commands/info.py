@@ -49,7 +49,11 @@ def _headline(robot) -> str:
     ]
     parts.append(
         f"{moving} moving joints"
-        + (f", {followers} of them mimic joints (no coordinate of their own)" if followers else "")
+        + (
+            f", {followers} of them {'a mimic joint' if followers == 1 else 'mimic joints'} (no coordinate of their own)"
+            if followers
+            else ""
+        )
     )
     return ", ".join(parts)
 
