@@ -20,6 +20,7 @@ from .._math import is_symbolic, matmul, pose_inverse, rpy_from_matrix
 from .dh import links_from_dh
 from .geometry import Box, Cylinder, Mesh, mesh_reference
 from .inertia import Inertia
+from .loop_files import loops_mapping
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -49,6 +50,8 @@ def robot_to_mapping(robot: Robot | Description, path: str | None = None) -> dic
         data.update(_tree_mapping(robot))
     if robot.visuals:
         data["visuals"] = [_visual_mapping(v, path) for v in robot.visuals]
+    if robot.loops:
+        data["loops"] = loops_mapping(robot.loops)
     return data
 
 
