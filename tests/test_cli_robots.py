@@ -253,6 +253,71 @@ def test_converted_mjcf_holds_relative_mesh_paths(capsys, meshy, tmp_path):
     assert model.nmesh == 1
 
 
+def test_written_urdf_and_robot_files_name_meshes_relative_to_themselves(meshy, tmp_path):
+    from kinedyn.description.geometry import resolve_mesh
+
+    mesh = (meshy.parent / "meshes" / "tri.stl").resolve()
+    robot = kd.load(meshy)
+    # beside the robot file, in the mesh's own folder, and in a sibling folder of it (a ROS
+    # package's urdf/ next to its meshes/): relative to the written file, which finds the mesh
+    (tmp_path / "robot" / "urdf").mkdir()
+    for out, expected in (
+        (meshy.parent / "copy.urdf", "meshes/tri.stl"),
+        (meshy.parent / "meshes" / "copy.urdf", "tri.stl"),
+        (tmp_path / "robot" / "urdf" / "copy.urdf", "../meshes/tri.stl"),
+        (tmp_path / "robot" / "urdf" / "copy.yaml", "../meshes/tri.stl"),
+    ):
+        if out.suffix == ".urdf":
+            robot.to_urdf(out)
+            assert f'filename="{expected}"' in out.read_text(), out.read_text()
+        else:
+            robot.save(out)
+            assert f"mesh: {expected}" in out.read_text(), out.read_text()
+        assert not [line for line in out.read_text().splitlines() if "tri.stl" in line and str(tmp_path) in line]
+        shape = kd.load(out).visuals[0].shape
+        assert resolve_mesh(shape.filename, shape.base_dir).resolve() == mesh
+    # far from the mesh (two folders away), or as text without a file: its absolute path, which
+    # finds it from wherever the file goes on this machine
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    far = tmp_path / "a" / "b" / "copy.urdf"
+    robot.to_urdf(far)
+    assert f'filename="{mesh}"' in far.read_text() and f'filename="{mesh}"' in robot.to_urdf()
+    assert kd.load(far).visuals[0].shape.filename == str(mesh)
+    # package:// kept as read
+    packaged = meshy.parent / "packaged.urdf"
+    packaged.write_text(MESHY.replace("meshes/tri.stl", "package://robot/meshes/tri.stl"))
+    written = kd.load(packaged).to_urdf(tmp_path / "robot" / "urdf" / "packaged.urdf")
+    assert 'filename="package://robot/meshes/tri.stl"' in written
+
+
+def test_report_and_info_show_the_robot_file_resolved_not_as_typed(capsys, meshy, tmp_path, monkeypatch):
+    from kinedyn.report.html import write_report
+
+    monkeypatch.setenv("COLUMNS", "400")  # the source line on one line
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    typed = "../robot/../robot/meshy.urdf"
+    resolved = str(meshy.resolve())
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))  # a home that does not hold the file
+    out = tmp_path / "r.html"
+    code, _, err = run(capsys, "report", typed, "-o", str(out), "--no-tutorial", "--t", "0.1")
+    assert code == 0, err
+    header = re.search(r"<header>.*?</header>", out.read_text(), re.S).group(0)
+    assert f"· {resolved} ·" in header and typed not in header, header
+    code, text, _ = run(capsys, "info", typed)
+    assert code == 0 and f"source: {resolved}\n" in text, text
+    monkeypatch.setenv("HOME", str(tmp_path))  # the file in the home folder: written from ~
+    code, text, _ = run(capsys, "info", typed, "--json")
+    assert code == 0 and '"source": "~/robot/meshy.urdf"' in text, text
+    # robots that no file holds: the header says what it knows and never "robot file"
+    dh = kd.Robot.from_dh([{"a": 0.5, "inertia": kd.Inertia.rod(1.0, 0.5)}])
+    string = kd.Robot.from_urdf(meshy.read_text())
+    for robot, shown in ((dh, None), (string, "URDF string")):
+        write_report(robot, out, t_end=0.1)
+        header = re.search(r"<header>.*?</header>", out.read_text(), re.S).group(0)
+        assert "robot file" not in header and (shown is None or f"· {shown} ·" in header), header
+
+
 # ------------------------------------------------------------------ info, units, names
 def test_info_counts_degrees_of_freedom_and_marks_mimic_joints(capsys, tmp_path, monkeypatch):
     monkeypatch.setenv("COLUMNS", "200")  # the table on one line per joint
@@ -261,7 +326,7 @@ def test_info_counts_degrees_of_freedom_and_marks_mimic_joints(capsys, tmp_path,
     code, out, err = run(capsys, "info", str(src))
     assert code == 0, err
     first = out.splitlines()[0]
-    assert "2 degrees of freedom" in first and "3 moving joints" in first and "1 of them mimic" in first
+    assert "2 degrees of freedom" in first and "3 moving joints" in first and "1 of them a mimic joint" in first
     row = next(line for line in out.splitlines() if "finger2" in line)
     assert "mimics finger1" in row
     doc = __import__("json").loads(run(capsys, "info", str(src), "--json")[1])

@@ -1,6 +1,7 @@
 """Ctrl-C stops long work: the command line exits 130 without a traceback even where a library
-swallows the interrupt (kinedyn._ui.interrupts), and a long native simulation stops inside its
-loop (the core polls a cancellation flag that the binding sets when a signal handler raises).
+swallows the interrupt (kinedyn._ui.interrupts), and long native work stops inside its loop: the
+simulator's steps, the batch runner's chunks, a batch IK's targets (each polls a cancellation flag
+that the binding sets when a signal handler raises, crates/kinedyn-py/src/guard.rs).
 
 Each test waits for the child to say where it is before interrupting it, and asserts behaviour
 (the status, the output) with generous time limits, never a speed: they hold on a loaded machine."""
@@ -30,13 +31,13 @@ def child_env() -> dict[str, str]:
     )
 
 
-def start(code: str) -> subprocess.Popen:
+def start(code: str, env: dict[str, str] | None = None) -> subprocess.Popen:
     return subprocess.Popen(
         [sys.executable, "-c", textwrap.dedent(code)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=child_env(),
+        env={**child_env(), **(env or {})},
     )
 
 
@@ -169,3 +170,77 @@ def test_a_long_native_simulation_stops_inside_its_loop_on_ctrl_c():
     wait_for_line(proc, "running")
     out, err = finish(proc, timeout=120.0)
     assert proc.returncode == 0 and "interrupted after" in out, (proc.returncode, out, err)
+
+
+def test_a_long_dynamics_batch_stops_between_its_chunks_on_ctrl_c():
+    # one batch call of mass matrices (one rayon thread: about a second of work or more on any
+    # machine), written into an out= array filled with NaN. A thread of the child sends SIGINT to
+    # the process as soon as the first state's M appears: the call must end with KeyboardInterrupt
+    # and leave states unwritten (the batch runner stopped between chunks), not finish the batch
+    proc = start(
+        """
+        import os, signal, threading
+        import numpy as np
+        import kinedyn as kd
+        from kinedyn.testing import random_robot
+
+        robot = random_robot(1, n=30)
+        q = np.random.default_rng(0).normal(size=(20000, robot.n))
+        out = np.full((len(q), robot.n, robot.n), np.nan)
+        call_ended = threading.Event()
+
+        def interrupt_once_written():
+            while np.isnan(out[0, 0, 0]) and not call_ended.is_set():
+                call_ended.wait(0.001)
+            os.kill(os.getpid(), signal.SIGINT)
+
+        threading.Thread(target=interrupt_once_written, daemon=True).start()
+        print("running", flush=True)
+        try:
+            robot.mass_matrix(q, out=out)
+            call_ended.set()
+            print("the call finished", flush=True)
+        except KeyboardInterrupt:
+            call_ended.set()
+            unwritten = int(np.isnan(out).any(axis=(1, 2)).sum())
+            print(f"interrupted with {unwritten} of {len(q)} states unwritten", flush=True)
+        """,
+        env={"RAYON_NUM_THREADS": "1"},
+    )
+    wait_for_line(proc, "running")
+    out, err = finish(proc, timeout=120.0)
+    assert proc.returncode == 0 and "interrupted with" in out, (proc.returncode, out, err)
+    unwritten = int(out.split("interrupted with ")[1].split()[0])
+    assert unwritten > 0, out
+
+
+def test_the_command_line_exits_130_during_a_long_ik_batch():
+    # a command (here a stand-in run of `kinedyn robots`) in one native IK call of a million
+    # unreachable targets (hours: every restart is tried); SIGINT arrives 1 s into the call. The
+    # command must exit 130 without a traceback because the call stopped, not because the CLI gave
+    # the process up (kinedyn._ui.interrupts.GIVE_UP after 10 s, which says "did not stop within")
+    proc = start(
+        """
+        import os, signal, sys, threading
+        import numpy as np
+        import kinedyn as kd
+        import kinedyn.cli.commands.robots as command
+        from kinedyn.cli import main
+
+        def run(args):
+            robot = kd.robots.get("ur5")
+            targets = np.tile([5.0, 0.0, 0.0], (10**6, 1))
+            threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT)).start()
+            print("running", flush=True)
+            robot.inverse_kinematics(targets, np.zeros(robot.n), method="numeric", progress=False)
+            print("the call finished", flush=True)
+            return 0
+
+        command.run = run
+        sys.exit(main(["robots"]))
+        """
+    )
+    wait_for_line(proc, "running")
+    out, err = finish(proc, timeout=120.0)
+    assert proc.returncode == 130, (proc.returncode, out, err)
+    assert "the call finished" not in out and "Traceback" not in err and "did not stop within" not in err, (out, err)

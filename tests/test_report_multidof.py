@@ -148,7 +148,7 @@ def test_kinedyn_report_floating_base_on_real_robots(capsys, tmp_path, urdf, joi
     page = out.read_text(encoding="utf-8")
     for section in ("view", "description", "equations", "dynamics"):
         assert f"<section id='{section}'>" in page
-    assert f"{joints} joints · nq = {robot.nq}, nv = {robot.nv}" in page
+    assert f"{joints} joint{'s' if joints != 1 else ''} · nq = {robot.nq}, nv = {robot.nv}" in page
     assert coordinate_labels(robot)[:7] == ["root_joint." + e for e in ("x", "y", "z", "qx", "qy", "qz", "qw")]
     assert velocity_labels(robot)[6:] == robot.joint_names[1:]
     # a configuration given on the command line: nq numbers, the quaternion checked

@@ -12,7 +12,7 @@
 //!   instead of queuing work for threads that do not exist and blocking forever.
 //! - [`interruptible`]: long work without the GIL runs on a helper thread while the caller checks
 //!   Python's signals, so Ctrl-C (KeyboardInterrupt) stops a long native run within a poll interval
-//!   instead of when it ends.
+//!   instead of when it ends; [`detached`] chooses it for a batch long enough to need it.
 //! - [`non_finite_error`]: `kinedyn.NonFiniteResultError` (a `FloatingPointError` and a
 //!   `ValueError`), raised when finite inputs give a non-finite result.
 
@@ -277,6 +277,27 @@ pub fn interruptible<R: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> 
         Some(e) => Err(e),
         None => Ok(result),
     }
+}
+
+/// Run batch `work` without the GIL: interruptibly ([`interruptible`]) when `long`, else on the
+/// calling thread (the helper thread costs tens of microseconds, more than a short batch takes).
+/// `work` is given the cancellation flag to poll between its pieces (see [`cancelled`]), or None.
+pub fn detached<R: Send>(
+    py: Python<'_>,
+    long: bool,
+    work: impl FnOnce(Option<&AtomicBool>) -> R + Send,
+) -> PyResult<R> {
+    if long {
+        interruptible(py, |cancel| work(Some(cancel)))
+    } else {
+        Ok(py.detach(|| work(None)))
+    }
+}
+
+/// Whether the flag of [`detached`] work is set: stop, the caller raises the signal's exception.
+#[inline]
+pub fn cancelled(flag: Option<&AtomicBool>) -> bool {
+    flag.is_some_and(|f| f.load(Ordering::Relaxed))
 }
 
 // ------------------------------------------------------------------ non-finite results

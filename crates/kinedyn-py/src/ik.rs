@@ -15,6 +15,12 @@ use rayon::prelude::*;
 use crate::guard::{self, guarded};
 use crate::PyModel;
 
+/// Batches of at least this many targets run interruptibly (`guard::detached`): Ctrl-C stops
+/// them between targets. A numeric target takes microseconds (converging) to milliseconds
+/// (unreachable, every restart tried), an analytic one microseconds; a few hundred outweigh the
+/// helper thread's tens of microseconds.
+const INTERRUPTIBLE_TARGETS: usize = 256;
+
 /// One target: a pose (4x4) or a position (3,), checked.
 fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResult<Transform> {
     let at = index.map(|k| format!(" (target {k})")).unwrap_or_default();
@@ -267,7 +273,8 @@ pub fn solve_ik<'py>(
                 out.iterations as i64,
             );
         };
-        py.detach(|| {
+        // a batch stops between targets on Ctrl-C (a target takes microseconds to milliseconds)
+        guard::detached(py, count >= INTERRUPTIBLE_TARGETS, |cancel| {
             let rows = q_out
                 .chunks_mut(n)
                 .zip(s_out.iter_mut())
@@ -299,13 +306,21 @@ pub fn solve_ik<'py>(
                         .zip(oe_out.par_iter_mut())
                         .zip(it_out.par_iter_mut())
                         .enumerate()
-                        .for_each_init(
+                        .try_for_each_init(
                             || Data::new(m),
-                            |data, (k, ((((qk, s), p), o), i))| write(data, k, qk, s, p, o, i),
+                            |data, (k, ((((qk, s), p), o), i))| {
+                                if guard::cancelled(cancel) {
+                                    return Err(());
+                                }
+                                write(data, k, qk, s, p, o, i);
+                                Ok(())
+                            },
                         )
                 })
+                // (cancelled: `detached` returns the signal's exception)
+                .map(|_| ())
             }
-        })?;
+        })??;
         let result = match batch {
             Some(_) => (
                 q.into_any(),
@@ -487,7 +502,7 @@ impl PyAnalyticIk {
                     oe.as_slice_mut()?,
                 )
             };
-            py.detach(|| {
+            guard::detached(py, count >= INTERRUPTIBLE_TARGETS, |cancel| {
                 guard::install(|| {
                     q_out
                         .par_chunks_mut(n)
@@ -495,9 +510,12 @@ impl PyAnalyticIk {
                         .zip(pe_out.par_iter_mut())
                         .zip(oe_out.par_iter_mut())
                         .enumerate()
-                        .for_each_init(
+                        .try_for_each_init(
                             || Data::new(&self.model),
                             |data, (k, (((qk, s), p), o))| {
+                                if guard::cancelled(cancel) {
+                                    return Err(());
+                                }
                                 let r = &refs[k * n..(k + 1) * n];
                                 let out = ik::analytic_solutions(
                                     &self.model,
@@ -522,10 +540,13 @@ impl PyAnalyticIk {
                                         (*s, *p, *o) = (false, f64::NAN, f64::NAN);
                                     }
                                 }
+                                Ok(())
                             },
                         )
                 })
-            })?;
+                // (cancelled: `detached` returns the signal's exception)
+                .map(|_| ())
+            })??;
             Ok((
                 q.cast_into::<PyArray2<f64>>()?,
                 success.cast_into::<PyArray1<bool>>()?,

@@ -8,7 +8,7 @@ use std::sync::atomic::Ordering;
 use kinedyn_core::batch::{self, Input, Kernel, Scratch, Simd};
 use kinedyn_core::{Data, Error as CoreError, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
@@ -60,6 +60,8 @@ pub(crate) type Outputs<const K: usize> = (&'static str, [&'static str; K]);
 enum Fault {
     Core(CoreError),
     Py(PyErr),
+    /// The cancellation flag was set (a signal handler raised): the remaining states are skipped.
+    Cancelled,
     NonFinite {
         state: usize,
         output: usize,
@@ -94,6 +96,11 @@ fn any_non_finite(x: &[f64]) -> bool {
     !lanes.iter().all(|l| l.is_finite()) && x.iter().any(|v| !v.is_finite())
 }
 
+/// A batch whose states times numbers per state (degrees of freedom plus result numbers) reach this
+/// runs interruptibly (`guard::detached`): about 5 ms of work or more (UR5 inverse dynamics: ~22k
+/// states), where the helper thread's tens of microseconds are lost in the noise.
+const INTERRUPTIBLE_WORK: usize = 1 << 18;
+
 /// Three arrays returned as a Python tuple.
 pub(crate) type Arrays3<'py> = (
     Bound<'py, PyArrayDyn<f64>>,
@@ -114,7 +121,8 @@ impl<'a> Batch<'a> {
     /// into a fresh NumPy array; `kernel` must write every element of `out_of_state` (it is not
     /// zeroed first). A single state runs with the cached `Data`, keeping the GIL (the
     /// call is shorter than releasing it); a batch runs with the GIL released, in parallel
-    /// chunks of 64 states, each rayon job reusing one `Data` over its chunks.
+    /// chunks of 64 states, each rayon job reusing one `Data` over its chunks; a long batch stops
+    /// between chunks on Ctrl-C (KeyboardInterrupt, the `out=` array partly written).
     ///
     /// `what` names the call and its result (`Output`) for the errors: a result that cannot be
     /// allocated (MemoryError) and a non-finite number in a result of finite inputs
@@ -348,22 +356,34 @@ impl<'a> Batch<'a> {
                     .try_for_each(|k| kernel(&m.model, &mut guard, &self.state(k), outputs(k)).map_err(Fault::from))
                     .and_then(|()| check_range(0, 1))
             }
-            Some(states) => py.detach(|| {
+            Some(states) => {
                 const CHUNK: usize = 64;
-                // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
-                guard::install(|| {
-                    (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
-                        || Scratch::new(&m.model),
-                        |scratch, c| states_range(scratch, c * CHUNK, ((c + 1) * CHUNK).min(states)),
-                    )
+                // long batches stop on Ctrl-C: every chunk first looks at the flag
+                let long = states.saturating_mul(m.model.n + per_state) >= INTERRUPTIBLE_WORK;
+                guard::detached(py, long, |cancel| {
+                    // one Data per rayon job (made by `init`, reused for all its chunks), not per chunk
+                    guard::install(|| {
+                        (0..states.div_ceil(CHUNK)).into_par_iter().try_for_each_init(
+                            || Scratch::new(&m.model),
+                            |scratch, c| {
+                                if guard::cancelled(cancel) {
+                                    return Err(Fault::Cancelled);
+                                }
+                                states_range(scratch, c * CHUNK, ((c + 1) * CHUNK).min(states))
+                            },
+                        )
+                    })
+                    .unwrap_or_else(|e| Err(Fault::Py(e)))
                 })
-                .unwrap_or_else(|e| Err(Fault::Py(e)))
-            }),
+                .unwrap_or_else(|raised| Err(Fault::Py(raised)))
+            }
         };
         match result {
             Ok(()) => Ok(arrays),
             Err(Fault::Core(e)) => Err(core_err(e)),
             Err(Fault::Py(e)) => Err(e),
+            // (`detached` returns the signal's own exception instead; this is its fallback)
+            Err(Fault::Cancelled) => Err(PyKeyboardInterrupt::new_err("interrupted")),
             Err(Fault::NonFinite {
                 state,
                 output,

@@ -28,7 +28,26 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["open_regular", "replacing", "require_regular", "same_file", "write_bytes", "write_text"]
+__all__ = ["open_regular", "readable_source", "replacing", "require_regular", "same_file", "write_bytes", "write_text"]
+
+
+def readable_source(source: str) -> str:
+    """A robot's ``source`` as a page or a table shows it. When it names a file (a robot loaded
+    from a path, which keeps the path as typed: ``../x/../robot.urdf`` means nothing once the folder
+    it was typed in is gone), the file's resolved path (symbolic links and ``..`` followed), with
+    the home folder written ``~``; anything else (a built-in's reference, "URDF string") as it is."""
+    if not source or source.startswith("<") or "\n" in source:
+        return source
+    try:
+        if not os.path.isfile(source):
+            return source
+        path = os.path.realpath(source)
+        home = os.path.realpath(os.path.expanduser("~"))
+    except (OSError, ValueError):  # a name the file system cannot hold (a NUL byte): not a file
+        return source
+    if home not in ("", os.sep) and os.path.commonpath([path, home]) == home:
+        return os.path.join("~", os.path.relpath(path, home))
+    return path
 
 
 def same_file(a, b) -> bool:

@@ -35,7 +35,7 @@ import numpy as np
 
 from .._math import pose_inverse, rot_axis, rpy_from_matrix, translation
 from .._ui.files import write_text
-from .geometry import Box, Cylinder, Mesh, Sphere, Visual, resolve_mesh
+from .geometry import Box, Cylinder, Mesh, Sphere, Visual, mesh_reference, resolve_mesh
 from .inertia import Inertia
 from .link import Link
 from .loop_files import mjcf_loop_sites, urdf_loop_elements, write_mjcf_loops
@@ -266,7 +266,7 @@ def _origin(parent: ET.Element, T: np.ndarray) -> None:
     ET.SubElement(parent, "origin", xyz=_fs(T[:3, 3]), rpy=_fs(rpy_from_matrix(T[:3, :3])))
 
 
-def _urdf_shape(parent: ET.Element, shape) -> None:
+def _urdf_shape(parent: ET.Element, shape, written: str | None) -> None:
     g = ET.SubElement(parent, "geometry")
     if isinstance(shape, Box):
         ET.SubElement(g, "box", size=_fs(shape.size))
@@ -275,7 +275,7 @@ def _urdf_shape(parent: ET.Element, shape) -> None:
     elif isinstance(shape, Sphere):
         ET.SubElement(g, "sphere", radius=_f(shape.radius))
     else:
-        attributes = {"filename": _mesh_file(shape)}
+        attributes = {"filename": mesh_reference(shape, written)}  # relative to the file where it can be
         if tuple(shape.scale) != (1.0, 1.0, 1.0):
             attributes["scale"] = _fs(shape.scale)
         ET.SubElement(g, "mesh", attributes)
@@ -458,7 +458,7 @@ def to_urdf(
             home, pose = geometry_home[v.frame]
             el = ET.SubElement(link_elements[home], tag)
             _origin(el, pose @ _np(v.origin))
-            _urdf_shape(el, v.shape)
+            _urdf_shape(el, v.shape, None if path is None else os.fspath(path))
             if tag == "visual" and v.rgba is not None:
                 material = ET.SubElement(el, "material", name=v.material or f"{v.frame}_color_{k}")
                 ET.SubElement(material, "color", rgba=_fs(v.rgba))

@@ -5,7 +5,6 @@ so that reading the file back gives the same kinematics, inertias and limits."""
 from __future__ import annotations
 
 import math
-import os
 import sys
 from typing import TYPE_CHECKING
 
@@ -19,7 +18,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 from .._lazy import LazyModule, sympy_instance
 from .._math import is_symbolic, matmul, pose_inverse, rpy_from_matrix
 from .dh import links_from_dh
-from .geometry import Box, Cylinder, Mesh
+from .geometry import Box, Cylinder, Mesh, mesh_reference
 from .inertia import Inertia
 from .loop_files import loops_mapping
 
@@ -37,8 +36,10 @@ __all__ = ["robot_to_mapping"]
 _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
-def robot_to_mapping(robot: Robot | Description) -> dict:
-    """The YAML/TOML contents for ``robot``: DH flavour when it has a consistent DH table."""
+def robot_to_mapping(robot: Robot | Description, path: str | None = None) -> dict:
+    """The YAML/TOML contents for ``robot``: DH flavour when it has a consistent DH table. ``path``:
+    where it will be written (mesh files near it are then named relative to it, see
+    :func:`~kinedyn.description.geometry.mesh_reference`)."""
     data: dict = {"name": robot.name, "gravity": [_dump(g) for g in robot.gravity]}
     if robot.source:
         data["source"] = robot.source
@@ -48,21 +49,17 @@ def robot_to_mapping(robot: Robot | Description) -> dict:
     else:
         data.update(_tree_mapping(robot))
     if robot.visuals:
-        data["visuals"] = [_visual_mapping(v) for v in robot.visuals]
+        data["visuals"] = [_visual_mapping(v, path) for v in robot.visuals]
     if robot.loops:
         data["loops"] = loops_mapping(robot.loops)
     return data
 
 
-def _visual_mapping(v) -> dict:
+def _visual_mapping(v, path: str | None) -> dict:
     out: dict = {"link": v.frame}
     s = v.shape
     if isinstance(s, Mesh):
-        out["mesh"] = (
-            s.filename
-            if s.base_dir is None or "://" in s.filename or os.path.isabs(s.filename)
-            else os.path.join(s.base_dir, s.filename)
-        )
+        out["mesh"] = mesh_reference(s, path)
         out["scale"] = [float(x) for x in s.scale]
     elif isinstance(s, Box):
         out["box"] = [float(x) for x in s.size]

@@ -72,7 +72,7 @@ def save(robot: Robot | Description, path: PathLike) -> None:
     """Write ``robot`` to a ``.yaml``/``.yml`` or ``.toml`` robot file (angles in radians)."""
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
-    data = robot_to_mapping(robot)
+    data = robot_to_mapping(robot, path)
     if ext in (".yaml", ".yml"):
         import yaml  # PyYAML loads only to write a YAML file
 

@@ -46,6 +46,7 @@ __all__ = [
     "MeshNotFound",
     "resolve_mesh",
     "mesh_search_folders",
+    "mesh_reference",
 ]
 
 MESH_EXTENSIONS = (".stl", ".obj", ".dae")
@@ -194,6 +195,42 @@ def resolve_mesh(filename: str, base_dir: str | None = None) -> Path:
     raise MeshNotFound(
         f"mesh '{filename}' was not found (looked in {shown or 'no folder'}; set ROS_PACKAGE_PATH to the folder holding its package)"
     )
+
+
+def mesh_reference(shape: Mesh, written: str | os.PathLike | None = None) -> str:
+    """How a robot file written to ``written`` names ``shape``'s mesh file.
+
+    ``package://`` (and other URLs) as read: ROS tools resolve them wherever the file goes. A file
+    under the written file's folder, or under that folder's parent (the ``../meshes`` of a ROS
+    package, whose robot files sit in ``urdf/``), relative to that folder, with ``/``: the written
+    file then holds no absolute path of this machine and moves with its meshes, and every reader
+    (URDF, MJCF, robot files) resolves a relative path against the file's folder. Anything else, or
+    without ``written``, the file's absolute path (where it was found, see :func:`resolve_mesh`),
+    which finds it from wherever the file is written on this machine. A name given without a robot
+    file (``base_dir`` None) and relative stays as given."""
+    name = shape.filename
+    if "://" in name and not name.startswith("file://"):
+        return name
+    plain = name[len("file://") :] if name.startswith("file://") else name
+    if shape.base_dir is None and not os.path.isabs(plain):
+        return name
+    try:
+        file = str(resolve_mesh(name, shape.base_dir))
+    except (MeshNotFound, ValueError):  # a missing mesh is reported where it is drawn: keep its name
+        file = plain if os.path.isabs(plain) else os.path.join(shape.base_dir or "", plain)
+    if written is None:
+        return file
+    # folders compared with symbolic links resolved (resolve_mesh resolves the robot file's folder);
+    # the mesh's own name kept, so a linked mesh stays the link
+    here = os.path.dirname(os.path.realpath(os.fspath(written)))
+    there = os.path.join(os.path.realpath(os.path.dirname(file)), os.path.basename(file))
+    try:
+        relative = Path(os.path.relpath(there, here))
+    except ValueError:  # another drive: no relative path exists
+        return file
+    if relative.parts[:2] == ("..", ".."):
+        return file
+    return relative.as_posix()
 
 
 def visuals_of_frames(visuals: Sequence[Visual], frames: Sequence[str]) -> list[Visual]:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from .. import robots
+from .._ui.files import readable_source
 from .._ui.progress import Steps
 from ..analysis.properties import mass_matrix_rate
 from ..configuration import check_configuration, default_configuration
@@ -313,7 +314,7 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     rep = singularity_report(robot, q)
     kinematics = {
         "robot": robot.name,
-        "source": robot.source,
+        "source": readable_source(robot.source),  # a file by its resolved path, not as typed
         "n": robot.n,
         "nq": robot.nq,
         "nv": robot.nv,

@@ -8,6 +8,7 @@ import math
 import numpy as np
 from rich.table import Table
 
+from ..._ui.files import readable_source
 from .. import app
 from ..app import console, emit, esc, fmt
 from ..options import robot_argument
@@ -48,7 +49,11 @@ def _headline(robot) -> str:
     ]
     parts.append(
         f"{moving} moving joints"
-        + (f", {followers} of them mimic joints (no coordinate of their own)" if followers else "")
+        + (
+            f", {followers} of them {'a mimic joint' if followers == 1 else 'mimic joints'} (no coordinate of their own)"
+            if followers
+            else ""
+        )
     )
     return ", ".join(parts)
 
@@ -98,7 +103,7 @@ def run(args) -> int:
     payload = {
         "name": robot.name,
         "n": robot.n,
-        "source": robot.source,
+        "source": readable_source(robot.source),
         "gravity": [_value(g) for g in robot.gravity],
         "tool": robot.tool,
         "frames": robot.frame_names,
@@ -120,7 +125,7 @@ def run(args) -> int:
             f"[bold]{esc(robot.name)}[/bold]: {_headline(robot)}, tool frame '{esc(robot.tool)}', gravity {esc(payload['gravity'])} m/s^2"
         )
         if robot.source:
-            c.print(f"source: {esc(robot.source)}")
+            c.print(f"source: {esc(payload['source'])}")
         t = Table(title="joints", title_justify="left")
         for col in ("#", "joint", "type", "parent -> link", "axis", "offset", "limits", "vel / effort"):
             t.add_column(col)
