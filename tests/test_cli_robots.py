@@ -303,7 +303,12 @@ def test_report_and_info_show_the_robot_file_resolved_not_as_typed(capsys, meshy
     code, _, err = run(capsys, "report", typed, "-o", str(out), "--no-tutorial", "--t", "0.1")
     assert code == 0, err
     header = re.search(r"<header>.*?</header>", out.read_text(), re.S).group(0)
-    assert f"· {resolved} ·" in header and typed not in header, header
+    # a page leaves the machine: no absolute path in it, the folder and the file name instead
+    assert "· .../robot/meshy.urdf ·" in header and typed not in header and str(tmp_path) not in header, header
+    monkeypatch.chdir(tmp_path)  # a file under the working folder: relative to it
+    code, _, err = run(capsys, "report", "elsewhere/" + typed, "-o", str(out), "--no-tutorial", "--t", "0.1")
+    assert code == 0 and "· robot/meshy.urdf ·" in re.search(r"<header>.*?</header>", out.read_text(), re.S).group(0)
+    monkeypatch.chdir(tmp_path / "elsewhere")
     code, text, _ = run(capsys, "info", typed)
     assert code == 0 and f"source: {resolved}\n" in text, text
     monkeypatch.setenv("HOME", str(tmp_path))  # the file in the home folder: written from ~

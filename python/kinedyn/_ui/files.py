@@ -31,11 +31,13 @@ from pathlib import Path
 __all__ = ["open_regular", "readable_source", "replacing", "require_regular", "same_file", "write_bytes", "write_text"]
 
 
-def readable_source(source: str) -> str:
+def readable_source(source: str, *, shared: bool = False) -> str:
     """A robot's ``source`` as a page or a table shows it. When it names a file (a robot loaded
     from a path, which keeps the path as typed: ``../x/../robot.urdf`` means nothing once the folder
     it was typed in is gone), the file's resolved path (symbolic links and ``..`` followed), with
-    the home folder written ``~``; anything else (a built-in's reference, "URDF string") as it is."""
+    the home folder written ``~``; anything else (a built-in's reference, "URDF string") as it is.
+    ``shared``: for a document that leaves the machine (the report), no absolute path: a file under
+    the working folder relative to it, under the home folder from ``~``, else ``.../folder/name``."""
     if not source or source.startswith("<") or "\n" in source:
         return source
     try:
@@ -43,10 +45,16 @@ def readable_source(source: str) -> str:
             return source
         path = os.path.realpath(source)
         home = os.path.realpath(os.path.expanduser("~"))
+        here = os.path.realpath(os.getcwd())
     except (OSError, ValueError):  # a name the file system cannot hold (a NUL byte): not a file
         return source
+    if shared and here != os.sep and os.path.commonpath([path, here]) == here:
+        return os.path.relpath(path, here)
     if home not in ("", os.sep) and os.path.commonpath([path, home]) == home:
         return os.path.join("~", os.path.relpath(path, home))
+    if shared:
+        folder, name = os.path.split(path)
+        return os.path.join("...", os.path.basename(folder), name)
     return path
 
 

@@ -314,7 +314,7 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     rep = singularity_report(robot, q)
     kinematics = {
         "robot": robot.name,
-        "source": readable_source(robot.source),  # a file by its resolved path, not as typed
+        "source": readable_source(robot.source, shared=True),  # resolved, and no absolute path in a page
         "n": robot.n,
         "nq": robot.nq,
         "nv": robot.nv,
