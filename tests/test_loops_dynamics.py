@@ -1,0 +1,200 @@
+"""The numbers of closed loops (kinedyn.closed_loops, the core's constraints/): self-checks
+(J against finite differences, J qdd + gamma = 0, inverse then forward dynamics) and Pinocchio's
+constraintDynamics as the oracle, on mechanisms read from the same URDF by both."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import kinedyn as kd
+
+pin = pytest.importorskip("pinocchio")
+
+
+def _link(name, mass, com, inertia=(0.01, 0.02, 0.015)):
+    ixx, iyy, izz = inertia
+    return (
+        f'<link name="{name}"><inertial><origin xyz="{com}"/><mass value="{mass}"/>'
+        f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0.001" ixz="0" iyz="0.002"/></inertial></link>'
+    )
+
+
+def _joint(name, parent, child, xyz, axis, kind="revolute"):
+    limit = '<limit lower="-10" upper="10" effort="10" velocity="10"/>' if kind == "revolute" else ""
+    axis_xml = f'<axis xyz="{axis}"/>' if kind == "revolute" else ""
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/>{axis_xml}{limit}</joint>'
+    )
+
+
+def _urdf(parts) -> str:
+    return '<robot name="mech"><link name="base"/>' + "".join(parts) + "</robot>"
+
+
+def four_bar() -> str:
+    """A planar four-bar in the x-z plane (axes along y, gravity in the plane): crank a1 and coupler
+    a2 from the base, rocker b1 from (0.6, 0, 0); tip_a (coupler end) meets tip_b (rocker end)."""
+    return _urdf(
+        [
+            _link("crank", 1.0, "0.1 0 0"),
+            _link("coupler", 0.8, "0.3 0 0.01"),
+            _link("rocker", 1.2, "0.2 0.01 0"),
+            _link("tip_a", 0.0, "0 0 0"),
+            _link("tip_b", 0.0, "0 0 0"),
+            _joint("a1", "base", "crank", "0 0 0", "0 1 0"),
+            _joint("a2", "crank", "coupler", "0.2 0 0", "0 1 0"),
+            _joint("b1", "base", "rocker", "0.6 0 0", "0 1 0"),
+            _joint("ta", "coupler", "tip_a", "0.7 0 0", "", kind="fixed"),
+            _joint("tb", "rocker", "tip_b", "0.5 0 0", "", kind="fixed"),
+        ]
+    )
+
+
+def spatial_loop() -> str:
+    """Two chains of three revolute joints with skew axes, their ends pinned together (a spatial
+    point loop, 3 DOF): no row is redundant."""
+    return _urdf(
+        [
+            _link("l1", 1.0, "0.1 0 0.05"),
+            _link("l2", 0.9, "0.15 0.02 0"),
+            _link("l3", 0.7, "0.1 0 0"),
+            _link("r1", 1.1, "0 0.1 0.05"),
+            _link("r2", 0.6, "0.1 0.1 0"),
+            _link("r3", 0.5, "0.05 0 0.1"),
+            _link("tip_a", 0.0, "0 0 0"),
+            _link("tip_b", 0.0, "0 0 0"),
+            _joint("j1", "base", "l1", "0 0 0", "0 0 1"),
+            _joint("j2", "l1", "l2", "0.3 0 0.1", "0 1 0"),
+            _joint("j3", "l2", "l3", "0.3 0 0", "1 0 1"),
+            _joint("k1", "base", "r1", "0.5 0.3 0", "0 0 1"),
+            _joint("k2", "r1", "r2", "0 0.3 0.1", "1 0 0"),
+            _joint("k3", "r2", "r3", "0 0.3 0", "0 1 1"),
+            _joint("ta", "l3", "tip_a", "0.25 0 0", "", kind="fixed"),
+            _joint("tb", "r3", "tip_b", "0 0.2 0", "", kind="fixed"),
+        ]
+    )
+
+
+def closed_state(robot, hold, seed):
+    """A closed configuration near a random one (the ``hold`` joints kept) and a velocity and an
+    acceleration-free torque that keep it closed."""
+    rng = np.random.default_rng(seed)
+    q = robot.project_configuration(rng.uniform(-0.6, 0.6, robot.n), hold=hold)
+    qd = robot.project_velocity(q, rng.uniform(-1, 1, robot.n))
+    tau = rng.uniform(-2, 2, robot.n)
+    return q, qd, tau
+
+
+def pinocchio_qdd(urdf, q, qd, tau):
+    model = pin.buildModelFromXML(urdf)
+    data = model.createData()
+    frame_a, frame_b = model.frames[model.getFrameId("tip_a")], model.frames[model.getFrameId("tip_b")]
+    constraint = pin.RigidConstraintModel(
+        pin.ContactType.CONTACT_3D,
+        model,
+        frame_a.parentJoint,
+        frame_a.placement,
+        frame_b.parentJoint,
+        frame_b.placement,
+        pin.ReferenceFrame.LOCAL,
+    )
+    models = pin.StdVec_RigidConstraintModel()
+    models.append(constraint)
+    datas = pin.StdVec_RigidConstraintData()
+    datas.append(constraint.createData())
+    pin.initConstraintDynamics(model, data, models, datas)
+    settings = pin.ProximalSettings(1e-14, 1e-10, 100)
+    qdd = pin.constraintDynamics(model, data, q, qd, tau, models, datas, settings)
+    # the force on frame a's link, in frame a's axes (LOCAL): to base axes
+    pin.framesForwardKinematics(model, data, q)
+    rot = (data.oMi[frame_a.parentJoint] * frame_a.placement).rotation
+    return qdd.copy(), rot @ data.lambda_c.copy()
+
+
+@pytest.mark.parametrize(("make", "hold"), [(four_bar, ["a1"]), (spatial_loop, ["j1"])])
+def test_constrained_forward_dynamics_matches_pinocchio(make, hold):
+    urdf = make()
+    robot = kd.Robot.from_urdf(urdf).add_loop("tip_a", "tip_b", kind="point")
+    for seed in range(3):
+        q, qd, tau = closed_state(robot, hold, seed)
+        assert np.abs(robot.loop_residual(q)).max() < 1e-12
+        qdd, lam = robot.constrained_forward_dynamics(q, qd, tau)
+        qdd_pin, lam_pin = pinocchio_qdd(urdf, q, qd, tau)
+        assert np.allclose(qdd, qdd_pin, rtol=0, atol=1e-9), (qdd, qdd_pin)
+        # J^T lambda (the joint torques of the loop force) is unique even where lambda is not
+        jac = robot.loop_jacobian(q)
+        assert np.allclose(jac.T @ lam, jac.T @ lam_pin, atol=1e-8)
+        if make is spatial_loop:  # no redundant row: lambda itself is unique
+            assert np.allclose(lam, lam_pin, atol=1e-8)
+
+
+def test_the_four_bar_out_of_plane_row_is_zero_and_gets_no_force():
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b")
+    q, qd, tau = closed_state(robot, ["a1"], 4)
+    jac = robot.loop_jacobian(q)
+    assert np.abs(jac[1]).max() == 0.0  # the y row: every axis is along y
+    qdd, lam = robot.constrained_forward_dynamics(q, qd, tau)
+    assert abs(lam[1]) < 1e-9  # least-norm multipliers
+    assert np.abs(jac @ qdd + robot.loop_gamma(q, qd)).max() < 1e-10
+
+
+def test_jacobian_is_the_derivative_of_the_residual_and_gamma_of_j_qd():
+    robot = kd.Robot.from_urdf(spatial_loop()).add_loop("tip_a", "tip_b")
+    rng = np.random.default_rng(1)
+    q, qd = rng.uniform(-1, 1, robot.n), rng.uniform(-1, 1, robot.n)
+    h = 1e-6
+    fd = np.column_stack(
+        [(robot.loop_residual(q + h * e) - robot.loop_residual(q - h * e)) / (2 * h) for e in np.eye(robot.n)]
+    )
+    assert np.allclose(robot.loop_jacobian(q), fd, atol=1e-8)
+    jdot_qd = (robot.loop_jacobian(q + h * qd) @ qd - robot.loop_jacobian(q - h * qd) @ qd) / (2 * h)
+    assert np.allclose(robot.loop_gamma(q, qd), jdot_qd, atol=1e-7)
+
+
+def test_a_batch_gives_the_single_calls():
+    robot = kd.Robot.from_urdf(spatial_loop()).add_loop("tip_a", "tip_b")
+    states = [closed_state(robot, ["j1"], s) for s in range(9)]
+    q, qd, tau = (np.array(x) for x in zip(*states))
+    qdd, lam = robot.constrained_forward_dynamics(q, qd, tau)
+    assert qdd.shape == (9, robot.n) and lam.shape == (9, 3)
+    for k in range(9):
+        one = robot.constrained_forward_dynamics(q[k], qd[k], tau[k])
+        assert np.allclose(qdd[k], one[0], atol=1e-10) and np.allclose(lam[k], one[1], atol=1e-9)
+
+
+def test_inverse_then_forward_gives_the_motion_back():
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b")
+    q, qd, tau = closed_state(robot, ["a1"], 2)
+    qdd, _ = robot.constrained_forward_dynamics(q, qd, tau)
+    tau_a = robot.constrained_inverse_dynamics(q, qd, qdd, actuated=["a1"])
+    assert tau_a[1] == 0.0 and tau_a[2] == 0.0
+    again, _ = robot.constrained_forward_dynamics(q, qd, tau_a)
+    assert np.allclose(again, qdd, atol=1e-9)
+
+
+def test_inverse_dynamics_names_what_is_wrong():
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b", name="pin")
+    q, qd, _ = closed_state(robot, ["a1"], 3)
+    with pytest.raises(ValueError, match="does not keep loop 'pin' closed"):
+        robot.constrained_inverse_dynamics(q, qd, np.ones(3), actuated=["a1"])
+    with pytest.raises(ValueError, match="unknown joint 'a9'"):
+        robot.constrained_inverse_dynamics(q, qd, np.zeros(3), actuated=["a9"])
+    qdd, _ = robot.constrained_forward_dynamics(q, qd, np.zeros(3))
+    with pytest.raises(ValueError, match="do not determine their torques"):
+        robot.constrained_inverse_dynamics(q, qd, qdd, actuated=["a1", "a2", "b1"])
+
+
+def test_forward_kinematics_of_the_parallel_mechanism_from_its_actuated_joint():
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b")
+    start = np.array([0.3, -0.2, 0.4])
+    q = robot.project_configuration(start, hold=["a1"])
+    assert q[0] == start[0]
+    assert np.abs(robot.loop_residual(q)).max() < 1e-12
+    tips = robot.pose(q, frame="tip_a")[:3, 3], robot.pose(q, frame="tip_b")[:3, 3]
+    assert np.allclose(*tips, atol=1e-12)
+    qd = robot.project_velocity(q, np.array([1.0, 0.0, 0.0]))
+    assert np.abs(robot.loop_jacobian(q) @ qd).max() < 1e-12
+    with pytest.raises(ValueError, match="do not close"):
+        robot.project_configuration(np.array([3.0, 0.0, 0.0]), hold=["a1", "a2"])
