@@ -81,36 +81,48 @@ def closed_state(robot, hold, seed):
     """A closed configuration near a random one (the ``hold`` joints kept) and a velocity and an
     acceleration-free torque that keep it closed."""
     rng = np.random.default_rng(seed)
-    q = robot.project_configuration(rng.uniform(-0.6, 0.6, robot.n), hold=hold)
+    q = robot.project_configuration(robot.integrate(robot.neutral(), rng.uniform(-0.6, 0.6, robot.n)), hold=hold)
     qd = robot.project_velocity(q, rng.uniform(-1, 1, robot.n))
     tau = rng.uniform(-2, 2, robot.n)
     return q, qd, tau
 
 
-def pinocchio_qdd(urdf, q, qd, tau):
-    model = pin.buildModelFromXML(urdf)
+def pinocchio_qdd(urdf, q, qd, tau, loops=(("point", "tip_a", "tip_b"),), floating=False):
+    """Pinocchio's constraintDynamics on the same URDF and loops: qdd, and the loops' forces on
+    frame a's link in base axes (Pinocchio gives them in frame a's axes, LOCAL)."""
+    model = pin.buildModelFromXML(urdf, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromXML(urdf)
     data = model.createData()
-    frame_a, frame_b = model.frames[model.getFrameId("tip_a")], model.frames[model.getFrameId("tip_b")]
-    constraint = pin.RigidConstraintModel(
-        pin.ContactType.CONTACT_3D,
-        model,
-        frame_a.parentJoint,
-        frame_a.placement,
-        frame_b.parentJoint,
-        frame_b.placement,
-        pin.ReferenceFrame.LOCAL,
-    )
-    models = pin.StdVec_RigidConstraintModel()
-    models.append(constraint)
-    datas = pin.StdVec_RigidConstraintData()
-    datas.append(constraint.createData())
+    models, datas = pin.StdVec_RigidConstraintModel(), pin.StdVec_RigidConstraintData()
+    kinds = {"point": pin.ContactType.CONTACT_3D, "weld": pin.ContactType.CONTACT_6D}
+    frames = []
+    for kind, a, b in loops:
+        frame_a, frame_b = model.frames[model.getFrameId(a)], model.frames[model.getFrameId(b)]
+        constraint = pin.RigidConstraintModel(
+            kinds[kind],
+            model,
+            frame_a.parentJoint,
+            frame_a.placement,
+            frame_b.parentJoint,
+            frame_b.placement,
+            pin.ReferenceFrame.LOCAL,
+        )
+        models.append(constraint)
+        datas.append(constraint.createData())
+        frames.append((kind, frame_a))
     pin.initConstraintDynamics(model, data, models, datas)
     settings = pin.ProximalSettings(1e-14, 1e-10, 100)
     qdd = pin.constraintDynamics(model, data, q, qd, tau, models, datas, settings)
-    # the force on frame a's link, in frame a's axes (LOCAL): to base axes
     pin.framesForwardKinematics(model, data, q)
-    rot = (data.oMi[frame_a.parentJoint] * frame_a.placement).rotation
-    return qdd.copy(), rot @ data.lambda_c.copy()
+    forces, at = [], 0
+    for kind, frame in frames:
+        rot = (data.oMi[frame.parentJoint] * frame.placement).rotation
+        rows = 3 if kind == "point" else 6
+        lam = data.lambda_c[at : at + rows]
+        forces.extend(rot @ lam[:3])
+        if rows == 6:
+            forces.extend(rot @ lam[3:])
+        at += rows
+    return qdd.copy(), np.array(forces)
 
 
 @pytest.mark.parametrize(("make", "hold"), [(four_bar, ["a1"]), (spatial_loop, ["j1"])])
@@ -128,6 +140,26 @@ def test_constrained_forward_dynamics_matches_pinocchio(make, hold):
         assert np.allclose(jac.T @ lam, jac.T @ lam_pin, atol=1e-8)
         if make is spatial_loop:  # no redundant row: lambda itself is unique
             assert np.allclose(lam, lam_pin, atol=1e-8)
+
+
+def test_a_floating_base_with_a_weld_to_the_ground_matches_pinocchio():
+    """The spatial mechanism on a free-flyer, its chain A welded to the ground (6 rows) and pinned to
+    chain B (3 rows): 12 velocities, 9 rows."""
+    urdf = spatial_loop()
+    robot = (
+        kd.Robot.from_urdf(urdf, floating_base=True)
+        .add_loop("tip_a", "universe", kind="weld")
+        .add_loop("tip_a", "tip_b", kind="point")
+    )
+    for seed in range(3):
+        q, qd, tau = closed_state(robot, [], seed)
+        assert np.abs(robot.loop_residual(q)).max() < 1e-12
+        qdd, lam = robot.constrained_forward_dynamics(q, qd, tau)
+        loops = (("weld", "tip_a", "universe"), ("point", "tip_a", "tip_b"))
+        qdd_pin, lam_pin = pinocchio_qdd(urdf, q, qd, tau, loops, floating=True)
+        assert np.allclose(qdd, qdd_pin, rtol=0, atol=1e-9), (qdd, qdd_pin)
+        jac = robot.loop_jacobian(q)
+        assert np.allclose(jac.T @ lam, jac.T @ lam_pin, atol=1e-8)
 
 
 def test_the_four_bar_out_of_plane_row_is_zero_and_gets_no_force():
