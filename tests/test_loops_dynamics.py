@@ -230,3 +230,18 @@ def test_forward_kinematics_of_the_parallel_mechanism_from_its_actuated_joint():
     assert np.abs(robot.loop_jacobian(q) @ qd).max() < 1e-12
     with pytest.raises(ValueError, match="do not close"):
         robot.project_configuration(np.array([3.0, 0.0, 0.0]), hold=["a1", "a2"])
+
+
+def test_reduced_mimic_joints_are_refused_by_name():
+    urdf = four_bar().replace(
+        '<axis xyz="0 1 0"/><limit lower="-10" upper="10" effort="10" velocity="10"/></joint><joint name="b1"',
+        '<axis xyz="0 1 0"/><limit lower="-10" upper="10" effort="10" velocity="10"/><mimic joint="a1"/></joint>'
+        '<joint name="b1"',
+    )
+    robot = kd.Robot.from_urdf(urdf).add_loop("tip_a", "tip_b")
+    assert robot.mimic_joints
+    with pytest.raises(ValueError, match="does not handle mimic joints.*'a2'"):
+        robot.constrained_forward_dynamics(np.zeros(robot.nq), np.zeros(robot.n), np.zeros(robot.n))
+    independent = kd.Robot.from_urdf(urdf, mimic="independent").add_loop("tip_a", "tip_b")
+    q = independent.project_configuration(np.array([0.3, -0.2, 0.4]), hold=["a1"])
+    assert np.abs(independent.loop_residual(q)).max() < 1e-12

@@ -34,13 +34,9 @@ __all__ = [
 
 
 def _native(description, model, feature: str):
-    """The native model, refusing robots whose loops the core cannot hold (reduced mimic joints)."""
-    if description.mimic_map is not None:
-        follower = description.mimic_joints[0] if description.mimic_joints else "a follower"
-        raise ValueError(
-            f"robot '{description.name}': {feature} does not handle reduced mimic joints yet (joint "
-            f"'{follower}' follows another); load it with mimic='independent' and close the coupling as a loop"
-        )
+    """The native model, refusing robots whose loops the core cannot hold (reduced mimic joints: the
+    core's model then has fewer columns than the loops' frames move)."""
+    description.require_no_mimic_joints(feature)
     return model
 
 
