@@ -245,3 +245,16 @@ def test_reduced_mimic_joints_are_refused_by_name():
     independent = kd.Robot.from_urdf(urdf, mimic="independent").add_loop("tip_a", "tip_b")
     q = independent.project_configuration(np.array([0.3, -0.2, 0.4]), hold=["a1"])
     assert np.abs(independent.loop_residual(q)).max() < 1e-12
+
+
+def test_an_external_wrench_acts_as_its_joint_torques():
+    robot = kd.Robot.from_urdf(spatial_loop()).add_loop("tip_a", "tip_b")
+    q, qd, tau = closed_state(robot, ["j1"], 6)
+    f_ext = np.zeros((len(robot.body_names), 6))
+    link = robot.body_names.index("l2")
+    f_ext[link] = [1.0, -2.0, 0.5, 0.3, 0.1, -0.2]
+    jac = robot.jacobian(q, frame="l2", reference="world")
+    with_wrench, lam = robot.constrained_forward_dynamics(q, qd, tau, f_ext=f_ext)
+    as_torque, lam_torque = robot.constrained_forward_dynamics(q, qd, tau + jac.T @ f_ext[link])
+    assert np.allclose(with_wrench, as_torque, atol=1e-10) and np.allclose(lam, lam_torque, atol=1e-9)
+    assert not np.allclose(with_wrench, robot.constrained_forward_dynamics(q, qd, tau)[0])

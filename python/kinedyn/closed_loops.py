@@ -71,11 +71,15 @@ def loop_gamma(description, model, q, qd):
 
 
 def constrained_forward_dynamics(description, model, q, qd, tau, f_ext=None):
-    """``(qdd, lambda)``, each with the batch's leading axis when ``q`` has one."""
-    native = _native(description, model, "constrained_forward_dynamics")
-    q = float64_array(q)
-    out = native.constrained_forward_dynamics(q, qd, tau, body_wrenches(description, q, f_ext))
-    n = native.n
+    """``(qdd, lambda)``, each with the batch's leading axis when ``q`` has one (a control loop's
+    call: the checks are the core's, only the mimic refusal and the wrench layout are here)."""
+    if description.mimic_map is not None:
+        _native(description, model, "constrained_forward_dynamics")
+    if f_ext is not None:
+        q = float64_array(q)
+        f_ext = body_wrenches(description, q, f_ext)
+    out = model.constrained_forward_dynamics(q, qd, tau, f_ext)
+    n = model.n
     return out[..., :n], out[..., n:]
 
 
