@@ -77,6 +77,25 @@ def spatial_loop() -> str:
     )
 
 
+def planar_slider() -> str:
+    """A planar joint (x, y, heading) carrying an arm whose tip is pinned to a rocker on the base
+    (joint and link names in the order both readers lay the tree out)."""
+    return _urdf(
+        [
+            _link("a_sled", 1.5, "0.05 0.02 0"),
+            _link("arm", 0.8, "0.2 0 0"),
+            _link("b_rocker", 1.0, "0.2 0.01 0"),
+            _link("tip_a", 0.0, "0 0 0"),
+            _link("tip_b", 0.0, "0 0 0"),
+            '<joint name="a0" type="planar"><parent link="base"/><child link="a_sled"/><axis xyz="0 0 1"/></joint>',
+            _joint("a", "a_sled", "arm", "0.1 0 0", "0 0 1"),
+            _joint("b", "base", "b_rocker", "0.8 0.2 0", "0 0 1"),
+            _joint("ta", "arm", "tip_a", "0.5 0 0", "", kind="fixed"),
+            _joint("tb", "b_rocker", "tip_b", "0.4 0 0", "", kind="fixed"),
+        ]
+    )
+
+
 def closed_state(robot, hold, seed):
     """A closed configuration near a random one (the ``hold`` joints kept) and a velocity and an
     acceleration-free torque that keep it closed."""
@@ -125,7 +144,7 @@ def pinocchio_qdd(urdf, q, qd, tau, loops=(("point", "tip_a", "tip_b"),), floati
     return qdd.copy(), np.array(forces)
 
 
-@pytest.mark.parametrize(("make", "hold"), [(four_bar, ["a1"]), (spatial_loop, ["j1"])])
+@pytest.mark.parametrize(("make", "hold"), [(four_bar, ["a1"]), (spatial_loop, ["j1"]), (planar_slider, [])])
 def test_constrained_forward_dynamics_matches_pinocchio(make, hold):
     urdf = make()
     robot = kd.Robot.from_urdf(urdf).add_loop("tip_a", "tip_b", kind="point")
