@@ -277,3 +277,25 @@ def test_an_external_wrench_acts_as_its_joint_torques():
     as_torque, lam_torque = robot.constrained_forward_dynamics(q, qd, tau + jac.T @ f_ext[link])
     assert np.allclose(with_wrench, as_torque, atol=1e-10) and np.allclose(lam, lam_torque, atol=1e-9)
     assert not np.allclose(with_wrench, robot.constrained_forward_dynamics(q, qd, tau)[0])
+
+
+@pytest.mark.parametrize(("make", "independent"), [(four_bar, None), (four_bar, ["a1"]), (spatial_loop, None)])
+def test_reduced_dynamics_gives_the_constrained_motion(make, independent):
+    robot = kd.Robot.from_urdf(make()).add_loop("tip_a", "tip_b")
+    q, _, tau = closed_state(robot, [robot.joint_names[0]], 7)
+    k = robot.n - np.linalg.matrix_rank(robot.loop_jacobian(q))
+    reduced = robot.reduced_dynamics(q, np.linspace(-0.7, 0.9, k), independent=independent)
+    qd = reduced["qd"]
+    assert np.abs(robot.loop_jacobian(q) @ qd).max() < 1e-12
+    qdd_i = np.linalg.solve(reduced["M"], reduced["G"].T @ tau - reduced["bias"] - reduced["g"])
+    qdd, _ = robot.constrained_forward_dynamics(q, qd, tau)
+    assert np.allclose(reduced["G"] @ qdd_i + reduced["a0"], qdd, atol=1e-9)
+    if independent:
+        assert reduced["independent"] == [robot.joint_names.index(independent[0])]
+
+
+def test_reduced_dynamics_refuses_coordinates_that_are_not_independent():
+    robot = kd.Robot.from_urdf(spatial_loop()).add_loop("tip_a", "tip_b")
+    q, _, _ = closed_state(robot, ["j1"], 8)
+    with pytest.raises(ValueError, match="not independent coordinates"):
+        robot.reduced_dynamics(q, np.zeros(2), independent=["j1", "j2"])

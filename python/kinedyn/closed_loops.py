@@ -29,6 +29,7 @@ __all__ = [
     "loop_residual",
     "project_configuration",
     "project_velocity",
+    "reduced_dynamics",
     "velocity_columns",
 ]
 
@@ -107,3 +108,60 @@ def project_configuration(description, model, q, hold=None, tolerance=1e-12, max
 def project_velocity(description, model, q, qd):
     """(nv,) or (N, nv): the velocity nearest ``qd`` with ``J qd = 0``."""
     return _native(description, model, "project_velocity").project_velocity(q, qd)
+
+
+def reduced_dynamics(description, model, q, qd_independent, independent=None):
+    """The equations of motion in independent coordinates at one closed state (Nikravesh,
+    Computer-Aided Analysis of Mechanical Systems, §13.4; Wehage & Haug 1982, "Generalized coordinate
+    partitioning"): the velocity columns split into independent ``i`` and dependent ``d`` ones, the
+    dependent rows of ``J`` being of full rank, so that ``J_d qd_d + J_i qd_i = 0`` gives
+    ``qd = G qd_i`` with ``G = [1; -J_d^+ J_i]`` (rows in column order), and ``J qdd + gamma = 0``
+    gives ``qdd = G qdd_i + a0``, ``a0 = [0; -J_d^+ gamma]``. Then
+    ``G^T M G qdd_i + G^T (M a0 + C qd + friction) + G^T g = G^T tau``.
+
+    ``independent``: joint names, or None to choose them by QR with column pivoting of ``J``
+    (Golub & Van Loan §5.4.2: the first ``rank J`` pivots are dependent). Returns a dict: ``G``
+    (nv, k), ``M`` (k, k), ``bias`` (k,) (the velocity terms ``G^T (M a0 + C qd + friction)``),
+    ``g`` (k,), ``a0`` (nv,), ``qd`` (nv,) and ``independent`` (the velocity columns)."""
+    native = _native(description, model, "reduced_dynamics")
+    q = float64_array(q)
+    n = native.n
+    jac = native.loop_jacobian(q)
+    rank = int(np.linalg.matrix_rank(jac)) if jac.size else 0
+    if independent is None:
+        from scipy.linalg import qr  # scipy loads only for this choice
+
+        _, _, pivots = qr(jac, pivoting=True, mode="economic") if jac.size else (None, None, np.arange(n))
+        dependent = sorted(int(k) for k in pivots[:rank])
+        columns = [k for k in range(n) if k not in dependent]
+    else:
+        columns = velocity_columns(description, independent, "reduced_dynamics, independent")
+        dependent = [k for k in range(n) if k not in columns]
+        if np.linalg.matrix_rank(jac[:, dependent]) < rank or len(dependent) != rank:
+            raise ValueError(
+                f"robot '{description.name}', reduced_dynamics: the joints {list(independent)} are not independent "
+                f"coordinates: the loops' Jacobian has rank {rank}, and its {len(dependent)} other columns must "
+                "have that rank and number"
+            )
+    qd_i = np.asarray(qd_independent, dtype=float)
+    if qd_i.shape != (len(columns),):
+        raise ValueError(f"reduced_dynamics: qd_independent must have shape ({len(columns)},), got {qd_i.shape}")
+    pinv_d = np.linalg.pinv(jac[:, dependent]) if dependent else np.zeros((0, jac.shape[0]))
+    big_g = np.zeros((n, len(columns)))
+    big_g[columns, np.arange(len(columns))] = 1.0
+    big_g[dependent] = -pinv_d @ jac[:, columns]
+    qd = big_g @ qd_i
+    a0 = np.zeros(n)
+    a0[dependent] = -pinv_d @ native.loop_gamma(q, qd)
+    mass = native.mass_matrix(q, None)
+    gravity = native.gravity_torque(q, None)
+    velocity_terms = native.inverse_dynamics(q, qd, np.zeros(n), None, None) - gravity
+    return {
+        "G": big_g,
+        "M": big_g.T @ mass @ big_g,
+        "bias": big_g.T @ (mass @ a0 + velocity_terms),
+        "g": big_g.T @ gravity,
+        "a0": a0,
+        "qd": qd,
+        "independent": columns,
+    }

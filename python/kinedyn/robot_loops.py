@@ -75,3 +75,10 @@ class ClosedLoops:
     def project_velocity(self, q, qd):
         """The velocity nearest ``qd`` (Euclidean) that keeps the loops closed: ``qd - J^+ J qd``."""
         return closed_loops.project_velocity(self.description, self._model, q, qd)
+
+    def reduced_dynamics(self, q, qd_independent, independent=None):
+        """The equations of motion in independent coordinates at one closed state (coordinate
+        partitioning): ``qd = G qd_i``, ``qdd = G qdd_i + a0`` and ``M_r qdd_i + bias + g_r = G^T tau``
+        as a dict of ``G``, ``M``, ``bias``, ``g``, ``a0``, ``qd``, ``independent`` (velocity
+        columns). ``independent``: joint names, or None to choose them from J by pivoted QR."""
+        return closed_loops.reduced_dynamics(self.description, self._model, q, qd_independent, independent)
