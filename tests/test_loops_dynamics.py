@@ -299,3 +299,15 @@ def test_reduced_dynamics_refuses_coordinates_that_are_not_independent():
     q, _, _ = closed_state(robot, ["j1"], 8)
     with pytest.raises(ValueError, match="not independent coordinates"):
         robot.reduced_dynamics(q, np.zeros(2), independent=["j1", "j2"])
+
+
+def test_a_robot_with_loops_pickles_with_them():
+    import pickle
+
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b")
+    q, qd, tau = closed_state(robot, ["a1"], 9)
+    again = pickle.loads(pickle.dumps(robot))
+    assert np.array_equal(
+        again.constrained_forward_dynamics(q, qd, tau)[0], robot.constrained_forward_dynamics(q, qd, tau)[0]
+    )
+    assert again.loop_jacobian(q).shape == (3, 3)
