@@ -311,3 +311,18 @@ def test_a_robot_with_loops_pickles_with_them():
         again.constrained_forward_dynamics(q, qd, tau)[0], robot.constrained_forward_dynamics(q, qd, tau)[0]
     )
     assert again.loop_jacobian(q).shape == (3, 3)
+
+
+def test_projections_and_inverse_dynamics_take_a_batch():
+    robot = kd.Robot.from_urdf(four_bar()).add_loop("tip_a", "tip_b")
+    starts = np.array([[0.3, -0.2, 0.4], [0.5, -0.4, 0.6], [0.1, 0.0, 0.3]])
+    q = robot.project_configuration(starts, hold=["a1"])
+    assert q.shape == (3, 3) and np.array_equal(q[:, 0], starts[:, 0])
+    assert np.abs(robot.loop_residual(q)).max() < 1e-12
+    qd = robot.project_velocity(q, np.ones((3, 3)))
+    qdd, _ = robot.constrained_forward_dynamics(q, qd, np.zeros((3, 3)))
+    tau = robot.constrained_inverse_dynamics(q, qd, qdd, actuated=["a1"])
+    assert tau.shape == (3, 3)
+    for k in range(3):
+        assert np.allclose(tau[k], robot.constrained_inverse_dynamics(q[k], qd[k], qdd[k], actuated=["a1"]))
+        assert np.allclose(robot.project_configuration(starts[k], hold=["a1"]), q[k])
