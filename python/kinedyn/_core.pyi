@@ -39,6 +39,23 @@ class Model:
     # the model with f_ext's moments taken about link-frame origins: (n, 3), each body's link-frame
     # origin in its body frame (zero: the body origin; the records' link_origin set them)
     def with_link_origins(self, origins: F64) -> Model: ...
+    def with_loops(self, loops: list[tuple[int, int, str, str]]) -> Model: ...
+    # closed loops (frame_a, frame_b, kind "point" | "weld", name), checked by the core
+    @property
+    def loop_rows(self) -> int: ...  # m: 3 per point loop, 6 per weld
+    def loop_residual(self, q: F64) -> F64: ...  # (m,) | (N, m), base axes
+    def loop_jacobian(self, q: F64) -> F64: ...  # (m, n) | (N, m, n)
+    def loop_gamma(self, q: F64, qd: F64) -> F64: ...  # (m,) | (N, m), dJ/dt qd
+    def constrained_forward_dynamics(
+        self, q: F64, qd: F64, tau: F64, f_ext: F64 | None = None
+    ) -> F64: ...  # [qdd; lambda] (n + m,) | (N, n + m)
+    def constrained_inverse_dynamics(
+        self, q: F64, qd: F64, qdd: F64, actuated: list[int], f_ext: F64 | None = None
+    ) -> F64: ...  # tau (n,) | (N, n), zero off the actuated velocity columns
+    def project_configuration(
+        self, q: F64, hold: list[int], tolerance: float, max_iter: int
+    ) -> F64: ...  # (nq,) | (N, nq)
+    def project_velocity(self, q: F64, qd: F64) -> F64: ...  # (n,) | (N, n)
     @property
     def link_bodies(self) -> I64: ...  # (links,) the body that carries each link (a multi-DOF joint's last)
     @property

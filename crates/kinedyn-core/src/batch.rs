@@ -389,6 +389,15 @@ pub mod kernels {
         }
     );
     kernel!(
+        /// `[qdd; lambda]` of a model with closed loops at `(q, qd, tau[, f_ext])`
+        /// (`constraints::constrained_forward_dynamics`, the default proximal settings).
+        ConstrainedForwardDynamics, |model| model.n + model.loop_rows(), |model, data, x, out| {
+            crate::constraints::constrained_forward_dynamics(
+                model, data, x[0], x[1], x[2], optional(x, 3), &crate::constraints::PROXIMAL, out,
+            )
+        }
+    );
+    kernel!(
         /// `g(q)`.
         Gravity, |model| model.n, |model, data, x, out| {
             out.copy_from_slice(alg::gravity_torque(model, data, x[0]));

@@ -108,6 +108,9 @@ pub struct Data<T: Real = f64> {
     pub hc: Vec<Vec3<T>>,
     /// Gravity acceleration in body axes.
     pub g_b: Vec<Vec3<T>>,
+
+    // ---- closed loops (constraints/) ----
+    pub loops: crate::constraints::LoopData<T>,
 }
 
 impl<T: Real> Data<T> {
@@ -160,6 +163,7 @@ impl<T: Real> Data<T> {
             mc: vec![zero; n],
             hc: vec![Vec3::zeros(); n],
             g_b: vec![Vec3::zeros(); n],
+            loops: crate::constraints::LoopData::new(model),
         }
     }
 }

@@ -6,6 +6,7 @@
 
 pub mod algorithms;
 pub mod batch;
+pub mod constraints;
 pub mod data;
 pub mod error;
 pub mod ik;

@@ -6,6 +6,7 @@ use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
+use kinedyn_core::constraints::{self, Loop, LoopKind};
 use kinedyn_core::spatial::Vec3;
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -439,6 +440,152 @@ model_methods! {
                     },
                 )?;
                 Ok((dq, dqd, dtau))
+            })
+        }
+
+        /// This model with closed loops, each `(frame_a, frame_b, kind, name)` (kind "point" or
+        /// "weld"), checked by the core's `Model::with_loops`.
+        fn with_loops(&self, loops: Vec<(i64, i64, String, String)>) -> PyResult<Self> {
+            guarded("Model.with_loops", || {
+                let mut records = Vec::with_capacity(loops.len());
+                for (a, b, kind, name) in loops {
+                    records.push(Loop {
+                        frame_a: self.frame(a)?,
+                        frame_b: self.frame(b)?,
+                        kind: LoopKind::from_name(&kind).map_err(core_err)?,
+                        name,
+                    });
+                }
+                let model = self.model.clone().with_loops(records).map_err(core_err)?;
+                let data = Mutex::new(Data::new(&model));
+                Ok(Self { model, data })
+            })
+        }
+
+        /// Constraint rows m of the loops.
+        #[getter]
+        fn loop_rows(&self) -> usize {
+            self.model.loop_rows()
+        }
+
+        /// The closure residual r (m,) | (N, m): per loop p_a - p_b, then R_b log3(R_b^T R_a) for a weld.
+        fn loop_residual<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.loop_residual", || {
+                let q = f64_array("q", &q)?;
+                let batch = Batch::gather(&[("q", &q, &[self.model.nq])])?;
+                batch.run(py, self, ("loop_residual", "r"), &[self.model.loop_rows()], |model, data, x, out| {
+                    constraints::loop_residual(model, data, x[0], out);
+                    Ok(())
+                })
+            })
+        }
+
+        /// The loops' Jacobian J (m, n) | (N, m, n), base axes.
+        fn loop_jacobian<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.loop_jacobian", || {
+                let q = f64_array("q", &q)?;
+                let batch = Batch::gather(&[("q", &q, &[self.model.nq])])?;
+                let shape = [self.model.loop_rows(), self.n()];
+                batch.run(py, self, ("loop_jacobian", "J"), &shape, |model, data, x, out| {
+                    constraints::loop_jacobian(model, data, x[0], out);
+                    Ok(())
+                })
+            })
+        }
+
+        /// gamma = dJ/dt qd (m,) | (N, m).
+        fn loop_gamma<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.loop_gamma", || {
+                let (q, qd) = (f64_array("q", &q)?, f64_array("qd", &qd)?);
+                let batch = Batch::gather(&[("q", &q, &[self.model.nq]), ("qd", &qd, &[self.n()])])?;
+                batch.run(py, self, ("loop_gamma", "gamma"), &[self.model.loop_rows()], |model, data, x, out| {
+                    constraints::loop_gamma(model, data, x[0], x[1], out);
+                    Ok(())
+                })
+            })
+        }
+
+        /// [qdd; lambda] (n + m,) | (N, n + m): M qdd + h = tau + J^T lambda, J qdd + gamma = 0
+        /// (the core's proximal solve, over SIMD lanes for a batch).
+        #[pyo3(signature = (q, qd, tau, f_ext=None))]
+        fn constrained_forward_dynamics<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+            tau: Bound<'py, PyAny>,
+            f_ext: Option<Bound<'py, PyAny>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.constrained_forward_dynamics", || {
+                let (q, qd, tau) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("tau", &tau)?);
+                let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+                let batch = self.gather_dynamics([("q", &q), ("qd", &qd), ("tau", &tau)], f_ext.as_ref())?;
+                let width = self.n() + self.model.loop_rows();
+                let what = ("constrained_forward_dynamics", "[qdd; lambda]");
+                batch.run_kernel(py, self, what, &[width], None, kernels::ConstrainedForwardDynamics)
+            })
+        }
+
+        /// tau (n,) | (N, n), zero off the `actuated` velocity columns, producing the closed motion qdd.
+        #[pyo3(signature = (q, qd, qdd, actuated, f_ext=None))]
+        fn constrained_inverse_dynamics<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+            qdd: Bound<'py, PyAny>,
+            actuated: Vec<usize>,
+            f_ext: Option<Bound<'py, PyAny>>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.constrained_inverse_dynamics", || {
+                let (q, qd, qdd) = (f64_array("q", &q)?, f64_array("qd", &qd)?, f64_array("qdd", &qdd)?);
+                let f_ext = f_ext.map(|f| f64_array("f_ext", &f)).transpose()?;
+                let batch = self.gather_dynamics([("q", &q), ("qd", &qd), ("qdd", &qdd)], f_ext.as_ref())?;
+                batch.run(py, self, ("constrained_inverse_dynamics", "tau"), &[self.n()], |model, data, x, out| {
+                    constraints::constrained_inverse_dynamics(model, data, x[0], x[1], x[2], optional(x, 3), &actuated, out)
+                })
+            })
+        }
+
+        /// A configuration (nq,) | (N, nq) near q closing the loops, the `hold` velocity columns fixed.
+        #[pyo3(signature = (q, hold, tolerance, max_iter))]
+        fn project_configuration<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            hold: Vec<usize>,
+            tolerance: f64,
+            max_iter: usize,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.project_configuration", || {
+                let q = f64_array("q", &q)?;
+                let batch = Batch::gather(&[("q", &q, &[self.model.nq])])?;
+                let nq = self.model.nq;
+                batch.run(py, self, ("project_configuration", "q"), &[nq], |model, data, x, out| {
+                    constraints::project_configuration(model, data, x[0], &hold, tolerance, max_iter, out).map(|_| ())
+                })
+            })
+        }
+
+        /// The velocity (n,) | (N, n) nearest qd with J qd = 0.
+        fn project_velocity<'py>(
+            &self,
+            py: Python<'py>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.project_velocity", || {
+                let (q, qd) = (f64_array("q", &q)?, f64_array("qd", &qd)?);
+                let batch = Batch::gather(&[("q", &q, &[self.model.nq]), ("qd", &qd, &[self.n()])])?;
+                batch.run(py, self, ("project_velocity", "qd"), &[self.n()], |model, data, x, out| {
+                    constraints::project_velocity(model, data, x[0], x[1], out);
+                    Ok(())
+                })
             })
         }
     }

@@ -109,6 +109,35 @@ fn singular_pivot(diagonal: &[f64], k: usize, hkk: f64, scale: f64) -> String {
     }
 }
 
+/// Solve `L^T D L x = b` in place (`l`: the factors of [`ltdl`]; RBDA Table 6.4's back-substitutions).
+#[inline(always)]
+pub fn ltdl_solve<T: Real>(model: &Model, l: &[T], x: &mut [T]) {
+    let n = model.n;
+    // L^T z = b: for i = n-1..0, z_i = b_i; b_j -= L_ij z_i for the ancestors j of i
+    for i in (0..n).rev() {
+        let zi = x[i];
+        let mut j = model.parent[i];
+        while let Some(jj) = j {
+            x[jj] -= l[i * n + jj] * zi;
+            j = model.parent[jj];
+        }
+    }
+    // w = D^-1 z
+    for i in 0..n {
+        x[i] = x[i] / l[i * n + i];
+    }
+    // L y = w: y_i = w_i - sum_{j ancestors of i} L_ij y_j
+    for i in 0..n {
+        let mut yi = x[i];
+        let mut j = model.parent[i];
+        while let Some(jj) = j {
+            yi -= l[i * n + jj] * x[jj];
+            j = model.parent[jj];
+        }
+        x[i] = yi;
+    }
+}
+
 /// `M(q)^-1` written row-major to `data.m` (n x n); `data.m2` holds the factors of `M`.
 #[inline(always)]
 pub fn mass_matrix_inverse<'d, T: Real>(model: &Model, data: &'d mut Data<T>, q: &[T]) -> Result<&'d [T]> {
@@ -126,29 +155,7 @@ pub fn inverse_of_mass_matrix<'d, T: Real>(model: &Model, data: &'d mut Data<T>)
         // b = e_col
         x[..n].fill(T::zero());
         x[col] = T::one();
-        // L^T z = b: for i = n-1..0, z_i = b_i; b_j -= L_ij z_i for the ancestors j of i
-        for i in (0..n).rev() {
-            let zi = x[i];
-            let mut j = model.parent[i];
-            while let Some(jj) = j {
-                x[jj] -= l[i * n + jj] * zi;
-                j = model.parent[jj];
-            }
-        }
-        // w = D^-1 z
-        for i in 0..n {
-            x[i] = x[i] / l[i * n + i];
-        }
-        // L y = w: y_i = w_i - sum_{j ancestors of i} L_ij y_j
-        for i in 0..n {
-            let mut yi = x[i];
-            let mut j = model.parent[i];
-            while let Some(jj) = j {
-                yi -= l[i * n + jj] * x[jj];
-                j = model.parent[jj];
-            }
-            x[i] = yi;
-        }
+        ltdl_solve(model, l, x);
         // keep the lower triangle (rows >= col) of column col, mirrored into the upper one
         for r in col..n {
             out[r * n + col] = x[r];

@@ -101,6 +101,9 @@ pub struct Model {
     /// Whether every subtree is the contiguous range `i..subtree_end[i]` (depth-first numbering:
     /// always true for a serial chain), which lets the CRBA treat a subtree's columns as a block.
     pub subtrees_contiguous: bool,
+    /// Closed loops between two frames (`crate::constraints`; empty for a tree), set by
+    /// [`Model::with_loops`].
+    pub loops: Vec<crate::constraints::Loop>,
 }
 
 fn finite(what: &str, values: &[f64]) -> Result<()> {
@@ -229,6 +232,7 @@ impl Model {
             support,
             subtree_end,
             subtrees_contiguous,
+            loops: Vec::new(),
         })
     }
 

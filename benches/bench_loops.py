@@ -1,0 +1,148 @@
+"""Constrained forward dynamics of closed loops (issue 27 §2): kinedyn's
+``robot.constrained_forward_dynamics`` (the core's proximal KKT solve) beside Pinocchio's
+``constraintDynamics`` called from Python, in the same run, as ratios; per call (one state) and
+per state of a batch (kinedyn: one native call for N states, SIMD lanes and threads; Pinocchio: a
+Python loop, which is how a Python user batches it).
+
+The mechanism: two chains of three revolute joints with skew axes whose ends are pinned together
+(a spatial point loop, 3 rows, 6 joints), read by both from one URDF; states closed by
+``project_configuration`` and ``project_velocity``.
+
+    PYTHONPATH=python python benches/bench_loops.py [--states 10000] [--repeat 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import pinocchio as pin
+
+import kinedyn as kd
+
+
+def link(name, mass, com):
+    return (
+        f'<link name="{name}"><inertial><origin xyz="{com}"/><mass value="{mass}"/>'
+        '<inertia ixx="0.01" iyy="0.02" izz="0.015" ixy="0.001" ixz="0" iyz="0.002"/></inertial></link>'
+    )
+
+
+def joint(name, parent, child, xyz, axis=None):
+    if axis is None:
+        return f'<joint name="{name}" type="fixed"><parent link="{parent}"/><child link="{child}"/><origin xyz="{xyz}"/></joint>'
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/><origin xyz="{xyz}"/>'
+        f'<axis xyz="{axis}"/><limit lower="-10" upper="10" effort="10" velocity="10"/></joint>'
+    )
+
+
+URDF = (
+    '<robot name="loop"><link name="base"/>'
+    + "".join(
+        link(n, m, c)
+        for n, m, c in [
+            ("l1", 1.0, "0.1 0 0.05"),
+            ("l2", 0.9, "0.15 0.02 0"),
+            ("l3", 0.7, "0.1 0 0"),
+            ("r1", 1.1, "0 0.1 0.05"),
+            ("r2", 0.6, "0.1 0.1 0"),
+            ("r3", 0.5, "0.05 0 0.1"),
+            ("tip_a", 0.0, "0 0 0"),
+            ("tip_b", 0.0, "0 0 0"),
+        ]
+    )
+    + joint("j1", "base", "l1", "0 0 0", "0 0 1")
+    + joint("j2", "l1", "l2", "0.3 0 0.1", "0 1 0")
+    + joint("j3", "l2", "l3", "0.3 0 0", "1 0 1")
+    + joint("k1", "base", "r1", "0.5 0.3 0", "0 0 1")
+    + joint("k2", "r1", "r2", "0 0.3 0.1", "1 0 0")
+    + joint("k3", "r2", "r3", "0 0.3 0", "0 1 1")
+    + joint("ta", "l3", "tip_a", "0.25 0 0")
+    + joint("tb", "r3", "tip_b", "0 0.2 0")
+    + "</robot>"
+)
+
+
+def best(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--states", type=int, default=10000)
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    robot = kd.Robot.from_urdf(URDF).add_loop("tip_a", "tip_b")
+    rng = np.random.default_rng(0)
+    count = min(args.states, 200)
+    q = np.array([robot.project_configuration(rng.uniform(-0.6, 0.6, 6), hold=["j1"]) for _ in range(count)])
+    qd = robot.project_velocity(q, rng.uniform(-1, 1, (count, 6)))
+    q, qd = np.resize(q, (args.states, 6)), np.resize(qd, (args.states, 6))
+    tau = rng.uniform(-2, 2, (args.states, 6))
+
+    model = pin.buildModelFromXML(URDF)
+    data = model.createData()
+    fa, fb = model.frames[model.getFrameId("tip_a")], model.frames[model.getFrameId("tip_b")]
+    cm = pin.RigidConstraintModel(
+        pin.ContactType.CONTACT_3D,
+        model,
+        fa.parentJoint,
+        fa.placement,
+        fb.parentJoint,
+        fb.placement,
+        pin.ReferenceFrame.LOCAL,
+    )
+    models, datas = pin.StdVec_RigidConstraintModel(), pin.StdVec_RigidConstraintData()
+    models.append(cm)
+    datas.append(cm.createData())
+    pin.initConstraintDynamics(model, data, models, datas)
+    settings = pin.ProximalSettings(1e-12, 1e-10, 100)
+
+    qdd, _ = robot.constrained_forward_dynamics(q[:50], qd[:50], tau[:50])
+    ref = np.array(
+        [pin.constraintDynamics(model, data, q[k], qd[k], tau[k], models, datas, settings) for k in range(50)]
+    )
+    print(f"largest |qdd_kinedyn - qdd_pinocchio| over 50 states: {np.abs(qdd - ref).max():.1e}")
+
+    calls = 2000
+    one_kd = (
+        best(lambda: [robot.constrained_forward_dynamics(q[k], qd[k], tau[k]) for k in range(calls)], args.repeat)
+        / calls
+    )
+    one_pin = (
+        best(
+            lambda: [
+                pin.constraintDynamics(model, data, q[k], qd[k], tau[k], models, datas, settings) for k in range(calls)
+            ],
+            args.repeat,
+        )
+        / calls
+    )
+    n = args.states
+    batch_kd = best(lambda: robot.constrained_forward_dynamics(q, qd, tau), args.repeat) / n
+    batch_pin = (
+        best(
+            lambda: [
+                pin.constraintDynamics(model, data, q[k], qd[k], tau[k], models, datas, settings) for k in range(n)
+            ],
+            1,
+        )
+        / n
+    )
+    print(
+        f"one call     : kinedyn {one_kd * 1e6:7.2f} us   pinocchio {one_pin * 1e6:7.2f} us   ratio {one_pin / one_kd:5.2f}x"
+    )
+    print(
+        f"batch of {n}: kinedyn {batch_kd * 1e6:7.3f} us/state   pinocchio loop {batch_pin * 1e6:7.3f} us/state   ratio {batch_pin / batch_kd:5.1f}x"
+    )
+
+
+if __name__ == "__main__":
+    main()
