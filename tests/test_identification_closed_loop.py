@@ -165,7 +165,7 @@ def test_iv_falls_back_on_the_prior_when_the_start_cannot_be_simulated():
     assert np.allclose(est, theta, atol=0.02) and it >= 1
     with pytest.raises(ValueError, match="diverges"):
         instrumental_fit("iv", W, y, np.ones(len(X)), -theta, instruments)
-    flips = iter([False, True, True])
+    flips = iter([False] + [True] * 10)  # every later model, halved steps too, diverges
 
     def later(t):
         if next(flips):
@@ -174,3 +174,53 @@ def test_iv_falls_back_on_the_prior_when_the_start_cannot_be_simulated():
 
     est, _, it, _, note = instrumental_fit("iv", W, y, np.ones(len(X)), theta, later, tol=0.0)
     assert it == 1 and "iteration 2 could not be simulated" in note and np.allclose(est, theta, atol=0.02)
+
+
+def test_a_step_into_a_model_that_cannot_be_simulated_is_halved():
+    """DIDIM is a Gauss-Newton iteration: a full step that lands on a model that cannot be simulated
+    is halved toward the last simulable estimate (step control) instead of ending the iterations."""
+    from kinedyn.analysis.closed_loop import instrumental_fit
+
+    rng = np.random.default_rng(1)
+    X = rng.normal(size=(5000, 2))
+    theta = np.array([2.0, 1.0])
+    y = X @ theta + 0.01 * rng.normal(size=len(X))
+    start = np.array([0.5, 1.0])
+    tried = []
+
+    def instruments(t):  # models with the first parameter above 1.5 "diverge" once, the first time
+        tried.append(t.copy())
+        if t[0] > 1.5 and len(tried) == 2:
+            raise ValueError("the identified model diverges under the controller at t = 1 s")
+        return X
+
+    est, _, it, _, note = instrumental_fit("didim", X, y, np.ones(len(X)), start, instruments)
+    assert "step was halved" in note
+    assert np.allclose(tried[2], start + 0.5 * (tried[1] - start))  # halfway toward the last simulable one
+    assert np.allclose(est, theta, atol=1e-3) and it >= 2
+
+
+def test_iv_keeps_the_instruments_of_smallest_covariance():
+    """Every noise-free simulation gives consistent instruments, not equally good ones: when an
+    iteration's instruments are nearly uncorrelated with one column of W, its estimate is far off and
+    its covariance says so; IV keeps the iterate whose covariance has the smallest log det."""
+    from kinedyn.analysis.closed_loop import instrumental_fit
+
+    rng = np.random.default_rng(2)
+    X = rng.normal(size=(20000, 3))
+    theta = np.array([1.0, -2.0, 0.5])
+    W = X + 0.3 * rng.normal(size=X.shape)
+    y = X @ theta + 0.05 * rng.normal(size=len(X))
+    weak = X.copy()
+    weak[:, 2] = 0.02 * X[:, 2] + rng.normal(size=len(X))  # a poor instrument for the third column
+    calls = []
+
+    def instruments(t):  # good, then poor ones: the iterations do not settle
+        calls.append(t)
+        return X if len(calls) == 1 else weak
+
+    est, cov, it, _, note = instrumental_fit("iv", W, y, np.ones(len(X)), theta + 0.3, instruments, tol=0.0)
+    assert it == 6 and "kept iteration 1's estimate" in note
+    good = np.linalg.solve(X.T @ W, X.T @ y)
+    assert np.allclose(est, good) and np.allclose(est, theta, atol=0.02)
+    assert np.all(np.sqrt(np.diag(cov)) < 0.05)

@@ -1,6 +1,7 @@
-"""The configuration space's ``integrate`` / ``difference`` are the core's (crates/kinedyn-core/src/lie.rs,
-``kinedyn._core.lie_integrate`` / ``lie_difference``): against the NumPy operations they replaced
-(tests/lie_oracle.py) on batches of every joint kind, at generic angles, near zero and near π."""
+"""The configuration space's ``integrate`` / ``difference``, their Jacobians and the quaternion helpers
+of :mod:`kinedyn.lie` are the core's (crates/kinedyn-core/src/lie.rs and lie/jacobians.rs,
+``kinedyn._core.lie_*``): against the NumPy operations they replaced (tests/lie_oracle.py) on batches
+of every joint kind, at generic angles, near zero and near π."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import lie_oracle as oracle
 import numpy as np
 import pytest
 
-from kinedyn import Joint
+from kinedyn import Joint, lie
 from kinedyn import configuration as cfg
 
 pytest.importorskip("kinedyn._core", reason="the native module is not built")
@@ -88,3 +89,82 @@ def test_the_core_rejects_bad_shapes_and_names_by_message():
         lie_integrate(["floating"], np.zeros((2, 7)), np.zeros((3, 6)))
     with pytest.raises(ValueError, match="joint 1: .*unknown joint kind 'helical'"):
         lie_difference(["", "helical"], np.zeros(2), np.zeros(2))
+
+
+def rotation_vectors(rng, size):
+    """Rotation vectors at angles 0, in the series branches (below 1e-2 and 0.5), generic and near π."""
+    w = rng.normal(size=(size, 3))
+    angle = np.concatenate(
+        [[0.0, 1e-9, 3e-3, 0.2, 0.45], rng.uniform(0.5, 3.0, size - 7), [np.pi - 1e-6, np.pi - 1e-3]]
+    )
+    return w / np.linalg.norm(w, axis=1, keepdims=True) * angle[:, None]
+
+
+def test_quaternion_helpers_equal_the_numpy_oracle():
+    rng = np.random.default_rng(31)
+    omega = rotation_vectors(rng, 30)
+    quat = oracle.exp3(omega)
+    np.testing.assert_allclose(lie.exp3(omega), quat, atol=1e-15, rtol=0)
+    np.testing.assert_allclose(lie.log3(quat), oracle.log3(quat), atol=1e-12, rtol=0)
+    np.testing.assert_allclose(lie.log3(-quat), oracle.log3(-quat), atol=1e-12, rtol=0)  # w < 0: the short way
+    other = oracle.exp3(rotation_vectors(rng, 30)[::-1])
+    np.testing.assert_allclose(
+        lie.quaternion_multiply(quat, other), oracle.quaternion_multiply(quat, other), atol=1e-15
+    )
+    p = rng.normal(size=(30, 3))
+    np.testing.assert_allclose(lie.quaternion_rotate(quat, p), oracle.quaternion_rotate(quat, p), atol=1e-14)
+    np.testing.assert_allclose(lie.quaternion_to_matrix(quat), oracle.quaternion_to_matrix(quat), atol=1e-15)
+    # shapes broadcast as NumPy's: one quaternion against a batch, one state without a batch axis
+    np.testing.assert_allclose(lie.quaternion_rotate(quat[3], p), oracle.quaternion_rotate(quat[3], p), atol=1e-14)
+    assert lie.quaternion_to_matrix(quat[0]).shape == (3, 3) and lie.exp3(omega[:4].reshape(2, 2, 3)).shape == (2, 2, 4)
+    with pytest.raises(ValueError, match="multiply: expected arrays of"):
+        lie.quaternion_multiply(quat, p)
+
+
+@pytest.mark.parametrize("kind", ["floating", "spherical", "planar"])
+def test_group_jacobians_equal_the_numpy_oracle(kind):
+    rng = np.random.default_rng(32)
+    omega = rotation_vectors(rng, 30)
+    if kind == "floating":
+        tau = np.concatenate([rng.normal(size=(30, 3)), omega], axis=1)
+    elif kind == "spherical":
+        tau = omega
+    else:  # the planar angle in (-π, π), both signs
+        tau = np.concatenate(
+            [rng.normal(size=(30, 2)), (np.linalg.norm(omega, axis=1) * rng.choice([-1, 1], 30))[:, None]], 1
+        )
+    for got, want, what in zip(
+        lie.block_jacobians(kind, tau), oracle.block_jacobians(kind, tau), ("Ad", "Jl", "Jl^-1")
+    ):
+        np.testing.assert_allclose(got, want, atol=1e-13, rtol=0, err_msg=f"{kind} {what}")
+
+
+def test_integrate_and_difference_jacobians_equal_the_oracle_joint_by_joint():
+    joints = [Joint(f"j{i}", kind=k) for i, k in enumerate(KINDS * 2)]
+    space = cfg.ConfigurationSpace(joints)
+    rng = np.random.default_rng(33)
+    q0 = space.random(rng, size=6)
+    v = rng.normal(size=(6, space.nv))
+    v[0] *= 1e-6  # the series branches
+    d_q, d_v = space.integrate_jacobians(q0, v, 0.4)
+    q1 = space.integrate(q0, v)
+    d_0, d_1 = space.difference_jacobians(q0, q1)
+    d = space.difference(q0, q1)
+    assert d_q.shape == d_v.shape == d_0.shape == d_1.shape == (6, space.nv, space.nv)
+    iv = 0
+    for j in joints:
+        cols = slice(iv, iv + j.nv)
+        if j.nv == 1:
+            want = (np.ones(6), np.full(6, 0.4), -np.ones(6), np.ones(6))
+            for got, w in zip((d_q, d_v, d_0, d_1), want):
+                np.testing.assert_array_equal(got[:, iv, iv], w)
+        else:
+            ad, jl, _ = oracle.block_jacobians(j.kind, -0.4 * v[:, cols])
+            np.testing.assert_allclose(d_q[:, cols, cols], ad, atol=1e-13, rtol=0, err_msg=j.kind)
+            np.testing.assert_allclose(d_v[:, cols, cols], 0.4 * jl, atol=1e-13, rtol=0, err_msg=j.kind)
+            np.testing.assert_allclose(d_0[:, cols, cols], -oracle.block_jacobians(j.kind, d[:, cols])[2], atol=1e-12)
+            np.testing.assert_allclose(d_1[:, cols, cols], oracle.block_jacobians(j.kind, -d[:, cols])[2], atol=1e-12)
+        # block diagonal: nothing between joints
+        for M in (d_q, d_v, d_0, d_1):
+            assert not np.any(M[:, cols, :iv]) and not np.any(M[:, cols, iv + j.nv :])
+        iv += j.nv

@@ -300,3 +300,28 @@ def test_constant_f_ext_with_a_controller_and_a_bad_f_ext_function():
     assert np.abs(as_data.q - kd.simulate(robot, 0.1, x0, dt=1e-3, controller=controller).q).max() > 1e-4
     with pytest.raises(ValueError, match=r"f_ext returned wrenches of shape \[5, 6\]"):
         kd.simulate(robot, 0.1, x0, dt=1e-3, f_ext=lambda t, q, qd: np.zeros((5, 6)))
+
+
+def test_the_core_takes_one_wrench_per_link_on_the_body_that_carries_it():
+    """With multi-DOF joints the native model has more bodies than links: f_ext is still one wrench
+    per link ((links, 6), one set shared by a batch), the core placing each on the body that carries
+    its link (``Model.link_bodies``: a joint's last body); one per native body is refused by shape."""
+    robot = with_link_offsets(random_robot(7, n=6, branching=True, floating=True, spherical=0.4, planar=0.3), 7)
+    links = len(robot.body_names)
+    assert robot.n > links
+    # the description's count: a joint of nv degrees of freedom ends nv - 1 bodies after its first
+    np.testing.assert_array_equal(robot._model.link_bodies, np.cumsum([j.nv for j in robot.joints]) - 1)
+    rng = np.random.default_rng(8)
+    q = robot.random_configuration(rng, size=3)
+    qd, qdd = rng.normal(size=(3, robot.nv)), rng.normal(size=(3, robot.nv))
+    f = rng.normal(size=(links, 6))
+    shared = robot.inverse_dynamics(q, qd, qdd, f_ext=f)
+    np.testing.assert_array_equal(shared, robot.inverse_dynamics(q, qd, qdd, f_ext=np.stack([f] * 3)))
+    np.testing.assert_array_equal(shared[1], robot.inverse_dynamics(q[1], qd[1], qdd[1], f_ext=f))
+    with pytest.raises(ValueError, match=rf"f_ext must have shape \({links}, 6\)"):
+        robot.inverse_dynamics(q[0], qd[0], qdd[0], f_ext=np.zeros((robot.n, 6)))
+    with pytest.raises(
+        ValueError, match=rf"f_ext returned wrenches of shape \[{robot.n}, 6\] at t = 0; the robot has {links} links"
+    ):
+        x0 = np.concatenate([q[0], np.zeros(robot.nv)])
+        kd.simulate(robot, 0.01, x0, dt=1e-3, method="rk4", f_ext=lambda t, q, qd: np.zeros((robot.n, 6)))

@@ -30,14 +30,17 @@ class Model:
         #   axis: (3,) unit axis (the planar joint's normal; not read for floating and spherical);
         #   inertia: (10,) = 0, [m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] of the link about its frame origin;
         #   offset, armature (r^2 J_m), viscous, coulomb: float = 0 (1-DOF joints only);
-        #   coulomb_negative: float | None = None, the Coulomb level for qd < 0 when it differs
+        #   coulomb_negative: float | None = None, the Coulomb level for qd < 0 when it differs;
+        #   link_origin: (3,) | None = None, the link frame's origin in the joint frame (f_ext's moments about it)
         joints: Sequence[Mapping[str, object]],
         gravity: F64,  # (3,) in base coordinates
         frames: Sequence[tuple[int, F64]] = (),  # (joint index, -1 = base; (4, 4) link frame -> named frame)
     ) -> None: ...
     # the model with f_ext's moments taken about link-frame origins: (n, 3), each body's link-frame
-    # origin in its body frame (zero: the body origin)
+    # origin in its body frame (zero: the body origin; the records' link_origin set them)
     def with_link_origins(self, origins: F64) -> Model: ...
+    @property
+    def link_bodies(self) -> I64: ...  # (links,) the body that carries each link (a multi-DOF joint's last)
     @property
     def n(self) -> int: ...  # bodies = degrees of freedom (nv)
     @property
@@ -57,7 +60,8 @@ class Model:
         self, q: F64, qd: F64, frame: int, reference: str, point: F64 | None = None
     ) -> F64: ...  # (6,) | (N, 6)
     # ---- dynamics (issue 3) ----
-    # f_ext: (n, 6) | (N, n, 6), per body [force; moment] in base axes, moment about the link-frame origin (with_link_origins; the body origin by default).
+    # f_ext: (links, 6) | (N, links, 6), one [force; moment] per link (the core places it on the body that
+    # carries the link), base axes, moment about the link-frame origin; one (links, 6) set serves a whole batch.
     # A singular mass matrix (forward_dynamics, mass_matrix_inverse) raises RuntimeError naming the joint.
     def inverse_dynamics(
         self, q: F64, qd: F64, qdd: F64, f_ext: F64 | None = None, out: F64 | None = None
@@ -167,7 +171,7 @@ def integrate_fixed(
     max_speed: float = 1e6,
     lower: F64 | None = None,  # (n,) joint position limits: inelastic stops when given
     upper: F64 | None = None,
-    f_ext: F64 | None = None,  # (n, 6) constant external wrenches per body (as Model.inverse_dynamics)
+    f_ext: F64 | None = None,  # (links, 6) constant external wrenches per link (as Model.inverse_dynamics)
 ) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
 def integrate_callback(
     model: Model,
@@ -185,10 +189,13 @@ def integrate_callback(
     | None = None,  # (step, t, q, qd) -> (dtau/dq, dtau/dqd) (n, n) each, or None
     lower: F64 | None = None,
     upper: F64 | None = None,
-    # external wrenches per body: None, (n, 6) constant, or (t, q, qd) -> (n, 6) at every stage
+    # external wrenches per link: None, (links, 6) constant, or (t, q, qd) -> (links, 6) at every stage
     f_ext: F64 | Callable[[float, F64, F64], F64] | None = None,
 ) -> tuple[F64, F64, F64, F64, I64, list[dict[str, Any] | None]]: ...
 
 # the core's Lie-group operations per joint block ("floating", "spherical", "planar", "" for 1-DOF):
 def lie_integrate(names: Sequence[str], q: F64, v: F64) -> F64: ...  # q (..., nq), v (..., nv) -> q ⊕ v
 def lie_difference(names: Sequence[str], q0: F64, q1: F64) -> F64: ...  # (..., nq) x2 -> v with q0 ⊕ v = q1
+
+# a joint's motion joint_from_body (4, 4) at its q block (kind and axis as in a joint record)
+def joint_transform(kind: str, axis: F64 | None, q: F64) -> F64: ...

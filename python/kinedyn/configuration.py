@@ -23,8 +23,9 @@ random rotations", *Graphics Gems III* (1992) for random quaternions.
 
 Everything here is NumPy and vectorised: ``q`` may be (nq,) or a batch (..., nq), ``v`` (nv,) or
 (..., nv), broadcast against each other. ``integrate`` and ``difference`` are the core's
-(``kinedyn._core.lie_integrate`` / ``lie_difference``, which need no model); their Jacobians and the
-quaternion helpers are NumPy (:mod:`kinedyn.lie`).
+(``kinedyn._core.lie_integrate`` / ``lie_difference``, which need no model), and so are their
+Jacobians (``lie_integrate_jacobians`` / ``lie_difference_jacobians``) and the quaternion helpers
+(:mod:`kinedyn.lie`).
 """
 
 from __future__ import annotations
@@ -37,10 +38,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._core import lie_difference, lie_integrate
+from ._core import lie_difference, lie_difference_jacobians, lie_integrate, lie_integrate_jacobians
 from .description.joint import Joint
 from .lie import (
-    block_jacobians,
     exp3,
     log3,
     quaternion_multiply,
@@ -97,12 +97,6 @@ class _Block:
     iv: int  # first index of the joint's block in v
 
 
-def _indices(blocks, kind: str, size: int, attr: str) -> np.ndarray:
-    return np.array(
-        [[getattr(b, attr) + k for k in range(size)] for b in blocks if b.joint.kind == kind], dtype=np.intp
-    ).reshape(-1, size)
-
-
 class ConfigurationSpace:
     """The configuration space of a sequence of moving joints (a robot's, in body order): sizes, and
     every operation vectorised over the joints of one kind and over a batch of states."""
@@ -123,13 +117,6 @@ class ConfigurationSpace:
             b.joint.kind if b.joint.kind in ("floating", "spherical", "planar") else "" for b in blocks
         ]
         self._scalar_q = np.array([b.iq for b in blocks if b.joint.nq == 1], dtype=np.intp)
-        self._scalar_v = np.array([b.iv for b in blocks if b.joint.nv == 1], dtype=np.intp)
-        self._kinds = {}  # kind -> (q indices (k, nq), v indices (k, nv)) for the multi-DOF kinds present
-        for kind in ("floating", "spherical", "planar"):
-            nq, nv = {"floating": (7, 6), "spherical": (4, 3), "planar": (4, 3)}[kind]
-            qi = _indices(blocks, kind, nq, "iq")
-            if len(qi):
-                self._kinds[kind] = (qi, _indices(blocks, kind, nv, "iv"))
         # where the unit-norm parts sit: quaternions (k, 4) and planar (cos, sin) pairs (k, 2), with their joints
         self._unit_parts = []
         for b in blocks:
@@ -241,12 +228,14 @@ class ConfigurationSpace:
     def difference(self, q0, q1) -> np.ndarray:
         """v with q0 ⊕ v = q1: Log(M(q0)⁻¹ M(q1)) per joint, q1 - q0 for 1-DOF joints; rotations the
         short way (angle in [0, π]; q and -q are the same rotation)."""
+        # the core's Log(M0⁻¹ M1) per joint block (crates/kinedyn-core/src/lie.rs)
+        return lie_difference(self._block_names, *self._pair(q0, q1))
+
+    def _pair(self, q0, q1) -> tuple:
+        """``q0``, ``q1`` checked and broadcast against each other, C-contiguous (for the core)."""
         q0, q1 = self.check(q0, "q0"), self.check(q1, "q1")
         shape = np.broadcast_shapes(q0.shape[:-1], q1.shape[:-1])
-        q0 = np.broadcast_to(q0, shape + (self.nq,))
-        q1 = np.broadcast_to(q1, shape + (self.nq,))
-        # the core's Log(M0⁻¹ M1) per joint block (crates/kinedyn-core/src/lie.rs)
-        return lie_difference(self._block_names, np.ascontiguousarray(q0), np.ascontiguousarray(q1))
+        return tuple(np.ascontiguousarray(np.broadcast_to(q, shape + (self.nq,))) for q in (q0, q1))
 
     def interpolate(self, q0, q1, t) -> np.ndarray:
         """q0 ⊕ t · difference(q0, q1): the geodesic from q0 (t = 0) to q1 (t = 1) in each joint's group;
@@ -266,42 +255,22 @@ class ConfigurationSpace:
     def integrate_jacobians(self, q, v, dt=1.0) -> tuple:
         """(∂(q ⊕ v dt)/∂q, ∂(q ⊕ v dt)/∂v), each (nv, nv) or (..., nv, nv), in the tangent spaces
         (perturbations on the right, as Pinocchio's ``dIntegrate`` ARG0 and ARG1): block diagonal,
-        Ad(Exp(v dt))⁻¹ and Jr(v dt) dt per multi-DOF joint, 1 and dt for 1-DOF joints."""
+        Ad(Exp(v dt))⁻¹ and Jr(v dt) dt per multi-DOF joint, 1 and dt for 1-DOF joints (the core's
+        ``lie::integrate_jacobians_block``)."""
         q = self.check(q)
         v = self._velocity(v)
         dt = np.asarray(dt, dtype=float)
         if dt.ndim or not np.isfinite(dt):
             raise ValueError(f"dt must be one finite number, got {dt}")
-        vdt = np.asarray(v * dt)
-        shape = np.broadcast_shapes(q.shape[:-1], vdt.shape[:-1])
-        vdt = np.broadcast_to(vdt, shape + (self.nv,))
-        d_q = np.zeros(shape + (self.nv, self.nv))
-        d_v = np.zeros(shape + (self.nv, self.nv))
-        d_q[..., self._scalar_v, self._scalar_v] = 1.0
-        d_v[..., self._scalar_v, self._scalar_v] = float(dt)
-        for kind, (_, vi) in self._kinds.items():
-            for cols in vi:
-                ad, jl, _ = block_jacobians(kind, -vdt[..., cols])
-                d_q[..., cols[:, None], cols[None, :]] = ad
-                d_v[..., cols[:, None], cols[None, :]] = jl * float(dt)
-        return d_q, d_v
+        shape = np.broadcast_shapes(q.shape[:-1], v.shape[:-1])
+        v = np.ascontiguousarray(np.broadcast_to(v, shape + (self.nv,)))
+        return lie_integrate_jacobians(self._block_names, v, float(dt))
 
     def difference_jacobians(self, q0, q1) -> tuple:
         """(∂ difference/∂q0, ∂ difference/∂q1), each (nv, nv) or (..., nv, nv), in the tangent spaces
         (as Pinocchio's ``dDifference`` ARG0 and ARG1): -Jl⁻¹(d) and Jr⁻¹(d) per multi-DOF joint,
-        d = difference(q0, q1); -1 and 1 for 1-DOF joints."""
-        d = self.difference(q0, q1)
-        d_q0 = np.zeros(d.shape[:-1] + (self.nv, self.nv))
-        d_q1 = np.zeros_like(d_q0)
-        d_q0[..., self._scalar_v, self._scalar_v] = -1.0
-        d_q1[..., self._scalar_v, self._scalar_v] = 1.0
-        for kind, (_, vi) in self._kinds.items():
-            for cols in vi:
-                _, _, inv_plus = block_jacobians(kind, d[..., cols])
-                _, _, inv_minus = block_jacobians(kind, -d[..., cols])
-                d_q0[..., cols[:, None], cols[None, :]] = -inv_plus
-                d_q1[..., cols[:, None], cols[None, :]] = inv_minus
-        return d_q0, d_q1
+        d = difference(q0, q1); -1 and 1 for 1-DOF joints (the core's ``lie::difference_jacobians_block``)."""
+        return lie_difference_jacobians(self._block_names, *self._pair(q0, q1))
 
     def normalize(self, q) -> np.ndarray:
         """``q`` with each quaternion and planar (cos, sin) pair divided by its norm (a copy)."""

@@ -77,6 +77,7 @@ class Conversion:
     max_mass_matrix_error: float = 0.0
     max_torque_error: float = 0.0
     frames_compared: list[str] = field(default_factory=list)
+    loops_compared: int = 0  # closed loops read back with their kind and both frames' poses compared
     notes: list[str] = field(default_factory=list)  # what the format could not hold, what the check skipped
 
     @property
@@ -89,7 +90,9 @@ class Conversion:
         ]
         if self.checked:
             lines.append(
-                f"checked by reading it back: {len(self.frames_compared)} frames, M and inverse dynamics at {self.states} random states: "
+                f"checked by reading it back: {len(self.frames_compared)} frames, "
+                + (f"{self.loops_compared} loop{'s' * (self.loops_compared > 1)}, " if self.loops_compared else "")
+                + f"M and inverse dynamics at {self.states} random states: "
                 f"max |FK error| {self.max_frame_error:.2e}, max |M error| {self.max_mass_matrix_error:.2e}, "
                 f"max |tau error| {self.max_torque_error:.2e}"
             )
@@ -250,8 +253,25 @@ def check_conversion(
         )
     if fmt == "dh":
         result.frames_compared = ["tool (the source's tool)"] + frames
+    _check_loops(source, back, result, states, seed)
     result.checked, result.states = True, states
     return result
+
+
+def _check_loops(source: Robot, back: Robot, result: Conversion, states: int, seed: int) -> None:
+    """The written file's loops are the source's: the same names and kinds, and each loop's two
+    frames where the source's are at random states (a loop end may read back as a frame of another
+    name: to_mjcf puts a site on a link)."""
+    ours, theirs = [(lp.name, lp.kind) for lp in source.loops], [(lp.name, lp.kind) for lp in back.loops]
+    if ours != theirs:
+        raise ValueError(f"the written file reads back with loops {theirs}, not the source's {ours}")
+    if not ours:
+        return
+    for q, _, _ in _random_states(source, states, seed):
+        for a, b in zip(source.loops, back.loops):
+            error = np.abs(source.frame_poses(q, [a.frame_a, a.frame_b]) - back.frame_poses(q, [b.frame_a, b.frame_b]))
+            result.max_frame_error = max(result.max_frame_error, float(error.max()))
+    result.loops_compared = len(ours)
 
 
 def mujoco_coordinates(source: Robot, model) -> tuple | None:
@@ -353,7 +373,12 @@ def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int
         result.notes.append("not checked: MuJoCo writes a planar joint as two slides and a hinge (no map here)")
         return result
     qpos, A, a_bias = maps
-    names = [l.name for l in source.links] + [f.name for f in source.frames]
+    # frames written as bodies (a loop end may be a site instead: its loop is compared below)
+    names = [
+        n
+        for n in [l.name for l in source.links] + [f.name for f in source.frames]
+        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) >= 0
+    ]
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
     result.frames_compared = names
     M = np.zeros((model.nv, model.nv))
@@ -374,6 +399,11 @@ def _check_with_mujoco(source: Robot, path: str, result: Conversion, states: int
         bias = source.coriolis_matrix(q, qd) @ qd + source.gravity_torque(q)
         bias_mj = Aq.T @ (data.qfrc_bias + M @ a_bias(q, qd))
         result.max_torque_error = max(result.max_torque_error, float(np.abs(bias_mj - bias).max(initial=0.0)))
+    if source.loops:  # kinedyn's MJCF reader reads MuJoCo's equalities as MuJoCo does (tests/test_loops_files.py)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # what MJCF holds that kinedyn does not model: the source had none
+            back = source.from_description(read_description(path))
+        _check_loops(source, back, result, states, seed)
     result.notes.append(
         "read back by MuJoCo: M = mj_fullM, and qfrc_bias against C qd + g (MuJoCo keeps friction out of the bias)"
         + ("; mimic followers compared on the independent coordinates (G^T M G)" if mimic is not None else "")

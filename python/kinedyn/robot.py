@@ -27,7 +27,7 @@ from .description.geometry import Visual
 from .description.link import Frame, Link
 from .description.loops import Loop
 from .ik.dispatch import inverse_kinematics as solve_ik
-from .native.compile import body_wrenches, compile_model, link_bodies, locked_block
+from .native.compile import compile_model, locked_block
 from .native.errors import robot_error
 from .robot_loops import ClosedLoops
 
@@ -290,11 +290,6 @@ class Robot(ClosedLoops):
     coulomb = _described("coulomb")
     coulomb_negative = _described("coulomb_negative")
 
-    @cached_property
-    def _dof_body(self) -> np.ndarray:
-        """(nv,) the moving link (index into body_names) each degree of freedom belongs to."""
-        return np.repeat(np.arange(len(self.tree.bodies)), [b.joint.nv for b in self.tree.bodies])
-
     @batched("qd")
     def friction_torque(self, qd: ArrayLike) -> np.ndarray:
         """viscous * qd + Coulomb friction (:func:`kinedyn.dynamics.friction_torque`), (n,) or (N, n)."""
@@ -516,14 +511,11 @@ class Robot(ClosedLoops):
     ) -> np.ndarray:
         """tau = M qdd + C qd + g + friction - sum_i J_i^T f_ext_i (recursive Newton-Euler).
 
-        ``f_ext``: (n, 6) (or (N, n, 6)), one wrench ``[force; moment]`` per moving link
-        (``robot.body_names``), acting on the link, in base axes, the moment taken about the origin of
+        ``f_ext``: (links, 6) (or (N, links, 6); links = ``len(robot.body_names)``, = n without
+        multi-DOF joints), one wrench ``[force; moment]`` per moving link, acting on the link, in base axes, the moment taken about the origin of
         the link's frame (``robot.forward_kinematics(q)[i]``), so that it maps to joint torques by
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
-        if f_ext is None:
-            return self._model.inverse_dynamics(q, qd, qdd, None, out)
-        q = float64_array(q)
-        return self._model.inverse_dynamics(q, qd, qdd, body_wrenches(self.description, q, f_ext), out)
+        return self._model.inverse_dynamics(q, qd, qdd, f_ext, out)
 
     @batched("q")
     def mass_matrix(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
@@ -548,10 +540,7 @@ class Robot(ClosedLoops):
         algorithm); ``f_ext`` as in :meth:`inverse_dynamics`. RuntimeError naming the joint if the
         mass matrix is singular (e.g. a massless subtree without rotor inertia)."""
         try:
-            if f_ext is None:
-                return self._model.forward_dynamics(q, qd, tau, None, out)
-            q = float64_array(q)
-            return self._model.forward_dynamics(q, qd, tau, body_wrenches(self.description, q, f_ext), out)
+            return self._model.forward_dynamics(q, qd, tau, f_ext, out)
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
@@ -565,10 +554,7 @@ class Robot(ClosedLoops):
         core's ``derivatives.rs``). ``f_ext`` is held fixed in base axes and applied at the
         link-frame origins, which move with q. Coulomb friction contributes its derivative, zero
         (qd != 0)."""
-        if f_ext is None:
-            return self._model.inverse_dynamics_derivatives(q, qd, qdd)
-        q = float64_array(q)
-        return self._model.inverse_dynamics_derivatives(q, qd, qdd, body_wrenches(self.description, q, f_ext))
+        return self._model.inverse_dynamics_derivatives(q, qd, qdd, f_ext)
 
     @batched("q", "qd", "tau", "f_ext")
     def forward_dynamics_derivatives(
@@ -578,10 +564,7 @@ class Robot(ClosedLoops):
         (N, n, n)): ``-M^-1`` times the inverse-dynamics derivatives at the forward-dynamics qdd
         (Carpentier & Mansard, RSS 2018). ``f_ext`` as in :meth:`inverse_dynamics_derivatives`."""
         try:
-            if f_ext is None:
-                return self._model.forward_dynamics_derivatives(q, qd, tau)
-            q = float64_array(q)
-            return self._model.forward_dynamics_derivatives(q, qd, tau, body_wrenches(self.description, q, f_ext))
+            return self._model.forward_dynamics_derivatives(q, qd, tau, f_ext)
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
@@ -649,8 +632,9 @@ class Robot(ClosedLoops):
         """Y(q, qd, qdd), (n, 10 n_links), with Y @ robot.inertial_parameters() == tau (no friction/rotor)."""
         y = self._model.regressor(q, qd, qdd)
         if self.has_multi_dof_joints:
-            # the native model's extra bodies of a multi-DOF joint are massless: keep the links' columns
-            columns = (10 * link_bodies(self.description)[:, None] + np.arange(10)).ravel()
+            # the native model's extra bodies of a multi-DOF joint are massless: keep the columns of
+            # the bodies that carry the links (the core's layout, Model.link_bodies)
+            columns = (10 * self._model.link_bodies[:, None] + np.arange(10)).ravel()
             y = np.ascontiguousarray(y[..., columns])
         return y
 

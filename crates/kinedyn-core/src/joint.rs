@@ -134,6 +134,62 @@ pub fn block_columns(block: Block, in_plane: (Vec3, Vec3)) -> Vec<Joint> {
     }
 }
 
+/// The joint transform `joint_from_body` of a multi-DOF block at its q block `qb` (Pinocchio's
+/// conventions: quaternion (x, y, z, w), assumed unit; planar (x, y, cos θ, sin θ) with in-plane
+/// axes `in_plane` = (e1, e2), read only for the planar block): a free-flyer's (R(quat), p), a
+/// spherical joint's (R(quat), 0), a planar joint's rotation by θ about n = e1 x e2,
+/// `R = c 1 + s [n]x + (1 - c) n n^T` (Rodrigues), and translation x e1 + y e2.
+#[inline(always)]
+pub fn block_transform<T: Real>(block: Block, in_plane: (Vec3, Vec3), qb: &[T]) -> Transform<T> {
+    use crate::lie::quaternion_matrix;
+    match block {
+        Block::FreeFlyer => Transform::new(quaternion_matrix(&qb[3..7]), Vec3::new(qb[0], qb[1], qb[2])),
+        Block::Spherical => Transform::new(quaternion_matrix(&qb[0..4]), Vec3::zeros()),
+        Block::Planar => {
+            let (e1, e2) = in_plane;
+            let n = e1.cross(&e2);
+            let (c, s) = (qb[2], qb[3]);
+            let (skew_n, nn) = (
+                crate::spatial::splat33::<T>(&crate::spatial::skew(&n)),
+                crate::spatial::splat33::<T>(&(n * n.transpose())),
+            );
+            let rot = Mat3::identity() * c + skew_n * s + nn * (T::one() - c);
+            Transform::new(rot, splat3::<T>(&e1) * qb[0] + splat3::<T>(&e2) * qb[1])
+        }
+        Block::Scalar => unreachable!("a 1-DOF joint's transform is its column's jcalc"),
+    }
+}
+
+impl JointType {
+    /// The joint's motion `joint_from_body` at its block of q (`block().nq()` numbers): `jcalc`
+    /// of a 1-DOF joint's column, [`block_transform`] of a multi-DOF joint (the planar joint's
+    /// in-plane axes from [`planar_basis`] of its normal, as the model builder lays them out).
+    /// What locking a joint at a configuration folds into the next placement. `Err` when `q` has
+    /// another length or is not finite, or its quaternion / (cos, sin) pair is not unit
+    /// ([`Block::not_unit`]).
+    pub fn transform(&self, q: &[f64]) -> Result<Transform> {
+        let block = self.block();
+        if q.len() != block.nq() || q.iter().any(|x| !x.is_finite()) {
+            return Err(Error::InvalidModel(format!(
+                "a {} joint's configuration is {} finite numbers, got {q:?}",
+                self.name(),
+                block.nq()
+            )));
+        }
+        if let Some((range, what, norm)) = block.not_unit(q) {
+            return Err(Error::InvalidModel(format!(
+                "{what} {:?} is not unit (norm {norm})",
+                &q[range]
+            )));
+        }
+        Ok(match *self {
+            JointType::Revolute { .. } | JointType::Prismatic { .. } => self.columns()[0].jcalc(q[0]).0,
+            JointType::Planar { normal } => block_transform(block, planar_basis(normal), q),
+            JointType::FreeFlyer | JointType::Spherical => block_transform(block, (Vec3::x(), Vec3::y()), q),
+        })
+    }
+}
+
 /// A one-degree-of-freedom joint: its kind and unit axis in the joint frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Joint {

@@ -20,6 +20,9 @@
 
 use crate::spatial::{Mat3, Real};
 
+mod jacobians;
+pub use jacobians::{difference_jacobians_block, integrate_jacobians_block, GroupJacobians, Square};
+
 /// A quaternion (x, y, z, w), w the scalar part (Pinocchio's and Eigen's storage order).
 pub type Quat = [f64; 4];
 

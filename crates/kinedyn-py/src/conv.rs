@@ -245,3 +245,40 @@ pub(crate) fn point(point: Option<PyReadonlyArrayDyn<f64>>) -> PyResult<Option<V
         })
         .transpose()
 }
+
+/// External wrenches given one per link (`links` = `Model::link_bodies` of 6 numbers each, per
+/// state of `per_link`) laid out one per body of `model`, as the core's algorithms read them (its
+/// `Model::link_wrenches`: a multi-DOF joint's link on its last body). A model of 1-DOF joints has
+/// one body per link: the numbers as given.
+pub(crate) fn wrenches_per_body(model: &kinedyn_core::Model, per_link: &[f64]) -> PyResult<Vec<f64>> {
+    let width = 6 * model.link_bodies().len();
+    if model.plain || width == 0 {
+        return guard::try_copy("f_ext", per_link);
+    }
+    let states = per_link.len() / width;
+    let mut out = guard::try_vec("f_ext per body", states * 6 * model.n)?;
+    out.resize(states * 6 * model.n, 0.0);
+    for (links, bodies) in per_link.chunks(width).zip(out.chunks_mut(6 * model.n)) {
+        model
+            .link_wrenches(links, bodies)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    }
+    Ok(out)
+}
+
+/// Constant external wrenches `f_ext` of a simulation, one per link ((links, 6), as
+/// `Model.inverse_dynamics` takes them), checked (shape, finite) and laid out one per body.
+pub(crate) fn constant_wrenches(
+    model: &kinedyn_core::Model,
+    f_ext: Option<&PyReadonlyArrayDyn<f64>>,
+) -> PyResult<Option<Vec<f64>>> {
+    let Some(f) = f_ext else { return Ok(None) };
+    let links = model.link_bodies().len();
+    let v = vec_of("f_ext", f, &[links, 6])?;
+    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "f_ext contains a non-finite value (NaN or inf) at flat index {k}"
+        )));
+    }
+    wrenches_per_body(model, &v).map(Some)
+}

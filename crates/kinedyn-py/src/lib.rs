@@ -42,6 +42,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     m.add_function(wrap_pyfunction!(simd, m)?)?;
     m.add_function(wrap_pyfunction!(planar_basis, m)?)?;
+    m.add_function(wrap_pyfunction!(records::joint_transform, m)?)?;
     m.add(
         "SingularMassMatrixError",
         m.py().get_type::<run::SingularMassMatrixError>(),

@@ -1,13 +1,14 @@
 //! `kinedyn._core.Model`: the compiled model and its numeric methods, each a call into the core
 //! run by `run.rs` over one state or a batch.
 
+use std::borrow::Cow;
 use std::sync::Mutex;
 
 use kinedyn_core::algorithms;
 use kinedyn_core::batch::{self, kernels, Input, Scratch, Simd};
 use kinedyn_core::spatial::Vec3;
 use kinedyn_core::{Data, Model};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -34,18 +35,39 @@ impl PyModel {
     }
 
     /// The three state arrays of a dynamics call (q (nq,), then two of (n,)) and the optional
-    /// external wrenches f_ext (n, 6), checked against each other.
+    /// external wrenches f_ext, one per link ((links, 6), one set shared by every state of a batch,
+    /// or (N, links, 6)), checked against each other and laid out one per body for the core
+    /// (`conv::wrenches_per_body`).
     fn gather_dynamics<'a>(
         &self,
         [(a, x), (b, y), (c, z)]: [(&str, &'a Bound<'_, PyArrayDyn<f64>>); 3],
         f_ext: Option<&'a Bound<'_, PyArrayDyn<f64>>>,
     ) -> PyResult<Batch<'a>> {
         let (n, nq) = (self.n(), self.model.nq);
-        let (sq, s1, s6) = ([nq], [n], [n, 6]);
-        match f_ext {
-            Some(f) => Batch::gather(&[(a, x, &sq), (b, y, &s1), (c, z, &s1), ("f_ext", f, &s6)]),
-            None => Batch::gather(&[(a, x, &sq), (b, y, &s1), (c, z, &s1)]),
+        let (sq, s1) = ([nq], [n]);
+        let states = [(a, x, &sq[..]), (b, y, &s1[..]), (c, z, &s1[..])];
+        let Some(f) = f_ext else { return Batch::gather(&states) };
+        let links = if self.model.plain {
+            n
+        } else {
+            self.model.link_bodies().len()
+        };
+        let sl = [links, 6];
+        let mut batch = Batch::gather(&states)?;
+        match batch.batch {
+            // one set of wrenches for every state of a batch, repeated as NumPy broadcasts it
+            Some(count) if f.shape() == sl => {
+                let one = Batch::gather(&[("f_ext", f, &sl[..])])?;
+                batch.values[3] = Cow::Owned(one.values[0].repeat(count));
+                (batch.width[3], batch.count) = (6 * links, 4);
+            }
+            _ => batch = Batch::gather(&[states[0], states[1], states[2], ("f_ext", f, &sl[..])])?,
         }
+        if !self.model.plain {
+            batch.values[3] = Cow::Owned(conv::wrenches_per_body(&self.model, &batch.values[3])?);
+            batch.width[3] = 6 * n;
+        }
+        Ok(batch)
     }
 
     /// Every state of `q` (nq numbers each) passes the core's `Model::check_configuration`.
@@ -66,7 +88,7 @@ impl PyModel {
 
 /// Writes `#[pymethods] impl PyModel` from one table of the methods whose arguments are state
 /// arrays, each row `fn name(input: width, ..; f_ext) -> "result" [per-state shape], out = how;`
-/// (`; f_ext` where the call takes external wrenches (n, 6), `, out` where it takes NumPy's
+/// (`; f_ext` where the call takes external wrenches (links, 6), `, out` where it takes NumPy's
 /// `out=`), where `how` is `kernel K` (a core batch `Kernel`, over SIMD lanes) or
 /// `per_state |model, data, x, out| ..` (one state at a time), followed by the methods written by
 /// hand (`by_hand { .. }`: those with options or several results). `|n, nq|` names the model's
@@ -199,6 +221,14 @@ model_methods! {
                 let data = Mutex::new(Data::new(&model));
                 Ok(Self { model, data })
             })
+        }
+
+        /// The body that carries each link, in joint order (the core's `Model::link_bodies`: a
+        /// multi-DOF joint's last body), as an int64 array (links,).
+        #[getter]
+        fn link_bodies<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+            let bodies: Vec<i64> = self.model.link_bodies().iter().map(|&b| b as i64).collect();
+            PyArray1::from_vec(py, bodies)
         }
 
         #[getter(n)]

@@ -7,6 +7,7 @@ use kinedyn_core::joint::JointType;
 use kinedyn_core::model::{JointRecord, ModelBuilder};
 use kinedyn_core::spatial::{Inertia, Transform, Vec3};
 use kinedyn_core::Model;
+use numpy::PyArrayMethods;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -15,13 +16,14 @@ use crate::conv::numbers;
 use crate::run::core_err;
 
 /// The keys of a joint record; the first three have no default.
-const KEYS: [&str; 11] = [
+const KEYS: [&str; 12] = [
     "name",
     "kind",
     "placement",
     "parent",
     "axis",
     "inertia",
+    "link_origin",
     "offset",
     "armature",
     "viscous",
@@ -85,6 +87,11 @@ fn record(k: usize, d: &Bound<'_, PyDict>) -> PyResult<JointRecord> {
         Some(x) => Inertia::from_parameters(&numbers(&what("inertia"), &x, &[10])?),
         None => Inertia::zero(),
     };
+    // the link frame's origin in the joint frame (where the moments of f_ext are taken): zero by default
+    let link_origin = match d.get_item("link_origin")? {
+        Some(u) if !u.is_none() => Vec3::from_column_slice(&numbers(&what("link_origin"), &u, &[3])?),
+        _ => Vec3::zeros(),
+    };
     let coulomb_negative = match d.get_item("coulomb_negative")? {
         Some(x) if !x.is_none() => Some(number("coulomb_negative")?),
         _ => None,
@@ -95,6 +102,7 @@ fn record(k: usize, d: &Bound<'_, PyDict>) -> PyResult<JointRecord> {
         viscous: number("viscous")?,
         coulomb: number("coulomb")?,
         coulomb_negative,
+        link_origin,
         ..JointRecord::new(&name, joint, parent, placement, inertia)
     })
 }
@@ -127,4 +135,29 @@ pub(crate) fn build(
             .map_err(core_err)?;
     }
     builder.build().map_err(core_err)
+}
+
+/// The motion `joint_from_body` (4, 4) of a joint of `kind` (with its `axis`, the planar joint's
+/// normal; None for "floating" and "spherical") at its block of q: the core's
+/// `JointType::transform` (what `Robot.lock_joints` folds into a placement). ValueError for a block
+/// of the wrong length, not finite, or whose quaternion / (cos, sin) pair is not unit.
+#[pyfunction]
+#[pyo3(signature = (kind, axis, q))]
+pub(crate) fn joint_transform<'py>(
+    py: Python<'py>,
+    kind: &str,
+    axis: Option<Bound<'py, PyAny>>,
+    q: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let axis = match axis {
+        Some(a) if !a.is_none() => Some(Vec3::from_column_slice(&numbers("axis", &a, &[3])?)),
+        _ => None,
+    };
+    let joint = JointType::from_name(kind, axis).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let q = crate::conv::f64_array("q", &q)?;
+    let q: Vec<f64> = q.readonly().as_array().iter().copied().collect();
+    let t = joint.transform(&q).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let m = t.to_homogeneous(); // row-major
+    let rows: Vec<Vec<f64>> = m.chunks(4).map(<[f64]>::to_vec).collect();
+    Ok(numpy::PyArray2::from_vec2(py, &rows)?)
 }

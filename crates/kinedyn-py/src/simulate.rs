@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use rayon::prelude::*;
 
+use crate::conv::{constant_wrenches, wrenches_per_body};
 use crate::guard::{self, guarded};
 use crate::{core_err, PyModel};
 
@@ -77,19 +78,6 @@ fn flat(name: &str, a: &PyReadonlyArrayDyn<f64>) -> PyResult<Vec<f64>> {
         )));
     }
     Ok(v)
-}
-
-/// Constant external wrenches `f_ext` ((n, 6), per body as `Model.inverse_dynamics` takes them),
-/// checked and flattened.
-fn constant_wrenches(n: usize, f_ext: Option<&PyReadonlyArrayDyn<f64>>) -> PyResult<Option<Vec<f64>>> {
-    let Some(f) = f_ext else { return Ok(None) };
-    if f.shape() != [n, 6] {
-        return Err(PyValueError::new_err(format!(
-            "f_ext must have shape ({n}, 6): one wrench per body, got {:?}",
-            f.shape()
-        )));
-    }
-    flat("f_ext", f).map(Some)
 }
 
 fn failure_dict<'py>(py: Python<'py>, f: &Failure) -> PyResult<Bound<'py, PyDict>> {
@@ -203,7 +191,7 @@ const INTERRUPTIBLE_STEPS: usize = 20_000;
 /// samples `tau`: None (zero), `(S, n)` shared by every trajectory or `(N, S, n)` one per trajectory;
 /// S = 1 is a constant, else samples at `t0 + k dt` held over each step (`linear=False`, S >= steps)
 /// or interpolated (`linear=True`, S >= steps + 1). A batch runs in parallel without the GIL.
-/// `f_ext`: constant external wrenches (n, 6) per body (as `Model.inverse_dynamics` takes them), or None.
+/// `f_ext`: constant external wrenches (links, 6), one per link (as `Model.inverse_dynamics`), or None.
 #[pyfunction]
 #[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, tau=None, linear=false, record_every=1, max_speed=1e6, lower=None, upper=None, f_ext=None))]
 #[allow(clippy::too_many_arguments)]
@@ -227,7 +215,7 @@ pub fn integrate_fixed<'py>(
     guarded("integrate_fixed", || {
         let m = model.get();
         let (n, nq) = (m.model.n, m.model.nq);
-        let f_ext = constant_wrenches(n, f_ext.as_ref())?;
+        let f_ext = constant_wrenches(&m.model, f_ext.as_ref())?;
         let bounds = limits(nq, lower.as_ref(), upper.as_ref())?;
         let limits = bounds.as_ref().map(|(lower, upper)| Limits { lower, upper });
         let settings = Settings {
@@ -422,7 +410,7 @@ fn matrix_into(value: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut [f64]) 
 /// (`hold=True`). A batch (N, n) runs its trajectories one after the other. An exception raised by
 /// the callback propagates unchanged. `jacobian(step, t, q, qd) -> (dtau_dq, dtau_dqd)` ((n, n)
 /// each) or None: the torque's derivatives, used by the implicit method. `f_ext`: None, constant
-/// wrenches (n, 6) or a callable `f_ext(t, q, qd) -> (n, 6)` evaluated at every stage.
+/// wrenches (links, 6) or a callable `f_ext(t, q, qd) -> (links, 6)` evaluated at every stage.
 #[pyfunction]
 #[pyo3(signature = (model, method_name, q0, qd0, t0, dt, steps, callback, hold=false, record_every=1, max_speed=1e6, jacobian=None, lower=None, upper=None, f_ext=None))]
 #[allow(clippy::too_many_arguments)]
@@ -530,11 +518,12 @@ pub fn integrate_callback<'py>(
                     message
                 })
             };
-        // external wrenches: None, a constant (n, 6) array, or a callable f_ext(t, q, qd) -> (n, 6)
+        // external wrenches, one per link: None, a constant array, or a callable f_ext(t, q, qd)
         let constant = match f_ext.as_ref() {
-            Some(f) if !f.is_callable() => constant_wrenches(n, Some(&f.extract::<PyReadonlyArrayDyn<f64>>()?))?,
+            Some(f) if !f.is_callable() => constant_wrenches(&m.model, Some(&f.extract()?))?,
             _ => None,
         };
+        let links = m.model.link_bodies().len();
         let wrenches = |_k: usize, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]| -> Result<bool, String> {
             if let Some(c) = constant.as_deref() {
                 out.copy_from_slice(c);
@@ -543,14 +532,17 @@ pub fn integrate_callback<'py>(
             let Some(f) = f_ext.as_ref() else { return Ok(false) };
             let mut call = || -> PyResult<bool> {
                 let value = f.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)))?;
-                let a: PyReadonlyArrayDyn<f64> = value.extract()?;
-                if a.shape() != [n, 6] {
+                let a = crate::conv::f64_array("f_ext", &value)?.readonly();
+                if a.shape() != [links, 6] {
                     return Err(PyValueError::new_err(format!(
-                        "f_ext returned wrenches of shape {:?} at t = {t}; the model has {n} bodies: ({n}, 6)",
+                        "f_ext returned wrenches of shape {:?} at t = {t}; the robot has {links} links: ({links}, 6)",
                         a.shape()
                     )));
                 }
-                out.iter_mut().zip(a.as_array().iter()).for_each(|(o, x)| *o = *x);
+                out.copy_from_slice(&wrenches_per_body(
+                    &m.model,
+                    &a.as_array().iter().copied().collect::<Vec<_>>(),
+                )?);
                 Ok(true)
             };
             call().map_err(|e| {

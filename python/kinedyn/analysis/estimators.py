@@ -38,6 +38,8 @@ __all__ = [
     "estimate_delay",
     "stribeck_search",
     "METHODS",
+    "resolve_method",
+    "speed_rows",
 ]
 
 #: the estimators by name (``auto``: ``iv`` when the controller is given, else ``ols``, or ``wls``
@@ -98,27 +100,80 @@ def least_squares(W: np.ndarray, y: np.ndarray, n: int, weights: np.ndarray | No
     return est, cov, r.reshape(-1, n)
 
 
-def joint_noise(r: np.ndarray, p: int) -> np.ndarray:
-    """Per-joint residual standard deviation (Gautier & Poignet 2001), never zero."""
+def joint_noise(r: np.ndarray, p: int, rows: np.ndarray | None = None) -> np.ndarray:
+    """Per-joint residual standard deviation (Gautier & Poignet 2001), never zero; ``rows`` (S, n):
+    the rows in the fit (left-out rows, e.g. near zero speed, do not count)."""
     S, n = r.shape
-    sig = np.sqrt((r**2).sum(axis=0) / max(S - p / n, 1.0))
+    m = np.ones((S, n)) if rows is None else np.asarray(rows, dtype=float).reshape(S, n)
+    sig = np.sqrt(((r * m) ** 2).sum(axis=0) / np.maximum(m.sum(axis=0) - p / n, 1.0))
     return np.where(sig > 0, sig, max(float(sig.max()), 1e-300))
 
 
-def irls(W: np.ndarray, y: np.ndarray, n: int, k: float = 1.345, iterations: int = 30, tol: float = 1e-10):
+def speed_rows(qd: np.ndarray, min_speed: float, spread: int = 0) -> np.ndarray:
+    """1 for the rows (sample, joint) whose joint moves at ``|qd_j| >= min_speed``, else 0, flattened
+    as the stacked rows. Near zero speed Coulomb friction is not ``Fc sign(qd)``: a joint sticks, or
+    its speed chatters about zero within one sample, and the friction there is any torque within the
+    static levels. Those rows are left out of the fit (the usual practice of identification with a
+    Coulomb model: it holds away from zero speed, Armstrong-Helouvry, Dupont & Canudas de Wit 1994).
+    ``spread``: samples left out on either side of a slow stretch too (a filtered log's torques carry
+    the stick's torque as far as its low-pass reaches)."""
+    if not (np.isfinite(min_speed) and min_speed >= 0):
+        raise ValueError(f"min_speed must be a speed >= 0 (rad/s or m/s), got {min_speed}")
+    slow = np.abs(np.asarray(qd, dtype=float)) < min_speed
+    if spread > 0 and slow.any():
+        box = np.ones(2 * spread + 1)
+        slow = np.stack([np.convolve(c.astype(float), box, mode="same") > 0 for c in slow.T], axis=1)
+    keep = (~slow).astype(float)
+    moving = keep.sum(axis=0)
+    if min_speed > 0 and np.any(moving < 0.2 * len(keep)):
+        j = int(np.argmin(moving))
+        raise ValueError(
+            f"min_speed={min_speed:g} leaves {int(moving[j])} of {len(keep)} samples of joint {j + 1}: "
+            "lower it, or move the joint faster"
+        )
+    return keep.reshape(-1)
+
+
+def resolve_method(method: str, weighted: bool, controller) -> str:
+    """The estimator ``method`` names (``auto``: IV with a controller, else OLS or WLS)."""
+    method = str(method).lower()
+    if method not in METHODS:
+        raise ValueError(f"unknown identification method '{method}': use one of {', '.join(METHODS)}")
+    if method == "auto":
+        return "iv" if controller is not None else ("wls" if weighted else "ols")
+    if method in ("iv", "didim") and controller is None:
+        raise ValueError(
+            f"method '{method}' simulates the identified model under the arm's controller: give controller=(t, q, qd) -> tau "
+            "(the one that ran the experiment, with its reference)"
+        )
+    return method
+
+
+def irls(
+    W: np.ndarray,
+    y: np.ndarray,
+    n: int,
+    k: float = 1.345,
+    iterations: int = 30,
+    tol: float = 1e-10,
+    rows: np.ndarray | None = None,
+):
     """Huber IRLS (see the module docstring): (estimate, covariance, residual (S, n), weights, iterations).
-    ``k`` = 1.345 robust scales: 95 % efficiency on Gaussian noise (Huber 1964)."""
-    est, _, r = least_squares(W, y, n)
-    w = np.ones(len(y))
+    ``k`` = 1.345 robust scales: 95 % efficiency on Gaussian noise (Huber 1964). ``rows``: 0/1 per
+    stacked row, the rows in the fit (:func:`speed_rows`)."""
+    keep = np.ones(len(y)) if rows is None else np.asarray(rows, dtype=float)
+    est, _, r = least_squares(W, y, n, keep)
+    w = keep
     it = 0
     while it < iterations:
         it += 1
-        # per joint: a robust scale of its residuals (MAD of a Gaussian is 0.6745 sigma)
-        scale = 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
+        # per joint: a robust scale of its residuals in the fit (MAD of a Gaussian is 0.6745 sigma)
+        kr = keep.reshape(-1, n) > 0
+        scale = np.array([1.4826 * np.median(np.abs(c[m] - np.median(c[m]))) for c, m in zip(r.T, kr.T)])
         scale = np.where(scale > 0, scale, max(float(scale.max()), 1e-300))
         u = np.abs(r / scale).reshape(-1)
         huber = np.where(u <= k, 1.0, k / np.maximum(u, 1e-300))
-        w = np.sqrt(huber) * np.tile(1.0 / scale, len(r))
+        w = keep * np.sqrt(huber) * np.tile(1.0 / scale, len(r))
         new, _, r = least_squares(W, y, n, w)
         change = np.linalg.norm(new - est) / max(np.linalg.norm(new), 1e-300)
         est = new
@@ -126,6 +181,17 @@ def irls(W: np.ndarray, y: np.ndarray, n: int, k: float = 1.345, iterations: int
             break
     _, cov, r = least_squares(W, y, n, w)
     return est, cov, r, w, it
+
+
+def delay_window(t: np.ndarray, max_delay: float) -> tuple:
+    """(edge, window): the samples a delay within ``+-max_delay`` can shift past either end, and the
+    mask of the samples every trial delay keeps."""
+    if not max_delay >= 0:
+        raise ValueError(f"max_delay must be >= 0 s, got {max_delay}")
+    edge = int(np.ceil(max_delay / float(np.median(np.diff(t))))) + 1
+    window = np.zeros(len(t), dtype=bool)
+    window[edge : len(t) - edge] = True
+    return edge, window
 
 
 def shift_torques(t: np.ndarray, tau: np.ndarray, delays) -> np.ndarray:

@@ -46,11 +46,14 @@ from .closed_loop import instrumental_fit, simulate_model
 from .estimators import (
     METHODS,
     Identifiability,
+    delay_window,
     estimate_delay,
     identifiability,
     irls,
     joint_noise,
     least_squares,
+    resolve_method,
+    speed_rows,
     stribeck_search,
     unseparable_mask,
 )
@@ -140,6 +143,9 @@ class Identification:
     stribeck_velocity_std: np.ndarray | None = None
     #: what the estimator had to do differently (e.g. IV's fallback on the prior model's instruments)
     notes: tuple = ()
+    #: iv / didim: the last iteration's relative change, the tolerance, and the OLS and WLS (the start)
+    #: estimates of the same rows, ``names`` then ``friction_names`` (the report's closed-loop section)
+    closed_loop: dict | None = field(default=None, repr=False)
 
     @property
     def consistent(self) -> bool:
@@ -362,6 +368,8 @@ class Identification:
             d.update(iterations=self.iterations)
         if self.notes:
             d.update(notes=list(self.notes))
+        if self.closed_loop is not None:
+            d.update(closed_loop=self.closed_loop)
         if self.identifiability is not None:
             d.update(identifiability=self.identifiability.to_dict())
         if self.stribeck:
@@ -412,20 +420,6 @@ class Identification:
         return "\n".join(lines)
 
 
-def _resolve_method(method: str, weighted: bool, controller) -> str:
-    method = str(method).lower()
-    if method not in METHODS:
-        raise ValueError(f"unknown identification method '{method}': use one of {', '.join(METHODS)}")
-    if method == "auto":
-        return "iv" if controller is not None else ("wls" if weighted else "ols")
-    if method in ("iv", "didim") and controller is None:
-        raise ValueError(
-            f"method '{method}' simulates the identified model under the arm's controller: give controller=(t, q, qd) -> tau "
-            "(the one that ran the experiment, with its reference)"
-        )
-    return method
-
-
 def identify(
     robot: Robot,
     data,
@@ -442,6 +436,7 @@ def identify(
     method: str = "auto",
     controller=None,
     control_period: float = 1e-3,
+    min_speed: float = 0.0,
     smoothing: float | None = None,
     regularization: float = 1e-4,
     margin: float = 1e-8,
@@ -465,14 +460,15 @@ def identify(
     ``method``: ``ols``, ``wls`` (also ``weighted=True``), ``irls``, ``iv`` or ``didim``
     (:mod:`.closed_loop`: they need the ``controller`` that ran the experiment, run at
     ``control_period``); ``auto``: ``iv`` when a controller is given, else ``ols`` (``wls`` with
-    ``weighted=True``). ``consistent``: the physically consistent estimate (an SDP with every body's
+    ``weighted=True``). ``min_speed``: rows of joint j where ``|qd_j|`` is below it are left out
+    (stick and Coulomb's jump, :func:`~.estimators.speed_rows`). ``consistent``: the physically consistent estimate (an SDP with every body's
     pseudo-inertia ``>= margin I``, ``regularization`` the weight of the pull toward ``robot``'s
     parameters, the armatures kept ``>= 0``; a least-squares data term, so with ols or wls)."""
     # joint logs hold one number per coordinate and a fixed base; a floating base needs its pose
     # and the contact wrenches in the log, which this workflow does not read
     robot.require_one_dof_joints("identification from joint logs")
     n = robot.n
-    method = _resolve_method(method, weighted, controller)
+    method = resolve_method(method, weighted, controller)
     if consistent and method not in ("ols", "wls"):
         raise ValueError(f"consistent=True fits a least-squares data term: use method 'ols' or 'wls', not '{method}'")
     simulated = isinstance(data, Measurements)
@@ -522,12 +518,8 @@ def identify(
     if isinstance(delay, str):
         if delay.strip().lower() != "estimate":
             raise ValueError(f"delay must be a number of seconds, None or 'estimate', got {delay!r}")
-        if not max_delay >= 0:
-            raise ValueError(f"max_delay must be >= 0 s, got {max_delay}")
         t = np.asarray(data.t, dtype=float)
-        edge = int(np.ceil(max_delay / float(np.median(np.diff(t))))) + 1
-        window = np.zeros(len(t), dtype=bool)
-        window[edge : len(t) - edge] = True
+        edge, window = delay_window(t, max_delay)
         W0 = columns(q, qd, qdd, sign, model, parallel).reshape(len(t) * n, -1)
         W0 = W0[:, np.linalg.norm(W0, axis=0) > 0]
         delay_s, *_ = estimate_delay(t, tau, W0, known(q, qd, qdd), window, max_delay)
@@ -572,16 +564,18 @@ def identify(
     dropped = tuple(nm for nm, u in zip(base.names, used) if not u)
     W = W[:, keep]
     names = tuple(nm for nm, u in zip(base.names, used) if u) + model.names(n)
-    seen = identifiability(W, names)
-    est, cov, r = least_squares(W, yv, n)
-    sig = joint_noise(r, W.shape[1])
-    w = np.ones(S * n) if method == "ols" else np.tile(1.0 / sig, S)
-    iterations = 0
-    note = None
+    cut = getattr(data, "cutoff", None)  # a filtered log: its low-pass spreads a stick over 1 / cutoff
+    rows = speed_rows(qd, min_speed, int(np.ceil(1.0 / (cut * np.median(np.diff(data.t))))) if cut else 0)
+    seen = identifiability(W[rows > 0], names)
+    est, cov, r = least_squares(W, yv, n, rows)
+    ols = est
+    sig = joint_noise(r, W.shape[1], rows)
+    w = rows if method == "ols" else rows * np.tile(1.0 / sig, S)
+    iterations, note, loop = 0, None, None
     if method in ("wls", "iv", "didim"):
         est, cov, r = least_squares(W, yv, n, w)
     if method == "irls":
-        est, cov, r, w, iterations = irls(W, yv, n)
+        est, cov, r, w, iterations = irls(W, yv, n, rows=rows)
     elif method in ("iv", "didim"):
 
         def simulated_regressor(theta, times, q0, qd0):
@@ -624,11 +618,20 @@ def identify(
             q, qd, qdd, tau, sign, parallel = arrays(data)
             yv = (tau - known(q, qd, qdd)).reshape(S * n)
             W = columns(q, qd, qdd, sign, model, parallel).reshape(S * n, nb + nf)[:, keep]
-            seen = identifiability(W, names)
+            seen = identifiability(W[w > 0], names)
         wz = w * np.repeat(settled(np.asarray(data.t)), n)
-        est, cov, iterations, _, note = instrumental_fit(
-            method, W, yv, wz, est, lambda theta: simulated_regressor(theta, data.t, q[0], qd[0]), fallback=prior
+        start, tol = est, 0.02
+        est, cov, iterations, change, note = instrumental_fit(
+            method,
+            W,
+            yv,
+            wz,
+            est,
+            lambda theta: simulated_regressor(theta, data.t, q[0], qd[0]),
+            tol=tol,
+            fallback=prior,
         )
+        loop = dict(ols=ols.tolist(), start=start.tolist(), last_change=change, tolerance=tol, converged=change < tol)
         r = (yv - W @ est).reshape(S, n)
     cond = float(np.linalg.cond(W * w[:, None]))
     std = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -641,6 +644,7 @@ def identify(
         s2 = float(((r.reshape(-1) * w) ** 2).sum()) / max(S * n - J.shape[1], 1)
         vstd = np.sqrt(np.maximum(np.diag(s2 * np.linalg.pinv(J.T @ J))[-n:], 0.0))
     kb = int(used.sum())
+    rm = (w > 0).reshape(S, n)  # the rows in the fit
 
     def result(est, r, **extra) -> Identification:
         return Identification(
@@ -650,7 +654,7 @@ def identify(
             covariance=cov[:kb, :kb],
             true_values=None if true_values is None else true_values[used],
             condition_number=cond,
-            residual_rms=np.sqrt((r**2).mean(axis=0)),
+            residual_rms=np.sqrt((r**2 * rm).sum(axis=0) / np.maximum(rm.sum(axis=0), 1)),
             weighted=method != "ols",
             base=base,
             nominal=robot,
@@ -660,7 +664,7 @@ def identify(
             friction_names=model.names(n),
             friction_estimates=est[kb:],
             friction_std=std[kb:],
-            noise=joint_noise(r, W.shape[1]),
+            noise=joint_noise(r, W.shape[1], rm),
             samples=S,
             rotor_joints=rotor_joints,
             data=data,
@@ -670,6 +674,7 @@ def identify(
             identifiability=seen,
             stribeck_velocity_std=vstd,
             notes=() if note is None else (note,),
+            closed_loop=loop,
             **extra,
         )
 

@@ -43,6 +43,7 @@ import numpy as np
 
 from .._math import rpy_to_matrix
 from .audit_facts import REVOLUTE_OR_PRISMATIC, Facts, Finding, LinkFacts, description_facts, mjcf_facts, urdf_facts
+from .audit_loops import loop_findings, source_kind
 from .audit_shapes import Solid, combined, solid_of
 from .description import Description
 from .files import read_description
@@ -102,7 +103,7 @@ def audit(source, *, geometry: bool = True) -> Audit:
     :class:`Description` (see the module docstring). ``geometry=False`` skips the checks that read
     meshes and measure shapes."""
     if isinstance(source, Description):
-        facts = description_facts(source)
+        facts, kind = description_facts(source), "description"
         # the file it was read from says more (lines, what the loader drops); a xacro file is
         # expanded only on trust, so its description is audited as it is
         readable = os.path.splitext(source.source)[1].lower() in (".urdf", ".xml", ".mjcf")
@@ -114,9 +115,11 @@ def audit(source, *, geometry: bool = True) -> Audit:
             raise TypeError(f"audit expects a path, an XML string or a Description, got {type(source).__name__}")
         is_xml = "<" in text or "\n" in text
         if is_xml:
-            facts = mjcf_facts(text) if "<mujoco" in text else urdf_facts(text)
+            kind = "mjcf" if "<mujoco" in text else "urdf"
+            facts = mjcf_facts(text) if kind == "mjcf" else urdf_facts(text)
         else:
             ext = os.path.splitext(text)[1].lower()
+            kind = source_kind(text)
             if ext == ".urdf":
                 facts = urdf_facts(text)
             elif ext in (".xml", ".mjcf"):
@@ -127,6 +130,7 @@ def audit(source, *, geometry: bool = True) -> Audit:
     _check_tree(facts)
     _check_joints(facts)
     _check_links(facts, geometry)
+    loop_findings(facts, source, kind)  # loops open at the file's reference configuration (audit_loops)
     order = {s: k for k, s in enumerate(SEVERITIES)}
     facts.findings.sort(key=lambda f: (order[f.severity], f.file, f.line or 0))
     return Audit(facts.source, facts.findings)

@@ -18,7 +18,9 @@ a body is placed at the link frame and its hinge/slide joint is given a ``pos`` 
 frame (``post⁻¹`` applied to the joint's axis line).
 
 Extra frames (``robot.frames``, e.g. a DH robot's ``tool``) become massless links on fixed joints
-(URDF) or massless bodies without joints (MJCF).
+(URDF) or massless bodies without joints (MJCF). Closed loops: a URDF ``<loop>`` between the links of
+their frames, an MJCF ``<equality><connect|weld>`` between sites (a loop end that is an extra frame
+is that site), :mod:`kinedyn.description.loop_files`.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from .._ui.files import write_text
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual, resolve_mesh
 from .inertia import Inertia
 from .link import Link
+from .loop_files import mjcf_loop_sites, urdf_loop_elements, write_mjcf_loops
 
 if TYPE_CHECKING:
     from .._typing import PathLike
@@ -310,8 +313,10 @@ def floating_trunk(robot: Robot):
     link = on_base[0]
     if not (_is_identity(_np(link.placement)) and _is_identity(_np(link.post))):
         return None
-    if any(f.link is None for f in robot.frames) or any(
-        v.frame == robot.base for v in (*robot.visuals, *robot.collisions)
+    if (
+        any(f.link is None for f in robot.frames)
+        or any(v.frame == robot.base for v in (*robot.visuals, *robot.collisions))
+        or any(robot.base in (lp.frame_a, lp.frame_b) for lp in robot.loops)
     ):
         return None
     return link
@@ -462,7 +467,7 @@ def to_urdf(
     for el in link_elements.values():
         if el not in list(root):
             root.append(el)
-    for el in joints + transmissions:
+    for el in joints + urdf_loop_elements(robot) + transmissions:  # loops: kinedyn's <loop> (loop_files)
         root.append(el)
     ET.indent(root)
     text = (
@@ -586,7 +591,10 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
                 )
             for suffix, kind, ax in (("x", "slide", "1 0 0"), ("y", "slide", "0 1 0"), ("theta", "hinge", "0 0 1")):
                 ET.SubElement(body, "joint", {"name": f"{j.name}_{suffix}", "type": kind, "axis": ax, **drive})
+    loop_sites = mjcf_loop_sites(robot, {v.frame for v in (*visuals, *collisions)})
     for frame in robot.frames:
+        if frame.name in loop_sites:  # a loop end: a site (write_mjcf_loops)
+            continue
         body = ET.SubElement(bodies[frame.link or robot.base], "body", name=frame.name)
         bodies[frame.name] = body
         _mj_pose(body, _np(frame.placement))
@@ -603,6 +611,7 @@ def to_mjcf(robot: Robot, path: PathLike | None = None, *, geometry: bool = True
                 joint2=relation.leader,
                 polycoef=_fs((float(relation.offset), float(relation.multiplier), 0.0, 0.0, 0.0)),
             )
+    write_mjcf_loops(robot, root, bodies, loop_sites, _mj_pose)  # sites and <equality><connect|weld>
     for group, items in ((1, visuals), (3, collisions)):
         for _k, v in enumerate(items):
             if v.frame not in bodies:

@@ -25,6 +25,7 @@ else:  # Python 3.10 (requires-python): tomllib is tomli, in the standard librar
 from .._lazy import LazyModule, sympy_instance
 from .._math import matmul, rpy_to_matrix, translation
 from .._ui.files import open_regular
+from .._ui.names import did_you_mean
 from ..expressions import parse_expression
 from .description import Description
 from .dh import DHRow, description_from_dh
@@ -33,6 +34,7 @@ from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia
 from .joint import Joint, Mimic
 from .link import Frame, Link
+from .loops import Loop
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -54,7 +56,7 @@ __all__ = [
     "MAX_TEXT",
 ]
 
-_TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals"}
+_TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals", "loops"}
 _TOP_DH = _TOP_COMMON | {"convention", "base_pose", "tool", "tool_frame", "joints"}
 _TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
 _ROW_KEYS = {
@@ -92,6 +94,7 @@ _INERTIAL_KEYS = {"mass", "com", "inertia"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _POSE_KEYS = {"xyz", "rpy"}
 _FRAME_KEYS = {"name", "link", "origin"}
+_LOOP_KEYS = {"name", "frame_a", "frame_b", "kind"}  # a Loop (kinedyn.description.loops)
 _VISUAL_KEYS = {"link", "origin", "color", "mesh", "scale", "box", "cylinder", "sphere"}
 _SHAPE_KEYS = ("mesh", "box", "cylinder", "sphere")
 _TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -370,6 +373,8 @@ def description_from_mapping(data, where: str = "<robot mapping>", inertia: str 
             if unknown:
                 r.fail("visuals", f"names links {unknown} that the robot does not have (frames: {frame_names})")
             description = replace(description, visuals=tuple(visuals))
+        if "loops" in data:
+            description = replace(description, loops=_loops(r, data["loops"], description.frame_names))
         return description
     except ValueError as e:
         if str(e).startswith(where):
@@ -392,6 +397,35 @@ def _frames(r: _Reader, raw) -> list:
         except ValueError as e:  # the description's own checks (finite, bounded placement)
             r.fail(ctx, str(e))
     return out
+
+
+def _loops(r: _Reader, raw, frame_names: list) -> tuple:
+    """``loops:`` [{name, frame_a, frame_b, kind}] (docs/model-files.md, "Closed loops")."""
+    out, seen = [], set()
+    for i, lp in enumerate(r.items(raw, "loops", "{name, frame_a, frame_b, kind}", lambda i: f"loops[{i}]")):
+        ctx = f"loops[{i}]"
+        lp = r.check_keys(lp, _LOOP_KEYS, ctx)
+        missing = [k for k in ("name", "frame_a", "frame_b") if k not in lp]
+        if missing:
+            r.fail(ctx, f"a loop needs {', '.join(repr(k) for k in missing)}")
+        name = r.text(lp["name"], f"{ctx}.name")
+        if name in seen:
+            r.fail(f"{ctx}.name", f"two loops are named '{name}'")
+        seen.add(name)
+        ends = []
+        for key in ("frame_a", "frame_b"):
+            frame = r.text(lp[key], f"{ctx}.{key}")
+            if frame not in frame_names:
+                r.fail(
+                    f"{ctx}.{key}",
+                    f"names no frame '{frame}'{did_you_mean(frame, frame_names)} (frames: {frame_names})",
+                )
+            ends.append(frame)
+        try:
+            out.append(Loop(name, ends[0], ends[1], r.text(lp.get("kind", "point"), f"{ctx}.kind")))
+        except ValueError as e:  # the kind, or a frame closed on itself
+            r.fail(ctx, str(e))
+    return tuple(out)
 
 
 def _visuals(r: _Reader, raw, where: str) -> list:

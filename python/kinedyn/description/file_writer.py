@@ -21,6 +21,7 @@ from .._math import is_symbolic, matmul, pose_inverse, rpy_from_matrix
 from .dh import links_from_dh
 from .geometry import Box, Cylinder, Mesh
 from .inertia import Inertia
+from .loop_files import loops_mapping
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -48,6 +49,8 @@ def robot_to_mapping(robot: Robot | Description) -> dict:
         data.update(_tree_mapping(robot))
     if robot.visuals:
         data["visuals"] = [_visual_mapping(v) for v in robot.visuals]
+    if robot.loops:
+        data["loops"] = loops_mapping(robot.loops)
     return data
 
 

@@ -24,7 +24,7 @@ __all__ = ["LOOP_KINDS", "Loop", "check_loops"]
 LOOP_KINDS = {"point": 3, "weld": 6}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Loop:
     """A closure between the frames ``frame_a`` and ``frame_b`` (names in ``robot.frame_names``)."""
 
@@ -45,6 +45,9 @@ class Loop:
             )
         if self.frame_a == self.frame_b:
             raise ValueError(f"loop '{self.name}' closes frame '{self.frame_a}' on itself")
+
+    def __repr__(self) -> str:  # one line a reader takes in at a glance (robot.loops prints a tuple of these)
+        return f"Loop({self.name!r}: {self.frame_a} meets {self.frame_b}, {self.kind}, {self.rows} rows)"
 
     @property
     def rows(self) -> int:

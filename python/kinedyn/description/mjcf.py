@@ -33,8 +33,11 @@ Reads the kinematic and inertial parts of a MuJoCo model (MuJoCo's "XML Referenc
 - ``<include file>``: relative to the including file's folder, which it may not leave; nested at
   most ``MAX_INCLUDE_DEPTH`` deep.
 
+``<equality><connect>`` and ``<weld>`` are closed loops (:mod:`kinedyn.description.mjcf_loops`).
+
 Not modelled, and named in one warning when present: actuators, tendons, equality constraints
-other than a linear joint equality (read as a mimic joint: ``mjcf_xml.with_joint_equalities``),
+other than a linear joint equality (read as a mimic joint: ``mjcf_xml.with_joint_equalities``), a
+weld or connect, and the softness of these,
 contact pairs and exclusions, sensors, keyframes, plugins (``<extension>``, a body's ``<plugin>``),
 fluid forces (``<option density viscosity wind>``), joint springs (``stiffness``, ``springdamper``),
 ``gravcomp``, friction and armature of ball and free joints, a ball joint's range (a cone); every
@@ -68,6 +71,7 @@ from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint
 from .link import Frame, Link
+from .mjcf_loops import equality_loops
 
 __all__ = ["description_from_mjcf", "MAX_DEPTH", "MAX_INCLUDE_DEPTH", "MAX_FILE_BYTES"]
 
@@ -113,6 +117,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
     reader = _Reader(src, root)
     links, frames, visuals, collisions = reader.read()
     links = with_joint_equalities(root, src, links, reader.ignored)  # mimic joints, as to_mjcf writes them
+    anchors, loops = equality_loops(reader)  # <connect> and <weld>: closed loops (mjcf_loops)
     name = root.get("model") or "mjcf_robot"
     source = src.label if src.base_dir is not None else "MJCF string"
     if gravity is None:
@@ -130,7 +135,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
             warnings.simplefilter("always", PhysicalConsistencyWarning)
             description = Description(
                 tuple(links),
-                tuple(frames),
+                tuple(frames) + tuple(anchors),
                 gravity=gravity,
                 base="world",
                 tool=tool,
@@ -139,6 +144,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
                 inertia=inertia,
                 visuals=visuals,
                 collisions=collisions,
+                loops=tuple(loops),
             )
     except ValueError as e:
         raise ValueError(f"{src.label}: {e}") from None
@@ -165,6 +171,8 @@ class _Reader(ModelSettings):
         # a site whose name a body has, before or after it in the file, is the frame 'site:NAME'
         self.body_names = {b.get("name") for b in root.iter("body") if b.get("name")}
         self.site_names: list = []
+        self.site_frames: dict = {}  # site name -> its frame's name (for <equality> site1/site2)
+        self.reference: dict = {"world": np.eye(4)}  # body -> its world pose at MuJoCo's qpos0 (mjcf_loops)
         self.body_count = 0
         self.joint_count = 0
 
@@ -341,6 +349,8 @@ class _Reader(ModelSettings):
         if a.get("mocap") == "true":
             raise self.src.error(element, f"{what} is a mocap body, which kinedyn does not read")
         parent_from_body = parent_from_here @ self.frame(element, a)
+        # at qpos0 every hinge and slide is at its ref (no motion) and a free body where the file puts it
+        self.reference[name] = self.reference[parent] @ parent_from_body
         joints = [j for j in element if j.tag in ("joint", "freejoint")]
         # the chain of links: one per joint (the last one is the body), or one welded link
         link_parent, placement = parent, parent_from_body
@@ -470,6 +480,7 @@ class _Reader(ModelSettings):
         self.site_names.append(name)
         frame_name = name if name not in self.names and name not in self.body_names else f"site:{name}"
         self.claim(frame_name, element, f"site '{name}'")
+        self.site_frames[name] = frame_name
         pose = self.frame(element, a)
         if "fromto" in a:  # a site, like a geom, may sit at the middle of a segment, z along it
             if a.get("type", "sphere") not in ("capsule", "cylinder", "box", "ellipsoid"):

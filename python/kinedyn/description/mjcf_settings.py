@@ -24,7 +24,7 @@ from .mjcf_xml import Sources, numbers, short
 __all__ = ["ModelSettings", "DEFAULTED", "FLUID_OPTIONS"]
 
 #: the elements whose <default> attributes kinedyn reads
-DEFAULTED = ("joint", "geom", "site", "mesh")
+DEFAULTED = ("joint", "geom", "site", "mesh", "equality")
 #: <option> attributes that switch on MuJoCo's fluid forces (its XML reference, "option")
 FLUID_OPTIONS = ("density", "viscosity", "wind")
 

@@ -270,23 +270,30 @@ def with_joint_equalities(root, src: Sources, links: list, ignored: set) -> list
     """``links`` with MuJoCo's linear joint equalities read as mimic joints (what ``to_mjcf`` writes
     for one). MJCF reference, equality/joint: ``y - y0 = a0 + a1 (x - x0) + a2 (x - x0)^2 + ...``
     with y = joint1, x = joint2 and y0, x0 their reference positions (kinedyn's offsets are
-    ``-ref``), so a follower with a2 = a3 = a4 = 0 is ``q_y = a1 q_x + a0 - off_y + a1 off_x``. Other
-    equalities (welds, connects, a polynomial, a joint held constant) stay in ``ignored``."""
+    ``-ref``), so a follower with a2 = a3 = a4 = 0 is ``q_y = a1 q_x + a0 - off_y + a1 off_x``. Welds
+    and connects are loops (:mod:`kinedyn.description.mjcf_loops`); the other equalities (a
+    polynomial, a joint held constant, tendons, flexes) are named in ``ignored``."""
     joints = {link.joint.name: k for k, link in enumerate(links)}
-    out, unread = list(links), 0
+    out, unread = list(links), {}
     for section in root.iterfind("equality"):
         for element in section:
+            if element.tag in ("connect", "weld"):
+                continue
+            if element.tag != "joint":
+                unread[element.tag] = unread.get(element.tag, 0) + 1
+                continue
             coefficients = numbers(element, "polycoef", src, at_most=5) if element.get("polycoef") else (0.0, 1.0)
             a = tuple(coefficients) + (0.0,) * (5 - len(coefficients))
             y, x = element.get("joint1"), element.get("joint2")
             readable = element.tag == "joint" and element.get("active", "true") == "true" and not any(a[2:])
             if not readable or y not in joints or x not in joints or y == x:
-                unread += 1
+                unread["joint"] = unread.get("joint", 0) + 1
                 continue
             follower, leader = out[joints[y]].joint, out[joints[x]].joint
             offset = a[0] - float(follower.offset) + a[1] * float(leader.offset)
             out[joints[y]] = replace(out[joints[y]], joint=replace(follower, mimic=Mimic(x, a[1], offset)))
     ignored.difference_update({e for e in ignored if e.startswith("<equality>")})
-    if unread:
-        ignored.add(f"<equality> ({unread} elements that are not a linear joint equality)")
+    for tag, count in sorted(unread.items()):
+        what = "that are not a linear joint equality" if tag == "joint" else "(not modelled)"
+        ignored.add(f"<equality><{tag}> ({count} element{'s' if count > 1 else ''} {what})")
     return out

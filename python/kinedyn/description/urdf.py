@@ -19,6 +19,9 @@ Reads the kinematic and inertial parts of a URDF (ROS wiki, "urdf/XML/joint" and
   ``<material name>`` with ``<color rgba>`` (inline, or defined by name at the robot level). Mesh files
   are not read here: they are found and read when the robot is drawn.
 
+- ``<loop name type><link1 link xyz rpy/><link2 .../></loop>``: a closed loop, kinedyn's extension
+  (:mod:`kinedyn.description.loop_files`; other URDF readers skip the element).
+
 Ignored: ``<texture>``, ``<transmission>``, ``<gazebo>``, ``<calibration>``,
 ``<safety_controller>``.
 
@@ -65,6 +68,7 @@ from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint, Mimic
 from .link import Link
+from .loop_files import urdf_loops
 from .tool import default_tool
 from .xacro import expand_xacro, is_xacro
 
@@ -159,6 +163,7 @@ def description_from_urdf(
     name = root.get("name") or "urdf_robot"
     source = src.label if not src.label.startswith("<") else "URDF string"
     visuals, collisions = _geometry(root, list(link_elements.items()), src)
+    loop_frames, loops = urdf_loops(root, src, list(link_elements), _floats)  # kinedyn's <loop> extension
     for note in src.notes:
         warnings.warn(note, UserWarning, stacklevel=caller_level())
     # the Description judges the inertias (policy) and checks the tree: its errors and warnings name a
@@ -172,6 +177,7 @@ def description_from_urdf(
             warnings.simplefilter("always", PhysicalConsistencyWarning)
             description = Description(
                 tuple(links),
+                tuple(loop_frames),
                 gravity=gravity,
                 base=base,
                 tool=tool,
@@ -181,6 +187,7 @@ def description_from_urdf(
                 visuals=visuals,
                 collisions=collisions,
                 mimic=mimic,
+                loops=tuple(loops),
             )
     except ValueError as e:
         raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._core import NonFiniteResultError, SingularMassMatrixError
+from .compile import dof_links
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -58,7 +59,7 @@ def robot_error(robot: Robot, error: RuntimeError) -> Exception:
         error,
         robot.name,
         lambda dof: dof_label(robot, dof),
-        lambda dof: nonphysical_note(robot, int(robot._dof_body[dof])),
+        lambda dof: nonphysical_note(robot, int(dof_links(robot.description)[dof])),
     )
 
 
@@ -66,7 +67,7 @@ def dof_label(robot: Robot, dof: int) -> tuple[str, str] | None:
     """How a message names the native body (a degree of freedom) ``dof``: its link's joint and body."""
     if not 0 <= dof < robot.n:
         return None
-    i = int(robot._dof_body[dof])
+    i = int(dof_links(robot.description)[dof])
     return robot.joint_names[i], robot.body_names[i]
 
 

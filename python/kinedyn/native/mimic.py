@@ -59,10 +59,11 @@ class ReducedModel:
     def n_frames(self) -> int:
         return self.native.n_frames
 
-    def with_link_origins(self, origins) -> ReducedModel:
-        """The full model's link origins (per body of the full model: they place wrenches, which act
-        on every link, mimic followers' too)."""
-        return ReducedModel(self.native.with_link_origins(origins), self.map, self.robot)
+    @property
+    def link_bodies(self) -> np.ndarray:
+        """The full model's body that carries each link (wrenches and inertial parameters belong to
+        every link, mimic followers' too)."""
+        return self.native.link_bodies
 
     def __getattr__(self, name: str):
         # a method of the native model this wrapper does not map (added to the core after it): an

@@ -6,8 +6,10 @@ their standard deviations and relative standard deviations (and the errors when 
 known, for simulated data); the friction coefficients per joint; the armature of each geared joint,
 or the base parameters it is grouped into; the per-joint noise and residual RMS; measured against
 predicted torque and the residual per joint, on the fitted log and on the validation log (RMS and
-R² per joint) when one is given; and, for a physically consistent fit, the smallest eigenvalue of
-M(q) over the log's states for the consistent and the unconstrained estimates.
+R² per joint) when one is given; for a physically consistent fit, the smallest eigenvalue of
+M(q) over the log's states for the consistent and the unconstrained estimates; and for IDIM-IV or
+DIDIM, the iterations (how many, converged or not, what had to change) and each base parameter
+beside its OLS and WLS estimates.
 
 It shares the robot report's style, tables and templates (templates/identification.html.j2); the plots are
 drawn by plotly.js inlined from the plotly package (assets/identification.js), from the JSON block ``#kinedyn-identification``
@@ -193,6 +195,45 @@ def _rotor_rows(d: dict) -> list[list[str]]:
     return rows
 
 
+def _closed_loop(d: dict) -> tuple[list[str], list[list[str]]] | None:
+    """IV / DIDIM: how the iterations went (one line each), and each base parameter by OLS, by the
+    weighted least squares the iterations started from, and by the closed-loop estimator, with the
+    change from OLS in the estimator's own standard deviations (closed-loop data bias OLS: a change
+    of many std is that bias removed, or the instruments' trouble, which the notes name)."""
+    loop = d.get("closed_loop")
+    if loop is None:
+        return None
+    how = METHOD_NAMES[d["method"]]
+    its = d.get("iterations", 0)
+    state = (
+        f"converged: the last iteration moved the estimate by {fmt(100 * loop['last_change'], 3)} % "
+        f"(tolerance {fmt(100 * loop['tolerance'], 3)} %)"
+        if loop["converged"]
+        else f"not converged: the last iteration still moved the estimate by {fmt(100 * loop['last_change'], 3)} % "
+        f"(tolerance {fmt(100 * loop['tolerance'], 3)} %)"
+    )
+    lines = [
+        f"{how}: {its} simulation{'s' if its != 1 else ''} of the identified model under the experiment's controller, "
+        "started from weighted least squares",
+        state,
+        *d.get("notes", []),
+    ]
+    rows = []
+    for k, nm in enumerate(d["names"]):
+        est, ols, std = d["estimates"][k], loop["ols"][k], d["std"][k]
+        rows.append(
+            [
+                nm,
+                fmt(ols, 6),
+                fmt(loop["start"][k], 6),
+                fmt(est, 6),
+                fmt(est - ols, 3),
+                fmt((est - ols) / std, 3) if std and np.isfinite(std) else "-",
+            ]
+        )
+    return lines, rows
+
+
 def _mass_check_rows(d: dict) -> list[list[str]] | None:
     """The smallest eigenvalue of M(q) over the log for the consistent and the unconstrained estimates."""
     mc = d.get("mass_matrix_check")
@@ -230,6 +271,8 @@ def identification_report(result: Identification, validate=None, *, title: str |
         friction_rows=friction_rows,
         rotor_rows=_rotor_rows(d),
         mass_check_rows=_mass_check_rows(d),
+        closed_loop=_closed_loop(d),
+        method_label=d["method"].upper(),
         torque_sections=[
             (k, t)
             for k, t in (("fit", "Torques on the fitted log"), ("validation", "Validation on another log"))

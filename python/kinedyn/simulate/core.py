@@ -210,7 +210,7 @@ def simulate(
     work = steps * count * (4 if method == "rk4" else 1)
     # The one place that sends a robot to the Python fixed-step loop (:mod:`.fixed_step`): a robot
     # with reduced mimic joints runs on its reduced methods (the native integrators take the full
-    # model). Wrenches about link frames (f_ext) are the core's (Model.with_link_origins).
+    # model). Wrenches about link frames (f_ext), one per link, are the core's (docs/architecture.md).
     native = robot and method in FIXED_METHODS and not getattr(system, "mimic_joints", None)
     if multi_dof and not native:
         why = f"the method '{method}'" if method not in FIXED_METHODS else "mimic joints"

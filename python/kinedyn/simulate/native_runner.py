@@ -9,7 +9,6 @@ from typing import Any
 import numpy as np
 
 from .._core import integrate_callback, integrate_fixed
-from ..native.compile import body_wrenches
 
 __all__ = ["run_native"]
 
@@ -37,14 +36,12 @@ def run_native(
 ):
     """The core's integrator, in chunks when a progress bar is shown or a time budget is set
     (chunk boundaries on recorded steps, so the samples are the same as in one call). ``f_ext``:
-    None, constant link wrenches (links, 6) or a function ``(t, q, qd) -> (links, 6)``, laid out
-    as the native model's bodies (:func:`kinedyn.native.compile.body_wrenches`)."""
+    None, constant link wrenches (links, 6) or a function ``(t, q, qd) -> (links, 6)``: the core
+    places each link's wrench on the body that carries it."""
     model = robot._model
-    wrenches: Any = None if f_ext is None or callable(f_ext) else body_wrenches(robot.description, None, f_ext)
+    wrenches: Any = None if f_ext is None or callable(f_ext) else np.asarray(f_ext, dtype=float)
     if callable(f_ext):
-
-        def wrenches(t, q, qd):
-            return body_wrenches(robot.description, None, f_ext(t, q, qd))
+        wrenches = f_ext
 
     bounded = deadline is not None and deadline.end is not None
     chunks = 1 if (not bar.enabled and not bounded) else min(200 if bounded else 50, max(1, steps // every))

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..native.compile import dof_links
+
 __all__ = ["RK4_STABLE", "choose_method"]
 
 #: ``method="auto"`` keeps RK4 while ``dt`` times the largest eigenvalue modulus of the linearised
@@ -39,9 +41,7 @@ def choose_method(robot, q0, qd0, t0, dt, jacobian, names) -> tuple:
         if abs(lam[i]) > worst:
             worst = float(abs(lam[i]))
             joint = int(np.argmax(np.abs(vec[:n, i]) + np.abs(vec[n:, i]) / max(worst, 1e-300)))
-            joint = (
-                int(robot._dof_body[joint]) if hasattr(robot, "_dof_body") else joint
-            )  # a degree of freedom -> its joint
+            joint = int(dof_links(robot.description)[joint])  # a degree of freedom -> its joint
     stiffness = dt * worst
     if stiffness <= RK4_STABLE:
         return "rk4", f"auto: rk4 (dt |lambda|max = {stiffness:.3g} <= {RK4_STABLE:g}, inside RK4's stability region)"

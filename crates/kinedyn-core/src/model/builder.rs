@@ -25,6 +25,11 @@ pub struct JointRecord {
     pub offset: f64,
     /// The moved link's inertia about its frame origin (the joint frame after the motion).
     pub inertia: Inertia,
+    /// The origin of the link's own frame in the joint frame after the motion (a standard-DH link
+    /// frame sits at `Tx(a)`; a URDF link frame at the joint frame: zero): the point about which the
+    /// moment of an external wrench on the link is given ([`Model::link_origin`] of the body that
+    /// carries the link).
+    pub link_origin: Vec3,
     /// Reflected rotor inertia `r^2 J_m`, viscous and Coulomb friction: 1-DOF joints only.
     pub armature: f64,
     pub viscous: f64,
@@ -43,6 +48,7 @@ impl JointRecord {
             placement,
             offset: 0.0,
             inertia,
+            link_origin: Vec3::zeros(),
             armature: 0.0,
             viscous: 0.0,
             coulomb: 0.0,
@@ -70,6 +76,9 @@ impl JointRecord {
         }
         if self.inertia.to_parameters().iter().any(|x| !x.is_finite()) {
             return Some("its link's inertia has a non-finite value".into());
+        }
+        if self.link_origin.iter().any(|x| !x.is_finite()) {
+            return Some("its link origin has a non-finite value".into());
         }
         if self.inertia.mass < 0.0 {
             return Some(format!("its link has negative mass {}", self.inertia.mass));
@@ -163,6 +172,7 @@ impl ModelBuilder {
             (Vec::with_capacity(nv), Vec::with_capacity(nv), Vec::with_capacity(nv));
         let mut negative = Vec::with_capacity(nv);
         let mut coordinates = Vec::with_capacity(nv);
+        let mut link_origin = Vec::with_capacity(nv);
         // the body that carries each joint's link: its last column
         let mut last_body: Vec<usize> = Vec::with_capacity(self.records.len());
         let mut at = 0;
@@ -177,11 +187,10 @@ impl ModelBuilder {
                 });
                 joints.push(*column);
                 placement.push(if head { r.placement } else { Transform::identity() });
-                inertia.push(if m + 1 == columns.len() {
-                    r.inertia
-                } else {
-                    Inertia::zero()
-                });
+                // the link (its inertia and frame) is on the last column's body
+                let last = m + 1 == columns.len();
+                inertia.push(if last { r.inertia } else { Inertia::zero() });
+                link_origin.push(if last { r.link_origin } else { Vec3::zeros() });
                 // drive and friction data exist for 1-DOF joints only (checked in `joint`)
                 offset.push(if head { r.offset } else { 0.0 });
                 armature.push(if head { r.armature } else { 0.0 });
@@ -224,6 +233,9 @@ impl ModelBuilder {
         )?;
         if asymmetric {
             model = model.with_coulomb_negative(negative)?;
+        }
+        if link_origin.iter().any(|u| *u != Vec3::zeros()) {
+            model = model.with_link_origins(link_origin)?;
         }
         if coordinates.iter().all(|c| matches!(c, Coordinates::Scalar { .. })) {
             return Ok(model);
@@ -468,5 +480,106 @@ mod tests {
         let mut builder = ModelBuilder::new(Vec3::zeros());
         let e = builder.frame(Some(0), Transform::identity()).unwrap_err().to_string();
         assert!(e.contains("frame 0 is fixed to joint 0, but there are 0 joints"), "{e}");
+    }
+
+    /// A link origin given in a record lands on the body that carries the link (a multi-DOF
+    /// joint's last), per-link wrenches are laid out on those bodies, and RNEA then equals the
+    /// chain laid out by hand with the same origins and per-body wrenches.
+    #[test]
+    fn link_origins_and_wrenches_go_to_the_body_that_carries_the_link() {
+        let mut rng = Rng::new(12);
+        let origins: Vec<Vec3> = (0..5).map(|_| rng.vec3(-0.4, 0.4)).collect();
+        let (builder, by_hand) = chain();
+        let mut with_origins = ModelBuilder::new(builder.gravity);
+        for (r, u) in builder.records.iter().zip(&origins) {
+            with_origins
+                .joint(JointRecord {
+                    link_origin: *u,
+                    ..r.clone()
+                })
+                .unwrap();
+        }
+        with_origins.frames = builder.frames.clone();
+        let built = with_origins.build().unwrap();
+        let carriers = [5, 8, 11, 12, 13];
+        assert_eq!(built.link_bodies(), carriers.to_vec());
+        assert_eq!(by_hand.link_bodies(), carriers.to_vec());
+        let mut per_body = vec![Vec3::zeros(); 14];
+        for (b, u) in carriers.iter().zip(&origins) {
+            per_body[*b] = *u;
+        }
+        assert_eq!(built.link_origin, per_body);
+        let by_hand = by_hand.with_link_origins(per_body).unwrap();
+
+        let per_link = rng.vector(6 * 5, -2.0, 2.0);
+        let mut bodies = vec![f64::NAN; 6 * 14];
+        built.link_wrenches(&per_link, &mut bodies).unwrap();
+        for b in 0..14 {
+            let want = match carriers.iter().position(|c| *c == b) {
+                Some(l) => per_link[6 * l..6 * l + 6].to_vec(),
+                None => vec![0.0; 6],
+            };
+            assert_eq!(bodies[6 * b..6 * b + 6], want[..], "body {b}");
+        }
+        let e = built
+            .link_wrenches(&per_link[..6], &mut bodies)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("6 numbers for 5 links"), "{e}");
+
+        let q = random_configuration(&built, &mut rng);
+        let (qd, qdd) = (rng.vector(14, -1.0, 1.0), rng.vector(14, -1.0, 1.0));
+        let (mut a, mut b) = (Data::new(&built), Data::new(&by_hand));
+        assert_eq!(
+            rnea(&built, &mut a, &q, &qd, &qdd, Some(&bodies)).to_vec(),
+            rnea(&by_hand, &mut b, &q, &qd, &qdd, Some(&bodies)).to_vec()
+        );
+        let bad = JointRecord {
+            link_origin: Vec3::new(0.0, f64::INFINITY, 0.0),
+            ..builder.records[0].clone()
+        };
+        let e = ModelBuilder::new(Vec3::zeros()).joint(bad).unwrap_err().to_string();
+        assert!(e.contains("link origin has a non-finite value"), "{e}");
+    }
+
+    /// `JointType::transform` (what locking a joint folds into a placement) is the motion the
+    /// model's kinematics give a lone joint of each kind at the same q; bad blocks are refused.
+    #[test]
+    fn a_joints_transform_is_its_motion_in_the_model() {
+        let mut rng = Rng::new(13);
+        let kinds = [
+            JointType::Revolute {
+                axis: Vec3::new(0.6, 0.0, 0.8),
+            },
+            JointType::Prismatic { axis: Vec3::y() },
+            JointType::FreeFlyer,
+            JointType::Spherical,
+            JointType::Planar {
+                normal: Vec3::new(1.0, 2.0, -0.5).normalize(),
+            },
+        ];
+        for joint in kinds {
+            let mut builder = ModelBuilder::new(Vec3::zeros());
+            let inertia = random_inertia(&mut rng);
+            builder
+                .joint(JointRecord::new("j", joint, None, Transform::identity(), inertia))
+                .unwrap();
+            let model = builder.build().unwrap();
+            let q = random_configuration(&model, &mut rng);
+            let mut data = Data::new(&model);
+            crate::algorithms::forward_kinematics(&model, &mut data, &q);
+            let want = data.world_from_body[model.n - 1].to_homogeneous();
+            let got = joint.transform(&q).unwrap().to_homogeneous();
+            let err = got.iter().zip(&want).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-15, "{}: {err:e}", joint.name());
+            if joint.block() != Block::Scalar {
+                let mut bad = q.clone();
+                bad[model.nq - 1] += 0.1;
+                let e = joint.transform(&bad).unwrap_err().to_string();
+                assert!(e.contains("not unit"), "{e}");
+            }
+            let e = joint.transform(&q[..model.nq - 1]).unwrap_err().to_string();
+            assert!(e.contains("finite numbers"), "{e}");
+        }
     }
 }

@@ -358,26 +358,15 @@ impl Model {
     }
 
     /// The joint transform `joint_from_body` of the multi-DOF joint whose head is body i, from its
-    /// block of q (Pinocchio's conventions: quaternion (x, y, z, w), assumed unit; planar (cos, sin)).
+    /// block of q ([`crate::joint::block_transform`], the planar joint's in-plane axes being its
+    /// first two bodies' axes).
     #[inline(always)]
     pub fn block_transform<T: Real>(&self, i: usize, block: Block, qb: &[T]) -> Transform<T> {
-        match block {
-            Block::FreeFlyer => Transform::new(quaternion_matrix(&qb[3..7]), Vec3::new(qb[0], qb[1], qb[2])),
-            Block::Spherical => Transform::new(quaternion_matrix(&qb[0..4]), Vec3::zeros()),
-            Block::Planar => {
-                let (e1, e2) = (self.joints[i].axis, self.joints[i + 1].axis);
-                let n = e1.cross(&e2);
-                let (c, s) = (qb[2], qb[3]);
-                // rotation about n by th: R = c 1 + s [n]x + (1 - c) n n^T
-                let (skew_n, nn) = (
-                    crate::spatial::splat33::<T>(&crate::spatial::skew(&n)),
-                    crate::spatial::splat33::<T>(&(n * n.transpose())),
-                );
-                let rot = Mat3::identity() * c + skew_n * s + nn * (T::one() - c);
-                Transform::new(rot, splat3::<T>(&e1) * qb[0] + splat3::<T>(&e2) * qb[1])
-            }
-            Block::Scalar => unreachable!("a multi-DOF head is never a scalar block (with_coordinates)"),
-        }
+        let in_plane = match block {
+            Block::Planar => (self.joints[i].axis, self.joints[i + 1].axis),
+            _ => (Vec3::x(), Vec3::y()),
+        };
+        crate::joint::block_transform(block, in_plane, qb)
     }
 
     /// `out = q ⊕ (v dt)`: each joint's block moved by its velocity (Lie-group exponential of a
@@ -469,6 +458,35 @@ impl Model {
         }
         self.link_origin = origins;
         Ok(self)
+    }
+
+    /// The body that carries each link, in joint order: the last body of each joint (a 1-DOF
+    /// joint's own body; a multi-DOF joint's last member, where the builder puts the link's inertia,
+    /// frames and link origin). A model of 1-DOF joints has one link per body.
+    pub fn link_bodies(&self) -> Vec<usize> {
+        (0..self.n).filter(|&i| self.group_last[i] == i).collect()
+    }
+
+    /// External wrenches given one per link (`links` = [`Model::link_bodies`]`.len()` of 6 numbers,
+    /// as [`Model::body_wrench`] reads them) laid out one per body in `out` (6 n): each link's
+    /// wrench on the body that carries it, zero on a multi-DOF joint's inner bodies (massless, they
+    /// carry no link). `Err` names the expected length when `per_link` has another.
+    pub fn link_wrenches(&self, per_link: &[f64], out: &mut [f64]) -> Result<()> {
+        let bodies = self.link_bodies();
+        if per_link.len() != 6 * bodies.len() || out.len() != 6 * self.n {
+            return Err(Error::InvalidModel(format!(
+                "external wrenches: {} numbers for {} links (6 each), into {} for {} bodies",
+                per_link.len(),
+                bodies.len(),
+                out.len(),
+                self.n
+            )));
+        }
+        out.fill(0.0);
+        for (l, &b) in bodies.iter().enumerate() {
+            out[6 * b..6 * b + 6].copy_from_slice(&per_link[6 * l..6 * l + 6]);
+        }
+        Ok(())
     }
 
     /// An external wrench `(f, n)` (base axes, moment about body i's link-frame origin) in body

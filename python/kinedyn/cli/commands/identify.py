@@ -7,6 +7,7 @@ from rich.table import Table
 
 from ..._ui.files import replacing
 from ...analysis.excitation import excitation_condition, optimize_excitation, write_trajectory_csv
+from ...analysis.experiment import CONTROLLERS, experiment_controller, load_reference
 from ...analysis.identification import excitation, identify, simulate_measurements
 from ...analysis.logs import load_log
 from ...report.identification import write_identification_html
@@ -62,9 +63,35 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--method",
         default="auto",
-        choices=("auto", "ols", "wls", "irls"),
-        help="estimator: ordinary, weighted or iteratively reweighted (robust) least squares (default: ols, "
-        "wls with --weighted); the closed-loop methods iv and didim need the controller: kinedyn.analysis.identify",
+        choices=("auto", "ols", "wls", "irls", "iv", "didim"),
+        help="estimator: ordinary, weighted or iteratively reweighted (robust) least squares; iv (instrumental "
+        "variables) and didim (output error) for closed-loop data, which simulate the model under the controller that "
+        "ran the experiment: a log does not hold it, so give --controller, --kp, --kd and --reference "
+        "(default: iv with --controller, else ols, wls with --weighted)",
+    )
+    p.add_argument(
+        "--controller",
+        choices=CONTROLLERS,
+        default=None,
+        help="the controller that ran the experiment (with --data): pd (Kp e + Kd ed), pdg (PD + the model's "
+        "gravity), ct (computed torque on the robot's model)",
+    )
+    p.add_argument("--kp", default=None, metavar="K|K1,..,Kn", help="the controller's proportional gains")
+    p.add_argument("--kd", default=None, metavar="K|K1,..,Kn", help="the controller's derivative gains")
+    p.add_argument(
+        "--reference",
+        metavar="CSV",
+        action=InputPath,
+        help="the trajectory the controller tracked (t, q1..qn[, qd1.., qdd1..], as --excite writes it), on the log's clock",
+    )
+    p.add_argument(
+        "--control-period", type=positive_float, default=1e-3, help="the controller's period, s (default 0.001)"
+    )
+    p.add_argument(
+        "--min-speed",
+        type=nonnegative_float,
+        default=0.0,
+        help="leave out the rows where a joint moves slower than this (rad/s): stick and Coulomb's jump",
     )
     p.add_argument(
         "--smoothing", type=positive_float, default=None, help="smooth the Coulomb sign as tanh(qd / SMOOTHING), rad/s"
@@ -200,9 +227,13 @@ def _identify_from_log(robot, args) -> int:
             delay = float(delay)
         except ValueError:
             raise ValueError(f"--delay: a number of seconds or 'estimate', got {delay!r}") from None
+    controller = _controller(robot, args)
     result = identify(
         robot,
         log,
+        controller=controller,
+        control_period=args.control_period,
+        min_speed=args.min_speed,
         weighted=args.weighted,
         friction=args.friction,
         consistent=args.consistent,
@@ -247,6 +278,15 @@ def _identify_from_log(robot, args) -> int:
                 f"{esc(s['joint'])}: Stribeck velocity {s['velocity']:.4g} rad/s (std {s['velocity_std']:.2g}), "
                 f"static friction {', '.join(f'{v:.4g}' for v in s['static'])} N m"
             )
+        loop = result.closed_loop
+        if loop is not None:
+            c.print(
+                f"{result.method}: {result.iterations} simulation(s) under the experiment's controller, "
+                + ("converged" if loop["converged"] else "not converged")
+                + f" (last change {100 * loop['last_change']:.3g} %, tolerance {100 * loop['tolerance']:.3g} %)"
+            )
+        for note in result.notes:
+            c.print(esc(note))
         assert result.identifiability is not None
         for group in result.identifiability.groups:
             c.print(f"not separable by the data (only a combination is identified): {esc(', '.join(group))}")
@@ -268,3 +308,40 @@ def _identify_from_log(robot, args) -> int:
 
     emit(args, payload, render)
     return 0
+
+
+def _gain_list(text, option: str):
+    try:
+        return [float(v) for v in str(text).split(",")]
+    except ValueError:
+        raise ValueError(f"{option}: a number or a comma-separated list of numbers, got {text!r}") from None
+
+
+def _controller(robot, args):
+    """The experiment's controller from --controller/--kp/--kd/--reference (None without them);
+    iv and didim without it: say what is missing, as the log cannot hold it."""
+    given = [
+        o
+        for o, v in (
+            ("--controller", args.controller),
+            ("--kp", args.kp),
+            ("--kd", args.kd),
+            ("--reference", args.reference),
+        )
+        if v is not None
+    ]
+    if not given:
+        if args.method in ("iv", "didim"):
+            raise ValueError(
+                f"--method {args.method} simulates the identified model under the controller that ran the experiment, "
+                "and a log does not hold it: give --controller pd|pdg|ct, --kp, --kd and --reference TRAJ.csv "
+                "(the trajectory it tracked), or use --method ols|wls|irls"
+            )
+        return None
+    missing = [o for o in ("--controller", "--kp", "--kd", "--reference") if o not in given]
+    if missing:
+        raise ValueError(f"the experiment's controller needs {', '.join(missing)} as well (given: {', '.join(given)})")
+    reference = load_reference(args.reference, robot.n)
+    return experiment_controller(
+        robot, args.controller, _gain_list(args.kp, "--kp"), _gain_list(args.kd, "--kd"), reference
+    )

@@ -108,6 +108,10 @@ def run(args) -> int:
         "bodies": bodies,
         "total_mass": _value(sum(b.inertia.mass for b in robot.tree.bodies)),
         "symbols": sorted(str(s) for s in robot.symbols),
+        "loops": [
+            {"name": lp.name, "frame_a": lp.frame_a, "frame_b": lp.frame_b, "kind": lp.kind, "rows": lp.rows}
+            for lp in robot.loops
+        ],
     }
 
     def render():
@@ -171,6 +175,14 @@ def run(args) -> int:
             )
         c.print(t)
         c.print(f"total moving mass: {esc(fmt(payload['total_mass']))} kg")
+        if payload["loops"]:  # closed loops (docs/closed-loops.md): constraints between two frames of the tree
+            t = Table(title="closed loops (frame_a meets frame_b)", title_justify="left")
+            for col in ("loop", "frame_a", "frame_b", "kind", "rows"):
+                t.add_column(col)
+            for lp in payload["loops"]:
+                what = "point (origins meet)" if lp["kind"] == "point" else "weld (frames meet)"
+                t.add_row(esc(lp["name"]), esc(lp["frame_a"]), esc(lp["frame_b"]), what, str(lp["rows"]))
+            c.print(t)
         if payload["symbols"]:
             c.print(
                 f"symbolic parameters: {', '.join(payload['symbols'])} (numeric commands take their values: --set NAME=VALUE)"
