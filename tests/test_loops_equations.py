@@ -488,3 +488,11 @@ def test_cli_check_proves_on_the_reduced_model_and_refuses_the_numeric_checks(tm
     assert checks["reduced model: dD/dt - 2C skew-symmetric"]["status"] in ("proved", "sampled", "failed")
     assert main(["check", str(path)]) != 0
     assert "kinedyn check --prove" in capsys.readouterr().err
+
+
+def test_newton_euler_tree_gives_the_same_closed_chain(four_bar):
+    """The tree's equations by the customised Newton-Euler model: the same closure, A and reduced M_r."""
+    eom = rex.four_bar_robot(gravity=True).equations_of_motion(method="newton_euler", steps=False)
+    assert eom.method == "newton_euler" and eom.phi == four_bar.phi and eom.A == four_bar.A
+    assert sp.simplify(eom.reduced.M[0, 0] - four_bar.reduced.M[0, 0]) == 0
+    assert sp.simplify(eom.reduced.g[0] - four_bar.reduced.g[0]) == 0
