@@ -128,6 +128,13 @@ def check_properties(
     there and the residual measures the integrator, not the model. Viscous friction stays in the
     simulated dynamics (its dissipation is a smooth term of the balance); that every friction torque
     dissipates, ``qd . friction(qd) >= 0``, is checked on the sampled rates."""
+    if robot.loops:
+        raise ValueError(
+            f"robot '{robot.name}' has closed loops ({', '.join(lp.name for lp in robot.loops)}): the numeric checks measure "
+            "a tree's equations, and a closed chain's are its reduced equations, which the numeric engine does not form; "
+            "robot.equations_of_motion().check_properties() proves them on the symbolic reduced model "
+            "(kinedyn check --prove)"
+        )
     rng = np.random.default_rng(seed)
     n = robot.n
     if n == 0:

@@ -30,6 +30,10 @@ class EquationsOfMotion:
     """Symbolic equations of motion (see the module docstring). Built by
     :func:`equations_of_motion` (robots) or :meth:`kinedyn.LagrangianSystem.equations_of_motion`."""
 
+    #: the equation the renderings print above the result (LaTeX, text); a closed chain's adds A^T lambda
+    result_latex = latex.RESULT_TITLE
+    result_text = "M(q) qdd + C(q, qd) qd + g(q) = tau"
+
     def __init__(
         self,
         q,
@@ -161,6 +165,11 @@ class EquationsOfMotion:
         for step in self._steps or []:
             step.owner = self  # its notebook display prints q̇, q̈ by self's names
         return self._steps or []
+
+    def configuration_rates(self) -> list[tuple]:
+        """(coordinate, rate) pairs along which d/dt of a function of the configuration is taken:
+        (q_k, qd_k); a closed chain's reduced equations add the dependent coordinates."""
+        return list(zip(self.q, self.qd))
 
     # ------------------------------------------------------------------ derived forms
     def hamiltonian(self, u=None):
@@ -318,7 +327,9 @@ class EquationsOfMotion:
         (also valid KaTeX/MathJax input). Long sums are broken over lines and wide matrices written
         entry by entry so that every line fits a 17 cm text width. :meth:`to_latex_document` gives a
         complete document (``kinedyn derive --format latex``)."""
-        return latex.fragment(self.steps if steps else [], self.result_equations(), self.latex_names)
+        return latex.fragment(
+            self.steps if steps else [], self.result_equations(), self.latex_names, title=self.result_latex
+        )
 
     def to_latex_document(self, steps: bool = True) -> str:
         """A complete LaTeX document (article, amsmath only) that ``pdflatex`` compiles: a section per
@@ -331,6 +342,7 @@ class EquationsOfMotion:
             self.latex_names,
             intro="\n\n".join(self.notes),
             legend=self.legend("latex"),
+            result_title=self.result_latex,
         )
 
     def to_markdown(self) -> str:
@@ -354,7 +366,7 @@ class EquationsOfMotion:
                 out += [step.text, ""]
             for lhs, value in step.equations:
                 out += block(lhs, value)
-        out += ["## Result: $M(q)\\ddot{q} + C(q,\\dot{q})\\dot{q} + g(q) = \\tau$", ""]
+        out += [f"## Result: ${self.result_latex}$", ""]
         for lhs, value in self.result_equations():
             out += block(lhs, value)
         return "\n".join(out)
@@ -390,15 +402,13 @@ class EquationsOfMotion:
                 parts.append(f"<p>{escape(step.text)}</p>")
             parts += [self.equation_mathml(lhs, value) for lhs, value in step.equations]
             parts.append("</section>")
-        parts.append("<section><h3>Result: M(q) q̈ + C(q, q̇) q̇ + g(q) = τ</h3>")
+        parts.append(f"<section><h3>Result: {escape(self.result_text)}</h3>")
         parts += [self.equation_mathml(lhs, value) for lhs, value in self.result_equations()]
         parts.append("</section></div>")
         return "\n".join(parts)
 
     def __str__(self) -> str:
-        out = [
-            f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): M(q) qdd + C(q, qd) qd + g(q) = tau"
-        ]
+        out = [f"Equations of motion{' of ' + self.name if self.name else ''} ({self.method}): {self.result_text}"]
         out += self.notes  # no legend: plain text writes the joints' own names
         rates = [*self.qdd, *self.qd]
         for k, step in enumerate(self.steps, start=1):

@@ -87,13 +87,18 @@ def prove_properties(
     qd = list(eom.qd)
     n = eom.n
     D, C, g = eom.M, eom.C, eom.g
-    variables = set(q) | set(qd) | set(eom.qdd)
+    # d/dt along the motion: (q_k, qd_k), and for a closed chain's reduced equations in a velocity map
+    # also the dependent coordinates at their rates G_d qd (eom.configuration_rates)
+    rates = eom.configuration_rates() if hasattr(eom, "configuration_rates") else list(zip(q, qd))
+    velocity_map = len(rates) > n
+    coordinates = [c for c, _ in rates]
+    variables = set(coordinates) | set(qd) | set(eom.qdd)
     checks = []
 
     floating = any(m.has(sp.Float) for m in (D, C, g)) or (eom.P is not None and sp.sympify(eom.P).has(sp.Float))
 
     def decided(name, entries, source, what):
-        status, residual, witness = _decide_zero(entries, q, variables, rng)
+        status, residual, witness = _decide_zero(entries, coordinates, variables, rng)
         how = {
             "proved": "reduces to 0 exactly (sin/cos of sums expanded, reduced modulo sin^2 + cos^2 = 1)",
             "sampled": f"not decided by simplification; zero to {residual:.2g} at random states (not proved)"
@@ -120,7 +125,7 @@ def prove_properties(
 
     decided("D symmetric", [D[i, j] - D[j, i] for i in range(n) for j in range(i + 1, n)], "Spong eq. 9.50", "D - D^T")
     Ddot = sp.zeros(n, n)
-    for qi, vi in zip(q, qd):
+    for qi, vi in rates:
         Ddot += D.diff(qi) * vi
     N = Ddot - 2 * C
     decided(
@@ -136,7 +141,21 @@ def prove_properties(
         "dD/dt - C - C^T",
     )
     P = eom.P
-    if P is not None:
+    if velocity_map:
+        checks.append(
+            Check(
+                "D qdd + C qd + g == d/dt dL/dqd - dL/dq",
+                True,
+                0.0,
+                0.0,
+                "the reduced equations G^T (M qdd + C qd + g) of a closed chain in a velocity map qd = G(q) qd_i are not "
+                "the Euler-Lagrange equations of a Lagrangian in the independent coordinates alone (the closure ties "
+                "the others to them implicitly); the tree's equations they come from satisfy it",
+                "Spong eqs. 9.52-9.61",
+                status="skipped",
+            )
+        )
+    elif P is not None:
         L = eom.K - P
         lhs = []
         for k in range(n):
@@ -167,6 +186,21 @@ def prove_properties(
     name = "inertia bounds lambda_min I <= D(q) <= lambda_max I"
     Dn = D.xreplace(by_name(params, eom.parameters)) if params else D
     free = sorted(Dn.free_symbols - set(q), key=str)
+    if velocity_map:
+        checks.append(
+            Check(
+                name,
+                True,
+                0.0,
+                0.0,
+                "D depends on the dependent coordinates of a closed chain, which its closure ties to the independent "
+                "ones: the bounds need a search on the closed configurations (give an explicit branch, solution=, for "
+                "D in the independent coordinates alone)",
+                "Spong eqs. 9.119-9.120",
+                status="skipped",
+            )
+        )
+        return PropertiesReport(eom.name or "equations of motion", samples, checks)
     if free:
         checks.append(
             Check(

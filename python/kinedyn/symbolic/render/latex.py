@@ -404,8 +404,15 @@ def equation_rows(lhs, value, limit: float = LINE_PT, names: dict | None = None)
 RESULT_TITLE = r"M(q)\ddot{q} + C(q,\dot{q})\dot{q} + g(q) = \tau"
 
 
-def fragment(steps: Sequence, final: Sequence[tuple], names: dict | None = None, limit: float | None = None) -> str:
-    """One ``align*`` block: each step's title as a ``\\text`` row, its equations, then the result."""
+def fragment(
+    steps: Sequence,
+    final: Sequence[tuple],
+    names: dict | None = None,
+    limit: float | None = None,
+    title: str = RESULT_TITLE,
+) -> str:
+    """One ``align*`` block: each step's title as a ``\\text`` row, its equations, then the result
+    (``title``: its equation, LaTeX)."""
     if limit is None:
         limit = rhs_limit([lhs for step in steps for lhs, _ in step.equations] + [lhs for lhs, _ in final])
     body: list[str] = []
@@ -413,7 +420,7 @@ def fragment(steps: Sequence, final: Sequence[tuple], names: dict | None = None,
         body.append(r"&\text{" + latex_text(step.title) + r"} \\")
         for lhs, value in step.equations:
             body += equation_rows(lhs, value, limit, names)
-    body.append(r"&\text{Equations of motion: } " + RESULT_TITLE + r" \\")
+    body.append(r"&\text{Equations of motion: } " + title + r" \\")
     for lhs, value in final:
         body += equation_rows(lhs, value, limit, names)
     if body:
@@ -445,9 +452,11 @@ def document(
     intro: str = "",
     limit: float | None = None,
     legend: str = "",
+    result_title: str = RESULT_TITLE,
 ) -> str:
     """A complete LaTeX document (``pdflatex`` compiles it): a section per step with its prose and its
-    equations, and the result; ``intro`` is prose (through :func:`latex_text`), ``legend`` LaTeX."""
+    equations, and the result (``result_title``: its equation, LaTeX); ``intro`` is prose (through
+    :func:`latex_text`), ``legend`` LaTeX."""
     parts = [PREAMBLE, r"\title{" + _escape(title) + "}", r"\date{}", r"\begin{document}", r"\maketitle"]
     if intro:
         parts.append(latex_text(intro) + "\n")
@@ -462,7 +471,7 @@ def document(
         for lhs, value in step.equations:
             rows += equation_rows(lhs, value, step_limit, names)
         parts.append(align(rows))
-    parts.append(r"\section*{Result: $" + RESULT_TITLE + "$}")
+    parts.append(r"\section*{Result: $" + result_title + "$}")
     rows = []
     final_limit = limit if limit is not None else rhs_limit([lhs for lhs, _ in final])
     for lhs, value in final:

@@ -25,6 +25,7 @@ from ..eom import EquationsOfMotion
 from ..render.mathml import Name, ddt_dL_dqd, dL_dq, dL_dqd, lagrangian, mi, name, of_q, tokens
 from ..steps import Step
 from ..values import exact
+from .closed_loops import closed_loop_equations
 
 __all__ = ["equations_of_motion", "lagrange_eom", "newton_euler_eom", "general_parameters"]
 
@@ -373,6 +374,8 @@ def equations_of_motion(
     parameters=None,
     form: str = "auto",
     snap_angles: float | None = None,
+    independent=None,
+    solution=None,
 ) -> EquationsOfMotion:
     """The symbolic equations of motion of a :class:`kinedyn.Robot` (numbers, symbols, or a mix).
 
@@ -397,7 +400,17 @@ def equations_of_motion(
     pi/2 (a file's ``1.570796325``) are made exact first, so that cos(pi/2) terms vanish instead of
     printing as 1e-12 (:func:`kinedyn.description.snap.snap_right_angles`); ``eom.notes`` says what
     moved and ``eom.robot`` is the snapped robot. ``kinedyn derive`` snaps within 1e-6 rad by default.
+
+    A robot with loops (``robot.loops``) gets a :class:`~kinedyn.symbolic.systems.closed_loops.ClosedLoopEquations`:
+    the tree's M, C, g with the closure phi(q) = 0, A = dphi/dq and M qdd + C qd + g = tau + A^T lambda, and
+    ``eom.reduced``, the equations in the independent coordinates (``independent``: their names, chosen
+    from A when not given; ``solution``: {dependent coordinate: expression of the independent ones},
+    an explicit branch of the closure; docs/closed-loops.md, "The equations").
     """
+    if (independent is not None or solution is not None) and not robot.loops:
+        raise ValueError(
+            f"independent= and solution= choose the reduced coordinates of a robot with loops; robot '{robot.name}' has none"
+        )
     notes = []
     if snap_angles:
         snapped, moved = snap_right_angles(robot.description, snap_angles)
@@ -419,4 +432,6 @@ def equations_of_motion(
     else:
         raise ValueError(f"method must be 'lagrange' or 'newton_euler', got {method!r}")
     eom.notes = notes
+    if robot.loops:
+        return closed_loop_equations(eom, robot, independent=independent, solution=solution, steps=steps)
     return eom
