@@ -19,7 +19,6 @@ import numpy as np
 
 from ._arrays import float64_array
 from ._ui.names import did_you_mean
-from .native.compile import body_wrenches
 
 __all__ = [
     "constrained_forward_dynamics",
@@ -73,12 +72,9 @@ def loop_gamma(description, model, q, qd):
 
 def constrained_forward_dynamics(description, model, q, qd, tau, f_ext=None):
     """``(qdd, lambda)``, each with the batch's leading axis when ``q`` has one (a control loop's
-    call: the checks are the core's, only the mimic refusal and the wrench layout are here)."""
+    call: the checks are the core's, the wrenches' layout too; only the mimic refusal is here)."""
     if description.mimic_map is not None:
         _native(description, model, "constrained_forward_dynamics")
-    if f_ext is not None:
-        q = float64_array(q)
-        f_ext = body_wrenches(description, q, f_ext)
     out = model.constrained_forward_dynamics(q, qd, tau, f_ext)
     n = model.n
     return out[..., :n], out[..., n:]
@@ -90,8 +86,7 @@ def constrained_inverse_dynamics(description, model, q, qd, qdd, actuated, f_ext
     if isinstance(actuated, str):
         actuated = [actuated]
     columns = velocity_columns(description, actuated, "constrained_inverse_dynamics, actuated")
-    q = float64_array(q)
-    return native.constrained_inverse_dynamics(q, qd, qdd, columns, body_wrenches(description, q, f_ext))
+    return native.constrained_inverse_dynamics(q, qd, qdd, columns, f_ext)
 
 
 def project_configuration(description, model, q, hold=None, tolerance=1e-12, max_iter=50):
