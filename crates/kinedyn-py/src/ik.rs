@@ -4,7 +4,7 @@
 
 use std::sync::Mutex;
 
-use kinedyn_core::ik::{self, AnalyticIk as CoreAnalytic, Settings};
+use kinedyn_core::ik::{self, AnalyticOutcome, ChainIk as CoreAnalytic, Settings};
 use kinedyn_core::spatial::{Mat3, Transform, Vec3};
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -47,7 +47,7 @@ fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResul
 }
 
 /// The numbers of a float64 array in C order, copied.
-fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
+pub(crate) fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
     // SAFETY: read while this thread holds the GIL and runs no Python code, so nothing writes to
     // the array meanwhile (a plain type check instead of rust-numpy's borrow tracking, ~0.4 us each)
     let view = unsafe { a.as_array() };
@@ -60,7 +60,7 @@ fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
 }
 
 /// Targets (4, 4) / (N, 4, 4) or positions (3,) / (N, 3): (transforms, batch size, position-only).
-fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transform>, Option<usize>, bool)> {
+pub(crate) fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transform>, Option<usize>, bool)> {
     let shape = targets.shape().to_vec();
     let (batch, position) = match shape.as_slice() {
         [4, 4] => (None, false),
@@ -82,7 +82,7 @@ fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transfo
     Ok((list, batch, position))
 }
 
-fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Vec<f64>> {
+pub(crate) fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Vec<f64>> {
     if a.shape() != [len] {
         return Err(PyValueError::new_err(format!(
             "{name} must have shape ({len},), got {:?}",
@@ -92,7 +92,7 @@ fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Ve
     numbers(a)
 }
 
-fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
+pub(crate) fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
     for i in 0..lower.len() {
         if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
             return Err(PyValueError::new_err(format!(
@@ -368,22 +368,101 @@ impl PyAnalyticIk {
         })
     }
 
-    /// Name of the detected structure (e.g. "spherical_wrist").
+    /// Name of the detected structure (e.g. "spherical_wrist"; "reversed_..." when it was found
+    /// from the tool end).
     #[getter]
     fn structure(&self) -> &'static str {
-        self.solver.structure.name()
+        self.solver.name()
     }
 
     /// Name of the arm of a spherical-wrist chain, else None.
     #[getter]
     fn arm(&self) -> Option<&'static str> {
-        self.solver.arm.map(|a| a.name())
+        self.solver.ik.arm.map(|a| a.name())
+    }
+
+    /// The most real solutions the structure's closed form has for one target.
+    #[getter]
+    fn max_solutions(&self) -> usize {
+        self.solver.max_solutions()
+    }
+
+    /// `solve` with the statement of completeness: (solutions, position errors, orientation
+    /// errors, found, singular, max_solutions, worst residual, merged).
+    #[pyo3(signature = (target, reference, respect_limits=true, tolerance=1e-9))]
+    fn solve_stated<'py>(
+        &self,
+        py: Python<'py>,
+        target: Bound<'py, PyArrayDyn<f64>>,
+        reference: Bound<'py, PyArrayDyn<f64>>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guarded("AnalyticIk.solve_stated", || {
+            let (targets, batch, position) = gather_targets(&target)?;
+            if batch.is_some() {
+                return Err(PyValueError::new_err(
+                    "AnalyticIk.solve_stated takes one target; use solve_all for a batch",
+                ));
+            }
+            let reference = vector("reference", &reference, self.model.n)?;
+            let out = {
+                let mut data = self.data.lock().unwrap_or_else(|e| e.into_inner());
+                ik::analytic_solutions(
+                    &self.model,
+                    &mut data,
+                    &self.solver,
+                    self.frame,
+                    &targets[0],
+                    position,
+                    &reference,
+                    &self.lower,
+                    &self.upper,
+                    respect_limits,
+                    tolerance,
+                )
+            };
+            stated(py, out, self.model.n)
+        })
+    }
+
+    /// Every solution of each target of a batch, in one call on all threads (see `all_branches`).
+    #[pyo3(signature = (targets, references, respect_limits=true, tolerance=1e-9))]
+    fn solve_all<'py>(
+        &self,
+        py: Python<'py>,
+        targets: Bound<'py, PyArrayDyn<f64>>,
+        references: Bound<'py, PyArrayDyn<f64>>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guarded("AnalyticIk.solve_all", || {
+            let n = self.model.n;
+            let (targets, _, position) = gather_targets(&targets)?;
+            let refs = references_of(&references, targets.len(), n)?;
+            let width = self.solver.max_solutions();
+            all_branches(py, &self.model, targets.len(), width, |data, k| {
+                ik::analytic_solutions(
+                    &self.model,
+                    data,
+                    &self.solver,
+                    self.frame,
+                    &targets[k],
+                    position,
+                    &refs[k * n..(k + 1) * n],
+                    &self.lower,
+                    &self.upper,
+                    respect_limits,
+                    tolerance,
+                )
+            })
+        })
     }
 
     /// Whether position-only targets (3,) have a closed form (else only full poses do).
     #[getter]
     fn solves_position(&self) -> bool {
-        self.solver.structure.solves_position()
+        self.solver.solves_position()
     }
 
     /// All solutions for one target (4, 4) or position (3,):
@@ -534,6 +613,110 @@ impl PyAnalyticIk {
             ))
         })
     }
+}
+
+/// References `(N, n)`, checked.
+pub(crate) fn references_of(references: &Bound<'_, PyArrayDyn<f64>>, count: usize, n: usize) -> PyResult<Vec<f64>> {
+    if references.shape() != [count, n] {
+        return Err(PyValueError::new_err(format!(
+            "references must have shape ({count}, {n}), got {:?}",
+            references.shape()
+        )));
+    }
+    let refs = numbers(references)?;
+    if refs.iter().any(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err("references contain a non-finite value"));
+    }
+    Ok(refs)
+}
+
+/// One target's outcome with its statement of completeness, as a tuple: (solutions (m, n),
+/// position errors (m,), orientation errors (m,), found, singular, max_solutions, worst residual,
+/// merged).
+pub(crate) fn stated<'py>(py: Python<'py>, out: AnalyticOutcome, n: usize) -> PyResult<Bound<'py, PyAny>> {
+    let m = out.solutions.len();
+    let flat: Vec<f64> = out.solutions.concat();
+    Ok((
+        PyArray1::from_vec(py, flat).reshape([m, n])?,
+        PyArray1::from_vec(py, out.position_error),
+        PyArray1::from_vec(py, out.orientation_error),
+        out.found,
+        out.singular,
+        out.max_solutions,
+        out.worst_residual,
+        out.merged,
+    )
+        .into_pyobject(py)?
+        .into_any())
+}
+
+/// Every solution of `count` targets, one `solve(data, k)` per target on all threads, packed as
+/// (solutions (N, width, n) NaN past each count, counts (N,), position errors (N, width),
+/// orientation errors (N, width), found (N,), singular (N,), max_solutions (N,), worst residual
+/// (N,), merged (N,)).
+pub(crate) fn all_branches<'py>(
+    py: Python<'py>,
+    model: &Model,
+    count: usize,
+    width: usize,
+    solve: impl Fn(&mut Data, usize) -> AnalyticOutcome + Sync,
+) -> PyResult<Bound<'py, PyAny>> {
+    const WHAT: &str = "inverse kinematics, every branch";
+    let n = model.n;
+    let outcomes: Vec<AnalyticOutcome> = py.detach(|| {
+        guard::install(|| {
+            (0..count)
+                .into_par_iter()
+                .map_init(|| Data::new(model), |data, k| solve(data, k))
+                .collect()
+        })
+    })?;
+    let width = outcomes.iter().map(|o| o.solutions.len()).fold(width, usize::max);
+    let q = guard::empty::<f64>(py, WHAT, &[count, width, n])?;
+    let [pe, oe] = [
+        guard::empty::<f64>(py, WHAT, &[count, width])?,
+        guard::empty::<f64>(py, WHAT, &[count, width])?,
+    ];
+    let [counts, found, most] = [
+        guard::empty::<i64>(py, WHAT, &[count])?,
+        guard::empty::<i64>(py, WHAT, &[count])?,
+        guard::empty::<i64>(py, WHAT, &[count])?,
+    ];
+    let worst = guard::empty::<f64>(py, WHAT, &[count])?;
+    let [singular, merged] = [
+        guard::zeros::<bool>(py, WHAT, &[count])?,
+        guard::zeros::<bool>(py, WHAT, &[count])?,
+    ];
+    // SAFETY: fresh arrays, referenced by nothing else until returned
+    unsafe {
+        let (qs, pes, oes) = (q.as_slice_mut()?, pe.as_slice_mut()?, oe.as_slice_mut()?);
+        qs.fill(f64::NAN);
+        pes.fill(f64::NAN);
+        oes.fill(f64::NAN);
+        let (cs, fs, ms, ws) = (
+            counts.as_slice_mut()?,
+            found.as_slice_mut()?,
+            most.as_slice_mut()?,
+            worst.as_slice_mut()?,
+        );
+        let (ss, gs) = (singular.as_slice_mut()?, merged.as_slice_mut()?);
+        for (k, o) in outcomes.iter().enumerate() {
+            for (b, sol) in o.solutions.iter().enumerate() {
+                qs[(k * width + b) * n..(k * width + b + 1) * n].copy_from_slice(sol);
+                pes[k * width + b] = o.position_error[b];
+                oes[k * width + b] = o.orientation_error[b];
+            }
+            cs[k] = o.solutions.len() as i64;
+            fs[k] = o.found as i64;
+            ms[k] = o.max_solutions as i64;
+            ws[k] = o.worst_residual;
+            ss[k] = o.singular;
+            gs[k] = o.merged;
+        }
+    }
+    Ok((q, counts, pe, oe, found, singular, most, worst, merged)
+        .into_pyobject(py)?
+        .into_any())
 }
 
 /// Register the IK functions and classes in `kinedyn._core`.
