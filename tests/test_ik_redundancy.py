@@ -263,3 +263,35 @@ def test_bad_redundancy_arguments_are_named(iiwa):
     with pytest.raises(ValueError, match="no closed form"):
         arm7 = kd.Robot.from_dh([kd.DHRow(a=0.3 + 0.1 * i, alpha=0.4 * i + 0.2, d=0.05 * i) for i in range(7)])
         arm7.inverse_kinematics(np.eye(4)[None], all_branches=True)
+
+
+# ------------------------------------------------------------------ the command line
+def run_cli(argv, capsys):
+    from kinedyn.cli import main
+
+    code = main(argv)
+    return code, capsys.readouterr().out
+
+
+def test_cli_all_on_a_seven_joint_urdf(iiwa, capsys):
+    import json
+
+    pybullet_data = pytest.importorskip("pybullet_data")
+    path = str(Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf")
+    base = ["ik", path, "--xyz", "0.4", "0.2", "0.6", "--rpy", "3.0", "0.1", "0.2", "--all", "--ignore-limits"]
+    code, out = run_cli([*base, "--json"], capsys)
+    payload = json.loads(out)
+    assert code == 0 and payload["count"] == 8 and payload["max_solutions"] == 8
+    assert "arm_angle" in payload["redundancy"] and "8 of at most 8" in payload["completeness"]
+    T = np.array(payload["target"])
+    for q in payload["solutions"]:
+        assert np.abs(iiwa.pose(np.array(q)) - T).max() < 1e-9
+    code, out = run_cli([*base, "--hold", "lbr_iiwa_joint_3=0.2"], capsys)
+    assert code == 0 and "held[lbr_iiwa_joint_3]+spherical_wrist: 8 of at most 8" in out
+    code, out = run_cli([*base, "--arm-angle", "0.5", "--json"], capsys)
+    payload = json.loads(out)
+    assert payload["redundancy"] == {"arm_angle": 0.5}
+    for q in payload["solutions"]:
+        assert abs(wrapped(kd.ik.arm_angle(iiwa, np.array(q)) - 0.5)) < 1e-9
+    code, out = run_cli(["ik", "ur5", "--xyz", "0.3", "0.2", "0.4", "--rpy", "3.1", "0", "0", "--all"], capsys)
+    assert code == 0 and "three_parallel: 8 of at most 8 real solutions found" in out

@@ -27,7 +27,7 @@ from .._core import RedundantIk
 from .branches import pack
 from .solve import IKResult, chain_of, check_q0, check_target
 
-__all__ = ["self_motion", "SelfMotion", "arm_angle", "solve_redundant"]
+__all__ = ["self_motion", "SelfMotion", "arm_angle", "solve_redundant", "default_redundancy"]
 
 
 def _seven(robot, frame: str | None):
@@ -131,6 +131,26 @@ def solve_redundant(robot, target, q0, respect_limits: bool, redundancy, frame, 
         worst_residual=worst,
         merged=merged,
     )
+
+
+def default_redundancy(robot, q0=None, frame: str | None = None) -> dict | None:
+    """A redundancy parameter that lists every closed-form branch near ``q0`` (default: the neutral
+    configuration) on a seven-joint arm: the arm angle of ``q0`` on an SRS arm, else the last joint
+    (then the others, last to first) whose holding at its ``q0`` value leaves a six-joint chain
+    with a closed form; None when there is none (or the robot is no seven-joint chain)."""
+    try:
+        chain, solver = _seven(robot, frame)
+    except ValueError:
+        return None
+    q = check_q0(q0, chain, None, robot)
+    if solver.srs:
+        psi = solver.arm_angle(np.ascontiguousarray(q, dtype=float))
+        if psi is not None:
+            return {"arm_angle": float(psi)}
+    for k in range(6, -1, -1):
+        if solver.held_structure(k, float(q[k])):
+            return {"joint": robot.joint_names[k], "value": float(q[k])}
+    return None
 
 
 def _structure(solver, mode: str, k: int, name, value: float) -> str:
