@@ -217,10 +217,11 @@ def test_a_batch_with_one_value_per_target(iiwa):
 def test_all_branches_of_a_batch_match_single_calls(name):
     robot = kd.robots.get(name)
     Q, T = targets(robot, 100, 4)
-    b = robot.inverse_kinematics(T, all_branches=True, respect_limits=False)
+    q0 = Q + 0.1  # each target's own reference: the order and the 2 pi k of its solutions
+    b = robot.inverse_kinematics(T, q0=q0, all_branches=True, respect_limits=False)
     assert b.solutions.shape[:2] == (100, 8)
     for k in range(100):
-        one = robot.inverse_kinematics(T[k], respect_limits=False)
+        one = robot.inverse_kinematics(T[k], q0=q0[k], respect_limits=False)
         rows = b.solutions[k, : b.count[k]]
         assert b.count[k] == len(one.solutions) == b.found[k]
         np.testing.assert_allclose(rows, one.solutions, atol=1e-12)
@@ -256,6 +257,8 @@ def test_bad_redundancy_arguments_are_named(iiwa):
         iiwa.inverse_kinematics(t, redundancy={"swivel": 0.1})
     with pytest.raises(ValueError, match="finite"):
         iiwa.inverse_kinematics(t, redundancy={"arm_angle": float("nan")})
+    with pytest.raises(ValueError, match="finite"):
+        iiwa.inverse_kinematics(t[None].repeat(2, 0), redundancy={"arm_angle": [0.1, np.inf]})
     with pytest.raises(ValueError, match="4x4 pose"):
         iiwa.inverse_kinematics(t[:3, 3], redundancy={"arm_angle": 0.1})
     with pytest.raises(ValueError, match="serial chain of 7"):
