@@ -13,7 +13,8 @@ use pyo3::prelude::*;
 use rayon::prelude::*;
 
 use crate::guard::{self, guarded};
-use crate::ik::{all_branches, check_limits, gather_targets, numbers, references_of, stated, vector};
+use crate::ik::{check_limits, gather_targets, numbers, vector};
+use crate::ik_branches::{all_branches, references_of, stated};
 use crate::PyModel;
 
 /// The redundancy parameter: joint `k` held at q = value, or the arm angle (rad).
@@ -69,7 +70,7 @@ impl PyRedundantIk {
     ) -> AnalyticOutcome {
         let m = &self.model;
         let theta_ref: Vec<f64> = (0..7).map(|i| reference[i] + m.offset[i]).collect();
-        let check = Check {
+        let check = |held: Option<usize>, most: usize, singular: bool| Check {
             frame: self.frame,
             target,
             position_only: false,
@@ -78,10 +79,9 @@ impl PyRedundantIk {
             upper: &self.upper,
             respect_limits,
             tolerance,
-            held: match param {
-                Param::Held(k) => Some(k),
-                Param::ArmAngle => None,
-            },
+            held,
+            most,
+            singular,
         };
         match param {
             Param::Held(k) => {
@@ -90,12 +90,7 @@ impl PyRedundantIk {
                     .solver
                     .solve_held(target, k, value + m.offset[k], &theta_ref, &mut rows)
                 {
-                    Some((singular, most)) => {
-                        let mut out = check.finish(m, data, rows.as_flattened(), 7);
-                        out.singular = singular;
-                        out.max_solutions = most;
-                        out
-                    }
+                    Some((singular, most)) => check(Some(k), most, singular).finish(m, data, rows.as_flattened(), 7),
                     None => AnalyticOutcome::default(), // max_solutions 0: no closed form here
                 }
             }
@@ -106,10 +101,7 @@ impl PyRedundantIk {
                     .solve_arm_angle(target, value, &theta_ref, &mut rows)
                     .unwrap_or(true);
                 let flat: Vec<f64> = rows.iter().flatten().flatten().copied().collect();
-                let mut out = check.finish(m, data, &flat, 7);
-                out.singular = singular;
-                out.max_solutions = SRS_MAX_SOLUTIONS;
-                out
+                check(None, SRS_MAX_SOLUTIONS, singular).finish(m, data, &flat, 7)
             }
         }
     }
@@ -320,6 +312,8 @@ impl PyRedundantIk {
                                         Param::Held(k) => Some(k),
                                         Param::ArmAngle => None,
                                     },
+                                    most: width,
+                                    singular: false,
                                 };
                                 let mut slots = vec![f64::NAN; width * 7];
                                 let mut put = |b: usize, theta: &[f64]| {

@@ -9,6 +9,7 @@
 mod conv;
 mod guard;
 mod ik;
+mod ik_branches;
 mod ik_redundant;
 mod lie;
 mod model;

@@ -70,7 +70,8 @@ pub struct AnalyticOutcome {
     pub worst_residual: f64,
     /// Branches merge at this target: two candidates coincide or nearly do (closer than
     /// `MERGE_DISTANCE`), or a solution's Jacobian (the solved joints' columns) is singular
-    /// (Hadamard ratio below `MERGE_RATIO`).
+    /// (Hadamard ratio below `MERGE_RATIO`; tested only when fewer than `max_solutions` were found
+    /// or the solver met a free joint: all `max_solutions` roots found distinct are simple).
     pub merged: bool,
 }
 
@@ -163,7 +164,7 @@ pub fn analytic_solutions(
     let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
     let mut candidates = Vec::with_capacity(8);
     let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
-    let check = Check {
+    Check {
         frame,
         target,
         position_only,
@@ -173,11 +174,10 @@ pub fn analytic_solutions(
         respect_limits,
         tolerance,
         held: None,
-    };
-    let mut out = check.finish(model, data, candidates.as_flattened(), 6);
-    out.singular = singular;
-    out.max_solutions = solver.max_solutions();
-    out
+        most: solver.max_solutions(),
+        singular,
+    }
+    .finish(model, data, candidates.as_flattened(), 6)
 }
 
 /// What a set of closed-form candidates is checked against (`Check::finish`).
@@ -194,6 +194,11 @@ pub struct Check<'a> {
     /// A joint held at its candidate value (a 7R arm's redundancy parameter): kept there by the
     /// refinement, its column left out of the merge test.
     pub held: Option<usize>,
+    /// The most solutions the solver has (its structure's bound) and whether it met a
+    /// non-isolated solution set: when every one of the `most` roots is found, distinct, they are
+    /// all simple (no two branches meet) and the Jacobian test is skipped.
+    pub most: usize,
+    pub singular: bool,
 }
 
 impl Check<'_> {
@@ -248,7 +253,7 @@ impl Check<'_> {
 
     /// Candidates (rows of `theta`, `stride` slots of which the model's n are used) mapped to q,
     /// verified by forward kinematics, refined, deduplicated, filtered by the limits and sorted by
-    /// their distance to the reference. `singular` and `max_solutions` are the caller's to set.
+    /// their distance to the reference.
     pub fn finish(&self, model: &Model, data: &mut Data, candidates: &[f64], stride: usize) -> AnalyticOutcome {
         let n = model.n;
         let (reference, lower, upper) = (self.reference, self.lower, self.upper);
@@ -276,7 +281,9 @@ impl Check<'_> {
             kept.push((q, ep, er, inside, dist));
         }
         out.found = kept.len();
-        if !out.merged {
+        out.max_solutions = self.most;
+        out.singular = self.singular;
+        if !out.merged && (out.found < self.most || self.singular) {
             out.merged = kept
                 .iter()
                 .any(|k| hadamard_ratio(model, data, self.frame, &k.0, self.position_only, self.held) < MERGE_RATIO);
@@ -325,29 +332,33 @@ pub fn hadamard_ratio(
     let n = model.n;
     let mut jac = vec![0.0; 6 * n];
     frame_jacobian(model, data, q, frame, Reference::World, None, &mut jac);
-    let rows: Vec<usize> = if position_only {
-        (0..3).collect()
-    } else {
-        (0..6).collect()
-    };
-    let cols: Vec<usize> = (0..n).filter(|&j| Some(j) != held).collect();
+    let rows: &[usize] = if position_only { &[0, 1, 2] } else { &[0, 1, 2, 3, 4, 5] };
+    let mut cols = [0usize; 16];
+    let mut k_cols = 0;
+    // (closed forms have at most seven joints)
+    for j in (0..n).filter(|&j| Some(j) != held).take(16) {
+        cols[k_cols] = j;
+        k_cols += 1;
+    }
+    let cols = &cols[..k_cols];
     // the Gram matrix of the smaller side
-    let (a, b) = if cols.len() <= rows.len() {
-        (&cols, &rows)
-    } else {
-        (&rows, &cols)
-    };
     let by_cols = cols.len() <= rows.len();
+    let (a, b) = if by_cols { (cols, rows) } else { (rows, cols) };
     let entry = |x: usize, y: usize| if by_cols { jac[y * n + x] } else { jac[x * n + y] };
+    let gram = |i: usize, j: usize| b.iter().map(|&m| entry(a[i], m) * entry(a[j], m)).sum::<f64>();
     let k = a.len();
-    let g = nalgebra::DMatrix::from_fn(k, k, |i, j| {
-        b.iter().map(|&m| entry(a[i], m) * entry(a[j], m)).sum::<f64>()
-    });
-    let norms: f64 = (0..k).map(|i| g[(i, i)].sqrt()).product();
+    let (det, norms) = if k == 6 {
+        // the common case (six solved joints, a pose): a fixed-size LU, no allocation
+        let g = nalgebra::Matrix6::from_fn(gram);
+        (g.determinant(), (0..6).map(|i| g[(i, i)].sqrt()).product::<f64>())
+    } else {
+        let g = nalgebra::DMatrix::from_fn(k, k, gram);
+        (g.determinant(), (0..k).map(|i| g[(i, i)].sqrt()).product::<f64>())
+    };
     if norms <= 0.0 {
         return 0.0;
     }
-    (g.determinant().max(0.0)).sqrt() / norms
+    det.max(0.0).sqrt() / norms
 }
 
 #[cfg(test)]
