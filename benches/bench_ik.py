@@ -5,7 +5,14 @@
 1. Closed forms, all solutions, per call from Python (``robot.inverse_kinematics(T)``), for the
    tutorial elbow arm (position target), the PUMA 560 and the UR5 (poses); also the native call
    alone (``_core.AnalyticIk.solve``). Target of issue 5: UR5 under 10 us per call.
-2. Numeric (Levenberg-Marquardt) on the Panda (example-robot-data URDF, fingers locked) and the
+2. Every branch beside the peers (issue 28), the same arm built on each side from kinedyn's screw
+   axes at q = 0 (EAIK's ``H, P``): per call from Python and per target in one batch call, kinedyn
+   against EAIK (``HPRobot.IK`` / ``IK_batched``) and ssik (``Manipulator.from_axes(...).solve``),
+   printed as ratios (peer time / kinedyn time: above 1, kinedyn is faster). Arms: UR5 and PUMA 560
+   (Pieper 6R), the KUKA iiwa with joint 3 held (EAIK's ``fixed_axes``; ssik on the locked six-joint
+   chain), the Panda with joint 7 held (EAIK only: ssik prepares that chain in minutes and finds
+   nothing), and the iiwa at one arm angle (kinedyn only: neither peer takes an arm angle).
+3. Numeric (Levenberg-Marquardt) on the Panda (example-robot-data URDF, fingers locked) and the
    UR5: success rate and median time per single-target call from the default start, beside
    Robotics Toolbox's ``ikine_LM`` (Python) and ``ik_LM`` (C++) on its own DH models of the same
    arms (``rtb.models.DH.Panda``, ``rtb.models.DH.UR5``), targets from random joint vectors within
@@ -68,6 +75,121 @@ def analytic_section(calls: int) -> None:
             f"{name:10s} {chain.solver.structure:28s} {statistics.mean(counts):9.2f} {py * 1e6:10.2f} {native * 1e6:10.2f} {batch * 1e6:16.3f}"
         )
     print("(solutions: mean count over 200 random targets without joint limits; batch: solve_nearest, all threads)")
+
+
+def hp_of(robot, frame=None):
+    """EAIK's (H, P) of the chain at q = 0 and the tool's rotation there (tests/test_ik_oracles.py)."""
+    q = np.zeros(robot.nq)
+    J = robot.jacobian(q, frame, reference="spatial")
+    H = J[3:].T.copy()
+    feet = np.cross(H, J[:3].T)
+    points = feet.copy()
+    for i in range(1, len(H)):
+        w0, w1, d = H[i - 1], H[i], feet[i] - points[i - 1]
+        n = np.cross(w0, w1)
+        if np.linalg.norm(n) > 1e-9:
+            points[i] = feet[i] + w1 * (np.cross(d, w0) @ n) / (n @ n)
+        else:
+            points[i] = feet[i] + w1 * (w1 @ (points[i - 1] - feet[i]))
+    home = robot.pose(q, frame)
+    return H, np.diff(np.vstack([np.zeros(3), points, home[:3, 3]]), axis=0), home[:3, :3]
+
+
+def iiwa():
+    try:
+        import pybullet_data
+    except ImportError:
+        return None
+    path = Path(pybullet_data.getDataPath()) / "kuka_iiwa/model.urdf"
+    return kd.load(str(path)) if path.exists() else None
+
+
+def peers_section(calls: int) -> None:
+    print(f"\n== every branch, beside EAIK and ssik ({calls} targets; ratio = peer time / kinedyn time) ==")
+    try:
+        from eaik.IK_HP import HPRobot
+    except ImportError:
+        HPRobot = None
+        print("EAIK is not installed (pip install EAIK): no EAIK column")
+    try:
+        import ssik
+    except ImportError:
+        ssik = None
+        print("ssik is not installed (pip install ssik): no ssik column")
+    print(
+        f"{'arm':22s} {'structure':44s} {'branches':>8s} {'kinedyn us':>10s} {'batch us':>9s} "
+        f"{'EAIK us':>8s} {'ratio':>6s} {'EAIK batch':>10s} {'ratio':>6s} {'ssik us':>8s} {'ratio':>6s}"
+    )
+    rng = np.random.default_rng(5)
+    arms = [
+        ("ur5", kd.robots.ur5(), None, None),
+        ("puma560", kd.robots.puma560(), None, None),
+        ("iiwa, joint 3 held", iiwa(), None, ("held", 2)),
+        ("panda, joint 7 held", panda(), "panda_hand_tcp", ("held", 6)),
+        ("iiwa, arm angle", iiwa(), None, ("arm_angle", None)),
+    ]
+    for label, robot, frame, param in arms:
+        if robot is None:
+            print(f"{label:22s} skipped: its URDF is not installed")
+            continue
+        Q = robot.random_configuration(rng, size=calls)
+        value = 0.4
+        if param is not None and param[0] == "held":
+            Q[:, param[1]] = value
+            redundancy = {"joint": param[1], "value": value}
+        elif param is not None:
+            redundancy = {"arm_angle": value}
+        else:
+            redundancy = None
+        T = robot.pose(Q, frame)
+        kw = dict(frame=frame, respect_limits=False)
+        if redundancy is not None:
+            kw["redundancy"] = redundancy
+        first = robot.inverse_kinematics(T[0], **kw)
+        counts = [len(robot.inverse_kinematics(t, **kw).solutions) for t in T[:200]]
+        ours = per_call(lambda t: robot.inverse_kinematics(t, **kw), T)
+        batch_kw = dict(kw) if redundancy is not None else dict(kw, all_branches=True)
+        t0 = time.perf_counter()
+        robot.inverse_kinematics(T, **batch_kw)
+        batch = (time.perf_counter() - t0) / calls
+        cells = [
+            f"{label:22s} {first.structure:44s} {statistics.mean(counts):8.2f} {ours * 1e6:10.2f} {batch * 1e6:9.3f}"
+        ]
+        H, P, R0 = hp_of(robot, frame)
+        X = np.eye(4)
+        X[:3, :3] = R0.T
+        Tp = np.ascontiguousarray(T @ X)
+        eaik_cells = f"{'':>8s} {'':>6s} {'':>10s} {'':>6s}"
+        if HPRobot is not None and (param is None or param[0] == "held"):
+            peer = HPRobot(H, P) if param is None else HPRobot(H, P, fixed_axes=[(param[1], value)])
+            theirs = per_call(peer.IK, Tp)
+            t0 = time.perf_counter()
+            peer.IK_batched(list(Tp))
+            theirs_batch = (time.perf_counter() - t0) / calls
+            eaik_cells = (
+                f"{theirs * 1e6:8.2f} {theirs / ours:5.2f}x {theirs_batch * 1e6:10.3f} {theirs_batch / batch:5.2f}x"
+            )
+        ssik_cells = f"{'':>8s} {'':>6s}"
+        if ssik is not None and (param is None or (param[0] == "held" and "panda" not in label)):
+            if param is None:
+                chain = ssik.Manipulator.from_axes(H, P)
+            else:
+                locked = robot.lock_joints({robot.joint_names[param[1]]: value})
+                Hl, Pl, Rl = hp_of(locked, frame)
+                chain = ssik.Manipulator.from_axes(Hl, Pl)
+                Xl = np.eye(4)
+                Xl[:3, :3] = Rl.T
+                Tp = np.ascontiguousarray(T @ Xl)
+            chain.solve(Tp[0], respect_limits=False)  # its one-time preparation, outside the timing
+            n_ssik = min(calls, 300)
+            theirs = per_call(lambda t: chain.solve(t, respect_limits=False), Tp[:n_ssik], repeat=1)
+            ssik_cells = f"{theirs * 1e6:8.1f} {theirs / ours:5.1f}x"
+        print(" ".join([cells[0], eaik_cells, ssik_cells]))
+    print(
+        "(kinedyn us: robot.inverse_kinematics(T, respect_limits=False) per call, every branch, with its statement of "
+        "completeness; batch: one call for all targets (all_branches=True, or a redundancy batch), all threads; "
+        "EAIK batch: IK_batched; ssik: solve(T, respect_limits=False) per call, 300 targets)"
+    )
 
 
 def rtb_models():
@@ -143,6 +265,7 @@ def main() -> None:
 
     print(f"kinedyn {kd.__version__}; numpy {np.__version__}; CPUs {os.cpu_count()}")
     analytic_section(args.calls)
+    peers_section(args.calls)
     numeric_section(args.targets)
 
 

@@ -170,6 +170,49 @@ class AnalyticIk:
         self, targets: F64, references: F64, respect_limits: bool = True, tolerance: float = 1e-09
     ) -> tuple[F64, NDArray[np.bool_], F64, F64]: ...
     # (q (N, n), success (N,), position errors (N,), orientation errors (N,)); q is NaN where no solution exists
+    @property
+    def max_solutions(self) -> int: ...  # the most real solutions the structure has for one target
+    def solve_stated(
+        self, target: F64, reference: F64, respect_limits: bool = True, tolerance: float = 1e-09
+    ) -> tuple[F64, F64, F64, int, bool, int, float, bool]: ...
+    # solve's tuple, then max_solutions, worst residual, merged (the statement of completeness)
+    def solve_all(
+        self, targets: F64, references: F64, respect_limits: bool = True, tolerance: float = 1e-09
+    ) -> tuple[F64, I64, F64, F64, I64, NDArray[np.bool_], I64, F64, NDArray[np.bool_]]: ...
+    # every solution of each target: (q (N, B, n) NaN-padded, count (N,), position errors (N, B),
+    # orientation errors (N, B), found (N,), singular (N,), max_solutions (N,), worst residual (N,), merged (N,))
+
+class RedundantIk:
+    """A seven-joint chain's closed forms: a held joint ("held") or an SRS arm's arm angle ("arm_angle")."""
+    @staticmethod
+    def detect(model: Model, frame: int, lower: F64, upper: F64) -> RedundantIk | None: ...
+    @property
+    def srs(self) -> bool: ...
+    def held_structure(self, joint: int, value: float) -> str | None: ...
+    def arm_angle(self, q: F64) -> float | None: ...
+    def solve(
+        self,
+        target: F64,
+        mode: str,
+        joint: int,
+        value: float,
+        reference: F64,
+        respect_limits: bool = True,
+        tolerance: float = 1e-09,
+    ) -> tuple[F64, F64, F64, int, bool, int, float, bool]: ...  # as AnalyticIk.solve_stated
+    def solve_batch(
+        self,
+        targets: F64,
+        mode: str,
+        joint: int,
+        values: F64,
+        references: F64,
+        respect_limits: bool = True,
+        tolerance: float = 1e-09,
+    ) -> tuple[F64, I64, F64, F64, I64, NDArray[np.bool_], I64, F64, NDArray[np.bool_]]: ...  # as AnalyticIk.solve_all
+    def sweep(
+        self, target: F64, mode: str, joint: int, values: F64, reference: F64, tolerance: float = 1e-09
+    ) -> tuple[F64, NDArray[np.bool_]]: ...  # (q (M, B, 7) per branch slot, NaN where absent; singular (M,))
 
 # ---- fixed-step integration (crates/kinedyn-py/src/simulate.rs) ----
 # Both return (q, qd, qdd, tau, steps, failures): arrays (samples, n) | (N, samples, n), steps (N,) int64,

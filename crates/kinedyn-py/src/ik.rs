@@ -4,7 +4,9 @@
 
 use std::sync::Mutex;
 
-use kinedyn_core::ik::{self, AnalyticIk as CoreAnalytic, Settings};
+use kinedyn_core::ik::{self, ChainIk as CoreAnalytic, Settings};
+
+use crate::ik_branches::{all_branches, references_of, stated};
 use kinedyn_core::spatial::{Mat3, Transform, Vec3};
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -53,7 +55,7 @@ fn parse_target(values: &[f64], position: bool, index: Option<usize>) -> PyResul
 }
 
 /// The numbers of a float64 array in C order, copied.
-fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
+pub(crate) fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
     // SAFETY: read while this thread holds the GIL and runs no Python code, so nothing writes to
     // the array meanwhile (a plain type check instead of rust-numpy's borrow tracking, ~0.4 us each)
     let view = unsafe { a.as_array() };
@@ -66,7 +68,7 @@ fn numbers(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<Vec<f64>> {
 }
 
 /// Targets (4, 4) / (N, 4, 4) or positions (3,) / (N, 3): (transforms, batch size, position-only).
-fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transform>, Option<usize>, bool)> {
+pub(crate) fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transform>, Option<usize>, bool)> {
     let shape = targets.shape().to_vec();
     let (batch, position) = match shape.as_slice() {
         [4, 4] => (None, false),
@@ -88,7 +90,7 @@ fn gather_targets(targets: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<Transfo
     Ok((list, batch, position))
 }
 
-fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Vec<f64>> {
+pub(crate) fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Vec<f64>> {
     if a.shape() != [len] {
         return Err(PyValueError::new_err(format!(
             "{name} must have shape ({len},), got {:?}",
@@ -98,7 +100,7 @@ fn vector(name: &str, a: &Bound<'_, PyArrayDyn<f64>>, len: usize) -> PyResult<Ve
     numbers(a)
 }
 
-fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
+pub(crate) fn check_limits(lower: &[f64], upper: &[f64]) -> PyResult<()> {
     for i in 0..lower.len() {
         if lower[i].is_nan() || upper[i].is_nan() || lower[i] > upper[i] {
             return Err(PyValueError::new_err(format!(
@@ -344,12 +346,12 @@ pub fn solve_ik<'py>(
 /// A closed-form solver detected from a model's geometry (`None` from `detect` when there is none).
 #[pyclass(name = "AnalyticIk", module = "kinedyn._core", frozen)]
 pub struct PyAnalyticIk {
-    solver: CoreAnalytic,
-    model: Model,
-    data: Mutex<Data>,
-    frame: usize,
-    lower: Vec<f64>,
-    upper: Vec<f64>,
+    pub(crate) solver: CoreAnalytic,
+    pub(crate) model: Model,
+    pub(crate) data: Mutex<Data>,
+    pub(crate) frame: usize,
+    pub(crate) lower: Vec<f64>,
+    pub(crate) upper: Vec<f64>,
 }
 
 #[pymethods]
@@ -383,22 +385,79 @@ impl PyAnalyticIk {
         })
     }
 
-    /// Name of the detected structure (e.g. "spherical_wrist").
+    /// Name of the detected structure (e.g. "spherical_wrist"; "reversed_..." when it was found
+    /// from the tool end).
     #[getter]
     fn structure(&self) -> &'static str {
-        self.solver.structure.name()
+        self.solver.name()
     }
 
     /// Name of the arm of a spherical-wrist chain, else None.
     #[getter]
     fn arm(&self) -> Option<&'static str> {
-        self.solver.arm.map(|a| a.name())
+        self.solver.ik.arm.map(|a| a.name())
+    }
+
+    /// The most real solutions the structure's closed form has for one target.
+    #[getter]
+    fn max_solutions(&self) -> usize {
+        self.solver.max_solutions()
+    }
+
+    /// `solve` with the statement of completeness: (solutions, position errors, orientation
+    /// errors, found, singular, max_solutions, worst residual, merged).
+    #[pyo3(signature = (target, reference, respect_limits=true, tolerance=1e-9))]
+    fn solve_stated<'py>(
+        &self,
+        py: Python<'py>,
+        target: Bound<'py, PyArrayDyn<f64>>,
+        reference: Bound<'py, PyArrayDyn<f64>>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guarded("AnalyticIk.solve_stated", || {
+            let out = self.one(&target, &reference, respect_limits, tolerance)?;
+            stated(py, out, self.model.n)
+        })
+    }
+
+    /// Every solution of each target of a batch, in one call on all threads (see `all_branches`).
+    #[pyo3(signature = (targets, references, respect_limits=true, tolerance=1e-9))]
+    fn solve_all<'py>(
+        &self,
+        py: Python<'py>,
+        targets: Bound<'py, PyArrayDyn<f64>>,
+        references: Bound<'py, PyArrayDyn<f64>>,
+        respect_limits: bool,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guarded("AnalyticIk.solve_all", || {
+            let n = self.model.n;
+            let (targets, _, position) = gather_targets(&targets)?;
+            let refs = references_of(&references, targets.len(), n)?;
+            let width = self.solver.max_solutions();
+            all_branches(py, &self.model, targets.len(), width, |data, k| {
+                ik::analytic_solutions(
+                    &self.model,
+                    data,
+                    &self.solver,
+                    self.frame,
+                    &targets[k],
+                    position,
+                    &refs[k * n..(k + 1) * n],
+                    &self.lower,
+                    &self.upper,
+                    respect_limits,
+                    tolerance,
+                )
+            })
+        })
     }
 
     /// Whether position-only targets (3,) have a closed form (else only full poses do).
     #[getter]
     fn solves_position(&self) -> bool {
-        self.solver.structure.solves_position()
+        self.solver.solves_position()
     }
 
     /// All solutions for one target (4, 4) or position (3,):
@@ -422,29 +481,7 @@ impl PyAnalyticIk {
     )> {
         guarded("AnalyticIk.solve", || {
             let n = self.model.n;
-            let (targets, batch, position) = gather_targets(&target)?;
-            if batch.is_some() {
-                return Err(PyValueError::new_err(
-                    "AnalyticIk.solve takes one target; use solve_nearest for a batch",
-                ));
-            }
-            let reference = vector("reference", &reference, n)?;
-            let out = {
-                let mut data = self.data.lock().unwrap_or_else(|e| e.into_inner());
-                ik::analytic_solutions(
-                    &self.model,
-                    &mut data,
-                    &self.solver,
-                    self.frame,
-                    &targets[0],
-                    position,
-                    &reference,
-                    &self.lower,
-                    &self.upper,
-                    respect_limits,
-                    tolerance,
-                )
-            };
+            let out = self.one(&target, &reference, respect_limits, tolerance)?;
             let m = out.solutions.len();
             let flat: Vec<f64> = out.solutions.concat();
             Ok((

@@ -9,6 +9,8 @@
 mod conv;
 mod guard;
 mod ik;
+mod ik_branches;
+mod ik_redundant;
 mod lie;
 mod model;
 mod records;
@@ -49,6 +51,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     guard::register(m)?;
     ik::register(m)?;
+    ik_redundant::register(m)?;
     lie::register(m)?;
     simulate::register(m)?;
     Ok(())

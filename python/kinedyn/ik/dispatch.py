@@ -12,16 +12,42 @@ import dataclasses
 import numpy as np
 
 from .._arrays import real_array
+from .branches import all_branches
+from .redundancy import solve_redundant
 from .solve import inverse_kinematics as solve
 
 __all__ = ["inverse_kinematics"]
 
 
 def inverse_kinematics(robot, target, q0=None, mask=None, method="auto", respect_limits=True, **kwargs):
-    """``robot.inverse_kinematics(...)``: the solver that fits the robot (see the module docstring)."""
+    """``robot.inverse_kinematics(...)``: the solver that fits the robot (see the module docstring).
+
+    ``redundancy={"joint": name, "value": v}`` or ``{"arm_angle": psi}`` solves a seven-joint arm
+    in closed form at that value (:mod:`kinedyn.ik.redundancy`); ``all_branches=True`` returns every
+    closed-form solution of each target of a batch (:mod:`kinedyn.ik.branches`)."""
+    redundancy = kwargs.pop("redundancy", None)
+    every = kwargs.pop("all_branches", False)
+    if redundancy is not None or every:
+        return _closed_forms(robot, target, q0, mask, method, respect_limits, redundancy, **kwargs)
     if robot.description.mimic_map is None:
         return solve(robot, target, q0, mask, method, respect_limits, **kwargs)
     return _with_mimic_joints(robot, target, q0, mask, method, respect_limits, **kwargs)
+
+
+def _closed_forms(robot, target, q0, mask, method, respect_limits, redundancy, frame=None, tolerance=1e-9, **rest):
+    """Every closed-form branch: a redundancy parameter's (seven-joint arms) or a batch's."""
+    unused = sorted(k for k in rest if k not in ("seed", "progress", "max_iterations", "restarts"))
+    if unused:
+        raise TypeError(f"inverse_kinematics() got unexpected keyword argument(s) {unused}")
+    if mask is not None or method not in ("auto", "analytic"):
+        raise ValueError(
+            "redundancy= and all_branches=True list closed-form branches: no mask, method 'auto' or 'analytic'"
+        )
+    if type(tolerance) is not float or not 0.0 < tolerance < np.inf:
+        raise ValueError(f"tolerance must be a positive number (m and rad), got {tolerance!r}")
+    if redundancy is not None:
+        return solve_redundant(robot, target, q0, respect_limits, redundancy, frame, tolerance)
+    return all_branches(robot, target, q0, respect_limits, frame, tolerance)
 
 
 def _with_mimic_joints(robot, target, q0, mask, method, respect_limits, **kwargs):

@@ -21,6 +21,7 @@ from .._core import AnalyticIk, solve_ik
 from .._ui.progress import SHOW_AFTER, Delayed, wanted
 from ..configuration import space
 from ..display import ik_html, ik_markdown
+from .completeness import statement
 from .idle import settle
 
 if TYPE_CHECKING:
@@ -63,6 +64,15 @@ class IKResult:
     nearest: np.ndarray | None = None
     nearest_q: np.ndarray | None = None
     message: str = ""
+    structure: str | None = None
+    max_solutions: int | None = None
+    worst_residual: float = float("nan")
+    merged: bool = False
+
+    @property
+    def completeness(self) -> str:
+        """The statement of completeness in words (kinedyn.ik.completeness.statement)."""
+        return statement(self)
 
     @property
     def q(self) -> np.ndarray | None:
@@ -89,6 +99,11 @@ class IKResult:
             "nearest": None if self.nearest is None else self.nearest.tolist(),
             "nearest_q": None if self.nearest_q is None else self.nearest_q.tolist(),
             "message": self.message,
+            "structure": self.structure,
+            "max_solutions": self.max_solutions,
+            "worst_residual": float(self.worst_residual),
+            "merged": bool(self.merged),
+            "completeness": self.completeness,
         }
 
     def __repr__(self) -> str:
@@ -441,37 +456,17 @@ def _analytic(
 ) -> IKResult:
     solver = chain.solver
     assert solver is not None  # callers take this route only for a chain with a closed form
-    sols, pe, oe, found, singular = solver.solve(t, q_ref, respect_limits, tolerance)
+    sols, pe, oe, found, singular, most, worst, merged = solver.solve_stated(t, q_ref, respect_limits, tolerance)
     name = "analytic:" + solver.structure
+    stated = dict(structure=solver.structure, max_solutions=most, worst_residual=worst, merged=merged)
     if len(sols):
-        return IKResult(
-            sols,
-            True,
-            pe,
-            oe,
-            0,
-            name,
-            True,
-            singular,
-            found,
-            message=f"{len(sols)} solution(s)"
-            + (" (singular target: a free joint was set from q0)" if singular else ""),
-        )
+        message = f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else "")
+        return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=message, **stated)
     if found:
-        return IKResult(
-            sols,
-            False,
-            pe,
-            oe,
-            0,
-            name,
-            True,
-            singular,
-            found,
-            message=f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)",
-        )
+        message = f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)"
+        return IKResult(sols, False, pe, oe, 0, name, True, singular, found, message=message, **stated)
     result = IKResult(
-        sols, False, pe, oe, 0, name, False, singular, 0, message="target out of reach: no solution exists"
+        sols, False, pe, oe, 0, name, False, singular, 0, message="target out of reach: no solution exists", **stated
     )
     if position:
         _nearest(robot, chain, t, q_ref, result, seed)
@@ -588,6 +583,8 @@ def _numeric(
             singular,
             1,
             message="converged" + (" at a singular configuration" if singular else ""),
+            worst_residual=max(float(pe), float(oe)),
+            merged=singular,
         )
     result = IKResult(
         np.zeros((0, chain.n)),
@@ -669,3 +666,10 @@ def _batch(
     )
     ok = ok & (pe <= tolerance) & (oe <= tolerance)
     return IKBatchResult(q, ok, pe, oe, it, "numeric:lm")
+
+
+# the per-(robot, frame) cache and the input checks, shared with the all-branch and seven-joint
+# solvers (kinedyn.ik.branches, kinedyn.ik.redundancy)
+chain_of = _chain
+check_target = _target
+check_q0 = _q0

@@ -39,8 +39,11 @@
 //! (`analytic_solutions`).
 //!
 //! Files: `numeric.rs` (the solver, its settings and start checks), `reduction.rs` (mimic joints),
-//! `analytic.rs` (structures and their closed forms), `subproblems.rs` (Paden-Kahan), `solutions.rs`
-//! (closed-form candidates to checked joint vectors); the pose error is here.
+//! `analytic.rs` (structures and their closed forms), `chain.rs` (a structure found from either
+//! end of the chain, and the most solutions it has), `redundant.rs` (seven-joint arms: a held
+//! joint, the arm angle of SRS arms), `subproblems.rs` (Paden-Kahan), `solutions.rs`
+//! (closed-form candidates to checked joint vectors, with the statement of completeness); the pose
+//! error is here.
 //!
 //! | symbol   | here          | meaning                                                  |
 //! |----------|---------------|----------------------------------------------------------|
@@ -50,15 +53,22 @@
 //! | `lambda` | `lambda`      | damping                                                  |
 
 pub mod analytic;
+pub mod chain;
 mod numeric;
 mod reduction;
+pub mod redundant;
 mod solutions;
 pub mod subproblems;
 
 pub use analytic::{AnalyticIk, Screw, Structure};
+pub use chain::ChainIk;
 pub use numeric::{check_start, numeric_ik, numeric_ik_reduced, solver_sizes, Outcome, Settings, UNIT_TOLERANCE};
 pub use reduction::Reduction;
-pub use solutions::{analytic_solutions, chain_screws, detect_analytic, AnalyticOutcome};
+pub use redundant::{Redundant, SRS_MAX_SOLUTIONS};
+pub use solutions::{
+    analytic_solutions, chain_screws, detect_analytic, hadamard_ratio, AnalyticOutcome, Check, MERGE_DISTANCE,
+    MERGE_RATIO,
+};
 
 use crate::spatial::{Mat3, Transform, Vec3};
 use std::f64::consts::PI;

@@ -8,9 +8,10 @@
 //! | `theta`  | `theta`     | joint coordinate of the product of exponentials, q + offset |
 //! | `q`      | `q`         | the model's joint vector                                    |
 
-use super::analytic::{AnalyticIk, Screw};
+use super::analytic::Screw;
+use super::chain::ChainIk;
 use super::{numeric_ik, pose_error, residuals, subproblems, Settings};
-use crate::algorithms::jacobian::frame_pose_at;
+use crate::algorithms::jacobian::{frame_jacobian, frame_pose_at, Reference};
 use crate::algorithms::kinematics::parent_from_body;
 use crate::data::Data;
 use crate::joint::JointKind;
@@ -44,13 +45,15 @@ pub fn chain_screws(model: &Model, data: &mut Data, frame: usize) -> Option<(Vec
     Some((screws, home))
 }
 
-/// The closed-form solver of `frame`'s chain, if its geometry has one (see `analytic`).
-pub fn detect_analytic(model: &Model, data: &mut Data, frame: usize) -> Option<AnalyticIk> {
+/// The closed-form solver of `frame`'s chain, if its geometry has one, from either end (see
+/// `analytic` and `chain`).
+pub fn detect_analytic(model: &Model, data: &mut Data, frame: usize) -> Option<ChainIk> {
     let (screws, home) = chain_screws(model, data, frame)?;
-    AnalyticIk::detect(screws, home)
+    ChainIk::detect(screws, home)
 }
 
-/// Solutions of a closed-form solve after mapping, checking and limits.
+/// Solutions of a closed-form solve after mapping, checking and limits, with the statement of
+/// completeness every result carries (`docs/ik.md`, "Completeness").
 #[derive(Clone, Debug, Default)]
 pub struct AnalyticOutcome {
     /// Joint vectors (q, offsets removed), nearest to the reference first.
@@ -61,7 +64,24 @@ pub struct AnalyticOutcome {
     pub found: usize,
     /// A non-isolated solution set was met (a free joint was set from the reference).
     pub singular: bool,
+    /// The most real solutions the method can have for one target (its structure's bound).
+    pub max_solutions: usize,
+    /// The largest position or orientation residual among the found solutions (0 when none).
+    pub worst_residual: f64,
+    /// Branches merge at this target: two candidates coincide or nearly do (closer than
+    /// `MERGE_DISTANCE`), or a solution's Jacobian (the solved joints' columns) is singular
+    /// (Hadamard ratio below `MERGE_RATIO`; tested only when fewer than `max_solutions` were found
+    /// or the solver met a free joint: all `max_solutions` roots found distinct are simple).
+    pub merged: bool,
 }
+
+/// Two solutions closer than this (rad or m, largest coordinate difference, angles modulo 2 pi)
+/// count as branches that merge.
+pub const MERGE_DISTANCE: f64 = 1e-6;
+/// A Jacobian whose Hadamard ratio `sqrt(det(A^T A)) / prod |a_i|` (A: the solved columns, or
+/// rows when there are more columns than rows) is below this counts as singular: the ratio is 1
+/// for orthogonal columns, scale-free, and goes to 0 linearly in the distance to the singularity.
+pub const MERGE_RATIO: f64 = 1e-6;
 
 /// The integer nearest `x` (ties to even): adding and removing 1.5 2^52 rounds without a call to
 /// `round`, which baseline x86-64 lacks as an instruction; `|x| >= 2^51` is already an integer.
@@ -130,7 +150,7 @@ fn wrap_angle(x: f64, lo: f64, hi: f64, reference: f64) -> f64 {
 pub fn analytic_solutions(
     model: &Model,
     data: &mut Data,
-    solver: &AnalyticIk,
+    solver: &ChainIk,
     frame: usize,
     target: &Transform,
     position_only: bool,
@@ -144,83 +164,201 @@ pub fn analytic_solutions(
     let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
     let mut candidates = Vec::with_capacity(8);
     let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
-    let weights = if position_only {
-        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
-    } else {
-        [1.0; 6]
-    };
-    let refine = Settings {
-        weights,
-        max_iterations: 8,
-        restarts: 0,
-        position_tolerance: 1e-13,
-        orientation_tolerance: 1e-13,
-        lambda_min: 1e-12,
-        max_step: 0.1,
-    };
-    let mut out = AnalyticOutcome {
+    Check {
+        frame,
+        target,
+        position_only,
+        reference,
+        lower,
+        upper,
+        respect_limits,
+        tolerance,
+        held: None,
+        most: solver.max_solutions(),
         singular,
-        ..Default::default()
-    };
-    // (q, position error, orientation error, inside the limits, squared distance to the reference)
-    let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len());
-    for theta in &candidates {
+    }
+    .finish(model, data, candidates.as_flattened(), 6)
+}
+
+/// What a set of closed-form candidates is checked against (`Check::finish`).
+pub struct Check<'a> {
+    pub frame: usize,
+    pub target: &'a Transform,
+    pub position_only: bool,
+    /// The caller's q0.
+    pub reference: &'a [f64],
+    pub lower: &'a [f64],
+    pub upper: &'a [f64],
+    pub respect_limits: bool,
+    pub tolerance: f64,
+    /// A joint held at its candidate value (a 7R arm's redundancy parameter): kept there by the
+    /// refinement, its column left out of the merge test.
+    pub held: Option<usize>,
+    /// The most solutions the solver has (its structure's bound) and whether it met a
+    /// non-isolated solution set: when every one of the `most` roots is found, distinct, they are
+    /// all simple (no two branches meet) and the Jacobian test is skipped.
+    pub most: usize,
+    pub singular: bool,
+}
+
+impl Check<'_> {
+    /// One candidate `theta` mapped to q (revolute angles moved by 2 pi k next to the reference,
+    /// inside the limits when possible), checked by forward kinematics and refined near tangency:
+    /// `(q, position error, orientation error)`, or None when its residual exceeds the tolerance.
+    pub fn one(&self, model: &Model, data: &mut Data, theta: &[f64]) -> Option<(Vec<f64>, f64, f64)> {
+        let n = model.n;
+        let (reference, lower, upper, target) = (self.reference, self.lower, self.upper, self.target);
+        let weights = if self.position_only {
+            [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+        } else {
+            [1.0; 6]
+        };
         let mut q: Vec<f64> = (0..n).map(|i| theta[i] - model.offset[i]).collect();
+        if q.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
         for i in 0..n {
             if model.joints[i].kind == JointKind::Revolute {
                 q[i] = wrap_angle(q[i], lower[i], upper[i], reference[i]);
             }
         }
-        let e = pose_error(&frame_pose_lean(model, &q, frame), target);
+        let e = pose_error(&frame_pose_lean(model, &q, self.frame), target);
         let (mut ep, mut er) = residuals(&e, &weights);
-        if ep > 1e-12 || er > 1e-12 {
-            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits)
-            if ep < 1e-4 && er < 1e-4 {
-                let (free, neg_free) = (vec![f64::INFINITY; n], vec![f64::NEG_INFINITY; n]);
-                let r = numeric_ik(model, data, frame, target, &q, &neg_free, &free, &refine, 0);
-                if r.position_error <= ep && r.orientation_error <= er {
-                    q = r.q;
-                    ep = r.position_error;
-                    er = r.orientation_error;
-                }
+        if (ep > 1e-12 || er > 1e-12) && ep < 1e-4 && er < 1e-4 {
+            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits; a
+            // held joint stays where it is held)
+            let refine = Settings {
+                weights,
+                max_iterations: 8,
+                restarts: 0,
+                position_tolerance: 1e-13,
+                orientation_tolerance: 1e-13,
+                lambda_min: 1e-12,
+                max_step: 0.1,
+            };
+            let mut lo = vec![f64::NEG_INFINITY; n];
+            let mut hi = vec![f64::INFINITY; n];
+            if let Some(k) = self.held {
+                (lo[k], hi[k]) = (q[k], q[k]);
+            }
+            let r = numeric_ik(model, data, self.frame, target, &q, &lo, &hi, &refine, 0);
+            if r.position_error <= ep && r.orientation_error <= er {
+                q = r.q;
+                ep = r.position_error;
+                er = r.orientation_error;
             }
         }
-        if ep > tolerance || er > tolerance {
-            continue;
+        (ep <= self.tolerance && er <= self.tolerance).then_some((q, ep, er))
+    }
+
+    /// Candidates (rows of `theta`, `stride` slots of which the model's n are used) mapped to q,
+    /// verified by forward kinematics, refined, deduplicated, filtered by the limits and sorted by
+    /// their distance to the reference.
+    pub fn finish(&self, model: &Model, data: &mut Data, candidates: &[f64], stride: usize) -> AnalyticOutcome {
+        let n = model.n;
+        let (reference, lower, upper) = (self.reference, self.lower, self.upper);
+        let mut out = AnalyticOutcome::default();
+        // (q, position error, orientation error, inside the limits, squared distance to the reference)
+        let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len() / stride.max(1));
+        for theta in candidates.chunks_exact(stride.max(1)) {
+            let Some((q, ep, er)) = self.one(model, data, theta) else {
+                continue;
+            };
+            // distinct modulo 2 pi; a near-duplicate is a merge of branches
+            let gap = kept
+                .iter()
+                .map(|(k, ..)| distance(model, k, &q))
+                .fold(f64::INFINITY, f64::min);
+            if gap < MERGE_DISTANCE {
+                out.merged = true;
+            }
+            if gap < 1e-7 {
+                continue;
+            }
+            let inside = (0..n).all(|i| q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
+            let dist = (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
+            out.worst_residual = out.worst_residual.max(ep).max(er);
+            kept.push((q, ep, er, inside, dist));
         }
-        // distinct modulo 2 pi
-        let same = kept.iter().any(|(k, ..)| {
-            (0..n).all(|i| {
-                let d = k[i] - q[i];
-                let d = if model.joints[i].kind == JointKind::Revolute {
-                    d - 2.0 * PI * round(d / (2.0 * PI))
-                } else {
-                    d
-                };
-                d.abs() < 1e-7
-            })
-        });
-        if same {
-            continue;
+        out.found = kept.len();
+        out.max_solutions = self.most;
+        out.singular = self.singular;
+        if !out.merged && (out.found < self.most || self.singular) {
+            out.merged = kept
+                .iter()
+                .any(|k| hadamard_ratio(model, data, self.frame, &k.0, self.position_only, self.held) < MERGE_RATIO);
         }
-        let inside = (0..n).all(|i| q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
-        let distance = (0..n).map(|i| (q[i] - reference[i]).powi(2)).sum::<f64>();
-        kept.push((q, ep, er, inside, distance));
+        if self.respect_limits {
+            kept.retain(|k| k.3);
+        }
+        kept.sort_by(|a, b| a.4.partial_cmp(&b.4).unwrap_or(std::cmp::Ordering::Equal));
+        out.solutions.reserve_exact(kept.len());
+        out.position_error.reserve_exact(kept.len());
+        out.orientation_error.reserve_exact(kept.len());
+        for (q, ep, er, ..) in kept {
+            out.solutions.push(q);
+            out.position_error.push(ep);
+            out.orientation_error.push(er);
+        }
+        out
     }
-    out.found = kept.len();
-    if respect_limits {
-        kept.retain(|k| k.3);
+}
+
+/// Largest coordinate difference of two joint vectors, revolute angles modulo 2 pi.
+fn distance(model: &Model, a: &[f64], b: &[f64]) -> f64 {
+    (0..model.n)
+        .map(|i| {
+            let d = a[i] - b[i];
+            if model.joints[i].kind == JointKind::Revolute {
+                (d - 2.0 * PI * round(d / (2.0 * PI))).abs()
+            } else {
+                d.abs()
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The Hadamard ratio of the frame's Jacobian at `q` (its target rows, the joints other than
+/// `held`): `sqrt(det(G)) / prod sqrt(G_ii)` with `G` the Gram matrix of the columns (or of the
+/// rows, when there are more columns than rows). 1 for orthogonal columns, 0 at a singularity.
+pub fn hadamard_ratio(
+    model: &Model,
+    data: &mut Data,
+    frame: usize,
+    q: &[f64],
+    position_only: bool,
+    held: Option<usize>,
+) -> f64 {
+    let n = model.n;
+    let mut jac = vec![0.0; 6 * n];
+    frame_jacobian(model, data, q, frame, Reference::World, None, &mut jac);
+    let rows: &[usize] = if position_only { &[0, 1, 2] } else { &[0, 1, 2, 3, 4, 5] };
+    let mut cols = [0usize; 16];
+    let mut k_cols = 0;
+    // (closed forms have at most seven joints)
+    for j in (0..n).filter(|&j| Some(j) != held).take(16) {
+        cols[k_cols] = j;
+        k_cols += 1;
     }
-    kept.sort_by(|a, b| a.4.partial_cmp(&b.4).unwrap_or(std::cmp::Ordering::Equal));
-    out.solutions.reserve_exact(kept.len());
-    out.position_error.reserve_exact(kept.len());
-    out.orientation_error.reserve_exact(kept.len());
-    for (q, ep, er, ..) in kept {
-        out.solutions.push(q);
-        out.position_error.push(ep);
-        out.orientation_error.push(er);
+    let cols = &cols[..k_cols];
+    // the Gram matrix of the smaller side
+    let by_cols = cols.len() <= rows.len();
+    let (a, b) = if by_cols { (cols, rows) } else { (rows, cols) };
+    let entry = |x: usize, y: usize| if by_cols { jac[y * n + x] } else { jac[x * n + y] };
+    let gram = |i: usize, j: usize| b.iter().map(|&m| entry(a[i], m) * entry(a[j], m)).sum::<f64>();
+    let k = a.len();
+    let (det, norms) = if k == 6 {
+        // the common case (six solved joints, a pose): a fixed-size LU, no allocation
+        let g = nalgebra::Matrix6::from_fn(gram);
+        (g.determinant(), (0..6).map(|i| g[(i, i)].sqrt()).product::<f64>())
+    } else {
+        let g = nalgebra::DMatrix::from_fn(k, k, gram);
+        (g.determinant(), (0..k).map(|i| g[(i, i)].sqrt()).product::<f64>())
+    };
+    if norms <= 0.0 {
+        return 0.0;
     }
-    out
+    det.max(0.0).sqrt() / norms
 }
 
 #[cfg(test)]

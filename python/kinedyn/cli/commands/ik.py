@@ -12,6 +12,7 @@ import numpy as np
 from rich.table import Table
 
 from ..._math import rpy_to_matrix
+from ...ik.redundancy import default_redundancy
 from ...ik.solve import METHODS, inverse_kinematics
 from .. import app
 from ..app import console, emit, esc, parse_q, q_labels, warn_degrees
@@ -50,7 +51,24 @@ def add_arguments(p) -> None:
         metavar=("ROLL", "PITCH", "YAW"),
         help="target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) (radians; degrees with --deg); omit for a position-only target",
     )
-    p.add_argument("--all", action="store_true", help="print every solution (default: only the one nearest q0)")
+    p.add_argument(
+        "--all",
+        action="store_true",
+        help="print every solution and the statement of completeness (default: only the one nearest q0); on a "
+        "seven-joint arm with a pose target, every branch at the arm angle of --q0 (SRS arms) or with a joint "
+        "held at its --q0 value, unless --arm-angle or --hold says which",
+    )
+    p.add_argument(
+        "--hold",
+        metavar="JOINT=VALUE",
+        help="seven-joint arms: hold JOINT at VALUE (rad; degrees with --deg) and list every branch",
+    )
+    p.add_argument(
+        "--arm-angle",
+        type=finite_float,
+        metavar="PSI",
+        help="SRS seven-joint arms: the elbow's swivel angle about the shoulder-wrist line (rad; degrees with --deg)",
+    )
     p.add_argument("--q0", nargs="+", type=float, metavar="Q", help="reference / start joint values (default zeros)")
     p.add_argument("--deg", action="store_true", help="--rpy and --q0 in degrees; angles printed in degrees")
     p.add_argument("--frame", help="frame to place (default: the tool)")
@@ -79,9 +97,15 @@ def run(args) -> int:
     q0 = None
     if args.q0 is not None:
         q0 = parse_q(args.q0, robot, args.deg, "--q0")
-    result = inverse_kinematics(
-        robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame
-    )
+    redundancy = _redundancy(args, robot, target, q0)
+    if redundancy is not None:
+        result = robot.inverse_kinematics(
+            target, q0=q0, respect_limits=not args.ignore_limits, frame=args.frame, redundancy=redundancy
+        )
+    else:
+        result = inverse_kinematics(
+            robot, target, q0=q0, method=args.method, respect_limits=not args.ignore_limits, frame=args.frame
+        )
     shown = result.solutions if args.all else result.solutions[:1]
     # per q coordinate: revolute angles (--deg) and the column names (a multi-DOF joint's block:
     # root.x, root.y, root.z, root.qx, ..., root.qw for a free-flyer; kinedyn.coordinates)
@@ -102,6 +126,7 @@ def run(args) -> int:
         "position_error": result.position_error[: len(shown)],
         "orientation_error": result.orientation_error[: len(shown)],
         "count": len(result.solutions),
+        "redundancy": redundancy,
     }
     if "message" in payload:
         payload["message"] = in_cli_terms(payload["message"], FLAG_PHRASES)
@@ -136,8 +161,43 @@ def run(args) -> int:
                     f"{result.orientation_error[k]:.0e}",
                 )
             c.print(table)
+        if redundancy is not None:
+            c.print(f"redundancy: {esc(_describe(redundancy, args.deg))}")
+        if args.all:
+            c.print(esc(result.completeness))
         style = "green" if result.success else "bold red"
         c.print(f"[{style}]{esc(in_cli_terms(result.message, FLAG_PHRASES))}[/{style}]")
 
     emit(args, payload, render)
     return EXIT_OK if result.success else EXIT_NO
+
+
+def _redundancy(args, robot, target, q0) -> dict | None:
+    """The redundancy parameter from --hold / --arm-angle, or for --all on a seven-joint arm with
+    a pose target the default one (kinedyn.ik.redundancy.default_redundancy); else None."""
+    if args.hold is not None and args.arm_angle is not None:
+        raise ValueError("give --hold or --arm-angle, not both")
+    if args.arm_angle is not None:
+        return {"arm_angle": math.radians(args.arm_angle) if args.deg else float(args.arm_angle)}
+    if args.hold is not None:
+        name, sep, value = args.hold.partition("=")
+        try:
+            v = float(value)
+        except ValueError:
+            v = math.nan
+        if not sep or not math.isfinite(v):
+            raise ValueError(f"--hold takes JOINT=VALUE (a finite number), got {args.hold!r}")
+        joint = robot.joint_names.index(name) if name in robot.joint_names else name
+        k = joint if isinstance(joint, int) else -1
+        revolute = 0 <= k < len(robot.joints) and robot.joints[k].kind == "revolute"
+        return {"joint": name, "value": math.radians(v) if args.deg and revolute else v}
+    if args.all and robot.nq == 7 and target.shape == (4, 4) and args.method == "auto":
+        return default_redundancy(robot, q0, args.frame)
+    return None
+
+
+def _describe(redundancy: dict, degrees: bool) -> str:
+    if "arm_angle" in redundancy:
+        psi = redundancy["arm_angle"]
+        return f"arm angle {math.degrees(psi):.4f} deg" if degrees else f"arm angle {psi:.6f} rad"
+    return f"{redundancy['joint']} held at {redundancy['value']:.6f}"
