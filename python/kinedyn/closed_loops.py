@@ -44,7 +44,7 @@ def velocity_columns(description, joints, what: str) -> list:
     """The velocity columns (indices into qd) of the named joints: all of a multi-DOF joint's."""
     names = description.joint_names
     starts = np.concatenate([[0], np.cumsum([j.nv for j in description.joints])]).astype(int)
-    columns = []
+    columns: list[int] = []
     for name in joints:
         if name not in names:
             raise ValueError(

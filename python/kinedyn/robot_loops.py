@@ -4,7 +4,7 @@ here is a one-line forward to the capability that does the work, as in ``kinedyn
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from . import closed_loops
 from .description.loops import Loop
@@ -26,7 +26,7 @@ class ClosedLoops:
         return self.description.loops
 
     description: Description  # the Robot's own (kinedyn.robot)
-    _model: object  # the Robot's compiled native model (kinedyn.robot)
+    _model: Any  # the Robot's compiled native model (kinedyn.robot, a cached property there)
 
     def add_loop(self, frame_a: str, frame_b: str, kind: str = "point", name: str | None = None) -> Robot:
         """A new robot with a loop closing ``frame_a`` on ``frame_b``: ``kind="point"`` makes their

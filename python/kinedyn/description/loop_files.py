@@ -47,7 +47,7 @@ def unique_name(name: str, taken: set) -> str:
 def urdf_loops(root, src, link_names, floats) -> tuple:
     """``(frames, loops)`` of a URDF's ``<loop>`` elements; ``src`` names file and line in errors,
     ``floats(text, n, default, what, element, src)`` reads numbers as the URDF reader does."""
-    frames, loops, seen = [], [], {}
+    frames, loops, seen = [], [], dict[str, ET.Element]()
     taken = set(link_names)
     for element in root.iterfind("loop"):
         name = element.get("name")
@@ -127,12 +127,11 @@ def write_mjcf_loops(robot, root, bodies: dict, sites: set, mj_pose) -> None:
         equality = ET.SubElement(root, "equality")
     for loop in robot.loops:
         ends = []
-        for frame, letter in ((loop.frame_a, "a"), (loop.frame_b, "b")):
-            if frame not in sites:
-                site = unique_name(f"{loop.name}_{letter}", taken)
-                ET.SubElement(bodies[frame], "site", name=site)
-                frame = site
-            ends.append(frame)
+        for end, letter in ((loop.frame_a, "a"), (loop.frame_b, "b")):
+            if end not in sites:
+                end = unique_name(f"{loop.name}_{letter}", taken)
+                ET.SubElement(bodies[loop.frame_a if letter == "a" else loop.frame_b], "site", name=end)
+            ends.append(end)
         tag = "connect" if loop.kind == "point" else "weld"
         ET.SubElement(equality, tag, name=loop.name, site1=ends[0], site2=ends[1])
 

@@ -274,7 +274,7 @@ def with_joint_equalities(root, src: Sources, links: list, ignored: set) -> list
     and connects are loops (:mod:`kinedyn.description.mjcf_loops`); the other equalities (a
     polynomial, a joint held constant, tendons, flexes) are named in ``ignored``."""
     joints = {link.joint.name: k for k, link in enumerate(links)}
-    out, unread = list(links), {}
+    out, unread = list(links), dict[str, int]()
     for section in root.iterfind("equality"):
         for element in section:
             if element.tag in ("connect", "weld"):

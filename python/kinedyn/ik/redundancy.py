@@ -20,6 +20,7 @@ keeps every joint inside its limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -84,6 +85,7 @@ def _value(value, name: str, count: int | None) -> float | np.ndarray:
         return float(v)
     if v.shape not in ((), (count,)) or not np.all(np.isfinite(v)):
         raise ValueError(f"redundancy {name} must be a finite number or one per target ({count},), got {value!r}")
+    assert count is not None  # a batch's values (a lone number returned above)
     return np.ascontiguousarray(np.broadcast_to(v, (count,)))
 
 
@@ -98,12 +100,12 @@ def solve_redundant(robot, target, q0, respect_limits: bool, redundancy, frame, 
     what = "value" if mode == "held" else "arm_angle"
     tol = float(tolerance)
     if batch:
-        values = _value(value, what, len(t))
+        values = np.asarray(_value(value, what, len(t)))
         refs = np.ascontiguousarray(np.broadcast_to(check_q0(q0, chain, len(t), robot), (len(t), 7)))
         raw = solver.solve_batch(np.ascontiguousarray(t), mode, k, values, refs, respect_limits, tol)
         structure = _structure(solver, mode, k, name, float(values[0]) if len(values) else 0.0)
         return pack(raw, "analytic:" + structure, structure)
-    value = _value(value, what, None)
+    value = float(_value(value, what, None))
     ref = check_q0(q0, chain, None, robot)
     sols, pe, oe, found, singular, most, worst, merged = solver.solve(t, mode, k, value, ref, respect_limits, tol)
     structure = _structure(solver, mode, k, name, value)
@@ -194,7 +196,7 @@ class SelfMotion:
     inside: np.ndarray
     singular: np.ndarray
     parameter: str
-    _solver: object
+    _solver: Any  # the native solver (_core)
     _slots: np.ndarray
     _args: tuple
     _limits: tuple

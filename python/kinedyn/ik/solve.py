@@ -12,7 +12,7 @@ Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -458,7 +458,7 @@ def _analytic(
     assert solver is not None  # callers take this route only for a chain with a closed form
     sols, pe, oe, found, singular, most, worst, merged = solver.solve_stated(t, q_ref, respect_limits, tolerance)
     name = "analytic:" + solver.structure
-    stated = dict(structure=solver.structure, max_solutions=most, worst_residual=worst, merged=merged)
+    stated: dict[str, Any] = dict(structure=solver.structure, max_solutions=most, worst_residual=worst, merged=merged)
     if len(sols):
         message = f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else "")
         return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=message, **stated)
