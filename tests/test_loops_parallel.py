@@ -1,0 +1,121 @@
+"""Parallel robots from the example files: the Delta robot (ball joints, five point loops) and the
+push-rod leg (a loop on a floating base) against Pinocchio's constraintDynamics; the Delta's forward
+kinematics from its motor angles against the intersection of three spheres (derived below)."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kinedyn as kd
+
+pin = pytest.importorskip("pinocchio")
+
+ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+MOTORS = ["arm1", "arm2", "arm3"]
+
+
+def delta() -> kd.Robot:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # MuJoCo's softness is not modelled: the loader says so
+        return kd.load(ROBOTS / "delta.xml")
+
+
+def pinocchio_delta(tmp_path):
+    """Pinocchio's model and its <connect> constraints of the same file. Its MJCF reader keeps only
+    the first body under <worldbody>, so the three arms hang under one body without a joint."""
+    text = (ROBOTS / "delta.xml").read_text()
+    text = text.replace("<worldbody>", '<worldbody><body name="hang">', 1).replace(
+        "</worldbody>", "</body></worldbody>"
+    )
+    path = tmp_path / "delta_hung.xml"
+    path.write_text(text)
+    model, constraints = pin.buildModelAndLegacyConstraintsFromMJCF(os.fspath(path))
+    return model, list(constraints)
+
+
+def pinocchio_solve(model, constraints, q, qd, tau):
+    """qdd, and each loop's force on its first body in base axes (Pinocchio's LOCAL is that body's
+    constraint frame)."""
+    data = model.createData()
+    models, datas = pin.StdVec_RigidConstraintModel(), pin.StdVec_RigidConstraintData()
+    for constraint in constraints:
+        models.append(constraint)
+        datas.append(constraint.createData())
+    pin.initConstraintDynamics(model, data, models, datas)
+    qdd = pin.constraintDynamics(model, data, q, qd, tau, models, datas, pin.ProximalSettings(1e-14, 1e-10, 100))
+    pin.forwardKinematics(model, data, q)
+    forces = []
+    for k, constraint in enumerate(constraints):
+        rot = (data.oMi[constraint.joint1_id] * constraint.joint1_placement).rotation
+        forces.extend(rot @ data.lambda_c[3 * k : 3 * k + 3])
+    return qdd.copy(), np.array(forces)
+
+
+def closed_state(robot, hold, seed, spread=0.3):
+    rng = np.random.default_rng(seed)
+    q = robot.project_configuration(robot.integrate(robot.neutral(), rng.uniform(-spread, spread, robot.n)), hold=hold)
+    qd = robot.project_velocity(q, rng.uniform(-1, 1, robot.n))
+    return q, qd, rng
+
+
+def test_delta_constrained_forward_dynamics_matches_pinocchio(tmp_path):
+    robot = delta()
+    model, constraints = pinocchio_delta(tmp_path)
+    assert (model.nq, model.nv, len(constraints)) == (robot.nq, robot.n, len(robot.loops))
+    motors = [model.joints[model.getJointId(name)].idx_v for name in MOTORS]
+    for seed in range(4):
+        q, qd, rng = closed_state(robot, MOTORS, seed)
+        jac = robot.loop_jacobian(q)
+        assert np.abs(robot.loop_residual(q)).max() < 1e-12
+        assert np.abs(jac @ qd).max() < 1e-12
+        # the motors drive, the ball joints are passive. (A torque on a ball joint spins its thin
+        # rod about its own axis, inertia ~1e-7 kg m^2: accelerations of 1e6 whose last digits
+        # neither solver can promise.)
+        tau = np.zeros(robot.n)
+        tau[motors] = rng.uniform(-2, 2, 3)
+        qdd, lam = robot.constrained_forward_dynamics(q, qd, tau)
+        qdd_pin, lam_pin = pinocchio_solve(model, constraints, q, qd, tau)
+        assert np.allclose(qdd, qdd_pin, rtol=0, atol=1e-9), np.abs(qdd - qdd_pin).max()
+        assert np.allclose(jac.T @ lam, jac.T @ lam_pin, rtol=0, atol=1e-8)
+        assert np.abs(jac @ qdd + robot.loop_gamma(q, qd)).max() < 1e-8
+
+
+def test_pushrod_leg_on_its_floating_base_matches_pinocchio():
+    """The leg's trunk is free; Pinocchio reads the URDF's floating joint as its free-flyer (the
+    same q and v layout as kinedyn's) and a continuous joint as (cos, sin); the loop, a kinedyn
+    extension Pinocchio skips, is built by hand from the file's two link points."""
+    path = ROBOTS / "pushrod_leg.urdf"
+    robot = kd.load(path)
+    model = pin.buildModelFromXML(path.read_text())
+
+    def point(link, xyz):
+        frame = model.frames[model.getFrameId(link)]
+        return frame.parentJoint, frame.placement * pin.SE3(np.eye(3), np.array(xyz, float))
+
+    (joint_a, at_a), (joint_b, at_b) = point("push_rod", [0, 0, -0.3]), point("shank", [0.05, 0, 0])
+    loop = pin.RigidConstraintModel(
+        pin.ContactType.CONTACT_3D, model, joint_a, at_a, joint_b, at_b, pin.ReferenceFrame.LOCAL
+    )
+
+    def to_pinocchio(q):
+        out, at = [], 0
+        for joint in model.joints[1:]:
+            width = 7 if joint.nq == 7 else 1
+            x = q[at : at + width]
+            at += width
+            out.extend([np.cos(x[0]), np.sin(x[0])] if joint.nq == 2 else x)
+        return np.array(out)
+
+    for seed in range(3):
+        q, qd, rng = closed_state(robot, ["root", "hip", "knee"], seed, spread=0.6)
+        assert np.abs(robot.loop_residual(q)).max() < 1e-11
+        tau = np.r_[np.zeros(6), rng.uniform(-2, 2, robot.n - 6)]  # nothing pushes the trunk
+        qdd, _ = robot.constrained_forward_dynamics(q, qd, tau)
+        qdd_pin, _ = pinocchio_solve(model, [loop], to_pinocchio(q), qd, tau)
+        assert np.abs(qdd).max() > 1.0  # a real motion, not a resting one
+        assert np.allclose(qdd, qdd_pin, rtol=0, atol=1e-9), np.abs(qdd - qdd_pin).max()
