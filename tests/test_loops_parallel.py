@@ -119,3 +119,75 @@ def test_pushrod_leg_on_its_floating_base_matches_pinocchio():
         qdd_pin, _ = pinocchio_solve(model, [loop], to_pinocchio(q), qd, tau)
         assert np.abs(qdd).max() > 1.0  # a real motion, not a resting one
         assert np.allclose(qdd, qdd_pin, rtol=0, atol=1e-9), np.abs(qdd - qdd_pin).max()
+
+
+# The Delta's geometry as its file's comment states it (base radius 0.2, platform radius 0.05, upper
+# arms 0.3 at 15.7 degrees below horizontal at angle 0, rods 0.8; arms at 0, 120, 240 degrees about z,
+# each turning about its own y axis, so that a positive angle lowers it).
+BASE, PLATFORM, UPPER, ROD = 0.2, 0.05, 0.3, 0.8
+DROP = np.arctan2(0.0810993756978, 0.288830211822)
+
+
+def delta_platform_closed_form(angles) -> np.ndarray:
+    """The platform centre from the three motor angles: each parallelogram keeps the platform's
+    axes, so the midpoint of arm i's rod ends is the platform centre plus PLATFORM u_i (u_i its radial
+    direction), a rod length from the elbow E_i. The centre P lies on the three spheres
+    |P - (E_i - PLATFORM u_i)| = ROD. Subtracting the first sphere from the others leaves two planes
+    2 (c_i - c_1) . P = |c_i|^2 - |c_1|^2, whose line P0 + t n (n = (c_2 - c_1) x (c_3 - c_1)) meets
+    the first sphere where |P0 + t n - c_1|^2 = ROD^2, a quadratic in t; the platform hangs below, the
+    root of lower z."""
+    centres = []
+    for k, theta in enumerate(angles):
+        phi = 2 * np.pi * k / 3
+        u = np.array([np.cos(phi), np.sin(phi), 0.0])
+        elbow = BASE * u + UPPER * (np.cos(DROP + theta) * u - np.sin(DROP + theta) * np.array([0, 0, 1.0]))
+        centres.append(elbow - PLATFORM * u)
+    c1, c2, c3 = centres
+    n = np.cross(c2 - c1, c3 - c1)
+    a = np.array([2 * (c2 - c1), 2 * (c3 - c1), n])
+    p0 = np.linalg.solve(a, [c2 @ c2 - c1 @ c1, c3 @ c3 - c1 @ c1, n @ c1])  # the point of the line in c_1's plane
+    d = p0 - c1
+    qa, qb, qc = n @ n, 2 * n @ d, d @ d - ROD**2
+    roots = (-qb + np.array([1.0, -1.0]) * np.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa)
+    points = p0 + roots[:, None] * n
+    return points[np.argmin(points[:, 2])]
+
+
+@pytest.mark.parametrize("angles", [(0.0, 0.0, 0.0), (0.3, -0.2, 0.5), (-0.4, 0.6, 0.1), (0.8, 0.7, -0.3)])
+def test_delta_forward_kinematics_from_its_motors_is_the_three_spheres(angles):
+    robot = delta()
+    start = robot.neutral()
+    columns = {name: np.flatnonzero(np.isfinite(robot.lower_limits))[k] for k, name in enumerate(MOTORS)}  # the hinges'
+    for name, angle in zip(MOTORS, angles, strict=True):
+        start[columns[name]] = angle
+    q = robot.project_configuration(start, hold=MOTORS)
+    assert np.allclose(q[list(columns.values())], angles, rtol=0, atol=1e-15)  # held
+    assert np.abs(robot.loop_residual(q)).max() < 1e-12
+    platform, tcp = robot.frame_poses(q, ["platform", "tcp"])
+    assert np.allclose(platform[:3, 3], delta_platform_closed_form(angles), rtol=0, atol=1e-10)
+    assert np.allclose(platform[:3, :3], np.eye(3), atol=1e-10)  # the parallelograms keep it level
+    assert np.allclose(tcp[:3, 3], platform[:3, 3] - [0, 0, 0.02], atol=1e-12)
+
+
+def test_inverse_kinematics_of_the_delta_closes_the_loops_and_finds_the_motor_angles():
+    """Inverse of the above: the tool point from the closed form, back to the motor angles; the
+    answer closes every loop (the tree's solvers would leave them open)."""
+    robot = delta()
+    motors = np.flatnonzero(np.isfinite(robot.lower_limits))
+    for angles in [(0.3, -0.2, 0.5), (-0.4, 0.6, 0.1)]:
+        target = delta_platform_closed_form(angles) - [0, 0, 0.02]
+        result = robot.inverse_kinematics(target, frame="tcp")
+        assert result.success and result.solver == "numeric:closed-chain", result
+        assert np.abs(robot.loop_residual(result.q)).max() < 1e-9
+        assert np.allclose(robot.frame_poses(result.q, ["tcp"])[0][:3, 3], target, atol=1e-9)
+        assert np.allclose(result.q[motors], angles, atol=1e-8)  # the Delta's inverse problem is unique on its branch
+
+
+def test_inverse_kinematics_on_loops_refuses_what_it_cannot_do():
+    robot = delta()
+    with pytest.raises(ValueError, match="closed loops.*no closed-form"):
+        robot.inverse_kinematics([0.0, 0.0, -0.8], frame="tcp", method="analytic")
+    with pytest.raises(ValueError, match="closed loops.*one target"):
+        robot.inverse_kinematics(np.zeros((2, 3)), frame="tcp")
+    far = robot.inverse_kinematics([0.0, 0.0, -3.0], frame="tcp")  # beyond the rods' reach
+    assert not far.success and len(far) == 0 and "did not converge" in far.message
