@@ -191,3 +191,45 @@ def test_inverse_kinematics_on_loops_refuses_what_it_cannot_do():
         robot.inverse_kinematics(np.zeros((2, 3)), frame="tcp")
     far = robot.inverse_kinematics([0.0, 0.0, -3.0], frame="tcp")  # beyond the rods' reach
     assert not far.success and len(far) == 0 and "did not converge" in far.message
+
+
+# ----------------------------------------------------------------------------- properties of the reduced model
+@pytest.mark.parametrize("name", ["four_bar.yaml", "five_bar.yaml", "parallelogram_arm.urdf"])
+def test_the_numeric_checks_run_on_the_reduced_model_at_closed_states(name):
+    robot = kd.load(ROBOTS / name)
+    report = kd.analysis.check_properties(robot, samples=30)
+    assert report.passed, report
+    names = [check.name for check in report.checks]
+    assert names == [
+        "M_r symmetric positive definite",
+        "dM_r/dt - 2C_r skew-symmetric",
+        "dM_r/dt == C_r + C_r^T",
+        "C_r qd_i == reduced bias",
+        "energy balance dH/dt == qd . (tau - friction)",
+    ]
+    assert all(check.residual < 1e-7 for check in report.checks), [(c.name, c.residual) for c in report.checks]
+    assert report.checks[0].data["min_eigenvalue"] > 0
+
+
+def test_reduced_dynamics_counts_the_rank_at_the_closures_accuracy():
+    """The parallelogram arm's loop is planar and turns with the yaw: where the loop is closed to 1e-13
+    rather than exactly, the yaw's column of J is 1e-13, not zero; the mechanism still has 3 degrees
+    of freedom, and G (qd = G qd_i) stays of order one."""
+    robot = kd.load(ROBOTS / "parallelogram_arm.urdf")
+    rng = np.random.default_rng(0)
+    for _ in range(8):
+        q = robot.project_configuration(robot.random_configuration(rng))
+        reduced = robot.reduced_dynamics(q, np.ones(3))
+        assert len(reduced["independent"]) == 3
+        assert np.abs(reduced["G"]).max() < 1e3
+        assert np.abs(robot.loop_jacobian(q) @ reduced["qd"]).max() < 1e-9
+
+
+def test_the_checks_refuse_a_closed_chain_with_ball_joints_and_the_command_line_runs_them(capsys):
+    from kinedyn.cli import main
+
+    with pytest.raises(ValueError, match="closed loops.*1-DOF joint"):
+        kd.analysis.check_properties(delta(), samples=5)
+    assert main(["check", os.fspath(ROBOTS / "four_bar.yaml"), "--samples", "10", "--json"]) == 0
+    out = capsys.readouterr().out
+    assert "dM_r/dt - 2C_r skew-symmetric" in out and "energy balance" in out
