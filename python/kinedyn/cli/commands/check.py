@@ -73,7 +73,8 @@ def run(args) -> int:
 def _table(report, robot, args) -> None:
     c = console()
     t = Table(
-        title=f"properties of {esc(robot.name)} ({args.samples} sampled states, {args.t:g} s trajectory)",
+        title=f"properties of {esc(robot.name)} ({args.samples} sampled states, "
+        + ("closed ones, the reduced equations)" if robot.loops else f"{args.t:g} s trajectory)"),
         title_justify="left",
     )
     for col in ("", "property", "how", "residual", "tolerance", "measured"):
