@@ -45,11 +45,17 @@ def closed_chain_inverse_kinematics(
     frame=None,
     tolerance=1e-9,
     max_iterations=50,
-    **_ignored,  # restarts, seed, progress: the tree solver's; one local solve here
+    **options,
 ) -> IKResult:
     """``robot.inverse_kinematics`` of a robot with loops (see the module docstring): one target (a
     4x4 pose or a 3-vector position) from ``q0`` (default: the neutral configuration)."""
     names = ", ".join(loop.name for loop in robot.loops)
+    # restarts, seed, progress steer the tree solver's random restarts: one local solve here
+    refused = sorted(set(options) - {"restarts", "seed", "progress"})
+    if refused:
+        raise ValueError(
+            f"robot '{robot.name}' has closed loops ({names}): inverse kinematics on a closed chain does not take {refused}"
+        )
     if method == "analytic":
         raise ValueError(
             f"robot '{robot.name}' has closed loops ({names}): no closed-form inverse kinematics; use method='numeric'"

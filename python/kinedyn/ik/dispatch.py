@@ -3,7 +3,6 @@
 A robot whose coordinates are its joints goes straight to :func:`kinedyn.ik.solve.inverse_kinematics`
 (closed form where the chain has one, else the native numeric solver). A robot with reduced mimic
 joints (:mod:`kinedyn.description.mimic`) is solved as below, then read back in its own coordinates.
-A robot with closed loops gets :mod:`kinedyn.ik.closed_chain` (the pose and the closure together).
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ import dataclasses
 import numpy as np
 
 from .._arrays import real_array
-from .closed_chain import closed_chain_inverse_kinematics
 from .solve import inverse_kinematics as solve
 
 __all__ = ["inverse_kinematics"]
@@ -21,8 +19,6 @@ __all__ = ["inverse_kinematics"]
 
 def inverse_kinematics(robot, target, q0=None, mask=None, method="auto", respect_limits=True, **kwargs):
     """``robot.inverse_kinematics(...)``: the solver that fits the robot (see the module docstring)."""
-    if robot.loops:  # the tree's solvers would leave the loops open (kinedyn.ik.closed_chain)
-        return closed_chain_inverse_kinematics(robot, target, q0, mask, method, respect_limits, **kwargs)
     if robot.description.mimic_map is None:
         return solve(robot, target, q0, mask, method, respect_limits, **kwargs)
     return _with_mimic_joints(robot, target, q0, mask, method, respect_limits, **kwargs)
