@@ -105,6 +105,9 @@ def project_velocity(description, model, q, qd):
     return _native(description, model, "project_velocity").project_velocity(q, qd)
 
 
+RANK_TOLERANCE = 1e-9  # singular values of J below this (relative to its largest entry) count as zero
+
+
 def reduced_dynamics(description, model, q, qd_independent, independent=None):
     """The equations of motion in independent coordinates at one closed state (Nikravesh,
     Computer-Aided Analysis of Mechanical Systems, §13.4; Wehage & Haug 1982, "Generalized coordinate
@@ -122,7 +125,10 @@ def reduced_dynamics(description, model, q, qd_independent, independent=None):
     q = float64_array(q)
     n = native.n
     jac = native.loop_jacobian(q)
-    rank = int(np.linalg.matrix_rank(jac)) if jac.size else 0
+    # the rank at the closure's accuracy, not at machine precision: a column that only a residual of
+    # 1e-13 makes nonzero (the yaw of a planar loop turned as a whole) is not a constraint direction
+    rank_tol = RANK_TOLERANCE * max(1.0, float(np.abs(jac).max())) if jac.size else 0.0
+    rank = int(np.linalg.matrix_rank(jac, tol=rank_tol)) if jac.size else 0
     if independent is None:
         from scipy.linalg import qr  # scipy loads only for this choice
 
@@ -132,7 +138,7 @@ def reduced_dynamics(description, model, q, qd_independent, independent=None):
     else:
         columns = velocity_columns(description, independent, "reduced_dynamics, independent")
         dependent = [k for k in range(n) if k not in columns]
-        if np.linalg.matrix_rank(jac[:, dependent]) < rank or len(dependent) != rank:
+        if len(dependent) != rank or (rank and np.linalg.matrix_rank(jac[:, dependent], tol=rank_tol) < rank):
             raise ValueError(
                 f"robot '{description.name}', reduced_dynamics: the joints {list(independent)} are not independent "
                 f"coordinates: the loops' Jacobian has rank {rank}, and its {len(dependent)} other columns must "

@@ -26,6 +26,7 @@ from .description.edit import lock_joints, substitute
 from .description.geometry import Visual
 from .description.link import Frame, Link
 from .description.loops import Loop
+from .ik.closed_chain import closed_chain_inverse_kinematics
 from .ik.dispatch import inverse_kinematics as solve_ik
 from .native.compile import compile_model, locked_block
 from .native.errors import robot_error
@@ -488,7 +489,10 @@ class Robot(ClosedLoops):
     ):  # IKResult, or IKBatchResult for a batch of targets
         """Joint vectors putting ``frame`` (default: the tool) at ``target`` (4x4 pose or 3-vector
         position, or a batch): closed form where the geometry has one, else numeric. Returns an
-        ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`."""
+        ``IKResult`` (solutions nearest q0 first); see :func:`kinedyn.ik.inverse_kinematics`. A robot
+        with closed loops solves the pose and the closure together (:mod:`kinedyn.ik.closed_chain`)."""
+        if self.loops:  # the tree's solvers would leave the loops open
+            return closed_chain_inverse_kinematics(self, target, q0, mask, method, respect_limits, **kwargs)
         if _DASK_ARRAY in sys.modules and (is_dask_array(target) or is_dask_array(q0)):
             return lazy_inverse_kinematics(
                 self,

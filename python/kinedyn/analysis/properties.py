@@ -42,6 +42,7 @@ from ..simulate import PDGravity, SimulationError, simulate
 from ..simulate.control import Controller
 from ..symbolic.derive.proofs import prove_properties
 from .bounds import robot_inertia_bounds
+from .closed_properties import check_closed_chain_properties
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -127,14 +128,12 @@ def check_properties(
     make the right-hand side discontinuous, so RK4 and the quadrature of the balance lose their order
     there and the residual measures the integrator, not the model. Viscous friction stays in the
     simulated dynamics (its dissipation is a smooth term of the balance); that every friction torque
-    dissipates, ``qd . friction(qd) >= 0``, is checked on the sampled rates."""
-    if robot.loops:
-        raise ValueError(
-            f"robot '{robot.name}' has closed loops ({', '.join(lp.name for lp in robot.loops)}): the numeric checks measure "
-            "a tree's equations, and a closed chain's are its reduced equations, which the numeric engine does not form; "
-            "robot.equations_of_motion().check_properties() proves them on the symbolic reduced model "
-            "(kinedyn check --prove)"
-        )
+    dissipates, ``qd . friction(qd) >= 0``, is checked on the sampled rates.
+
+    A robot with closed loops is measured on its reduced equations at sampled closed states instead
+    (:mod:`kinedyn.analysis.closed_properties`; ``T``, ``dt`` and ``time_budget`` do not apply)."""
+    if robot.loops:  # the reduced equations at sampled closed states (kinedyn.analysis.closed_properties)
+        return check_closed_chain_properties(robot, samples=samples, seed=seed, h=h)
     rng = np.random.default_rng(seed)
     n = robot.n
     if n == 0:
