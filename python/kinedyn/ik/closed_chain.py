@@ -118,4 +118,6 @@ def closed_chain_inverse_kinematics(
         solver="numeric:closed-chain",
         reachable=None,
         message=message,
+        structure="closed chain (numeric)",
+        worst_residual=max(position, orientation, closure),
     )
