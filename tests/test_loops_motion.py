@@ -85,9 +85,12 @@ def test_open_start_is_projected_and_bad_methods_refused(four_bar):
         kd.simulate(four_bar, 0.01, np.concatenate([Q_CLOSED, np.zeros(3)]), method="rk45")
 
 
-def test_cli_simulates_the_four_bar(tmp_path):
+@pytest.mark.parametrize("name", ["four_bar.yaml", "five_bar.yaml"])
+def test_cli_simulates_a_linkage_from_a_closed_start(name):
+    """Zeros are a singular configuration of both (stretched flat, folded): the command line starts
+    from a regular closed one. Measured: four-bar 2.7e-9, five-bar 7.3e-6 of the energy scale."""
     out = subprocess.run(
-        [sys.executable, "-m", "kinedyn", "simulate", str(FOUR_BAR), "--t", "1", "--json"],
+        [sys.executable, "-m", "kinedyn", "simulate", str(ROOT / "examples" / "robots" / name), "--t", "1", "--json"],
         capture_output=True,
         text=True,
         timeout=300,
@@ -96,4 +99,4 @@ def test_cli_simulates_the_four_bar(tmp_path):
     payload = json.loads(out.stdout)
     assert payload["method"] == "rk4"
     assert payload["loop_residual_max"] < 2e-12
-    assert payload["energy_drift_relative"] < 1e-6
+    assert payload["energy_drift_relative"] < 3e-5

@@ -38,23 +38,30 @@ def closed_start(robot, q0, qd0):
 
 
 def closed_configuration(robot, q, tries: int = 20):
-    """A closed configuration near ``q`` for a start that has none given (the command line's
-    default): ``q`` projected, or, where Gauss-Newton stalls there (a four-bar stretched flat is a
-    singular configuration: its loop Jacobian loses rank), ``q`` plus deterministic offsets in
-    [-1, 1] rad (a seeded generator) until one projects. A ValueError when none does."""
+    """A regular closed configuration near ``q`` for a start that has none given (the command line's
+    default): ``q`` and ``q`` plus deterministic offsets in [-1, 1] rad (a seeded generator), each
+    projected; the first whose loop Jacobian has the largest rank among them. Zeros are often a
+    singular configuration of a linkage (a four-bar stretched flat, Spong's five-bar folded), where
+    the Jacobian loses rank and the constrained dynamics have no solution. A ValueError when none
+    projects."""
     q = np.asarray(q, dtype=float)
     rng = np.random.default_rng(0)
-    error = None
+    error, found = None, []
     for k in range(tries):
         start = q if k == 0 else q + rng.uniform(-1.0, 1.0, q.size)
         try:
-            return np.asarray(robot.project_configuration(start), dtype=float)
+            closed = np.asarray(robot.project_configuration(start), dtype=float)
         except ValueError as e:
             error = e
-    raise ValueError(
-        f"robot '{robot.name}': no closed configuration found near {np.array2string(q, precision=4)} "
-        f"({tries} starts); give a closed start (--q): {error}"
-    )
+            continue
+        found.append((int(np.linalg.matrix_rank(robot.loop_jacobian(closed), tol=1e-9)), closed))
+    if not found:
+        raise ValueError(
+            f"robot '{robot.name}': no closed configuration found near {np.array2string(q, precision=4)} "
+            f"({tries} starts); give a closed start (--q): {error}"
+        )
+    best = max(rank for rank, _ in found)
+    return next(closed for rank, closed in found if rank == best)
 
 
 def run_closed_loops(
