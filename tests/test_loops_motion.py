@@ -100,3 +100,21 @@ def test_cli_simulates_a_linkage_from_a_closed_start(name):
     assert payload["method"] == "rk4"
     assert payload["loop_residual_max"] < 2e-12
     assert payload["energy_drift_relative"] < 3e-5
+
+
+@pytest.mark.parametrize("name", ["four_bar.yaml", "five_bar.yaml", "parallelogram_arm.urdf"])
+def test_drawings_start_closed(name):
+    """The report, the viewer and the notebook drawings start at default_configuration: closed for a
+    robot with loops (the generic 0.5, -0.7, ... projected onto them)."""
+    from kinedyn.configuration import default_configuration
+    from kinedyn.report.data import collect
+
+    robot = kd.load(str(ROOT / "examples" / "robots" / name))
+    q = default_configuration(robot)
+    assert np.abs(robot.loop_residual(q)).max() < 1e-12
+    data = collect(robot, t_end=0.05, eom_joints=0, time_budget=None)
+    assert np.array_equal(np.asarray(data["q"]), q)
+    # the frames the loop pins together are drawn at one point
+    loop = robot.loops[0]
+    a, b = robot.frame_poses(q, [loop.frame_a, loop.frame_b])
+    assert np.allclose(a[:3, 3], b[:3, 3], atol=1e-12)
