@@ -118,3 +118,12 @@ def test_drawings_start_closed(name):
     loop = robot.loops[0]
     a, b = robot.frame_poses(q, [loop.frame_a, loop.frame_b])
     assert np.allclose(a[:3, 3], b[:3, 3], atol=1e-12)
+
+
+def test_singular_configuration_stops_the_run_with_its_samples():
+    """Spong's five-bar folded flat (zeros) is closed but singular: the loops cannot all hold under
+    gravity there, and the run stops with a SimulationError naming the loop, not a bare ValueError."""
+    five_bar = kd.load(str(ROOT / "examples" / "robots" / "five_bar.yaml"))
+    with pytest.raises(kd.simulate.SimulationError, match="loop 'parallelogram'") as caught:
+        kd.simulate(five_bar, 0.1, np.zeros(8), dt=1e-3)
+    assert caught.value.step == 0 and len(caught.value.trajectory) == 1

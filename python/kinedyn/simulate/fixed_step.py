@@ -164,6 +164,8 @@ def fixed_step_trajectory(
                 )
     except StopRun as stop:
         failure = stop.failure
+        if failure["step"] is None:  # raised where the step is not known (the dynamics): this step
+            failure["step"] = k
     except np.linalg.LinAlgError as e:
         failure = dict(
             step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=f"singular system matrix ({e})"

@@ -72,7 +72,10 @@ def run_closed_loops(
 
     def accel(t, q, qd, tau):
         f = None if fext_fn is None else fext_fn(t, q, qd)
-        return robot.constrained_forward_dynamics(q, qd, tau, f)[0]
+        try:
+            return robot.constrained_forward_dynamics(q, qd, tau, f)[0]
+        except ValueError as e:  # a singular configuration of the mechanism: the loops cannot all hold
+            raise StopRun(dict(step=None, t=t, joint=None, kind="singular", value=None, message=str(e))) from None
 
     def project(k, t, q, qd):
         try:
