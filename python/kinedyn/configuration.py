@@ -402,10 +402,19 @@ def default_configuration(robot: Robot) -> np.ndarray:
     """A generic (non-singular) configuration: 0.5, -0.7, 0.5, -0.7, ... rad (m for prismatic joints,
     x 0.2), clipped to the joint limits; a multi-DOF joint keeps its neutral block (identity rotation).
     The report, the viewer and the notebook drawings start here, where the structure shows (q = 0 is
-    often singular)."""
+    often singular). A robot with closed loops gets that configuration projected onto its loops
+    (``robot.project_configuration``: the nearest closed one, least-norm Gauss-Newton steps), so that
+    every drawing shows the chain closed; where no closed configuration is near it, the open one.
+    (docs/closed-loops.md, "Motion")"""
     q, start = robot.neutral(), 0
     for i, j in enumerate(robot.joints):
         if not j.is_multi_dof:
             q[start] = (0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2)
         start += j.nq
-    return np.clip(q, robot.lower_limits, robot.upper_limits)
+    q = np.clip(q, robot.lower_limits, robot.upper_limits)
+    if getattr(robot, "loops", ()):
+        try:
+            q = np.asarray(robot.project_configuration(q), dtype=float)
+        except ValueError:  # no closed configuration near this one (or loops the core cannot hold): drawn open
+            pass
+    return q

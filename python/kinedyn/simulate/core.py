@@ -71,6 +71,7 @@ from .inputs import (
     time_grid,
     torque_sources,
 )
+from .loops_runner import LOOP_METHODS, closed_start, loop_forces, run_closed_loops
 from .native_runner import run_native
 from .runs import Deadline, TimeBar
 from .stiffness import RK4_STABLE, choose_method
@@ -165,6 +166,8 @@ def simulate(
     # a floating, spherical or planar joint: q (nq) and qd (nv) differ, and only the core's
     # fixed-step integrators step q on the manifold (q ⊕ h qd)
     multi_dof = robot and cast("Robot", system).has_multi_dof_joints
+    # closed loops: the constrained dynamics and a projection after each step (:mod:`.loops_runner`)
+    loops = robot and bool(getattr(system, "loops", ()))
     mech = None if robot else as_mechanical(system, params, baumgarte, points)
     target = system if robot else mech
     n = system.n if mech is None else mech.n
@@ -179,7 +182,12 @@ def simulate(
     jac = getattr(controller, "jacobian", None) if controller is not None else None
     jac = jac if callable(jac) else None
     choice = None
-    if method == "auto":
+    if loops:
+        _check_loops(cast("Robot", system), method, multi_dof)
+        q0, qd0, moved_q, moved_qd = closed_start(system, q0, qd0)
+    if method == "auto" and loops:
+        method, choice = "rk4", "auto: rk4 (closed loops: projected onto their manifold after each step)"
+    elif method == "auto":
         method, choice = (
             choose_method(system, q0, qd0, t0, dt, jac, names)
             if robot
@@ -211,7 +219,7 @@ def simulate(
     # The one place that sends a robot to the Python fixed-step loop (:mod:`.fixed_step`): a robot
     # with reduced mimic joints runs on its reduced methods (the native integrators take the full
     # model). Wrenches about link frames (f_ext), one per link, are the core's (docs/architecture.md).
-    native = robot and method in FIXED_METHODS and not getattr(system, "mimic_joints", None)
+    native = robot and method in FIXED_METHODS and not getattr(system, "mimic_joints", None) and not loops
     if multi_dof and not native:
         why = f"the method '{method}'" if method not in FIXED_METHODS else "mimic joints"
         raise ValueError(
@@ -238,8 +246,16 @@ def simulate(
         info["joint_limits"] = True
     deadline = Deadline(time_budget)
     start = time.perf_counter()
+    if loops:
+        info["loops"] = "projection after each step (Hairer, Lubich and Wanner, GNI IV.4)"
+        info["loop_start_shift"] = {"q": moved_q, "qd": moved_qd}
     try:
-        if native:
+        if loops:
+            out = run_closed_loops(
+                system, fext_fn, method, q0, qd0, t0, dt, steps, torque_for, hold, record_every, max_speed, bar,
+                batch, limits, deadline,
+            )  # fmt: skip
+        elif native:
             out = run_native(
                 system,
                 method,
@@ -330,7 +346,24 @@ def simulate(
 
     raise_failure(target, names, failures, steps_done, partial, steps)
     traj = Trajectory(target, t, Q, QD, QDD, TAU, method=method, dt=dt, info=info)
+    if loops:
+        traj.loop_forces = loop_forces(system, fext_fn, t, Q, QD, TAU)
+        info["loop_residual_max"] = float(np.abs(cast("Robot", system).loop_residual(Q.reshape(-1, Q.shape[-1]))).max())
+        traj.info = info
     return traj
+
+
+def _check_loops(robot, method, multi_dof):
+    if method != "auto" and method not in LOOP_METHODS:
+        raise ValueError(
+            f"robot '{robot.name}' has closed loops: simulate it with a fixed-step method that projects onto them "
+            f"after each step (auto, {', '.join(LOOP_METHODS)}), not '{method}'"
+        )
+    if multi_dof:
+        raise ValueError(
+            f"robot '{robot.name}' has closed loops and multi-DOF joints (nq = {robot.nq}, nv = {robot.n}): "
+            "the loops' integrator steps q + h qd, which needs one coordinate per velocity"
+        )
 
 
 def _sample_times(t0, dt, steps, every):

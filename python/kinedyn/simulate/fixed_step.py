@@ -87,10 +87,13 @@ def fixed_step_trajectory(
     implicit=None,
     limits=None,
     deadline=None,
+    project=None,
 ):
     """One trajectory with the schemes of the core's sim/, the dynamics called from Python.
     ``implicit``: (derivatives(t, q, qd, tau), jacobian(t, q, qd) or None, coulomb or None) for the
-    implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`Deadline`."""
+    implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`Deadline`;
+    ``project``: None or ``(k, t, q, qd) -> (q, qd)`` after each step (closed loops: back onto their
+    manifold, :mod:`.loops_runner`)."""
     n = q0.size
     samples = -(-steps // record_every) + 1
     Q, QD, QDD, TAU = (np.zeros((samples, n)) for _ in range(4))
@@ -149,6 +152,8 @@ def fixed_step_trajectory(
                 qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
             if limits is not None:
                 q, qd = clamp_to_limits(q, qd, *limits)
+            if project is not None:
+                q, qd = project(k, t + dt, q, qd)
             bad = np.flatnonzero(~(np.isfinite(q) & np.isfinite(qd)))
             if bad.size:
                 raise StopRun(dict(step=k, t=t, joint=int(bad[0]), kind="non_finite", value=None, message=""))
@@ -159,6 +164,8 @@ def fixed_step_trajectory(
                 )
     except StopRun as stop:
         failure = stop.failure
+        if failure["step"] is None:  # raised where the step is not known (the dynamics): this step
+            failure["step"] = k
     except np.linalg.LinAlgError as e:
         failure = dict(
             step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=f"singular system matrix ({e})"

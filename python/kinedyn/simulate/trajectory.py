@@ -65,6 +65,9 @@ class Trajectory:
         self.dt = dt
         self.info = dict(info or {})
         self.failure = failure
+        # a robot with closed loops: the loops' multipliers per sample, (S, m) or (N, S, m)
+        # (docs/closed-loops.md, "Motion"); None otherwise
+        self.loop_forces: np.ndarray | None = None
 
     # ------------------------------------------------------------------ shape
     @property
@@ -83,7 +86,7 @@ class Trajectory:
         """Trajectory ``i`` of a batch."""
         if self.batch is None:
             raise TypeError("this is a single trajectory; index its arrays (.q[k]) instead")
-        return Trajectory(
+        one = Trajectory(
             self.system,
             self.t,
             self.q[i],
@@ -94,6 +97,8 @@ class Trajectory:
             dt=self.dt,
             info=self.info,
         )
+        one.loop_forces = None if self.loop_forces is None else self.loop_forces[i]
+        return one
 
     @property
     def x(self) -> np.ndarray:

@@ -8,6 +8,7 @@ import numpy as np
 
 from ...simulate.control import make_controller
 from ...simulate.core import ADAPTIVE_METHODS, SimulationError, SimulationTruncatedWarning, simulate
+from ...simulate.loops_runner import closed_configuration
 from .. import app
 from ..app import console, emit, esc, parse_q
 from ..options import OutputPath, positive_float, positive_int, robot_argument
@@ -71,7 +72,13 @@ def add_arguments(p) -> None:
         default=2.0,
         help="duration of the computed-torque quintic (default 2 s)",
     )
-    p.add_argument("--q", nargs="+", type=float, metavar="Q", help="initial joint values (default zeros)")
+    p.add_argument(
+        "--q",
+        nargs="+",
+        type=float,
+        metavar="Q",
+        help="initial joint values (default zeros; for a robot with closed loops, a closed configuration found from there)",
+    )
     p.add_argument("--qd", nargs="+", type=float, metavar="QD", help="initial joint velocities (default zeros)")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument(
@@ -123,6 +130,9 @@ def run(args) -> int:
     robot = app.robot(args)
     q0 = parse_q(args.q, robot, args.deg, flag="--q")
     qd0 = parse_q(args.qd, robot, args.deg, flag="--qd")
+    if robot.loops and args.q is None:
+        # zeros rarely close a loop (and a linkage stretched flat is singular there): start closed
+        q0 = closed_configuration(robot, q0)
     if robot.has_multi_dof_joints and args.controller != "none":
         raise ValueError(
             f"--controller {args.controller} steers joint coordinates to --goal; robot '{robot.name}' has multi-DOF joints, "
@@ -201,6 +211,7 @@ def run(args) -> int:
         "method_choice": traj.info.get("method_choice"),
         "joint_limits": bool(args.joint_limits),
         "truncated": traj.info.get("truncated"),
+        "loop_residual_max": traj.info.get("loop_residual_max"),
         "files": files,
     }
 
@@ -212,6 +223,11 @@ def run(args) -> int:
         )
         if payload["method_choice"]:
             c.print(f"  method {payload['method_choice']}")
+        if payload["loop_residual_max"] is not None:
+            c.print(
+                f"  loops {', '.join(esc(loop.name) for loop in robot.loops)} held by projection after each step: "
+                f"max |residual| {payload['loop_residual_max']:.3g} over the run"
+            )
         if payload["truncated"]:
             c.print(f"  [bold yellow]cut short[/bold yellow]: {payload['truncated']}")
         c.print(f"  q(T)  = {np.array2string(traj.q[-1], precision=5)}")
