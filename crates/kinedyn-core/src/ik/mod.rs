@@ -50,6 +50,9 @@
 //! | `lambda` | `lambda`      | damping                                                  |
 
 pub mod analytic;
+// index loops keep the equations' subscripts (q: equation, m: sample, p: power)
+#[allow(clippy::needless_range_loop, clippy::manual_memcpy)]
+pub mod general6r;
 mod numeric;
 mod reduction;
 mod solutions;
