@@ -47,14 +47,13 @@
 //! | `t,a,b`  | `eig`, ...  | the U joint whose tangent is the eigenvalue, and the other two |
 
 use super::pose_error;
-use super::subproblems::{sp1_dir, Axis};
+use super::subproblems::{sp1_dir, sp4, Axis};
 use crate::joint::axis_angle;
 use crate::spatial::{Transform, Vec3};
-use nalgebra::{linalg::Schur, Matrix6, SMatrix, Vector6};
+use nalgebra::{linalg::Schur, DMatrix, Matrix6, SMatrix, Vector6};
 use std::f64::consts::PI;
 
 type M12 = SMatrix<f64, 12, 12>;
-type M24 = SMatrix<f64, 24, 24>;
 type Eqs = [f64; 14];
 
 /// Most real solutions a 6R chain can have (Raghavan & Roth 1993; Manseur & Doty 1989).
@@ -86,6 +85,8 @@ pub struct General6R {
     v: Vec<Item>,
     /// Position in `uj` of the eigen joint.
     eig: usize,
+    /// Whether Q_Y has full rank (8).
+    full_rank: bool,
     /// Left null space of Q_Y (6 x 14), its pseudo-inverse (8 x 14), the constant column H_0.
     null: SMatrix<f64, 6, 14>,
     qy_pinv: SMatrix<f64, 8, 14>,
@@ -206,6 +207,7 @@ impl General6R {
             vj: [vj[0], vj[1]],
             v,
             eig: 0,
+            full_rank: true,
             null: SMatrix::zeros(),
             qy_pinv: SMatrix::zeros(),
             h0: [0.0; 14],
@@ -245,19 +247,32 @@ impl General6R {
             }
         }
         let svd = qy.svd(true, true);
-        let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-        if smin <= 1e-7 * smax {
-            return None; // the V pair's products are dependent: y is not determined
+        let smax = svd.singular_values.max();
+        if smax.is_nan() || smax <= 0.0 {
+            return None;
         }
-        me.qy_pinv = svd.pseudo_inverse(0.0).ok()?;
+        // Q_Y of full rank (axes of the V pair skew): y, hence the V joints, by least squares;
+        // else (they meet or are parallel) more than 6 equations are free of V: 6 fixed generic
+        // combinations of them, and the V joints by subproblems
+        me.full_rank = svd.singular_values.min() > 1e-7 * smax;
+        me.qy_pinv = svd.pseudo_inverse(1e-7 * smax).ok()?;
         // left null space: eigenvectors of I - Q_Y Q_Y^+ with eigenvalue 1
         let proj = SMatrix::<f64, 14, 14>::identity() - qy * me.qy_pinv;
         let eig = proj.symmetric_eigen();
         let mut order: Vec<usize> = (0..14).collect();
         order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-        for (row, &c) in order[..6].iter().enumerate() {
-            for q in 0..14 {
-                me.null[(row, q)] = eig.eigenvectors[(q, c)];
+        let dim = order.iter().filter(|&&c| eig.eigenvalues[c] > 0.5).count();
+        let mut rng = crate::rng::Rng::new(0xbb67_ae85_84ca_a73b);
+        for row in 0..6 {
+            for (i, &c) in order[..dim].iter().enumerate() {
+                let weight = if dim == 6 {
+                    f64::from(u8::from(i == row))
+                } else {
+                    rng.uniform(-1.0, 1.0)
+                };
+                for q in 0..14 {
+                    me.null[(row, q)] += weight * eig.eigenvectors[(q, c)];
+                }
             }
         }
         Some(me)
@@ -407,16 +422,44 @@ impl General6R {
                 m[pt][(6 + i, 3 * (pa + 1) + pb)] = c;
             }
         }
-        let lu = m[2].full_piv_lu();
-        let piv = lu.u().diagonal().map(f64::abs);
-        let lead = piv.min() / piv.max().max(1e-300);
-        let Some(inv) = (lead > 1e-13).then(|| lu.try_inverse()).flatten() else {
+        // monomials absent from every equation (axes that meet or are parallel): drop their
+        // columns and square the system by fixed generic combinations of its rows
+        let big = m.iter().map(|mp| mp.amax()).fold(0.0, f64::max);
+        let present: Vec<usize> = (0..12)
+            .filter(|&c| m.iter().any(|mp| mp.column(c).amax() > 1e-12 * big))
+            .collect();
+        let n = present.len();
+        let mut rng = crate::rng::Rng::new(0x3c6e_f372_fe94_f82b);
+        let mix = if n < 12 {
+            DMatrix::from_fn(n, 12, |_, _| rng.uniform(-1.0, 1.0))
+        } else {
+            DMatrix::identity(12, 12)
+        };
+        let md: Vec<DMatrix<f64>> = m
+            .iter()
+            .map(|mp| &mix * DMatrix::from_fn(12, n, |i, j| mp[(i, present[j])]))
+            .collect();
+        // x = eigenvalue of [0 I; -M2^-1 M0, -M2^-1 M1]; if M2 is singular (roots at x = inf),
+        // 1/x = eigenvalue of [0 I; -M0^-1 M2, -M0^-1 M1] (the infinite roots become 0)
+        let gap = |a: &DMatrix<f64>| {
+            let lu = a.clone().full_piv_lu();
+            let piv = lu.u().diagonal().map(f64::abs);
+            (piv.min() / piv.max().max(1e-300), lu)
+        };
+        let (lead2, lu2) = gap(&md[2]);
+        let (lead0, lu0) = gap(&md[0]);
+        let reversed = lead0 > 100.0 * lead2;
+        let (lead, lu, first) = if reversed { (lead0, lu0, 2) } else { (lead2, lu2, 0) };
+        let Some(inv) = (n > 0 && lead > 1e-13).then(|| lu.try_inverse()).flatten() else {
             return (stats, 0.0);
         };
-        let mut c = M24::zeros();
-        c.fixed_view_mut::<12, 12>(0, 12).fill_with_identity();
-        c.fixed_view_mut::<12, 12>(12, 0).copy_from(&(-inv * m[0]));
-        c.fixed_view_mut::<12, 12>(12, 12).copy_from(&(-inv * m[1]));
+        let mut c = DMatrix::zeros(2 * n, 2 * n);
+        c.view_mut((0, n), (n, n)).fill_with_identity();
+        c.view_mut((n, 0), (n, n)).copy_from(&(-&inv * &md[first]));
+        c.view_mut((n, n), (n, n)).copy_from(&(-&inv * &md[1]));
+        if c.iter().any(|x| !x.is_finite()) {
+            return (stats, 0.0);
+        }
         let Some(schur) = Schur::try_new(c, f64::EPSILON, 2000) else {
             return (stats, 0.0);
         };
@@ -425,6 +468,10 @@ impl General6R {
             .iter()
             .filter(|z| z.im.abs() <= 1e-4 * (1.0 + z.re.abs()))
             .map(|z| z.re)
+            .filter_map(|x| match reversed {
+                false => Some(x),
+                true => (x.abs() > 1e-12).then(|| 1.0 / x),
+            })
             .collect();
         xs.sort_by(f64::total_cmp);
         for w in xs.windows(2) {
@@ -434,8 +481,19 @@ impl General6R {
         }
         stats.candidates = xs.len();
         for &x in &xs {
-            let mx = m[2] * (x * x) + m[1] * x + m[0];
-            let u = null_vector(&mx);
+            let u = if n == 12 {
+                null_vector(&(m[2] * (x * x) + m[1] * x + m[0]))
+            } else {
+                let mx = &md[2] * (x * x) + &md[1] * x + &md[0];
+                let svd = mx.svd(false, true);
+                let Some(vt) = svd.v_t else { continue };
+                let row = vt.row(svd.singular_values.imin());
+                let mut u = [0.0; 12];
+                for (j, &c) in present.iter().enumerate() {
+                    u[c] = row[j];
+                }
+                u
+            };
             let mut th = [0.0; 6];
             th[self.uj[t]] = SHIFT[self.uj[t]] + 2.0 * x.atan();
             // x_a from consecutive powers of x_a (i, i + 1), x_b from (j, j + 1)
@@ -443,11 +501,11 @@ impl General6R {
             for i in 0..4 {
                 for j in 0..3 {
                     let e = u[3 * i + j];
-                    if i < 3 {
+                    if i < 3 && present.contains(&(3 * i + j)) && present.contains(&(3 * (i + 1) + j)) {
                         let h = u[3 * (i + 1) + j];
                         (lo_a, hi_a, cr_a) = (lo_a + e * e, hi_a + h * h, cr_a + e * h);
                     }
-                    if j < 2 {
+                    if j < 2 && present.contains(&(3 * i + j)) && present.contains(&(3 * i + j + 1)) {
                         let h = u[3 * i + j + 1];
                         (lo_b, hi_b, cr_b) = (lo_b + e * e, hi_b + h * h, cr_b + e * h);
                     }
@@ -467,14 +525,19 @@ impl General6R {
         (stats, lead)
     }
 
-    /// The V joints from `y = Q_Y^+ (F(th_u) - H_0)`, then the cut joint by subproblem 1.
+    /// The V joints from `y = Q_Y^+ (F(th_u) - H_0)` (or by subproblems), then the cut joint by
+    /// subproblem 1.
     fn back_substitute(&self, th: &mut [f64; 6], g: &Transform) {
-        let fu = self.side(&self.u, th, g);
-        let rhs = SMatrix::<f64, 14, 1>::from_fn(|q, _| fu[q] - self.h0[q]);
-        let y = self.qy_pinv * rhs;
-        // y[idx - 1] multiplies row a = idx / 3 (first V joint), column b = idx % 3 (second)
-        th[self.vj[0]] = y[5].atan2(y[2]);
-        th[self.vj[1]] = y[1].atan2(y[0]);
+        if self.full_rank {
+            let fu = self.side(&self.u, th, g);
+            let rhs = SMatrix::<f64, 14, 1>::from_fn(|q, _| fu[q] - self.h0[q]);
+            let y = self.qy_pinv * rhs;
+            // y[idx - 1] multiplies row a = idx / 3 (first V joint), column b = idx % 3 (second)
+            th[self.vj[0]] = y[5].atan2(y[2]);
+            th[self.vj[1]] = y[1].atan2(y[0]);
+        } else {
+            self.v_by_subproblems(th, g);
+        }
         // E_k = (E_0 .. E_{k-1})^-1 G (E_{k+1} .. E_5)^-1
         let k = self.cut;
         let mut before = Transform::identity();
@@ -489,6 +552,52 @@ impl General6R {
         let w = self.axes[k].w;
         let n = if w.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
         th[k] = sp1_dir(&w, &n, &(ek.rot * n)).values[0];
+    }
+
+    /// The V joints `a, b` from `E_a E_b r_k = p`, `R_a R_b w_k = l` (p, l: the U side): rotations
+    /// about `w_a` keep components along `w_a`, so `theta_b` solves subproblem 4 for the
+    /// direction and for the point; `theta_a` then subproblem 1. The best fitting pair is kept.
+    fn v_by_subproblems(&self, th: &mut [f64; 6], g: &Transform) {
+        let cut = &self.axes[self.cut];
+        let (mut p, mut l) = (cut.r, cut.w);
+        for item in self.u.iter().rev() {
+            let t = match *item {
+                Item::Joint(j, sign) => joint_exp(&self.axes[j], sign * th[j]),
+                Item::Target(false) => *g,
+                Item::Target(true) => g.inverse(),
+            };
+            p = t.act_point(&p);
+            l = t.rot * l;
+        }
+        let ((ja, sa), (jb, sb)) = match (self.v[0], self.v[1]) {
+            (Item::Joint(ja, sa), Item::Joint(jb, sb)) => ((ja, sa), (jb, sb)),
+            _ => return,
+        };
+        let (a, b) = (self.axes[ja], self.axes[jb]);
+        let from_direction = sp4(&a.w, &b.w, &cut.w, a.w.dot(&l));
+        let from_point = sp4(&a.w, &b.w, &(cut.r - b.r), a.w.dot(&(p - a.r)) - a.w.dot(&(b.r - a.r)));
+        let mut best = (f64::INFINITY, 0.0, 0.0);
+        for (angles, ok) in [
+            (from_direction, !from_direction.singular),
+            (from_point, !from_point.singular),
+        ] {
+            for &phi_b in angles.as_slice().iter().filter(|_| ok) {
+                let eb = joint_exp(&b, phi_b);
+                let (x, d) = (eb.act_point(&cut.r), eb.rot * cut.w);
+                for phi_a in [sp1_dir(&a.w, &d, &l), sp1_dir(&a.w, &(x - a.r), &(p - a.r))] {
+                    if phi_a.singular {
+                        continue;
+                    }
+                    let ea = joint_exp(&a, phi_a.values[0]);
+                    let err = (ea.act_point(&x) - p).norm() / self.scale + (ea.rot * d - l).norm();
+                    if err < best.0 {
+                        best = (err, phi_a.values[0], phi_b);
+                    }
+                }
+            }
+        }
+        th[ja] = sa * best.1;
+        th[jb] = sb * best.2;
     }
 
     /// Newton steps on the pose error (world-aligned Jacobian of the screws): the solution and

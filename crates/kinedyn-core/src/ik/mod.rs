@@ -39,7 +39,8 @@
 //! (`analytic_solutions`).
 //!
 //! Files: `numeric.rs` (the solver, its settings and start checks), `reduction.rs` (mimic joints),
-//! `analytic.rs` (structures and their closed forms), `subproblems.rs` (Paden-Kahan), `solutions.rs`
+//! `analytic.rs` (structures and their closed forms), `general6r.rs` (any 6R chain: Raghavan & Roth's
+//! elimination as an eigenvalue problem), `subproblems.rs` (Paden-Kahan), `solutions.rs`
 //! (closed-form candidates to checked joint vectors); the pose error is here.
 //!
 //! | symbol   | here          | meaning                                                  |
