@@ -1,5 +1,8 @@
+use super::back::wrap;
 use super::*;
+use crate::ik::pose_error;
 use crate::rng::Rng;
+use nalgebra::{Matrix6, Vector6};
 
 /// A random 6R chain: random unit axes through random points, a random home pose.
 fn random_chain(seed: u64) -> ([Axis; 6], Transform) {
