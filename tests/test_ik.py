@@ -299,15 +299,22 @@ def test_detection_reads_geometry_not_names():
     assert ik.analytic_structure(craig) == "arm_intersecting_shoulder"
     res = craig.inverse_kinematics(craig.pose(np.array([0.1, 0.5, -0.7]))[:3, 3])
     assert len(res) == 4
-    # break the wrist: a small offset between axes 5 and 6 of the PUMA leaves no closed form
+    # break the wrist: a small offset between axes 5 and 6 of the PUMA leaves no special structure,
+    # so the general 6R elimination takes it (the name stays the PUMA's: detection reads geometry)
     rows = list(kd.robots.puma560().dh)
     rows[4] = dataclasses.replace(rows[4], a=0.01)
     bent = kd.Robot.from_dh(rows, name="puma560")
-    assert ik.analytic_structure(bent) is None
-    T = bent.pose(np.array([0.1, 0.4, -0.3, 0.5, 0.6, -0.2]))
-    assert bent.inverse_kinematics(T).solver == "numeric:lm"
+    assert ik.analytic_structure(bent) == "general_6r"
+    q = np.array([0.1, 0.4, -0.3, 0.5, 0.6, -0.2])
+    T = bent.pose(q)
+    res = bent.inverse_kinematics(T, respect_limits=False)
+    assert res.solver == "analytic:general_6r" and res.max_solutions == 16
+    assert np.min(np.max(np.abs(res.solutions - q), axis=1)) < 1e-8
+    # with a prismatic joint in the chain no closed form is left
+    prismatic = kd.Robot.from_dh([dataclasses.replace(rows[0], kind="prismatic"), *rows[1:]], name="puma560")
+    assert ik.analytic_structure(prismatic) is None
     with pytest.raises(ValueError, match="no closed-form"):
-        bent.inverse_kinematics(T, method="analytic")
+        prismatic.inverse_kinematics(prismatic.pose(q), method="analytic")
 
 
 def test_urdf_ur5_gets_the_closed_form():

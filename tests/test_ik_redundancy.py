@@ -166,13 +166,15 @@ def test_panda_held_last_joint_is_a_reversed_spherical_wrist(panda):
         assert contains(r.solutions, q)
 
 
-def test_panda_other_held_joints_fall_back_to_the_locked_robot(panda):
+def test_panda_other_held_joints_use_the_general_6r(panda):
+    # joints 2..7 of the Panda have no special structure from either end: the general 6R solves them
     frame = "panda_hand_tcp"
     q = np.array([0.3, -0.5, 0.2, -2.0, 0.4, 1.5, 0.7])
     t = panda.pose(q, frame)
     r = panda.inverse_kinematics(t, redundancy={"joint": "panda_joint1", "value": 0.3}, frame=frame)
-    assert r.success and r.solver.startswith("numeric:lm") and r.max_solutions is None
+    assert r.success and r.solver == "analytic:held[panda_joint1]+general_6r" and r.max_solutions == 16
     assert np.all(r.solutions[:, 0] == 0.3)
+    assert np.min(np.max(np.abs(r.solutions - q), axis=1)) < 1e-8
     assert_reaches(panda, r.solutions, t, frame)
     with pytest.raises(ValueError, match="not an SRS arm"):
         panda.inverse_kinematics(t, redundancy={"arm_angle": 0.0}, frame=frame)

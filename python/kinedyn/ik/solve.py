@@ -225,7 +225,7 @@ def _chain(robot: Robot, frame: str | None) -> _Chain:
 def analytic_structure(robot: Robot, frame: str | None = None) -> str | None:
     """Name of the closed-form structure detected from the robot's geometry for ``frame``
     (``"planar_2r"``, ``"planar_3r"``, ``"arm_intersecting_shoulder"``, ``"arm_parallel_elbow"``,
-    ``"spherical_wrist"``, ``"three_parallel"``), or None."""
+    ``"spherical_wrist"``, ``"three_parallel"``, ``"general_6r"``), or None."""
     solver = _chain(robot, frame).solver
     return None if solver is None else solver.structure
 
@@ -441,7 +441,8 @@ def _why_not_analytic(robot: Robot, chain: _Chain, position: bool, weights) -> s
         return (
             f"robot '{robot.name}' has no closed-form inverse kinematics here: its axes match none of the "
             "structures kinedyn solves in closed form (planar 2R/3R, an RRR arm whose first two axes meet or whose "
-            "2nd and 3rd are parallel, 6R with a spherical wrist, 6R with three parallel axes); use method='numeric'"
+            "2nd and 3rd are parallel, 6R with a spherical wrist, 6R with three parallel axes, any other 6R arm with "
+            "finitely many solutions); use method='numeric'"
         )
     if weights is not None:
         return "a weighted mask has no closed form; use method='numeric' (or no mask / a position-only mask)"

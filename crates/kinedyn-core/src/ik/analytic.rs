@@ -9,7 +9,8 @@
 //! where `xi_i` is joint i's axis at `theta = 0` (a `Screw`: unit direction `w` through the point `r`,
 //! or a prismatic direction) and `g(0)` the tool pose there ("home"). The structure is detected
 //! from these lines alone (parallel / intersecting axes), never from a robot's name, and each
-//! structure is reduced to the subproblems of [`super::subproblems`]:
+//! structure but the last is reduced to the subproblems of [`super::subproblems`]; the last is
+//! the eigenvalue elimination of [`super::general6r`] (tried only when no other structure fits):
 //!
 //! | structure          | condition on the axes                                   | solutions |
 //! |--------------------|---------------------------------------------------------|-----------|
@@ -19,11 +20,13 @@
 //! | `ArmParallel`      | axes 2 and 3 parallel, axis 1 not                       | <= 4      |
 //! | `SphericalWrist`   | one of the arms above + axes 4, 5, 6 meet in one point  | <= 8      |
 //! | `ThreeParallel`    | axes 2, 3, 4 parallel, axes 5 and 6 meet (UR family)    | <= 8      |
+//! | `General6R`        | any other 6R chain with a finite solution set           | <= 16     |
 //!
 //! Arms (n = 3) and planar 2R chains solve position targets (the tool origin); the others full poses.
 //! Every candidate is returned as joint coordinates `theta` (offsets included); the caller maps
 //! them to `q`, checks them by forward kinematics and applies joint limits (`super::analytic_solutions`).
 
+use super::general6r::General6R;
 use super::subproblems::{rotate, rotate_point, sp1, sp1_dir, sp2, sp3, sp4, Axis};
 use crate::joint::axis_angle;
 use crate::spatial::{Mat3, Transform, Vec3};
@@ -65,6 +68,7 @@ pub enum Structure {
     ArmParallel,
     SphericalWrist,
     ThreeParallel,
+    General6R,
 }
 
 impl Structure {
@@ -76,6 +80,7 @@ impl Structure {
             Structure::ArmParallel => "arm_parallel_elbow",
             Structure::SphericalWrist => "spherical_wrist",
             Structure::ThreeParallel => "three_parallel",
+            Structure::General6R => "general_6r",
         }
     }
     /// Whether the structure solves a position-only target (else it needs a full pose).
@@ -96,6 +101,8 @@ pub struct AnalyticIk {
     pub screws: Vec<Screw>,
     /// `g(0)`: the tool pose at theta = 0.
     pub home: Transform,
+    /// The eigenvalue solver of a `General6R` chain.
+    pub general: Option<Box<General6R>>,
     /// Intersection of axes 1 and 2 (intersecting-shoulder arms).
     shoulder: Vec3,
     /// Wrist centre (axes 4, 5, 6 meet) or the point where axes 5 and 6 meet (three parallel).
@@ -156,6 +163,7 @@ impl AnalyticIk {
             arm: None,
             screws: screws.clone(),
             home,
+            general: None,
             shoulder: Vec3::zeros(),
             wrist: Vec3::zeros(),
         };
@@ -238,10 +246,29 @@ impl AnalyticIk {
                         }
                     }
                 }
+                // no special structure here: `ChainIk` reads the chain backwards, then falls back to
+                // `detect_general`
                 None
             }
             _ => None,
         }
+    }
+
+    /// The general 6R elimination of a chain of six revolute joints (`None` where it is degenerate
+    /// or a joint is prismatic): what a chain with no special structure from either end is solved by.
+    pub fn detect_general(screws: Vec<Screw>, home: Transform) -> Option<Self> {
+        let axes: Vec<Axis> = screws.iter().filter_map(|s| s.axis().copied()).collect();
+        let axes: [Axis; 6] = axes.try_into().ok()?;
+        let general = General6R::new(axes, home)?;
+        Some(Self {
+            structure: Structure::General6R,
+            arm: None,
+            screws,
+            home,
+            general: Some(Box::new(general)),
+            shoulder: Vec3::zeros(),
+            wrist: Vec3::zeros(),
+        })
     }
 
     pub fn n(&self) -> usize {
@@ -270,6 +297,12 @@ impl AnalyticIk {
             }
             Structure::SphericalWrist => self.spherical_wrist(&g, reference, out),
             Structure::ThreeParallel => self.three_parallel(&g, reference, out),
+            Structure::General6R => {
+                if let Some(general) = &self.general {
+                    general.solve(target, out);
+                }
+                false
+            }
         }
     }
 

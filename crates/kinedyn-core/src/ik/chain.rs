@@ -31,6 +31,8 @@ pub fn max_solutions(structure: Structure) -> usize {
         Structure::Planar2R | Structure::Planar3R => 2,
         Structure::ArmIntersecting | Structure::ArmParallel => 4,
         Structure::SphericalWrist | Structure::ThreeParallel => 8,
+        // Raghavan & Roth: the degree-16 polynomial of the general 6R
+        Structure::General6R => super::general6r::MAX_SOLUTIONS,
     }
 }
 
@@ -55,7 +57,7 @@ fn moved(h: &Transform, s: &Screw) -> Screw {
 
 impl ChainIk {
     /// The structure of the chain, else of the reversed chain (6 joints: the arm/wrist split
-    /// has a direction), else None.
+    /// has a direction), else the general 6R elimination, else None.
     pub fn detect(screws: Vec<Screw>, home: Transform) -> Option<Self> {
         let n = screws.len();
         if let Some(ik) = AnalyticIk::detect(screws.clone(), home) {
@@ -66,7 +68,10 @@ impl ChainIk {
         }
         let h = home.inverse();
         let back: Vec<Screw> = screws.iter().rev().map(|s| moved(&h, s)).collect();
-        AnalyticIk::detect(back, h).map(|ik| Self { ik, reversed: true })
+        if let Some(ik) = AnalyticIk::detect(back, h) {
+            return Some(Self { ik, reversed: true });
+        }
+        AnalyticIk::detect_general(screws, home).map(|ik| Self { ik, reversed: false })
     }
 
     pub fn n(&self) -> usize {

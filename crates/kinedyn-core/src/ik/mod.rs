@@ -39,11 +39,11 @@
 //! (`analytic_solutions`).
 //!
 //! Files: `numeric.rs` (the solver, its settings and start checks), `reduction.rs` (mimic joints),
-//! `analytic.rs` (structures and their closed forms), `chain.rs` (a structure found from either
-//! end of the chain, and the most solutions it has), `redundant.rs` (seven-joint arms: a held
-//! joint, the arm angle of SRS arms), `subproblems.rs` (Paden-Kahan), `solutions.rs`
-//! (closed-form candidates to checked joint vectors, with the statement of completeness); the pose
-//! error is here.
+//! `analytic.rs` (structures and their closed forms), `general6r.rs` (any 6R chain: Raghavan & Roth's
+//! elimination as an eigenvalue problem), `chain.rs` (a structure found from either end of the
+//! chain, and the most solutions it has), `redundant.rs` (seven-joint arms: a held joint, the arm
+//! angle of SRS arms), `subproblems.rs` (Paden-Kahan), `solutions.rs` (closed-form candidates to
+//! checked joint vectors, with the statement of completeness); the pose error is here.
 //!
 //! | symbol   | here          | meaning                                                  |
 //! |----------|---------------|----------------------------------------------------------|
@@ -54,6 +54,9 @@
 
 pub mod analytic;
 pub mod chain;
+// index loops keep the equations' subscripts (q: equation, m: sample, p: power)
+#[allow(clippy::needless_range_loop, clippy::manual_memcpy)]
+pub mod general6r;
 mod numeric;
 mod reduction;
 pub mod redundant;

@@ -1,0 +1,245 @@
+use super::back::wrap;
+use super::*;
+use crate::ik::pose_error;
+use crate::rng::Rng;
+use nalgebra::{Matrix6, Vector6};
+
+/// A random 6R chain: random unit axes through random points, a random home pose.
+fn random_chain(seed: u64) -> ([Axis; 6], Transform) {
+    let mut rng = Rng::new(seed);
+    let axes = std::array::from_fn(|_| Axis {
+        w: rng.unit(),
+        r: rng.vec3(-0.5, 0.5),
+    });
+    (axes, Transform::new(rng.rotation(), rng.vec3(-0.6, 0.6)))
+}
+
+fn random_angles(rng: &mut Rng) -> [f64; 6] {
+    std::array::from_fn(|_| rng.uniform(-PI, PI))
+}
+
+fn residual(solver: &General6R, th: &[f64; 6], target: &Transform) -> f64 {
+    let e = pose_error(&solver.forward(th), target);
+    e.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// An independent dense search: Levenberg-Marquardt with a finite-difference Jacobian of the
+/// forward kinematics from many random starts, converged solutions deduplicated.
+fn dense_search(solver: &General6R, target: &Transform, starts: usize, seed: u64) -> Vec<[f64; 6]> {
+    let mut rng = Rng::new(seed);
+    let mut found: Vec<[f64; 6]> = Vec::new();
+    for _ in 0..starts {
+        let mut q = random_angles(&mut rng);
+        let mut lambda = 1e-3;
+        let mut e = pose_error(&solver.forward(&q), target);
+        let mut cost: f64 = e.iter().map(|x| x * x).sum();
+        for _ in 0..200 {
+            if cost < 1e-26 {
+                break;
+            }
+            let mut jac = Matrix6::zeros();
+            for j in 0..6 {
+                let mut qh = q;
+                qh[j] += 1e-7;
+                let eh = pose_error(&solver.forward(&qh), target);
+                for r in 0..6 {
+                    jac[(r, j)] = (e[r] - eh[r]) / 1e-7; // de/dq = -d(fk)/dq
+                }
+            }
+            let ev = Vector6::from_column_slice(&e);
+            let a = jac.transpose() * jac + Matrix6::identity() * lambda;
+            let Some(step) = a.lu().solve(&(jac.transpose() * ev)) else {
+                break;
+            };
+            let mut qn = q;
+            for j in 0..6 {
+                qn[j] += step[j];
+            }
+            let en = pose_error(&solver.forward(&qn), target);
+            let cn: f64 = en.iter().map(|x| x * x).sum();
+            if cn < cost {
+                (q, e, cost, lambda) = (qn, en, cn, (lambda * 0.3).max(1e-12));
+            } else {
+                lambda *= 10.0;
+                if lambda > 1e6 {
+                    break;
+                }
+            }
+        }
+        if cost < 1e-22 {
+            let q = wrap(q);
+            if !found.iter().any(|s| same_angles(s, &q, 1e-5)) {
+                found.push(q);
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn equations_interpolate_exactly() {
+    // each side of the 14 equations is of degree one in (cos, sin) of each joint: its 3^3-point
+    // Fourier interpolant equals it everywhere
+    for seed in 0..4 {
+        let (axes, home) = random_chain(seed);
+        let me = General6R::formulation(&axes, &home, 1.0, 5, false).expect("generic chain");
+        let mut rng = Rng::new(seed + 100);
+        let g = Transform::new(rng.rotation(), rng.vec3(-1.0, 1.0));
+        let [j0, j1, j2] = me.uj;
+        let mut samples = [[[[0.0; 3]; 3]; 3]; 14];
+        let mut th = [0.0; 6];
+        for m0 in 0..3 {
+            for m1 in 0..3 {
+                for m2 in 0..3 {
+                    th[j0] = 2.0 * PI * m0 as f64 / 3.0;
+                    th[j1] = 2.0 * PI * m1 as f64 / 3.0;
+                    th[j2] = 2.0 * PI * m2 as f64 / 3.0;
+                    let e = me.side(&me.u, &th, &g);
+                    for q in 0..14 {
+                        samples[q][m0][m1][m2] = e[q];
+                    }
+                }
+            }
+        }
+        for _ in 0..20 {
+            let x = random_angles(&mut rng);
+            let direct = me.side(&me.u, &x, &g);
+            let basis = |t: f64| [1.0, t.cos(), t.sin()];
+            let (b0, b1, b2) = (basis(x[j0]), basis(x[j1]), basis(x[j2]));
+            for q in 0..14 {
+                // coefficients by the transform along each axis
+                let s = &samples[q];
+                let mut value = 0.0;
+                for (a, ba) in b0.iter().enumerate() {
+                    for (b, bb) in b1.iter().enumerate() {
+                        for (c, bc) in b2.iter().enumerate() {
+                            let mut coef = 0.0;
+                            // separable: c_abc = sum_m w_a(m0) w_b(m1) w_c(m2) s[m0][m1][m2]
+                            let w = |k: usize, m: usize| {
+                                let ang = 2.0 * PI * m as f64 / 3.0;
+                                match k {
+                                    0 => 1.0 / 3.0,
+                                    1 => 2.0 / 3.0 * ang.cos(),
+                                    _ => 2.0 / 3.0 * ang.sin(),
+                                }
+                            };
+                            for m0 in 0..3 {
+                                for m1 in 0..3 {
+                                    for m2 in 0..3 {
+                                        coef += w(a, m0) * w(b, m1) * w(c, m2) * s[m0][m1][m2];
+                                    }
+                                }
+                            }
+                            value += coef * ba * bb * bc;
+                        }
+                    }
+                }
+                assert!(
+                    (value - direct[q]).abs() < 1e-10 * (1.0 + direct[q].abs()),
+                    "equation {q}: interpolant {value} vs {}",
+                    direct[q]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn fourier_recovers_a_first_degree_trigonometric_polynomial() {
+    let (c0, c1, c2) = (0.3, -1.7, 2.2);
+    let f = |t: f64| c0 + c1 * t.cos() + c2 * t.sin();
+    let c = fourier(f(0.0), f(2.0 * PI / 3.0), f(4.0 * PI / 3.0));
+    assert!(
+        (c[0] - c0).abs() < 1e-14 && (c[1] - c1).abs() < 1e-14 && (c[2] - c2).abs() < 1e-14,
+        "{c:?}"
+    );
+}
+
+#[test]
+fn random_chains_find_the_known_solution_and_only_solutions() {
+    let mut hits = 0;
+    for seed in 0..30 {
+        let (axes, home) = random_chain(1000 + seed);
+        let solver = General6R::new(axes, home).expect("a generic chain has a formulation");
+        let mut rng = Rng::new(seed);
+        let mut out = Vec::new();
+        for _ in 0..5 {
+            let q = random_angles(&mut rng);
+            let target = solver.forward(&q);
+            let stats = solver.solve(&target, &mut out);
+            assert!(
+                out.len() <= MAX_SOLUTIONS && out.len() % 2 == 0,
+                "seed {seed}: {} solutions",
+                out.len()
+            );
+            assert!(
+                out.iter().any(|s| same_angles(s, &q, 1e-7)),
+                "seed {seed}: the generating q {q:?} is missing from {out:?}"
+            );
+            for s in &out {
+                assert!(residual(&solver, s, &target) < 1e-9, "seed {seed}: residual");
+            }
+            assert!(stats.worst_residual < 1e-9);
+            hits += out.len();
+        }
+    }
+    assert!(hits > 150);
+}
+
+#[test]
+fn solution_count_matches_a_dense_numeric_search() {
+    for seed in 0..4 {
+        let (axes, home) = random_chain(2000 + seed);
+        let solver = General6R::new(axes, home).expect("generic chain");
+        let mut rng = Rng::new(seed + 7);
+        for _ in 0..2 {
+            let target = solver.forward(&random_angles(&mut rng));
+            let mut out = Vec::new();
+            solver.solve(&target, &mut out);
+            let dense = dense_search(&solver, &target, 600, seed);
+            for d in &dense {
+                assert!(
+                    out.iter().any(|s| same_angles(s, d, 1e-5)),
+                    "seed {seed}: numeric solution {d:?} missed ({} vs {})",
+                    out.len(),
+                    dense.len()
+                );
+            }
+            assert_eq!(out.len(), dense.len(), "seed {seed}: eigenvalue count vs dense search");
+        }
+    }
+}
+
+#[test]
+fn unreachable_targets_have_no_solution() {
+    let (axes, home) = random_chain(3000);
+    let solver = General6R::new(axes, home).unwrap();
+    let far = Transform::new(Mat3Alias::identity(), Vec3::new(50.0, 0.0, 0.0));
+    let mut out = Vec::new();
+    solver.solve(&far, &mut out);
+    assert!(out.is_empty());
+}
+
+type Mat3Alias = crate::spatial::Mat3;
+
+#[test]
+fn time_per_solve() {
+    // a figure, not a gate (`cargo test --release -p kinedyn-core time_per_solve -- --nocapture`)
+    let (axes, home) = random_chain(4000);
+    let solver = General6R::new(axes, home).unwrap();
+    let mut rng = Rng::new(4);
+    let targets: Vec<Transform> = (0..200).map(|_| solver.forward(&random_angles(&mut rng))).collect();
+    let mut out = Vec::with_capacity(16);
+    let mut total = 0;
+    let start = std::time::Instant::now();
+    for t in &targets {
+        solver.solve(t, &mut out);
+        total += out.len();
+    }
+    let us = start.elapsed().as_secs_f64() * 1e6 / targets.len() as f64;
+    println!(
+        "general 6R: {us:.1} us per target, {:.2} solutions on average",
+        total as f64 / 200.0
+    );
+    assert!(total >= targets.len());
+}
