@@ -46,8 +46,8 @@ def _states(robot, count: int, seed: int):
 def _calls(robot, q, v, a):
     """(name, batch result, per-state results) of every batched algorithm."""
     model = robot._model
-    bodies = getattr(model, "native", model).n  # f_ext is per body (a mimic follower's too)
-    f_ext = np.random.default_rng(1).normal(size=(len(q), bodies, 6))
+    links = len(model.link_bodies)  # f_ext is one wrench per link (a mimic follower's too)
+    f_ext = np.random.default_rng(1).normal(size=(len(q), links, 6))
     tau = model.inverse_dynamics(q, v, a)
     calls = {
         "inverse_dynamics": (lambda *x: model.inverse_dynamics(*x), (q, v, a)),

@@ -65,6 +65,24 @@ class ReducedModel:
         every link, mimic followers' too)."""
         return self.native.link_bodies
 
+    # the core's methods a reduced model does not offer, refused by name through __getattr__ below:
+    # the closed-loop ones move the full model's coordinates (kinedyn.closed_loops refuses a robot with
+    # loops and reduced mimic joints first, docs/closed-loops.md); link origins come with the joint
+    # records (native/compile.py), not after
+    refused = frozenset(
+        (
+            "with_link_origins",
+            "with_loops",
+            "loop_residual",
+            "loop_jacobian",
+            "loop_gamma",
+            "constrained_forward_dynamics",
+            "constrained_inverse_dynamics",
+            "project_configuration",
+            "project_velocity",
+        )
+    )
+
     def __getattr__(self, name: str):
         # a method of the native model this wrapper does not map (added to the core after it): an
         # error naming it, never the full model's answer in the wrong coordinates

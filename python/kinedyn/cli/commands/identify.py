@@ -82,7 +82,7 @@ def add_arguments(p) -> None:
         "--reference",
         metavar="CSV",
         action=InputPath,
-        help="the trajectory the controller tracked (t, q1..qn[, qd1.., qdd1..], as --excite writes it), on the log's clock",
+        help="the trajectory the controller tracked (t, q1..qn[, qd1.., qdd1..], as --excite saves it), on the log's clock",
     )
     p.add_argument(
         "--control-period", type=positive_float, default=1e-3, help="the controller's period, s (default 0.001)"
