@@ -4,9 +4,8 @@
 
 use std::sync::Mutex;
 
-use kinedyn_core::ik::{self, ChainIk as CoreAnalytic, Settings};
-
 use crate::ik_branches::{all_branches, references_of, stated};
+use kinedyn_core::ik::{self, ChainIk as CoreAnalytic, Settings};
 use kinedyn_core::spatial::{Mat3, Transform, Vec3};
 use kinedyn_core::{Data, Model};
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -17,10 +16,9 @@ use rayon::prelude::*;
 use crate::guard::{self, guarded};
 use crate::PyModel;
 
-/// Batches of at least this many targets run interruptibly (`guard::detached`): Ctrl-C stops
-/// them between targets. A numeric target takes microseconds (converging) to milliseconds
-/// (unreachable, every restart tried), an analytic one microseconds; a few hundred outweigh the
-/// helper thread's tens of microseconds.
+/// Batches of at least this many targets run interruptibly (`guard::detached`): Ctrl-C stops them
+/// between targets. A numeric target takes microseconds (converging) to milliseconds (unreachable,
+/// every restart tried), an analytic one microseconds; a few hundred outweigh the helper thread.
 const INTERRUPTIBLE_TARGETS: usize = 256;
 
 /// One target: a pose (4x4) or a position (3,), checked.
