@@ -157,8 +157,9 @@ fn fourier_recovers_a_first_degree_trigonometric_polynomial() {
 
 #[test]
 fn random_chains_find_the_known_solution_and_only_solutions() {
+    // 12 chains x 5 targets (unoptimised in `cargo test`: a minute for 30 chains in .ci/run)
     let mut hits = 0;
-    for seed in 0..30 {
+    for seed in 0..12 {
         let (axes, home) = random_chain(1000 + seed);
         let solver = General6R::new(axes, home).expect("a generic chain has a formulation");
         let mut rng = Rng::new(seed);
@@ -183,12 +184,13 @@ fn random_chains_find_the_known_solution_and_only_solutions() {
             hits += out.len();
         }
     }
-    assert!(hits > 150);
+    assert!(hits > 60);
 }
 
 #[test]
 fn solution_count_matches_a_dense_numeric_search() {
-    for seed in 0..4 {
+    // 2 chains x 2 targets x 600 starts: the dense search is the slowest test of the crate
+    for seed in 0..2 {
         let (axes, home) = random_chain(2000 + seed);
         let solver = General6R::new(axes, home).expect("generic chain");
         let mut rng = Rng::new(seed + 7);
