@@ -46,6 +46,14 @@ def run_fixed_step(
             jac,
             (coulomb[0], coulomb[1]) if coulomb is not None and np.any(coulomb) else None,
         )
+    return run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar,
+                    implicit, limits, deadline)  # fmt: skip
+
+
+def run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar, implicit,
+             limits, deadline, project=None):  # fmt: skip
+    """:func:`fixed_step_trajectory` for each state of a batch (``batch`` None: one run), the runs
+    stacked (``stack_runs``); ``torque_for(i)`` gives run i's torque law."""
     results = []
     for i in range(batch or 1):
         qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
@@ -66,7 +74,8 @@ def run_fixed_step(
                 implicit,
                 limits,
                 deadline,
-            )
+                project,
+            )  # fmt: skip
         )
     return stack_runs(results, batch)
 

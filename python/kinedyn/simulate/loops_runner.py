@@ -20,8 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import StopRun
-from .fixed_step import fixed_step_trajectory
-from .runs import stack_runs
+from .fixed_step import run_each
 
 __all__ = ["LOOP_METHODS", "run_closed_loops", "closed_start", "loop_forces"]
 
@@ -84,30 +83,8 @@ def run_closed_loops(
         except ValueError as e:  # the step left the manifold's reach (a singular configuration)
             raise StopRun(dict(step=k, t=t, joint=None, kind="singular", value=None, message=str(e))) from None
 
-    results = []
-    for i in range(batch or 1):
-        qi, qdi = (q0[i], qd0[i]) if batch is not None else (q0, qd0)
-        results.append(
-            fixed_step_trajectory(
-                accel,
-                torque_for(i),
-                method,
-                t0,
-                dt,
-                steps,
-                qi,
-                qdi,
-                every,
-                max_speed,
-                hold,
-                bar,
-                None,
-                limits,
-                deadline,
-                project,
-            )  # fmt: skip
-        )
-    return stack_runs(results, batch)
+    return run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar, None,
+                    limits, deadline, project)  # fmt: skip
 
 
 def loop_forces(robot, fext_fn, t, Q, QD, TAU):
