@@ -18,6 +18,7 @@ pub mod scalar;
 pub mod sim;
 pub mod spatial;
 pub mod testing;
+pub mod trace;
 
 pub use data::Data;
 pub use error::{Error, Result};
