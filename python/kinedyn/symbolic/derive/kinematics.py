@@ -16,6 +16,7 @@ the base origin, angular velocity, base axes).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
@@ -88,8 +89,16 @@ def _book(model: RingModel, e, factor: bool = True):
     prod = ring.to_product_form(ring.chop(e))
     if len(sp.Add.make_args(sp.expand(prod))) > 8:  # trigsimp grows fast: long entries stay in Fourier form
         return f
-    g = sp.factor_terms(sp.trigsimp(sp.factor_terms(prod)))
+    g = _trigsimp_factored(prod)
     return _unminus(g if sp.count_ops(g) < sp.count_ops(f) else f)
+
+
+@functools.lru_cache(maxsize=4096)
+def _trigsimp_factored(prod: sp.Expr) -> sp.Expr:
+    """trigsimp between factor_terms, remembered: the pose, the Jacobians in each reference and the
+    frames along the chain share many entries (a third to a half of the PUMA's), and trigsimp is
+    nearly all of a derivation's time."""
+    return sp.factor_terms(sp.trigsimp(sp.factor_terms(prod)))
 
 
 def _unminus(e):
