@@ -38,13 +38,14 @@ pub fn ltdl<T: Real>(model: &Model, data: &mut Data<T>) -> Result<()> {
     h.copy_from_slice(&data.m[..n * n]);
     // the largest diagonal entry, lane by lane (one lane per state of a batch)
     let mut scale = [0.0f64; 16];
-    for (l, s) in scale[..T::LANES].iter_mut().enumerate() {
+    for (l, s) in scale[..T::LANES].iter_mut().enumerate().filter(|_| !T::RECORDING) {
         *s = (0..n).map(|i| data.m[i * n + i].lane(l)).fold(0.0, f64::max);
     }
     for k in (0..n).rev() {
         let (hkk, mkk) = (h[k * n + k], data.m[k * n + k]);
-        // D_k must be a positive part of M_kk, and M_kk a positive part of the scale of M
-        for l in 0..T::LANES {
+        // D_k must be a positive part of M_kk, and M_kk a positive part of the scale of M (a
+        // recording has no values to test: the program's caller tests them, trace::record)
+        for l in (0..T::LANES).filter(|_| !T::RECORDING) {
             let (hkk, mkk, scale) = (hkk.lane(l), mkk.lane(l), scale[l]);
             if !(hkk > EPS_D * mkk && mkk > EPS_M * scale) || !hkk.is_finite() || !scale.is_finite() {
                 let diagonal: Vec<f64> = (0..n).map(|i| data.m[i * n + i].lane(l)).collect();

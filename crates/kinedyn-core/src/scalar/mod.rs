@@ -41,6 +41,10 @@ pub trait Real:
 {
     /// States per value (1 for `f64`).
     const LANES: usize;
+    /// Whether values are recorded rather than computed ([`crate::trace::Traced`]): a recording
+    /// cannot branch on a value, so the algorithms skip their tests of values (the pivots of the
+    /// mass matrix) and leave them to whoever runs the recorded program (`trace::record`).
+    const RECORDING: bool = false;
     /// The same number in every lane.
     fn splat(x: f64) -> Self;
     /// `(sin x, cos x)` per lane ([`trig::sin_cos`]'s numbers).

@@ -19,5 +19,5 @@ mod record;
 mod traced;
 
 pub use program::{Op, Program};
-pub use record::record_rnea;
+pub use record::{record_algorithm, record_rnea, Algorithm};
 pub use traced::{record, Traced};

@@ -216,6 +216,7 @@ impl num_traits::One for Traced {
 
 impl crate::Real for Traced {
     const LANES: usize = 1;
+    const RECORDING: bool = true;
     fn splat(x: f64) -> Self {
         Traced::Const(x)
     }
