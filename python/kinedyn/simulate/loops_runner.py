@@ -19,20 +19,40 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..closed_loops import RANK_TOLERANCE
 from .errors import StopRun
 from .fixed_step import run_each
+from .lie_steps import GroupStep
 
-__all__ = ["LOOP_METHODS", "run_closed_loops", "closed_start", "loop_forces"]
+__all__ = ["LOOP_METHODS", "run_closed_loops", "closed_start", "loop_forces", "project"]
 
 # the schemes that take a projection after each step (the implicit scheme linearises the tree's dynamics)
 LOOP_METHODS = ("rk4", "semi_implicit", "euler")
+
+# The projection's tolerance on |residual| (m). Tighter than project_configuration's default 1e-12:
+# a loop whose rows are redundant only where it is exactly closed (the push-rod leg's planar loop on
+# a tumbling trunk: turning the trunk moves the two ends apart by omega x (p_a - p_b)) has a Jacobian
+# whose smallest singular value is the residual itself, and a demand b along it of the residual
+# times the velocities; at 1e-12 that demand (2e-13) is above what the constrained dynamics accept
+# (1e-12 of |b|), and they refuse the state as conflicting. Gauss-Newton converges quadratically,
+# so 1e-14 costs at most one more iteration; where rounding keeps a large mechanism above it, the
+# default tolerance is taken instead.
+TOLERANCE, FALLBACK = 1e-14, 1e-12
+
+
+def project(robot, q, qd):
+    """``(q, qd)`` projected onto the loops (``TOLERANCE``, else ``FALLBACK``) and their velocities."""
+    try:
+        q = np.asarray(robot.project_configuration(q, tolerance=TOLERANCE), dtype=float)
+    except ValueError:
+        q = np.asarray(robot.project_configuration(q, tolerance=FALLBACK), dtype=float)
+    return q, np.asarray(robot.project_velocity(q, qd), dtype=float)
 
 
 def closed_start(robot, q0, qd0):
     """``(q, qd)`` on the loops' manifold nearest the start, and how far each moved (max abs). A
     ValueError (the core's, naming the loop) when no closed configuration is near ``q0``."""
-    q = np.asarray(robot.project_configuration(q0), dtype=float)
-    qd = np.asarray(robot.project_velocity(q, qd0), dtype=float)
+    q, qd = project(robot, q0, qd0)
     return q, qd, float(np.max(np.abs(q - q0), initial=0.0)), float(np.max(np.abs(qd - qd0), initial=0.0))
 
 
@@ -69,22 +89,62 @@ def run_closed_loops(
     """The fixed-step run of :mod:`.fixed_step`, the acceleration the constrained one and a
     projection after each step (the module docstring)."""
 
+    closed = {"q": q0}  # the last state projected onto the loops (the current step's start)
+
     def accel(t, q, qd, tau):
         f = None if fext_fn is None else fext_fn(t, q, qd)
         try:
             return robot.constrained_forward_dynamics(q, qd, tau, f)[0]
         except ValueError as e:  # a singular configuration of the mechanism: the loops cannot all hold
-            raise StopRun(dict(step=None, t=t, joint=None, kind="singular", value=None, message=str(e))) from None
+            error = e
+        if not np.array_equal(q, closed["q"]):  # a stage off the manifold: the rows independent at the step's start
+            qdd = stage_dynamics(robot, closed["q"], q, qd, tau, f)
+            if qdd is not None:
+                return qdd
+        raise StopRun(dict(step=None, t=t, joint=None, kind="singular", value=None, message=str(error)))
 
-    def project(k, t, q, qd):
+    def onto_loops(k, t, q, qd):
         try:
-            q = np.asarray(robot.project_configuration(q), dtype=float)
-            return q, np.asarray(robot.project_velocity(q, qd), dtype=float)
+            q, qd = project(robot, q, qd)
+            closed["q"] = q
+            return q, qd
         except ValueError as e:  # the step left the manifold's reach (a singular configuration)
             raise StopRun(dict(step=k, t=t, joint=None, kind="singular", value=None, message=str(e))) from None
 
-    return run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar, None,
-                    limits, deadline, project)  # fmt: skip
+    # ball, planar and floating joints: each stage moves q on its group (Lie-Euler, Munthe-Kaas RK4; :mod:`.lie_steps`)
+    group = GroupStep(robot) if robot.has_multi_dof_joints else None
+
+    def run_one(i):  # each state of a batch starts its own record of the last closed state
+        closed["q"] = q0[i] if batch is not None else q0
+        return torque_for(i)
+
+    return run_each(accel, run_one, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar, None,
+                    limits, deadline, onto_loops, group)  # fmt: skip
+
+
+def stage_dynamics(robot, start, q, qd, tau, f_ext):
+    """``qdd`` at a stage ``(q, qd)`` of a step from the closed configuration ``start``, holding only
+    the loop rows independent at ``start`` (None when ``start`` has no redundant row).
+
+    Rows redundant on the manifold may not be redundant off it: the push-rod leg's planar loop on a
+    turning trunk. Its third row is zero only where the two ends meet; a stage state sits off the
+    manifold by the scheme's truncation error, where that row has a singular value of the residual's
+    size and a demand of the residual times the velocities, which the core's solve (exact on every row)
+    refuses as conflicting. The rows kept are the left singular vectors ``U_r`` of ``J(start)`` above
+    ``RANK_TOLERANCE`` (the rank ``reduced_dynamics`` counts): ``U_r^T (J qdd + gamma) = 0`` with
+    ``M qdd + h = tau + J^T U_r lam_r`` (the KKT system, reduced to ``(U_r^T J M^-1 J^T U_r) lam_r =
+    -U_r^T (J qdd_free + gamma)``; the removed rows' error is the stage's own, which the step's
+    projection clears)."""
+    jac = robot.loop_jacobian(start)
+    u, sigma, _ = np.linalg.svd(jac)
+    kept = u[:, : int(np.sum(sigma > RANK_TOLERANCE * max(1.0, float(np.abs(jac).max()))))]
+    if kept.shape[1] == jac.shape[0]:
+        return None
+    rows = kept.T @ robot.loop_jacobian(q)
+    free = robot.forward_dynamics(q, qd, tau, f_ext)
+    y = np.linalg.solve(robot.mass_matrix(q), rows.T)
+    lam = np.linalg.solve(rows @ y, -(rows @ free + kept.T @ robot.loop_gamma(q, qd)))
+    return free + y @ lam
 
 
 def loop_forces(robot, fext_fn, t, Q, QD, TAU):
