@@ -251,17 +251,24 @@ def test_forward_kinematics_of_the_parallel_mechanism_from_its_actuated_joint():
         robot.project_configuration(np.array([3.0, 0.0, 0.0]), hold=["a1", "a2"])
 
 
-def test_reduced_mimic_joints_are_refused_by_name():
+def test_reduced_mimic_joints_compose_with_the_loops():
+    """The coupler a2 following the crank a1 (a2 = a1): the loop's Jacobian in the reduced coordinates
+    is the full one times the mimic map (tests/test_loops_mimic.py has the dynamics), and with the crank
+    held the rocker alone cannot close the loop: refused by name."""
     urdf = four_bar().replace(
         '<axis xyz="0 1 0"/><limit lower="-10" upper="10" effort="10" velocity="10"/></joint><joint name="b1"',
         '<axis xyz="0 1 0"/><limit lower="-10" upper="10" effort="10" velocity="10"/><mimic joint="a1"/></joint>'
         '<joint name="b1"',
     )
     robot = kd.Robot.from_urdf(urdf).add_loop("tip_a", "tip_b")
-    assert robot.mimic_joints
-    with pytest.raises(ValueError, match="does not handle mimic joints.*'a2'"):
-        robot.constrained_forward_dynamics(np.zeros(robot.nq), np.zeros(robot.n), np.zeros(robot.n))
+    assert robot.mimic_joints and robot.n == 2
     independent = kd.Robot.from_urdf(urdf, mimic="independent").add_loop("tip_a", "tip_b")
+    q = np.array([0.3, 0.4])
+    full = independent.loop_jacobian(np.array([0.3, 0.3, 0.4]))
+    assert np.allclose(robot.loop_jacobian(q), np.c_[full[:, 0] + full[:, 1], full[:, 2]], atol=1e-14)
+    assert np.allclose(robot.loop_residual(q), independent.loop_residual(np.array([0.3, 0.3, 0.4])), atol=1e-15)
+    with pytest.raises(ValueError, match="loops do not close.*held joints"):
+        robot.project_configuration(q, hold=["a1"])
     q = independent.project_configuration(np.array([0.3, -0.2, 0.4]), hold=["a1"])
     assert np.abs(independent.loop_residual(q)).max() < 1e-12
 

@@ -33,13 +33,6 @@ __all__ = [
 ]
 
 
-def _native(description, model, feature: str):
-    """The native model, refusing robots whose loops the core cannot hold (reduced mimic joints: the
-    core's model then has fewer columns than the loops' frames move)."""
-    description.require_no_mimic_joints(feature)
-    return model
-
-
 def velocity_columns(description, joints, what: str) -> list:
     """The velocity columns (indices into qd) of the named joints: all of a multi-DOF joint's."""
     names = description.joint_names
@@ -57,24 +50,23 @@ def velocity_columns(description, joints, what: str) -> list:
 
 def loop_residual(description, model, q):
     """(m,) or (N, m): the closure residual."""
-    return _native(description, model, "loop_residual").loop_residual(q)
+    return model.loop_residual(q)
 
 
 def loop_jacobian(description, model, q):
     """(m, nv) or (N, m, nv): the loops' Jacobian."""
-    return _native(description, model, "loop_jacobian").loop_jacobian(q)
+    return model.loop_jacobian(q)
 
 
 def loop_gamma(description, model, q, qd):
     """(m,) or (N, m): ``gamma = dJ/dt qd``."""
-    return _native(description, model, "loop_gamma").loop_gamma(q, qd)
+    return model.loop_gamma(q, qd)
 
 
 def constrained_forward_dynamics(description, model, q, qd, tau, f_ext=None):
     """``(qdd, lambda)``, each with the batch's leading axis when ``q`` has one (a control loop's
-    call: the checks are the core's, the wrenches' layout too; only the mimic refusal is here)."""
-    if description.mimic_map is not None:
-        _native(description, model, "constrained_forward_dynamics")
+    call: the checks are the core's, the wrenches' layout too). A robot with reduced mimic joints has a
+    ReducedModel, which composes the full model's loops with its map (kinedyn.native.mimic_loops)."""
     out = model.constrained_forward_dynamics(q, qd, tau, f_ext)
     n = model.n
     return out[..., :n], out[..., n:]
@@ -82,27 +74,25 @@ def constrained_forward_dynamics(description, model, q, qd, tau, f_ext=None):
 
 def constrained_inverse_dynamics(description, model, q, qd, qdd, actuated, f_ext=None):
     """(nv,) or (N, nv) torques, zero off the actuated joints' columns."""
-    native = _native(description, model, "constrained_inverse_dynamics")
     if isinstance(actuated, str):
         actuated = [actuated]
     columns = velocity_columns(description, actuated, "constrained_inverse_dynamics, actuated")
-    return native.constrained_inverse_dynamics(q, qd, qdd, columns, f_ext)
+    return model.constrained_inverse_dynamics(q, qd, qdd, columns, f_ext)
 
 
 def project_configuration(description, model, q, hold=None, tolerance=1e-12, max_iter=50):
     """(nq,) or (N, nq): a configuration near ``q`` that closes the loops, the ``hold`` joints fixed."""
-    native = _native(description, model, "project_configuration")
     if isinstance(hold, str):
         hold = [hold]
     columns = velocity_columns(description, hold or (), "project_configuration, hold")
     if not tolerance > 0:
         raise ValueError(f"project_configuration: tolerance must be positive, got {tolerance}")
-    return native.project_configuration(q, columns, float(tolerance), int(max_iter))
+    return model.project_configuration(q, columns, float(tolerance), int(max_iter))
 
 
 def project_velocity(description, model, q, qd):
     """(nv,) or (N, nv): the velocity nearest ``qd`` with ``J qd = 0``."""
-    return _native(description, model, "project_velocity").project_velocity(q, qd)
+    return model.project_velocity(q, qd)
 
 
 RANK_TOLERANCE = 1e-9  # singular values of J below this (relative to its largest entry) count as zero
@@ -121,7 +111,7 @@ def reduced_dynamics(description, model, q, qd_independent, independent=None):
     (Golub & Van Loan §5.4.2: the first ``rank J`` pivots are dependent). Returns a dict: ``G``
     (nv, k), ``M`` (k, k), ``bias`` (k,) (the velocity terms ``G^T (M a0 + C qd + friction)``),
     ``g`` (k,), ``a0`` (nv,), ``qd`` (nv,) and ``independent`` (the velocity columns)."""
-    native = _native(description, model, "reduced_dynamics")
+    native = model
     q = float64_array(q)
     n = native.n
     jac = native.loop_jacobian(q)

@@ -6,9 +6,11 @@ At a closed configuration ``q`` with independent velocities ``qd_i`` (coordinate
 ``robot.reduced_dynamics``: ``qd = G qd_i``), the reduced equations are
 ``M_r qdd_i + C_r qd_i + g_r = G^T tau`` with ``M_r = G^T M G`` and ``C_r = G^T (M dG/dt + C G)``
 (Spong §9.4.4 for the five-bar; Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, §13.4).
-Each derivative along the motion is a central difference along the closed curve whose independent
-coordinates move as ``q_i + t qd_i`` (``robot.project_configuration`` holding the independent joints
-at ``q ⊕ t qd``): ``dM_r/dt`` and ``dG/dt``. Measured:
+Each derivative along the motion is a central difference along the closed curve ``P(q ⊕ t qd)``
+(``P``: ``robot.project_configuration``, least-norm Gauss-Newton, whose derivative on the manifold
+is the projector onto its tangent space, so the curve's velocity at ``q`` is ``qd``), with ``G`` there
+for the same split of the velocity columns (:func:`partition_map`): ``dM_r/dt`` and ``dG/dt``.
+Measured:
 
 - ``M_r`` symmetric positive definite;
 - ``dM_r/dt - 2 C_r`` skew-symmetric and ``dM_r/dt == C_r + C_r^T`` (Spong Prop. 9.1 carried to the
@@ -20,8 +22,8 @@ at ``q ⊕ t qd``): ``dM_r/dt`` and ``dG/dt``. Measured:
   no work: ``J qd = 0``), ``dH/dt = qd^T M qdd + qd^T dM/dt qd / 2 + g . qd`` (Spong eq. 9.113 in its
   differential form).
 
-Only robots whose coordinates are all 1-DOF joints (no ball, planar or floating joint): there the
-independent coordinates are whole joints that ``project_configuration`` can hold.
+Ball, planar and floating joints included: the independent velocity columns need not be whole
+joints, since the curve is not held at them.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from ..property_checks import Check, PropertiesReport
 if TYPE_CHECKING:
     from ..robot import Robot
 
-__all__ = ["check_closed_chain_properties"]
+__all__ = ["check_closed_chain_properties", "partition_map"]
 
 
 def _refuse(robot, why: str) -> ValueError:
@@ -64,15 +66,8 @@ def closed_states(robot: Robot, samples: int, rng: np.random.Generator) -> np.nd
 
 def check_closed_chain_properties(robot: Robot, samples: int = 200, seed: int = 0, h: float = 1e-6) -> PropertiesReport:
     """The checks of the module docstring on ``samples`` closed states drawn from ``seed``."""
-    if robot.nq != robot.n or len(robot.joint_names) != robot.n:
-        raise _refuse(
-            robot,
-            "the numeric checks of a closed chain need every coordinate to be a 1-DOF joint (its independent "
-            "coordinates whole joints to hold); this robot has ball, planar or floating joints",
-        )
     rng = np.random.default_rng(seed)
     pool: list = []
-    names = list(robot.joint_names)
     worst = dict(sym=0.0, skew=0.0, cct=0.0, bias=0.0, energy=0.0)
     least_eigenvalue, dof = np.inf, None
     done = skipped = 0
@@ -81,7 +76,7 @@ def check_closed_chain_properties(robot: Robot, samples: int = 200, seed: int = 
             pool = list(closed_states(robot, samples - done, rng))
         q = pool.pop()
         try:
-            measured = _measure(robot, q, names, rng, h)
+            measured = _measure(robot, q, rng, h)
         except ValueError:  # the rank of J changes within h: a singular configuration of the mechanism
             skipped += 1
             if skipped > 20 * samples:
@@ -96,7 +91,7 @@ def check_closed_chain_properties(robot: Robot, samples: int = 200, seed: int = 
             worst[key] = max(worst[key], value)
     tol_fd = 1e-6
     skipped_note = f"; {skipped} singular closed states (J's rank changing within h) drawn again" if skipped else ""
-    along = f"central differences (step {10 * h:g}) along closed motions, the {dof} independent joints at constant rate"
+    along = f"central differences (step {10 * h:g}) along closed motions, {dof} independent velocity columns"
     checks = [
         Check(
             "M_r symmetric positive definite",
@@ -145,28 +140,44 @@ def check_closed_chain_properties(robot: Robot, samples: int = 200, seed: int = 
     return PropertiesReport(robot.name, samples, checks)
 
 
-def _measure(robot, q, names, rng, h) -> dict:
+def partition_map(jac, independent) -> np.ndarray:
+    """``G`` with ``qd = G qd_i`` for the velocity columns ``independent`` (``robot.reduced_dynamics``'
+    map, here for a given split at any configuration): ``[1; -J_d^+ J_i]``. A ValueError where the
+    dependent columns lose rank (a singular configuration within the step)."""
+    n = jac.shape[1]
+    dependent = [k for k in range(n) if k not in independent]
+    tol = RANK_TOLERANCE * max(1.0, float(np.abs(jac).max()))
+    if np.linalg.matrix_rank(jac[:, dependent], tol=tol) < np.linalg.matrix_rank(jac, tol=tol):
+        raise ValueError("the dependent columns of the loop Jacobian lose rank here")
+    G = np.zeros((n, len(independent)))
+    G[independent, np.arange(len(independent))] = 1.0
+    G[dependent] = -np.linalg.pinv(jac[:, dependent]) @ jac[:, independent]
+    return G
+
+
+def _measure(robot, q, rng, h) -> dict:
     """Each check's residual at one closed state (the module docstring)."""
     jac = robot.loop_jacobian(q)
     rank = int(
         np.linalg.matrix_rank(jac, tol=RANK_TOLERANCE * max(1.0, float(np.abs(jac).max())))
     )  # as reduced_dynamics counts
-    probe = robot.reduced_dynamics(q, np.zeros(robot.n - rank))
-    independent = [names[k] for k in probe["independent"]]
-    if not independent:
+    dof = robot.n - rank
+    if not dof:
         return dict(dof=0)
-    dof = len(independent)
     qd_i = rng.uniform(-2.0, 2.0, dof)
-    here = robot.reduced_dynamics(q, qd_i, independent=independent)
-    qd, G, M_r = here["qd"], here["G"], here["M"]
-    # the closed curve through q with velocity qd, its independent joints moving at qd_i
-    # (closed to 1e-14, a step of 10 h: the projection's error over 20 h stays near 1e-9 of the derivative)
-    ahead = robot.project_configuration(robot.integrate(q, qd, 10 * h), hold=independent, tolerance=1e-14)
-    behind = robot.project_configuration(robot.integrate(q, qd, -10 * h), hold=independent, tolerance=1e-14)
-    at_ahead = robot.reduced_dynamics(ahead, qd_i, independent=independent)
-    at_behind = robot.reduced_dynamics(behind, qd_i, independent=independent)
-    M_r_dot = (at_ahead["M"] - at_behind["M"]) / (20 * h)
-    G_dot = (at_ahead["G"] - at_behind["G"]) / (20 * h)
+    here = robot.reduced_dynamics(q, qd_i)  # the independent velocity columns chosen by pivoted QR of J
+    qd, G, M_r, independent = here["qd"], here["G"], here["M"], list(here["independent"])
+    # the closed curve through q with velocity qd: q ⊕ t qd projected onto the loops (least-norm
+    # Gauss-Newton, whose derivative on the manifold is the projector onto its tangent space, so the
+    # curve's velocity at q is qd), closed to 1e-14, a step of 10 h (the projection's error over 20 h
+    # stays near 1e-9 of the derivative); G along it for the same split of the velocity columns
+    ahead = robot.project_configuration(robot.integrate(q, qd, 10 * h), tolerance=1e-14)
+    behind = robot.project_configuration(robot.integrate(q, qd, -10 * h), tolerance=1e-14)
+    G_ahead, G_behind = (partition_map(robot.loop_jacobian(x), independent) for x in (ahead, behind))
+    M_r_dot = (G_ahead.T @ robot.mass_matrix(ahead) @ G_ahead - G_behind.T @ robot.mass_matrix(behind) @ G_behind) / (
+        20 * h
+    )
+    G_dot = (G_ahead - G_behind) / (20 * h)
     M = robot.mass_matrix(q)
     C_r = G.T @ (M @ G_dot + robot.coriolis_matrix(q, qd) @ G)
     scale = max(1.0, float(np.abs(M_r_dot).max()))

@@ -86,15 +86,17 @@ def compile_model(description: Description):
     ]
     frames = [(int(f.body), to_float_array(f.placement, (4, 4), f"frame '{f.name}'")) for f in tree.frames]
     native = Model(joints, to_float_array(description.gravity, (3,), "gravity"), frames)
+    if description.loops:
+        # the core checks and names them (crates/kinedyn-core/src/constraints/mod.rs); with reduced
+        # mimic joints they stay on the full model and ReducedModel composes them with G
+        index = {f.name: k for k, f in enumerate(tree.frames)}
+        native = native.with_loops(
+            [(index[lp.frame_a], index[lp.frame_b], lp.kind, lp.name) for lp in description.loops]
+        )
     if description.mimic_map is None:
-        if description.loops:
-            # the core checks and names them (crates/kinedyn-core/src/constraints/mod.rs)
-            index = {f.name: k for k, f in enumerate(tree.frames)}
-            native = native.with_loops(
-                [(index[lp.frame_a], index[lp.frame_b], lp.kind, lp.name) for lp in description.loops]
-            )
         return native
-    return ReducedModel(native, description.mimic_map, description.name)
+    loops = tuple((lp.name, lp.rows) for lp in description.loops)
+    return ReducedModel(native, description.mimic_map, description.name, loops)
 
 
 def dof_links(description: Description) -> np.ndarray:

@@ -33,14 +33,17 @@ import numpy as np
 from .._arrays import finite_result, real_array
 from .._core import NonFiniteResultError
 from ..description.mimic import MimicMap
+from .mimic_loops import ReducedLoops
 
 __all__ = ["ReducedModel"]
 
 
-class ReducedModel:
-    """``_core.Model`` in reduced coordinates (see the module). ``native``: the full model."""
+class ReducedModel(ReducedLoops):
+    """``_core.Model`` in reduced coordinates (see the module). ``native``: the full model, with its
+    loops; ``loops``: their (name, rows), for the errors that name one."""
 
-    def __init__(self, native, coordinates: MimicMap, robot: str = "robot"):
+    def __init__(self, native, coordinates: MimicMap, robot: str = "robot", loops: tuple = ()):
+        self.loops = tuple(loops)
         self.native = native
         self.map = coordinates
         self.robot = robot
@@ -66,22 +69,9 @@ class ReducedModel:
         return self.native.link_bodies
 
     # the core's methods a reduced model does not offer, refused by name through __getattr__ below:
-    # the closed-loop ones move the full model's coordinates (kinedyn.closed_loops refuses a robot with
-    # loops and reduced mimic joints first, docs/closed-loops.md); link origins come with the joint
-    # records (native/compile.py), not after
-    refused = frozenset(
-        (
-            "with_link_origins",
-            "with_loops",
-            "loop_residual",
-            "loop_jacobian",
-            "loop_gamma",
-            "constrained_forward_dynamics",
-            "constrained_inverse_dynamics",
-            "project_configuration",
-            "project_velocity",
-        )
-    )
+    # loops and link origins come with the full model (native/compile.py), not after; the loops'
+    # numbers are composed with G (:mod:`.mimic_loops`)
+    refused = frozenset(("with_link_origins", "with_loops"))
 
     def __getattr__(self, name: str):
         # a method of the native model this wrapper does not map (added to the core after it): an

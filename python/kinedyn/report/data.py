@@ -20,6 +20,7 @@ from .. import robots
 from .._ui.files import readable_source
 from .._ui.progress import Steps
 from ..analysis.properties import mass_matrix_rate
+from ..closed_loops import RANK_TOLERANCE
 from ..configuration import check_configuration, default_configuration
 from ..coordinates import (  # noqa: F401 (the report's names for them)
     Q_ENTRIES,
@@ -43,6 +44,8 @@ __all__ = [
     "joint_rows",
     "property_checks",
     "simulate_free_motion",
+    "closest_singular_passage",
+    "NEAR_SINGULAR",
     "symbolic_equations",
     "SIMULATION_BUDGET",
     "Q_ENTRIES",
@@ -101,6 +104,25 @@ def simulate_free_motion(
         "note": note,
         "wall_time": float(info.get("wall_time", 0.0)),
     }
+
+
+# s_r / s_1 below which the report calls a configuration near a singular one of the loops (wording only)
+NEAR_SINGULAR = 1e-2
+
+
+def closest_singular_passage(robot, t, q) -> dict | None:
+    """Where the sampled motion ``q`` (S, nq) of a robot with loops comes nearest a singular
+    configuration of its loops: the sample whose loop Jacobian has the smallest ratio
+    ``s_r / s_1`` of its r-th to its largest singular value, r the largest rank over the samples
+    (counted as ``reduced_dynamics`` counts it). None when the loops leave no rank to lose."""
+    s = np.linalg.svd(robot.loop_jacobian(np.asarray(q, dtype=float)), compute_uv=False)
+    largest = s[:, :1]
+    rank = int(np.max(np.sum(s > RANK_TOLERANCE * np.maximum(largest, 1.0), axis=1), initial=0))
+    if rank == 0:
+        return None
+    ratio = s[:, rank - 1] / largest[:, 0]
+    k = int(np.argmin(ratio))
+    return {"t": float(t[k]), "ratio": float(ratio[k]), "rank": rank}
 
 
 def property_checks(robot, q, qd, rng) -> list[dict]:
@@ -355,12 +377,26 @@ def _collect(robot, q, qd, name, t_end, eom_joints, seed, time_budget, progress,
     H = sim["H"]
     simulation["energy_drift"] = float(np.max(np.abs(H - H[0])))
     friction = any(float(j.viscous) or float(j.coulomb) for j in robot.joints)
+    # a robot with loops: how near its motion came to a singular configuration of the loops, where a
+    # fixed step is least accurate (docs/closed-loops.md, "Motion"); the energy check names it
+    passage = closest_singular_passage(robot, sim["t"], sim["q"]) if getattr(robot, "loops", ()) else None
+    simulation["singular_passage"] = passage
     # energy is a property check only where the integrator conserves it (RK4; implicit Euler damps)
     if sim["integrator"] == "rk4" and not sim["note"]:
+        near = ""
+        if passage is not None:
+            r = passage["rank"]
+            near = (
+                f"; the loops stay regular (s_{r}/s_1 >= {passage['ratio']:.2g}, s_i the loop Jacobian's singular values)"
+                if passage["ratio"] >= NEAR_SINGULAR
+                else f"; the motion passes near a singular configuration of the loops, s_{r}/s_1 = {passage['ratio']:.2g} "
+                f"at t = {passage['t']:.3g} s (s_i the loop Jacobian's singular values, rank {r} elsewhere), where the "
+                "step is least accurate"
+            )
         properties.append(
             {
                 "property": "energy conserved (tau = 0, no friction)",
-                "measure": f"max |H(t) - H(0)| over the {t_end:g} s simulation",
+                "measure": f"max |H(t) - H(0)| over the {t_end:g} s simulation{near}",
                 "value": simulation["energy_drift"],
                 "ok": simulation["energy_drift"] <= 1e-6 * max(1.0, float(np.max(np.abs(H)))) or friction,
             }

@@ -164,7 +164,7 @@ def simulate(
         raise ValueError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
     robot = is_robot(system)
     # a floating, spherical or planar joint: q (nq) and qd (nv) differ, and only the core's
-    # fixed-step integrators step q on the manifold (q ⊕ h qd)
+    # fixed-step integrators and the closed loops' runner step q on the manifold (q ⊕ h qd)
     multi_dof = robot and cast("Robot", system).has_multi_dof_joints
     # closed loops: the constrained dynamics and a projection after each step (:mod:`.loops_runner`)
     loops = robot and bool(getattr(system, "loops", ()))
@@ -183,7 +183,7 @@ def simulate(
     jac = jac if callable(jac) else None
     choice = None
     if loops:
-        _check_loops(cast("Robot", system), method, multi_dof)
+        _check_loops(cast("Robot", system), method)
         q0, qd0, moved_q, moved_qd = closed_start(system, q0, qd0)
     if method == "auto" and loops:
         method, choice = "rk4", "auto: rk4 (closed loops: projected onto their manifold after each step)"
@@ -220,7 +220,7 @@ def simulate(
     # with reduced mimic joints runs on its reduced methods (the native integrators take the full
     # model). Wrenches about link frames (f_ext), one per link, are the core's (docs/architecture.md).
     native = robot and method in FIXED_METHODS and not getattr(system, "mimic_joints", None) and not loops
-    if multi_dof and not native:
+    if multi_dof and not native and not loops:
         why = f"the method '{method}'" if method not in FIXED_METHODS else "mimic joints"
         raise ValueError(
             f"simulation of robot '{name}' with multi-DOF joints (nq = {q0.shape[-1]}, nv = {n}) runs in the native fixed-step "
@@ -353,16 +353,11 @@ def simulate(
     return traj
 
 
-def _check_loops(robot, method, multi_dof):
+def _check_loops(robot, method):
     if method != "auto" and method not in LOOP_METHODS:
         raise ValueError(
             f"robot '{robot.name}' has closed loops: simulate it with a fixed-step method that projects onto them "
             f"after each step (auto, {', '.join(LOOP_METHODS)}), not '{method}'"
-        )
-    if multi_dof:
-        raise ValueError(
-            f"robot '{robot.name}' has closed loops and multi-DOF joints (nq = {robot.nq}, nv = {robot.n}): "
-            "the loops' integrator steps q + h qd, which needs one coordinate per velocity"
         )
 
 

@@ -51,7 +51,7 @@ def run_fixed_step(
 
 
 def run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, max_speed, hold, bar, implicit,
-             limits, deadline, project=None):  # fmt: skip
+             limits, deadline, project=None, group=None):  # fmt: skip
     """:func:`fixed_step_trajectory` for each state of a batch (``batch`` None: one run), the runs
     stacked (``stack_runs``); ``torque_for(i)`` gives run i's torque law."""
     results = []
@@ -75,6 +75,7 @@ def run_each(accel, torque_for, method, t0, dt, steps, q0, qd0, batch, every, ma
                 limits,
                 deadline,
                 project,
+                group,
             )  # fmt: skip
         )
     return stack_runs(results, batch)
@@ -97,15 +98,19 @@ def fixed_step_trajectory(
     limits=None,
     deadline=None,
     project=None,
+    group=None,
 ):
     """One trajectory with the schemes of the core's sim/, the dynamics called from Python.
     ``implicit``: (derivatives(t, q, qd, tau), jacobian(t, q, qd) or None, coulomb or None) for the
     implicit method; ``limits``: (lower, upper) or None; ``deadline``: a :class:`Deadline`;
     ``project``: None or ``(k, t, q, qd) -> (q, qd)`` after each step (closed loops: back onto their
-    manifold, :mod:`.loops_runner`)."""
-    n = q0.size
+    manifold, :mod:`.loops_runner`); ``group``: None (``q + h v``) or a :class:`.lie_steps.GroupStep`
+    for robots with ball, planar or floating joints (``q ⊕ h v`` per stage: Lie-Euler, and RK4 as
+    Runge-Kutta-Munthe-Kaas)."""
+    n = qd0.size  # the velocities; q has nq >= n coordinates where a joint is ball, planar or floating
     samples = -(-steps // record_every) + 1
-    Q, QD, QDD, TAU = (np.zeros((samples, n)) for _ in range(4))
+    Q = np.zeros((samples, q0.size))
+    QD, QDD, TAU = (np.zeros((samples, n)) for _ in range(3))
     q, qd = q0.copy(), qd0.copy()
     s = 0
     failure = None
@@ -141,10 +146,12 @@ def fixed_step_trajectory(
                     A_q, A_v = A_q + Minv @ K[0], A_v + Minv @ K[1]
                 q, qd = implicit_step(q, qd, a1, dt, A_q, A_v, Minv, coulomb)
             elif method == "euler":
-                q, qd = q + dt * qd, qd + dt * a1
+                q, qd = (q + dt * qd if group is None else group.advance(q, qd, dt)), qd + dt * a1
             elif method == "semi_implicit":
                 qd = qd + dt * a1
-                q = q + dt * qd
+                q = q + dt * qd if group is None else group.advance(q, qd, dt)
+            elif group is not None:
+                q, qd = _munthe_kaas_rk4(group, accel if hold else None, evaluate, tau, k, t, dt, q, qd, a1)
             else:
                 f = (
                     (lambda tt, x, v: (tau, accel(tt, x, v, tau))[1])
@@ -160,17 +167,18 @@ def fixed_step_trajectory(
                 q = q + dt / 6 * (qd + 2 * v2 + 2 * v3 + v4)
                 qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
             if limits is not None:
-                q, qd = clamp_to_limits(q, qd, *limits)
+                q, qd = clamp_to_limits(q, qd, *limits) if group is None else group.clamp(q, qd, *limits)
             if project is not None:
                 q, qd = project(k, t + dt, q, qd)
-            bad = np.flatnonzero(~(np.isfinite(q) & np.isfinite(qd)))
+            of_q, of_v = (None, None) if group is None else (group.joint_of_q, group.joint_of_v)
+            bad = np.concatenate([np.flatnonzero(~np.isfinite(q)), np.flatnonzero(~np.isfinite(qd))])
             if bad.size:
-                raise StopRun(dict(step=k, t=t, joint=int(bad[0]), kind="non_finite", value=None, message=""))
+                joint = int(bad[0] if of_q is None else np.concatenate([of_q, of_v])[bad[0]])
+                raise StopRun(dict(step=k, t=t, joint=joint, kind="non_finite", value=None, message=""))
             fast = np.flatnonzero(np.abs(qd) > max_speed)
             if fast.size:
-                raise StopRun(
-                    dict(step=k, t=t, joint=int(fast[0]), kind="diverged", value=float(qd[fast[0]]), message="")
-                )
+                joint = int(fast[0] if of_v is None else of_v[fast[0]])
+                raise StopRun(dict(step=k, t=t, joint=joint, kind="diverged", value=float(qd[fast[0]]), message=""))
     except StopRun as stop:
         failure = stop.failure
         if failure["step"] is None:  # raised where the step is not known (the dynamics): this step
@@ -184,6 +192,26 @@ def fixed_step_trajectory(
             raise
         failure = dict(step=k, t=t0 + k * dt, joint=None, kind="singular", value=None, message=str(e))
     return Q, QD, QDD, TAU, (k if failure or k < steps else steps), s, failure
+
+
+def _munthe_kaas_rk4(group, held, evaluate, tau, k, t, h, q, qd, a1):
+    """One RK4 step with the configuration on its group (:mod:`.lie_steps`): the stages at
+    ``q ⊕ Ω_i`` with ``Ω_2 = h/2 K_1``, ``Ω_3 = h/2 K_2``, ``Ω_4 = h K_3``, ``K_i = Jr(Ω_i)⁻¹ v_i``
+    the chart's rates (``K_1 = qd``), and ``q ⊕ h (K_1 + 2 K_2 + 2 K_3 + K_4) / 6`` (HLW IV.8.2,
+    Algorithm 8.4, the classical tableau). ``held``: the acceleration with the torque held over the
+    step, or None to evaluate the torque law at each stage."""
+
+    def f(tt, x, v):
+        return held(tt, x, v, tau) if held is not None else evaluate(k, tt, x, v)[1]
+
+    rates, accelerations = [qd], [a1]
+    for c in (0.5 * h, 0.5 * h, h):
+        omega = c * rates[-1]
+        v = qd + c * accelerations[-1]
+        accelerations.append(f(t + c, group.advance(q, rates[-1], c), v))
+        rates.append(group.chart_rate(q, omega, v))
+    mean = (rates[0] + 2 * rates[1] + 2 * rates[2] + rates[3]) / 6
+    return group.advance(q, mean, h), qd + h / 6 * (a1 + 2 * accelerations[1] + 2 * accelerations[2] + accelerations[3])
 
 
 def coulomb_torque(coulomb, v):
