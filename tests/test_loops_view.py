@@ -39,7 +39,7 @@ def page_of(name: str, tmp_path_factory):
     robot = kd.load(str(ROOT / "examples" / "robots" / name))
     q = default_configuration(robot)
     model = view_model(robot, q)
-    path = tmp_path_factory.mktemp("loops") / name.replace(".yaml", ".html")
+    path = tmp_path_factory.mktemp("loops") / (Path(name).stem + ".html")
     path.write_text(
         "<!DOCTYPE html><html><body><div id='kinedyn-view'></div><div id='kinedyn-sliders'></div>"
         "<button id='kinedyn-reset'></button><span id='kinedyn-tool'></span><p id='kinedyn-q'></p>"
@@ -90,7 +90,7 @@ def test_page_holds_closed_configurations(page):
         assert np.abs(np.diff(grid, axis=k)).max() < 3 * step
     # the drawn configuration is the grid's reference position
     np.testing.assert_allclose(grid[tuple(loop["reference"])], q, atol=1e-12)
-    assert "nothing is interpolated" in loop["note"]
+    assert "Nothing is interpolated" in loop["note"]
 
 
 @pytest.fixture(scope="module")
@@ -113,7 +113,7 @@ def test_page_sliders_in_chromium(browser, five_bar_page):
     tab.wait_for_function("window.kinedyn", timeout=60000)
     inputs = tab.locator("#kinedyn-sliders input")
     assert inputs.count() == freedom(robot, q)
-    assert "closed loops" in tab.locator("#kinedyn-loop-sliders").inner_text()
+    assert "Closed loops" in tab.locator("#kinedyn-loop-sliders").inner_text()
     seen = [q]
     for fractions in ([0.2, 0.75], [0.8, 0.4]):
         at = [int(f * (len(v) - 1)) for f, v in zip(fractions, loop["values"])]
@@ -128,6 +128,38 @@ def test_page_sliders_in_chromium(browser, five_bar_page):
     # the tool readout follows the library's forward kinematics of the configuration shown
     tool = robot.frame_poses(shown, [robot.tool])[0][:3, 3]
     assert tab.locator("#kinedyn-tool").inner_text() == "tool at (" + ", ".join(f"{v:.4f}" for v in tool) + ") m"
+    assert errors == [], errors
+    context.close()
+
+
+def test_sweeps_of_three_sliders_in_chromium(browser, tmp_path_factory):
+    """Three independent coordinates (the parallelogram arm: yaw, shoulder, elbow drive): a 1-D
+    sweep per slider from the drawn configuration; moving one slider puts the others back there,
+    every configuration shown is closed, and a slider's joint is at its position."""
+    robot, q, path, model = page_of("parallelogram_arm.urdf", tmp_path_factory)
+    loop = model["loop"]
+    assert loop["mode"] == "sweeps" and loop["joints"] == [
+        "yaw",
+        "shoulder",
+        "elbow_drive",
+    ] == robot.independent_joints(q)
+    held = [s for states in loop["states"] for s in states if s is not None]
+    assert len(held) == loop["positions"] and np.abs(robot.loop_residual(np.array(held))).max() < 1e-9
+    context = browser.new_context(viewport={"width": 800, "height": 600})
+    tab = context.new_page()
+    errors = []
+    tab.on("pageerror", lambda e: errors.append(str(e)))
+    tab.goto(path.resolve().as_uri())
+    tab.wait_for_function("window.kinedyn", timeout=60000)
+    inputs = tab.locator("#kinedyn-sliders input")
+    assert inputs.count() == 3 == freedom(robot, q)
+    inputs.nth(0).fill("10")
+    inputs.nth(2).fill("100")  # the elbow drive: the yaw goes back to the drawn configuration's
+    shown = np.array(tab.evaluate("window.kinedyn.q()"))
+    entries = loop["q"]
+    assert shown[entries[2]] == loop["values"][2][100] and shown[entries[0]] == pytest.approx(q[entries[0]], abs=1e-12)
+    assert int(inputs.nth(0).input_value()) == loop["reference"][0]
+    assert np.abs(robot.loop_residual(shown)).max() < 1e-9
     assert errors == [], errors
     context.close()
 

@@ -211,10 +211,10 @@ def _note(robot, names, mode, axes, free, unreachable, residual) -> str:
             "configuration (moving one slider puts the others back there)"
         )
     text = (
-        f"This robot has closed loops: the sliders move its independent coordinates ({listed}) and the other "
-        f"joints follow, solved by projection onto the loops (project_configuration, holding {listed}) when "
-        f"the page was written, at {grid}; the largest loop residual of those configurations is "
-        f"{residual:.1e}. A slider steps from one solved configuration to the next: nothing is interpolated."
+        f"Closed loops: each slider moves an independent coordinate ({listed}) and the other joints follow, "
+        f"solved by projection onto the loops (holding {listed}) when the page was written, at {grid}. "
+        f"Largest loop residual of those configurations: {residual:.1e}. Nothing is interpolated: a slider "
+        "steps from one solved configuration to the next."
     )
     if unreachable:
         text += (
@@ -222,14 +222,13 @@ def _note(robot, names, mode, axes, free, unreachable, residual) -> str:
             "(a coordinate that cannot turn all the way, a singular configuration): there the drawing stays "
             "where it was and says so."
         )
-    if free > len(names):
-        text += (
-            f" The mechanism has {free} degrees of freedom; the {free - len(names)} left in multi-DOF joints "
-            "have no slider and stay where the solver puts them (least-norm steps)."
-        )
     multi = [j.name for j in robot.joints if j.is_multi_dof]
     if multi:
-        text += f" The multi-DOF joints ({', '.join(multi)}) have no slider here."
+        left = f"the other {free - len(names)} degrees of freedom of the mechanism and " if free > len(names) else ""
+        text += (
+            f" No slider moves {left}the multi-DOF joints ({', '.join(multi)}): they stay where the solver "
+            "puts them (least-norm steps)."
+        )
     return text
 
 
