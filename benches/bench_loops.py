@@ -157,6 +157,27 @@ def main() -> None:
     print(
         f"batch of {n}: kinedyn {batch_kd * 1e6:7.3f} us/state   pinocchio loop {batch_pin * 1e6:7.3f} us/state   ratio {batch_pin / batch_kd:5.1f}x"
     )
+    closed_chain_ik(args.repeat)
+
+
+def closed_chain_ik(repeat: int) -> None:
+    """Inverse kinematics on a closed chain (kinedyn.ik.closed_chain): Spong's five-bar, its tool at
+    200 positions along a path of its motors, from one q0: one batched call against one call per
+    target (no peer: Pinocchio has no inverse kinematics of a closed chain)."""
+    from pathlib import Path
+
+    robot = kd.load(str(Path(__file__).resolve().parents[1] / "examples" / "robots" / "five_bar.yaml"))
+    t = np.linspace(0.0, 1.0, 200)
+    q1, q2 = 0.2 + 1.5 * t, 1.0 + 1.2 * np.sin(3 * t)
+    path = np.stack([q1, q2 - q1, q2, q1 - q2], axis=1)  # closed: the parallelogram branch
+    targets = robot.frame_poses(path, ["tool"])[:, 0, :3, 3]
+    batch = best(lambda: robot.inverse_kinematics(targets, path[0]), repeat)
+    single = best(lambda: [robot.inverse_kinematics(x, path[0]) for x in targets], max(1, repeat // 3))
+    solved = robot.inverse_kinematics(targets, path[0]).success.sum()
+    print(
+        f"closed-chain IK, 200 targets: batch {batch * 1e3:7.2f} ms   one by one {single * 1e3:7.1f} ms   "
+        f"ratio {single / batch:5.1f}x   ({solved} solved)"
+    )
 
 
 if __name__ == "__main__":

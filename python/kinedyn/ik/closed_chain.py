@@ -21,7 +21,8 @@ A batch of targets ``(N, 4, 4)`` / ``(N, 3)`` is one call returning an :class:`I
   each for the frame poses, the frame Jacobians, the loop residuals and Jacobians (the core's batches),
   the least-norm steps by one stacked SVD (``numpy.linalg.pinv`` on the ``(N, 6 + m, nv)`` stack),
   the backtracking halving only the steps of the targets whose residual grew. A target's answer is
-  the one a single call from the same start gives.
+  the one a single call from the same start gives (to rounding: a single target runs the same
+  iteration on vectors, ``_solve_one``, which NumPy's per-call overhead makes twice as fast there).
 - **Warm-started along the batch**: each target starts from ``q0`` (its own row when ``q0`` is
   ``(N, nq)``); a target not reached from there is tried again from the solution of its neighbour in
   the batch (the previous target solved, then the next), pass after pass while a pass solves more,
@@ -52,6 +53,14 @@ def _rotation_vectors(rot: np.ndarray) -> np.ndarray:
     return s * scale[:, None]
 
 
+def _batched(fn, q, *more):
+    """``fn`` on the rows of q (k, ...) as a batch, and on a single row as one state: a batch of one
+    would pay the core's batch runner (threads, chunks) for nothing."""
+    if len(q) == 1:
+        return np.asarray(fn(q[0], *(m[0] for m in more)))[None]
+    return np.asarray(fn(q, *more))
+
+
 class _Problem:
     """The stacked residual and Jacobian of N targets (module docstring), evaluated in batches."""
 
@@ -61,16 +70,16 @@ class _Problem:
     def residual(self, q: np.ndarray, rows: np.ndarray):
         """(r (k, 6 + m), pose error (k, 6)) of the targets ``rows`` at q (k, nq)."""
         robot, pose = self.robot, self.poses[rows]
-        actual = robot.frame_poses(q, [self.frame])[:, 0]
+        actual = _batched(lambda x: robot.frame_poses(x, [self.frame]), q)[:, 0]
         rotation = np.einsum("nij,nkj->nik", pose[:, :3, :3], actual[:, :3, :3])  # R_target R(q)^T
         error = np.concatenate([pose[:, :3, 3] - actual[:, :3, 3], _rotation_vectors(rotation)], axis=1)
-        closure = np.asarray(robot.loop_residual(q)).reshape(len(q), -1)
+        closure = _batched(robot.loop_residual, q).reshape(len(q), -1)
         return np.concatenate([self.weights * error, -closure], axis=1), error
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         robot = self.robot
-        frame = np.asarray(robot.jacobian(q, self.frame)).reshape(len(q), 6, robot.nv)
-        loops = np.asarray(robot.loop_jacobian(q)).reshape(len(q), -1, robot.nv)
+        frame = _batched(lambda x: robot.jacobian(x, self.frame), q).reshape(len(q), 6, robot.nv)
+        loops = _batched(robot.loop_jacobian, q).reshape(len(q), -1, robot.nv)
         return np.concatenate([self.weights[:, None] * frame, loops], axis=1)
 
 
@@ -91,14 +100,14 @@ def _gauss_newton(problem: _Problem, rows: np.ndarray, q: np.ndarray, tolerance:
         # least-norm steps (SVD, singular values below 1e-12 of the largest dropped), stacked
         step = np.einsum("kij,kj->ki", np.linalg.pinv(problem.jacobian(q[at]), rcond=1e-12), r[at])
         norm = np.linalg.norm(r[at], axis=1)
-        trial_q = np.asarray(problem.robot.integrate(q[at], step)).reshape(len(at), -1)
+        trial_q = _batched(problem.robot.integrate, q[at], step).reshape(len(at), -1)
         trial_r, trial_e = problem.residual(trial_q, rows[at])
         for _ in range(HALVINGS):  # backtracking: halve the steps of the targets whose residual grew
             grew = np.linalg.norm(trial_r, axis=1) > norm
             if not grew.any():
                 break
             step[grew] *= 0.5
-            again = np.asarray(problem.robot.integrate(q[at[grew]], step[grew])).reshape(int(grew.sum()), -1)
+            again = _batched(problem.robot.integrate, q[at[grew]], step[grew]).reshape(int(grew.sum()), -1)
             trial_q[grew] = again
             trial_r[grew], trial_e[grew] = problem.residual(again, rows[at[grew]])
         q[at], r[at], error[at] = trial_q, trial_r, trial_e
@@ -111,7 +120,7 @@ def _gauss_newton(problem: _Problem, rows: np.ndarray, q: np.ndarray, tolerance:
 
 def _verdicts(robot, q, error, iterations, weights, tolerance, max_iterations, respect_limits):
     """Per target: (success, position error, orientation error, closure, message)."""
-    closure = np.abs(np.asarray(robot.loop_residual(q)).reshape(len(q), -1)).max(axis=1, initial=0.0)
+    closure = np.abs(_batched(robot.loop_residual, q).reshape(len(q), -1)).max(axis=1, initial=0.0)
     position = np.linalg.norm(weights[:3] * error[:, :3], axis=1)
     orientation = np.linalg.norm(weights[3:] * error[:, 3:], axis=1)
     success = np.maximum(np.maximum(position, orientation), closure) <= tolerance
@@ -163,6 +172,42 @@ def _solve_batch(problem, starts, tolerance, max_iterations, respect_limits, war
         q[take], error[take] = q2[better], e2[better]
         verdict = _verdicts(robot, q, error, iterations, problem.weights, tolerance, max_iterations, respect_limits)
     return q, iterations, verdict
+
+
+def _rotation_vector(rot: np.ndarray) -> np.ndarray:
+    """The rotation vector of one rotation matrix (``_rotation_vectors`` of a stack of one, without
+    the stack's overhead)."""
+    s = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
+    sin = np.linalg.norm(s)
+    angle = np.arctan2(sin, 0.5 * (np.trace(rot) - 1.0))
+    return s if sin < 1e-12 else s * (angle / sin)
+
+
+def _solve_one(robot, frame, pose, weights, q, tolerance, max_iterations):
+    """One target: the same Gauss-Newton as ``_gauss_newton`` on one state (``lstsq`` for the
+    least-norm step, 30 halvings), in plain NumPy calls on vectors: a stack of one pays NumPy's
+    per-call overhead on every small array (measured twice as slow). Returns (q, pose error (6,),
+    iterations)."""
+
+    def residual(q):
+        actual = robot.frame_poses(q, [frame])[0]
+        error = np.concatenate([pose[:3, 3] - actual[:3, 3], _rotation_vector(pose[:3, :3] @ actual[:3, :3].T)])
+        return np.concatenate([weights * error, -robot.loop_residual(q)]), error
+
+    r, error = residual(q)
+    iterations = 0
+    while np.abs(r).max() > tolerance and iterations < max_iterations:
+        iterations += 1
+        jac = np.vstack([weights[:, None] * robot.jacobian(q, frame), robot.loop_jacobian(q)])
+        step = np.linalg.lstsq(jac, r, rcond=1e-12)[0]
+        for _ in range(30):  # backtracking: halve until the residual does not grow
+            trial = robot.integrate(q, step)
+            r_trial, error_trial = residual(trial)
+            if np.linalg.norm(r_trial) <= np.linalg.norm(r):
+                break
+            step = 0.5 * step
+        q, r, error = trial, r_trial, error_trial
+    return q, error, iterations
 
 
 def closed_chain_inverse_kinematics(
@@ -220,10 +265,17 @@ def closed_chain_inverse_kinematics(
     else:
         want = f"({robot.nq},)" + (f" or ({n}, {robot.nq})" if batch else "")
         raise ValueError(f"q0 must have shape {want}, got {q.shape}")
-    problem = _Problem(robot, frame, poses, weights)
-    q, iterations, (success, position, orientation, closure, messages) = _solve_batch(
-        problem, starts, tolerance, max_iterations, respect_limits, warm
-    )
+    if not batch:
+        q, error, iterations = _solve_one(robot, frame, poses[0], weights, starts[0], tolerance, max_iterations)
+        q, error, iterations = q[None], error[None], np.array([iterations])
+        success, position, orientation, closure, messages = _verdicts(
+            robot, q, error, iterations, weights, tolerance, max_iterations, respect_limits
+        )
+    else:
+        problem = _Problem(robot, frame, poses, weights)
+        q, iterations, (success, position, orientation, closure, messages) = _solve_batch(
+            problem, starts, tolerance, max_iterations, respect_limits, warm
+        )
     if batch:
         extra = {"message": messages, "closure": closure}
         return IKBatchResult(q, success, position, orientation, iterations, "numeric:closed-chain", extra)
