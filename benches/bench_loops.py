@@ -8,7 +8,14 @@ The mechanism: two chains of three revolute joints with skew axes whose ends are
 (a spatial point loop, 3 rows, 6 joints), read by both from one URDF; states closed by
 ``project_configuration`` and ``project_velocity``.
 
-    PYTHONPATH=python python benches/bench_loops.py [--states 10000] [--repeat 5]
+    PYTHONPATH=python python benches/bench_loops.py [--states 10000] [--repeat 5] [--rounds 400]
+
+One call is timed as the minimum over ``--rounds`` short rounds (50 calls each, cycling over the
+states) of the mean time per call: on a machine shared by many jobs most rounds are preempted, and a
+round short enough to run undisturbed measures the call itself (a round of 2000 calls rarely does:
+the figures of the first table in benches/NOTES.md varied 30 % between runs). It is given for the
+Python API (``robot.constrained_forward_dynamics``), for the native call alone
+(``robot._model.constrained_forward_dynamics``: the binding and the core) and for Pinocchio.
 """
 
 from __future__ import annotations
@@ -74,10 +81,24 @@ def best(fn, repeat):
     return min(times)
 
 
+def per_call(fn, count, rounds, calls=50):
+    """Minimum over ``rounds`` rounds of ``calls`` calls ``fn(k)`` (k cycling over ``count`` states)
+    of the mean time per call."""
+    best_round = float("inf")
+    for r in range(rounds):
+        ks = [(r * calls + j) % count for j in range(calls)]
+        start = time.perf_counter()
+        for k in ks:
+            fn(k)
+        best_round = min(best_round, time.perf_counter() - start)
+    return best_round / calls
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--states", type=int, default=10000)
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--rounds", type=int, default=400)
     args = parser.parse_args()
     robot = kd.Robot.from_urdf(URDF).add_loop("tip_a", "tip_b")
     rng = np.random.default_rng(0)
@@ -111,19 +132,12 @@ def main() -> None:
     )
     print(f"largest |qdd_kinedyn - qdd_pinocchio| over 50 states: {np.abs(qdd - ref).max():.1e}")
 
-    calls = 2000
-    one_kd = (
-        best(lambda: [robot.constrained_forward_dynamics(q[k], qd[k], tau[k]) for k in range(calls)], args.repeat)
-        / calls
-    )
-    one_pin = (
-        best(
-            lambda: [
-                pin.constraintDynamics(model, data, q[k], qd[k], tau[k], models, datas, settings) for k in range(calls)
-            ],
-            args.repeat,
-        )
-        / calls
+    count = min(args.states, 2000)
+    native = robot._model  # the binding and the core, without the Python layers
+    one_kd = per_call(lambda k: robot.constrained_forward_dynamics(q[k], qd[k], tau[k]), count, args.rounds)
+    one_native = per_call(lambda k: native.constrained_forward_dynamics(q[k], qd[k], tau[k], None), count, args.rounds)
+    one_pin = per_call(
+        lambda k: pin.constraintDynamics(model, data, q[k], qd[k], tau[k], models, datas, settings), count, args.rounds
     )
     n = args.states
     batch_kd = best(lambda: robot.constrained_forward_dynamics(q, qd, tau), args.repeat) / n
@@ -138,9 +152,31 @@ def main() -> None:
     )
     print(
         f"one call     : kinedyn {one_kd * 1e6:7.2f} us   pinocchio {one_pin * 1e6:7.2f} us   ratio {one_pin / one_kd:5.2f}x"
+        f"   (native call alone {one_native * 1e6:5.2f} us)"
     )
     print(
         f"batch of {n}: kinedyn {batch_kd * 1e6:7.3f} us/state   pinocchio loop {batch_pin * 1e6:7.3f} us/state   ratio {batch_pin / batch_kd:5.1f}x"
+    )
+    closed_chain_ik(args.repeat)
+
+
+def closed_chain_ik(repeat: int) -> None:
+    """Inverse kinematics on a closed chain (kinedyn.ik.closed_chain): Spong's five-bar, its tool at
+    200 positions along a path of its motors, from one q0: one batched call against one call per
+    target (no peer: Pinocchio has no inverse kinematics of a closed chain)."""
+    from pathlib import Path
+
+    robot = kd.load(str(Path(__file__).resolve().parents[1] / "examples" / "robots" / "five_bar.yaml"))
+    t = np.linspace(0.0, 1.0, 200)
+    q1, q2 = 0.2 + 1.5 * t, 1.0 + 1.2 * np.sin(3 * t)
+    path = np.stack([q1, q2 - q1, q2, q1 - q2], axis=1)  # closed: the parallelogram branch
+    targets = robot.frame_poses(path, ["tool"])[:, 0, :3, 3]
+    batch = best(lambda: robot.inverse_kinematics(targets, path[0]), repeat)
+    single = best(lambda: [robot.inverse_kinematics(x, path[0]) for x in targets], max(1, repeat // 3))
+    solved = robot.inverse_kinematics(targets, path[0]).success.sum()
+    print(
+        f"closed-chain IK, 200 targets: batch {batch * 1e3:7.2f} ms   one by one {single * 1e3:7.1f} ms   "
+        f"ratio {single / batch:5.1f}x   ({solved} solved)"
     )
 
 

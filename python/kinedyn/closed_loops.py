@@ -23,6 +23,7 @@ from ._ui.names import did_you_mean
 __all__ = [
     "constrained_forward_dynamics",
     "constrained_inverse_dynamics",
+    "independent_joints",
     "loop_gamma",
     "loop_jacobian",
     "loop_residual",
@@ -156,3 +157,39 @@ def reduced_dynamics(description, model, q, qd_independent, independent=None):
         "qd": qd,
         "independent": columns,
     }
+
+
+def independent_joints(description, model, q) -> list:
+    """Names of 1-DOF joints that are independent coordinates of the loops at ``q``: holding them
+    fixes every other 1-DOF coordinate (a slider each, in the drawings; ``hold=`` of
+    ``project_configuration``). With ``N`` a basis of the null space of ``J`` (the closed motions),
+    a set ``S`` of columns is independent when the rows ``N[S]`` are (coordinate partitioning, Wehage
+    & Haug 1982); the joints are taken greedily nearest the base first (fewest ancestors; a parallel
+    mechanism's motors sit there), then in joint order, until there are ``nv - rank J`` or no 1-DOF
+    joint is left (the remaining freedom is then in multi-DOF joints: a Delta robot's rod spins)."""
+    native = _native(description, model, "independent_joints")
+    q = float64_array(q)
+    jac = native.loop_jacobian(q)
+    n = jac.shape[1]
+    rank_tol = RANK_TOLERANCE * max(1.0, float(np.abs(jac).max())) if jac.size else 0.0
+    _, sigma, vt = np.linalg.svd(jac) if jac.size else (None, np.zeros(0), np.zeros((0, n)))
+    rank = int(np.sum(sigma > rank_tol))
+    null = vt[rank:].T if jac.size else np.eye(n)  # (n, n - rank), orthonormal columns
+    starts = np.concatenate([[0], np.cumsum([j.nv for j in description.joints])]).astype(int)
+    bodies = description.tree.bodies
+    depth = {}
+    for b in bodies:  # parents come first (parent < own index)
+        depth[b.joint.name] = 0 if b.parent < 0 else depth[bodies[b.parent].joint.name] + 1
+    order = sorted(
+        (k for k, j in enumerate(description.joints) if j.nv == 1 and not j.is_multi_dof),
+        key=lambda k: (depth.get(description.joints[k].name, 0), k),
+    )
+    chosen: list[int] = []
+    for k in order:
+        if len(chosen) == null.shape[1]:
+            break
+        rows = null[[starts[c] for c in chosen + [k]]]
+        # the rows stay independent: their least singular value well above the rank tolerance
+        if np.linalg.svd(rows, compute_uv=False)[-1] > 1e-6:
+            chosen.append(k)
+    return [description.joints[k].name for k in sorted(chosen)]

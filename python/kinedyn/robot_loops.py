@@ -76,6 +76,13 @@ class ClosedLoops:
         """The velocity nearest ``qd`` (Euclidean) that keeps the loops closed: ``qd - J^+ J qd``."""
         return closed_loops.project_velocity(self.description, self._model, q, qd)
 
+    def independent_joints(self, q) -> list:
+        """Names of 1-DOF joints that are independent coordinates of the loops at the closed
+        configuration ``q`` (nearest the base first: a parallel mechanism's motors): holding them
+        (``project_configuration(q, hold=...)``) fixes the other 1-DOF joints. As many as the
+        mechanism's degrees of freedom, fewer when some of its freedom is in multi-DOF joints."""
+        return closed_loops.independent_joints(self.description, self._model, q)
+
     def reduced_dynamics(self, q, qd_independent, independent=None):
         """The equations of motion in independent coordinates at one closed state (coordinate
         partitioning): ``qd = G qd_i``, ``qdd = G qdd_i + a0`` and ``M_r qdd_i + bias + g_r = G^T tau``

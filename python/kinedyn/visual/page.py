@@ -15,6 +15,7 @@ import numpy as np
 from ..coordinates import coordinate_labels, coordinate_units, in_multi_dof_block
 from ..description.joint import planar_basis
 from ..description.mimic import body_coordinates
+from .loops import loop_sliders
 from .scene import DEFAULT_BUDGET, MissingMeshWarning, robot_scene, scene_bounds
 from .web import encode_scene, plotly_script
 
@@ -78,6 +79,14 @@ def view_model(robot, q, geometry: str = "visual", budget: int | None = None) ->
     qs = np.vstack([q, robot.random_configuration(np.random.default_rng(1), size=64)])
     origins = np.vstack([np.zeros((1, 3)), robot.frame_poses(qs)[..., :3, 3].reshape(-1, 3)])
     reach = max(float(np.max(np.linalg.norm(origins, axis=-1))), 1e-3)
+    # closed loops: a slider per independent coordinate instead, stepping through configurations
+    # solved here (kinedyn.visual.loops; viewer.js reads model.loop)
+    loop = loop_sliders(robot, q, reach)
+    if loop is not None:
+        sliders = [
+            {"name": name, "q": e, "revolute": revolute, "loop": k}
+            for k, (name, e, revolute) in enumerate(zip(loop["joints"], loop["q"], loop["revolute"]))
+        ]
     # the cube the view shows: around every frame origin of those configurations, with a margin for the meshes
     lo, hi = origins.min(axis=0), origins.max(axis=0)
     half = float(np.max(hi - lo)) / 2 + 0.12 * reach
@@ -108,6 +117,7 @@ def view_model(robot, q, geometry: str = "visual", budget: int | None = None) ->
         "coordinate_units": units,
         "coordinate_named": in_multi_dof_block(robot),
         "sliders": sliders,
+        "loop": loop,
         "lower": [float(x) if math.isfinite(x) else None for x in robot.lower_limits],
         "upper": [float(x) if math.isfinite(x) else None for x in robot.upper_limits],
         "q": [float(x) for x in q],

@@ -4,7 +4,8 @@ It runs a viser server (a real web server with a three.js client, both from the 
 package; nothing is fetched from elsewhere) on this machine, by default on ``127.0.0.1`` (only this
 machine can connect), and prints its URL. The robot's meshes (:func:`kinedyn.visual.robot_scene`) are
 sent once, each fixed to a scene frame whose pose follows the forward kinematics; the stick figure,
-the base and tool frames, a slider per joint and, for a trajectory, a time slider with play/pause.
+the base and tool frames, a slider per joint (a robot with closed loops: per independent coordinate,
+the other joints solved as it moves) and, for a trajectory, a time slider with play/pause.
 
 On a remote machine, forward the port: ``ssh -L 8080:localhost:8080 user@host``, then open
 http://localhost:8080 here (docs/visualisation.md).
@@ -26,6 +27,7 @@ import numpy as np
 
 from .._ui import interrupts
 from ..configuration import default_configuration
+from .loops import CLOSED, LiveLoop
 from .scene import DEFAULT_BUDGET, robot_scene, scene_bounds
 from .serving import HandshakeGuard, guarded_viser, listen_address
 
@@ -235,10 +237,21 @@ class Viewer:
         self._sliders: list[Any] = []
         self._slider_coordinates: list[int] = []  # the entry of q each slider moves
         self._quiet = False
+        # a robot with closed loops, drawn closed: a slider per independent coordinate, the other
+        # joints solved as it moves (kinedyn.visual.loops.LiveLoop); otherwise a slider per joint
+        self._loop = None
+        if getattr(robot, "loops", ()):
+            try:
+                if np.abs(robot.loop_residual(self.q)).max() < CLOSED:
+                    self._loop = LiveLoop(robot, self.q)
+            except ValueError:  # loops the core cannot hold (reduced mimic joints): a slider per joint
+                self._loop = None
         with gui.add_folder("Joints"):
             start = 0
             for j in robot.joints:
                 i, start = start, start + j.nq
+                if self._loop is not None and j.name not in self._loop.joints:
+                    continue
                 if j.is_multi_dof:
                     # a quaternion or (cos, sin) block is no slider: it stays where q puts it
                     gui.add_markdown(f"{j.kind} joint `{j.name}`: held at q[{i}:{start}]")
@@ -253,6 +266,13 @@ class Viewer:
                 slider.on_update(self._slider_moved(len(self._sliders), i))
                 self._sliders.append(slider)
                 self._slider_coordinates.append(i)
+            if self._loop is not None:
+                names = ", ".join(self._loop.joints) or "none"
+                gui.add_markdown(
+                    f"Closed loops: the sliders move the independent coordinates ({names}); the other joints are "
+                    "solved as they move (project_configuration). A position the loops cannot close leaves the "
+                    "robot where it was."
+                )
             reset = gui.add_button("reset")
             start = self.q.copy()
             reset.on_click(lambda _: self.set_q(start))
@@ -279,6 +299,10 @@ class Viewer:
             if self._quiet:
                 return
             q = self.q.copy()
+            if self._loop is not None:  # the other joints follow, solved onto the loops
+                closed = self._loop.move(q, k, float(self._sliders[k].value))
+                self.set_q(q if closed is None else closed)  # unsolved: the robot (and its slider) stay
+                return
             q[i] = float(self._sliders[k].value)
             self.set_q(q)
 

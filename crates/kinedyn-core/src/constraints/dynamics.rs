@@ -29,7 +29,7 @@
 //! base axes, the moment about frame a's origin; frame b's link receives the opposite.
 
 use super::dense::{dot, lane_max_abs, ldlt, ldlt_solve};
-use super::kinematics::{loop_gamma, loop_jacobian};
+use super::kinematics::{gamma_after_accelerations, jacobian_after_kinematics, world_poses};
 use super::LoopData;
 use crate::algorithms::crba::crba;
 use crate::algorithms::minv::{ltdl, ltdl_solve};
@@ -38,6 +38,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::scalar::Real;
+use crate::spatial::splat3;
 
 /// Settings of the proximal iteration.
 #[derive(Clone, Copy, Debug)]
@@ -94,6 +95,16 @@ fn solve<T: Real>(
     for i in 0..n {
         s.free[i] = tau[i] - h[i];
     }
+    if m > 0 {
+        // J and gamma from RNEA's forward pass at qdd = 0 (its joint transforms, twists and
+        // accelerations, gravity taken off), not from two more passes of forward kinematics
+        if f_ext.is_none() {
+            world_poses(model, data); // RNEA with f_ext has them already
+        }
+        jacobian_after_kinematics(model, data, &mut s.j);
+        let gravity = -splat3::<T>(&model.gravity);
+        gamma_after_accelerations(model, data, gravity, &mut s.gamma);
+    }
     // qdd_free = M^-1 (tau - h)
     crba(model, data, q);
     ltdl(model, data)?;
@@ -102,8 +113,6 @@ fn solve<T: Real>(
         out[..n].copy_from_slice(&s.free);
         return Ok(());
     }
-    loop_jacobian(model, data, q, &mut s.j);
-    loop_gamma(model, data, q, qd, &mut s.gamma);
     // Y = M^-1 J^T, one column per constraint row
     for k in 0..m {
         let y = &mut s.y[k * n..(k + 1) * n];

@@ -50,8 +50,14 @@ pub fn loop_residual(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64])
 /// `J(q)`, row-major m x n, written to `out` (runs forward kinematics).
 #[inline(always)]
 pub fn loop_jacobian<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], out: &mut [T]) {
-    let n = model.n;
     forward_kinematics(model, data, q);
+    jacobian_after_kinematics(model, data, out);
+}
+
+/// `J` from the poses `data.world_from_body` of a forward pass already run at `q`.
+#[inline(always)]
+pub(super) fn jacobian_after_kinematics<T: Real>(model: &Model, data: &Data<T>, out: &mut [T]) {
+    let n = model.n;
     out[..model.loop_rows() * n].fill(T::zero());
     let mut row = 0;
     for l in &model.loops {
@@ -77,6 +83,17 @@ pub fn loop_jacobian<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], out: &
 #[inline(always)]
 pub fn loop_gamma<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], out: &mut [T]) {
     forward_acceleration(model, data, q, qd, None);
+    gamma_after_accelerations(model, data, Vec3::zeros(), out);
+}
+
+/// `gamma` from the poses, twists and accelerations of a forward pass already run at `(q, qd)` with
+/// `qdd = 0`, whose base moved with the linear acceleration `base` (zero; or `-g`, RNEA's fictitious
+/// upward acceleration that stands for gravity, RBDA §5.3). That acceleration reaches every body
+/// as `^iX_0 (base, 0)`, whose classical linear acceleration in base axes is `base` itself (no
+/// angular part, so no transport term): it is taken off each frame's row (it would cancel between
+/// the two frames of a loop, except where one of them is on the base).
+#[inline(always)]
+pub(super) fn gamma_after_accelerations<T: Real>(model: &Model, data: &Data<T>, base: Vec3<T>, out: &mut [T]) {
     out[..model.loop_rows()].fill(T::zero());
     let mut row = 0;
     for l in &model.loops {
@@ -90,7 +107,7 @@ pub fn loop_gamma<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T],
             let v = body_from_frame.inv_act_motion(&data.v[body]);
             let a = body_from_frame.inv_act_motion(&data.a[body]);
             // d/dt of the world twist: classical acceleration of the origin, angular acceleration
-            let lin: Vec3<T> = mv(&rot, &(a.lin + cross(&v.ang, &v.lin)));
+            let lin: Vec3<T> = mv(&rot, &(a.lin + cross(&v.ang, &v.lin))) - base;
             let ang: Vec3<T> = mv(&rot, &a.ang);
             let values = [lin.x, lin.y, lin.z, ang.x, ang.y, ang.z];
             for (r, value) in values[..rows].iter().enumerate() {
@@ -98,5 +115,23 @@ pub fn loop_gamma<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T],
             }
         }
         row += rows;
+    }
+}
+
+/// `data.world_from_body` from `data.parent_from_body` (the second half of `forward_kinematics`,
+/// for a pass that already has the joint transforms: RNEA's).
+#[inline(always)]
+pub(super) fn world_poses<T: Real>(model: &Model, data: &mut Data<T>) {
+    let n = model.n;
+    let (parent, x_up, world) = (
+        &model.parent[..n],
+        &data.parent_from_body[..n],
+        &mut data.world_from_body[..n],
+    );
+    for i in 0..n {
+        world[i] = match parent[i] {
+            Some(p) => world[p] * x_up[i],
+            None => x_up[i],
+        };
     }
 }

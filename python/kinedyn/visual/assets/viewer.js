@@ -3,7 +3,8 @@
 // The model (bodies, joint axes, placements, frames, meshes) comes from the JSON block #kinedyn-model;
 // the forward kinematics below is the one of kinedyn.Robot: T_i = T_parent(i) * placement_i * motion_i(q_i + offset_i).
 // Each mesh is sent once, in its frame's coordinates (vertices quantised to 16 bits over its bounding
-// box, base64); a new q moves it by its frame's pose. Sliders move the joints, the play button replays
+// box, base64); a new q moves it by its frame's pose. Sliders move the joints (a robot with closed loops:
+// its independent coordinates, through configurations solved in Python), the play button replays
 // the simulation (#kinedyn-data's simulation.q). window.kinedyn exposes fk(), setQ() and counts for tests.
 (function () {
   "use strict";
@@ -211,13 +212,54 @@
   }
 
   // ---------------------------------------------------------------- sliders, reset, playback
+  // A robot with closed loops (model.loop, kinedyn.visual.loops): a slider per independent coordinate,
+  // each stepping through the positions model.loop.values; the configuration drawn is the one solved
+  // in Python for those positions (model.loop.states: one row-major grid over the sliders, or one
+  // 1-D sweep per slider from the drawn configuration), never interpolated; null: none was reached.
+  const loop = model.loop || null;
+  let loopAt = loop ? loop.reference.slice() : null;
+  function loopState(at) {
+    if (loop.mode === "sweeps") {
+      const moved = at.findIndex((k, i) => k !== loop.reference[i]);
+      return moved < 0 ? loop.states[0][loop.reference[0]] : loop.states[moved][at[moved]];
+    }
+    let flat = 0;
+    for (let i = 0; i < at.length; i++) flat = flat * loop.values[i].length + at[i];
+    return loop.states[0][flat];
+  }
+  function nearest(values, v) {
+    let best = 0;
+    for (let k = 1; k < values.length; k++) if (Math.abs(values[k] - v) < Math.abs(values[best] - v)) best = k;
+    return best;
+  }
   const sliders = document.getElementById("kinedyn-sliders");
+  let loopNote = null;
   function label(s) {
     const v = q[s.q];
     return s.revolute ? (v * 180 / Math.PI).toFixed(1) + "\u00b0" : v.toFixed(3) + " m";
   }
   function syncSliders() {
-    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => { el.value = q[sliderList[i].q]; el.nextElementSibling.textContent = label(sliderList[i]); });
+    if (loop) loopAt = loop.q.map((k, i) => nearest(loop.values[i], q[k]));
+    document.querySelectorAll("#kinedyn-sliders input").forEach((el, i) => {
+      const s = sliderList[i];
+      el.value = s.loop === undefined ? q[s.q] : loopAt[s.loop];
+      el.nextElementSibling.textContent = label(s);
+    });
+  }
+  function moveLoop(s, k) {
+    const at = loop.mode === "sweeps" ? loop.reference.slice() : loopAt.slice();
+    at[s.loop] = k;
+    const state = loopState(at);
+    if (state === null) {  // no closed configuration solved there: the drawing stays, and says so
+      if (loopNote) loopNote.textContent = s.name + " = " + fmt(loop.values[s.loop][k]) + ": no closed configuration was reached there; the drawing stays at the last one.";
+      syncSliders();
+      return;
+    }
+    if (loopNote) loopNote.textContent = "";
+    q = state.slice();
+    loopAt = at;
+    syncSliders();
+    draw();
   }
   if (sliders) {
     for (const s of sliderList) {
@@ -231,16 +273,35 @@
       row.querySelector(".jn").textContent = s.name;
       row.title = s.name;
       const input = row.querySelector("input");
-      input.min = lo; input.max = hi; input.step = (hi - lo) / 1000; input.value = q[s.q];
+      if (s.loop === undefined) {
+        input.min = lo; input.max = hi; input.step = (hi - lo) / 1000; input.value = q[s.q];
+      } else {  // the index of the slider's solved position
+        input.min = 0; input.max = loop.values[s.loop].length - 1; input.step = 1; input.value = loopAt[s.loop];
+      }
       input.setAttribute("aria-label", s.name);
       const out = row.querySelector("output");
       out.textContent = label(s);
-      input.addEventListener("input", () => { stop(); q[s.q] = parseFloat(input.value); out.textContent = label(s); draw(); });
+      input.addEventListener("input", () => {
+        stop();
+        if (s.loop !== undefined) { moveLoop(s, parseInt(input.value, 10)); return; }
+        q[s.q] = parseFloat(input.value); out.textContent = label(s); draw();
+      });
       sliders.appendChild(row);
+    }
+    if (loop) {
+      const note = document.createElement("p");
+      note.className = "note";
+      note.id = "kinedyn-loop-sliders";
+      note.textContent = loop.note;
+      loopNote = document.createElement("p");
+      loopNote.className = "bad";
+      loopNote.id = "kinedyn-loop-unreached";
+      sliders.appendChild(note);
+      sliders.appendChild(loopNote);
     }
   }
   const reset = document.getElementById("kinedyn-reset");
-  if (reset) reset.addEventListener("click", () => { stop(); q = model.q.slice(); syncSliders(); if (view && window.Plotly) window.Plotly.relayout(view, { "scene.camera": layout.scene.camera }); draw(); });
+  if (reset) reset.addEventListener("click", () => { stop(); q = model.q.slice(); syncSliders(); if (loopNote) loopNote.textContent = ""; if (view && window.Plotly) window.Plotly.relayout(view, { "scene.camera": layout.scene.camera }); draw(); });
 
   const sim = data.simulation && data.simulation.q && data.simulation.q.length > 1 ? data.simulation : null;
   const play = document.getElementById("kinedyn-play"), time = document.getElementById("kinedyn-time"), clock = document.getElementById("kinedyn-clock");
@@ -279,6 +340,7 @@
   window.kinedyn = {
     model: model, fk: fk, draw: draw,
     setQ: (v) => { stop(); q = v.slice(); syncSliders(); return draw(); },
+    loop: loop,  // the solved configurations of a robot with closed loops (null for a tree)
     q: () => q.slice(),
     meshes: meshes.length,
     drawnVisuals: () => Array.from(drawnVisuals).sort((a, b) => a - b),
