@@ -65,6 +65,7 @@ def commands(tmp: Path):
         ("identify", ["--periods", "0.2"]),
         ("report", ["-o", tmp / "r.html", "--t", "0.01", "--eom-joints", "0"]),
         ("derive", []),
+        ("codegen", ["--algorithms", "gravity"]),
         ("view", ["--no-wait", "--port", "0"]),  # the live viewer: starts its server and stops at once
         ("convert", [tmp / "converted.urdf"]),
     ]

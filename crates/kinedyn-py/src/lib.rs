@@ -6,6 +6,7 @@
 //! `guard::guarded` (a panic is a RuntimeError), allocates its results through `guard` (a MemoryError
 //! naming the bytes, never an abort) and runs batches in `guard::install`'s fork-safe pool.
 
+mod codegen;
 mod conv;
 mod guard;
 mod ik;
@@ -49,6 +50,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SingularMassMatrixError",
         m.py().get_type::<run::SingularMassMatrixError>(),
     )?;
+    codegen::register(m)?;
     guard::register(m)?;
     ik::register(m)?;
     ik_redundant::register(m)?;

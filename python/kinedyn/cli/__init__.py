@@ -73,6 +73,7 @@ COMMANDS = {
     "convert": ("convert", "write a robot as URDF, MJCF, a robot file or a DH table, and check the result"),
     "ik": ("ik", "inverse kinematics: the joint values that put the tool at a target"),
     "derive": ("derive", "symbolic equations of motion (LaTeX, Markdown, MathML, text, Python, NumPy, C)"),
+    "codegen": ("codegen", "the robot's dynamics (RNEA, CRBA, M^-1, ABA, derivatives) as straight-line C or Rust"),
     "simulate": ("simulate", "simulate a robot under a controller (RK4 in the native core by default)"),
     "check": ("check", "properties of the equations of motion, each with its residual (Spong §9.5)"),
     "identify": (

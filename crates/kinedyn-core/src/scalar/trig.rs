@@ -13,24 +13,24 @@
 #![allow(clippy::excessive_precision)]
 
 // pi/2 = PIO2_1 + PIO2_2 + PIO2_3, the first two with 33 significant bits (k PIO2_i exact for |k| < 2^20)
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
-const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
-const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI; // fdlibm's invpio2 6.36619772367581382433e-01, the same double
-                                                      // sin r = r + r z (S1 + z (S2 + ... + z S6))
-const S1: f64 = -1.666_666_666_666_663_243_48e-01;
-const S2: f64 = 8.333_333_333_322_489_461_24e-03;
-const S3: f64 = -1.984_126_982_985_794_931_34e-04;
-const S4: f64 = 2.755_731_370_707_006_767_89e-06;
-const S5: f64 = -2.505_076_025_340_686_341_95e-08;
-const S6: f64 = 1.589_690_995_211_550_102_21e-10;
+pub(crate) const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
+pub(crate) const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
+pub(crate) const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
+pub(crate) const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI; // fdlibm's invpio2 6.36619772367581382433e-01, the same double
+                                                                 // sin r = r + r z (S1 + z (S2 + ... + z S6))
+pub(crate) const S1: f64 = -1.666_666_666_666_663_243_48e-01;
+pub(crate) const S2: f64 = 8.333_333_333_322_489_461_24e-03;
+pub(crate) const S3: f64 = -1.984_126_982_985_794_931_34e-04;
+pub(crate) const S4: f64 = 2.755_731_370_707_006_767_89e-06;
+pub(crate) const S5: f64 = -2.505_076_025_340_686_341_95e-08;
+pub(crate) const S6: f64 = 1.589_690_995_211_550_102_21e-10;
 // cos r = 1 - z/2 + z^2 (C1 + z (C2 + ... + z C6))
-const C1: f64 = 4.166_666_666_666_660_190_37e-02;
-const C2: f64 = -1.388_888_888_887_410_957_49e-03;
-const C3: f64 = 2.480_158_728_947_672_941_78e-05;
-const C4: f64 = -2.755_731_435_139_066_330_35e-07;
-const C5: f64 = 2.087_572_321_298_174_827_90e-09;
-const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+pub(crate) const C1: f64 = 4.166_666_666_666_660_190_37e-02;
+pub(crate) const C2: f64 = -1.388_888_888_887_410_957_49e-03;
+pub(crate) const C3: f64 = 2.480_158_728_947_672_941_78e-05;
+pub(crate) const C4: f64 = -2.755_731_435_139_066_330_35e-07;
+pub(crate) const C5: f64 = 2.087_572_321_298_174_827_90e-09;
+pub(crate) const C6: f64 = -1.135_964_755_778_819_482_65e-11;
 
 /// `(sin x, cos x)`.
 // `!(|x| < LIMIT)` also sends NaN to the standard library, in one comparison

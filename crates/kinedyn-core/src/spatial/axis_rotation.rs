@@ -25,7 +25,7 @@ pub enum AxisRotation {
 impl AxisRotation {
     /// Entries that must be 0 or 1 may be off by this (the rounding of `c + (1 - c)` in
     /// Rodrigues' formula); treating them as exact changes the result at the rounding level.
-    const TOL: f64 = 4.0 * f64::EPSILON;
+    pub const TOL: f64 = 4.0 * f64::EPSILON;
 
     /// The class of `r`.
     pub fn classify(r: &Mat3) -> Self {

@@ -12,12 +12,18 @@
 //! Derivatives*, 2nd ed., ch. 6), done on the algorithms' own source.
 //!
 //! A program has no loops and no branches; [`Program::eval`] runs it (the reference for every
-//! backend), and backends compile it.
+//! backend), [`Program::optimized`] applies the exact rewrites of `passes.rs` (negations absorbed),
+//! [`Program::counts`] measures it, [`emit::source`] writes it as C or Rust, and backends compile it.
+//! [`record_algorithm`] records each algorithm of [`Algorithm`] with its input and output layout.
 
+pub mod emit;
+mod passes;
 mod program;
 mod record;
+mod snap;
 mod traced;
 
+pub use passes::{absorb_negations, Counts};
 pub use program::{Op, Program};
 pub use record::{record_algorithm, record_rnea, Algorithm};
 pub use traced::{record, Traced};
