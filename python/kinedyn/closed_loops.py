@@ -167,9 +167,8 @@ def independent_joints(description, model, q) -> list:
     & Haug 1982); the joints are taken greedily nearest the base first (fewest ancestors; a parallel
     mechanism's motors sit there), then in joint order, until there are ``nv - rank J`` or no 1-DOF
     joint is left (the remaining freedom is then in multi-DOF joints: a Delta robot's rod spins)."""
-    native = _native(description, model, "independent_joints")
     q = float64_array(q)
-    jac = native.loop_jacobian(q)
+    jac = model.loop_jacobian(q)
     n = jac.shape[1]
     rank_tol = RANK_TOLERANCE * max(1.0, float(np.abs(jac).max())) if jac.size else 0.0
     _, sigma, vt = np.linalg.svd(jac) if jac.size else (None, np.zeros(0), np.zeros((0, n)))
