@@ -167,7 +167,7 @@ def independent_joints(description, model, q) -> list:
     & Haug 1982); the joints are taken greedily nearest the base first (fewest ancestors; a parallel
     mechanism's motors sit there), then in joint order, until there are ``nv - rank J`` or no 1-DOF
     joint is left (the remaining freedom is then in multi-DOF joints: a Delta robot's rod spins)."""
-    native = _native(description, model, "independent_joints")
+    native = model  # the core model (or the ReducedModel of a robot with mimic joints), as above
     q = float64_array(q)
     jac = native.loop_jacobian(q)
     n = jac.shape[1]
