@@ -82,3 +82,18 @@ def test_wrong_joint_names_and_counts_are_named(tmp_path):
     robot = kd.load(str(EXAMPLES / "pushrod_leg.urdf"))
     with pytest.raises(ValueError, match=r"joint 'root' \(floating\) needs 7 numbers"):
         robot.replace(reference_configuration={"root": [0, 0, 0, 1]})
+
+
+def test_mjcf_states_its_assembly_mode_by_qpos0():
+    """An MJCF body-form equality closes at MuJoCo's qpos0 (each hinge at its ``ref``): the reader
+    states qpos0 as the reference, and the drawing starts there (closed by construction)."""
+    mjcf = """<mujoco model="pinned"><compiler angle="radian"/><worldbody>
+      <body name="crank"><joint name="j1" axis="0 0 1" ref="0.3"/><geom size="0.01"/>
+        <body name="coupler" pos="0.1 0 0"><joint name="j2" axis="0 0 1" ref="-0.2"/><geom size="0.01"/></body></body>
+      <body name="rocker" pos="0.4 0 0"><joint name="j3" axis="0 0 1" ref="0.1"/><geom size="0.01"/></body>
+    </worldbody><equality><connect name="pin" body1="coupler" body2="rocker" anchor="0.3 0.2 0"/></equality></mujoco>"""
+    with pytest.warns(UserWarning, match="softness"):
+        robot = kd.Robot.from_mjcf(mjcf)
+    assert robot.description.reference_configuration == {"j1": 0.3, "j2": -0.2, "j3": 0.1}
+    q = default_configuration(robot)
+    np.testing.assert_allclose(q, [0.3, -0.2, 0.1], atol=1e-12)
