@@ -94,6 +94,6 @@ def test_mjcf_states_its_assembly_mode_by_qpos0():
     </worldbody><equality><connect name="pin" body1="coupler" body2="rocker" anchor="0.3 0.2 0"/></equality></mujoco>"""
     with pytest.warns(UserWarning, match="softness"):
         robot = kd.Robot.from_mjcf(mjcf)
-    assert robot.description.reference_configuration == {"j1": 0.3, "j2": -0.2, "j3": 0.1}
+    assert robot.reference_configuration == {"j1": 0.3, "j2": -0.2, "j3": 0.1}
     q = default_configuration(robot)
     np.testing.assert_allclose(q, [0.3, -0.2, 0.1], atol=1e-12)
