@@ -131,10 +131,10 @@ def test_singular_configuration_stops_the_run_with_its_samples():
 
 
 def test_report_energy_check_of_the_five_bar_passes_and_names_the_singular_passage():
-    """The report's free fall of Spong's five-bar from its drawing configuration (RK4 at 1 ms) passes
-    near its flat parallelogram (the loop Jacobian's s_2/s_1 down to 5.7e-4 at the samples, t = 0.18 s).
-    Measured: energy drift 1.5e-7 J over 0.5 s (4.3e-7 J over the report's 3 s; tolerance 1e-6 of
-    max |H| = 8.1 J); with the stages left unprojected 1.2e-3 J over 0.5 s (2.0e-2 J over 3 s)."""
+    """The report's free fall of Spong's five-bar from its drawing configuration (the file's reference,
+    the parallelogram at q1 = 0.5, q2 = 2.0; RK4 at 1 ms) passes near a singular configuration of the
+    loop (the loop Jacobian's s_2/s_1 down to 1.8e-3 at the samples, t = 0.342 s). Measured: energy
+    drift 1.4e-8 J over 0.5 s (8.8e-8 J over the report's 3 s; tolerance 1e-6 of max |H|)."""
     from kinedyn.report.data import NEAR_SINGULAR, collect
 
     five_bar = kd.load(str(ROOT / "examples" / "robots" / "five_bar.yaml"))
@@ -142,7 +142,7 @@ def test_report_energy_check_of_the_five_bar_passes_and_names_the_singular_passa
     (energy,) = [p for p in data["properties"] if p["property"].startswith("energy conserved")]
     assert energy["ok"] and energy["value"] < 1e-6, energy
     passage = data["simulation"]["singular_passage"]
-    assert passage["rank"] == 2 and passage["ratio"] < 1e-3 < NEAR_SINGULAR
-    assert 0.1 < passage["t"] < 0.3
+    assert passage["rank"] == 2 and passage["ratio"] < 3e-3 < NEAR_SINGULAR
+    assert 0.3 < passage["t"] < 0.4
     assert "passes near a singular configuration of the loops" in energy["measure"]
     assert data["simulation"]["note"] is None  # the whole run

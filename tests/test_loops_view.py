@@ -184,7 +184,8 @@ def test_live_viewer_solves_the_loop_as_a_slider_moves():
         assert np.abs(robot.loop_residual(q)).max() < 1e-9
         assert q[2] == pytest.approx(1.0, abs=1e-12) and q[0] == pytest.approx(q0[0], abs=1e-12)
         assert abs(q[3] - q0[3]) > 0.1  # a solved joint followed
-        # still the drawn configuration's assembly branch (default_configuration's: q4 = q3)
-        assert q[1] == pytest.approx(q[3], abs=1e-9)
+        # still the drawn configuration's assembly branch (the file's reference: the parallelogram,
+        # q = [q1, q4, q2, q3] with q3 = q1 - q2, q4 = q2 - q1)
+        assert q[3] == pytest.approx(q[0] - q[2], abs=1e-9) and q[1] == pytest.approx(q[2] - q[0], abs=1e-9)
     finally:
         viewer.close()

@@ -405,13 +405,24 @@ def default_configuration(robot: Robot) -> np.ndarray:
     often singular). A robot with closed loops gets that configuration projected onto its loops
     (``robot.project_configuration``: the nearest closed one, least-norm Gauss-Newton steps), so that
     every drawing shows the chain closed; where no closed configuration is near it, the open one.
-    (docs/closed-loops.md, "Motion")"""
+    The projection starts from the description's reference configuration where it states one (the
+    mechanism's assembly mode: the projection of the generic configuration may land on another
+    branch, a five-bar's crossed linkage for its parallelogram), its joints at their stated values
+    and the others at the generic ones. (docs/closed-loops.md, "Motion")"""
     q, start = robot.neutral(), 0
     for i, j in enumerate(robot.joints):
         if not j.is_multi_dof:
             q[start] = (0.5 if i % 2 == 0 else -0.7) * (1.0 if j.kind == "revolute" else 0.2)
         start += j.nq
     q = np.clip(q, robot.lower_limits, robot.upper_limits)
+    reference = getattr(getattr(robot, "description", None), "reference_configuration", None)
+    if reference and getattr(robot, "loops", ()):
+        start = 0
+        for j in robot.joints:  # a reduced mimic follower is no coordinate: its stated value is implied
+            if j.name in reference:
+                q[start : start + j.nq] = reference[j.name]
+            start += j.nq
+        q = robot.normalize(q)  # a stated quaternion rounded in the file
     if getattr(robot, "loops", ()):
         try:
             q = np.asarray(robot.project_configuration(q), dtype=float)

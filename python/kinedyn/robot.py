@@ -131,6 +131,7 @@ class Robot(ClosedLoops):
     nonphysical = property(lambda self: self.description.nonphysical)
     inertia_policy = property(lambda self: self.description.inertia)
     mimic_mode = property(lambda self: self.description.mimic)
+    reference_configuration = property(lambda self: self.description.reference_configuration)  # loops' assembly mode
     _mimic = property(lambda self: self.description.mimic_map)
 
     # ------------------------------------------------------------------ construction

@@ -27,7 +27,7 @@ from .._math import is_symbolic
 from .._ui.names import did_you_mean
 from .checks import vector
 from .link import KinematicTree, build_tree, judge_inertias
-from .loops import check_loops
+from .loops import check_loops, check_reference
 from .mimic import MimicMap, mimic_map, reduced_coefficient
 from .tool import default_tool
 
@@ -48,6 +48,9 @@ class Description:
     ``"reduce"`` or ``"independent"`` (:mod:`kinedyn.description.mimic`). ``tool``: a frame name;
     ``None`` picks one (a frame named "tool", else :func:`kinedyn.description.tool.default_tool`).
     ``loops``: closed kinematic loops between two frames (:class:`~kinedyn.description.loops.Loop`).
+    ``reference_configuration``: ``{joint name: value}``, where the loops close on the branch the
+    mechanism is assembled in (its assembly mode; :func:`~kinedyn.description.loops.check_reference`);
+    ``None`` when the description states none.
     """
 
     links: tuple
@@ -64,6 +67,7 @@ class Description:
     collisions: tuple = ()
     mimic: str = "reduce"
     loops: tuple = ()
+    reference_configuration: dict | None = None
     # derived on construction
     tree: KinematicTree = field(init=False, repr=False)
     nonphysical: dict = field(init=False, repr=False)
@@ -97,6 +101,8 @@ class Description:
             )
         put(self, "tool", tool)
         put(self, "loops", check_loops(self.loops, names, self.name))
+        joints = [b.joint for b in tree.bodies]
+        put(self, "reference_configuration", check_reference(self.reference_configuration, joints, self.name))
 
     # ------------------------------------------------------------------ joints and frames
     @property

@@ -101,7 +101,10 @@ def lock(description: Description, values: Mapping) -> Description:
                 link, joint=Joint(j.name, "fixed", j.axis), placement=matmul(link.placement, motion)
             )
         links.append(link)
-    return dataclasses.replace(description, links=tuple(links), dh=None)
+    reference = description.reference_configuration  # a locked joint is no longer a coordinate
+    if reference is not None:
+        reference = {name: v for name, v in reference.items() if name not in values}
+    return dataclasses.replace(description, links=tuple(links), dh=None, reference_configuration=reference)
 
 
 def lock_joints(description: Description, joints, at, block_motion) -> Description:

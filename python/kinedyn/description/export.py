@@ -38,7 +38,7 @@ from .._ui.files import write_text
 from .geometry import Box, Cylinder, Mesh, Sphere, Visual, mesh_reference, resolve_mesh
 from .inertia import Inertia
 from .link import Link
-from .loop_files import mjcf_loop_sites, urdf_loop_elements, write_mjcf_loops
+from .loop_files import mjcf_loop_sites, urdf_loop_elements, urdf_reference_element, write_mjcf_loops
 
 if TYPE_CHECKING:
     from .._typing import PathLike
@@ -467,7 +467,7 @@ def to_urdf(
     for el in link_elements.values():
         if el not in list(root):
             root.append(el)
-    for el in joints + urdf_loop_elements(robot) + transmissions:  # loops: kinedyn's <loop> (loop_files)
+    for el in joints + urdf_loop_elements(robot) + urdf_reference_element(robot) + transmissions:  # loop_files
         root.append(el)
     ET.indent(root)
     text = (

@@ -56,7 +56,7 @@ __all__ = [
     "MAX_TEXT",
 ]
 
-_TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals", "loops"}
+_TOP_COMMON = {"name", "gravity", "units", "frames", "source", "visuals", "loops", "reference_configuration"}
 _TOP_DH = _TOP_COMMON | {"convention", "base_pose", "tool", "tool_frame", "joints"}
 _TOP_TREE = _TOP_COMMON | {"base", "tool", "links"}
 _ROW_KEYS = {
@@ -375,6 +375,10 @@ def description_from_mapping(data, where: str = "<robot mapping>", inertia: str 
             description = replace(description, visuals=tuple(visuals))
         if "loops" in data:
             description = replace(description, loops=_loops(r, data["loops"], description.frame_names))
+        if "reference_configuration" in data:
+            description = replace(
+                description, reference_configuration=_reference(r, data["reference_configuration"], description)
+            )
         return description
     except ValueError as e:
         if str(e).startswith(where):
@@ -426,6 +430,33 @@ def _loops(r: _Reader, raw, frame_names: list) -> tuple:
         except ValueError as e:  # the kind, or a frame closed on itself
             r.fail(ctx, str(e))
     return tuple(out)
+
+
+def _reference(r: _Reader, raw, description: Description) -> dict:
+    """``reference_configuration: {joint: value}``: where the loops close on the mechanism's branch
+    (docs/closed-loops.md, "The assembly mode"); a revolute joint's value in the file's angle unit, a
+    multi-DOF joint's its block of q."""
+    ctx = "reference_configuration"
+    if not isinstance(raw, dict):
+        r.fail(ctx, f"expected a mapping of joint names to values, got {_kind(raw)}")
+    r.remember_lines(raw, ctx)
+    joints = {b.joint.name: b.joint for b in description.tree.bodies}
+    out = {}
+    for name, value in raw.items():
+        key = f"{ctx}.{name}"
+        joint = joints.get(name)
+        if joint is None:
+            names = list(joints)
+            r.fail(key, f"names no moving joint '{name}'{did_you_mean(str(name), names)} (moving joints: {names})")
+        if joint.is_multi_dof:
+            out[name] = tuple(
+                r.number(v, f"{key}[{i}]") for i, v in enumerate(r.items(value, key, f"{joint.nq} numbers", None))
+            )
+            if len(out[name]) != joint.nq:
+                r.fail(key, f"a {joint.kind} joint's value is its block of q: {joint.nq} numbers, got {len(out[name])}")
+        else:
+            out[name] = r.number(value, key) * (math.pi / 180 if r.deg and joint.kind == "revolute" else 1.0)
+    return out
 
 
 def _visuals(r: _Reader, raw, where: str) -> list:

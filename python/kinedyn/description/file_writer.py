@@ -52,6 +52,9 @@ def robot_to_mapping(robot: Robot | Description, path: str | None = None) -> dic
         data["visuals"] = [_visual_mapping(v, path) for v in robot.visuals]
     if robot.loops:
         data["loops"] = loops_mapping(robot.loops)
+    reference = getattr(robot, "description", robot).reference_configuration
+    if reference:  # radians, as every angle this writer writes
+        data["reference_configuration"] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in reference.items()}
     return data
 
 

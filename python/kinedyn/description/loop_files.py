@@ -16,6 +16,15 @@ roll-pitch-yaw; both default to zero). An end at the link's own frame is that li
 elsewhere adds a frame ``<loop>_a`` (``_b``) on the link there. ``to_urdf`` writes each end as
 the link of the same name (every kinedyn frame is a URDF link in the written file), so a loop
 reads back between the frames it had.
+
+The reference configuration, where the loops close on the branch the mechanism is assembled in, is
+one more top-level element, a value per joint as SRDF's ``<group_state>`` lists them (a multi-DOF
+joint's value is its block of q, numbers separated by spaces)::
+
+    <reference_configuration>
+      <joint name="shoulder" value="-0.5"/>
+      <joint name="elbow" value="1.1"/>
+    </reference_configuration>
 """
 
 from __future__ import annotations
@@ -29,7 +38,16 @@ from .._ui.names import did_you_mean
 from .link import Frame
 from .loops import LOOP_KINDS, Loop
 
-__all__ = ["urdf_loops", "urdf_loop_elements", "mjcf_loop_sites", "write_mjcf_loops", "loops_mapping", "unique_name"]
+__all__ = [
+    "urdf_loops",
+    "urdf_loop_elements",
+    "urdf_reference",
+    "urdf_reference_element",
+    "mjcf_loop_sites",
+    "write_mjcf_loops",
+    "loops_mapping",
+    "unique_name",
+]
 
 _ENDS = (("link1", "a"), ("link2", "b"))
 
@@ -97,6 +115,46 @@ def urdf_loop_elements(robot) -> list:
         ET.SubElement(el, "link2", link=loop.frame_b)
         out.append(el)
     return out
+
+
+def urdf_reference(root, src, joints: dict, floats) -> dict | None:
+    """The ``<reference_configuration>`` element's ``{joint: value}`` (None without one); ``joints``:
+    the moving joints' ``{name: nq}``."""
+    elements = root.findall("reference_configuration")
+    if not elements:
+        return None
+    if len(elements) > 1:
+        raise src.error(elements[1], "a second <reference_configuration> (a robot has one)")
+    out: dict = {}
+    for end in elements[0]:
+        name = end.get("name")
+        if end.tag != "joint" or not name:
+            raise src.error(end, f"<reference_configuration> holds <joint name value/> elements, got <{end.tag}>")
+        if name not in joints:
+            raise src.error(
+                end,
+                f"<reference_configuration> names joint '{name}', which is no moving <joint>{did_you_mean(name, list(joints))}",
+            )
+        if name in out:
+            raise src.error(end, f"<reference_configuration> states joint '{name}' twice")
+        n = joints[name]
+        values = floats(end.get("value"), n, None, f"the reference value of joint '{name}'", end, src)
+        if values is None:
+            raise src.error(end, f"<reference_configuration>: joint '{name}' has no value")
+        out[name] = values[0] if n == 1 else values
+    return out
+
+
+def urdf_reference_element(robot) -> list:
+    """``[<reference_configuration>]`` of ``robot``'s reference configuration, or ``[]``."""
+    reference = getattr(robot, "description", robot).reference_configuration
+    if not reference:
+        return []
+    el = ET.Element("reference_configuration")
+    for name, value in reference.items():
+        values = value if isinstance(value, tuple) else (value,)
+        ET.SubElement(el, "joint", name=name, value=" ".join(repr(float(v)) for v in values))
+    return [el]
 
 
 # ------------------------------------------------------------------------------------------ MJCF

@@ -14,11 +14,12 @@ Algorithms, section 13.4 (holonomic constraints with Lagrange multipliers).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from .._ui.names import did_you_mean
 
-__all__ = ["LOOP_KINDS", "Loop", "check_loops"]
+__all__ = ["LOOP_KINDS", "Loop", "check_loops", "check_reference"]
 
 # kind -> constraint rows (translation; translation and rotation)
 LOOP_KINDS = {"point": 3, "weld": 6}
@@ -71,3 +72,42 @@ def check_loops(loops, frame_names, robot: str) -> tuple:
                 )
         out.append(loop)
     return tuple(out)
+
+
+def check_reference(reference, joints, robot: str) -> dict | None:
+    """``reference`` (a mapping joint name -> value, or None) as a dict of floats: a number for a 1-DOF
+    joint, a tuple of its nq numbers (its block of q) for a multi-DOF one. The reference configuration
+    is where the robot's loops close on the branch it is assembled in (a closed mechanism's assembly
+    mode: MuJoCo's ``qpos0``); ``joints``: the moving joints of the tree."""
+    if reference is None:
+        return None
+    if not hasattr(reference, "items"):
+        raise ValueError(
+            f"robot '{robot}': reference_configuration must map joint names to values, got {type(reference).__name__}"
+        )
+    by_name = {j.name: j for j in joints}
+    out: dict = {}
+    for name, value in reference.items():
+        joint = by_name.get(name)
+        if joint is None:
+            names = list(by_name)
+            raise ValueError(
+                f"robot '{robot}': reference_configuration names joint '{name}', which is no moving joint"
+                f"{did_you_mean(str(name), names)} (moving joints: {names})"
+            )
+        values = value if isinstance(value, (list, tuple)) else (value,)
+        if len(values) != joint.nq or any(isinstance(v, bool) for v in values):
+            raise ValueError(
+                f"robot '{robot}': reference_configuration of joint '{name}' ({joint.kind}) needs {joint.nq} "
+                f"number{'s' * (joint.nq > 1)} (its block of q), got {value!r}"
+            )
+        try:
+            numbers = tuple(float(v) for v in values)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"robot '{robot}': reference_configuration of joint '{name}' must be numbers, got {value!r}"
+            ) from None
+        if not all(math.isfinite(v) for v in numbers):
+            raise ValueError(f"robot '{robot}': reference_configuration of joint '{name}' is not finite: {value!r}")
+        out[name] = numbers[0] if joint.nq == 1 else numbers
+    return out

@@ -145,6 +145,7 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
                 visuals=visuals,
                 collisions=collisions,
                 loops=tuple(loops),
+                reference_configuration=_qpos0(links) if loops else None,
             )
     except ValueError as e:
         raise ValueError(f"{src.label}: {e}") from None
@@ -154,6 +155,17 @@ def description_from_mjcf(path_or_string, *, tool: str | None = None, inertia: s
 
 
 # ============================================================================== the reader
+def _qpos0(links) -> dict:
+    """MuJoCo's reference configuration ``qpos0``, where its body-form equalities close (the loops'
+    assembly mode, docs/closed-loops.md): each hinge and slide at its ``ref`` (its offset is ``-ref``,
+    so kinedyn's ``q`` is MuJoCo's ``qpos``). Ball and free joints are left to the drawing's start."""
+    return {
+        link.joint.name: -float(link.joint.offset)
+        for link in links
+        if link.joint.kind in ("revolute", "prismatic") and link.joint.mimic is None
+    }
+
+
 class _Reader(ModelSettings):
     def __init__(self, src: Sources, root):
         self.src = src

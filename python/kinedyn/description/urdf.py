@@ -68,7 +68,7 @@ from .geometry import Box, Cylinder, Mesh, Sphere, Visual
 from .inertia import Inertia, PhysicalConsistencyWarning
 from .joint import Joint, Mimic
 from .link import Link
-from .loop_files import urdf_loops
+from .loop_files import urdf_loops, urdf_reference
 from .tool import default_tool
 from .xacro import expand_xacro, is_xacro
 
@@ -164,6 +164,8 @@ def description_from_urdf(
     source = src.label if not src.label.startswith("<") else "URDF string"
     visuals, collisions = _geometry(root, list(link_elements.items()), src)
     loop_frames, loops = urdf_loops(root, src, list(link_elements), _floats)  # kinedyn's <loop> extension
+    moving = {link.joint.name: link.joint.nq for link in links if link.joint.is_moving}
+    reference = urdf_reference(root, src, moving, _floats)  # and its <reference_configuration> (loop_files)
     for note in src.notes:
         warnings.warn(note, UserWarning, stacklevel=caller_level())
     # the Description judges the inertias (policy) and checks the tree: its errors and warnings name a
@@ -188,6 +190,7 @@ def description_from_urdf(
                 collisions=collisions,
                 mimic=mimic,
                 loops=tuple(loops),
+                reference_configuration=reference,
             )
     except ValueError as e:
         raise ValueError(f"{src.at(_line_of(str(e), lines))}: {e}") from None
