@@ -66,6 +66,7 @@ class Model:
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
+    def frame_pose(self, q: F64, frame: int) -> F64: ...  # (4, 4) | (N, 4, 4)
     def jacobian(self, q: F64, frame: int, reference: str, point: F64 | None = None) -> F64: ...  # (6, n) | (N, 6, n)
     def jacobian_hessian(
         self, q: F64, frame: int, reference: str, point: F64 | None = None

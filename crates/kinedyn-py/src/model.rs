@@ -252,7 +252,7 @@ model_methods! {
         fn frame_poses<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frames: Bound<'py, PyArray1<i64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.frame_poses", || {
@@ -261,17 +261,14 @@ model_methods! {
                     .iter()
                     .map(|&f| self.frame(f))
                     .collect::<PyResult<Vec<_>>>()?;
-                let nq = self.model.nq;
-                let batch = Batch::gather(&[("q", &q, &[nq])])?;
-                batch.run_kernel(
-                    py,
-                    self,
-                    ("frame_poses", "pose"),
-                    &[ids.len(), 4, 4],
-                    None,
-                    kernels::FramePoses { frames: &ids },
-                )
+                self.poses(py, "frame_poses", &q, &ids, &[ids.len(), 4, 4])
             })
+        }
+
+        /// Pose of one frame: (4, 4) or (N, 4, 4) (`frame_poses` of one frame, without the frames'
+        /// axis: no id array to build and no view to take per call).
+        fn frame_pose<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, frame: i64) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.frame_pose", || self.poses(py, "frame_pose", &q, &[self.frame(frame)?], &[4, 4]))
         }
 
         /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
@@ -279,14 +276,14 @@ model_methods! {
         fn jacobian<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q) = (self.n(), self.model.nq, f64_array("q", &q)?);
                 let batch = Batch::gather(&[("q", &q, &[nq])])?;
                 batch.run_kernel(
                     py,
@@ -308,14 +305,14 @@ model_methods! {
         fn jacobian_hessian<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian_hessian", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q) = (self.n(), self.model.nq, f64_array("q", &q)?);
                 let batch = Batch::gather(&[("q", &q, &[nq])])?;
                 batch.run(
                     py,
@@ -335,15 +332,15 @@ model_methods! {
         fn frame_velocity<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
-            qd: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.frame_velocity", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q, qd) = (self.n(), self.model.nq, f64_array("q", &q)?, f64_array("qd", &qd)?);
                 let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
                 batch.run(py, self, ("frame_velocity", "twist"), &[6], |model, data, x, out| {
                     out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
@@ -357,15 +354,15 @@ model_methods! {
         fn jdot_qd<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
-            qd: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jdot_qd", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q, qd) = (self.n(), self.model.nq, f64_array("q", &q)?, f64_array("qd", &qd)?);
                 let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
                 batch.run(py, self, ("jdot_qd", "dJ/dt qd"), &[6], |model, data, x, out| {
                     out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());

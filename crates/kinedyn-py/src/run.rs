@@ -5,14 +5,14 @@
 use std::borrow::Cow;
 use std::sync::atomic::Ordering;
 
-use kinedyn_core::batch::{self, Input, Kernel, Scratch, Simd};
+use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
 use kinedyn_core::{Data, Error as CoreError, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::conv::{Batch, MAX_INPUTS};
+use crate::conv::{f64_array, Batch, MAX_INPUTS};
 use crate::guard::{self, shape_text};
 use crate::model::PyModel;
 
@@ -45,6 +45,30 @@ pub(crate) fn core_err(e: CoreError) -> PyErr {
             }
         }),
         _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+impl PyModel {
+    /// Poses of the frames `ids` at `q` (any array NumPy takes) as `shape` per state (the core's
+    /// `FramePoses`); `name` is the method's, for the errors.
+    pub(crate) fn poses<'py>(
+        &self,
+        py: Python<'py>,
+        name: &'static str,
+        q: &Bound<'py, PyAny>,
+        ids: &[usize],
+        shape: &[usize],
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array("q", q)?;
+        let batch = Batch::gather(&[("q", &q, &[self.model.nq])])?;
+        batch.run_kernel(
+            py,
+            self,
+            (name, "pose"),
+            shape,
+            None,
+            kernels::FramePoses { frames: ids },
+        )
     }
 }
 
