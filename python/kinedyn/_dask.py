@@ -111,9 +111,7 @@ def _any_dask(values: tuple) -> bool:
     return False
 
 
-def batched(
-    *state_args: str, native: bool = False, errors: Callable | None = None, scalar: bool = False
-) -> Callable[[F], F]:
+def batched(*state_args: str, native: bool = False, errors: Callable | None = None) -> Callable[[F], F]:
     """Decorate a Robot method whose arguments ``state_args`` are (N, ...) batches of states: with a
     dask array among them it returns a lazy dask array (a tuple of them for tuple results).
 
@@ -125,8 +123,7 @@ def batched(
     called with the same arguments, ``return self._model.NAME(args)``; the wrapper then makes that
     call itself instead of calling the method (one Python frame per call instead of two: a single
     state's call is a few hundred nanoseconds, issue 30). ``errors``: the body maps a RuntimeError
-    of that call by ``raise errors(self, e) from None``; ``scalar``: it returns a 0-d result as a
-    Python float (``_arrays.scalar_or_array``). The method itself still serves dask's chunks
+    of that call by ``raise errors(self, e) from None``. The method itself still serves dask's chunks
     (``__wrapped__``), and tests/test_api_native_forward.py checks that both give the same."""
 
     def decorate(method: F) -> F:
@@ -142,14 +139,12 @@ def batched(
         states = ", ".join(state_args) + ("," if len(state_args) == 1 else "")
         self_name = parameters[0].name
         call = f"{self_name}._model.{method.__name__}({names})" if native else f"_method({self_name}, {names})"
-        if scalar:
-            body = f"    r = {call}\n    return float(r) if r.ndim == 0 else r\n"
-        elif errors is not None:
+        if errors is not None:
             body = f"    try:\n        return {call}\n    except RuntimeError as e:\n        raise _errors({self_name}, e) from None\n"
         else:
             body = f"    return {call}\n"
-        if (scalar or errors is not None) and not native:
-            raise TypeError(f"batched: {method.__name__}: errors= and scalar= describe a native=True body")
+        if errors is not None and not native:
+            raise TypeError(f"batched: {method.__name__}: errors= describes a native=True body")
         source = (
             f"def {method.__name__}({header}):\n"
             f"    if _DASK_ARRAY in _MODULES and _any_dask(({states})):\n"

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Union
 import numpy as np
 
 from . import configuration, display, dynamics
-from ._arrays import point_in_frame, scalar_or_array
+from ._arrays import point_in_frame
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from ._ui.names import did_you_mean
@@ -591,15 +591,15 @@ class Robot(ClosedLoops):
         """C(q, qd) qd + g(q) (without friction)."""
         return self._model.bias_torque(q, qd, out)
 
-    @batched("q", "qd", native=True, scalar=True)
+    @batched("q", "qd", native=True)
     def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> FloatOrArray:
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
-        return scalar_or_array(self._model.kinetic_energy(q, qd))
+        return self._model.kinetic_energy(q, qd)  # the native model gives a float for one state
 
-    @batched("q", native=True, scalar=True)
+    @batched("q", native=True)
     def potential_energy(self, q: ArrayLike) -> FloatOrArray:
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
-        return scalar_or_array(self._model.potential_energy(q))
+        return self._model.potential_energy(q)
 
     @batched("q", native=True)
     def center_of_mass(self, q: ArrayLike) -> np.ndarray:

@@ -99,6 +99,13 @@ fn bytes_text(bytes: u128) -> String {
 /// Check that `count` float64 arrays of `shape` can exist at all (their bytes fit in `isize`,
 /// the most any allocation may hold); `what` names the caller for the message.
 pub fn check_size(what: &str, count: usize, shape: &[usize]) -> PyResult<()> {
+    // every call asks: the common answer in machine words first (no 128-bit products)
+    let small = shape
+        .iter()
+        .try_fold(8usize.saturating_mul(count), |b, &d| b.checked_mul(d));
+    if small.is_some_and(|b| b <= isize::MAX as usize) {
+        return Ok(());
+    }
     let elements = shape.iter().map(|&d| d as u128).product::<u128>();
     let bytes = elements * 8 * count as u128;
     if bytes > isize::MAX as u128 {

@@ -115,7 +115,7 @@ macro_rules! model_methods {
                     $($arg: Bound<'py, PyAny>,)+
                     $($fext: Option<Bound<'py, PyAny>>,)?
                     $($out: Option<Bound<'py, PyAny>>,)?
-                ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+                ) -> PyResult<Bound<'py, PyAny>> {
                     guarded(concat!("Model.", stringify!($name)), || {
                         $(let $fext = $fext.map(|f| f64_array("f_ext", &f)).transpose()?;)?
                         $(let $arg = f64_array(stringify!($arg), &$arg)?;)+
@@ -137,12 +137,17 @@ macro_rules! model_methods {
         $self.gather_dynamics([$((stringify!($arg), &$arg)),+], $fext.as_ref())?
     };
     (@run kernel $batch:ident, $($args:expr),+) => {
-        $batch.run_kernel($($args),+)
+        $batch.run_kernel($($args),+).map(Bound::into_any)
     };
+    // a scalar per state: a Python float for a single state (no 0-d array), else an array
+    (@run scalar $batch:ident, $py:expr, $m:expr, $what:expr, $dims:expr, $out:expr, $kernel:expr) => {{
+        let _none: Option<Bound<'_, PyAny>> = $out;
+        $batch.run_scalar($py, $m, $what, $kernel)
+    }};
     // one state at a time; no `out=` (a row of this form never has one)
     (@run per_state $batch:ident, $py:expr, $m:expr, $what:expr, $dims:expr, $out:expr, $kernel:expr) => {{
         let _none: Option<Bound<'_, PyAny>> = $out;
-        $batch.run($py, $m, $what, $dims, $kernel)
+        $batch.run($py, $m, $what, $dims, $kernel).map(Bound::into_any)
     }};
     (@out) => {
         None
@@ -170,10 +175,10 @@ model_methods! {
     fn gravity_torque(q: nq) -> "g" [n], out = kernel kernels::Gravity;
     /// C qd + g (n,) | (N, n), without friction.
     fn bias_torque(q: nq, qd: n) -> "bias" [n], out = kernel kernels::Bias;
-    /// K () | (N,).
-    fn kinetic_energy(q: nq, qd: n) -> "K" [] = kernel kernels::KineticEnergy;
-    /// P () | (N,).
-    fn potential_energy(q: nq) -> "P" [] = kernel kernels::PotentialEnergy;
+    /// K, a float | (N,).
+    fn kinetic_energy(q: nq, qd: n) -> "K" [] = scalar kernels::KineticEnergy;
+    /// P, a float | (N,).
+    fn potential_energy(q: nq) -> "P" [] = scalar kernels::PotentialEnergy;
     /// Y (n, 10 n) | (N, n, 10 n).
     fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernel kernels::Regressor;
     /// Centre of mass (3,) | (N, 3) in base coordinates.

@@ -223,6 +223,31 @@ impl<'a> Batch<'a> {
         Ok(array)
     }
 
+    /// `run_kernel` for a kernel of one number per state: a single state's result as a Python
+    /// float, computed into a stack slot (no 0-d array to allocate, read and free: the energies'
+    /// per-call cost, issue 30). A failing state (a core error, a non-finite result) is run again
+    /// by `run_kernel`, which raises its error with the batch path's messages.
+    pub(crate) fn run_scalar<'py, Kn: Kernel>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Output,
+        kernel: Kn,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if self.batch.is_none() {
+            m.check_configurations(&self.values[0])?;
+            let mut value = [0.0];
+            let done = {
+                let mut data = m.data.lock().unwrap_or_else(|e| e.into_inner());
+                kernel.run(&m.model, &mut data, &self.state(0), &mut value)
+            };
+            if done.is_ok() && value[0].is_finite() {
+                return Ok(pyo3::types::PyFloat::new(py, value[0]).into_any());
+            }
+        }
+        self.run_kernel(py, m, what, &[], None, kernel).map(Bound::into_any)
+    }
+
     /// `out` as the destination of this call's result (see `run_out`), or a clear error.
     pub(crate) fn checked_out<'py>(
         &self,
