@@ -66,6 +66,7 @@ class Model:
     def n_frames(self) -> int: ...
     # ---- kinematics (issue 2) ----
     def frame_poses(self, q: F64, frames: I64) -> F64: ...  # (k, 4, 4) | (N, k, 4, 4)
+    def frame_pose(self, q: F64, frame: int) -> F64: ...  # (4, 4) | (N, 4, 4)
     def jacobian(self, q: F64, frame: int, reference: str, point: F64 | None = None) -> F64: ...  # (6, n) | (N, 6, n)
     def jacobian_hessian(
         self, q: F64, frame: int, reference: str, point: F64 | None = None
@@ -92,8 +93,8 @@ class Model:
     def christoffel(self, q: F64) -> F64: ...  # (n, n, n) | (N, n, n, n), c[i, j, k]
     def gravity_torque(self, q: F64, out: F64 | None = None) -> F64: ...  # (n,) | (N, n)
     def bias_torque(self, q: F64, qd: F64, out: F64 | None = None) -> F64: ...  # (n,) | (N, n), C qd + g
-    def kinetic_energy(self, q: F64, qd: F64) -> F64: ...  # () | (N,)
-    def potential_energy(self, q: F64) -> F64: ...  # () | (N,)
+    def kinetic_energy(self, q: F64, qd: F64) -> float | F64: ...  # a float | (N,)
+    def potential_energy(self, q: F64) -> float | F64: ...  # a float | (N,)
     def inverse_dynamics_derivatives(
         self, q: F64, qd: F64, qdd: F64, f_ext: F64 | None = None
     ) -> tuple[F64, F64, F64]: ...

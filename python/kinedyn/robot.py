@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Union
 import numpy as np
 
 from . import configuration, display, dynamics
-from ._arrays import float64_array, point_in_frame, scalar_or_array
+from ._arrays import point_in_frame
 from ._dask import batched, dask_targets, is_dask_array, lazy_inverse_kinematics
 from ._math import by_name, to_float_array
 from ._ui.names import did_you_mean
@@ -385,31 +385,29 @@ class Robot(ClosedLoops):
     @batched("q")
     def forward_kinematics(self, q: ArrayLike) -> np.ndarray:
         """Poses of the moving links' frames in the base: (n, 4, 4), or (N, n, 4, 4) for a batch."""
-        return self._model.frame_poses(float64_array(q), self._link_frame_ids)
+        return self._model.frame_poses(q, self._link_frame_ids)
 
     @batched("q")
     def frame_poses(self, q: ArrayLike, frames: Sequence[str] | None = None) -> np.ndarray:
         """Poses of the named frames (all frames if None): (k, 4, 4) or (N, k, 4, 4)."""
         names = self.frame_names if frames is None else list(frames)
         ids = np.array([self.frame_index(f) for f in names], dtype=np.int64)
-        return self._model.frame_poses(float64_array(q), ids)
+        return self._model.frame_poses(q, ids)
 
     @batched("q")
     def pose(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Pose of one frame (default: the tool) in the base: (4, 4) or (N, 4, 4)."""
-        out = self._model.frame_poses(float64_array(q), self._frame_id_array(frame or self.tool))
-        return out[0] if out.ndim == 3 else out[:, 0]
+        # the native model converts and checks q (shape, dtype, finite) with the messages of
+        # kinedyn._arrays.real_array; here only the frame's index, the tool's looked up once
+        fid = self._tool_frame_id if frame is None else self._frame_ids.get(frame)
+        if fid is None:  # the checked path, with its error message
+            fid = self.frame_index(frame or self.tool)
+        return self._model.frame_pose(q, fid)
 
     @cached_property
-    def _frame_id_arrays(self) -> dict:
-        return {}
-
-    def _frame_id_array(self, frame: str) -> np.ndarray:
-        """A one-element id array per frame name, made once."""
-        ids = self._frame_id_arrays.get(frame)
-        if ids is None:
-            ids = self._frame_id_arrays[frame] = np.array([self.frame_index(frame)], dtype=np.int64)
-        return ids
+    def _tool_frame_id(self) -> int | None:
+        """The tool frame's index (None: no tool, frame_index names the problem)."""
+        return self._frame_ids.get(self.tool)
 
     @batched("q")
     def jacobian(
@@ -421,10 +419,10 @@ class Robot(ClosedLoops):
         axes) and angular velocity, in base axes; ``"local"``: both in the frame's axes;
         ``"spatial"``: the spatial Jacobian (velocity of the body point at the base origin).
         """
-        fid = self._frame_ids.get(frame or self.tool)
+        fid = self._tool_frame_id if frame is None else self._frame_ids.get(frame)
         if fid is None or point is not None:  # the checked path, with its error messages
             fid, point = self.frame_index(frame or self.tool), point_in_frame(point)
-        return self._model.jacobian(float64_array(q), fid, reference, point)
+        return self._model.jacobian(q, fid, reference, point)
 
     @batched("q")
     def jacobian_hessian(
@@ -441,7 +439,7 @@ class Robot(ClosedLoops):
         Jacobian's columns (Haviland & Corke 2022, Part I; derivation in crates/kinedyn-core/src/algorithms/jacobian.rs).
         """
         fid = self.frame_index(frame or self.tool)
-        return self._model.jacobian_hessian(float64_array(q), fid, reference, point_in_frame(point))
+        return self._model.jacobian_hessian(q, fid, reference, point_in_frame(point))
 
     @batched("q", "qd")
     def frame_velocity(
@@ -454,8 +452,8 @@ class Robot(ClosedLoops):
     ) -> np.ndarray:
         """Twist [v; w] of a frame, = J(q) qd, computed by the recursive velocity pass."""
         return self._model.frame_velocity(
-            float64_array(q),
-            float64_array(qd, "qd"),
+            q,
+            qd,
             self.frame_index(frame or self.tool),
             reference,
             point_in_frame(point),
@@ -472,8 +470,8 @@ class Robot(ClosedLoops):
     ) -> np.ndarray:
         """The acceleration drift dJ/dt qd: the frame's (classical) acceleration when qdd = 0."""
         return self._model.jdot_qd(
-            float64_array(q),
-            float64_array(qd, "qd"),
+            q,
+            qd,
             self.frame_index(frame or self.tool),
             reference,
             point_in_frame(point),
@@ -510,7 +508,7 @@ class Robot(ClosedLoops):
     # Equations of motion (docs/architecture.md): M(q) qdd + C(q, qd) qd + g(q) + friction(qd) = tau + sum_i J_i^T f_ext_i,
     # friction = viscous qd + coulomb sign(qd) (direction-dependent levels: friction_torque), M including
     # the reflected rotor inertia r^2 J_m.
-    @batched("q", "qd", "qdd", "f_ext")
+    @batched("q", "qd", "qdd", "f_ext", native=True)
     def inverse_dynamics(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: ArrayLike | None = None, out: np.ndarray | None = None
     ) -> np.ndarray:
@@ -522,14 +520,14 @@ class Robot(ClosedLoops):
         ``J_i^T`` with ``J_i = robot.jacobian(q, frame=body_names[i], reference="world")``; or None."""
         return self._model.inverse_dynamics(q, qd, qdd, f_ext, out)
 
-    @batched("q")
+    @batched("q", native=True)
     def mass_matrix(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """M(q) (composite-rigid-body algorithm), reflected rotor inertia included; exactly symmetric.
         ``out``: a float64 array of the result's shape to write into instead of allocating one (as
         NumPy's ``out=``; also on the other per-step methods, for control loops)."""
         return self._model.mass_matrix(q, out)
 
-    @batched("q")
+    @batched("q", native=True, errors=robot_error)
     def mass_matrix_inverse(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """M(q)^-1 (sparse L^T D L factorisation of M); RuntimeError if M is singular."""
         try:
@@ -537,7 +535,7 @@ class Robot(ClosedLoops):
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
-    @batched("q", "qd", "tau", "f_ext")
+    @batched("q", "qd", "tau", "f_ext", native=True, errors=robot_error)
     def forward_dynamics(
         self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: ArrayLike | None = None, out: np.ndarray | None = None
     ) -> np.ndarray:
@@ -549,7 +547,7 @@ class Robot(ClosedLoops):
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
-    @batched("q", "qd", "qdd", "f_ext")
+    @batched("q", "qd", "qdd", "f_ext", native=True)
     def inverse_dynamics_derivatives(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext: ArrayLike | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -561,7 +559,7 @@ class Robot(ClosedLoops):
         (qd != 0)."""
         return self._model.inverse_dynamics_derivatives(q, qd, qdd, f_ext)
 
-    @batched("q", "qd", "tau", "f_ext")
+    @batched("q", "qd", "tau", "f_ext", native=True, errors=robot_error)
     def forward_dynamics_derivatives(
         self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext: ArrayLike | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -573,49 +571,49 @@ class Robot(ClosedLoops):
         except RuntimeError as e:
             raise robot_error(self, e) from None
 
-    @batched("q", "qd")
+    @batched("q", "qd", native=True)
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """C(q, qd) built from Christoffel symbols, so that dM/dt - 2C is skew-symmetric."""
         return self._model.coriolis_matrix(q, qd, out)
 
-    @batched("q")
+    @batched("q", native=True)
     def christoffel(self, q: ArrayLike) -> np.ndarray:
         """c[i, j, k] = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) (Spong eq. 9.58), (n, n, n);
         ``C[k, j] = sum_i c[i, j, k] qd[i]``."""
         return self._model.christoffel(q)
 
-    @batched("q")
+    @batched("q", native=True)
     def gravity_torque(self, q: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """g(q) = dP/dq."""
         return self._model.gravity_torque(q, out)
 
-    @batched("q", "qd")
+    @batched("q", "qd", native=True)
     def bias_torque(self, q: ArrayLike, qd: ArrayLike, out: np.ndarray | None = None) -> np.ndarray:
         """C(q, qd) qd + g(q) (without friction)."""
         return self._model.bias_torque(q, qd, out)
 
-    @batched("q", "qd")
+    @batched("q", "qd", native=True)
     def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> FloatOrArray:
         """K = 1/2 qd . M(q) qd (rotor inertia included): a float, or (N,) for a batch."""
-        return scalar_or_array(self._model.kinetic_energy(q, qd))
+        return self._model.kinetic_energy(q, qd)  # the native model gives a float for one state
 
-    @batched("q")
+    @batched("q", native=True)
     def potential_energy(self, q: ArrayLike) -> FloatOrArray:
         """P = -sum_i m_i g . c_i (zero with all masses at the base origin): a float, or (N,)."""
-        return scalar_or_array(self._model.potential_energy(q))
+        return self._model.potential_energy(q)
 
-    @batched("q")
+    @batched("q", native=True)
     def center_of_mass(self, q: ArrayLike) -> np.ndarray:
         """Centre of mass of the moving links in base coordinates, (3,) or (N, 3)."""
         return self._model.center_of_mass(q)
 
-    @batched("q", "qd")
+    @batched("q", "qd", native=True)
     def momentum(self, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
         """Spatial momentum of the robot, (6,) or (N, 6): [linear momentum; angular momentum about
         the base origin], base axes (Pinocchio's WORLD-frame momentum)."""
         return self._model.momentum(q, qd)
 
-    @batched("q")
+    @batched("q", native=True)
     def centroidal_momentum_matrix(self, q: ArrayLike) -> np.ndarray:
         """A_G(q), (6, n) or (N, 6, n): the momentum about the centre of mass, h_G = A_G qd =
         [m c_dot; L_G] in base axes (Orin, Goswami & Lee 2013; Pinocchio's ``ccrba`` ``Ag``)."""

@@ -7,7 +7,7 @@ use std::borrow::Cow;
 use kinedyn_core::algorithms::Reference;
 use kinedyn_core::spatial::Vec3;
 use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 
@@ -93,10 +93,21 @@ pub(crate) fn f64_array<'py>(name: &str, x: &Bound<'py, PyAny>) -> PyResult<Boun
     let asarray = ASARRAY
         .get_or_try_init(py, || py.import("numpy")?.getattr("asarray").map(Bound::unbind))?
         .bind(py);
+    // a Python integer beyond float64 (and int64): the ValueError of `_arrays.real_array`
+    let too_large = |e: PyErr| {
+        if e.is_instance_of::<PyOverflowError>(py) {
+            PyValueError::new_err(format!("{name} holds an integer too large for float64"))
+        } else {
+            e
+        }
+    };
     // an array (or what NumPy makes of a list) of what dtype?
     let array = match x.cast::<numpy::PyUntypedArray>() {
         Ok(a) => a.clone(),
-        Err(_) => asarray.call1((x,))?.cast_into::<numpy::PyUntypedArray>()?,
+        Err(_) => asarray
+            .call1((x,))
+            .map_err(too_large)?
+            .cast_into::<numpy::PyUntypedArray>()?,
     };
     let dtype = array.dtype();
     let kind = dtype.kind();
@@ -110,6 +121,9 @@ pub(crate) fn f64_array<'py>(name: &str, x: &Bound<'py, PyAny>) -> PyResult<Boun
     }
     let kwargs = [("dtype", "float64")].into_py_dict(py)?;
     let converted = asarray.call((&array,), Some(&kwargs)).map_err(|e| {
+        if e.is_instance_of::<PyOverflowError>(py) {
+            return too_large(e);
+        }
         // an object array holding something that is not a real number (complex, None, text ...)
         PyTypeError::new_err(format!("{name} must be real numbers: {}", e.value(py)))
     })?;

@@ -99,6 +99,13 @@ fn bytes_text(bytes: u128) -> String {
 /// Check that `count` float64 arrays of `shape` can exist at all (their bytes fit in `isize`,
 /// the most any allocation may hold); `what` names the caller for the message.
 pub fn check_size(what: &str, count: usize, shape: &[usize]) -> PyResult<()> {
+    // every call asks: the common answer in machine words first (no 128-bit products)
+    let small = shape
+        .iter()
+        .try_fold(8usize.saturating_mul(count), |b, &d| b.checked_mul(d));
+    if small.is_some_and(|b| b <= isize::MAX as usize) {
+        return Ok(());
+    }
     let elements = shape.iter().map(|&d| d as u128).product::<u128>();
     let bytes = elements * 8 * count as u128;
     if bytes > isize::MAX as u128 {
@@ -137,19 +144,31 @@ fn allocate<'py, T: Element>(
     zeroed: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     check_size(what, 1, shape)?;
-    let mut dims: Vec<npy_intp> = shape.iter().map(|&d| d as npy_intp).collect();
+    // the dimensions on the stack: a per-call Vec was a malloc and a free on every single call
+    const MAX_DIMS: usize = 32; // NumPy 1.x's NPY_MAXDIMS; kinedyn's results have at most 5
+    if shape.len() > MAX_DIMS {
+        return Err(PyRuntimeError::new_err(format!(
+            "{what}: a result of {} dimensions (NumPy allows {MAX_DIMS})",
+            shape.len()
+        )));
+    }
+    let mut dims: [npy_intp; MAX_DIMS] = [0; MAX_DIMS];
+    for (d, &s) in dims.iter_mut().zip(shape) {
+        *d = s as npy_intp;
+    }
+    let ndim = shape.len() as i32;
     // SAFETY: the NumPy C API with a valid descriptor (its reference is stolen by the call) and
-    // `dims.len()` dimensions; a NULL result leaves a Python error set, fetched below.
+    // `ndim` dimensions; a NULL result leaves a Python error set, fetched below.
     unsafe {
         let descr = T::get_dtype(py).into_dtype_ptr();
         let ptr = if zeroed {
-            PY_ARRAY_API.PyArray_Zeros(py, dims.len() as i32, dims.as_mut_ptr(), descr, 0)
+            PY_ARRAY_API.PyArray_Zeros(py, ndim, dims.as_mut_ptr(), descr, 0)
         } else {
             PY_ARRAY_API.PyArray_NewFromDescr(
                 py,
                 PY_ARRAY_API.get_type_object(py, npyffi::NpyTypes::PyArray_Type),
                 descr,
-                dims.len() as i32,
+                ndim,
                 dims.as_mut_ptr(),
                 ptr::null_mut(),
                 ptr::null_mut(),

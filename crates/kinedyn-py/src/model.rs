@@ -115,7 +115,7 @@ macro_rules! model_methods {
                     $($arg: Bound<'py, PyAny>,)+
                     $($fext: Option<Bound<'py, PyAny>>,)?
                     $($out: Option<Bound<'py, PyAny>>,)?
-                ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+                ) -> PyResult<Bound<'py, PyAny>> {
                     guarded(concat!("Model.", stringify!($name)), || {
                         $(let $fext = $fext.map(|f| f64_array("f_ext", &f)).transpose()?;)?
                         $(let $arg = f64_array(stringify!($arg), &$arg)?;)+
@@ -137,12 +137,17 @@ macro_rules! model_methods {
         $self.gather_dynamics([$((stringify!($arg), &$arg)),+], $fext.as_ref())?
     };
     (@run kernel $batch:ident, $($args:expr),+) => {
-        $batch.run_kernel($($args),+)
+        $batch.run_kernel($($args),+).map(Bound::into_any)
     };
+    // a scalar per state: a Python float for a single state (no 0-d array), else an array
+    (@run scalar $batch:ident, $py:expr, $m:expr, $what:expr, $dims:expr, $out:expr, $kernel:expr) => {{
+        let _none: Option<Bound<'_, PyAny>> = $out;
+        $batch.run_scalar($py, $m, $what, $kernel)
+    }};
     // one state at a time; no `out=` (a row of this form never has one)
     (@run per_state $batch:ident, $py:expr, $m:expr, $what:expr, $dims:expr, $out:expr, $kernel:expr) => {{
         let _none: Option<Bound<'_, PyAny>> = $out;
-        $batch.run($py, $m, $what, $dims, $kernel)
+        $batch.run($py, $m, $what, $dims, $kernel).map(Bound::into_any)
     }};
     (@out) => {
         None
@@ -170,10 +175,10 @@ model_methods! {
     fn gravity_torque(q: nq) -> "g" [n], out = kernel kernels::Gravity;
     /// C qd + g (n,) | (N, n), without friction.
     fn bias_torque(q: nq, qd: n) -> "bias" [n], out = kernel kernels::Bias;
-    /// K () | (N,).
-    fn kinetic_energy(q: nq, qd: n) -> "K" [] = kernel kernels::KineticEnergy;
-    /// P () | (N,).
-    fn potential_energy(q: nq) -> "P" [] = kernel kernels::PotentialEnergy;
+    /// K, a float | (N,).
+    fn kinetic_energy(q: nq, qd: n) -> "K" [] = scalar kernels::KineticEnergy;
+    /// P, a float | (N,).
+    fn potential_energy(q: nq) -> "P" [] = scalar kernels::PotentialEnergy;
     /// Y (n, 10 n) | (N, n, 10 n).
     fn regressor(q: nq, qd: n, qdd: n) -> "Y" [n, 10 * n] = kernel kernels::Regressor;
     /// Centre of mass (3,) | (N, 3) in base coordinates.
@@ -252,7 +257,7 @@ model_methods! {
         fn frame_poses<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frames: Bound<'py, PyArray1<i64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.frame_poses", || {
@@ -261,17 +266,14 @@ model_methods! {
                     .iter()
                     .map(|&f| self.frame(f))
                     .collect::<PyResult<Vec<_>>>()?;
-                let nq = self.model.nq;
-                let batch = Batch::gather(&[("q", &q, &[nq])])?;
-                batch.run_kernel(
-                    py,
-                    self,
-                    ("frame_poses", "pose"),
-                    &[ids.len(), 4, 4],
-                    None,
-                    kernels::FramePoses { frames: &ids },
-                )
+                self.poses(py, "frame_poses", &q, &ids, &[ids.len(), 4, 4])
             })
+        }
+
+        /// Pose of one frame: (4, 4) or (N, 4, 4) (`frame_poses` of one frame, without the frames'
+        /// axis: no id array to build and no view to take per call).
+        fn frame_pose<'py>(&self, py: Python<'py>, q: Bound<'py, PyAny>, frame: i64) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            guarded("Model.frame_pose", || self.poses(py, "frame_pose", &q, &[self.frame(frame)?], &[4, 4]))
         }
 
         /// Jacobian (6, n) or (N, 6, n) of a frame or a point fixed in it.
@@ -279,14 +281,14 @@ model_methods! {
         fn jacobian<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q) = (self.n(), self.model.nq, f64_array("q", &q)?);
                 let batch = Batch::gather(&[("q", &q, &[nq])])?;
                 batch.run_kernel(
                     py,
@@ -308,14 +310,14 @@ model_methods! {
         fn jacobian_hessian<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jacobian_hessian", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q) = (self.n(), self.model.nq, f64_array("q", &q)?);
                 let batch = Batch::gather(&[("q", &q, &[nq])])?;
                 batch.run(
                     py,
@@ -335,15 +337,15 @@ model_methods! {
         fn frame_velocity<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
-            qd: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.frame_velocity", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q, qd) = (self.n(), self.model.nq, f64_array("q", &q)?, f64_array("qd", &qd)?);
                 let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
                 batch.run(py, self, ("frame_velocity", "twist"), &[6], |model, data, x, out| {
                     out.copy_from_slice(&algorithms::frame_velocity(model, data, x[0], x[1], f, r, p.as_ref()).to_array());
@@ -357,15 +359,15 @@ model_methods! {
         fn jdot_qd<'py>(
             &self,
             py: Python<'py>,
-            q: Bound<'py, PyArrayDyn<f64>>,
-            qd: Bound<'py, PyArrayDyn<f64>>,
+            q: Bound<'py, PyAny>,
+            qd: Bound<'py, PyAny>,
             frame: i64,
             reference: &str,
             point: Option<PyReadonlyArrayDyn<f64>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             guarded("Model.jdot_qd", || {
                 let (f, r, p) = (self.frame(frame)?, conv::reference(reference)?, conv::point(point)?);
-                let (n, nq) = (self.n(), self.model.nq);
+                let (n, nq, q, qd) = (self.n(), self.model.nq, f64_array("q", &q)?, f64_array("qd", &qd)?);
                 let batch = Batch::gather(&[("q", &q, &[nq]), ("qd", &qd, &[n])])?;
                 batch.run(py, self, ("jdot_qd", "dJ/dt qd"), &[6], |model, data, x, out| {
                     out.copy_from_slice(&algorithms::jacobian_dot_qd(model, data, x[0], x[1], f, r, p.as_ref()).to_array());

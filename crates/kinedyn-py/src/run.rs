@@ -5,14 +5,14 @@
 use std::borrow::Cow;
 use std::sync::atomic::Ordering;
 
-use kinedyn_core::batch::{self, Input, Kernel, Scratch, Simd};
+use kinedyn_core::batch::{self, kernels, Input, Kernel, Scratch, Simd};
 use kinedyn_core::{Data, Error as CoreError, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::conv::{Batch, MAX_INPUTS};
+use crate::conv::{f64_array, Batch, MAX_INPUTS};
 use crate::guard::{self, shape_text};
 use crate::model::PyModel;
 
@@ -45,6 +45,30 @@ pub(crate) fn core_err(e: CoreError) -> PyErr {
             }
         }),
         _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+impl PyModel {
+    /// Poses of the frames `ids` at `q` (any array NumPy takes) as `shape` per state (the core's
+    /// `FramePoses`); `name` is the method's, for the errors.
+    pub(crate) fn poses<'py>(
+        &self,
+        py: Python<'py>,
+        name: &'static str,
+        q: &Bound<'py, PyAny>,
+        ids: &[usize],
+        shape: &[usize],
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let q = f64_array("q", q)?;
+        let batch = Batch::gather(&[("q", &q, &[self.model.nq])])?;
+        batch.run_kernel(
+            py,
+            self,
+            (name, "pose"),
+            shape,
+            None,
+            kernels::FramePoses { frames: ids },
+        )
     }
 }
 
@@ -197,6 +221,31 @@ impl<'a> Batch<'a> {
             |model, data, x, [out]| kernel.run(model, data, x, out),
         )?;
         Ok(array)
+    }
+
+    /// `run_kernel` for a kernel of one number per state: a single state's result as a Python
+    /// float, computed into a stack slot (no 0-d array to allocate, read and free: the energies'
+    /// per-call cost, issue 30). A failing state (a core error, a non-finite result) is run again
+    /// by `run_kernel`, which raises its error with the batch path's messages.
+    pub(crate) fn run_scalar<'py, Kn: Kernel>(
+        &self,
+        py: Python<'py>,
+        m: &PyModel,
+        what: Output,
+        kernel: Kn,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if self.batch.is_none() {
+            m.check_configurations(&self.values[0])?;
+            let mut value = [0.0];
+            let done = {
+                let mut data = m.data.lock().unwrap_or_else(|e| e.into_inner());
+                kernel.run(&m.model, &mut data, &self.state(0), &mut value)
+            };
+            if done.is_ok() && value[0].is_finite() {
+                return Ok(pyo3::types::PyFloat::new(py, value[0]).into_any());
+            }
+        }
+        self.run_kernel(py, m, what, &[], None, kernel).map(Bound::into_any)
     }
 
     /// `out` as the destination of this call's result (see `run_out`), or a clear error.

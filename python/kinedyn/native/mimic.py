@@ -140,6 +140,9 @@ class ReducedModel(ReducedLoops):
     def frame_poses(self, q, frames):
         return self.native.frame_poses(self._q(q)[1], frames)
 
+    def frame_pose(self, q, frame):
+        return self.native.frame_pose(self._q(q)[1], frame)
+
     def jacobian(self, q, frame, reference, point=None):
         return self.native.jacobian(self._q(q)[1], frame, reference, point) @ self.G
 
