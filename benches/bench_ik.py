@@ -1,6 +1,6 @@
 """Inverse kinematics benchmark (never a CI gate; prints figures and ratios measured in one run).
 
-    PYTHONPATH=python python benches/bench_ik.py [--targets 300] [--calls 3000]
+    PYTHONPATH=python python benches/bench_ik.py [--targets 300] [--calls 3000] [--sections analytic,peers,numeric]
 
 1. Closed forms, all solutions, per call from Python (``robot.inverse_kinematics(T)``), for the
    tutorial elbow arm (position target), the PUMA 560 and the UR5 (poses); also the native call
@@ -260,13 +260,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--calls", type=int, default=3000, help="targets for the closed-form timings")
     parser.add_argument("--targets", type=int, default=300, help="targets for the numeric comparison")
+    parser.add_argument(
+        "--sections",
+        default="analytic,peers,numeric",
+        help="comma-separated sections to run (analytic, peers, numeric)",
+    )
     args = parser.parse_args()
+    sections = set(args.sections.split(","))
     import os
 
     print(f"kinedyn {kd.__version__}; numpy {np.__version__}; CPUs {os.cpu_count()}")
-    analytic_section(args.calls)
-    peers_section(args.calls)
-    numeric_section(args.targets)
+    if "analytic" in sections:
+        analytic_section(args.calls)
+    if "peers" in sections:
+        peers_section(args.calls)
+    if "numeric" in sections:
+        numeric_section(args.targets)
 
 
 if __name__ == "__main__":
