@@ -228,9 +228,12 @@ impl Check<'_> {
         }
         let e = pose_error(&frame_pose_lean(model, &q, self.frame), target);
         let (mut ep, mut er) = residuals(&e, &weights);
-        if (ep > 1e-12 || er > 1e-12) && ep < 1e-4 && er < 1e-4 {
-            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits; a
-            // held joint stays where it is held)
+        // refine near-tangent candidates (residuals of the order of the square root of rounding)
+        // by a few damped Gauss-Newton steps (no limits; a held joint stays where it is held);
+        // not those at rounding level already, well inside the tolerance: refining them gains
+        // nothing the caller asked for and costs a Jacobian per step (docs/ik.md, "Speed")
+        let refine_above = (0.01 * self.tolerance).min(1e-10);
+        if (ep > refine_above || er > refine_above) && ep < 1e-4 && er < 1e-4 {
             let refine = Settings {
                 weights,
                 max_iterations: 8,
