@@ -12,6 +12,7 @@ Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from math import isfinite
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -254,6 +255,15 @@ def _target(target: ArrayLike) -> tuple:
         )
     # a target so far away that the solver's squared residuals would overflow float64 (NaN and inf
     # are checked natively)
+    if not batch:
+        # one target: three Python floats, cheaper than array reductions on a per-call path
+        x, y, z = (t if position else t[:3, 3]).tolist()
+        if isfinite(x) and isfinite(y) and isfinite(z) and max(abs(x), abs(y), abs(z)) > MAX_REACH:
+            raise ValueError(
+                f"target position is {max(abs(x), abs(y), abs(z)):.3g} m from the base: beyond {MAX_REACH:g} m, "
+                "no robot reaches it (and float64 cannot solve for it)"
+            )
+        return t, position, batch
     reach = np.abs(t if position else t[..., :3, 3])
     if np.isfinite(reach).all() and reach.max(initial=0.0) > MAX_REACH:
         raise ValueError(
