@@ -189,6 +189,33 @@ def test_eight_solutions_at_generic_poses(name, q):
     assert len(robot.inverse_kinematics(robot.pose(np.array(poses[0])), respect_limits=False)) == 8
 
 
+def test_a_rail_under_an_intersecting_shoulder_has_four():
+    # joint 1 prismatic, axes 2 and 3 meeting: arm_prismatic_base (crates/kinedyn-core/src/ik/prismatic.rs);
+    # every solution reproduces the target (FK), the original is one, and the numeric solver from
+    # random starts finds none outside them (the Rust test checks the count by a dense search)
+    rows = [kd.DHRow(kind="prismatic", a=0.1, theta=0.3), kd.DHRow(alpha=np.pi / 2), kd.DHRow(a=0.4)]
+    rail = kd.Robot.from_dh(rows, name="rail")  # (massless: a kinematic model)
+    assert ik.analytic_structure(rail) == "arm_prismatic_base"
+    q = np.array([0.2, 0.5, -0.7])
+    p = rail.pose(q)[:3, 3]
+    res = rail.inverse_kinematics(p, respect_limits=False)
+    assert (len(res), res.max_solutions, res.merged) == (4, 4, False)
+    for s in res.solutions:
+        np.testing.assert_allclose(rail.pose(s)[:3, 3], p, atol=1e-12)
+
+    def gap(x):  # to the nearest closed-form solution, the revolute angles modulo 2 pi
+        d = x - res.solutions
+        d[:, 1:] -= 2 * np.pi * np.round(d[:, 1:] / (2 * np.pi))
+        return np.abs(d).max(axis=1).min()
+
+    assert gap(q) < 1e-9
+    for seed in range(8):
+        start = np.random.default_rng(seed).uniform(-2, 2, 3)
+        num = rail.inverse_kinematics(p, start, method="numeric", respect_limits=False, seed=seed)
+        if num.success:
+            assert gap(num.solutions[0]) < 1e-6
+
+
 def test_stanford_has_up_to_eight_and_limits_keep_the_prismatic_stroke():
     robot = kd.robots.stanford()
     q = np.array([0.3, -0.5, 0.6, 0.2, 0.7, -0.4])

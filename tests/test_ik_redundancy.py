@@ -100,10 +100,16 @@ def test_iiwa_held_joint_keeps_its_value(iiwa):
             assert contains(r.solutions, q)
 
 
-def test_iiwa_self_motion_is_continuous_and_reaches_the_target(iiwa):
+@pytest.fixture(scope="module")
+def iiwa_sweep(iiwa):
+    """(q, target, the arm-angle sweep of 1441 samples at the target), shared by two tests."""
     q = np.array([0.4, 0.7, -0.5, 1.2, 0.3, -0.8, 0.6])
     t = iiwa.pose(q)
-    sm = kd.ik.self_motion(iiwa, t, samples=1441)
+    return q, t, kd.ik.self_motion(iiwa, t, samples=1441)
+
+
+def test_iiwa_self_motion_is_continuous_and_reaches_the_target(iiwa, iiwa_sweep):
+    q, t, sm = iiwa_sweep
     assert sm.q.shape == (1441, 8, 7) and sm.parameter == "arm_angle"
     step = sm.values[1] - sm.values[0]
     for b in range(sm.branches):
@@ -149,6 +155,26 @@ def test_iiwa_arm_angle_limit_intervals(iiwa):
                 assert not inside(branch_at(end + outward, at)), (b, end)
                 ends += 1
     assert ends > 0
+
+
+def test_iiwa_arm_angle_intervals_are_a_dense_sampling_s(iiwa, iiwa_sweep):
+    # the closed-form intervals against the runs of a dense sampling's inside flags, to one step;
+    # a coarse sweep gets the same intervals (they do not depend on the samples)
+    _, t, dense = iiwa_sweep
+    coarse = kd.ik.self_motion(iiwa, t, samples=7)
+    step = dense.values[1] - dense.values[0]
+    ends = 0
+    for b in range(dense.branches):
+        exact = dense.intervals(b)
+        assert exact == coarse.intervals(b)
+        member = np.zeros(len(dense.values), bool)
+        near = np.zeros(len(dense.values), bool)
+        for a, z in exact:
+            member |= (dense.values >= a) & (dense.values <= z)
+            near |= (np.abs(dense.values - a) < step) | (np.abs(dense.values - z) < step)
+            ends += sum(-np.pi < e < np.pi for e in (a, z))
+        assert np.array_equal(member[~near], dense.inside[~near, b]), b
+    assert ends >= 4
 
 
 # ------------------------------------------------------------------ Panda: a held joint

@@ -134,6 +134,7 @@ fn main() {
             alg::forward_kinematics(&model, d, black_box(&q))
         });
         bench_batches(name, &model, &filter);
+        bench_ik(name, &model, &filter);
         if filter == "flops" {
             print_flops(name, &model);
         }
@@ -142,6 +143,64 @@ fn main() {
     for path in trees.split(':').filter(|p| !p.is_empty()) {
         bench_tree(&models::read_tree(path), &filter);
     }
+}
+
+/// Closed-form IK of every branch per target (issue 28), over 64 targets from random joint
+/// vectors: the candidates alone (`<model>/ik_candidates`, `ChainIk::solve`), and the whole call the
+/// bindings make (`<model>/ik_all`: candidates mapped to q, verified by forward kinematics,
+/// deduplicated, stated and sorted). Chains without a closed form print nothing.
+fn bench_ik(name: &str, model: &kinedyn_core::Model, filter: &str) {
+    use kinedyn_core::algorithms::jacobian::frame_pose_at;
+    use kinedyn_core::ik;
+    let mut model = model.clone();
+    model.frames.push(kinedyn_core::model::Frame {
+        body: Some(model.n - 1),
+        body_from_frame: kinedyn_core::spatial::Transform::identity(),
+    });
+    let frame = model.frames.len() - 1;
+    let mut data = Data::new(&model);
+    let Some(solver) = ik::detect_analytic(&model, &mut data, frame) else {
+        return;
+    };
+    let mut rng = kinedyn_core::testing::Rng::new(28);
+    let targets: Vec<_> = (0..64)
+        .map(|_| {
+            let q = kinedyn_core::testing::random_configuration(&model, &mut rng);
+            frame_pose_at(&model, &mut data, &q, frame)
+        })
+        .collect();
+    let (n, reference) = (model.n, vec![0.0; model.n]);
+    let (lower, upper) = (vec![-1e3; n], vec![1e3; n]);
+    let per_target = |key: &str, f: &mut dyn FnMut(&kinedyn_core::spatial::Transform)| {
+        let key = format!("{name}/{key}");
+        if key.contains(filter) {
+            println!(
+                "{key:28} {:8.1}",
+                min_ns(|| targets.iter().for_each(&mut *f)) / targets.len() as f64
+            );
+        }
+    };
+    let mut rows = Vec::with_capacity(16);
+    per_target("ik_candidates", &mut |t| {
+        _ = black_box(solver.solve(black_box(t), false, &reference, &mut rows));
+    });
+    let d = &mut data;
+    per_target("ik_all", &mut |t| {
+        let out = ik::analytic_solutions(
+            &model,
+            d,
+            &solver,
+            frame,
+            black_box(t),
+            false,
+            &reference,
+            &lower,
+            &upper,
+            false,
+            1e-9,
+        );
+        _ = black_box(out.found);
+    });
 }
 
 /// Per state, batches of 1024 random states on one thread (issue 17): rnea, crba and aba with

@@ -4,7 +4,7 @@
 
 use std::sync::Mutex;
 
-use kinedyn_core::ik::{self, AnalyticOutcome, Check, Redundant, SRS_MAX_SOLUTIONS};
+use kinedyn_core::ik::{self, AnalyticOutcome, Check, Met, Redundant, SRS_MAX_SOLUTIONS};
 use kinedyn_core::spatial::Transform;
 use kinedyn_core::{Data, Model};
 use numpy::{PyArrayDyn, PyArrayMethods};
@@ -70,7 +70,7 @@ impl PyRedundantIk {
     ) -> AnalyticOutcome {
         let m = &self.model;
         let theta_ref: Vec<f64> = (0..7).map(|i| reference[i] + m.offset[i]).collect();
-        let check = |held: Option<usize>, most: usize, singular: bool| Check {
+        let check = |held: Option<usize>, most: usize, met: Met| Check {
             frame: self.frame,
             target,
             position_only: false,
@@ -81,7 +81,8 @@ impl PyRedundantIk {
             tolerance,
             held,
             most,
-            singular,
+            singular: met.singular,
+            merged: met.merged,
         };
         match param {
             Param::Held(k) => {
@@ -90,18 +91,21 @@ impl PyRedundantIk {
                     .solver
                     .solve_held(target, k, value + m.offset[k], &theta_ref, &mut rows)
                 {
-                    Some((singular, most)) => check(Some(k), most, singular).finish(m, data, rows.as_flattened(), 7),
+                    Some((met, most)) => check(Some(k), most, met).finish(m, data, rows.as_flattened(), 7),
                     None => AnalyticOutcome::default(), // max_solutions 0: no closed form here
                 }
             }
             Param::ArmAngle => {
                 let mut rows = [None; SRS_MAX_SOLUTIONS];
-                let singular = self
+                let met = self
                     .solver
                     .solve_arm_angle(target, value, &theta_ref, &mut rows)
-                    .unwrap_or(true);
+                    .unwrap_or(Met {
+                        singular: true,
+                        merged: false,
+                    });
                 let flat: Vec<f64> = rows.iter().flatten().flatten().copied().collect();
-                check(None, SRS_MAX_SOLUTIONS, singular).finish(m, data, &flat, 7)
+                check(None, SRS_MAX_SOLUTIONS, met).finish(m, data, &flat, 7)
             }
         }
     }
@@ -167,6 +171,39 @@ impl PyRedundantIk {
         let q = vector("q", &q, 7)?;
         let theta: Vec<f64> = (0..7).map(|i| q[i] + self.model.offset[i]).collect();
         Ok(self.solver.arm_angle(&theta))
+    }
+
+    /// The arm-angle intervals within [lo, hi] where each SRS branch (by its number, as in
+    /// `sweep`) keeps every joint inside the limits, in closed form (`ik::self_motion`): a list of
+    /// 8 lists of (start, end); None when psi is undefined at this target (stretched elbow).
+    #[allow(clippy::type_complexity)]
+    fn arm_angle_intervals(
+        &self,
+        target: Bound<'_, PyArrayDyn<f64>>,
+        lo: f64,
+        hi: f64,
+    ) -> PyResult<Option<Vec<Vec<(f64, f64)>>>> {
+        guarded("RedundantIk.arm_angle_intervals", || {
+            self.param("arm_angle", -1)?;
+            let (targets, batch, position) = gather_targets(&target)?;
+            if batch.is_some() || position {
+                return Err(PyValueError::new_err(
+                    "RedundantIk.arm_angle_intervals takes one 4x4 pose",
+                ));
+            }
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(PyValueError::new_err(format!(
+                    "the arm-angle span must be finite with lo <= hi, got [{lo}, {hi}]"
+                )));
+            }
+            let off = &self.model.offset;
+            let lower: Vec<f64> = (0..7).map(|i| self.lower[i] + off[i]).collect();
+            let upper: Vec<f64> = (0..7).map(|i| self.upper[i] + off[i]).collect();
+            Ok(self
+                .solver
+                .arm_angle_intervals(&targets[0], &lower, &upper, (lo, hi))
+                .map(|found| found.into_iter().collect()))
+        })
     }
 
     /// Every solution for one target (4, 4) at one value of the parameter (`mode` "held" with
@@ -314,6 +351,7 @@ impl PyRedundantIk {
                                     },
                                     most: width,
                                     singular: false,
+                                    merged: false,
                                 };
                                 let mut slots = vec![f64::NAN; width * 7];
                                 let mut put = |b: usize, theta: &[f64]| {
@@ -336,7 +374,7 @@ impl PyRedundantIk {
                                         for (b, row) in cands.iter().enumerate() {
                                             put(b, row);
                                         }
-                                        s.is_none_or(|(s, _)| s)
+                                        s.is_none_or(|(s, _)| s.singular)
                                     }
                                     Param::ArmAngle => {
                                         let mut cands = [None; SRS_MAX_SOLUTIONS];
@@ -346,7 +384,7 @@ impl PyRedundantIk {
                                                 put(b, row);
                                             }
                                         }
-                                        s.unwrap_or(true)
+                                        s.is_none_or(|s| s.singular)
                                     }
                                 };
                                 (slots, singular)

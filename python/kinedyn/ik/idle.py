@@ -56,11 +56,21 @@ def rest(robot, q0) -> np.ndarray:
 
 def settle(robot, frame: str | None, target, mask, q0, result):
     """``result`` (an IKResult or IKBatchResult) with its idle coordinates at :func:`rest`."""
-    t = np.asarray(target)
-    weights = np.ones(6) if mask is None else np.array(mask, dtype=float).reshape(6)
-    if t.shape[-1] == 3:  # a position target (3,) or a batch of them (N, 3); poses are (4, 4), (N, 4, 4)
-        weights[3:] = 0.0
-    idle = idle_coordinates(robot, frame or robot.tool, weights)
+    position = np.shape(target)[-1:] == (3,)  # a position (3,) or a batch of them (N, 3); poses are (4, 4), (N, 4, 4)
+    if mask is None:
+        # the common call: no mask; its idle set looked up once per frame and target kind (a
+        # single call's overhead is microseconds here, docs/ik.md "Speed")
+        cache = robot.__dict__.setdefault("_ik_idle_unmasked", {})
+        key = (frame, position)
+        idle = cache.get(key)
+        if idle is None:
+            weights = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0] if position else [1.0] * 6)
+            idle = cache[key] = idle_coordinates(robot, frame or robot.tool, weights)
+    else:
+        weights = np.array(mask, dtype=float).reshape(6)
+        if position:
+            weights[3:] = 0.0
+        idle = idle_coordinates(robot, frame or robot.tool, weights)
     if not idle.size:
         return result
     at = rest(robot, q0)

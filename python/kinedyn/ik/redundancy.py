@@ -14,12 +14,12 @@ Two parameters (``crates/kinedyn-core/src/ik/redundant.rs`` derives both):
 
 :func:`self_motion` sweeps either parameter and returns every branch at each sample, branches
 numbered so that each is continuous along the sweep, with the parameter intervals where a branch
-keeps every joint inside its limits.
+keeps every joint inside its limits (for the arm angle in closed form: ``self_motion.rs`` in the core).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -200,15 +200,24 @@ class SelfMotion:
     _slots: np.ndarray
     _args: tuple
     _limits: tuple
+    _cache: dict = field(default_factory=dict)
 
     @property
     def branches(self) -> int:
         return self.q.shape[1]
 
     def intervals(self, branch: int, refine: int = 40) -> list[tuple[float, float]]:
-        """The parameter intervals where ``branch`` exists inside the joint limits: runs of samples,
-        each end moved between its sample and the next by bisection (``refine`` halvings), so an
-        interval narrower than one sample step can be missed."""
+        """The parameter intervals where ``branch`` exists inside the joint limits.
+
+        For the arm angle: in closed form over ``[min(values), max(values)]`` (each joint's limit
+        crossings are the roots of a sinusoid in psi, Shimizu et al. 2008; inner ends lie on a
+        limit), whatever the sampling. For a held joint: runs of samples, each end moved between
+        its sample and the next by bisection (``refine`` halvings), so an interval narrower than
+        one sample step can be missed."""
+        if self.parameter == "arm_angle":
+            exact = self._exact()
+            if exact is not None:
+                return [(float(a), float(z)) for a, z in exact[self._slots[branch]]]
         ok = self.inside[:, branch]
         out = []
         m = 0
@@ -228,6 +237,16 @@ class SelfMotion:
             out.append((float(lo), float(hi)))
             m += 1
         return out
+
+    def _exact(self):
+        """Every SRS branch's arm-angle intervals (by core branch number), computed once; None
+        where psi is undefined at the target."""
+        if "exact" not in self._cache:
+            t = self._args[0]
+            self._cache["exact"] = self._solver.arm_angle_intervals(
+                t, float(self.values.min()), float(self.values.max())
+            )
+        return self._cache["exact"]
 
     def _edge(self, branch: int, good: float, bad: float, refine: int) -> float:
         for _ in range(refine):

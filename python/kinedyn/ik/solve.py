@@ -12,6 +12,7 @@ Mask: weights of the six error components ``[x, y, z, rx, ry, rz]`` in base axes
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from math import isfinite
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -225,7 +226,8 @@ def _chain(robot: Robot, frame: str | None) -> _Chain:
 def analytic_structure(robot: Robot, frame: str | None = None) -> str | None:
     """Name of the closed-form structure detected from the robot's geometry for ``frame``
     (``"planar_2r"``, ``"planar_3r"``, ``"arm_intersecting_shoulder"``, ``"arm_parallel_elbow"``,
-    ``"spherical_wrist"``, ``"three_parallel"``, ``"general_6r"``), or None."""
+    ``"arm_prismatic_base"``, ``"arm_cartesian"``, ``"spherical_wrist"`` and its prismatic-arm forms,
+    ``"three_parallel"``, the ``reversed_`` forms, ``"general_6r"``; docs/ik.md), or None."""
     solver = _chain(robot, frame).solver
     return None if solver is None else solver.structure
 
@@ -253,6 +255,15 @@ def _target(target: ArrayLike) -> tuple:
         )
     # a target so far away that the solver's squared residuals would overflow float64 (NaN and inf
     # are checked natively)
+    if not batch:
+        # one target: three Python floats, cheaper than array reductions on a per-call path
+        x, y, z = (t if position else t[:3, 3]).tolist()
+        if isfinite(x) and isfinite(y) and isfinite(z) and max(abs(x), abs(y), abs(z)) > MAX_REACH:
+            raise ValueError(
+                f"target position is {max(abs(x), abs(y), abs(z)):.3g} m from the base: beyond {MAX_REACH:g} m, "
+                "no robot reaches it (and float64 cannot solve for it)"
+            )
+        return t, position, batch
     reach = np.abs(t if position else t[..., :3, 3])
     if np.isfinite(reach).all() and reach.max(initial=0.0) > MAX_REACH:
         raise ValueError(
@@ -335,11 +346,13 @@ def inverse_kinematics(
 
     Returns an :class:`IKResult` (one target) or :class:`IKBatchResult` (a batch).
     """
-    if robot.nv == 0:
-        raise ValueError(
-            f"robot '{robot.name}' has no moving joint: no joint value can move its frames "
-            "(floating_base=True makes a lone body a free flyer)"
-        )
+    if not robot.__dict__.get("_ik_has_joints"):  # robot.nv sums over the joints: asked once
+        if robot.nv == 0:
+            raise ValueError(
+                f"robot '{robot.name}' has no moving joint: no joint value can move its frames "
+                "(floating_base=True makes a lone body a free flyer)"
+            )
+        robot.__dict__["_ik_has_joints"] = True
     result = _solve(
         robot, target, q0, mask, method, respect_limits, frame, tolerance, max_iterations, restarts, seed, progress
     )
@@ -441,7 +454,7 @@ def _why_not_analytic(robot: Robot, chain: _Chain, position: bool, weights) -> s
         return (
             f"robot '{robot.name}' has no closed-form inverse kinematics here: its axes match none of the "
             "structures kinedyn solves in closed form (planar 2R/3R, an RRR arm whose first two axes meet or whose "
-            "2nd and 3rd are parallel, 6R with a spherical wrist, 6R with three parallel axes, any other 6R arm with "
+            "2nd and 3rd are parallel, a prismatic first joint under axes that meet, a gantry, 6R with a spherical wrist, 6R with three parallel axes, any other 6R arm with "
             "finitely many solutions); use method='numeric'"
         )
     if weights is not None:
@@ -458,11 +471,15 @@ def _analytic(
     solver = chain.solver
     assert solver is not None  # callers take this route only for a chain with a closed form
     sols, pe, oe, found, singular, most, worst, merged = solver.solve_stated(t, q_ref, respect_limits, tolerance)
-    name = "analytic:" + solver.structure
-    stated: dict[str, Any] = dict(structure=solver.structure, max_solutions=most, worst_residual=worst, merged=merged)
+    structure = solver.structure
+    name = "analytic:" + structure
+    stated: dict[str, Any] = dict(structure=structure, max_solutions=most, worst_residual=worst, merged=merged)
     if len(sols):
         message = f"{len(sols)} solution(s)" + (" (singular target: a free joint was set from q0)" if singular else "")
-        return IKResult(sols, True, pe, oe, 0, name, True, singular, found, message=message, **stated)
+        # positional: this is the per-call path of every closed form (docs/ik.md, "Speed")
+        return IKResult(
+            sols, True, pe, oe, 0, name, True, singular, found, None, None, message, structure, most, worst, merged
+        )
     if found:
         message = f"reachable, but all {found} solution(s) violate the joint limits (respect_limits=False lists them)"
         return IKResult(sols, False, pe, oe, 0, name, True, singular, found, message=message, **stated)

@@ -18,6 +18,8 @@
 //! | `Planar3R`         | 3 revolute, parallel (pose target)                      | <= 2      |
 //! | `ArmIntersecting`  | axes 1, 2 meet (joint 3 revolute or prismatic)          | <= 4      |
 //! | `ArmParallel`      | axes 2 and 3 parallel, axis 1 not                       | <= 4      |
+//! | `ArmPrismaticBase` | joint 1 prismatic, axes 2, 3 meet (`prismatic.rs`)      | <= 4      |
+//! | `ArmCartesian`     | joints 1-3 prismatic, independent (`prismatic.rs`)      | 1         |
 //! | `SphericalWrist`   | one of the arms above + axes 4, 5, 6 meet in one point  | <= 8      |
 //! | `ThreeParallel`    | axes 2, 3, 4 parallel, axes 5 and 6 meet (UR family)    | <= 8      |
 //! | `General6R`        | any other 6R chain with a finite solution set           | <= 16     |
@@ -27,9 +29,34 @@
 //! them to `q`, checks them by forward kinematics and applies joint limits (`super::analytic_solutions`).
 
 use super::general6r::General6R;
-use super::subproblems::{rotate, rotate_point, sp1, sp1_dir, sp2, sp3, sp4, Axis};
+use super::subproblems::{rotate, rotate_point, sp1, sp1_dir, sp2, sp3, sp4, Angles, Axis};
 use crate::joint::axis_angle;
 use crate::spatial::{Mat3, Transform, Vec3};
+
+/// What a closed form met besides its roots: a non-isolated solution set (`singular`: a free
+/// joint was set from the reference), or two roots of a subproblem merged into one (`merged`: a
+/// discriminant within tolerance of zero, where two branches of the chain meet).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Met {
+    pub singular: bool,
+    pub merged: bool,
+}
+
+impl Met {
+    pub fn of(a: &Angles) -> Self {
+        Self {
+            singular: a.singular,
+            merged: a.tangent,
+        }
+    }
+}
+
+impl std::ops::BitOrAssign for Met {
+    fn bitor_assign(&mut self, other: Self) {
+        self.singular |= other.singular;
+        self.merged |= other.merged;
+    }
+}
 
 /// A joint's motion at `theta = 0`, in base coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +93,8 @@ pub enum Structure {
     Planar3R,
     ArmIntersecting,
     ArmParallel,
+    ArmPrismaticBase,
+    ArmCartesian,
     SphericalWrist,
     ThreeParallel,
     General6R,
@@ -78,6 +107,8 @@ impl Structure {
             Structure::Planar3R => "planar_3r",
             Structure::ArmIntersecting => "arm_intersecting_shoulder",
             Structure::ArmParallel => "arm_parallel_elbow",
+            Structure::ArmPrismaticBase => "arm_prismatic_base",
+            Structure::ArmCartesian => "arm_cartesian",
             Structure::SphericalWrist => "spherical_wrist",
             Structure::ThreeParallel => "three_parallel",
             Structure::General6R => "general_6r",
@@ -87,7 +118,11 @@ impl Structure {
     pub fn solves_position(&self) -> bool {
         matches!(
             self,
-            Structure::Planar2R | Structure::ArmIntersecting | Structure::ArmParallel
+            Structure::Planar2R
+                | Structure::ArmIntersecting
+                | Structure::ArmParallel
+                | Structure::ArmPrismaticBase
+                | Structure::ArmCartesian
         )
     }
 }
@@ -104,7 +139,7 @@ pub struct AnalyticIk {
     /// The eigenvalue solver of a `General6R` chain.
     pub general: Option<Box<General6R>>,
     /// Intersection of axes 1 and 2 (intersecting-shoulder arms).
-    shoulder: Vec3,
+    pub(super) shoulder: Vec3,
     /// Wrist centre (axes 4, 5, 6 meet) or the point where axes 5 and 6 meet (three parallel).
     wrist: Vec3,
 }
@@ -117,13 +152,13 @@ fn parallel(a: &Vec3, b: &Vec3) -> bool {
 }
 
 /// Distance from point `p` to the line of `a`.
-fn distance_to_line(a: &Axis, p: &Vec3) -> f64 {
+pub(super) fn distance_to_line(a: &Axis, p: &Vec3) -> f64 {
     let d = p - a.r;
     (d - a.w * a.w.dot(&d)).norm()
 }
 
 /// The point where two non-parallel lines meet, if they do (within `tol`).
-fn intersection(a: &Axis, b: &Axis, tol: f64) -> Option<Vec3> {
+pub(super) fn intersection(a: &Axis, b: &Axis, tol: f64) -> Option<Vec3> {
     let n = a.w.cross(&b.w);
     let nn = n.norm_squared();
     if nn <= GEOMETRY_TOL * GEOMETRY_TOL {
@@ -169,6 +204,9 @@ impl AnalyticIk {
         };
         // an arm on joints 0..3 moving the point p0
         let arm = |p0: &Vec3| -> Option<(Structure, Vec3)> {
+            if let Some(found) = super::prismatic::detect_arm(&screws, p0, tol) {
+                return Some(found);
+            }
             let (a0, a1) = (rev(0)?, rev(1)?);
             if let Some(c) = intersection(&a0, &a1, tol) {
                 let ok = match screws[2] {
@@ -281,27 +319,28 @@ impl AnalyticIk {
 
     /// All candidate `theta` for the target `world_from_tool` (`position_only`: only its origin
     /// counts). `reference` (theta of the caller's q0) fixes free joints at singular targets.
-    /// Returns whether a singular (non-isolated) solution set was met.
-    pub fn solve(&self, target: &Transform, position_only: bool, reference: &[f64], out: &mut Solutions) -> bool {
+    /// Returns what was met: a singular (non-isolated) solution set, a merge of two roots.
+    pub fn solve(&self, target: &Transform, position_only: bool, reference: &[f64], out: &mut Solutions) -> Met {
         out.clear();
         if position_only && !self.structure.solves_position() {
-            return false;
+            return Met::default();
         }
         // G = g_d g(0)^-1, so that exp(xi_1 theta_1) ... exp(xi_n theta_n) = G
         let g = target * &self.home.inverse();
         match self.structure {
             Structure::Planar2R => self.planar_2r(0, &self.home.trans, &target.trans, [0.0; 6], reference, out),
             Structure::Planar3R => self.planar_3r(&g, reference, out),
-            Structure::ArmIntersecting | Structure::ArmParallel => {
-                self.arm(self.structure, &self.home.trans, &target.trans, reference, out)
-            }
+            Structure::ArmIntersecting
+            | Structure::ArmParallel
+            | Structure::ArmPrismaticBase
+            | Structure::ArmCartesian => self.arm(self.structure, &self.home.trans, &target.trans, reference, out),
             Structure::SphericalWrist => self.spherical_wrist(&g, reference, out),
             Structure::ThreeParallel => self.three_parallel(&g, reference, out),
             Structure::General6R => {
                 if let Some(general) = &self.general {
                     general.solve(target, out);
                 }
-                false
+                Met::default()
             }
         }
     }
@@ -316,15 +355,15 @@ impl AnalyticIk {
         prefix: [f64; 6],
         reference: &[f64],
         out: &mut Solutions,
-    ) -> bool {
+    ) -> Met {
         let (a0, a1) = (self.axis(i), self.axis(i + 1));
         // |exp(xi_{i+1} theta) p0 - r_i| = |p - r_i|
         let t1 = sp3(&a1, p0, &a0.r, (p - a0.r).norm());
-        let mut singular = t1.singular;
+        let mut met = Met::of(&t1);
         for &theta1 in t1.as_slice() {
             let p1 = rotate_point(&a1, theta1, p0);
             let t0 = sp1(&a0, &p1, p);
-            singular |= t0.singular;
+            met |= Met::of(&t0);
             let mut row = prefix;
             row[i] = if t0.singular {
                 reference.get(i).copied().unwrap_or(0.0)
@@ -334,25 +373,25 @@ impl AnalyticIk {
             row[i + 1] = theta1;
             out.push(row);
         }
-        singular
+        met
     }
 
     /// Planar 3R: theta_1 + theta_2 + theta_3 is the rotation of G about the common direction;
     /// a point on axis 3 fixes theta_1, theta_2 (planar 2R).
-    fn planar_3r(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> bool {
+    fn planar_3r(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> Met {
         let (a0, a2) = (self.axis(0), self.axis(2));
         let x = normal_to(&a0.w);
         let phi = sp1_dir(&a0.w, &x, &(g.rot * x)).values[0];
-        let singular = self.planar_2r(0, &a2.r, &g.act_point(&a2.r), [0.0; 6], reference, out);
+        let met = self.planar_2r(0, &a2.r, &g.act_point(&a2.r), [0.0; 6], reference, out);
         for row in out.iter_mut() {
             row[2] = phi - row[0] - row[1];
         }
-        singular
+        met
     }
 
     /// The first three joints moving p0 to p (appends rows with theta_1..3 set).
-    fn arm(&self, structure: Structure, p0: &Vec3, p: &Vec3, reference: &[f64], out: &mut Solutions) -> bool {
-        let mut singular = false;
+    fn arm(&self, structure: Structure, p0: &Vec3, p: &Vec3, reference: &[f64], out: &mut Solutions) -> Met {
+        let mut met = Met::default();
         match structure {
             Structure::ArmIntersecting => {
                 let c = self.shoulder;
@@ -364,7 +403,7 @@ impl AnalyticIk {
                 match self.screws[2] {
                     Screw::Revolute(a2) => {
                         let t = sp3(&a2, p0, &c, delta);
-                        singular |= t.singular;
+                        met |= Met::of(&t);
                         count = t.count;
                         third = t.values;
                     }
@@ -379,13 +418,15 @@ impl AnalyticIk {
                         } else if disc > -1e-9 * scale {
                             third = [-b, 0.0];
                             count = 1;
+                            met.merged = true; // a double root
                         }
                     }
                 }
                 for &t3 in &third[..count] {
                     let p3 = self.screws[2].exp(t3).act_point(p0);
                     let (pairs, m, s) = sp2(&a0, &a1, &p3, p);
-                    singular |= s;
+                    met.singular |= s;
+                    met.merged |= m == 1;
                     if s && m > 0 {
                         // p on axis 1: theta_1 is free; keep the reference, solve theta_2 by subproblem 1
                         let t1 = reference.first().copied().unwrap_or(0.0);
@@ -402,7 +443,7 @@ impl AnalyticIk {
                 let (a0, a1) = (self.axis(0), self.axis(1));
                 // joints 2, 3 keep the component along w2: w2 . exp(-w1 theta_1)(p - r1) = w2 . (p0 - r1)
                 let t0 = sp4(&a1.w, &a0.w, &(p - a0.r), a1.w.dot(&(p0 - a0.r)));
-                singular |= t0.singular;
+                met |= Met::of(&t0);
                 for &phi in t0.as_slice() {
                     // on axis 1 theta_1 is free: keep the reference
                     let phi = if t0.singular {
@@ -413,12 +454,13 @@ impl AnalyticIk {
                     let theta0 = -phi;
                     let p1 = rotate_point(&a0, phi, p);
                     let prefix = [theta0, 0.0, 0.0, 0.0, 0.0, 0.0];
-                    singular |= self.planar_2r(1, p0, &p1, prefix, reference, out);
+                    met |= self.planar_2r(1, p0, &p1, prefix, reference, out);
                 }
             }
+            Structure::ArmPrismaticBase | Structure::ArmCartesian => met |= self.prismatic_arm(structure, p0, p, out),
             _ => unreachable!("not an arm"),
         }
-        singular
+        met
     }
 
     /// `exp(xi_1 theta_1) ... exp(xi_k theta_k)`.
@@ -432,11 +474,11 @@ impl AnalyticIk {
 
     /// Arm to the wrist centre, then the wrist: subproblem 2 on axes 4, 5 with a point on axis 6,
     /// subproblem 1 for axis 6.
-    fn spherical_wrist(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> bool {
+    fn spherical_wrist(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> Met {
         let w = self.wrist;
         // joints 4-6 fix w: exp(xi_1 theta_1) exp(xi_2 theta_2) exp(xi_3 theta_3) w = G w
         let mut arms = Vec::with_capacity(4);
-        let mut singular = self.arm(
+        let mut met = self.arm(
             self.arm.expect("arm of a wrist"),
             &w,
             &g.act_point(&w),
@@ -457,9 +499,10 @@ impl AnalyticIk {
             let (pairs, m, s) = sp2(&a3, &a4, &p, &hp);
             let mut rows: [(f64, f64); 2] = pairs;
             let mut count = m;
+            met.merged |= m == 1;
             if s && m > 0 {
                 // axis 6 lines up with axis 4: theta_4 + theta_6 is fixed; keep theta_4 at the reference
-                singular = true;
+                met.singular = true;
                 let t3 = reference.get(3).copied().unwrap_or(0.0);
                 let t4 = sp1(&a4, &p, &rotate_point(&a3, -t3, &hp)).values[0];
                 rows = [(t3, t4), (0.0, 0.0)];
@@ -471,19 +514,19 @@ impl AnalyticIk {
                 out.push([arm[0], arm[1], arm[2], t3, t4, t5.values[0]]);
             }
         }
-        singular
+        met
     }
 
     /// UR-type chains: theta_1 and theta_5 by subproblem 4 (rotations about the parallel axes
     /// keep components along their direction w2), theta_6 by subproblem 1, theta_2..4 planar.
-    fn three_parallel(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> bool {
+    fn three_parallel(&self, g: &Transform, reference: &[f64], out: &mut Solutions) -> Met {
         let (a0, a1, a3, a4, a5) = (self.axis(0), self.axis(1), self.axis(3), self.axis(4), self.axis(5));
         let w2 = a1.w;
-        let mut singular = false;
+        let mut met = Met::default();
         // w2 . exp(-xi_1 theta_1) G w = w2 . w   (joints 2-4 keep it, joints 5, 6 fix w)
         let pw = g.act_point(&self.wrist);
         let t0 = sp4(&w2, &a0.w, &(pw - a0.r), w2.dot(&(self.wrist - a0.r)));
-        singular |= t0.singular;
+        met |= Met::of(&t0);
         let x = normal_to(&w2);
         for &phi in t0.as_slice() {
             let theta0 = if t0.singular {
@@ -494,7 +537,7 @@ impl AnalyticIk {
             let r0 = axis_angle(&a0.w, theta0);
             // w2 . R5(theta_5) w6 = w2 . R1^T R_G w6
             let t4 = sp4(&w2, &a4.w, &a5.w, w2.dot(&(r0.transpose() * (g.rot * a5.w))));
-            singular |= t4.singular;
+            met |= Met::of(&t4);
             for &theta4 in t4.as_slice() {
                 let theta4 = if t4.singular {
                     reference.get(4).copied().unwrap_or(0.0)
@@ -506,7 +549,7 @@ impl AnalyticIk {
                 let u = rotate(&a4.w, -theta4, &w2);
                 let t5 = sp1_dir(&a5.w, &v, &u);
                 let theta5 = if t5.singular {
-                    singular = true;
+                    met.singular = true;
                     reference.get(5).copied().unwrap_or(0.0)
                 } else {
                     t5.values[0]
@@ -516,7 +559,7 @@ impl AnalyticIk {
                 let phi234 = sp1_dir(&w2, &x, &(h.rot * x)).values[0];
                 let mut planar = Vec::with_capacity(2);
                 // e2 e3 r4 = H r4 (joint 4 fixes a point on its axis)
-                singular |= self.planar_2r(
+                met |= self.planar_2r(
                     1,
                     &a3.r,
                     &h.act_point(&a3.r),
@@ -530,6 +573,6 @@ impl AnalyticIk {
                 }
             }
         }
-        singular
+        met
     }
 }

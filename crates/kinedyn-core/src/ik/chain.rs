@@ -20,7 +20,7 @@
 //! | `H`       | `h`        | `g(0)^-1`, the reversed chain's home             |
 //! | `theta'`  | row        | the reversed chain's coordinates                 |
 
-use super::analytic::{AnalyticIk, Screw, Solutions, Structure};
+use super::analytic::{AnalyticIk, Met, Screw, Solutions, Structure};
 use super::subproblems::Axis;
 use crate::spatial::Transform;
 
@@ -29,7 +29,8 @@ use crate::spatial::Transform;
 pub fn max_solutions(structure: Structure) -> usize {
     match structure {
         Structure::Planar2R | Structure::Planar3R => 2,
-        Structure::ArmIntersecting | Structure::ArmParallel => 4,
+        Structure::ArmIntersecting | Structure::ArmParallel | Structure::ArmPrismaticBase => 4,
+        Structure::ArmCartesian => 1,
         Structure::SphericalWrist | Structure::ThreeParallel => 8,
         // Raghavan & Roth: the degree-16 polynomial of the general 6R
         Structure::General6R => super::general6r::MAX_SOLUTIONS,
@@ -85,7 +86,12 @@ impl ChainIk {
     /// The structure's name, `reversed_` before it when it was found from the tool end.
     pub fn name(&self) -> &'static str {
         if !self.reversed {
-            return self.ik.structure.name();
+            // a spherical wrist on an arm with a prismatic first joint (`prismatic.rs`) says so
+            return match (self.ik.structure, self.ik.arm) {
+                (Structure::SphericalWrist, Some(Structure::ArmCartesian)) => "spherical_wrist_cartesian_arm",
+                (Structure::SphericalWrist, Some(Structure::ArmPrismaticBase)) => "spherical_wrist_prismatic_base",
+                (s, _) => s.name(),
+            };
         }
         match self.ik.structure {
             Structure::SphericalWrist => "reversed_spherical_wrist",
@@ -96,7 +102,11 @@ impl ChainIk {
     }
 
     pub fn max_solutions(&self) -> usize {
-        max_solutions(self.ik.structure)
+        match (self.ik.structure, self.ik.arm) {
+            // the arm's roots times the wrist's two
+            (Structure::SphericalWrist, Some(arm)) => 2 * max_solutions(arm),
+            (s, _) => max_solutions(s),
+        }
     }
 
     /// Whether a position target has a closed form (never for a reversed chain: its "position"
@@ -105,28 +115,28 @@ impl ChainIk {
         !self.reversed && self.ik.structure.solves_position()
     }
 
-    /// All candidate `theta` rows (see [`AnalyticIk::solve`]); returns the singular flag.
-    pub fn solve(&self, target: &Transform, position_only: bool, reference: &[f64], out: &mut Solutions) -> bool {
+    /// All candidate `theta` rows (see [`AnalyticIk::solve`]); returns what was met.
+    pub fn solve(&self, target: &Transform, position_only: bool, reference: &[f64], out: &mut Solutions) -> Met {
         if !self.reversed {
             return self.ik.solve(target, position_only, reference, out);
         }
         if position_only {
             out.clear();
-            return false;
+            return Met::default();
         }
         let n = self.n();
         let mut back_ref = [0.0; 6];
         for k in 0..n.min(reference.len()) {
             back_ref[k] = -reference[n - 1 - k];
         }
-        let singular = self.ik.solve(&target.inverse(), false, &back_ref[..n], out);
+        let met = self.ik.solve(&target.inverse(), false, &back_ref[..n], out);
         for row in out.iter_mut() {
             let back = *row;
             for k in 0..n {
                 row[k] = -back[n - 1 - k];
             }
         }
-        singular
+        met
     }
 }
 
@@ -187,5 +197,34 @@ mod tests {
             original,
             "the configuration the target came from is among the candidates"
         );
+    }
+
+    /// A spherical wrist at q5 = 0 (axes 4 and 6 in line) and near it: the wrist's subproblem 2
+    /// meets a double root and says so; away from it, all eight roots are simple.
+    #[test]
+    fn a_wrist_singularity_is_met_as_merged_roots() {
+        let screws = vec![
+            rev([0.0, 0.0, 1.0], [0.0, 0.0, 0.0]),
+            rev([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]),
+            rev([0.0, 1.0, 0.0], [0.43, 0.15, 0.0]),
+            rev([0.0, 0.0, 1.0], [0.45, 0.15, 0.43]),
+            rev([0.0, 1.0, 0.0], [0.45, 0.15, 0.43]),
+            rev([0.0, 0.0, 1.0], [0.45, 0.15, 0.43]),
+        ];
+        let home = Transform::new(axis_angle(&Vec3::y(), 0.3), Vec3::new(0.45, 0.15, 0.5));
+        let solver = ChainIk::detect(screws.clone(), home).expect("structure");
+        assert_eq!(solver.name(), "spherical_wrist");
+        let mut out = Vec::new();
+        for (q5, merged) in [(0.0, true), (1e-6, true), (1e-5, true), (0.4, false)] {
+            let theta = [0.3, -0.4, 0.5, 0.7, q5, -0.2];
+            let met = solver.solve(&fk(&screws, &home, &theta), false, &[0.0; 6], &mut out);
+            assert_eq!(met.merged, merged, "q5 = {q5}");
+            assert_eq!(
+                out.len() < solver.max_solutions(),
+                merged,
+                "q5 = {q5}: {} roots",
+                out.len()
+            );
+        }
     }
 }

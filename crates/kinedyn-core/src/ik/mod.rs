@@ -39,10 +39,12 @@
 //! (`analytic_solutions`).
 //!
 //! Files: `numeric.rs` (the solver, its settings and start checks), `reduction.rs` (mimic joints),
-//! `analytic.rs` (structures and their closed forms), `general6r.rs` (any 6R chain: Raghavan & Roth's
+//! `analytic.rs` (structures and their closed forms), `prismatic.rs` (arms
+//! whose first joint is prismatic), `general6r.rs` (any 6R chain: Raghavan & Roth's
 //! elimination as an eigenvalue problem), `chain.rs` (a structure found from either end of the
 //! chain, and the most solutions it has), `redundant.rs` (seven-joint arms: a held joint, the arm
-//! angle of SRS arms), `subproblems.rs` (Paden-Kahan), `solutions.rs` (closed-form candidates to
+//! angle of SRS arms), `self_motion.rs` (an SRS arm's arm-angle intervals inside the joint limits, in
+//! closed form), `subproblems.rs` (Paden-Kahan), `solutions.rs` (closed-form candidates to
 //! checked joint vectors, with the statement of completeness); the pose error is here.
 //!
 //! | symbol   | here          | meaning                                                  |
@@ -58,12 +60,14 @@ pub mod chain;
 #[allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 pub mod general6r;
 mod numeric;
+mod prismatic;
 mod reduction;
 pub mod redundant;
+mod self_motion;
 mod solutions;
 pub mod subproblems;
 
-pub use analytic::{AnalyticIk, Screw, Structure};
+pub use analytic::{AnalyticIk, Met, Screw, Structure};
 pub use chain::ChainIk;
 pub use numeric::{check_start, numeric_ik, numeric_ik_reduced, solver_sizes, Outcome, Settings, UNIT_TOLERANCE};
 pub use reduction::Reduction;

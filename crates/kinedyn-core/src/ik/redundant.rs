@@ -45,7 +45,7 @@
 //! | `E_0`   | `elbow`           | the point of axis 4 nearest S, at theta = 0 |
 //! | `psi`   | `psi`             | arm angle (rad)                             |
 
-use super::analytic::{Screw, Solutions};
+use super::analytic::{Met, Screw, Solutions};
 use super::chain::ChainIk;
 use super::subproblems::{sp1, sp2, sp3, Axis};
 use crate::spatial::{Mat3, Transform, Vec3};
@@ -71,6 +71,33 @@ pub struct Redundant {
     pub home: Transform,
     /// Present when axes 1-3 and 5-7 meet in two points (the arm angle applies).
     pub srs: Option<Srs>,
+}
+
+/// A target's elbow circle (steps 1-2 of the module header): the shoulder's rotation
+/// `R(psi) = F_d(psi) F_0^T` for each elbow root, with `F_d(psi)` the triad of `(u, cos psi n_1 +
+/// sin psi n_2)`, so that every entry of `R(psi)` is `a sin psi + b cos psi + c`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ArmCircle {
+    /// `g_d g(0)^-1`
+    pub g: Transform,
+    pub u: Vec3,
+    pub n1: Vec3,
+    pub n2: Vec3,
+    /// Per elbow root: (theta_4, F_0).
+    pub elbows: [Option<(f64, Mat3)>; 2],
+    /// psi undefined (see `solve_arm_angle`), or the two elbow roots merged.
+    pub met: Met,
+}
+
+impl ArmCircle {
+    /// The shoulder rotation `R_1 R_2 R_3` of elbow root `ie` at arm angle `psi`.
+    pub fn rotation(&self, ie: usize, psi: f64) -> Option<Mat3> {
+        let (_, f0) = self.elbows[ie]?;
+        let (sp, cp) = psi.sin_cos();
+        // the unit part of E(psi) - S normal to u is cos psi n_1 + sin psi n_2 exactly
+        let y = self.n1 * cp + self.n2 * sp;
+        Some(Mat3::from_columns(&[self.u, y, self.u.cross(&y)]) * f0.transpose())
+    }
 }
 
 fn axis_of(s: &Screw) -> Option<Axis> {
@@ -147,6 +174,11 @@ impl Redundant {
         Some(Self { screws, home, srs })
     }
 
+    /// Axis `i` of an SRS arm (revolute by construction of `srs`).
+    pub(super) fn axis(&self, i: usize) -> Axis {
+        axis_of(&self.screws[i]).expect("SRS axes are revolute")
+    }
+
     /// The six-joint chain left with joint `k` held at `theta_k` (see the module header), and
     /// its solver if its axes have a structure.
     pub fn held(&self, k: usize, theta_k: f64) -> Option<ChainIk> {
@@ -166,7 +198,7 @@ impl Redundant {
     }
 
     /// Candidates (rows of 7 `theta`) with joint `k` held at `theta_k`: one row per branch of the
-    /// six-joint solver, `theta_k` in slot k. Returns (singular flag, the most solutions) or None
+    /// six-joint solver, `theta_k` in slot k. Returns (what was met, the most solutions) or None
     /// when the held chain has no structure.
     pub fn solve_held(
         &self,
@@ -175,12 +207,12 @@ impl Redundant {
         theta_k: f64,
         reference: &[f64],
         out: &mut Vec<[f64; 7]>,
-    ) -> Option<(bool, usize)> {
+    ) -> Option<(Met, usize)> {
         out.clear();
         let chain = self.held(k, theta_k)?;
         let reduced: Vec<f64> = (0..7).filter(|&j| j != k).map(|j| reference[j]).collect();
         let mut rows: Solutions = Vec::with_capacity(8);
-        let singular = chain.solve(target, false, &reduced, &mut rows);
+        let met = chain.solve(target, false, &reduced, &mut rows);
         for r in &rows {
             let mut row = [0.0; 7];
             let mut at = 0;
@@ -194,91 +226,128 @@ impl Redundant {
             }
             out.push(row);
         }
-        Some((singular, chain.max_solutions()))
+        Some((met, chain.max_solutions()))
+    }
+
+    /// Steps 1-2 of the module header for `target`: the elbow angles and, for each, the frames
+    /// that give the shoulder rotation at any arm angle (`ArmCircle::rotation`); None when the
+    /// chain is not SRS.
+    pub(super) fn arm_circle(&self, target: &Transform) -> Option<ArmCircle> {
+        let srs = self.srs?;
+        let ax = |i: usize| axis_of(&self.screws[i]).expect("SRS axes are revolute");
+        let g = target * &self.home.inverse();
+        let s = srs.shoulder;
+        let wd = g.act_point(&srs.wrist);
+        let d = (wd - s).norm();
+        let mut met = Met::default();
+        // 1. the elbow angle keeps |W - S|
+        let t4 = sp3(&ax(3), &srs.wrist, &s, d);
+        met |= Met::of(&t4);
+        let u = (wd - s) / d.max(1e-300);
+        let z1 = ax(0).w;
+        let mut n1 = z1 - u * u.dot(&z1);
+        if n1.norm() <= 1e-9 {
+            // the wrist on the first axis: psi is measured from the second axis instead
+            met.singular = true;
+            let z2 = ax(1).w;
+            n1 = z2 - u * u.dot(&z2);
+        }
+        let n1 = n1.normalize();
+        let n2 = u.cross(&n1);
+        let mut elbows = [None; 2];
+        for (ie, &theta4) in t4.as_slice().iter().enumerate() {
+            let p4 = self.screws[3].exp(theta4).act_point(&srs.wrist);
+            let (v, e0) = (p4 - s, srs.elbow - s);
+            // 2. the elbow on its circle about the S-W line: foot c, radius rho (> 0 for psi to act)
+            let c = e0.dot(&v) / d.max(1e-300);
+            let rho2 = e0.norm_squared() - c * c;
+            if rho2 <= 1e-12 * e0.norm_squared().max(1e-300) {
+                met.singular = true; // elbow on the S-W line: every psi is the same posture
+            }
+            match triad(&v, &e0) {
+                Some(f0) => elbows[ie] = Some((theta4, f0)),
+                None => met.singular = true,
+            }
+        }
+        Some(ArmCircle {
+            g,
+            u,
+            n1,
+            n2,
+            elbows,
+            met,
+        })
     }
 
     /// The SRS branches at arm angle `psi`: `out[b]` is branch b (`4 elbow + 2 shoulder + wrist`)
-    /// or None where that root does not exist. Returns the singular flag (psi undefined: the arm
-    /// stretched or folded so that the elbow is on the shoulder-wrist line, or a free joint), or
-    /// None when the chain is not SRS.
+    /// or None where that root does not exist. Returns what was met (singular: psi undefined, the
+    /// arm stretched or folded so that the elbow is on the shoulder-wrist line, or a free joint;
+    /// merged: a double root), or None when the chain is not SRS.
     pub fn solve_arm_angle(
         &self,
         target: &Transform,
         psi: f64,
         reference: &[f64],
         out: &mut [Option<[f64; 7]>; SRS_MAX_SOLUTIONS],
-    ) -> Option<bool> {
-        let srs = self.srs?;
+    ) -> Option<Met> {
+        let circle = self.arm_circle(target)?;
+        let _ = reference; // branches are numbered, not ordered by the reference
+        Some(self.branches_at(&circle, psi, out))
+    }
+
+    /// Steps 3-4 of the module header at arm angle `psi` (see `solve_arm_angle`): what was met.
+    pub(super) fn branches_at(
+        &self,
+        circle: &ArmCircle,
+        psi: f64,
+        out: &mut [Option<[f64; 7]>; SRS_MAX_SOLUTIONS],
+    ) -> Met {
         out.fill(None);
+        let Some(srs) = self.srs else {
+            return Met {
+                singular: true,
+                merged: false,
+            };
+        };
         let ax = |i: usize| axis_of(&self.screws[i]).expect("SRS axes are revolute");
-        let g = target * &self.home.inverse();
         let s = srs.shoulder;
-        let wd = g.act_point(&srs.wrist);
-        let d = (wd - s).norm();
-        let mut singular = false;
-        // 1. the elbow angle keeps |W - S|
-        let t4 = sp3(&ax(3), &srs.wrist, &s, d);
-        singular |= t4.singular;
-        let u = (wd - s) / d.max(1e-300);
-        let z1 = ax(0).w;
-        let mut n1 = z1 - u * u.dot(&z1);
-        if n1.norm() <= 1e-9 {
-            // the wrist on the first axis: psi is measured from the second axis instead
-            singular = true;
-            let z2 = ax(1).w;
-            n1 = z2 - u * u.dot(&z2);
-        }
-        let n1 = n1.normalize();
-        let n2 = u.cross(&n1);
+        let mut met = circle.met;
         let (a0, a1, a2) = (Axis { r: s, ..ax(0) }, Axis { r: s, ..ax(1) }, Axis { r: s, ..ax(2) });
         let w = srs.wrist;
         let (a4, a5, a6) = (Axis { r: w, ..ax(4) }, Axis { r: w, ..ax(5) }, Axis { r: w, ..ax(6) });
-        for (ie, &theta4) in t4.as_slice().iter().enumerate() {
-            let p4 = self.screws[3].exp(theta4).act_point(&srs.wrist);
-            let (v, e0) = (p4 - s, srs.elbow - s);
-            // 2. the elbow on its circle about the S-W line
-            let c = e0.dot(&v) / d.max(1e-300);
-            let rho2 = e0.norm_squared() - c * c;
-            let size = e0.norm_squared().max(1e-300);
-            if rho2 <= 1e-12 * size {
-                singular = true; // elbow on the S-W line: every psi is the same posture
-            }
-            let rho = rho2.max(0.0).sqrt();
-            let (sp, cp) = psi.sin_cos();
-            let ed = u * c + (n1 * cp + n2 * sp) * rho;
-            // 3. the shoulder rotation, split into three angles
-            let (Some(f0), Some(fd)) = (triad(&v, &e0), triad(&(wd - s), &ed)) else {
-                singular = true;
+        for (ie, elbow) in circle.elbows.iter().enumerate() {
+            let (Some(&(theta4, ..)), Some(r)) = (elbow.as_ref(), circle.rotation(ie, psi)) else {
                 continue;
             };
-            let r = fd * f0.transpose();
+            // 3. the shoulder rotation, split into three angles
             let p = s + a2.w;
             let q = s + r * a2.w;
             let (pairs, m, sing) = sp2(&a0, &a1, &p, &q);
-            singular |= sing;
+            met.singular |= sing;
+            met.merged |= m == 1;
             let x = normal_to(&a2.w);
             for (is, &(t1, t2)) in pairs[..m].iter().enumerate() {
                 let e12 = self.screws[0].exp(t1) * self.screws[1].exp(t2);
                 let t3 = sp1(&a2, &(s + x), &(s + e12.rot.transpose() * (r * x)));
-                singular |= t3.singular;
+                met.singular |= t3.singular;
                 let t3 = t3.values[0];
                 // 4. the wrist
                 let front = e12 * self.screws[2].exp(t3) * self.screws[3].exp(theta4);
-                let h = front.inverse() * g;
+                let h = front.inverse() * circle.g;
                 let pw = w + a6.w;
                 let (wp, wm, ws) = sp2(&a4, &a5, &pw, &h.act_point(&pw));
-                singular |= ws;
+                met.singular |= ws;
+                met.merged |= wm == 1;
                 let xw = w + normal_to(&a6.w);
                 for (iw, &(t5, t6)) in wp[..wm].iter().enumerate() {
                     let e56 = self.screws[4].exp(t5) * self.screws[5].exp(t6);
                     let t7 = sp1(&a6, &xw, &e56.inverse().act_point(&h.act_point(&xw)));
-                    singular |= t7.singular;
+                    met.singular |= t7.singular;
                     out[4 * ie + 2 * is + iw] = Some([t1, t2, t3, theta4, t5, t6, t7.values[0]]);
                 }
             }
         }
-        let _ = reference; // branches are numbered, not ordered by the reference
-        Some(singular)
+        met
     }
 
     /// The arm angle of the joint vector `theta` (SRS arms): the angle about the shoulder-wrist

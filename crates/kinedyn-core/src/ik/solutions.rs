@@ -68,8 +68,8 @@ pub struct AnalyticOutcome {
     pub max_solutions: usize,
     /// The largest position or orientation residual among the found solutions (0 when none).
     pub worst_residual: f64,
-    /// Branches merge at this target: two candidates coincide or nearly do (closer than
-    /// `MERGE_DISTANCE`), or a solution's Jacobian (the solved joints' columns) is singular
+    /// Branches merge at this target: a subproblem met a double root, two candidates coincide
+    /// or nearly do (closer than `MERGE_DISTANCE`), or a solution's Jacobian (the solved joints' columns) is singular
     /// (Hadamard ratio below `MERGE_RATIO`; tested only when fewer than `max_solutions` were found
     /// or the solver met a free joint: all `max_solutions` roots found distinct are simple).
     pub merged: bool,
@@ -163,7 +163,7 @@ pub fn analytic_solutions(
     let n = model.n;
     let theta_ref: Vec<f64> = (0..n).map(|i| reference[i] + model.offset[i]).collect();
     let mut candidates = Vec::with_capacity(8);
-    let singular = solver.solve(target, position_only, &theta_ref, &mut candidates);
+    let met = solver.solve(target, position_only, &theta_ref, &mut candidates);
     Check {
         frame,
         target,
@@ -175,7 +175,8 @@ pub fn analytic_solutions(
         tolerance,
         held: None,
         most: solver.max_solutions(),
-        singular,
+        singular: met.singular,
+        merged: met.merged,
     }
     .finish(model, data, candidates.as_flattened(), 6)
 }
@@ -199,6 +200,9 @@ pub struct Check<'a> {
     /// all simple (no two branches meet) and the Jacobian test is skipped.
     pub most: usize,
     pub singular: bool,
+    /// The closed form met a double root (a subproblem's discriminant at zero within tolerance):
+    /// two branches merge at this target, and their one candidate stands for both.
+    pub merged: bool,
 }
 
 impl Check<'_> {
@@ -224,9 +228,12 @@ impl Check<'_> {
         }
         let e = pose_error(&frame_pose_lean(model, &q, self.frame), target);
         let (mut ep, mut er) = residuals(&e, &weights);
-        if (ep > 1e-12 || er > 1e-12) && ep < 1e-4 && er < 1e-4 {
-            // refine near-tangent candidates by a few damped Gauss-Newton steps (no limits; a
-            // held joint stays where it is held)
+        // refine near-tangent candidates (residuals of the order of the square root of rounding)
+        // by a few damped Gauss-Newton steps (no limits; a held joint stays where it is held);
+        // not those at rounding level already, well inside the tolerance: refining them gains
+        // nothing the caller asked for and costs a Jacobian per step (docs/ik.md, "Speed")
+        let refine_above = (0.01 * self.tolerance).min(1e-10);
+        if (ep > refine_above || er > refine_above) && ep < 1e-4 && er < 1e-4 {
             let refine = Settings {
                 weights,
                 max_iterations: 8,
@@ -257,7 +264,10 @@ impl Check<'_> {
     pub fn finish(&self, model: &Model, data: &mut Data, candidates: &[f64], stride: usize) -> AnalyticOutcome {
         let n = model.n;
         let (reference, lower, upper) = (self.reference, self.lower, self.upper);
-        let mut out = AnalyticOutcome::default();
+        let mut out = AnalyticOutcome {
+            merged: self.merged,
+            ..Default::default()
+        };
         // (q, position error, orientation error, inside the limits, squared distance to the reference)
         let mut kept: Vec<(Vec<f64>, f64, f64, bool, f64)> = Vec::with_capacity(candidates.len() / stride.max(1));
         for theta in candidates.chunks_exact(stride.max(1)) {

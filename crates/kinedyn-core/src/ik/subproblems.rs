@@ -15,7 +15,8 @@
 //!
 //! Every function returns all solutions (0, 1 or 2) and whether the problem was degenerate
 //! (a point on the axis: any angle solves it, 0 is returned and `singular` is set). Distances
-//! within `tol` of tangency give a single solution (the limit of the two).
+//! within `tol` of tangency give a single solution (the limit of the two), flagged `tangent`
+//! (sp2: a count of 1), where two branches of a chain's solution merge.
 
 use crate::spatial::Vec3;
 
@@ -32,6 +33,9 @@ pub struct Angles {
     pub count: usize,
     pub values: [f64; 2],
     pub singular: bool,
+    /// The two roots met (a discriminant within tolerance of zero): one value is returned for
+    /// both, and two branches of the solution merge there.
+    pub tangent: bool,
 }
 
 impl Angles {
@@ -43,6 +47,14 @@ impl Angles {
             count: 1,
             values: [a, 0.0],
             singular,
+            tangent: false,
+        }
+    }
+    /// The double root of a tangency.
+    fn double(a: f64) -> Self {
+        Self {
+            tangent: true,
+            ..Self::one(a, false)
         }
     }
     fn two(a: f64, b: f64) -> Self {
@@ -50,6 +62,7 @@ impl Angles {
             count: 2,
             values: [a, b],
             singular: false,
+            tangent: false,
         }
     }
     pub fn as_slice(&self) -> &[f64] {
@@ -99,7 +112,8 @@ pub fn sp1_dir(w: &Vec3, u: &Vec3, v: &Vec3) -> Angles {
 }
 
 /// Subproblem 2 (MLS §3.2.2): `exp(xi1^ theta1) exp(xi2^ theta2) p = q` for two axes meeting at
-/// `r` (`axis1.r` must be the intersection point). Returns pairs `(theta1, theta2)`.
+/// `r` (`axis1.r` must be the intersection point). Returns pairs `(theta1, theta2)`, their
+/// count (1 only at a tangency: the two pairs merged) and the singular flag.
 ///
 /// The intermediate point `c = exp(xi2^ theta2) p = exp(-xi1^ theta1) q` is `r + z` with
 /// `z = alpha w1 + beta w2 + gamma (w1 x w2)` (MLS eqs. 3.43-3.46).
@@ -162,7 +176,7 @@ pub fn sp3(axis: &Axis, p: &Vec3, q: &Vec3, delta: f64) -> Angles {
         let phi = cosine.acos();
         Angles::two(theta0 + phi, theta0 - phi)
     } else if (cosine.abs() - 1.0) <= 1e-7 {
-        Angles::one(theta0 + if cosine > 0.0 { 0.0 } else { std::f64::consts::PI }, false)
+        Angles::double(theta0 + if cosine > 0.0 { 0.0 } else { std::f64::consts::PI })
     } else {
         Angles::none()
     }
@@ -194,7 +208,7 @@ pub fn sp4(h: &Vec3, w: &Vec3, p: &Vec3, d: f64) -> Angles {
         let phi = cosine.acos();
         Angles::two(base + phi, base - phi)
     } else if cosine.abs() - 1.0 <= 1e-7 {
-        Angles::one(base + if cosine > 0.0 { 0.0 } else { std::f64::consts::PI }, false)
+        Angles::double(base + if cosine > 0.0 { 0.0 } else { std::f64::consts::PI })
     } else {
         Angles::none()
     }
