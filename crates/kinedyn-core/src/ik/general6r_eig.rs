@@ -111,9 +111,8 @@ impl Square {
                 self.a[i][k - 1] = 0.0;
                 // row i -= m row k (left), then column k += m column i (right)
                 let (top, bottom) = self.a.split_at_mut(i);
-                let (rk, ri) = (&top[k], &mut bottom[0]);
-                for j in k..n {
-                    ri[j] -= m * rk[j];
+                for (x, y) in bottom[0][k..n].iter_mut().zip(&top[k][k..n]) {
+                    *x -= m * y;
                 }
                 for row in self.a[..n].iter_mut() {
                     row[k] += m * row[i];
@@ -213,13 +212,23 @@ impl Square {
                     let (v1, v2) = (y, if three { z } else { 0.0 });
                     let beta = 2.0 / (v0 * v0 + v1 * v1 + v2 * v2);
                     let first = if k > l { k - 1 } else { l };
-                    for j in first..=e {
-                        let dot = v0 * h[k][j] + v1 * h[k + 1][j] + if three { v2 * h[k + 2][j] } else { 0.0 };
-                        let f = beta * dot;
-                        h[k][j] -= f * v0;
-                        h[k + 1][j] -= f * v1;
-                        if three {
-                            h[k + 2][j] -= f * v2;
+                    // rows k, k + 1 (and k + 2) as slices: the loop runs without bounds checks
+                    let (top, rest) = h.split_at_mut(k + 1);
+                    let (r1, rest) = rest.split_at_mut(1);
+                    let (r0, r1) = (&mut top[k][first..=e], &mut r1[0][first..=e]);
+                    if three {
+                        let r2 = &mut rest[0][first..=e];
+                        for ((a, b), c) in r0.iter_mut().zip(r1.iter_mut()).zip(r2.iter_mut()) {
+                            let f = beta * (v0 * *a + v1 * *b + v2 * *c);
+                            *a -= f * v0;
+                            *b -= f * v1;
+                            *c -= f * v2;
+                        }
+                    } else {
+                        for (a, b) in r0.iter_mut().zip(r1.iter_mut()) {
+                            let f = beta * (v0 * *a + v1 * *b);
+                            *a -= f * v0;
+                            *b -= f * v1;
                         }
                     }
                     let last = (k + 3).min(e);
