@@ -111,3 +111,44 @@ def test_an_unreachable_pose_has_no_branch(arm):
     target[0, 3] = 3.0
     result = arm.inverse_kinematics(target)
     assert not result.success and result.reachable is False and len(result) == 0
+
+
+def singular_configuration(robot, rng) -> np.ndarray:
+    """A configuration where the Jacobian is singular: det J changes sign along joint 5 (0-based 4)
+    between two samples, found by bisection (det J is smooth in q)."""
+    while True:
+        q = rng.uniform(-np.pi, np.pi, 6)
+
+        def det(x, q=q):
+            p = q.copy()
+            p[4] = x
+            return np.linalg.det(robot.jacobian(p))
+
+        grid = np.linspace(-np.pi, np.pi, 25)
+        values = [det(x) for x in grid]
+        for lo, hi, flo, fhi in zip(grid[:-1], grid[1:], values[:-1], values[1:]):
+            if flo * fhi < 0:
+                for _ in range(80):
+                    mid = 0.5 * (lo + hi)
+                    if (det(mid) < 0) == (flo < 0):
+                        lo = mid
+                    else:
+                        hi = mid
+                q[4] = 0.5 * (lo + hi)
+                return q
+
+
+def test_a_target_where_two_branches_merge_is_flagged(arm):
+    # at a singular configuration two real branches meet (a double root of the elimination): the
+    # result finds it, reproduces the target and says the branches merged; a regular target does not
+    rng = np.random.default_rng(4)
+    for _ in range(2):
+        q = singular_configuration(arm, rng)
+        J = arm.jacobian(q)
+        assert np.linalg.svd(J, compute_uv=False)[-1] < 1e-9
+        result = arm.inverse_kinematics(arm.pose(q), respect_limits=False)
+        assert result.solver == "analytic:general_6r"
+        assert any(same(s, q, 1e-5) for s in result.solutions), (q, result.solutions)
+        assert result.merged and result.worst_residual < 1e-9
+    regular = arm.inverse_kinematics(arm.pose(rng.uniform(-np.pi, np.pi, 6)), respect_limits=False)
+    assert not regular.merged

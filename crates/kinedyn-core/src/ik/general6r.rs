@@ -49,11 +49,12 @@
 use super::subproblems::Axis;
 use crate::joint::axis_angle;
 use crate::spatial::{Transform, Vec3};
-use nalgebra::{linalg::Schur, DMatrix, SMatrix};
+use nalgebra::SMatrix;
 use std::f64::consts::PI;
 
-type M12 = SMatrix<f64, 12, 12>;
 type Eqs = [f64; 14];
+/// Most rows of the matrix polynomial (6 equations times 4 monomial multipliers).
+const ROWS: usize = 24;
 
 /// Most real solutions a 6R chain can have (Raghavan & Roth 1993; Manseur & Doty 1989).
 pub const MAX_SOLUTIONS: usize = 16;
@@ -86,6 +87,13 @@ pub struct General6R {
     eig: usize,
     /// Whether Q_Y has full rank (8).
     full_rank: bool,
+    /// The extended formulation: rows `x_b d` and `x_a x_b d` too (24 x 16, squared by `mix`),
+    /// for chains whose 12 x 12 matrix polynomial is singular at every `x_t`.
+    extended: bool,
+    /// Fixed generic row combinations that square a non-square system.
+    mix: [[f64; ROWS]; SIDE],
+    /// Each joint's motion at the U side's three sample angles (sign included).
+    grid: [[Transform; 3]; 6],
     /// Left null space of Q_Y (6 x 14), its pseudo-inverse (8 x 14), the constant column H_0.
     null: SMatrix<f64, 6, 14>,
     qy_pinv: SMatrix<f64, 8, 14>,
@@ -146,18 +154,26 @@ impl General6R {
             .fold(home.trans.norm(), f64::max)
             .max(1e-3);
         let mut best: Option<(f64, Self)> = None;
-        for cut in 0..6 {
-            for v_first in [true, false] {
-                let Some(mut me) = Self::formulation(&axes, &home, scale, cut, v_first) else {
-                    continue;
-                };
-                for eig in 0..3 {
-                    me.eig = eig;
-                    let score = me.trial();
-                    if score > 0.0 && best.as_ref().is_none_or(|b| score > b.0) {
-                        best = Some((score, me.clone()));
+        // the 12 x 12 formulations first; where every one is singular at every x_t (consecutive
+        // axes that all meet or are parallel: JACO 2, Gen3 lite, CRX), the extended ones
+        for extended in [false, true] {
+            for cut in 0..6 {
+                for v_first in [true, false] {
+                    let Some(mut me) = Self::formulation(&axes, &home, scale, cut, v_first) else {
+                        continue;
+                    };
+                    me.extended = extended;
+                    for eig in 0..3 {
+                        me.eig = eig;
+                        let score = me.trial();
+                        if score > 0.0 && best.as_ref().is_none_or(|b| score > b.0) {
+                            best = Some((score, me.clone()));
+                        }
                     }
                 }
+            }
+            if best.is_some() {
+                break;
             }
         }
         best.map(|b| b.1)
@@ -207,6 +223,9 @@ impl General6R {
             v,
             eig: 0,
             full_rank: true,
+            extended: false,
+            mix: [[0.0; ROWS]; SIDE],
+            grid: [[Transform::identity(); 3]; 6],
             null: SMatrix::zeros(),
             qy_pinv: SMatrix::zeros(),
             h0: [0.0; 14],
@@ -274,6 +293,20 @@ impl General6R {
                 }
             }
         }
+        for item in &me.u {
+            if let Item::Joint(j, sign) = *item {
+                for m in 0..3 {
+                    let th = SHIFT[j] + 2.0 * PI * m as f64 / 3.0;
+                    me.grid[j][m] = joint_exp(&axes[j], sign * th);
+                }
+            }
+        }
+        let mut rng = crate::rng::Rng::new(0x3c6e_f372_fe94_f82b);
+        for row in me.mix.iter_mut() {
+            for x in row.iter_mut() {
+                *x = rng.uniform(-1.0, 1.0);
+            }
+        }
         Some(me)
     }
 
@@ -294,8 +327,8 @@ impl General6R {
         equations(&((p - a.r) / self.scale), &l)
     }
 
-    /// Score of this formulation on targets of known solutions: 0 if one is missed, else the
-    /// smallest relative gap to singularity of the leading matrix met.
+    /// Score of this formulation on targets of known solutions: 0 if one is missed or two roots
+    /// meet, else the smallest relative gap to singularity of the leading matrix met.
     fn trial(&self) -> f64 {
         let mut rng = crate::rng::Rng::new(0x6a09_e667_f3bc_c908 ^ (self.cut * 7 + self.eig) as u64);
         let mut out = Vec::with_capacity(16);
@@ -307,7 +340,10 @@ impl General6R {
             }
             let target = self.forward(&q);
             let (stats, lead) = self.solve_with(&target, &mut out);
-            if stats.candidates == 0 || !out.iter().any(|s| same_angles(s, &q, 1e-6)) {
+            // two roots together at a random target: the eigen joint's angle is shared by pairs
+            // of solutions (a wrist's flip), its null space is two-dimensional there and the
+            // other joints cannot be read from it
+            if stats.candidates == 0 || stats.near_double || !out.iter().any(|s| same_angles(s, &q, 1e-6)) {
                 return 0.0;
             }
             worst = worst.min(lead);
@@ -342,73 +378,21 @@ impl General6R {
         out.clear();
         let mut stats = General6RStats::default();
         let g = *target * self.home.inverse();
-        // U side: 27 samples on the shifted grid, then its Fourier coefficients f[q][a][b][c]
-        let mut f = [[[[0.0; 3]; 3]; 3]; 14];
-        let mut th = [0.0; 6];
-        let [j0, j1, j2] = self.uj;
-        for m0 in 0..3 {
-            th[j0] = SHIFT[j0] + 2.0 * PI * m0 as f64 / 3.0;
-            for m1 in 0..3 {
-                th[j1] = SHIFT[j1] + 2.0 * PI * m1 as f64 / 3.0;
-                for m2 in 0..3 {
-                    th[j2] = SHIFT[j2] + 2.0 * PI * m2 as f64 / 3.0;
-                    let e = self.side(&self.u, &th, &g);
-                    for q in 0..14 {
-                        f[q][m0][m1][m2] = e[q];
-                    }
-                }
-            }
-        }
-        // reduced equations N (F - H_0) in half-angle powers d[i][p0][p1][p2]
-        let mut d = [[[[0.0; 3]; 3]; 3]; 6];
-        for q in 0..14 {
-            let fq = &mut f[q];
-            for m0 in 0..3 {
-                for m1 in 0..3 {
-                    fq[m0][m1] = powers(fourier(fq[m0][m1][0], fq[m0][m1][1], fq[m0][m1][2]));
-                }
-                for p2 in 0..3 {
-                    let c = powers(fourier(fq[m0][0][p2], fq[m0][1][p2], fq[m0][2][p2]));
-                    for p1 in 0..3 {
-                        fq[m0][p1][p2] = c[p1];
-                    }
-                }
-            }
-            for p1 in 0..3 {
-                for p2 in 0..3 {
-                    let c = powers(fourier(fq[0][p1][p2], fq[1][p1][p2], fq[2][p1][p2]));
-                    for p0 in 0..3 {
-                        fq[p0][p1][p2] = c[p0];
-                    }
-                }
-            }
-            // the constant H_0 (moved to this side) is 1 = (1 + x^2)/(1 + x^2) in every variable
-            let h = self.h0[q];
-            for p0 in [0, 2] {
-                for p1 in [0, 2] {
-                    for p2 in [0, 2] {
-                        fq[p0][p1][p2] -= h;
-                    }
-                }
-            }
-            for i in 0..6 {
-                let n = self.null[(i, q)];
-                for p0 in 0..3 {
-                    for p1 in 0..3 {
-                        for p2 in 0..3 {
-                            d[i][p0][p1][p2] += n * fq[p0][p1][p2];
-                        }
-                    }
-                }
-            }
-        }
-        // M(x_t) = sum_p M_p x_t^p on monomials x_a^i x_b^j (column 3 i + j), rows d and x_a d
+        let d = self.reduced_equations(&g);
+        // M(x_t) = sum_p M_p x_t^p on monomials x_a^i x_b^j (column nb i + j): rows d and x_a d
+        // (Manocha & Canny), and in the extended formulation also x_b d and x_a x_b d
         let (t, a, b) = match self.eig {
             0 => (0, 1, 2),
             1 => (1, 0, 2),
             _ => (2, 0, 1),
         };
-        let mut m = [M12::zeros(); 3];
+        let (nb, shifts): (usize, &[(usize, usize)]) = if self.extended {
+            (4, &[(0, 0), (1, 0), (0, 1), (1, 1)])
+        } else {
+            (3, &[(0, 0), (1, 0)])
+        };
+        let rows = 6 * shifts.len();
+        let mut m = [[[0.0; SIDE]; ROWS]; 3];
         for i in 0..6 {
             for pw in 0..27 {
                 let (pt, pa, pb) = (pw / 9, (pw / 3) % 3, pw % 3);
@@ -417,56 +401,77 @@ impl General6R {
                 idx[a] = pa;
                 idx[b] = pb;
                 let c = d[i][idx[0]][idx[1]][idx[2]];
-                m[pt][(i, 3 * pa + pb)] = c;
-                m[pt][(6 + i, 3 * (pa + 1) + pb)] = c;
+                for (s, &(sa, sb)) in shifts.iter().enumerate() {
+                    m[pt][6 * s + i][nb * (pa + sa) + pb + sb] = c;
+                }
             }
         }
-        // monomials absent from every equation (axes that meet or are parallel): drop their
-        // columns and square the system by fixed generic combinations of its rows
-        let big = m.iter().map(|mp| mp.amax()).fold(0.0, f64::max);
-        let present: Vec<usize> = (0..12)
-            .filter(|&c| m.iter().any(|mp| mp.column(c).amax() > 1e-12 * big))
-            .collect();
-        let n = present.len();
-        let mut rng = crate::rng::Rng::new(0x3c6e_f372_fe94_f82b);
-        let mix = if n < 12 {
-            DMatrix::from_fn(n, 12, |_, _| rng.uniform(-1.0, 1.0))
-        } else {
-            DMatrix::identity(12, 12)
-        };
-        let md: Vec<DMatrix<f64>> = m
+        // monomials absent from every equation (axes that meet or are parallel) are dropped; a
+        // system that is then not square is squared by fixed generic combinations of its rows
+        // (a random projection: it keeps every root, adds spurious ones that the residual of the
+        // full system rejects; Hochstenbach, Mehl & Plestenjak, "Solving singular generalized
+        // eigenvalue problems. Part II: projection and augmentation", SIMAX 44(4), 2023)
+        let cols = 4 * nb;
+        let big = m
             .iter()
-            .map(|mp| &mix * DMatrix::from_fn(12, n, |i, j| mp[(i, present[j])]))
-            .collect();
-        // x = eigenvalue of [0 I; -M2^-1 M0, -M2^-1 M1]; if M2 is singular (roots at x = inf),
-        // 1/x = eigenvalue of [0 I; -M0^-1 M2, -M0^-1 M1] (the infinite roots become 0)
-        let gap = |a: &DMatrix<f64>| {
-            let lu = a.clone().full_piv_lu();
-            let piv = lu.u().diagonal().map(f64::abs);
-            (piv.min() / piv.max().max(1e-300), lu)
+            .flatten()
+            .flat_map(|r| r[..cols].iter())
+            .fold(0.0f64, |s, x| s.max(x.abs()));
+        let mut present = [0usize; SIDE];
+        let mut n = 0;
+        for c in 0..cols {
+            if m.iter().any(|mp| mp[..rows].iter().any(|r| r[c].abs() > 1e-12 * big)) {
+                present[n] = c;
+                n += 1;
+            }
+        }
+        let mixed = n != rows;
+        let mut sq = [[[0.0; SIDE]; SIDE]; 3];
+        for p in 0..3 {
+            for i in 0..n {
+                for (j, &c) in present[..n].iter().enumerate() {
+                    sq[p][i][j] = if mixed {
+                        (0..rows).map(|r| self.mix[i][r] * m[p][r][c]).sum()
+                    } else {
+                        m[p][i][c]
+                    };
+                }
+            }
+        }
+        // x = eigenvalue of [0 I; -S2^-1 S0, -S2^-1 S1]; if S2 is nearly singular (roots near
+        // x = inf), 1/x = eigenvalue of [0 I; -S0^-1 S2, -S0^-1 S1] (the infinite roots become 0)
+        let mut blocks = [[0.0; 2 * SIDE]; SIDE];
+        let mut other = [[0.0; 2 * SIDE]; SIDE];
+        let lead2 = solve_blocks(&sq[2], &sq[0], &sq[1], n, &mut blocks).unwrap_or(0.0);
+        // (the reversed form only where S2 is far from regular: one elimination less per call)
+        let lead0 = if lead2 < 1e-3 {
+            solve_blocks(&sq[0], &sq[2], &sq[1], n, &mut other).unwrap_or(0.0)
+        } else {
+            0.0
         };
-        let (lead2, lu2) = gap(&md[2]);
-        let (lead0, lu0) = gap(&md[0]);
         let reversed = lead0 > 100.0 * lead2;
-        let (lead, lu, first) = if reversed { (lead0, lu0, 2) } else { (lead2, lu2, 0) };
-        let Some(inv) = (n > 0 && lead > 1e-13).then(|| lu.try_inverse()).flatten() else {
-            return (stats, 0.0);
-        };
-        let mut c = DMatrix::zeros(2 * n, 2 * n);
-        c.view_mut((0, n), (n, n)).fill_with_identity();
-        c.view_mut((n, 0), (n, n)).copy_from(&(-&inv * &md[first]));
-        c.view_mut((n, n), (n, n)).copy_from(&(-&inv * &md[1]));
-        if c.iter().any(|x| !x.is_finite()) {
+        let lead = if reversed { lead0 } else { lead2 };
+        if reversed {
+            blocks = other;
+        }
+        if n == 0 || lead <= 1e-13 {
             return (stats, 0.0);
         }
-        let Some(schur) = Schur::try_new(c, f64::EPSILON, 2000) else {
+        let mut c = Square::zeros(2 * n);
+        for i in 0..n {
+            c.a[i][n + i] = 1.0;
+            for j in 0..2 * n {
+                c.a[n + i][j] = -blocks[i][j];
+            }
+        }
+        let mut roots = Vec::with_capacity(2 * SIDE);
+        if c.eigenvalues(&mut roots).is_none() {
             return (stats, 0.0);
-        };
-        let roots = schur.complex_eigenvalues();
+        }
         let mut xs: Vec<f64> = roots
             .iter()
-            .filter(|z| z.im.abs() <= 1e-4 * (1.0 + z.re.abs()))
-            .map(|z| z.re)
+            .filter(|z| z.1.abs() <= 1e-4 * (1.0 + z.0.abs()))
+            .map(|z| z.0)
             .filter_map(|x| match reversed {
                 false => Some(x),
                 true => (x.abs() > 1e-12).then(|| 1.0 / x),
@@ -479,33 +484,49 @@ impl General6R {
             }
         }
         stats.candidates = xs.len();
+        let has = |c: usize| present[..n].contains(&c);
         for &x in &xs {
-            let u = if n == 12 {
-                null_vector(&(m[2] * (x * x) + m[1] * x + m[0]))
-            } else {
-                let mx = &md[2] * (x * x) + &md[1] * x + &md[0];
-                let svd = mx.svd(false, true);
-                let Some(vt) = svd.v_t else { continue };
-                let row = vt.row(svd.singular_values.imin());
-                let mut u = [0.0; 12];
-                for (j, &c) in present.iter().enumerate() {
-                    u[c] = row[j];
+            let mut mx = [[0.0; SIDE]; SIDE];
+            for i in 0..n {
+                for j in 0..n {
+                    mx[i][j] = (sq[2][i][j] * x + sq[1][i][j]) * x + sq[0][i][j];
                 }
-                u
-            };
+            }
+            let z = null_vector(&mx, n);
+            let mut u = [0.0; SIDE];
+            for (j, &c) in present[..n].iter().enumerate() {
+                u[c] = z[j];
+            }
+            if mixed {
+                // a root of the projection only: the full system is not singular there
+                let (mut res, mut size) = (0.0f64, 0.0f64);
+                for r in 0..rows {
+                    let (mut dot, mut row) = (0.0, 0.0);
+                    for &c in &present[..n] {
+                        let e = (m[2][r][c] * x + m[1][r][c]) * x + m[0][r][c];
+                        dot += e * u[c];
+                        row += e * e;
+                    }
+                    res = res.max(dot.abs());
+                    size = size.max(row.sqrt());
+                }
+                if res > 1e-6 * size {
+                    continue;
+                }
+            }
             let mut th = [0.0; 6];
             th[self.uj[t]] = SHIFT[self.uj[t]] + 2.0 * x.atan();
             // x_a from consecutive powers of x_a (i, i + 1), x_b from (j, j + 1)
             let (mut lo_a, mut hi_a, mut cr_a, mut lo_b, mut hi_b, mut cr_b) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
             for i in 0..4 {
-                for j in 0..3 {
-                    let e = u[3 * i + j];
-                    if i < 3 && present.contains(&(3 * i + j)) && present.contains(&(3 * (i + 1) + j)) {
-                        let h = u[3 * (i + 1) + j];
+                for j in 0..nb {
+                    let e = u[nb * i + j];
+                    if i < 3 && has(nb * i + j) && has(nb * (i + 1) + j) {
+                        let h = u[nb * (i + 1) + j];
                         (lo_a, hi_a, cr_a) = (lo_a + e * e, hi_a + h * h, cr_a + e * h);
                     }
-                    if j < 2 && present.contains(&(3 * i + j)) && present.contains(&(3 * i + j + 1)) {
-                        let h = u[3 * i + j + 1];
+                    if j + 1 < nb && has(nb * i + j) && has(nb * i + j + 1) {
+                        let h = u[nb * i + j + 1];
                         (lo_b, hi_b, cr_b) = (lo_b + e * e, hi_b + h * h, cr_b + e * h);
                     }
                 }
@@ -527,8 +548,11 @@ impl General6R {
 
 #[path = "general6r_back.rs"]
 mod back;
-use back::null_vector;
 pub use back::same_angles;
+use back::{null_vector, solve_blocks, SIDE};
+#[path = "general6r_eig.rs"]
+mod eig;
+use eig::Square;
 
 #[cfg(test)]
 #[path = "general6r_tests.rs"]

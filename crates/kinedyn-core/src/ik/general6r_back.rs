@@ -1,8 +1,8 @@
-//! The last steps of the general-6R solve (`super`): the remaining joints from an eigenvalue
-//! (least squares or subproblems), Newton refinement on the pose error, and the null vector of
-//! the matrix polynomial.
+//! The steps of the general-6R solve (`super`) around its eigenvalue problem: the reduced
+//! equations of a target, the remaining joints from an eigenvalue (least squares or subproblems),
+//! Newton refinement on the pose error, the null vector and block solve of the matrix polynomial.
 
-use super::{joint_exp, General6R, Item, M12};
+use super::{equations, fourier, joint_exp, powers, General6R, Item};
 use crate::ik::pose_error;
 use crate::ik::subproblems::{sp1_dir, sp4};
 use crate::spatial::{Transform, Vec3};
@@ -85,6 +85,92 @@ impl General6R {
         th[jb] = sb * best.2;
     }
 
+    /// The six equations free of the V joints, `N (F(th_u) - H_0)`, as coefficients
+    /// `d[i][p0][p1][p2]` of the half-angle powers of the U joints (each shifted by `SHIFT`).
+    #[inline(never)]
+    pub(super) fn reduced_equations(&self, g: &Transform) -> [[[[f64; 3]; 3]; 3]; 6] {
+        // U side: 27 samples on the shifted grid, then its Fourier coefficients f[q][a][b][c].
+        // The cut axis is carried through the factors from the right, each joint's three sampled
+        // motions precomputed (`grid`): 3 + 9 + 27 rigid motions instead of 27 products
+        let mut f = [[[[0.0; 3]; 3]; 3]; 14];
+        let cut = &self.axes[self.cut];
+        let mut states = [(Vec3::zeros(), Vec3::zeros()); 27];
+        states[0] = (cut.r, cut.w);
+        let mut count = 1;
+        let g_inv = g.inverse();
+        for item in self.u.iter().rev() {
+            match *item {
+                Item::Joint(j, _) => {
+                    for s in (0..count).rev() {
+                        let (p, l) = states[s];
+                        for (m, e) in self.grid[j].iter().enumerate() {
+                            states[3 * s + m] = (e.act_point(&p), e.rot * l);
+                        }
+                    }
+                    count *= 3;
+                }
+                Item::Target(inverse) => {
+                    let t = if inverse { &g_inv } else { g };
+                    for st in states[..count].iter_mut() {
+                        *st = (t.act_point(&st.0), t.rot * st.1);
+                    }
+                }
+            }
+        }
+        // state index: the first joint met from the right (uj[2]) varies slowest
+        for (s, (p, l)) in states.iter().enumerate() {
+            let e = equations(&((p - cut.r) / self.scale), l);
+            let (m2, m1, m0) = (s / 9, (s / 3) % 3, s % 3);
+            for q in 0..14 {
+                f[q][m0][m1][m2] = e[q];
+            }
+        }
+        // reduced equations N (F - H_0) in half-angle powers d[i][p0][p1][p2]
+        let mut d = [[[[0.0; 3]; 3]; 3]; 6];
+        for q in 0..14 {
+            let fq = &mut f[q];
+            for m0 in 0..3 {
+                for m1 in 0..3 {
+                    fq[m0][m1] = powers(fourier(fq[m0][m1][0], fq[m0][m1][1], fq[m0][m1][2]));
+                }
+                for p2 in 0..3 {
+                    let c = powers(fourier(fq[m0][0][p2], fq[m0][1][p2], fq[m0][2][p2]));
+                    for p1 in 0..3 {
+                        fq[m0][p1][p2] = c[p1];
+                    }
+                }
+            }
+            for p1 in 0..3 {
+                for p2 in 0..3 {
+                    let c = powers(fourier(fq[0][p1][p2], fq[1][p1][p2], fq[2][p1][p2]));
+                    for p0 in 0..3 {
+                        fq[p0][p1][p2] = c[p0];
+                    }
+                }
+            }
+            // the constant H_0 (moved to this side) is 1 = (1 + x^2)/(1 + x^2) in every variable
+            let h = self.h0[q];
+            for p0 in [0, 2] {
+                for p1 in [0, 2] {
+                    for p2 in [0, 2] {
+                        fq[p0][p1][p2] -= h;
+                    }
+                }
+            }
+            for i in 0..6 {
+                let n = self.null[(i, q)];
+                for p0 in 0..3 {
+                    for p1 in 0..3 {
+                        for p2 in 0..3 {
+                            d[i][p0][p1][p2] += n * fq[p0][p1][p2];
+                        }
+                    }
+                }
+            }
+        }
+        d
+    }
+
     /// Newton steps on the pose error (world-aligned Jacobian of the screws): the solution and
     /// its residual, or None if it does not reproduce the target.
     pub(super) fn refine(&self, mut th: [f64; 6], target: &Transform) -> Option<([f64; 6], f64)> {
@@ -152,44 +238,124 @@ pub fn same_angles(a: &[f64; 6], b: &[f64; 6], tol: f64) -> bool {
     })
 }
 
-/// A unit null vector of a (numerically) singular 12 x 12 matrix: Gaussian elimination with full
-/// pivoting, the last pivot taken as zero.
-pub(super) fn null_vector(m: &M12) -> [f64; 12] {
+/// Largest side of the square matrix polynomial (16 monomials of the extended formulation).
+pub(super) const SIDE: usize = 16;
+pub(super) type Sq = [[f64; SIDE]; SIDE];
+
+/// A unit null vector of a (numerically) singular `n x n` matrix (its leading block of `a`):
+/// Gaussian elimination with full pivoting, the last pivot taken as zero.
+#[inline(never)]
+pub(super) fn null_vector(m: &Sq, n: usize) -> [f64; SIDE] {
     let mut a = *m;
-    let mut col: [usize; 12] = std::array::from_fn(|i| i);
-    for k in 0..11 {
+    let mut col: [usize; SIDE] = std::array::from_fn(|i| i);
+    for k in 0..n.saturating_sub(1) {
         let (mut pr, mut pc, mut best) = (k, k, -1.0);
-        for i in k..12 {
-            for j in k..12 {
-                if a[(i, j)].abs() > best {
-                    (pr, pc, best) = (i, j, a[(i, j)].abs());
+        for (i, row) in a.iter().enumerate().take(n).skip(k) {
+            for (j, x) in row.iter().enumerate().take(n).skip(k) {
+                if x.abs() > best {
+                    (pr, pc, best) = (i, j, x.abs());
                 }
             }
         }
-        a.swap_rows(k, pr);
-        a.swap_columns(k, pc);
+        a.swap(k, pr);
+        for row in a.iter_mut().take(n) {
+            row.swap(k, pc);
+        }
         col.swap(k, pc);
         if best == 0.0 {
             continue;
         }
-        for i in k + 1..12 {
-            let f = a[(i, k)] / a[(k, k)];
-            for j in k..12 {
-                a[(i, j)] -= f * a[(k, j)];
+        let (top, bottom) = a.split_at_mut(k + 1);
+        let pivot_row = &top[k];
+        for row in bottom.iter_mut().take(n - k - 1) {
+            let f = row[k] / pivot_row[k];
+            for j in k..n {
+                row[j] -= f * pivot_row[j];
             }
         }
     }
-    // upper triangular: z_11 = 1, back substitution for z_0..z_10
-    let mut z = [0.0; 12];
-    z[11] = 1.0;
-    for i in (0..11).rev() {
-        let s: f64 = (i + 1..12).map(|j| a[(i, j)] * z[j]).sum();
-        z[i] = if a[(i, i)] != 0.0 { -s / a[(i, i)] } else { 0.0 };
+    // upper triangular: z_{n-1} = 1, back substitution for the others
+    let mut z = [0.0; SIDE];
+    if n == 0 {
+        return z;
     }
-    let norm = z.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let mut u = [0.0; 12];
-    for i in 0..12 {
+    z[n - 1] = 1.0;
+    for i in (0..n - 1).rev() {
+        let s: f64 = (i + 1..n).map(|j| a[i][j] * z[j]).sum();
+        z[i] = if a[i][i] != 0.0 { -s / a[i][i] } else { 0.0 };
+    }
+    let norm = z[..n].iter().map(|x| x * x).sum::<f64>().sqrt();
+    let mut u = [0.0; SIDE];
+    for i in 0..n {
         u[col[i]] = z[i] / norm;
     }
     u
+}
+
+/// `A^-1 [B C]` for `n x n` blocks by Gaussian elimination with full pivoting, into `out` (row i:
+/// the `2n` entries of row i of the result); returns the smallest pivot relative to the largest
+/// (how far `A` is from singular), or None if `A` is singular.
+pub(super) fn solve_blocks(a: &Sq, b: &Sq, c: &Sq, n: usize, out: &mut [[f64; 2 * SIDE]; SIDE]) -> Option<f64> {
+    let mut m = *a;
+    for i in 0..n {
+        out[i][..n].copy_from_slice(&b[i][..n]);
+        out[i][n..2 * n].copy_from_slice(&c[i][..n]);
+    }
+    let mut col: [usize; SIDE] = std::array::from_fn(|i| i);
+    let (mut small, mut large) = (f64::INFINITY, 0.0f64);
+    for k in 0..n {
+        let (mut pr, mut pc, mut best) = (k, k, -1.0);
+        for (i, row) in m.iter().enumerate().take(n).skip(k) {
+            for (j, x) in row.iter().enumerate().take(n).skip(k) {
+                if x.abs() > best {
+                    (pr, pc, best) = (i, j, x.abs());
+                }
+            }
+        }
+        if best <= 0.0 || !best.is_finite() {
+            return None;
+        }
+        (small, large) = (small.min(best), large.max(best));
+        m.swap(k, pr);
+        out.swap(k, pr);
+        for row in m.iter_mut().take(n) {
+            row.swap(k, pc);
+        }
+        col.swap(k, pc);
+        let (top, bottom) = m.split_at_mut(k + 1);
+        let (otop, obottom) = out.split_at_mut(k + 1);
+        for (row, orow) in bottom.iter_mut().zip(obottom.iter_mut()).take(n - k - 1) {
+            let f = row[k] / top[k][k];
+            if f == 0.0 {
+                continue;
+            }
+            for j in k..n {
+                row[j] -= f * top[k][j];
+            }
+            for j in 0..2 * n {
+                orow[j] -= f * otop[k][j];
+            }
+        }
+    }
+    // back substitution, rows of the permuted unknowns, then undo the column permutation
+    for i in (0..n).rev() {
+        for j in i + 1..n {
+            let f = m[i][j];
+            if f != 0.0 {
+                let (top, bottom) = out.split_at_mut(j);
+                for t in 0..2 * n {
+                    top[i][t] -= f * bottom[0][t];
+                }
+            }
+        }
+        let d = m[i][i];
+        for t in 0..2 * n {
+            out[i][t] /= d;
+        }
+    }
+    let permuted = *out;
+    for i in 0..n {
+        out[col[i]] = permuted[i];
+    }
+    Some(small / large)
 }

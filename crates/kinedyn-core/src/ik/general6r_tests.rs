@@ -226,7 +226,9 @@ type Mat3Alias = crate::spatial::Mat3;
 
 #[test]
 fn time_per_solve() {
-    // a figure, not a gate (`cargo test --release -p kinedyn-core time_per_solve -- --nocapture`)
+    // a figure, not a gate (`cargo test --release -p kinedyn-core time_per_solve -- --nocapture`):
+    // the whole solve, then its stages alone (the reduced equations of the targets; the eigenvalues
+    // of random 24 x 24 matrices, the companion's order)
     let (axes, home) = random_chain(4000);
     let solver = General6R::new(axes, home).unwrap();
     let mut rng = Rng::new(4);
@@ -239,9 +241,89 @@ fn time_per_solve() {
         total += out.len();
     }
     let us = start.elapsed().as_secs_f64() * 1e6 / targets.len() as f64;
+    let start = std::time::Instant::now();
+    let mut sink = 0.0;
+    for t in &targets {
+        sink += solver.reduced_equations(&(*t * solver.home.inverse()))[0][1][1][1];
+    }
+    let equations_us = start.elapsed().as_secs_f64() * 1e6 / targets.len() as f64;
+    let matrices: Vec<Square> = (0..200)
+        .map(|_| {
+            let mut m = Square::zeros(24);
+            for row in m.a.iter_mut().take(24) {
+                for x in row.iter_mut().take(24) {
+                    *x = rng.uniform(-1.0, 1.0);
+                }
+            }
+            m
+        })
+        .collect();
+    let mut roots = Vec::with_capacity(32);
+    let start = std::time::Instant::now();
+    for m in &matrices {
+        let mut m = m.clone();
+        m.eigenvalues(&mut roots).unwrap();
+        sink += roots[0].0;
+    }
+    let eig_us = start.elapsed().as_secs_f64() * 1e6 / matrices.len() as f64;
     println!(
-        "general 6R: {us:.1} us per target, {:.2} solutions on average",
+        "general 6R: {us:.1} us per target ({equations_us:.1} us reduced equations, {eig_us:.1} us eigenvalues \
+         of a 24 x 24), {:.2} solutions on average ({sink:.1e})",
         total as f64 / 200.0
     );
     assert!(total >= targets.len());
+}
+
+fn chain_of(rows: &[([f64; 3], [f64; 3]); 6], home_trans: [f64; 3]) -> ([Axis; 6], Transform) {
+    let axes = std::array::from_fn(|i| Axis {
+        w: Vec3::new(rows[i].0[0], rows[i].0[1], rows[i].0[2]).normalize(),
+        r: Vec3::new(rows[i].1[0], rows[i].1[1], rows[i].1[2]),
+    });
+    let [x, y, z] = home_trans;
+    (axes, Transform::new(Mat3Alias::identity(), Vec3::new(x, y, z)))
+}
+
+/// Arms whose consecutive axes all meet or are parallel, the wrist not spherical: the 12 x 12
+/// matrix polynomial is singular at every x_t for each choice of cut and joints, and the extended
+/// formulation is used. Axes at q = 0 (m) as ssik 8.2's prebuilt kinova/jaco2 and fanuc/crx10ia
+/// build them (world-aligned, w and a point r per joint).
+#[test]
+fn consecutive_axes_meeting_or_parallel_get_the_extended_formulation() {
+    let s = 0.866_025_605_676_658;
+    let jaco = [
+        ([0.0, 0.0, -1.0], [0.0, 0.0, 0.0]),
+        ([0.0, -1.0, 0.0], [0.0, 0.0, 0.2755]),
+        ([0.0, 1.0, 0.0], [0.0, 0.0, -0.1345]),
+        ([0.0, 0.0, -1.0], [0.0, -0.0098, 0.0]),
+        (
+            [0.0, -s, -0.499_999_650_312_255_35],
+            [0.0, -0.052_489_241_271_964_98, 0.090_914_117_511_228_83],
+        ),
+        ([0.0, 0.0, -1.0], [0.0, 0.064_261_895_297_037_98, 0.0]),
+    ];
+    let crx = [
+        ([0.0, 0.0, 1.0], [0.0, 0.0, 0.0]),
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 0.245]),
+        ([0.0, -1.0, 0.0], [0.0, 0.0, 0.785]),
+        ([-1.0, 0.0, 0.0], [0.0, 0.0, 0.785]),
+        ([0.0, -1.0, 0.0], [0.54, 0.0, 0.785]),
+        ([-1.0, 0.0, 0.0], [0.0, -0.15, 0.785]),
+    ];
+    for (name, rows, home) in [("jaco", jaco, [0.0, 0.064, 0.361]), ("crx", crx, [0.7, -0.15, 0.785])] {
+        let (axes, home) = chain_of(&rows, home);
+        let solver = General6R::new(axes, home).expect("a formulation");
+        assert!(solver.extended, "{name}: {}", solver.formulation_name());
+        let mut rng = Rng::new(5);
+        let mut out = Vec::new();
+        for _ in 0..3 {
+            let q = random_angles(&mut rng);
+            let target = solver.forward(&q);
+            solver.solve(&target, &mut out);
+            assert!(out.iter().any(|s| same_angles(s, &q, 1e-7)), "{name}: {q:?} missing");
+            assert!(out.len() >= 2 && out.len() <= MAX_SOLUTIONS, "{name}: {}", out.len());
+            for s in &out {
+                assert!(residual(&solver, s, &target) < 1e-9, "{name}: residual");
+            }
+        }
+    }
 }
