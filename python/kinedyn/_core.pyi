@@ -214,6 +214,9 @@ class RedundantIk:
     def sweep(
         self, target: F64, mode: str, joint: int, values: F64, reference: F64, tolerance: float = 1e-09
     ) -> tuple[F64, NDArray[np.bool_]]: ...  # (q (M, B, 7) per branch slot, NaN where absent; singular (M,))
+    def arm_angle_intervals(
+        self, target: F64, lo: float, hi: float
+    ) -> list[list[tuple[float, float]]] | None: ...  # per branch slot (8), the arm-angle intervals inside the limits
 
 # ---- fixed-step integration (crates/kinedyn-py/src/simulate.rs) ----
 # Both return (q, qd, qdd, tau, steps, failures): arrays (samples, n) | (N, samples, n), steps (N,) int64,

@@ -176,7 +176,7 @@ def independent_joints(description, model, q) -> list:
     null = vt[rank:].T if jac.size else np.eye(n)  # (n, n - rank), orthonormal columns
     starts = np.concatenate([[0], np.cumsum([j.nv for j in description.joints])]).astype(int)
     bodies = description.tree.bodies
-    depth = {}
+    depth: dict[str, int] = {}
     for b in bodies:  # parents come first (parent < own index)
         depth[b.joint.name] = 0 if b.parent < 0 else depth[bodies[b.parent].joint.name] + 1
     order = sorted(

@@ -441,7 +441,7 @@ def _reference(r: _Reader, raw, description: Description) -> dict:
         r.fail(ctx, f"expected a mapping of joint names to values, got {_kind(raw)}")
     r.remember_lines(raw, ctx)
     joints = {b.joint.name: b.joint for b in description.tree.bodies}
-    out = {}
+    out: dict[str, float | tuple[float, ...]] = {}
     for name, value in raw.items():
         key = f"{ctx}.{name}"
         joint = joints.get(name)
@@ -449,11 +449,12 @@ def _reference(r: _Reader, raw, description: Description) -> dict:
             names = list(joints)
             r.fail(key, f"names no moving joint '{name}'{did_you_mean(str(name), names)} (moving joints: {names})")
         if joint.is_multi_dof:
-            out[name] = tuple(
+            block = tuple(
                 r.number(v, f"{key}[{i}]") for i, v in enumerate(r.items(value, key, f"{joint.nq} numbers", None))
             )
-            if len(out[name]) != joint.nq:
-                r.fail(key, f"a {joint.kind} joint's value is its block of q: {joint.nq} numbers, got {len(out[name])}")
+            if len(block) != joint.nq:
+                r.fail(key, f"a {joint.kind} joint's value is its block of q: {joint.nq} numbers, got {len(block)}")
+            out[name] = block
         else:
             out[name] = r.number(value, key) * (math.pi / 180 if r.deg and joint.kind == "revolute" else 1.0)
     return out
