@@ -32,6 +32,25 @@ FLOATING_URDFS = {
     "anymal": "anymal_b_simple_description/robots/anymal.urdf",
 }
 LOCKED = {"panda": ["panda_finger_joint1", "panda_finger_joint2"]}
+# fixed-base arms of the generated-code comparison (issue 30): the two above and the KUKA iiwa
+ARMS = ("ur5", "panda", "iiwa")
+
+
+def iiwa_urdf() -> Path:
+    """The KUKA LBR iiwa 14 URDF: example-robot-data has none; pybullet_data's (as tests/test_pinocchio.py)."""
+    import pybullet_data
+
+    return Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
+
+
+def load_arm(name: str):
+    """kinedyn's robot of one of ``ARMS``, the Panda's finger joints locked."""
+    import kinedyn as kd
+
+    robot = kd.Robot.from_urdf(str(iiwa_urdf() if name == "iiwa" else erd_robots_dir() / PEER_URDFS[name]))
+    if name in LOCKED:
+        robot = robot.lock_joints({j: 0.0 for j in LOCKED[name]})
+    return robot
 
 
 def load_pair(name: str):
@@ -39,13 +58,10 @@ def load_pair(name: str):
     import numpy as np
     import pinocchio as pin
 
-    import kinedyn as kd
-
     path = erd_robots_dir() / PEER_URDFS[name]
-    robot = kd.Robot.from_urdf(str(path))
+    robot = load_arm(name)
     model = pin.buildModelFromUrdf(str(path))
     if name in LOCKED:
-        robot = robot.lock_joints({j: 0.0 for j in LOCKED[name]})
         ids = [model.getJointId(j) for j in LOCKED[name]]
         model = pin.buildReducedModel(model, ids, pin.neutral(model))
     assert model.nq == robot.n, (model.nq, robot.n)

@@ -16,7 +16,8 @@ SP=$(python -c "import site; print(site.getsitepackages()[0])")
 INC="$SP/cmeel.prefix/include"
 OUT=${KINEDYN_BENCH_DIR:-/tmp/kinedyn-cpp-bench}
 mkdir -p "$OUT"
-if [ ! -x "$OUT/pinocchio_dynamics" ] || [ benches/cpp/pinocchio_dynamics.cpp -nt "$OUT/pinocchio_dynamics" ]; then
+if [ ! -x "$OUT/pinocchio_dynamics" ] || [ benches/cpp/pinocchio_dynamics.cpp -nt "$OUT/pinocchio_dynamics" ] \
+  || [ benches/cpp/harness.hpp -nt "$OUT/pinocchio_dynamics" ]; then
   echo "compiling Pinocchio (several minutes)..." >&2
   g++ -O3 -march=native -DNDEBUG -std=c++17 -w -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 \
     -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS -DBOOST_FUSION_INVOKE_MAX_ARITY=12 -I"$INC" -I"$INC/eigen3" \

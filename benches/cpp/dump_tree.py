@@ -6,6 +6,8 @@ without a URDF parser.
 
 A name ending in ``_fixed`` (``talos_fixed``) is the same URDF with its root link fixed to the world
 (no free-flyer): beside the floating robot it shows what the free-flyer itself costs on each side.
+``ur5``, ``panda`` and ``iiwa`` are the fixed-base arms of ``common.ARMS`` (the URDFs, not the DH
+models of the `quick` bench; the Panda's fingers locked): compare_codegen.sh's robots.
 
 Bodies in kinedyn's order (``robot.tree.bodies``: fixed joints merged, parents before children).
 Format, one record a line, numbers in full precision (``%.17g``):
@@ -19,7 +21,8 @@ Format, one record a line, numbers in full precision (``%.17g``):
     expect_rnea ... (NV)
 
 PARENT: the parent body's index (-1: the base); KIND: free (Pinocchio's free-flyer, q block
-(x, y, z, qx, qy, qz, qw)), revolute or prismatic with its unit axis; R, T: the joint frame's placement
+(x, y, z, qx, qy, qz, qw)), spherical (a ball joint, q block (qx, qy, qz, qw); its axis a placeholder),
+revolute or prismatic with its unit axis; R, T: the joint frame's placement
 in the parent body (q = 0); MASS, C, I: the body's mass, centre of mass and rotational inertia about the
 centre of mass, in the body frame. ``expect_rnea``: kinedyn's Python ``inverse_dynamics`` of the robot
 (friction removed, as both harnesses leave it out) at this state: the three sides must agree.
@@ -33,9 +36,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import FLOATING_URDFS, erd_robots_dir, random_state, without_friction  # noqa: E402
+from common import ARMS, FLOATING_URDFS, erd_robots_dir, load_arm, random_state, without_friction  # noqa: E402
 
-KINDS = {"floating": "free", "revolute": "revolute", "prismatic": "prismatic"}
+KINDS = {"floating": "free", "spherical": "spherical", "revolute": "revolute", "prismatic": "prismatic"}
 
 
 def fmt(values) -> str:
@@ -46,12 +49,20 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
     import kinedyn as kd
 
     urdf = name.removesuffix("_fixed")
-    # every joint its own coordinate, as Pinocchio builds the file (mimic="independent")
-    robot = without_friction(
-        kd.Robot.from_urdf(
-            str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name, mimic="independent"
+    if name in ARMS:
+        robot = without_friction(load_arm(name))
+    else:  # every joint its own coordinate, as Pinocchio builds the file (mimic="independent")
+        robot = without_friction(
+            kd.Robot.from_urdf(
+                str(erd_robots_dir() / FLOATING_URDFS[urdf]), floating_base=urdf == name, mimic="independent"
+            )
         )
-    )
+    q, v, a = random_state(robot, np.random.default_rng(seed))
+    path.write_text("\n".join(tree_lines(name, robot, q, v, a)) + "\n")
+
+
+def tree_lines(name: str, robot, q, v, a) -> list[str]:
+    """The file's lines for ``robot`` (friction already removed) at the state ``(q, v, a)``."""
     if np.any(np.asarray(robot.armature) != 0):
         raise SystemExit(f"{name}: the harnesses leave rotor inertia (armature) out; this robot has some")
     bodies = robot.tree.bodies
@@ -60,7 +71,8 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
         j = body.joint
         if j.kind not in KINDS:
             raise SystemExit(
-                f"{name}: joint '{j.name}' of kind {j.kind}: the harnesses build free, revolute and prismatic joints only"
+                f"{name}: joint '{j.name}' of kind {j.kind}: the harnesses build free, spherical, revolute and "
+                "prismatic joints only"
             )
         T = np.asarray(body.placement, dtype=float)
         inertia = body.inertia
@@ -70,7 +82,7 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
                     "body",
                     str(body.parent),
                     KINDS[j.kind],
-                    fmt(j.axis),
+                    fmt(j.axis if j.axis is not None else (0.0, 0.0, 1.0)),  # none for a free or ball joint
                     fmt(T[:3, :3]),
                     fmt(T[:3, 3]),
                     fmt([inertia.mass]),
@@ -79,9 +91,7 @@ def dump(name: str, path: Path, seed: int = 14) -> None:
                 ]
             )
         )
-    q, v, a = random_state(robot, np.random.default_rng(seed))
-    lines += [f"q {fmt(q)}", f"v {fmt(v)}", f"a {fmt(a)}", f"expect_rnea {fmt(robot.inverse_dynamics(q, v, a))}"]
-    path.write_text("\n".join(lines) + "\n")
+    return lines + [f"q {fmt(q)}", f"v {fmt(v)}", f"a {fmt(a)}", f"expect_rnea {fmt(robot.inverse_dynamics(q, v, a))}"]
 
 
 if __name__ == "__main__":

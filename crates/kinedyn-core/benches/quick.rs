@@ -7,7 +7,9 @@
 //! `KINEDYN_BENCH_TREES=a.tree:b.tree` adds floating-base robots read from `benches/cpp/dump_tree.py`
 //! files (issue 14; Pinocchio's C++ harness builds its models from the same files): rnea, crba and
 //! aba on the file's state, with `<robot>/check_<algorithm>` lines of their results for
-//! `benches/cpp/compare_core.sh` to compare across the two sides.
+//! `benches/cpp/compare_core.sh` to compare across the two sides; also M^-1 and the derivatives, and
+//! with the filter `flops` the operation counts (`benches/cpp/compare_codegen.sh`, issue 30).
+//! `KINEDYN_BENCH_TREES_ONLY=1` leaves out the built-in DH models.
 
 mod models;
 
@@ -60,7 +62,9 @@ fn main() {
         .skip(1)
         .find(|a| !a.starts_with("--"))
         .unwrap_or_default();
-    for (name, model) in models::all() {
+    // KINEDYN_BENCH_TREES_ONLY=1: the tree files alone (compare_codegen.sh), not the DH models
+    let built_in = std::env::var("KINEDYN_BENCH_TREES_ONLY").map_or(true, |v| v != "1");
+    for (name, model) in models::all().into_iter().filter(|_| built_in) {
         let n = model.n;
         let mut data = Data::new(&model);
         let (q, qd, qdd) = models::state(n);
@@ -284,6 +288,19 @@ fn bench_tree(tree: &models::TreeFile, filter: &str) {
         &format!("{name}/check_aba"),
         alg::aba(model, &mut data, q, v, &tau, None).unwrap(),
     );
+    // issue 30's comparison with Pinocchio's generated code (compare_codegen.sh): M^-1 (upper
+    // triangle) and the derivatives (dtau/dq then dtau/dv; dqdd/dq then dqdd/dv, row-major)
+    let minv = alg::mass_matrix_inverse(model, &mut data, q).unwrap().to_vec();
+    let minv_upper: Vec<f64> = (0..n)
+        .flat_map(|i| (i..n).map(move |j| (i, j)))
+        .map(|(i, j)| minv[i * n + j])
+        .collect();
+    print_check(&format!("{name}/check_mass_matrix_inverse"), &minv_upper);
+    let (mut d1, mut d2, mut d3) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+    alg::rnea_derivatives(model, &mut data, q, v, a, None, &mut d1, &mut d2, Some(&mut d3));
+    print_check(&format!("{name}/check_rnea_derivatives"), &[&d1[..], &d2[..]].concat());
+    alg::aba_derivatives(model, &mut data, q, v, &tau, None, &mut d1, &mut d2, &mut d3).unwrap();
+    print_check(&format!("{name}/check_aba_derivatives"), &[&d1[..], &d2[..]].concat());
     let d = &mut data;
     let mut run = |alg: &str, f: &mut dyn FnMut(&mut Data)| {
         let key = format!("{name}/{alg}");
@@ -298,6 +315,40 @@ fn bench_tree(tree: &models::TreeFile, filter: &str) {
     run("aba", &mut |d| {
         _ = black_box(alg::aba(model, d, black_box(q), black_box(v), black_box(&tau), None).unwrap()[0])
     });
+    run("mass_matrix_inverse", &mut |d| {
+        _ = black_box(alg::mass_matrix_inverse(model, d, black_box(q)).unwrap()[0])
+    });
+    // dtau/dqdd = M as well: Pinocchio's computeRNEADerivatives (and its generated code) give all three
+    run("rnea_derivatives", &mut |d| {
+        alg::rnea_derivatives(
+            model,
+            d,
+            black_box(q),
+            black_box(v),
+            black_box(a),
+            None,
+            &mut d1,
+            &mut d2,
+            Some(&mut d3),
+        )
+    });
+    run("aba_derivatives", &mut |d| {
+        alg::aba_derivatives(
+            model,
+            d,
+            black_box(q),
+            black_box(v),
+            black_box(&tau),
+            None,
+            &mut d1,
+            &mut d2,
+            &mut d3,
+        )
+        .unwrap()
+    });
+    if filter == "flops" {
+        print_flops(name, model);
+    }
     free_flyer_crba_share(model, d, tree, filter);
 }
 
@@ -474,11 +525,30 @@ fn print_flops(name: &str, model: &kinedyn_core::Model) {
     );
     let mut data = Data::<Counted>::new(model);
     let d = &mut data;
+    let n = model.n;
+    let m = || vec![Counted(0.0); n * n];
+    let (mut d1, mut d2, mut d3) = (m(), m(), m());
     for (alg, (ops, trig)) in [
         ("rnea", count(|| _ = alg::rnea(model, d, &q, &qd, &qdd, None))),
         ("crba", count(|| _ = alg::crba(model, d, &q))),
         ("aba", count(|| _ = alg::aba(model, d, &q, &qd, &qdd, None).unwrap())),
+        (
+            "mass_matrix_inverse",
+            count(|| _ = alg::mass_matrix_inverse(model, d, &q).unwrap()),
+        ),
+        (
+            "rnea_derivatives",
+            count(|| alg::rnea_derivatives(model, d, &q, &qd, &qdd, None, &mut d1, &mut d2, Some(&mut d3))),
+        ),
+        (
+            "aba_derivatives",
+            count(|| alg::aba_derivatives(model, d, &q, &qd, &qdd, None, &mut d1, &mut d2, &mut d3).unwrap()),
+        ),
     ] {
         println!("{name}/{alg}_flops {ops} {trig}");
     }
+    // the same algorithm recorded for this one robot (kinedyn_core::trace: constants folded,
+    // repeated operations merged, dead values dropped): the arithmetic a specialised kernel runs
+    let recorded = kinedyn_core::trace::record_rnea(model).without_dead_code();
+    println!("{name}/rnea_recorded_ops {}", recorded.arithmetic_count());
 }

@@ -135,6 +135,8 @@ pub struct TreeFile {
     pub a: Vec<f64>,
     /// kinedyn's Python `inverse_dynamics` at the state (a third side of the check).
     pub expect_rnea: Vec<f64>,
+    /// `benches/cpp/dump_loops.py`'s closed states, `[q, qd, tau, qdd]` each (none in a plain tree file).
+    pub states: Vec<Vec<f64>>,
 }
 
 #[allow(dead_code)]
@@ -205,14 +207,6 @@ pub fn read_tree(path: &str) -> TreeFile {
             ))
             .unwrap_or_else(|e| panic!("{path}: {e}"));
     }
-    let model = builder.build().unwrap_or_else(|e| panic!("{path}: {e}"));
-    assert_eq!(
-        (model.nq, model.n),
-        (nq, nv),
-        "{path}: built nq, nv = {}, {}, the file says {nq}, {nv}",
-        model.nq,
-        model.n
-    );
     let mut vector = |key: &str, len: usize| -> Vec<f64> {
         let (line, words) = next(key);
         let joined = words.join(" ");
@@ -220,6 +214,47 @@ pub fn read_tree(path: &str) -> TreeFile {
     };
     let (q, v, a) = (vector("q", nq), vector("v", nv), vector("a", nv));
     let expect_rnea = vector("expect_rnea", nv);
+    // dump_loops.py's lines: "loop KIND BODY_A R T BODY_B R T" ..., "states K", K "state" lines
+    let mut loops = Vec::new();
+    let mut states = Vec::new();
+    for line in lines {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("loop") => {
+                let kind = kinedyn_core::constraints::LoopKind::from_name(words.next().unwrap_or(""))
+                    .unwrap_or_else(|e| panic!("{path}: {e}"));
+                let mut frame = |words: &mut std::str::SplitWhitespace| {
+                    let body: i64 = words.next().and_then(|w| w.parse().ok()).expect("a loop's body");
+                    let x = parse_numbers(path, line, words, 12);
+                    let rot = Mat3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]);
+                    let placement = Transform::new(rot, Vec3::new(x[9], x[10], x[11]));
+                    builder
+                        .frame(usize::try_from(body).ok(), placement)
+                        .unwrap_or_else(|e| panic!("{path}: {e}"))
+                };
+                let (frame_a, frame_b) = (frame(&mut words), frame(&mut words));
+                loops.push(kinedyn_core::constraints::Loop {
+                    name: format!("loop {}", loops.len()),
+                    frame_a,
+                    frame_b,
+                    kind,
+                });
+            }
+            Some("state") => states.push(parse_numbers(path, line, &mut words, nq + 3 * nv)),
+            _ => {}
+        }
+    }
+    let model = builder
+        .build()
+        .and_then(|m| m.with_loops(loops))
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    assert_eq!(
+        (model.nq, model.n),
+        (nq, nv),
+        "{path}: built nq, nv = {}, {}, the file says {nq}, {nv}",
+        model.nq,
+        model.n
+    );
     TreeFile {
         name,
         model,
@@ -227,5 +262,6 @@ pub fn read_tree(path: &str) -> TreeFile {
         v,
         a,
         expect_rnea,
+        states,
     }
 }
