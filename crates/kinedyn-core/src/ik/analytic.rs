@@ -66,6 +66,15 @@ pub enum Screw {
     Prismatic(Vec3),
 }
 
+/// A revolute screw along `w` (normalised) through the point `r`: the arms of the IK tests.
+#[cfg(test)]
+pub(crate) fn rev(w: [f64; 3], r: [f64; 3]) -> Screw {
+    Screw::Revolute(Axis {
+        w: Vec3::new(w[0], w[1], w[2]).normalize(),
+        r: Vec3::new(r[0], r[1], r[2]),
+    })
+}
+
 impl Screw {
     /// `exp(xi^ theta)` as a rigid transform: `[R, (I - R) r]` (revolute) or `[I, v theta]`.
     #[inline]

@@ -146,12 +146,7 @@ mod tests {
     use crate::joint::axis_angle;
     use crate::spatial::Vec3;
 
-    fn rev(w: [f64; 3], r: [f64; 3]) -> Screw {
-        Screw::Revolute(Axis {
-            w: Vec3::new(w[0], w[1], w[2]).normalize(),
-            r: Vec3::new(r[0], r[1], r[2]),
-        })
-    }
+    use crate::ik::analytic::rev;
 
     fn fk(screws: &[Screw], home: &Transform, theta: &[f64]) -> Transform {
         let mut t = Transform::identity();

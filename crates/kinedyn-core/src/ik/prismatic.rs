@@ -99,12 +99,7 @@ mod tests {
     use crate::spatial::Transform;
     use std::f64::consts::PI;
 
-    fn rev(w: [f64; 3], r: [f64; 3]) -> Screw {
-        Screw::Revolute(Axis {
-            w: Vec3::new(w[0], w[1], w[2]).normalize(),
-            r: Vec3::new(r[0], r[1], r[2]),
-        })
-    }
+    use crate::ik::analytic::rev;
 
     fn prism(v: [f64; 3]) -> Screw {
         Screw::Prismatic(Vec3::new(v[0], v[1], v[2]).normalize())

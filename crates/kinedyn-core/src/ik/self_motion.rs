@@ -175,18 +175,11 @@ impl Redundant {
 
 #[cfg(test)]
 mod tests {
-    use super::super::analytic::Screw;
-    use super::super::subproblems::Axis;
     use super::*;
     use crate::joint::axis_angle;
     use crate::spatial::Transform;
 
-    fn rev(w: [f64; 3], r: [f64; 3]) -> Screw {
-        Screw::Revolute(Axis {
-            w: Vec3::new(w[0], w[1], w[2]).normalize(),
-            r: Vec3::new(r[0], r[1], r[2]),
-        })
-    }
+    use crate::ik::analytic::rev;
 
     /// An SRS arm with skewed shoulder and wrist axes (not the iiwa's right angles, so that the
     /// existence bounds of the module header cut too), and iiwa-like limits.
