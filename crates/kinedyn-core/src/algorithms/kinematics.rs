@@ -122,6 +122,13 @@ pub fn joint_transforms<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
 #[inline(always)]
 pub fn forward_kinematics<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     joint_transforms(model, data, q);
+    world_poses(model, data);
+}
+
+/// `data.world_from_body` from `data.parent_from_body` (the second half of `forward_kinematics`,
+/// for a pass that already has the joint transforms, e.g. RNEA's).
+#[inline(always)]
+pub fn world_poses<T: Real>(model: &Model, data: &mut Data<T>) {
     let n = model.n;
     let (parent, x_up, world) = (
         &model.parent[..n],

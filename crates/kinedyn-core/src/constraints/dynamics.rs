@@ -29,9 +29,10 @@
 //! base axes, the moment about frame a's origin; frame b's link receives the opposite.
 
 use super::dense::{dot, lane_max_abs, ldlt, ldlt_solve};
-use super::kinematics::{gamma_after_accelerations, jacobian_after_kinematics, world_poses};
+use super::kinematics::{gamma_after_accelerations, jacobian_after_kinematics};
 use super::LoopData;
 use crate::algorithms::crba::crba;
+use crate::algorithms::kinematics::world_poses;
 use crate::algorithms::minv::{ltdl, ltdl_solve};
 use crate::algorithms::rnea;
 use crate::data::Data;

@@ -117,21 +117,3 @@ pub(super) fn gamma_after_accelerations<T: Real>(model: &Model, data: &Data<T>, 
         row += rows;
     }
 }
-
-/// `data.world_from_body` from `data.parent_from_body` (the second half of `forward_kinematics`,
-/// for a pass that already has the joint transforms: RNEA's).
-#[inline(always)]
-pub(super) fn world_poses<T: Real>(model: &Model, data: &mut Data<T>) {
-    let n = model.n;
-    let (parent, x_up, world) = (
-        &model.parent[..n],
-        &data.parent_from_body[..n],
-        &mut data.world_from_body[..n],
-    );
-    for i in 0..n {
-        world[i] = match parent[i] {
-            Some(p) => world[p] * x_up[i],
-            None => x_up[i],
-        };
-    }
-}
