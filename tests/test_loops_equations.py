@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 import sympy as sp
+from trig_zero import all_zero
 
 import kinedyn as kd
 from kinedyn.description import Frame, Joint, Link
@@ -42,7 +43,7 @@ def _numeric(matrix, args, values):
 
 
 def _same(a: sp.Matrix, b: sp.Matrix) -> bool:
-    return (a - b).applyfunc(lambda e: sp.simplify(sp.expand_trig(sp.expand(e)))) == sp.zeros(*a.shape)
+    return all_zero(a - b)
 
 
 # ----------------------------------------------------------------------------- four-bar

@@ -19,6 +19,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from trig_zero import all_zero, is_zero
 
 import kinedyn as kd
 from kinedyn.symbolic import LagrangianSystem
@@ -43,15 +44,6 @@ def ddt(e, q=Q, qd=QD, qdd=QDD):
 
 def euler_lagrange(L, q=Q, qd=QD, qdd=QDD):
     return [sp.expand(ddt(sp.diff(L, v), q, qd, qdd) - sp.diff(L, c)) for c, v in zip(q, qd)]
-
-
-def is_zero(e) -> bool:
-    e = sp.expand(sp.expand_trig(sp.expand(e)))
-    return e == 0 or sp.simplify(e) == 0
-
-
-def all_zero(M) -> bool:
-    return all(is_zero(e) for e in sp.Matrix(M))
 
 
 def at_random_state(e):

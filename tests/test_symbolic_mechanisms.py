@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from trig_zero import all_zero
 
 import kinedyn as kd
 from kinedyn.robots import examples as rex
@@ -33,7 +34,7 @@ def _random_values(names, **given):
 
 
 def _same(a: sp.Matrix, b: sp.Matrix) -> bool:
-    return (a - b).applyfunc(lambda e: sp.simplify(sp.expand_trig(sp.expand(e)))) == sp.zeros(*a.shape)
+    return all_zero(a - b)
 
 
 # ----------------------------------------------------------------------------- change of coordinates

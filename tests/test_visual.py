@@ -311,7 +311,7 @@ def test_live_viewer_of_the_panda(browser):
     viewer = robot.show(block=False, port=free_port(), verbose=False)
     try:
         assert viewer.scene.drawn == len(robot.visuals) and len(viewer._mesh_handles) == len(viewer.scene.parts)
-        context = browser.new_context(viewport={"width": 1100, "height": 800})
+        context = browser.new_context(viewport={"width": 720, "height": 480})
         page = context.new_page()
         requests, errors = watch(page, viewer.url)
         page.goto(viewer.url)
